@@ -1,0 +1,62 @@
+/* hearth/camera.h - the pinhole camera with 5-parameter Brown-Conrady
+ * distortion, in OpenCV's conventions.
+ *
+ * Camera axes: +x right, +y down, +z forward. Pixel (0,0) is the centre of
+ * the top-left pixel. Distortion order [k1, k2, p1, p2, k3]:
+ *   x = X/Z, y = Y/Z, r2 = x^2 + y^2
+ *   radial = 1 + k1 r2 + k2 r2^2 + k3 r2^3
+ *   xd = x radial + 2 p1 x y + p2 (r2 + 2 x^2)
+ *   yd = y radial + p1 (r2 + 2 y^2) + 2 p2 x y
+ *   u = fx xd + cx,  v = fy yd + cy
+ * See docs/conventions.md. */
+#ifndef HEARTH_CAMERA_H
+#define HEARTH_CAMERA_H
+
+#include "hearth/geom.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct hearth_camera {
+  int width, height;   /* pixels */
+  double fx, fy, cx, cy;
+  double dist[5];      /* k1 k2 p1 p2 k3 */
+} hearth_camera;
+
+/* Jacobians filled by hearth_camera_project when the pointers are non-NULL
+ * (row-major, 2 rows): */
+typedef struct hearth_project_jac {
+  double d_point[6];   /* d(u,v) / d(X,Y,Z) in the camera frame */
+  double d_intr[8];    /* d(u,v) / d(fx, fy, cx, cy) */
+  double d_dist[10];   /* d(u,v) / d(k1, k2, p1, p2, k3) */
+} hearth_project_jac;
+
+/* Distort normalised coordinates (x, y) -> (xd, yd), optionally with the
+ * 2x2 Jacobian d(xd,yd)/d(x,y) (row-major). */
+void hearth_distort(const double dist[5], double x, double y, double *xd, double *yd,
+                    double J[4]);
+
+/* Project a point in the camera frame to pixels. Returns 0 if Z <= 0
+ * (u, v untouched), 1 otherwise. */
+int hearth_camera_project(const hearth_camera *cam, const double Xc[3], double uv[2],
+                          hearth_project_jac *jac);
+
+/* Undistort a pixel to normalised ideal coordinates (x, y) such that
+ * project((x, y, 1)) == (u, v). Newton's method on the distortion model with
+ * a fixed-point start; converges to 1e-10 px over the whole image for
+ * realistic lenses. Returns the final residual in pixels (or a negative value
+ * if the iteration diverged). */
+double hearth_camera_undistort(const hearth_camera *cam, double u, double v, double xy[2]);
+
+/* The unit ray direction (camera frame) through pixel (u, v). Returns the
+ * undistortion residual as above. */
+double hearth_camera_ray(const hearth_camera *cam, double u, double v, double dir[3]);
+
+/* K as a row-major 3x3. */
+void hearth_camera_K(const hearth_camera *cam, double K[9]);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,153 @@
+/* hearth/core.h - status codes, error reports, files, threads, numbers.
+ *
+ * Every fallible function in hearth returns a hearth_status and, when the
+ * caller passes a hearth_err, fills it with a message a person can act on:
+ * which file, which line/column or view, what was expected. The library
+ * never exits the process and keeps no global mutable state.
+ * Conventions (frames, units, pixel centres): docs/conventions.md. */
+#ifndef HEARTH_CORE_H
+#define HEARTH_CORE_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum hearth_status {
+  HEARTH_OK = 0,
+  HEARTH_E_ARG,          /* a caller passed an invalid argument */
+  HEARTH_E_NOMEM,        /* allocation failed or a size would overflow */
+  HEARTH_E_IO,           /* a file could not be opened, read, written or renamed */
+  HEARTH_E_PARSE,        /* input is malformed (syntax) */
+  HEARTH_E_UNSUPPORTED,  /* well-formed input using a feature hearth does not read */
+  HEARTH_E_RANGE,        /* a value lies outside its allowed range */
+  HEARTH_E_SIZE,         /* wrong dimensions or counts */
+  HEARTH_E_INCONSISTENT, /* files or fields contradict each other */
+  HEARTH_E_NUMERIC,      /* a solver failed: singular system, no convergence */
+  HEARTH_E_NOT_FOUND,    /* a required file, key, view or target is absent */
+  HEARTH_E_LIMIT         /* input exceeds an explicit safety limit */
+} hearth_status;
+
+/* "HEARTH_E_PARSE" etc.; never NULL. */
+const char *hearth_status_name(hearth_status s);
+/* A short description of the status; never NULL. */
+const char *hearth_strerror(hearth_status s);
+
+/* An error report. Owned by the caller; functions fill it on failure. */
+typedef struct hearth_err {
+  hearth_status status;
+  char msg[1024];
+} hearth_err;
+
+/* Record status s with a printf-style message in err (which may be NULL);
+ * returns s so callers can write `return hearth_err_set(err, ...)`. */
+hearth_status hearth_err_set(hearth_err *err, hearth_status s, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+/* Prefix the existing message with context ("reading cup_03/hot: ..."). */
+hearth_status hearth_err_prefix(hearth_err *err, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+
+/* ---- overflow-checked sizes ---------------------------------------------- */
+/* *out = a * b; returns 0 on overflow. */
+int hearth_mul_size(size_t a, size_t b, size_t *out);
+/* malloc of n * size bytes with overflow check; NULL on failure. */
+void *hearth_alloc_array(size_t n, size_t size);
+void *hearth_calloc_array(size_t n, size_t size);
+
+/* ---- files ----------------------------------------------------------------- */
+/* Read a whole file; *data is malloc'ed (caller frees) and NUL-terminated
+ * (the NUL is not counted in *size). Files larger than max_size are refused
+ * with HEARTH_E_LIMIT. */
+hearth_status hearth_read_file(const char *path, size_t max_size, uint8_t **data,
+                               size_t *size, hearth_err *err);
+
+/* Write data to path atomically: a temporary name in the same directory,
+ * flushed, then renamed over path. On failure nothing is left behind. */
+hearth_status hearth_write_file_atomic(const char *path, const void *data, size_t size,
+                                       hearth_err *err);
+
+/* A streamed atomic writer for code that writes through FILE*:
+ * open -> fwrite/fprintf to af.fp -> commit (rename) or abort (unlink). */
+typedef struct hearth_atomic_file {
+  FILE *fp;
+  char tmp_path[4096];
+  char path[4096];
+} hearth_atomic_file;
+hearth_status hearth_atomic_open(hearth_atomic_file *af, const char *path, hearth_err *err);
+hearth_status hearth_atomic_commit(hearth_atomic_file *af, hearth_err *err);
+void hearth_atomic_abort(hearth_atomic_file *af);
+
+/* mkdir -p. */
+hearth_status hearth_mkdirs(const char *path, hearth_err *err);
+/* 1 if path exists (file or directory). */
+int hearth_path_exists(const char *path);
+/* Remove a directory tree (used to discard a half-built temporary tree). */
+hearth_status hearth_remove_tree(const char *path, hearth_err *err);
+/* snprintf into buf, joining parts with '/'. Returns HEARTH_E_LIMIT if it
+ * does not fit. */
+hearth_status hearth_path_join(char *buf, size_t bufsz, const char *a, const char *b);
+
+/* ---- threads --------------------------------------------------------------- */
+/* Number of worker threads to use when a caller passes 0: $HEARTH_THREADS if
+ * set, else the online processor count. */
+int hearth_default_threads(void);
+
+/* Run fn over [0, n) split into contiguous chunks, one per thread, in
+ * parallel. Chunk boundaries depend only on n and the chunk count, never on
+ * timing; callers that need thread-count-independent output write results by
+ * index and reduce in index order. thread_index < nthreads identifies
+ * per-thread scratch. */
+typedef void (*hearth_range_fn)(void *ctx, size_t begin, size_t end, int thread_index);
+hearth_status hearth_parallel_for(size_t n, int nthreads, hearth_range_fn fn, void *ctx);
+
+/* ---- locale-independent numbers ------------------------------------------ */
+/* Parse a decimal number from s[0..len): optional sign, digits, optional
+ * '.' or ',' (if decimal_comma) fraction, optional exponent. The whole span
+ * must be consumed. Rejects NaN/Inf spellings. Returns 0 on success. */
+int hearth_parse_double(const char *s, size_t len, int decimal_comma, double *out);
+/* Write x with `decimals` fixed decimals using '.', independent of locale.
+ * Returns the length written (excluding NUL) or -1 if it did not fit. */
+int hearth_format_fixed(char *buf, size_t bufsz, double x, int decimals);
+
+/* ---- deterministic random numbers ------------------------------------------ */
+/* A small counter-based generator (SplitMix64 seeding, xoshiro256**):
+ * same seed, same stream on every machine. */
+typedef struct hearth_rng { uint64_t s[4]; } hearth_rng;
+void hearth_rng_seed(hearth_rng *r, uint64_t seed);
+/* Derive an independent stream for a named sub-task (e.g. view index). */
+void hearth_rng_fork(const hearth_rng *parent, uint64_t stream, hearth_rng *child);
+uint64_t hearth_rng_u64(hearth_rng *r);
+double hearth_rng_uniform(hearth_rng *r);            /* [0, 1) */
+double hearth_rng_range(hearth_rng *r, double lo, double hi);
+double hearth_rng_normal(hearth_rng *r);             /* N(0, 1) */
+
+/* ---- progress -------------------------------------------------------------- */
+/* A progress reporter for long jobs: a bar on a terminal, plain lines
+ * otherwise (one every ~5 %), silent if quiet. Not thread-safe: call
+ * hearth_progress_step from one thread. */
+typedef struct hearth_progress {
+  const char *label;
+  size_t total, done;
+  int is_tty, quiet, last_percent;
+  double t_start;
+  FILE *out;
+} hearth_progress;
+void hearth_progress_begin(hearth_progress *p, const char *label, size_t total, int quiet);
+void hearth_progress_step(hearth_progress *p, size_t k);
+void hearth_progress_end(hearth_progress *p);
+/* Monotonic seconds. */
+double hearth_now(void);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

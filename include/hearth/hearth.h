@@ -1,0 +1,13 @@
+/* hearth/hearth.h - everything. */
+#ifndef HEARTH_HEARTH_H
+#define HEARTH_HEARTH_H
+#include "hearth/core.h"
+#include "hearth/geom.h"
+#include "hearth/camera.h"
+#include "hearth/image.h"
+#include "hearth/thermal.h"
+#include "hearth/npy.h"
+#include "hearth/mesh.h"
+#include "hearth/release.h"
+#include "hearth/synth.h"
+#endif

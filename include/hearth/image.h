@@ -1,0 +1,81 @@
+/* hearth/image.h - images in memory and on disk (PNG 8/16-bit, JPEG), the
+ * Turbo colour map and a few drawing helpers for overlays and contact sheets.
+ *
+ * Pixels are row-major, channels interleaved, row 0 at the top. */
+#ifndef HEARTH_IMAGE_H
+#define HEARTH_IMAGE_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "hearth/core.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum hearth_pixtype {
+  HEARTH_PIX_U8 = 1,
+  HEARTH_PIX_U16 = 2,
+  HEARTH_PIX_F32 = 4
+} hearth_pixtype;
+
+typedef struct hearth_image {
+  size_t width, height;
+  int channels;          /* 1..4 */
+  hearth_pixtype type;   /* bytes per sample = (int)type */
+  void *data;            /* owned; width*height*channels samples */
+} hearth_image;
+
+/* Allocate a zeroed image; sizes are overflow-checked. */
+hearth_status hearth_image_alloc(hearth_image *img, size_t width, size_t height, int channels,
+                                 hearth_pixtype type, hearth_err *err);
+void hearth_image_free(hearth_image *img); /* accepts a zeroed image */
+size_t hearth_image_bytes(const hearth_image *img);
+
+/* Limits applied to untrusted image files. */
+#define HEARTH_IMAGE_MAX_DIM 16384
+
+/* PNG: reads 8- or 16-bit gray, gray+alpha, RGB or RGBA (palette and low
+ * bit depths are expanded to 8-bit). Writes U8 or U16 images, 1-4 channels. */
+hearth_status hearth_png_read(const char *path, hearth_image *img, hearth_err *err);
+hearth_status hearth_png_read_mem(const void *data, size_t size, const char *name,
+                                  hearth_image *img, hearth_err *err);
+hearth_status hearth_png_write(const char *path, const hearth_image *img, hearth_err *err);
+/* Encode to memory (*out malloc'ed). */
+hearth_status hearth_png_encode(const hearth_image *img, uint8_t **out, size_t *size,
+                                hearth_err *err);
+
+/* JPEG (8-bit gray or RGB). quality 1..100. */
+hearth_status hearth_jpeg_read(const char *path, hearth_image *img, hearth_err *err);
+hearth_status hearth_jpeg_read_mem(const void *data, size_t size, const char *name,
+                                   hearth_image *img, hearth_err *err);
+hearth_status hearth_jpeg_write(const char *path, const hearth_image *img, int quality,
+                                hearth_err *err);
+
+/* Turbo colour map (Google's 2019 polynomial approximation of the published
+ * table). t is clamped to [0, 1]. */
+void hearth_turbo(double t, uint8_t rgb[3]);
+/* Colour a float temperature image (1 channel) with Turbo over [lo, hi] degC
+ * into an RGB U8 image. NaN pixels get nan_rgb. */
+hearth_status hearth_turbo_image(const hearth_image *temps, double lo, double hi,
+                                 const uint8_t nan_rgb[3], hearth_image *rgb, hearth_err *err);
+
+/* Drawing on RGB(A) U8 images, clipped to the image. */
+void hearth_draw_line(hearth_image *img, double x0, double y0, double x1, double y1,
+                      const uint8_t rgb[3], int thickness);
+void hearth_draw_circle(hearth_image *img, double cx, double cy, double r,
+                        const uint8_t rgb[3]);
+/* Nearest-neighbour or box resample of a U8 image to new size (for
+ * thumbnails). */
+hearth_status hearth_image_resize(const hearth_image *src, size_t width, size_t height,
+                                  hearth_image *dst, hearth_err *err);
+/* Copy src (U8, same channel count, or gray into RGB) into dst at (x, y). */
+void hearth_image_blit(hearth_image *dst, const hearth_image *src, size_t x, size_t y);
+/* Write text with a built-in 5x7 pixel font, scale >= 1. */
+void hearth_draw_text(hearth_image *img, size_t x, size_t y, const char *text,
+                      const uint8_t rgb[3], int scale);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,103 @@
+/* hearth/mesh.h - triangle meshes with UVs, glTF binary (GLB) files, and the
+ * ray caster used by the virtual rig, scale recovery and mapping.
+ *
+ * UVs follow glTF: (0,0) is the top-left of the texture image, v grows
+ * downwards, so texel [row][col] of an R x R map has its centre at
+ * u = (col + 0.5) / R, v = (row + 0.5) / R. Positions are in metres in
+ * metric frames. */
+#ifndef HEARTH_MESH_H
+#define HEARTH_MESH_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "hearth/core.h"
+#include "hearth/image.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct hearth_mesh {
+  size_t n_vertices;
+  float *positions;   /* 3 * n_vertices */
+  float *uvs;         /* 2 * n_vertices, or NULL if the mesh has none */
+  size_t n_triangles;
+  uint32_t *indices;  /* 3 * n_triangles, counter-clockwise front faces */
+  hearth_image texture; /* base colour (RGB/RGBA U8), data NULL if none */
+} hearth_mesh;
+
+void hearth_mesh_free(hearth_mesh *m); /* accepts a zeroed mesh */
+hearth_status hearth_mesh_alloc(hearth_mesh *m, size_t n_vertices, size_t n_triangles,
+                                int with_uvs, hearth_err *err);
+hearth_status hearth_mesh_copy(const hearth_mesh *src, hearth_mesh *dst, hearth_err *err);
+/* Axis-aligned bounds. */
+void hearth_mesh_bounds(const hearth_mesh *m, double lo[3], double hi[3]);
+/* Apply x' = s R x + t to every vertex. */
+void hearth_mesh_transform(hearth_mesh *m, double s, const double R[9], const double t[3]);
+/* Check indices in range, finite positions/UVs; HEARTH_E_RANGE with the
+ * triangle index otherwise. `name` is used in messages. */
+hearth_status hearth_mesh_validate(const hearth_mesh *m, const char *name, hearth_err *err);
+
+/* ---- glTF binary ---------------------------------------------------------- */
+typedef struct hearth_glb_read_opts {
+  int require_uvs;        /* fail with HEARTH_E_NOT_FOUND naming the primitive if no TEXCOORD_0 */
+  int load_texture;       /* decode the base colour texture of the first material if embedded */
+  size_t max_triangles;   /* 0: default limit (50 million) */
+} hearth_glb_read_opts;
+
+/* Read a GLB: walks the default scene's node hierarchy applying node
+ * transforms (matrix or TRS), concatenates every triangle primitive
+ * (indexed or not) of every mesh instance into one mesh. Draco/meshopt
+ * compression, sparse accessors, non-triangle modes, out-of-range indices
+ * and truncated chunks are errors naming the file and the element. */
+hearth_status hearth_glb_read(const char *path, const hearth_glb_read_opts *opts,
+                              hearth_mesh *out, hearth_err *err);
+hearth_status hearth_glb_parse(const void *data, size_t size, const char *name,
+                               const hearth_glb_read_opts *opts, hearth_mesh *out,
+                               hearth_err *err);
+/* Write one mesh (POSITION, TEXCOORD_0 if present, NORMAL computed, uint32
+ * indices) and, if m->texture is set, an embedded PNG base-colour texture.
+ * The file passes the Khronos glTF validator. Atomic. */
+hearth_status hearth_glb_write(const char *path, const hearth_mesh *m, hearth_err *err);
+hearth_status hearth_glb_encode(const hearth_mesh *m, uint8_t **out, size_t *size,
+                                hearth_err *err);
+
+/* ---- ray casting (Embree) ------------------------------------------------ */
+typedef struct hearth_raycaster hearth_raycaster;
+
+typedef struct hearth_ray_hit {
+  float t;          /* distance along the (unit) direction */
+  uint32_t prim;    /* triangle index */
+  float b1, b2;     /* barycentrics of vertices 1 and 2 of the triangle */
+  int front;        /* 1 if the ray hit the front (counter-clockwise) side */
+} hearth_ray_hit;
+
+/* Build an acceleration structure over m (m must outlive it). */
+hearth_status hearth_raycaster_new(const hearth_mesh *m, hearth_raycaster **out,
+                                   hearth_err *err);
+void hearth_raycaster_free(hearth_raycaster *rc);
+/* Nearest hit in (tnear, tfar). Returns 1 on a hit. Thread-safe. */
+int hearth_raycast(const hearth_raycaster *rc, const double org[3], const double dir[3],
+                   double tnear, double tfar, hearth_ray_hit *hit);
+/* Cast n rays (org/dir 3*n floats); hits[i].prim = UINT32_MAX where none. */
+void hearth_raycast_batch(const hearth_raycaster *rc, size_t n, const float *org,
+                          const float *dir, float tnear, float tfar, hearth_ray_hit *hits);
+
+/* ---- UV islands and texel rasterisation ----------------------------------- */
+/* Label connected UV islands: triangles sharing an edge in UV space (same two
+ * UV coordinates, bit-exact after welding identical UVs) belong to one
+ * island. island_of_tri[n_triangles] gets 0..n_islands-1. */
+hearth_status hearth_uv_islands(const hearth_mesh *m, uint32_t *island_of_tri,
+                                uint32_t *n_islands, hearth_err *err);
+
+/* Rasterise the UV layout into R x R: tri_of_texel[row*R+col] is the
+ * triangle whose UV triangle contains the texel centre (UINT32_MAX if none;
+ * ties go to the lowest triangle index, so the result is deterministic),
+ * bary (optional, 3 floats per texel) its barycentrics. */
+hearth_status hearth_uv_rasterize(const hearth_mesh *m, size_t R, uint32_t *tri_of_texel,
+                                  float *bary, hearth_err *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

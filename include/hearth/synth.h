@@ -1,0 +1,60 @@
+/* hearth/synth.h - the virtual capture rig: a digital twin of the paper's
+ * RGB-thermal-depth rig that writes a release tree with ground truth.
+ *
+ * It is an independent forward model (scene -> sensor): thermal pixels
+ * integrate the scene over their footprint through the distorting lens, then
+ * optical blur and sensor noise are applied. It never runs a pipeline stage
+ * backwards. Requirements: docs/virtual-rig.md. */
+#ifndef HEARTH_SYNTH_H
+#define HEARTH_SYNTH_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "hearth/core.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define HEARTH_SYNTH_MAX_ITEMS 32
+
+typedef struct hearth_synth_opts {
+  uint64_t seed;                 /* default 1 */
+  const char *out_root;          /* release root to create (must not exist, or be empty) */
+  /* categories to make; NULL/0 = the default set (every procedural category) */
+  size_t n_categories;
+  const char *categories[HEARTH_SYNTH_MAX_ITEMS];
+  int instances_per_category;    /* default 1 */
+  /* states per instance; 0 = the category's defaults (neutral + its second state) */
+  size_t n_states;
+  const char *states[8];
+  int n_views;                   /* views per state, <= 30; default 30 (3 x 10) */
+  size_t triangles;              /* target mesh detail; default 20000, up to 200000+ */
+  size_t texture_size;           /* RGB texture side; default 1024 */
+  size_t map_resolution;         /* R of ground-truth temperature maps; default 1024 */
+  int calibration;               /* write calibration/ captures; default 1 */
+  int n_thermal_frames;          /* default 27 */
+  int n_stereo_pairs;            /* default 24 */
+  int rgb_full_size;             /* 1 = 1920x1080 colour (default); tests may shrink nothing */
+  /* put a given UV-mapped GLB on the turntable instead of a procedural object */
+  const char *mesh_path;
+  double mesh_size_m;            /* largest extent after scaling; default 0.12 */
+  const char *mesh_category;     /* whose states to use; default "cup" */
+  int contact_sheet;             /* write instances/<id>/raw/<state>/contact_sheet.png */
+  double netd_c;                 /* thermal noise, default 0.05 degC */
+  int threads;                   /* 0 = hearth_default_threads() */
+  int quiet;                     /* no progress output */
+} hearth_synth_opts;
+
+void hearth_synth_opts_default(hearth_synth_opts *o);
+/* Write a complete release tree (atomically: built under a temporary name
+ * beside out_root, renamed at the end). */
+hearth_status hearth_synth_release(const hearth_synth_opts *o, hearth_err *err);
+
+/* Names of the procedural categories available. */
+size_t hearth_synth_categories(const char **names, size_t max);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

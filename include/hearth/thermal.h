@@ -1,0 +1,39 @@
+/* hearth/thermal.h - apparent-temperature matrices (thermal CSV).
+ *
+ * The canonical file is 192 lines of 256 comma-separated decimal numbers in
+ * degrees Celsius, no header, native sensor row order. Readers also accept
+ * what camera software exports: header lines before the matrix, ';' or tab
+ * separators, quoted values, decimal commas. Anything else (NaN, empty
+ * cells, ragged rows, wrong size, values outside -50..650 degC) is rejected
+ * with the file, line and column. Raw matrices are never modified. */
+#ifndef HEARTH_THERMAL_H
+#define HEARTH_THERMAL_H
+
+#include "hearth/image.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define HEARTH_THERMAL_MIN_C (-50.0)
+#define HEARTH_THERMAL_MAX_C (650.0)
+
+/* Expected size; 0 means "any consistent rectangle". */
+typedef struct hearth_csv_opts {
+  size_t width, height;
+} hearth_csv_opts;
+
+/* Read into a 1-channel F32 image. opts may be NULL (expect 256x192). */
+hearth_status hearth_thermal_read_csv(const char *path, const hearth_csv_opts *opts,
+                                      hearth_image *out, hearth_err *err);
+hearth_status hearth_thermal_parse_csv(const char *text, size_t len, const char *name,
+                                       const hearth_csv_opts *opts, hearth_image *out,
+                                       hearth_err *err);
+/* Write the canonical form with `decimals` fixed decimals (atomic). */
+hearth_status hearth_thermal_write_csv(const char *path, const hearth_image *temps,
+                                       int decimals, hearth_err *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# Installs what hearth needs on Debian (12, bookworm) and builds it.
+#   scripts/setup.sh [--sanitize] [BUILD_DIR]
+# Idempotent: packages already present are not reinstalled; the build is
+# incremental. Needs root (or sudo) only when packages are missing.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+sanitize=0
+if [ "${1:-}" = "--sanitize" ]; then sanitize=1; shift; fi
+build=${1:-build}
+[ $sanitize = 1 ] && [ "$build" = build ] && build=build-asan
+
+pkgs="build-essential cmake pkg-config clang libclang-rt-14-dev git
+  libembree-dev libjansson-dev libpng-dev libjpeg62-turbo-dev
+  liblapacke-dev liblapack-dev libblas-dev libhdf5-dev
+  libmujoco-dev libosmesa6-dev
+  python3 python3-numpy python3-h5py python3-opencv python3-websockets python3-msgpack
+  nodejs npm"
+missing=""
+for p in $pkgs; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
+done
+if [ -n "$missing" ]; then
+  echo "setup: installing$missing"
+  SUDO=""; [ "$(id -u)" = 0 ] || SUDO=sudo
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends $missing >/dev/null
+fi
+
+# The Khronos glTF validator (npm) checks every GLB hearth writes.
+if [ ! -e .tools/node_modules/gltf-validator/package.json ]; then
+  echo "setup: installing gltf-validator (npm) into .tools/"
+  mkdir -p .tools
+  npm install --silent --no-audit --no-fund --prefix .tools gltf-validator@2 >/dev/null 2>&1 ||
+    echo "setup: warning: gltf-validator could not be installed; the GLB validator test will fail"
+fi
+
+type=RelWithDebInfo
+extra=""
+if [ $sanitize = 1 ]; then type=Debug; extra="-DHEARTH_SANITIZE=ON"; fi
+cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=$type $extra >/dev/null
+cmake --build "$build" -j"$(nproc)"

@@ -1,0 +1,24 @@
+/* Private to the command-line tool: each subcommand lives in cmd_<name>.c
+ * and exports `int hearth_cmd_<name>(int argc, char **argv)` where argv[0]
+ * is the subcommand's name. A command handles `--help` itself, prints errors
+ * to stderr and returns the process exit status (0 ok, 1 failure, 2 usage). */
+#ifndef HEARTH_CLI_H
+#define HEARTH_CLI_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "hearth/core.h"
+
+/* Small option helpers shared by the commands. */
+int cli_is_help(const char *arg);
+/* Parse "--name=value" or "--name value"; returns 1 and sets *val if argv[*i]
+ * is option `name` (advancing *i past a separate value), -1 if the value is
+ * missing, 0 otherwise. */
+int cli_opt(int argc, char **argv, int *i, const char *name, const char **val);
+int cli_parse_int(const char *s, long lo, long hi, long *out);
+int cli_parse_u64(const char *s, uint64_t *out);
+int cli_parse_num(const char *s, double *out);
+/* Print "hearth <cmd>: <message>" for a failed status; returns 1. */
+int cli_fail(const char *cmd, const hearth_err *err);
+
+#endif

@@ -1,0 +1,82 @@
+/* hearth - the command-line tool: a table of (name, function, summary).
+ * A subcommand exists in a build when its cmd_<name>.c is compiled in; the
+ * weak references below let areas add commands without touching this file. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "cli/cli.h"
+
+typedef int (*cmd_fn)(int argc, char **argv);
+
+#define HEARTH_CMD(name) extern int hearth_cmd_##name(int argc, char **argv) __attribute__((weak));
+HEARTH_CMD(synth)
+HEARTH_CMD(detect)
+HEARTH_CMD(calibrate)
+HEARTH_CMD(scale)
+HEARTH_CMD(transfer)
+HEARTH_CMD(refine)
+HEARTH_CMD(map)
+HEARTH_CMD(overlay)
+HEARTH_CMD(build)
+HEARTH_CMD(validate)
+HEARTH_CMD(stats)
+HEARTH_CMD(demo)
+HEARTH_CMD(sim)
+HEARTH_CMD(inspect)
+
+typedef struct command {
+  const char *name;
+  cmd_fn fn;
+  const char *summary;
+} command;
+
+static int usage(FILE *out, const command *cmds, size_t n) {
+  fprintf(out,
+          "hearth %s - temperature-textured 3D assets from RGB-thermal-depth captures\n\n"
+          "usage: hearth <command> [ROOT] [options]     hearth <command> --help\n\n"
+          "Pipeline commands take the release root as their first argument.\n\n"
+          "commands:\n",
+          HEARTH_VERSION);
+  for (size_t i = 0; i < n; i++)
+    if (cmds[i].fn) fprintf(out, "  %-10s %s\n", cmds[i].name, cmds[i].summary);
+  fprintf(out, "\nEnvironment: HEARTH_THREADS sets the default worker count.\n"
+               "Conventions and file layout: docs/conventions.md, docs/dataset.md.\n");
+  return out == stdout ? 0 : 2;
+}
+
+int main(int argc, char **argv) {
+  const command cmds[] = {
+      {"synth", hearth_cmd_synth, "make a release with the virtual capture rig (ground truth included)"},
+      {"inspect", hearth_cmd_inspect, "read and summarise one file (CSV, PNG, JPEG, NPY, GLB, JSON)"},
+      {"detect", hearth_cmd_detect, "find plate hole centres in the calibration captures"},
+      {"calibrate", hearth_cmd_calibrate, "thermal intrinsics and RGB-thermal stereo from detections"},
+      {"scale", hearth_cmd_scale, "recover metric scale from recorded depth"},
+      {"transfer", hearth_cmd_transfer, "thermal poses from colour poses through the rig transform"},
+      {"refine", hearth_cmd_refine, "refine thermal poses automatically"},
+      {"map", hearth_cmd_map, "map temperatures onto the mesh's UV layout"},
+      {"overlay", hearth_cmd_overlay, "draw projected mesh outlines on thermal views"},
+      {"build", hearth_cmd_build, "run the whole pipeline over a release"},
+      {"validate", hearth_cmd_validate, "check a release against the layout contract"},
+      {"stats", hearth_cmd_stats, "dataset overview table of a release"},
+      {"demo", hearth_cmd_demo, "make, build and report a small virtual release"},
+      {"sim", hearth_cmd_sim, "temperature-aware manipulation tasks (render, collect, eval)"},
+  };
+  size_t n = sizeof cmds / sizeof cmds[0];
+  if (argc < 2) return usage(stderr, cmds, n);
+  if (cli_is_help(argv[1]) || !strcmp(argv[1], "help")) return usage(stdout, cmds, n);
+  if (!strcmp(argv[1], "--version")) {
+    printf("hearth %s\n", HEARTH_VERSION);
+    return 0;
+  }
+  for (size_t i = 0; i < n; i++) {
+    if (!strcmp(argv[1], cmds[i].name)) {
+      if (!cmds[i].fn) {
+        fprintf(stderr, "hearth: '%s' is not part of this build\n", argv[1]);
+        return 2;
+      }
+      return cmds[i].fn(argc - 1, argv + 1);
+    }
+  }
+  fprintf(stderr, "hearth: unknown command '%s' (see 'hearth --help')\n", argv[1]);
+  return 2;
+}
