@@ -10,4 +10,7 @@
 #include "hearth/mesh.h"
 #include "hearth/release.h"
 #include "hearth/synth.h"
+#include "hearth/calib.h"
+#include "hearth/map.h"
+#include "hearth/pipeline.h"
 #endif

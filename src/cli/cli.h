@@ -21,4 +21,15 @@ int cli_parse_num(const char *s, double *out);
 /* Print "hearth <cmd>: <message>" for a failed status; returns 1. */
 int cli_fail(const char *cmd, const hearth_err *err);
 
+/* Instances of a release (release.json) or just `only`; states of an
+ * instance (instance.json) or just `only`. */
+#define CLI_MAX_NAMES 4096
+typedef struct cli_names {
+  size_t n;
+  char names[CLI_MAX_NAMES][64];
+} cli_names;
+hearth_status cli_instances(const char *root, const char *only, cli_names *out, hearth_err *err);
+hearth_status cli_states(const char *root, const char *instance, const char *only, cli_names *out,
+                         hearth_err *err);
+
 #endif

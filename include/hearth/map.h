@@ -1,0 +1,98 @@
+/* hearth/map.h - temperature (and colour) mapping from camera views onto a
+ * mesh's UV layout: the paper's "Temperature Mapping and Thermal Textures".
+ *
+ * For each view, every pixel's undistorted centre is cast into the scene;
+ * the nearest front-facing surface takes that pixel's raw value unchanged,
+ * splatted with bilinear weights into an R x R UV map. Within a view,
+ * contributions are averaged by weight; across views they are fused (the
+ * paper's maximum by default). Unobserved surface texels are then filled
+ * from the nearest observed texel of the same UV island. Conventions:
+ * docs/conventions.md (UV row 0 at v = 0, texel centre (col+0.5)/R). */
+#ifndef HEARTH_MAP_H
+#define HEARTH_MAP_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "hearth/camera.h"
+#include "hearth/core.h"
+#include "hearth/geom.h"
+#include "hearth/image.h"
+#include "hearth/mesh.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum hearth_fusion {
+  HEARTH_FUSE_MAX = 0,    /* paper: upper envelope of the per-view means */
+  HEARTH_FUSE_ROBUST = 1, /* silhouette pixels rejected, weighted median over views */
+  HEARTH_FUSE_MEAN = 2    /* weighted mean over views (colour textures) */
+} hearth_fusion;
+
+/* Mask values of a map (also the values of mask.npy). */
+enum {
+  HEARTH_TEXEL_NONE = 0,       /* no surface at this texel */
+  HEARTH_TEXEL_OBSERVED = 1,
+  HEARTH_TEXEL_FILLED = 2,
+  HEARTH_TEXEL_UNOBSERVED = 3  /* surface, but its island was never observed */
+};
+
+typedef struct hearth_map_opts {
+  size_t resolution;      /* R; default 1024 */
+  hearth_fusion fusion;   /* default HEARTH_FUSE_MAX */
+  double min_cos;         /* reject hits seen more obliquely than this cosine; default 0 */
+  int pixel_stride;       /* cast every k-th pixel in x and y (colour baking); default 1 */
+  int threads;            /* 0 = hearth_default_threads() */
+} hearth_map_opts;
+void hearth_map_opts_default(hearth_map_opts *o);
+
+/* One view: an image (F32 1-channel temperatures, or U8 RGB colour) and the
+ * camera's pose. Images are read, never modified. */
+typedef struct hearth_map_view {
+  const hearth_image *image;
+  hearth_rigid T_world_from_cam;
+} hearth_map_view;
+
+typedef struct hearth_map_result {
+  size_t R;
+  int channels;               /* 1 for temperature, 3 for colour */
+  float *observed;            /* R*R*channels; NaN where mask != OBSERVED */
+  float *filled;              /* R*R*channels; NaN where mask not in {OBSERVED, FILLED} */
+  uint8_t *mask;              /* R*R, HEARTH_TEXEL_* */
+  float *best_cos;            /* R*R: largest viewing cosine among observing views (0 if none) */
+  uint32_t *view_hits;        /* n_views: pixels of each view that landed on the surface */
+  size_t n_views;
+  size_t n_surface, n_observed, n_filled, n_unobserved;
+} hearth_map_result;
+void hearth_map_result_free(hearth_map_result *r);
+
+/* Map n views seen by one camera model onto mesh (which must have UVs).
+ * rc is a ray caster built over the same mesh (or NULL to build one here).
+ * Deterministic: the same bytes for any thread count. */
+hearth_status hearth_map_views(const hearth_mesh *mesh, const hearth_raycaster *rc,
+                               const hearth_camera *cam, const hearth_map_view *views,
+                               size_t n_views, const hearth_map_opts *opts,
+                               hearth_map_result *out, hearth_err *err);
+
+/* Time spent in each phase of the last hearth_map_views call on a result
+ * (seconds), for benchmarks. */
+typedef struct hearth_map_timing {
+  double raster, cast, fuse, fill, total;
+} hearth_map_timing;
+hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_raycaster *rc,
+                                     const hearth_camera *cam, const hearth_map_view *views,
+                                     size_t n_views, const hearth_map_opts *opts,
+                                     hearth_map_result *out, hearth_map_timing *timing,
+                                     hearth_err *err);
+
+/* Copy the filled map into an image for a texture: Turbo over [lo, hi] for
+ * temperatures (channels == 1) or the colour (channels == 3); texels without
+ * a value are padded from neighbours for `pad` texels (so bilinear texture
+ * lookups at island borders stay clean) and set to nan_rgb beyond. */
+hearth_status hearth_map_texture(const hearth_map_result *r, double lo, double hi, int pad,
+                                 const uint8_t nan_rgb[3], hearth_image *out, hearth_err *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

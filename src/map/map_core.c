@@ -1,0 +1,613 @@
+/* Temperature / colour mapping onto a UV layout (see include/hearth/map.h).
+ *
+ * Determinism: views are processed in parallel, but every cross-view
+ * reduction is order-independent by construction: the maximum is exact,
+ * means are accumulated in 64-bit fixed point (integer addition is
+ * associative), and the robust median works on per-view records reduced in
+ * view order. Within a view, pixels are visited in raster order by one
+ * thread. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "hearth/map.h"
+
+#define FIX_SCALE 1048576.0 /* 2^20: fixed-point resolution of mean fusion */
+#define MAX_BACKFACE_SKIPS 8
+
+void hearth_map_opts_default(hearth_map_opts *o) {
+  memset(o, 0, sizeof *o);
+  o->resolution = 1024;
+  o->fusion = HEARTH_FUSE_MAX;
+  o->min_cos = 0.0;
+  o->pixel_stride = 1;
+}
+
+void hearth_map_result_free(hearth_map_result *r) {
+  if (!r) return;
+  free(r->observed);
+  free(r->filled);
+  free(r->mask);
+  free(r->best_cos);
+  free(r->view_hits);
+  memset(r, 0, sizeof *r);
+}
+
+/* a per-view contribution to one texel, for the robust fusion */
+typedef struct view_record {
+  uint32_t texel;
+  float value;
+  float weight;
+} view_record;
+
+typedef struct map_ctx {
+  const hearth_mesh *mesh;
+  const hearth_raycaster *rc;
+  const hearth_camera *cam;
+  const hearth_map_view *views;
+  size_t n_views;
+  const hearth_map_opts *opts;
+  size_t R;
+  int C;
+  /* layout */
+  const uint32_t *tri_of_texel;
+  const uint32_t *island_of_tri;
+  const float *tri_normal; /* 3 per triangle, unit */
+  /* pixel grid */
+  size_t n_pix, pix_w, pix_h;
+  const float *pix_dir; /* 3 per pixel, camera frame, unit */
+  const uint32_t *pix_index; /* image pixel index of grid pixel */
+  /* per-thread scratch, indexed by thread */
+  int n_threads;
+  double **sum, **wsum;
+  uint32_t **touched;
+  uint8_t **touched_flag;
+  float **fmax, **fcos;
+  int64_t **isum, **iw;
+  float *hit_t; /* per thread: n_pix */
+  uint32_t *hit_tri;
+  float *hit_b1, *hit_b2;
+  float *ray_org, *ray_dir;
+  hearth_ray_hit *hits;
+  /* outputs */
+  uint32_t *view_hits;
+  view_record **records; /* robust: per view */
+  size_t *n_records;
+  int failed;
+} map_ctx;
+
+static float image_value(const hearth_image *img, size_t idx, int c) {
+  if (img->type == HEARTH_PIX_F32) return ((const float *)img->data)[idx * (size_t)img->channels + (size_t)c];
+  return (float)((const uint8_t *)img->data)[idx * (size_t)img->channels + (size_t)c];
+}
+
+/* cast every grid pixel of view v; fill hit_* arrays of thread t */
+static void cast_view(map_ctx *m, size_t v, int t) {
+  const hearth_rigid *T = &m->views[v].T_world_from_cam;
+  size_t n = m->n_pix;
+  float *org = m->ray_org + (size_t)t * 3 * n, *dir = m->ray_dir + (size_t)t * 3 * n;
+  hearth_ray_hit *hits = m->hits + (size_t)t * n;
+  for (size_t p = 0; p < n; p++) {
+    const float *d = m->pix_dir + 3 * p;
+    for (int i = 0; i < 3; i++) {
+      org[3 * p + i] = (float)T->t[i];
+      dir[3 * p + i] = (float)(T->R[3 * i] * d[0] + T->R[3 * i + 1] * d[1] + T->R[3 * i + 2] * d[2]);
+    }
+  }
+  hearth_raycast_batch(m->rc, n, org, dir, 0.0f, INFINITY, hits);
+  float *ht = m->hit_t + (size_t)t * n, *b1 = m->hit_b1 + (size_t)t * n, *b2 = m->hit_b2 + (size_t)t * n;
+  uint32_t *tri = m->hit_tri + (size_t)t * n;
+  for (size_t p = 0; p < n; p++) {
+    hearth_ray_hit h = hits[p];
+    /* back faces are culled: continue the ray behind them */
+    for (int k = 0; k < MAX_BACKFACE_SKIPS && h.prim != UINT32_MAX && !h.front; k++) {
+      double o[3] = {org[3 * p], org[3 * p + 1], org[3 * p + 2]};
+      double d[3] = {dir[3 * p], dir[3 * p + 1], dir[3 * p + 2]};
+      double tn = (double)h.t * (1.0 + 1e-6) + 1e-7;
+      if (!hearth_raycast(m->rc, o, d, tn, INFINITY, &h)) h.prim = UINT32_MAX;
+    }
+    if (h.prim != UINT32_MAX && h.front) {
+      ht[p] = h.t;
+      tri[p] = h.prim;
+      b1[p] = h.b1;
+      b2[p] = h.b2;
+    } else {
+      ht[p] = INFINITY;
+      tri[p] = UINT32_MAX;
+    }
+  }
+}
+
+/* 1 if grid pixel p is at a silhouette: a 4-neighbour misses the surface or
+ * lies at a clearly different depth */
+static int is_silhouette(const map_ctx *m, const float *ht, size_t p) {
+  size_t x = p % m->pix_w, y = p / m->pix_w;
+  float t0 = ht[p];
+  const long dx[4] = {-1, 1, 0, 0}, dy[4] = {0, 0, -1, 1};
+  for (int k = 0; k < 4; k++) {
+    long nx = (long)x + dx[k], ny = (long)y + dy[k];
+    if (nx < 0 || ny < 0 || nx >= (long)m->pix_w || ny >= (long)m->pix_h) continue;
+    float tn = ht[(size_t)ny * m->pix_w + (size_t)nx];
+    if (!isfinite(tn) || fabsf(tn - t0) > 0.03f * t0) return 1;
+  }
+  return 0;
+}
+
+static void process_view(map_ctx *m, size_t v, int t) {
+  const hearth_mesh *mesh = m->mesh;
+  size_t R = m->R, n = m->n_pix;
+  int C = m->C;
+  double *sum = m->sum[t], *wsum = m->wsum[t];
+  uint32_t *touched = m->touched[t];
+  uint8_t *tflag = m->touched_flag[t];
+  size_t n_touched = 0;
+  cast_view(m, v, t);
+  const float *ht = m->hit_t + (size_t)t * n, *hb1 = m->hit_b1 + (size_t)t * n,
+              *hb2 = m->hit_b2 + (size_t)t * n;
+  const uint32_t *htri = m->hit_tri + (size_t)t * n;
+  const float *dirs = m->ray_dir + (size_t)t * 3 * n;
+  const hearth_image *img = m->views[v].image;
+  uint32_t hits = 0;
+  float *fcos = m->fcos[t];
+  for (size_t p = 0; p < n; p++) {
+    uint32_t tri = htri[p];
+    if (tri == UINT32_MAX) continue;
+    const float *nrm = m->tri_normal + 3 * (size_t)tri, *d = dirs + 3 * p;
+    float cosv = -(nrm[0] * d[0] + nrm[1] * d[1] + nrm[2] * d[2]);
+    if (cosv < (float)m->opts->min_cos) continue;
+    if (m->opts->fusion == HEARTH_FUSE_ROBUST && is_silhouette(m, ht, p)) continue;
+    hits++;
+    /* UV of the hit point */
+    const uint32_t *ix = mesh->indices + 3 * (size_t)tri;
+    float b1 = hb1[p], b2 = hb2[p], b0 = 1.0f - b1 - b2;
+    float u = b0 * mesh->uvs[2 * ix[0]] + b1 * mesh->uvs[2 * ix[1]] + b2 * mesh->uvs[2 * ix[2]];
+    float vv = b0 * mesh->uvs[2 * ix[0] + 1] + b1 * mesh->uvs[2 * ix[1] + 1] +
+               b2 * mesh->uvs[2 * ix[2] + 1];
+    double x = (double)u * (double)R - 0.5, y = (double)vv * (double)R - 0.5;
+    double x0f = floor(x), y0f = floor(y);
+    double fx = x - x0f, fy = y - y0f;
+    long x0 = (long)x0f, y0 = (long)y0f;
+    uint32_t island = m->island_of_tri[tri];
+    size_t src = m->pix_index[p];
+    for (int k = 0; k < 4; k++) {
+      long tx = x0 + (k & 1), ty = y0 + (k >> 1);
+      if (tx < 0 || ty < 0 || tx >= (long)R || ty >= (long)R) continue;
+      double w = ((k & 1) ? fx : 1.0 - fx) * ((k >> 1) ? fy : 1.0 - fy);
+      if (w <= 0.0) continue;
+      size_t q = (size_t)ty * R + (size_t)tx;
+      uint32_t qt = m->tri_of_texel[q];
+      /* splat only into surface texels of the same island */
+      if (qt == UINT32_MAX || m->island_of_tri[qt] != island) continue;
+      if (!tflag[q]) {
+        tflag[q] = 1;
+        touched[n_touched++] = (uint32_t)q;
+        wsum[q] = 0.0;
+        for (int c = 0; c < C; c++) sum[q * (size_t)C + (size_t)c] = 0.0;
+      }
+      wsum[q] += w;
+      for (int c = 0; c < C; c++) sum[q * (size_t)C + (size_t)c] += w * (double)image_value(img, src, c);
+      if (cosv > fcos[q]) fcos[q] = cosv;
+    }
+  }
+  m->view_hits[v] = hits;
+  /* fold this view's per-texel means into the thread's fusion state */
+  if (m->opts->fusion == HEARTH_FUSE_ROBUST) {
+    view_record *rec = malloc((n_touched ? n_touched : 1) * sizeof *rec);
+    if (!rec) {
+      m->failed = 1;
+    } else {
+      /* records in texel order: scan flags over the touched range */
+      size_t k = 0;
+      for (size_t i = 0; i < n_touched; i++) {
+        uint32_t q = touched[i];
+        rec[k++] = (view_record){q, (float)(sum[q] / wsum[q]), (float)wsum[q]};
+      }
+      m->records[v] = rec;
+      m->n_records[v] = k;
+    }
+  } else if (m->opts->fusion == HEARTH_FUSE_MAX) {
+    float *fmax = m->fmax[t];
+    for (size_t i = 0; i < n_touched; i++) {
+      uint32_t q = touched[i];
+      for (int c = 0; c < C; c++) {
+        float mean = (float)(sum[q * (size_t)C + (size_t)c] / wsum[q]);
+        if (mean > fmax[q * (size_t)C + (size_t)c]) fmax[q * (size_t)C + (size_t)c] = mean;
+      }
+    }
+  } else {
+    int64_t *isum = m->isum[t], *iw = m->iw[t];
+    for (size_t i = 0; i < n_touched; i++) {
+      uint32_t q = touched[i];
+      /* each view counts with its total weight at this texel */
+      iw[q] += (int64_t)llround(wsum[q] * FIX_SCALE);
+      for (int c = 0; c < C; c++)
+        isum[q * (size_t)C + (size_t)c] += (int64_t)llround(sum[q * (size_t)C + (size_t)c] * FIX_SCALE);
+    }
+  }
+  for (size_t i = 0; i < n_touched; i++) tflag[touched[i]] = 0;
+}
+
+static void views_range(void *ctx, size_t b, size_t e, int t) {
+  map_ctx *m = ctx;
+  for (size_t v = b; v < e; v++) process_view(m, v, t);
+}
+
+static int cmp_record_texel(const void *a, const void *b) {
+  uint32_t x = ((const view_record *)a)->texel, y = ((const view_record *)b)->texel;
+  return (x > y) - (x < y);
+}
+
+/* weighted median of n (value, weight) pairs; sorts in place */
+typedef struct vw {
+  float v, w;
+} vw;
+static int cmp_vw(const void *a, const void *b) {
+  float x = ((const vw *)a)->v, y = ((const vw *)b)->v;
+  return (x > y) - (x < y);
+}
+static float weighted_median(vw *a, size_t n) {
+  qsort(a, n, sizeof *a, cmp_vw);
+  double total = 0, acc = 0;
+  for (size_t i = 0; i < n; i++) total += a[i].w;
+  for (size_t i = 0; i < n; i++) {
+    acc += a[i].w;
+    if (acc >= 0.5 * total) return a[i].v;
+  }
+  return a[n - 1].v;
+}
+
+/* nearest-observed fill restricted to islands: repeated forward/backward
+ * sweeps propagate the nearest seed (Euclidean distance in texels) through
+ * texels of the same island; ties go to the lower seed index */
+static void fill_islands(size_t R, const uint32_t *island_of_texel, uint8_t *mask, int32_t *seed) {
+  size_t N = R * R;
+  for (size_t q = 0; q < N; q++) seed[q] = mask[q] == HEARTH_TEXEL_OBSERVED ? (int32_t)q : -1;
+  static const int fdx[4] = {-1, -1, 0, 1}, fdy[4] = {0, -1, -1, -1};
+  int changed = 1;
+  for (int pass = 0; changed && pass < 64; pass++) {
+    changed = 0;
+    for (int dir = 0; dir < 2; dir++) {
+      for (size_t k = 0; k < N; k++) {
+        size_t q = dir == 0 ? k : N - 1 - k;
+        uint32_t isl = island_of_texel[q];
+        if (isl == UINT32_MAX || mask[q] == HEARTH_TEXEL_OBSERVED) continue;
+        long x = (long)(q % R), y = (long)(q / R);
+        int32_t best = seed[q];
+        double bd = 0;
+        if (best >= 0) {
+          double sx = (double)(best % (int32_t)R) - (double)x, sy = (double)(best / (int32_t)R) - (double)y;
+          bd = sx * sx + sy * sy;
+        }
+        for (int j = 0; j < 4; j++) {
+          long nx = x + (dir == 0 ? fdx[j] : -fdx[j]), ny = y + (dir == 0 ? fdy[j] : -fdy[j]);
+          if (nx < 0 || ny < 0 || nx >= (long)R || ny >= (long)R) continue;
+          size_t nq = (size_t)ny * R + (size_t)nx;
+          if (island_of_texel[nq] != isl) continue;
+          int32_t s = seed[nq];
+          if (s < 0) continue;
+          double sx = (double)(s % (int32_t)R) - (double)x, sy = (double)(s / (int32_t)R) - (double)y;
+          double d = sx * sx + sy * sy;
+          if (best < 0 || d < bd || (d == bd && s < best)) {
+            best = s;
+            bd = d;
+          }
+        }
+        if (best != seed[q]) {
+          seed[q] = best;
+          changed = 1;
+        }
+      }
+    }
+  }
+}
+
+static void free_scratch(map_ctx *m) {
+  for (int t = 0; t < m->n_threads; t++) {
+    if (m->sum) free(m->sum[t]);
+    if (m->wsum) free(m->wsum[t]);
+    if (m->touched) free(m->touched[t]);
+    if (m->touched_flag) free(m->touched_flag[t]);
+    if (m->fmax) free(m->fmax[t]);
+    if (m->fcos) free(m->fcos[t]);
+    if (m->isum) free(m->isum[t]);
+    if (m->iw) free(m->iw[t]);
+  }
+  free(m->sum);
+  free(m->wsum);
+  free(m->touched);
+  free(m->touched_flag);
+  free(m->fmax);
+  free(m->fcos);
+  free(m->isum);
+  free(m->iw);
+  free(m->hit_t);
+  free(m->hit_tri);
+  free(m->hit_b1);
+  free(m->hit_b2);
+  free(m->ray_org);
+  free(m->ray_dir);
+  free(m->hits);
+  if (m->records)
+    for (size_t v = 0; v < m->n_views; v++) free(m->records[v]);
+  free(m->records);
+  free(m->n_records);
+}
+
+hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_raycaster *rc_in,
+                                     const hearth_camera *cam, const hearth_map_view *views,
+                                     size_t n_views, const hearth_map_opts *opts_in,
+                                     hearth_map_result *out, hearth_map_timing *timing,
+                                     hearth_err *err) {
+  double t_start = hearth_now();
+  memset(out, 0, sizeof *out);
+  hearth_map_opts opts;
+  if (opts_in) opts = *opts_in;
+  else hearth_map_opts_default(&opts);
+  if (!mesh || !cam || (!views && n_views))
+    return hearth_err_set(err, HEARTH_E_ARG, "map: missing mesh, camera or views");
+  if (!mesh->uvs) return hearth_err_set(err, HEARTH_E_NOT_FOUND, "map: the mesh has no UVs (TEXCOORD_0)");
+  size_t R = opts.resolution;
+  if (R < 2 || R > 16384) return hearth_err_set(err, HEARTH_E_RANGE, "map: resolution %zu outside 2..16384", R);
+  if (opts.pixel_stride < 1) opts.pixel_stride = 1;
+  if (cam->width <= 0 || cam->height <= 0) return hearth_err_set(err, HEARTH_E_ARG, "map: camera has no size");
+  int C = 0;
+  for (size_t v = 0; v < n_views; v++) {
+    const hearth_image *im = views[v].image;
+    if (!im || !im->data) return hearth_err_set(err, HEARTH_E_ARG, "map: view %zu has no image", v);
+    if (im->width != (size_t)cam->width || im->height != (size_t)cam->height)
+      return hearth_err_set(err, HEARTH_E_SIZE, "map: view %zu is %zux%zu, the camera is %dx%d", v,
+                            im->width, im->height, cam->width, cam->height);
+    int c = im->type == HEARTH_PIX_F32 && im->channels == 1 ? 1
+            : im->type == HEARTH_PIX_U8 && im->channels >= 3 ? 3 : 0;
+    if (!c) return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "map: view %zu: need F32 gray or U8 RGB", v);
+    if (C && c != C) return hearth_err_set(err, HEARTH_E_INCONSISTENT, "map: views mix image kinds");
+    C = c;
+  }
+  if (!C) C = 1;
+  if (opts.fusion == HEARTH_FUSE_ROBUST && C != 1)
+    return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "map: robust fusion is for temperatures only");
+  hearth_status s = hearth_mesh_validate(mesh, "map mesh", err);
+  if (s) return s;
+
+  map_ctx m;
+  memset(&m, 0, sizeof m);
+  hearth_raycaster *own_rc = NULL;
+  uint32_t *tri_of_texel = NULL, *island_of_tri = NULL, *island_of_texel = NULL, *pix_index = NULL;
+  float *tri_normal = NULL, *pix_dir = NULL;
+  int32_t *seed = NULL;
+  size_t N = R * R;
+  double t_raster0 = hearth_now();
+  tri_of_texel = hearth_alloc_array(N, sizeof *tri_of_texel);
+  island_of_tri = hearth_alloc_array(mesh->n_triangles, sizeof *island_of_tri);
+  tri_normal = hearth_alloc_array(mesh->n_triangles, 3 * sizeof *tri_normal);
+  if (!tri_of_texel || !island_of_tri || !tri_normal) {
+    s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory for R=%zu", R);
+    goto done;
+  }
+  if ((s = hearth_uv_rasterize(mesh, R, tri_of_texel, NULL, err))) goto done;
+  uint32_t n_islands = 0;
+  if ((s = hearth_uv_islands(mesh, island_of_tri, &n_islands, err))) goto done;
+  for (size_t i = 0; i < mesh->n_triangles; i++) {
+    const uint32_t *ix = mesh->indices + 3 * i;
+    const float *a = mesh->positions + 3 * ix[0], *b = mesh->positions + 3 * ix[1],
+                *c = mesh->positions + 3 * ix[2];
+    double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    double nn[3];
+    hearth_cross3(e1, e2, nn);
+    double l = hearth_norm3(nn);
+    for (int k = 0; k < 3; k++) tri_normal[3 * i + k] = l > 0 ? (float)(nn[k] / l) : 0.0f;
+  }
+  double t_cast0 = hearth_now();
+  if (timing) timing->raster = t_cast0 - t_raster0;
+  if (!rc_in) {
+    if ((s = hearth_raycaster_new(mesh, &own_rc, err))) goto done;
+  }
+  /* pixel grid: undistorted centres of every stride-th pixel */
+  size_t st = (size_t)opts.pixel_stride;
+  size_t pw = ((size_t)cam->width + st - 1) / st, ph = ((size_t)cam->height + st - 1) / st;
+  size_t np = pw * ph;
+  pix_dir = hearth_alloc_array(np, 3 * sizeof *pix_dir);
+  pix_index = hearth_alloc_array(np, sizeof *pix_index);
+  if (!pix_dir || !pix_index) {
+    s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
+    goto done;
+  }
+  for (size_t y = 0; y < ph; y++)
+    for (size_t x = 0; x < pw; x++) {
+      size_t p = y * pw + x;
+      double d[3];
+      hearth_camera_ray(cam, (double)(x * st), (double)(y * st), d);
+      for (int k = 0; k < 3; k++) pix_dir[3 * p + k] = (float)d[k];
+      pix_index[p] = (uint32_t)(y * st * (size_t)cam->width + x * st);
+    }
+
+  int nt = opts.threads > 0 ? opts.threads : hearth_default_threads();
+  if ((size_t)nt > n_views) nt = n_views ? (int)n_views : 1;
+  m = (map_ctx){.mesh = mesh, .rc = rc_in ? rc_in : own_rc, .cam = cam, .views = views,
+                .n_views = n_views, .opts = &opts, .R = R, .C = C, .tri_of_texel = tri_of_texel,
+                .island_of_tri = island_of_tri, .tri_normal = tri_normal, .n_pix = np,
+                .pix_w = pw, .pix_h = ph, .pix_dir = pix_dir, .pix_index = pix_index,
+                .n_threads = nt};
+  m.sum = calloc((size_t)nt, sizeof *m.sum);
+  m.wsum = calloc((size_t)nt, sizeof *m.wsum);
+  m.touched = calloc((size_t)nt, sizeof *m.touched);
+  m.touched_flag = calloc((size_t)nt, sizeof *m.touched_flag);
+  m.fmax = calloc((size_t)nt, sizeof *m.fmax);
+  m.fcos = calloc((size_t)nt, sizeof *m.fcos);
+  m.isum = calloc((size_t)nt, sizeof *m.isum);
+  m.iw = calloc((size_t)nt, sizeof *m.iw);
+  m.hit_t = hearth_alloc_array(np * (size_t)nt, sizeof(float));
+  m.hit_tri = hearth_alloc_array(np * (size_t)nt, sizeof(uint32_t));
+  m.hit_b1 = hearth_alloc_array(np * (size_t)nt, sizeof(float));
+  m.hit_b2 = hearth_alloc_array(np * (size_t)nt, sizeof(float));
+  m.ray_org = hearth_alloc_array(np * (size_t)nt, 3 * sizeof(float));
+  m.ray_dir = hearth_alloc_array(np * (size_t)nt, 3 * sizeof(float));
+  m.hits = hearth_alloc_array(np * (size_t)nt, sizeof(hearth_ray_hit));
+  m.view_hits = calloc(n_views ? n_views : 1, sizeof *m.view_hits);
+  int bad = !m.sum || !m.wsum || !m.touched || !m.touched_flag || !m.fmax || !m.fcos || !m.isum ||
+            !m.iw || !m.hit_t || !m.hit_tri || !m.hit_b1 || !m.hit_b2 || !m.ray_org ||
+            !m.ray_dir || !m.hits || !m.view_hits;
+  if (opts.fusion == HEARTH_FUSE_ROBUST) {
+    m.records = calloc(n_views ? n_views : 1, sizeof *m.records);
+    m.n_records = calloc(n_views ? n_views : 1, sizeof *m.n_records);
+    bad |= !m.records || !m.n_records;
+  }
+  for (int t = 0; !bad && t < nt; t++) {
+    m.sum[t] = hearth_alloc_array(N, (size_t)C * sizeof(double));
+    m.wsum[t] = hearth_alloc_array(N, sizeof(double));
+    m.touched[t] = hearth_alloc_array(N, sizeof(uint32_t));
+    m.touched_flag[t] = calloc(N, 1);
+    m.fcos[t] = calloc(N, sizeof(float));
+    bad |= !m.sum[t] || !m.wsum[t] || !m.touched[t] || !m.touched_flag[t] || !m.fcos[t];
+    if (bad) break;
+    if (opts.fusion == HEARTH_FUSE_MAX) {
+      m.fmax[t] = hearth_alloc_array(N, (size_t)C * sizeof(float));
+      bad |= !m.fmax[t];
+      if (!bad)
+        for (size_t i = 0; i < N * (size_t)C; i++) m.fmax[t][i] = -INFINITY;
+    } else if (opts.fusion == HEARTH_FUSE_MEAN) {
+      m.isum[t] = calloc(N * (size_t)C, sizeof(int64_t));
+      m.iw[t] = calloc(N, sizeof(int64_t));
+      bad |= !m.isum[t] || !m.iw[t];
+    }
+  }
+  if (bad) {
+    s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory for %d threads at R=%zu", nt, R);
+    goto done;
+  }
+  hearth_parallel_for(n_views, nt, views_range, &m);
+  if (m.failed) {
+    s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory while fusing views");
+    goto done;
+  }
+  double t_fuse0 = hearth_now();
+  if (timing) timing->cast = t_fuse0 - t_cast0;
+
+  /* results */
+  out->R = R;
+  out->channels = C;
+  out->n_views = n_views;
+  out->observed = hearth_alloc_array(N, (size_t)C * sizeof(float));
+  out->filled = hearth_alloc_array(N, (size_t)C * sizeof(float));
+  out->mask = calloc(N, 1);
+  out->best_cos = calloc(N, sizeof(float));
+  out->view_hits = m.view_hits;
+  m.view_hits = NULL;
+  island_of_texel = hearth_alloc_array(N, sizeof *island_of_texel);
+  seed = hearth_alloc_array(N, sizeof *seed);
+  if (!out->observed || !out->filled || !out->mask || !out->best_cos || !island_of_texel || !seed) {
+    s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
+    goto done;
+  }
+  for (size_t q = 0; q < N; q++) {
+    uint32_t tq = tri_of_texel[q];
+    island_of_texel[q] = tq == UINT32_MAX ? UINT32_MAX : island_of_tri[tq];
+    float bc = 0;
+    for (int t = 0; t < nt; t++)
+      if (m.fcos[t][q] > bc) bc = m.fcos[t][q];
+    out->best_cos[q] = bc;
+    for (int c = 0; c < C; c++) out->observed[q * (size_t)C + (size_t)c] = NAN;
+    out->mask[q] = tq == UINT32_MAX ? HEARTH_TEXEL_NONE : HEARTH_TEXEL_UNOBSERVED;
+  }
+  if (opts.fusion == HEARTH_FUSE_MAX) {
+    for (size_t q = 0; q < N; q++)
+      for (int c = 0; c < C; c++) {
+        float best = -INFINITY;
+        for (int t = 0; t < nt; t++)
+          if (m.fmax[t][q * (size_t)C + (size_t)c] > best) best = m.fmax[t][q * (size_t)C + (size_t)c];
+        if (best > -INFINITY) {
+          out->observed[q * (size_t)C + (size_t)c] = best;
+          out->mask[q] = HEARTH_TEXEL_OBSERVED;
+        }
+      }
+  } else if (opts.fusion == HEARTH_FUSE_MEAN) {
+    for (size_t q = 0; q < N; q++) {
+      int64_t w = 0;
+      for (int t = 0; t < nt; t++) w += m.iw[t][q];
+      if (w <= 0) continue;
+      for (int c = 0; c < C; c++) {
+        int64_t sm = 0;
+        for (int t = 0; t < nt; t++) sm += m.isum[t][q * (size_t)C + (size_t)c];
+        out->observed[q * (size_t)C + (size_t)c] = (float)((double)sm / (double)w);
+      }
+      out->mask[q] = HEARTH_TEXEL_OBSERVED;
+    }
+  } else {
+    /* robust: gather every view's record per texel in view order */
+    size_t total = 0;
+    for (size_t v = 0; v < n_views; v++) total += m.n_records[v];
+    view_record *all = hearth_alloc_array(total ? total : 1, sizeof *all);
+    vw *tmp = hearth_alloc_array(n_views ? n_views : 1, sizeof *tmp);
+    if (!all || !tmp) {
+      free(all);
+      free(tmp);
+      s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
+      goto done;
+    }
+    size_t k = 0;
+    for (size_t v = 0; v < n_views; v++) {
+      memcpy(all + k, m.records[v], m.n_records[v] * sizeof *all);
+      k += m.n_records[v];
+    }
+    /* group by texel; the median depends only on each group's values and
+       weights, so qsort's instability cannot change the result */
+    qsort(all, total, sizeof *all, cmp_record_texel);
+    for (size_t i = 0; i < total;) {
+      size_t j = i;
+      while (j < total && all[j].texel == all[i].texel) j++;
+      size_t cnt = 0;
+      for (size_t r = i; r < j && cnt < n_views; r++) tmp[cnt++] = (vw){all[r].value, all[r].weight};
+      uint32_t q = all[i].texel;
+      out->observed[q] = weighted_median(tmp, cnt);
+      out->mask[q] = HEARTH_TEXEL_OBSERVED;
+      i = j;
+    }
+    free(all);
+    free(tmp);
+  }
+  double t_fill0 = hearth_now();
+  if (timing) timing->fuse = t_fill0 - t_fuse0;
+  fill_islands(R, island_of_texel, out->mask, seed);
+  for (size_t q = 0; q < N; q++) {
+    uint8_t mk = out->mask[q];
+    for (int c = 0; c < C; c++) out->filled[q * (size_t)C + (size_t)c] = NAN;
+    if (mk == HEARTH_TEXEL_NONE) continue;
+    if (mk == HEARTH_TEXEL_OBSERVED) {
+      out->n_observed++;
+      for (int c = 0; c < C; c++)
+        out->filled[q * (size_t)C + (size_t)c] = out->observed[q * (size_t)C + (size_t)c];
+    } else if (seed[q] >= 0) {
+      out->mask[q] = HEARTH_TEXEL_FILLED;
+      out->n_filled++;
+      for (int c = 0; c < C; c++)
+        out->filled[q * (size_t)C + (size_t)c] = out->observed[(size_t)seed[q] * (size_t)C + (size_t)c];
+    } else {
+      out->n_unobserved++;
+    }
+    out->n_surface++;
+  }
+  if (timing) {
+    timing->fill = hearth_now() - t_fill0;
+    timing->total = hearth_now() - t_start;
+  }
+  s = HEARTH_OK;
+done:
+  free_scratch(&m);
+  free(m.view_hits);
+  hearth_raycaster_free(own_rc);
+  free(tri_of_texel);
+  free(island_of_tri);
+  free(island_of_texel);
+  free(tri_normal);
+  free(pix_dir);
+  free(pix_index);
+  free(seed);
+  if (s) hearth_map_result_free(out);
+  return s;
+}
+
+hearth_status hearth_map_views(const hearth_mesh *mesh, const hearth_raycaster *rc,
+                               const hearth_camera *cam, const hearth_map_view *views,
+                               size_t n_views, const hearth_map_opts *opts,
+                               hearth_map_result *out, hearth_err *err) {
+  return hearth_map_views_timed(mesh, rc, cam, views, n_views, opts, out, NULL, err);
+}

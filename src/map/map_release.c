@@ -1,0 +1,383 @@
+/* Release-level stages: pose transfer, temperature mapping of one state and
+ * colour-texture baking (see include/hearth/pipeline.h). */
+#include <errno.h>
+#include <stdarg.h>
+#include <jansson.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+#include "hearth/npy.h"
+#include "hearth/pipeline.h"
+#include "hearth/release.h"
+#include "hearth/thermal.h"
+
+#define PATH_SZ 4096
+
+static hearth_status joinf(char *buf, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
+static hearth_status joinf(char *buf, const char *fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  int n = vsnprintf(buf, PATH_SZ, fmt, ap);
+  va_end(ap);
+  return (n < 0 || n >= PATH_SZ) ? HEARTH_E_LIMIT : HEARTH_OK;
+}
+
+hearth_status hearth_transfer_run(const hearth_transfer_job *job, hearth_err *err) {
+  if (!job || !job->root || !job->instance)
+    return hearth_err_set(err, HEARTH_E_ARG, "transfer: root and instance are required");
+  char rig_path[PATH_SZ], poses_path[PATH_SZ], out1[PATH_SZ], out2[PATH_SZ];
+  if (job->rig_path) snprintf(rig_path, PATH_SZ, "%s", job->rig_path);
+  else joinf(rig_path, "%s/calibration/rig.json", job->root);
+  if (job->poses_path) snprintf(poses_path, PATH_SZ, "%s", job->poses_path);
+  else joinf(poses_path, "%s/instances/%s/derived/poses_rgb.json", job->root, job->instance);
+  joinf(out1, "%s/instances/%s/derived/poses_thermal_transferred.json", job->root, job->instance);
+  joinf(out2, "%s/instances/%s/derived/poses_thermal.json", job->root, job->instance);
+  hearth_rig rig;
+  hearth_status s = hearth_rig_read(rig_path, &rig, err);
+  if (s) return s;
+  hearth_poses poses = {0};
+  if ((s = hearth_poses_read(poses_path, &poses, err))) return s;
+  /* T_world_from_th = T_world_from_rgb * T_rgb_from_th */
+  hearth_rigid T_rgb_from_th;
+  hearth_rigid_inverse(&rig.T_thermal_from_rgb, &T_rgb_from_th);
+  for (size_t i = 0; i < poses.n; i++)
+    hearth_rigid_compose(&poses.views[i].T_world_from_cam, &T_rgb_from_th,
+                         &poses.views[i].T_world_from_cam);
+  char dir[PATH_SZ];
+  joinf(dir, "%s/instances/%s/derived", job->root, job->instance);
+  if ((s = hearth_mkdirs(dir, err))) goto done;
+  if ((s = hearth_poses_write(out1, &poses, err))) goto done;
+  if (!(job->keep_refined && hearth_path_exists(out2))) s = hearth_poses_write(out2, &poses, err);
+done:
+  hearth_poses_free(&poses);
+  return s;
+}
+
+void hearth_map_job_default(hearth_map_job *job) {
+  memset(job, 0, sizeof *job);
+  hearth_map_opts_default(&job->map);
+  job->turbo_lo = 10.0;
+  job->turbo_hi = 60.0;
+}
+
+/* the views to use: all manifest views, or the named subset (each must exist) */
+static hearth_status select_views(const hearth_manifest *man, const char *list, const char *mpath,
+                                  size_t *idx, size_t *n, hearth_err *err) {
+  *n = 0;
+  if (!list || !*list) {
+    for (size_t i = 0; i < man->n_views; i++) idx[(*n)++] = i;
+    return HEARTH_OK;
+  }
+  const char *p = list;
+  while (*p) {
+    const char *e = strchr(p, ',');
+    size_t len = e ? (size_t)(e - p) : strlen(p);
+    size_t found = SIZE_MAX;
+    for (size_t i = 0; i < man->n_views; i++)
+      if (strlen(man->views[i].view) == len && !strncmp(man->views[i].view, p, len)) found = i;
+    if (found == SIZE_MAX)
+      return hearth_err_set(err, HEARTH_E_NOT_FOUND, "%s: no view '%.*s' in this state", mpath,
+                            (int)len, p);
+    for (size_t k = 0; k < *n; k++)
+      if (idx[k] == found)
+        return hearth_err_set(err, HEARTH_E_ARG, "view '%.*s' named twice", (int)len, p);
+    idx[(*n)++] = found;
+    p = e ? e + 1 : p + len;
+  }
+  if (!*n) return hearth_err_set(err, HEARTH_E_ARG, "no views selected");
+  return HEARTH_OK;
+}
+
+static json_t *mat3_json(const double *M) {
+  json_t *a = json_array();
+  for (int r = 0; r < 3; r++) {
+    json_t *row = json_array();
+    for (int c = 0; c < 3; c++) json_array_append_new(row, json_real(M[3 * r + c]));
+    json_array_append_new(a, row);
+  }
+  return a;
+}
+
+static json_t *vec_json(const double *v, int n) {
+  json_t *a = json_array();
+  for (int i = 0; i < n; i++) json_array_append_new(a, json_real(v[i]));
+  return a;
+}
+
+static const char *fusion_name(hearth_fusion f) {
+  return f == HEARTH_FUSE_MAX ? "max" : f == HEARTH_FUSE_ROBUST ? "robust" : "mean";
+}
+
+static hearth_status write_provenance(const char *path, const hearth_map_job *job,
+                                      const hearth_manifest *man, const size_t *idx, size_t n,
+                                      const hearth_map_result *r, const hearth_rig *rig,
+                                      const char *rig_path, const char *poses_path,
+                                      const char *mesh_path, hearth_err *err) {
+  json_t *o = json_object();
+  json_object_set_new(o, "instance", json_string(job->instance));
+  json_object_set_new(o, "state", json_string(job->state));
+  json_t *sv = json_array(), *hits = json_object();
+  for (size_t k = 0; k < n; k++) {
+    const char *name = man->views[idx[k]].view;
+    json_array_append_new(sv, json_string(name));
+    json_object_set_new(hits, name, json_integer(r->view_hits[k]));
+  }
+  json_object_set_new(o, "source_views", sv);
+  json_object_set_new(o, "surface_pixels_per_view", hits);
+  json_t *rj = json_object();
+  json_object_set_new(rj, "path", json_string(rig_path));
+  double K[9];
+  hearth_camera_K(&rig->thermal, K);
+  json_object_set_new(rj, "thermal_K", mat3_json(K));
+  json_object_set_new(rj, "thermal_dist", vec_json(rig->thermal.dist, 5));
+  json_object_set_new(rj, "T_thermal_from_rgb_R", mat3_json(rig->T_thermal_from_rgb.R));
+  json_object_set_new(rj, "T_thermal_from_rgb_t", vec_json(rig->T_thermal_from_rgb.t, 3));
+  json_object_set_new(o, "rig", rj);
+  json_object_set_new(o, "poses", json_string(poses_path));
+  json_object_set_new(o, "mesh", json_string(mesh_path));
+  json_t *pj = json_object();
+  json_object_set_new(pj, "resolution", json_integer((json_int_t)r->R));
+  json_object_set_new(pj, "fusion", json_string(fusion_name(job->map.fusion)));
+  json_object_set_new(pj, "min_cos", json_real(job->map.min_cos));
+  json_object_set_new(pj, "turbo_range_c", vec_json((double[]){job->turbo_lo, job->turbo_hi}, 2));
+  json_object_set_new(pj, "splat", json_string("bilinear"));
+  json_object_set_new(pj, "fill", json_string("nearest observed texel within the UV island"));
+  json_object_set_new(o, "parameters", pj);
+  json_t *cj = json_object();
+  json_object_set_new(cj, "surface_texels", json_integer((json_int_t)r->n_surface));
+  json_object_set_new(cj, "observed_texels", json_integer((json_int_t)r->n_observed));
+  json_object_set_new(cj, "filled_texels", json_integer((json_int_t)r->n_filled));
+  json_object_set_new(cj, "unobserved_texels", json_integer((json_int_t)r->n_unobserved));
+  json_object_set_new(cj, "observed_fraction",
+                      json_real(r->n_surface ? (double)r->n_observed / (double)r->n_surface : 0.0));
+  json_object_set_new(o, "coverage", cj);
+  json_object_set_new(o, "software_version", json_string(HEARTH_VERSION));
+  char *text = json_dumps(o, JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(17));
+  json_decref(o);
+  if (!text) return hearth_err_set(err, HEARTH_E_NOMEM, "%s: cannot encode", path);
+  size_t len = strlen(text);
+  text[len] = 0;
+  hearth_status s = hearth_write_file_atomic(path, text, len, err);
+  free(text);
+  return s;
+}
+
+/* replace directory final_dir by tmp_dir as one rename (old one removed) */
+static hearth_status swap_dir(const char *tmp_dir, const char *final_dir, hearth_err *err) {
+  char old[PATH_SZ];
+  int had_old = 0;
+  if (hearth_path_exists(final_dir)) {
+    if (joinf(old, "%s.old-%ld", final_dir, (long)getpid()))
+      return hearth_err_set(err, HEARTH_E_LIMIT, "%s: path too long", final_dir);
+    if (rename(final_dir, old) != 0)
+      return hearth_err_set(err, HEARTH_E_IO, "%s: cannot move aside: %s", final_dir, strerror(errno));
+    had_old = 1;
+  }
+  if (rename(tmp_dir, final_dir) != 0) {
+    int e = errno;
+    if (had_old) rename(old, final_dir);
+    return hearth_err_set(err, HEARTH_E_IO, "%s: cannot rename into place: %s", final_dir, strerror(e));
+  }
+  if (had_old) return hearth_remove_tree(old, err);
+  return HEARTH_OK;
+}
+
+hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats, hearth_err *err) {
+  if (!job || !job->root || !job->instance || !job->state)
+    return hearth_err_set(err, HEARTH_E_ARG, "map: root, instance and state are required");
+  char rig_path[PATH_SZ], poses_path[PATH_SZ], mesh_path[PATH_SZ], man_path[PATH_SZ],
+      out_dir[PATH_SZ], tmp_dir[PATH_SZ], path[PATH_SZ];
+  const char *inst = job->instance, *root = job->root;
+  if (job->rig_path) snprintf(rig_path, PATH_SZ, "%s", job->rig_path);
+  else joinf(rig_path, "%s/calibration/rig.json", root);
+  if (job->poses_path) snprintf(poses_path, PATH_SZ, "%s", job->poses_path);
+  else joinf(poses_path, "%s/instances/%s/derived/poses_thermal.json", root, inst);
+  if (job->mesh_path) snprintf(mesh_path, PATH_SZ, "%s", job->mesh_path);
+  else joinf(mesh_path, "%s/instances/%s/derived/mesh.glb", root, inst);
+  joinf(man_path, "%s/instances/%s/raw/%s/manifest.json", root, inst, job->state);
+  if (job->out_dir) snprintf(out_dir, PATH_SZ, "%s", job->out_dir);
+  else joinf(out_dir, "%s/instances/%s/derived/%s", root, inst, job->state);
+
+  hearth_rig rig;
+  hearth_manifest man = {0};
+  hearth_poses poses = {0};
+  hearth_mesh mesh = {0};
+  hearth_image *imgs = NULL;
+  hearth_map_view *views = NULL;
+  size_t *idx = NULL, n = 0;
+  hearth_map_result r = {0};
+  tmp_dir[0] = 0;
+  hearth_status s;
+  if ((s = hearth_rig_read(rig_path, &rig, err))) goto done;
+  if ((s = hearth_manifest_read(man_path, &man, err))) goto done;
+  if (strcmp(man.instance, inst) || strcmp(man.state, job->state)) {
+    s = hearth_err_set(err, HEARTH_E_INCONSISTENT, "%s: names instance '%s' state '%s', expected '%s' '%s'",
+                       man_path, man.instance, man.state, inst, job->state);
+    goto done;
+  }
+  if ((s = hearth_poses_read(poses_path, &poses, err))) goto done;
+  hearth_glb_read_opts gopts = {.require_uvs = 1};
+  if ((s = hearth_glb_read(mesh_path, &gopts, &mesh, err))) goto done;
+  idx = calloc(man.n_views ? man.n_views : 1, sizeof *idx);
+  imgs = calloc(man.n_views ? man.n_views : 1, sizeof *imgs);
+  views = calloc(man.n_views ? man.n_views : 1, sizeof *views);
+  if (!idx || !imgs || !views) {
+    s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
+    goto done;
+  }
+  if ((s = select_views(&man, job->views, man_path, idx, &n, err))) goto done;
+  hearth_csv_opts copts = {(size_t)rig.thermal.width, (size_t)rig.thermal.height};
+  for (size_t k = 0; k < n; k++) {
+    const hearth_view_files *vf = &man.views[idx[k]];
+    const hearth_view_pose *vp = hearth_poses_find(&poses, job->state, vf->view);
+    if (!vp) {
+      s = hearth_err_set(err, HEARTH_E_NOT_FOUND, "%s: no pose for state '%s' view '%s'", poses_path,
+                         job->state, vf->view);
+      goto done;
+    }
+    joinf(path, "%s/instances/%s/raw/%s/%s", root, inst, job->state, vf->thermal);
+    if ((s = hearth_thermal_read_csv(path, &copts, &imgs[k], err))) goto done;
+    views[k].image = &imgs[k];
+    views[k].T_world_from_cam = vp->T_world_from_cam;
+  }
+  if ((s = hearth_map_views(&mesh, NULL, &rig.thermal, views, n, &job->map, &r, err))) {
+    hearth_err_prefix(err, "%s/%s", inst, job->state);
+    goto done;
+  }
+  /* write everything into a temporary sibling directory, then swap it in */
+  char parent[PATH_SZ];
+  joinf(parent, "%s/instances/%s/derived", root, inst);
+  if (!job->out_dir && (s = hearth_mkdirs(parent, err))) goto done;
+  if (joinf(tmp_dir, "%s.tmp-XXXXXX", out_dir) || !mkdtemp(tmp_dir)) {
+    s = hearth_err_set(err, HEARTH_E_IO, "%s: cannot create a temporary directory: %s", out_dir,
+                       strerror(errno));
+    tmp_dir[0] = 0;
+    goto done;
+  }
+  size_t shape[2] = {r.R, r.R};
+  joinf(path, "%s/temperature_observed.npy", tmp_dir);
+  if ((s = hearth_npy_write(path, HEARTH_NPY_F32, 2, shape, r.observed, err))) goto done;
+  joinf(path, "%s/temperature_filled.npy", tmp_dir);
+  if ((s = hearth_npy_write(path, HEARTH_NPY_F32, 2, shape, r.filled, err))) goto done;
+  joinf(path, "%s/mask.npy", tmp_dir);
+  if ((s = hearth_npy_write(path, HEARTH_NPY_U8, 2, shape, r.mask, err))) goto done;
+  hearth_image tex = {0};
+  const uint8_t grey[3] = {0, 0, 0};
+  if ((s = hearth_map_texture(&r, job->turbo_lo, job->turbo_hi, 4, grey, &tex, err))) goto done;
+  joinf(path, "%s/thermal_turbo.png", tmp_dir);
+  s = hearth_png_write(path, &tex, err);
+  hearth_image_free(&tex);
+  if (s) goto done;
+  joinf(path, "%s/provenance.json", tmp_dir);
+  if ((s = write_provenance(path, job, &man, idx, n, &r, &rig, rig_path, poses_path, mesh_path, err)))
+    goto done;
+  if ((s = swap_dir(tmp_dir, out_dir, err))) goto done;
+  tmp_dir[0] = 0;
+  if (stats) {
+    *stats = r;
+    stats->observed = stats->filled = NULL;
+    stats->mask = NULL;
+    stats->best_cos = NULL;
+    stats->view_hits = NULL;
+  }
+done:
+  if (tmp_dir[0]) hearth_remove_tree(tmp_dir, NULL);
+  hearth_map_result_free(&r);
+  if (imgs)
+    for (size_t k = 0; k < man.n_views; k++) hearth_image_free(&imgs[k]);
+  free(imgs);
+  free(views);
+  free(idx);
+  hearth_mesh_free(&mesh);
+  hearth_poses_free(&poses);
+  hearth_manifest_free(&man);
+  return s;
+}
+
+hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err) {
+  if (!job || !job->root || !job->instance)
+    return hearth_err_set(err, HEARTH_E_ARG, "bake: root and instance are required");
+  const char *root = job->root, *inst = job->instance;
+  char rig_path[PATH_SZ], poses_path[PATH_SZ], mesh_path[PATH_SZ], man_path[PATH_SZ],
+      path[PATH_SZ], state[HEARTH_NAME_MAX];
+  if (job->rig_path) snprintf(rig_path, PATH_SZ, "%s", job->rig_path);
+  else joinf(rig_path, "%s/calibration/rig.json", root);
+  if (job->poses_path) snprintf(poses_path, PATH_SZ, "%s", job->poses_path);
+  else joinf(poses_path, "%s/instances/%s/derived/poses_rgb.json", root, inst);
+  if (job->mesh_path) snprintf(mesh_path, PATH_SZ, "%s", job->mesh_path);
+  else joinf(mesh_path, "%s/instances/%s/derived/mesh.glb", root, inst);
+  hearth_status s;
+  if (job->state) {
+    snprintf(state, sizeof state, "%s", job->state);
+  } else {
+    hearth_instance_doc idoc;
+    joinf(path, "%s/instances/%s/instance.json", root, inst);
+    if ((s = hearth_instance_read(path, &idoc, err))) return s;
+    if (!idoc.n_states) return hearth_err_set(err, HEARTH_E_INCONSISTENT, "%s: no states", path);
+    snprintf(state, sizeof state, "%s", idoc.states[0]);
+  }
+  joinf(man_path, "%s/instances/%s/raw/%s/manifest.json", root, inst, state);
+  hearth_rig rig;
+  hearth_manifest man = {0};
+  hearth_poses poses = {0};
+  hearth_mesh mesh = {0};
+  hearth_image *imgs = NULL;
+  hearth_map_view *views = NULL;
+  hearth_map_result r = {0};
+  if ((s = hearth_rig_read(rig_path, &rig, err))) goto done;
+  if ((s = hearth_manifest_read(man_path, &man, err))) goto done;
+  if ((s = hearth_poses_read(poses_path, &poses, err))) goto done;
+  hearth_glb_read_opts gopts = {.require_uvs = 1};
+  if ((s = hearth_glb_read(mesh_path, &gopts, &mesh, err))) goto done;
+  imgs = calloc(man.n_views ? man.n_views : 1, sizeof *imgs);
+  views = calloc(man.n_views ? man.n_views : 1, sizeof *views);
+  if (!imgs || !views) {
+    s = hearth_err_set(err, HEARTH_E_NOMEM, "bake: out of memory");
+    goto done;
+  }
+  for (size_t k = 0; k < man.n_views; k++) {
+    const hearth_view_files *vf = &man.views[k];
+    const hearth_view_pose *vp = hearth_poses_find(&poses, state, vf->view);
+    if (!vp) {
+      s = hearth_err_set(err, HEARTH_E_NOT_FOUND, "%s: no pose for state '%s' view '%s'", poses_path,
+                         state, vf->view);
+      goto done;
+    }
+    joinf(path, "%s/instances/%s/raw/%s/%s", root, inst, state, vf->rgb);
+    if ((s = hearth_jpeg_read(path, &imgs[k], err))) goto done;
+    if (imgs[k].channels != 3) {
+      s = hearth_err_set(err, HEARTH_E_UNSUPPORTED, "%s: expected an RGB image", path);
+      goto done;
+    }
+    views[k].image = &imgs[k];
+    views[k].T_world_from_cam = vp->T_world_from_cam;
+  }
+  hearth_map_opts mo;
+  hearth_map_opts_default(&mo);
+  mo.fusion = HEARTH_FUSE_MEAN;
+  mo.resolution = job->resolution ? job->resolution : 1024;
+  mo.pixel_stride = job->pixel_stride > 0 ? job->pixel_stride : 2;
+  mo.min_cos = 0.2; /* grazing colour samples smear texture detail */
+  mo.threads = job->threads;
+  if ((s = hearth_map_views(&mesh, NULL, &rig.rgb, views, man.n_views, &mo, &r, err))) goto done;
+  hearth_image_free(&mesh.texture);
+  const uint8_t grey[3] = {128, 128, 128};
+  if ((s = hearth_map_texture(&r, 0, 255, 8, grey, &mesh.texture, err))) goto done;
+  joinf(path, "%s/instances/%s/derived/rgb_texture.png", root, inst);
+  if ((s = hearth_png_write(path, &mesh.texture, err))) goto done;
+  joinf(path, "%s/instances/%s/derived/mesh.glb", root, inst);
+  s = hearth_glb_write(path, &mesh, err);
+done:
+  hearth_map_result_free(&r);
+  if (imgs)
+    for (size_t k = 0; k < man.n_views; k++) hearth_image_free(&imgs[k]);
+  free(imgs);
+  free(views);
+  hearth_mesh_free(&mesh);
+  hearth_poses_free(&poses);
+  hearth_manifest_free(&man);
+  return s;
+}

@@ -1,0 +1,74 @@
+/* Texture images from fused maps: Turbo for temperatures, colour as is, with
+ * a few texels of padding around islands for clean bilinear lookups. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "hearth/map.h"
+
+hearth_status hearth_map_texture(const hearth_map_result *r, double lo, double hi, int pad,
+                                 const uint8_t nan_rgb[3], hearth_image *out, hearth_err *err) {
+  size_t R = r->R, N = R * R;
+  int C = r->channels;
+  hearth_status s = hearth_image_alloc(out, R, R, 3, HEARTH_PIX_U8, err);
+  if (s) return s;
+  uint8_t *px = out->data;
+  /* have[q]: 1 if q carries a colour (value or padding) */
+  uint8_t *have = calloc(N, 1), *next = calloc(N, 1);
+  uint8_t *tmp = hearth_alloc_array(N, 3);
+  if (!have || !next || !tmp) {
+    free(have);
+    free(next);
+    free(tmp);
+    hearth_image_free(out);
+    return hearth_err_set(err, HEARTH_E_NOMEM, "texture: out of memory");
+  }
+  for (size_t q = 0; q < N; q++) {
+    uint8_t *p = px + 3 * q;
+    if (r->mask[q] == HEARTH_TEXEL_OBSERVED || r->mask[q] == HEARTH_TEXEL_FILLED) {
+      if (C == 1) {
+        double t = (r->filled[q] - lo) / (hi - lo);
+        hearth_turbo(t, p);
+      } else {
+        for (int c = 0; c < 3; c++) {
+          double v = r->filled[q * (size_t)C + (size_t)c];
+          p[c] = (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : lround(v));
+        }
+      }
+      have[q] = 1;
+    } else {
+      memcpy(p, nan_rgb, 3);
+    }
+  }
+  /* padding: each round, a texel without colour takes the mean of its
+     coloured 4-neighbours (deterministic: reads the previous round only) */
+  for (int round = 0; round < pad; round++) {
+    memcpy(next, have, N);
+    memcpy(tmp, px, 3 * N);
+    for (size_t q = 0; q < N; q++) {
+      if (have[q]) continue;
+      size_t x = q % R, y = q / R;
+      int acc[3] = {0, 0, 0}, n = 0;
+      size_t nb[4];
+      int k = 0;
+      if (x > 0) nb[k++] = q - 1;
+      if (x + 1 < R) nb[k++] = q + 1;
+      if (y > 0) nb[k++] = q - R;
+      if (y + 1 < R) nb[k++] = q + R;
+      for (int j = 0; j < k; j++)
+        if (have[nb[j]]) {
+          for (int c = 0; c < 3; c++) acc[c] += px[3 * nb[j] + (size_t)c];
+          n++;
+        }
+      if (n) {
+        for (int c = 0; c < 3; c++) tmp[3 * q + (size_t)c] = (uint8_t)((acc[c] + n / 2) / n);
+        next[q] = 1;
+      }
+    }
+    memcpy(have, next, N);
+    memcpy(px, tmp, 3 * N);
+  }
+  free(have);
+  free(next);
+  free(tmp);
+  return HEARTH_OK;
+}

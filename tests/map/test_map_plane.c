@@ -1,0 +1,171 @@
+/* Mapping against closed forms: quads in the plane z = 0 seen from above,
+ * a linear temperature field, occlusion, back-face culling, max fusion,
+ * island-bounded filling and thread-count determinism. */
+#include "hearth/hearth.h"
+#include "test_util.h"
+
+#define RES 320
+
+/* field on the visible quads: T = 20 + 200 x (degC, x in metres) */
+static double field(double x) { return 20.0 + 200.0 * x; }
+
+/* add an axis-aligned rectangle at height z; facing +z (up) if up else -z */
+static void add_quad(hearth_mesh *m, size_t *nv, size_t *nt, double x0, double x1, double y0,
+                     double y1, double z, int up, double u0, double u1, double v0, double v1) {
+  size_t b = *nv;
+  double P[4][3] = {{x0, y0, z}, {x1, y0, z}, {x1, y1, z}, {x0, y1, z}};
+  double U[4][2] = {{u0, v1}, {u1, v1}, {u1, v0}, {u0, v0}};
+  for (int i = 0; i < 4; i++) {
+    for (int k = 0; k < 3; k++) m->positions[3 * (b + i) + k] = (float)P[i][k];
+    m->uvs[2 * (b + i)] = (float)U[i][0];
+    m->uvs[2 * (b + i) + 1] = (float)U[i][1];
+  }
+  uint32_t t[2][3] = {{0, 1, 2}, {0, 2, 3}};
+  for (int j = 0; j < 2; j++) {
+    uint32_t *ix = m->indices + 3 * (*nt + j);
+    ix[0] = (uint32_t)b + t[j][0];
+    ix[1] = (uint32_t)b + (up ? t[j][1] : t[j][2]);
+    ix[2] = (uint32_t)b + (up ? t[j][2] : t[j][1]);
+  }
+  *nv += 4;
+  *nt += 2;
+}
+
+/* render the scene's temperatures the simple way: a ray per pixel centre
+ * against the planes (independent of the ray caster) */
+static void render(const hearth_camera *cam, const hearth_rigid *T, double offset, hearth_image *img) {
+  hearth_err err;
+  hearth_image_alloc(img, (size_t)cam->width, (size_t)cam->height, 1, HEARTH_PIX_F32, &err);
+  float *px = img->data;
+  for (int v = 0; v < cam->height; v++)
+    for (int u = 0; u < cam->width; u++) {
+      double d[3], w[3];
+      hearth_camera_ray(cam, u, v, d);
+      hearth_rigid_rotate(T, d, w);
+      double t = -T->t[2] / w[2]; /* plane z = 0 */
+      double x = T->t[0] + t * w[0], y = T->t[1] + t * w[1];
+      double val = 22.0; /* background */
+      int on_a = x >= -0.12 && x <= -0.02 && y >= -0.05 && y <= 0.05;
+      int on_b = x >= 0.02 && x <= 0.12 && y >= -0.05 && y <= 0.05;
+      if (on_a || on_b) val = field(x) + offset;
+      px[(size_t)v * (size_t)cam->width + (size_t)u] = (float)val;
+    }
+}
+
+static void look_down(double cx, double cy, double h, hearth_rigid *T) {
+  double R_[9] = {1, 0, 0, 0, -1, 0, 0, 0, -1}; /* cam z -> world -z */
+  memcpy(T->R, R_, sizeof R_);
+  T->t[0] = cx;
+  T->t[1] = cy;
+  T->t[2] = h;
+}
+
+int main(void) {
+  hearth_err err = {0};
+  hearth_mesh m = {0};
+  CHECK_OK(hearth_mesh_alloc(&m, 16, 8, 1, &err), &err);
+  size_t nv = 0, nt = 0;
+  /* island A (left), island B (right), island C hidden under A, quad D
+     facing down above B (culled: its back faces the camera) */
+  add_quad(&m, &nv, &nt, -0.12, -0.02, -0.05, 0.05, 0.0, 1, 0.05, 0.45, 0.05, 0.45);
+  add_quad(&m, &nv, &nt, 0.02, 0.12, -0.05, 0.05, 0.0, 1, 0.55, 0.95, 0.05, 0.45);
+  add_quad(&m, &nv, &nt, -0.10, -0.04, -0.03, 0.03, -0.01, 1, 0.05, 0.45, 0.55, 0.95);
+  add_quad(&m, &nv, &nt, 0.04, 0.10, -0.03, 0.03, 0.05, 0, 0.55, 0.95, 0.55, 0.95);
+  hearth_camera cam = {256, 192, 275.0, 276.0, 127.3, 95.8, {-0.3, 0.12, 0.001, -0.0015, -0.02}};
+  hearth_rigid T0, T1;
+  look_down(0.0, 0.0, 0.35, &T0);
+  look_down(0.01, -0.005, 0.34, &T1);
+  hearth_image img0, img1;
+  render(&cam, &T0, 0.0, &img0);
+  render(&cam, &T1, 1.0, &img1); /* second view reads 1 degC warmer */
+  hearth_map_view views[2] = {{&img0, T0}, {&img1, T1}};
+  hearth_map_opts o;
+  hearth_map_opts_default(&o);
+  o.resolution = RES;
+  o.threads = 1;
+
+  /* one view: observed texels match the field within the splat footprint */
+  hearth_map_result r1;
+  CHECK_OK(hearth_map_views(&m, NULL, &cam, views, 1, &o, &r1, &err), &err);
+  double texel_m = 0.1 / (0.4 * RES);             /* metres per texel on A and B */
+  double bound = 200.0 * 1.5 * texel_m + 1e-3;  /* |grad| x (splat reach) */
+  double worst = 0;
+  size_t n_obs[4] = {0}, n_mask[4] = {0};
+  for (size_t row = 0; row < RES; row++)
+    for (size_t col = 0; col < RES; col++) {
+      size_t q = row * RES + col;
+      double u = (col + 0.5) / RES, v = (row + 0.5) / RES;
+      n_mask[r1.mask[q]]++;
+      int isl = v < 0.5 ? (u < 0.5 ? 0 : 1) : (u < 0.5 ? 2 : 3);
+      if (r1.mask[q] == HEARTH_TEXEL_OBSERVED) {
+        n_obs[isl]++;
+        if (isl < 2) {
+          double x = isl == 0 ? -0.12 + (u - 0.05) / 0.4 * 0.1 : 0.02 + (u - 0.55) / 0.4 * 0.1;
+          double e = fabs(r1.observed[q] - field(x));
+          if (e > worst) worst = e;
+        }
+      }
+      if (r1.mask[q] == HEARTH_TEXEL_FILLED && isl < 2) {
+        /* filled values come from the same island's range only */
+        double lo = isl == 0 ? field(-0.12) : field(0.02), hi = isl == 0 ? field(-0.02) : field(0.12);
+        CHECK(r1.filled[q] >= lo - bound && r1.filled[q] <= hi + bound);
+      }
+      if (r1.mask[q] != HEARTH_TEXEL_OBSERVED) CHECK(isnan(r1.observed[q]));
+      if (r1.mask[q] == HEARTH_TEXEL_NONE || r1.mask[q] == HEARTH_TEXEL_UNOBSERVED)
+        CHECK(isnan(r1.filled[q]));
+    }
+  CHECK_MSG(worst <= bound, "max error %.4f > bound %.4f", worst, bound);
+  CHECK(n_obs[0] > 1000 && n_obs[1] > 1000);
+  CHECK_MSG(n_obs[2] == 0, "hidden island observed at %zu texels", n_obs[2]);
+  CHECK_MSG(n_obs[3] == 0, "back-facing quad observed at %zu texels", n_obs[3]);
+  CHECK(n_mask[HEARTH_TEXEL_UNOBSERVED] > 0);
+  CHECK(r1.n_surface == r1.n_observed + r1.n_filled + r1.n_unobserved);
+  CHECK(r1.n_observed + r1.n_filled > 0);
+  /* the surface is the four UV rectangles: 4 x (0.4 R)^2 texels */
+  CHECK_NEAR((double)r1.n_surface, 4.0 * 0.4 * RES * 0.4 * RES, 4.0 * 4 * 0.4 * RES);
+
+  /* two views with max fusion: where both see, the warmer one wins */
+  hearth_map_result r2, r3;
+  CHECK_OK(hearth_map_views(&m, NULL, &cam, views, 2, &o, &r2, &err), &err);
+  size_t warmer = 0, both = 0;
+  for (size_t q = 0; q < (size_t)RES * RES; q++)
+    if (r1.mask[q] == HEARTH_TEXEL_OBSERVED && r2.mask[q] == HEARTH_TEXEL_OBSERVED) {
+      both++;
+      if (r2.observed[q] >= r1.observed[q] + 1.0 - 2.0 * bound) warmer++;
+    }
+  CHECK(both > 0);
+  CHECK_MSG(warmer > 0.95 * both, "max fusion: %zu of %zu texels took the warmer view", warmer, both);
+
+  /* same bytes for any thread count */
+  o.threads = 2;
+  CHECK_OK(hearth_map_views(&m, NULL, &cam, views, 2, &o, &r3, &err), &err);
+  CHECK(!memcmp(r2.mask, r3.mask, (size_t)RES * RES));
+  CHECK(!memcmp(r2.filled, r3.filled, (size_t)RES * RES * sizeof(float)));
+  hearth_map_result_free(&r3);
+  o.fusion = HEARTH_FUSE_MEAN;
+  o.threads = 1;
+  CHECK_OK(hearth_map_views(&m, NULL, &cam, views, 2, &o, &r3, &err), &err);
+  hearth_map_result r4;
+  o.threads = 2;
+  CHECK_OK(hearth_map_views(&m, NULL, &cam, views, 2, &o, &r4, &err), &err);
+  CHECK(!memcmp(r3.filled, r4.filled, (size_t)RES * RES * sizeof(float)));
+  hearth_map_result_free(&r4);
+
+  /* errors: mesh without UVs, wrong image size */
+  float *uvs = m.uvs;
+  m.uvs = NULL;
+  CHECK(hearth_map_views(&m, NULL, &cam, views, 1, &o, &r4, &err) == HEARTH_E_NOT_FOUND);
+  m.uvs = uvs;
+  hearth_camera small = cam;
+  small.width = 255;
+  CHECK(hearth_map_views(&m, NULL, &small, views, 1, &o, &r4, &err) == HEARTH_E_SIZE);
+  CHECK(strstr(err.msg, "256x192") != NULL);
+
+  hearth_map_result_free(&r1);
+  hearth_map_result_free(&r2);
+  hearth_map_result_free(&r3);
+  hearth_image_free(&img0);
+  hearth_image_free(&img1);
+  hearth_mesh_free(&m);
+  TEST_MAIN_END();
+}
