@@ -33,7 +33,7 @@ fi
 if [ ! -e .tools/node_modules/gltf-validator/package.json ]; then
   echo "setup: installing gltf-validator (npm) into .tools/"
   mkdir -p .tools
-  npm install --silent --no-audit --no-fund --prefix .tools gltf-validator@2 >/dev/null 2>&1 ||
+  npm install --silent --no-audit --no-fund --prefix .tools gltf-validator@2.0.0-dev.3.10 >/dev/null 2>&1 ||
     echo "setup: warning: gltf-validator could not be installed; the GLB validator test will fail"
 fi
 
