@@ -40,6 +40,21 @@ hearth_status hearth_depth_intrinsics_read(const char *path, hearth_depth_intrin
                                            hearth_err *err);
 hearth_status hearth_depth_intrinsics_write(const char *path, const hearth_depth_intrinsics *d,
                                             hearth_err *err);
+hearth_status hearth_depth_intrinsics_parse(const char *text, size_t len, const char *name,
+                                            hearth_depth_intrinsics *d, hearth_err *err);
+
+/* ---- calibration/factory.json: factory colour + depth calibration -------- */
+/* rig.json's schema without the thermal camera, T_thermal_from_rgb and the
+ * rms fields (docs/dataset.md). */
+typedef struct hearth_factory_calib {
+  hearth_camera rgb, depth;
+  hearth_rigid T_depth_from_rgb;
+} hearth_factory_calib;
+hearth_status hearth_factory_read(const char *path, hearth_factory_calib *f, hearth_err *err);
+hearth_status hearth_factory_parse(const char *text, size_t len, const char *name,
+                                   hearth_factory_calib *f, hearth_err *err);
+hearth_status hearth_factory_write(const char *path, const hearth_factory_calib *f,
+                                   hearth_err *err);
 
 /* ---- manifest.json ------------------------------------------------------- */
 typedef struct hearth_view_files {
@@ -108,6 +123,7 @@ hearth_status hearth_detections_write(const char *path, const hearth_detections 
                                       hearth_err *err);
 
 /* ---- scale.json --------------------------------------------------------------- */
+/* views_used and residual_median_mm are optional in the file (0 when absent). */
 typedef struct hearth_scale_doc {
   double scale;
   int views_used;
@@ -115,6 +131,8 @@ typedef struct hearth_scale_doc {
 } hearth_scale_doc;
 hearth_status hearth_scale_read(const char *path, hearth_scale_doc *s, hearth_err *err);
 hearth_status hearth_scale_write(const char *path, const hearth_scale_doc *s, hearth_err *err);
+hearth_status hearth_scale_parse(const char *text, size_t len, const char *name,
+                                 hearth_scale_doc *s, hearth_err *err);
 
 /* ---- release.json / instance.json ---------------------------------------- */
 #define HEARTH_MAX_STATES 8
@@ -128,6 +146,8 @@ typedef struct hearth_instance_doc {
 hearth_status hearth_instance_read(const char *path, hearth_instance_doc *d, hearth_err *err);
 hearth_status hearth_instance_write(const char *path, const hearth_instance_doc *d,
                                     hearth_err *err);
+hearth_status hearth_instance_parse(const char *text, size_t len, const char *name,
+                                    hearth_instance_doc *d, hearth_err *err);
 
 typedef struct hearth_release_doc {
   char name[128];
@@ -140,6 +160,8 @@ void hearth_release_free(hearth_release_doc *d);
 hearth_status hearth_release_read(const char *path, hearth_release_doc *d, hearth_err *err);
 hearth_status hearth_release_write(const char *path, const hearth_release_doc *d,
                                    hearth_err *err);
+hearth_status hearth_release_parse(const char *text, size_t len, const char *name,
+                                   hearth_release_doc *d, hearth_err *err);
 
 /* ---- names ----------------------------------------------------------------- */
 /* The 18 categories of the paper, lower case with underscores
@@ -148,6 +170,8 @@ extern const char *const hearth_categories[18];
 int hearth_category_valid(const char *name);
 /* neutral | hot | warm | iced | used */
 int hearth_state_valid(const char *name);
+/* "<category>_<NN>": a valid category, '_', two to four decimal digits. */
+int hearth_instance_id_valid(const char *id);
 
 #ifdef __cplusplus
 }

@@ -1,0 +1,493 @@
+/* Per-view documents of a release (docs/dataset.md): manifest.json,
+ * poses_*.json and detections.json. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "hearth/release.h"
+#include "io/io_json.h"
+#include "io/io_release_priv.h"
+
+/* poses cover every state of an instance; detections every capture frame */
+#define HR_MAX_POSES ((size_t)HEARTH_MAX_VIEWS * HEARTH_MAX_STATES)
+#define HR_MAX_FRAMES ((size_t)HEARTH_MAX_VIEWS * 4)
+#define HR_MAX_INDEX 100000
+
+#define HR_CONVENTION "T_world_from_cam, OpenCV camera axes"
+#define HR_UNITS "m"
+
+/* ---- duplicates ------------------------------------------------------------------ */
+
+typedef struct hr_keyed {
+  const char *a, *b;
+  size_t i;
+} hr_keyed;
+
+static int hr_keyed_cmp(const void *pa, const void *pb) {
+  const hr_keyed *x = pa, *y = pb;
+  int c = strcmp(x->a, y->a);
+  if (!c && x->b && y->b) c = strcmp(x->b, y->b);
+  if (!c) c = (x->i > y->i) - (x->i < y->i);
+  return c;
+}
+
+int hr_find_duplicate(size_t n, hr_key_fn key, const void *ctx, size_t *first, size_t *second) {
+  if (n < 2) return 0;
+  hr_keyed *k = hearth_alloc_array(n, sizeof *k);
+  int found = 0;
+  if (!k) {
+    /* no memory for the sort: fall back to the quadratic scan */
+    for (size_t j = 1; j < n && !found; j++)
+      for (size_t i = 0; i < j && !found; i++) {
+        const char *a1, *b1, *a2, *b2;
+        key(ctx, i, &a1, &b1);
+        key(ctx, j, &a2, &b2);
+        if (!strcmp(a1, a2) && (!b1 || !b2 || !strcmp(b1, b2))) {
+          *first = i;
+          *second = j;
+          found = 1;
+        }
+      }
+    return found;
+  }
+  for (size_t i = 0; i < n; i++) {
+    key(ctx, i, &k[i].a, &k[i].b);
+    k[i].i = i;
+  }
+  qsort(k, n, sizeof *k, hr_keyed_cmp);
+  /* equal keys sit together ordered by index; report the smallest repeat */
+  for (size_t j = 1; j < n; j++) {
+    int same = !strcmp(k[j].a, k[j - 1].a) && (!k[j].b || !strcmp(k[j].b, k[j - 1].b));
+    if (same && (!found || k[j].i < *second)) {
+      size_t g = j - 1;
+      while (g > 0 && !strcmp(k[g - 1].a, k[j].a) && (!k[j].b || !strcmp(k[g - 1].b, k[j].b)))
+        g--;
+      *first = k[g].i;
+      *second = k[j].i;
+      found = 1;
+    }
+  }
+  free(k);
+  return found;
+}
+
+/* ---- manifest.json ------------------------------------------------------------------ */
+
+void hearth_manifest_free(hearth_manifest *m) {
+  if (!m) return;
+  free(m->views);
+  m->views = NULL;
+  m->n_views = 0;
+}
+
+static void key_manifest(const void *ctx, size_t i, const char **a, const char **b) {
+  const hearth_manifest *m = ctx;
+  *a = m->views[i].view;
+  *b = NULL;
+}
+
+static hearth_status view_files_from_json(hj_ctx *c, const json_t *v, hearth_view_files *f) {
+  if (!json_is_object(v))
+    return hj_fail(c, HEARTH_E_PARSE, "expected an object, found %s", hj_type_name(v));
+  hearth_status s;
+  if ((s = hr_get_checked(c, v, "view", f->view, sizeof f->view, hj_simple_name,
+                          "a view name of letters, digits, '_' or '-'")))
+    return s;
+  if ((s = hj_get_int(c, v, "elevation_index", 0, HR_MAX_INDEX, &f->elevation_index))) return s;
+  if ((s = hj_get_int(c, v, "azimuth_index", 0, HR_MAX_INDEX, &f->azimuth_index))) return s;
+  static const char *const keys[5] = {"rgb", "cutout", "depth", "depth_intrinsics", "thermal"};
+  char *dst[5] = {f->rgb, f->cutout, f->depth, f->depth_intrinsics, f->thermal};
+  for (int k = 0; k < 5; k++)
+    if ((s = hr_get_checked(c, v, keys[k], dst[k], sizeof f->rgb, hj_relative_path_ok,
+                            "a relative path without '..' or empty components")))
+      return s;
+  return HEARTH_OK;
+}
+
+static hearth_status manifest_from_json(hj_ctx *c, const json_t *root, void *out) {
+  hearth_manifest m;
+  memset(&m, 0, sizeof m);
+  hearth_status s;
+  if ((s = hr_get_checked(c, root, "instance", m.instance, sizeof m.instance,
+                          hearth_instance_id_valid,
+                          "an instance id <category>_<NN> with one of the 18 categories")))
+    return s;
+  if ((s = hr_get_checked(c, root, "state", m.state, sizeof m.state, hearth_state_valid,
+                          "neutral, hot, warm, iced or used")))
+    return s;
+  json_t *vv;
+  if ((s = hj_member(c, root, "views", &vv))) return s;
+  size_t mk = hj_push_key(c, "views");
+  size_t n;
+  if ((s = hj_array(c, vv, 1, HEARTH_MAX_VIEWS, &n))) return s;
+  m.views = hearth_calloc_array(n, sizeof *m.views);
+  if (!m.views) return hj_fail(c, HEARTH_E_NOMEM, "cannot allocate %zu views", n);
+  for (size_t i = 0; i < n; i++) {
+    size_t m2 = hj_push_index(c, i);
+    if ((s = view_files_from_json(c, json_array_get(vv, i), &m.views[i]))) {
+      free(m.views);
+      return s;
+    }
+    hj_pop(c, m2);
+  }
+  m.n_views = n;
+  size_t first, second;
+  if (hr_find_duplicate(n, key_manifest, &m, &first, &second)) {
+    hj_push_index(c, second);
+    hj_push_key(c, "view");
+    s = hj_fail(c, HEARTH_E_INCONSISTENT, "duplicate view name \"%s\" (also views[%zu])",
+                m.views[second].view, first);
+    free(m.views);
+    return s;
+  }
+  hj_pop(c, mk);
+  *(hearth_manifest *)out = m;
+  return HEARTH_OK;
+}
+
+hearth_status hearth_manifest_parse(const char *text, size_t len, const char *name,
+                                    hearth_manifest *m, hearth_err *err) {
+  memset(m, 0, sizeof *m);
+  return hr_parse_doc(text, len, name, manifest_from_json, m, err);
+}
+
+hearth_status hearth_manifest_read(const char *path, hearth_manifest *m, hearth_err *err) {
+  memset(m, 0, sizeof *m);
+  return hr_read_doc(path, manifest_from_json, m, err);
+}
+
+static hearth_status manifest_validate(const char *text, size_t len, const char *name,
+                                       hearth_err *err) {
+  hearth_manifest m;
+  hearth_status s = hearth_manifest_parse(text, len, name, &m, err);
+  hearth_manifest_free(&m);
+  return s;
+}
+
+hearth_status hearth_manifest_write(const char *path, const hearth_manifest *m, hearth_err *err) {
+  json_t *o = json_object();
+  json_t *vv = json_array();
+  int ok = o && vv;
+  for (size_t i = 0; ok && i < m->n_views; i++) {
+    const hearth_view_files *f = &m->views[i];
+    json_t *v = json_object();
+    ok = hj_set(v, "view", hj_str(f->view)) &&
+         hj_set(v, "elevation_index", json_integer(f->elevation_index)) &&
+         hj_set(v, "azimuth_index", json_integer(f->azimuth_index)) &&
+         hj_set(v, "rgb", hj_str(f->rgb)) && hj_set(v, "cutout", hj_str(f->cutout)) &&
+         hj_set(v, "depth", hj_str(f->depth)) &&
+         hj_set(v, "depth_intrinsics", hj_str(f->depth_intrinsics)) &&
+         hj_set(v, "thermal", hj_str(f->thermal));
+    if (!ok || json_array_append_new(vv, v) != 0) {
+      if (ok) ok = 0;
+      else json_decref(v);
+    }
+  }
+  ok = ok && hj_set(o, "instance", hj_str(m->instance)) && hj_set(o, "state", hj_str(m->state)) &&
+       hj_set(o, "views", json_incref(vv));
+  json_decref(vv);
+  if (!ok) {
+    json_decref(o);
+    o = NULL;
+  }
+  return hj_write_doc(path, o, manifest_validate, err);
+}
+
+/* ---- poses_*.json ------------------------------------------------------------------------ */
+
+void hearth_poses_free(hearth_poses *p) {
+  if (!p) return;
+  free(p->views);
+  p->views = NULL;
+  p->n = 0;
+}
+
+const hearth_view_pose *hearth_poses_find(const hearth_poses *p, const char *state,
+                                          const char *view) {
+  if (!p || !state || !view) return NULL;
+  for (size_t i = 0; i < p->n; i++)
+    if (!strcmp(p->views[i].state, state) && !strcmp(p->views[i].view, view))
+      return &p->views[i];
+  return NULL;
+}
+
+static void key_poses(const void *ctx, size_t i, const char **a, const char **b) {
+  const hearth_poses *p = ctx;
+  *a = p->views[i].state;
+  *b = p->views[i].view;
+}
+
+/* a fixed string value ("convention", "units") */
+static hearth_status get_fixed(hj_ctx *c, const json_t *obj, const char *key, const char *want) {
+  char buf[128];
+  hearth_status s = hj_get_string(c, obj, key, buf, sizeof buf);
+  if (s) return s;
+  if (strcmp(buf, want) != 0) {
+    size_t m = hj_push_key(c, key);
+    s = hj_fail(c, HEARTH_E_UNSUPPORTED, "expected \"%s\", found \"%s\"", want, buf);
+    hj_pop(c, m);
+  }
+  return s;
+}
+
+static hearth_status pose_from_json(hj_ctx *c, const json_t *v, hearth_view_pose *p) {
+  if (!json_is_object(v))
+    return hj_fail(c, HEARTH_E_PARSE, "expected an object, found %s", hj_type_name(v));
+  hearth_status s;
+  if ((s = hr_get_checked(c, v, "state", p->state, sizeof p->state, hearth_state_valid,
+                          "neutral, hot, warm, iced or used")))
+    return s;
+  if ((s = hr_get_checked(c, v, "view", p->view, sizeof p->view, hj_simple_name,
+                          "a view name of letters, digits, '_' or '-'")))
+    return s;
+  json_t *tv;
+  if ((s = hj_member(c, v, "T_world_from_cam", &tv))) return s;
+  size_t m = hj_push_key(c, "T_world_from_cam");
+  if ((s = hj_mat4_rigid(c, tv, &p->T_world_from_cam))) return s;
+  hj_pop(c, m);
+  return HEARTH_OK;
+}
+
+static hearth_status poses_from_json(hj_ctx *c, const json_t *root, void *out) {
+  hearth_poses p = {0, NULL};
+  hearth_status s;
+  if ((s = get_fixed(c, root, "convention", HR_CONVENTION))) return s;
+  if ((s = get_fixed(c, root, "units", HR_UNITS))) return s;
+  json_t *vv;
+  if ((s = hj_member(c, root, "views", &vv))) return s;
+  size_t mk = hj_push_key(c, "views");
+  size_t n;
+  if ((s = hj_array(c, vv, 0, HR_MAX_POSES, &n))) return s;
+  p.views = hearth_calloc_array(n ? n : 1, sizeof *p.views);
+  if (!p.views) return hj_fail(c, HEARTH_E_NOMEM, "cannot allocate %zu poses", n);
+  for (size_t i = 0; i < n; i++) {
+    size_t m2 = hj_push_index(c, i);
+    if ((s = pose_from_json(c, json_array_get(vv, i), &p.views[i]))) {
+      free(p.views);
+      return s;
+    }
+    hj_pop(c, m2);
+  }
+  p.n = n;
+  size_t first, second;
+  if (hr_find_duplicate(n, key_poses, &p, &first, &second)) {
+    hj_push_index(c, second);
+    s = hj_fail(c, HEARTH_E_INCONSISTENT, "duplicate pose for state \"%s\", view \"%s\" "
+                "(also views[%zu])", p.views[second].state, p.views[second].view, first);
+    free(p.views);
+    return s;
+  }
+  hj_pop(c, mk);
+  *(hearth_poses *)out = p;
+  return HEARTH_OK;
+}
+
+hearth_status hearth_poses_parse(const char *text, size_t len, const char *name, hearth_poses *p,
+                                 hearth_err *err) {
+  memset(p, 0, sizeof *p);
+  return hr_parse_doc(text, len, name, poses_from_json, p, err);
+}
+
+hearth_status hearth_poses_read(const char *path, hearth_poses *p, hearth_err *err) {
+  memset(p, 0, sizeof *p);
+  return hr_read_doc(path, poses_from_json, p, err);
+}
+
+static hearth_status poses_validate(const char *text, size_t len, const char *name,
+                                    hearth_err *err) {
+  hearth_poses p;
+  hearth_status s = hearth_poses_parse(text, len, name, &p, err);
+  hearth_poses_free(&p);
+  return s;
+}
+
+hearth_status hearth_poses_write(const char *path, const hearth_poses *p, hearth_err *err) {
+  json_t *o = json_object();
+  json_t *vv = json_array();
+  int ok = o && vv;
+  for (size_t i = 0; ok && i < p->n; i++) {
+    const hearth_view_pose *q = &p->views[i];
+    json_t *v = json_object();
+    ok = hj_set(v, "state", hj_str(q->state)) && hj_set(v, "view", hj_str(q->view)) &&
+         hj_set(v, "T_world_from_cam", hj_mat4_new(&q->T_world_from_cam));
+    if (!ok || json_array_append_new(vv, v) != 0) {
+      if (ok) ok = 0;
+      else json_decref(v);
+    }
+  }
+  ok = ok && hj_set(o, "convention", hj_str(HR_CONVENTION)) &&
+       hj_set(o, "units", hj_str(HR_UNITS)) && hj_set(o, "views", json_incref(vv));
+  json_decref(vv);
+  if (!ok) {
+    json_decref(o);
+    o = NULL;
+  }
+  return hj_write_doc(path, o, poses_validate, err);
+}
+
+/* ---- detections.json ------------------------------------------------------------------ */
+
+void hearth_detections_free(hearth_detections *d) {
+  if (!d) return;
+  free(d->frames);
+  d->frames = NULL;
+  d->n = 0;
+}
+
+static void key_detections(const void *ctx, size_t i, const char **a, const char **b) {
+  const hearth_detections *d = ctx;
+  *a = d->frames[i].frame;
+  *b = d->frames[i].camera;
+}
+
+static int camera_name_ok(const char *s) { return !strcmp(s, "thermal") || !strcmp(s, "rgb"); }
+
+/* the plate block must describe the plate hearth knows (release.h constants) */
+static hearth_status pattern_from_json(hj_ctx *c, const json_t *root) {
+  json_t *pv;
+  hearth_status s = hj_get_object(c, root, "pattern", &pv);
+  if (s) return s;
+  size_t m = hj_push_key(c, "pattern");
+  static const struct {
+    const char *key;
+    int want;
+  } ints[3] = {{"rows", HEARTH_PLATE_ROWS}, {"cols_even", 11}, {"cols_odd", 10}};
+  for (int i = 0; i < 3; i++) {
+    int x;
+    if ((s = hj_get_int(c, pv, ints[i].key, 0, 1 << 20, &x))) return s;
+    if (x != ints[i].want) {
+      hj_push_key(c, ints[i].key);
+      return hj_fail(c, HEARTH_E_UNSUPPORTED, "expected %d (the plate of docs/dataset.md), "
+                     "found %d", ints[i].want, x);
+    }
+  }
+  static const struct {
+    const char *key;
+    double want;
+  } reals[2] = {{"pitch_m", HEARTH_PLATE_PITCH_M}, {"row_step_m", HEARTH_PLATE_ROW_STEP_M}};
+  for (int i = 0; i < 2; i++) {
+    double x;
+    if ((s = hj_get_number(c, pv, reals[i].key, &x))) return s;
+    if (!(fabs(x - reals[i].want) <= 1e-9)) {
+      hj_push_key(c, reals[i].key);
+      return hj_fail(c, HEARTH_E_UNSUPPORTED, "expected %.9g (the plate of docs/dataset.md), "
+                     "found %.17g", reals[i].want, x);
+    }
+  }
+  hj_pop(c, m);
+  return HEARTH_OK;
+}
+
+static hearth_status detection_from_json(hj_ctx *c, const json_t *v, hearth_detection *f) {
+  if (!json_is_object(v))
+    return hj_fail(c, HEARTH_E_PARSE, "expected an object, found %s", hj_type_name(v));
+  hearth_status s;
+  if ((s = hr_get_checked(c, v, "frame", f->frame, sizeof f->frame, hj_simple_name,
+                          "a frame name of letters, digits, '_' or '-'")))
+    return s;
+  if ((s = hr_get_checked(c, v, "camera", f->camera, sizeof f->camera, camera_name_ok,
+                          "\"thermal\" or \"rgb\"")))
+    return s;
+  json_t *fv;
+  if ((s = hj_member(c, v, "found", &fv))) return s;
+  size_t m = hj_push_key(c, "found");
+  if ((s = hj_bool(c, fv, &f->found))) return s;
+  hj_pop(c, m);
+  if (f->found) {
+    json_t *cv;
+    if ((s = hj_member(c, v, "centres", &cv))) return s;
+    m = hj_push_key(c, "centres");
+    if ((s = hj_mat(c, cv, HEARTH_PLATE_HOLES, 2, &f->centres[0][0]))) return s;
+    hj_pop(c, m);
+  } else {
+    /* a frame without a detection says why; partial centres are not read */
+    if ((s = hr_get_nonempty(c, v, "reason", f->reason, sizeof f->reason))) return s;
+  }
+  return HEARTH_OK;
+}
+
+static hearth_status detections_from_json(hj_ctx *c, const json_t *root, void *out) {
+  hearth_detections d = {0, NULL};
+  hearth_status s;
+  if ((s = pattern_from_json(c, root))) return s;
+  json_t *fv;
+  if ((s = hj_member(c, root, "frames", &fv))) return s;
+  size_t mk = hj_push_key(c, "frames");
+  size_t n;
+  if ((s = hj_array(c, fv, 0, HR_MAX_FRAMES, &n))) return s;
+  d.frames = hearth_calloc_array(n ? n : 1, sizeof *d.frames);
+  if (!d.frames) return hj_fail(c, HEARTH_E_NOMEM, "cannot allocate %zu frames", n);
+  for (size_t i = 0; i < n; i++) {
+    size_t m2 = hj_push_index(c, i);
+    if ((s = detection_from_json(c, json_array_get(fv, i), &d.frames[i]))) {
+      free(d.frames);
+      return s;
+    }
+    hj_pop(c, m2);
+  }
+  d.n = n;
+  size_t first, second;
+  if (hr_find_duplicate(n, key_detections, &d, &first, &second)) {
+    hj_push_index(c, second);
+    s = hj_fail(c, HEARTH_E_INCONSISTENT, "duplicate frame \"%s\" of camera \"%s\" "
+                "(also frames[%zu])", d.frames[second].frame, d.frames[second].camera, first);
+    free(d.frames);
+    return s;
+  }
+  hj_pop(c, mk);
+  *(hearth_detections *)out = d;
+  return HEARTH_OK;
+}
+
+hearth_status hearth_detections_parse(const char *text, size_t len, const char *name,
+                                      hearth_detections *d, hearth_err *err) {
+  memset(d, 0, sizeof *d);
+  return hr_parse_doc(text, len, name, detections_from_json, d, err);
+}
+
+hearth_status hearth_detections_read(const char *path, hearth_detections *d, hearth_err *err) {
+  memset(d, 0, sizeof *d);
+  return hr_read_doc(path, detections_from_json, d, err);
+}
+
+static hearth_status detections_validate(const char *text, size_t len, const char *name,
+                                         hearth_err *err) {
+  hearth_detections d;
+  hearth_status s = hearth_detections_parse(text, len, name, &d, err);
+  hearth_detections_free(&d);
+  return s;
+}
+
+hearth_status hearth_detections_write(const char *path, const hearth_detections *d,
+                                      hearth_err *err) {
+  json_t *o = json_object();
+  json_t *pat = json_object();
+  json_t *fv = json_array();
+  int ok = o && pat && fv;
+  ok = ok && hj_set(pat, "rows", json_integer(HEARTH_PLATE_ROWS)) &&
+       hj_set(pat, "cols_even", json_integer(11)) && hj_set(pat, "cols_odd", json_integer(10)) &&
+       hj_set(pat, "pitch_m", json_real(HEARTH_PLATE_PITCH_M)) &&
+       hj_set(pat, "row_step_m", json_real(HEARTH_PLATE_ROW_STEP_M));
+  for (size_t i = 0; ok && i < d->n; i++) {
+    const hearth_detection *f = &d->frames[i];
+    json_t *v = json_object();
+    ok = hj_set(v, "frame", hj_str(f->frame)) && hj_set(v, "camera", hj_str(f->camera)) &&
+         hj_set(v, "found", json_boolean(f->found));
+    if (ok && f->found)
+      ok = hj_set(v, "centres", hj_mat_new(&f->centres[0][0], HEARTH_PLATE_HOLES, 2));
+    else if (ok)
+      ok = hj_set(v, "reason", hj_str(f->reason));
+    if (!ok || json_array_append_new(fv, v) != 0) {
+      if (ok) ok = 0;
+      else json_decref(v);
+    }
+  }
+  ok = ok && hj_set(o, "pattern", json_incref(pat)) && hj_set(o, "frames", json_incref(fv));
+  json_decref(pat);
+  json_decref(fv);
+  if (!ok) {
+    json_decref(o);
+    o = NULL;
+  }
+  return hj_write_doc(path, o, detections_validate, err);
+}
