@@ -1,0 +1,135 @@
+/* Pinhole camera with 5-parameter Brown-Conrady distortion (OpenCV order). */
+#include <math.h>
+#include <stddef.h>
+#include "hearth/camera.h"
+
+void hearth_camera_K(const hearth_camera *cam, double K[9]) {
+  K[0] = cam->fx; K[1] = 0.0;     K[2] = cam->cx;
+  K[3] = 0.0;     K[4] = cam->fy; K[5] = cam->cy;
+  K[6] = 0.0;     K[7] = 0.0;     K[8] = 1.0;
+}
+
+void hearth_distort(const double dist[5], double x, double y, double *xd, double *yd,
+                    double J[4]) {
+  const double k1 = dist[0], k2 = dist[1], p1 = dist[2], p2 = dist[3], k3 = dist[4];
+  double x2 = x * x, y2 = y * y, xy = x * y, r2 = x2 + y2;
+  double radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
+  *xd = x * radial + 2.0 * p1 * xy + p2 * (r2 + 2.0 * x2);
+  *yd = y * radial + p1 * (r2 + 2.0 * y2) + 2.0 * p2 * xy;
+  if (J) {
+    /* d radial / d r2 */
+    double dr = k1 + r2 * (2.0 * k2 + 3.0 * k3 * r2);
+    J[0] = radial + 2.0 * x2 * dr + 2.0 * p1 * y + 6.0 * p2 * x;
+    J[1] = 2.0 * xy * dr + 2.0 * p1 * x + 2.0 * p2 * y;
+    J[2] = J[1];
+    J[3] = radial + 2.0 * y2 * dr + 6.0 * p1 * y + 2.0 * p2 * x;
+  }
+}
+
+int hearth_camera_project(const hearth_camera *cam, const double Xc[3], double uv[2],
+                          hearth_project_jac *jac) {
+  double Z = Xc[2];
+  if (!(Z > 0.0)) return 0;
+  double iz = 1.0 / Z, x = Xc[0] * iz, y = Xc[1] * iz, xd, yd, J[4];
+  hearth_distort(cam->dist, x, y, &xd, &yd, jac ? J : NULL);
+  uv[0] = cam->fx * xd + cam->cx;
+  uv[1] = cam->fy * yd + cam->cy;
+  if (jac) {
+    /* chain: d(u,v)/d(xd,yd) = diag(fx, fy); d(x,y)/dX = [[1/Z,0,-x/Z],[0,1/Z,-y/Z]] */
+    double A[4] = {cam->fx * J[0], cam->fx * J[1], cam->fy * J[2], cam->fy * J[3]};
+    for (int r = 0; r < 2; r++) {
+      jac->d_point[r * 3 + 0] = A[r * 2 + 0] * iz;
+      jac->d_point[r * 3 + 1] = A[r * 2 + 1] * iz;
+      jac->d_point[r * 3 + 2] = -(A[r * 2 + 0] * x + A[r * 2 + 1] * y) * iz;
+    }
+    jac->d_intr[0] = xd;  jac->d_intr[1] = 0.0; jac->d_intr[2] = 1.0; jac->d_intr[3] = 0.0;
+    jac->d_intr[4] = 0.0; jac->d_intr[5] = yd;  jac->d_intr[6] = 0.0; jac->d_intr[7] = 1.0;
+    double r2 = x * x + y * y, r4 = r2 * r2, r6 = r4 * r2, xy = x * y;
+    double *dd = jac->d_dist;
+    dd[0] = cam->fx * x * r2;
+    dd[1] = cam->fx * x * r4;
+    dd[2] = cam->fx * 2.0 * xy;
+    dd[3] = cam->fx * (r2 + 2.0 * x * x);
+    dd[4] = cam->fx * x * r6;
+    dd[5] = cam->fy * y * r2;
+    dd[6] = cam->fy * y * r4;
+    dd[7] = cam->fy * (r2 + 2.0 * y * y);
+    dd[8] = cam->fy * 2.0 * xy;
+    dd[9] = cam->fy * y * r6;
+  }
+  return 1;
+}
+
+/* Pixel residual of a normalised point against the target pixel. */
+static double reproj_residual(const hearth_camera *cam, double x, double y, double tu,
+                              double tv, double *ex, double *ey) {
+  double xd, yd;
+  hearth_distort(cam->dist, x, y, &xd, &yd, NULL);
+  /* residual in distorted normalised coordinates, scored in pixels */
+  *ex = xd - tu;
+  *ey = yd - tv;
+  return hypot(cam->fx * *ex, cam->fy * *ey);
+}
+
+double hearth_camera_undistort(const hearth_camera *cam, double u, double v, double xy[2]) {
+  if (!isfinite(u) || !isfinite(v) || !(cam->fx != 0.0) || !(cam->fy != 0.0)) return -1.0;
+  double tu = (u - cam->cx) / cam->fx, tv = (v - cam->cy) / cam->fy;
+  /* start at the distorted point itself: for radial models r * radial(r) is
+   * monotone on the valid part of the image, and Newton from there stays on
+   * the branch that contains the origin */
+  double x = tu, y = tv, ex, ey;
+  double res = reproj_residual(cam, x, y, tu, tv, &ex, &ey);
+  for (int it = 0; it < 100 && res > 1e-13; it++) {
+    double xd, yd, J[4];
+    hearth_distort(cam->dist, x, y, &xd, &yd, J);
+    double det = J[0] * J[3] - J[1] * J[2];
+    if (!(fabs(det) > 1e-300) || !isfinite(det)) return -1.0;
+    double dx = -(J[3] * ex - J[1] * ey) / det;
+    double dy = -(-J[2] * ex + J[0] * ey) / det;
+    /* step control: never move farther than the current radius + 1 in one
+     * step, then halve until the residual decreases */
+    double len = hypot(dx, dy), cap = 1.0 + hypot(x, y);
+    if (len > cap) {
+      dx *= cap / len;
+      dy *= cap / len;
+    }
+    double lam = 1.0, nres = res, nx = x, ny = y, nex = ex, ney = ey;
+    int accepted = 0;
+    for (int h = 0; h < 60; h++) {
+      nx = x + lam * dx;
+      ny = y + lam * dy;
+      nres = reproj_residual(cam, nx, ny, tu, tv, &nex, &ney);
+      if (nres < res) {
+        accepted = 1;
+        break;
+      }
+      lam *= 0.5;
+    }
+    if (!accepted) break; /* no descent left: at the floating-point floor */
+    x = nx;
+    y = ny;
+    ex = nex;
+    ey = ney;
+    res = nres;
+  }
+  if (!isfinite(res)) return -1.0;
+  /* a root where the distortion map folds over (det <= 0) lies outside the
+   * region where the lens model is invertible */
+  double xd, yd, J[4];
+  hearth_distort(cam->dist, x, y, &xd, &yd, J);
+  if (!(J[0] * J[3] - J[1] * J[2] > 0.0)) return -1.0;
+  xy[0] = x;
+  xy[1] = y;
+  return res;
+}
+
+double hearth_camera_ray(const hearth_camera *cam, double u, double v, double dir[3]) {
+  double xy[2];
+  double res = hearth_camera_undistort(cam, u, v, xy);
+  if (res < 0.0) return res;
+  double n = sqrt(xy[0] * xy[0] + xy[1] * xy[1] + 1.0);
+  dir[0] = xy[0] / n;
+  dir[1] = xy[1] / n;
+  dir[2] = 1.0 / n;
+  return res;
+}
