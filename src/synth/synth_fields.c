@@ -1,0 +1,374 @@
+/* Temperature fields of the virtual rig: apparent surface temperature as a
+ * smooth function of the object-frame position and the part of the surface.
+ *
+ * synth_field_make draws the state's temperatures from the seed and caches
+ * what the evaluation needs in f->params (layout below), so that
+ * synth_field_eval is a pure function: deterministic and thread-safe. The
+ * shapes follow the paper's examples: a hot cup whose body is hottest below
+ * the liquid line, with a cooler rim and handle; an iced can colder at the
+ * bottom; a phone warm over its battery; an orange close to ambient. */
+#include <math.h>
+#include <string.h>
+
+#include "synth/synth_object.h"
+
+/* params layout */
+enum {
+  P_CAT, P_STATE, P_H, P_ZF, P_RB, P_RMAX, P_NAMP, P_GRAD, P_T0 = 8, /* P_T0..P_T0+7: temps */
+  P_ROLE = 16 /* role of part k at P_ROLE + k */
+};
+
+enum { ST_NEUTRAL, ST_HOT, ST_WARM, ST_ICED, ST_USED };
+static const char *const k_states[] = {"neutral", "hot", "warm", "iced", "used"};
+
+enum {
+  R_BODY, R_BOTTOM, R_RIM, R_INNER, R_HANDLE, R_TOP, R_NECK, R_CAP, R_BACK, R_FRAME, R_SCREEN,
+  R_FOAM, R_PAD, R_BASE, R_LID, R_SPOUT, R_CUSHION, R_BAND, R_SHELL
+};
+
+static int role_of(const char *name) {
+  static const struct { const char *n; int r; } t[] = {
+      {"body", R_BODY},     {"bottom", R_BOTTOM}, {"rim", R_RIM},       {"inner", R_INNER},
+      {"handle", R_HANDLE}, {"top", R_TOP},       {"stem_end", R_TOP},  {"neck", R_NECK},
+      {"cap", R_CAP},       {"back", R_BACK},     {"frame", R_FRAME},   {"screen", R_SCREEN},
+      {"foam", R_FOAM},     {"pad", R_PAD},       {"base", R_BASE},     {"lid", R_LID},
+      {"spout", R_SPOUT},   {"cushion", R_CUSHION}, {"band", R_BAND},   {"shell", R_SHELL},
+      {"side", R_SHELL},    {"cup", R_SHELL}};
+  if (!name) return R_BODY;
+  for (size_t i = 0; i < sizeof t / sizeof t[0]; i++)
+    if (strcmp(name, t[i].n) == 0) return t[i].r;
+  return R_BODY;
+}
+
+enum {
+  F_CUP, F_CAN, F_BOTTLE, F_ORANGE, F_PHONE, F_SPONGE, F_KETTLE, F_POT, F_MOUSE, F_LAPTOP,
+  F_HEADSET, F_OTHER
+};
+
+static int fcat(const char *c) {
+  static const char *const n[] = {"cup",    "canned_drink", "bottled_drink",   "orange",
+                                  "smartphone", "sponge",   "electric_kettle", "pot",
+                                  "mouse",  "laptop",       "headset"};
+  for (int i = 0; i < F_OTHER; i++)
+    if (strcmp(c, n[i]) == 0) return i;
+  return F_OTHER;
+}
+
+/* ---- smooth noise -------------------------------------------------------- */
+
+static uint64_t mix64(uint64_t x) {
+  x ^= x >> 30;
+  x *= 0xbf58476d1ce4e5b9ULL;
+  x ^= x >> 27;
+  x *= 0x94d049bb133111ebULL;
+  x ^= x >> 31;
+  return x;
+}
+
+static double lat(uint64_t seed, int64_t a, int64_t b, int64_t c) {
+  uint64_t h = mix64(seed ^ mix64((uint64_t)a * 0x9E3779B97F4A7C15ULL ^
+                                  mix64((uint64_t)b + 0x632BE59BD9B4E019ULL) ^
+                                  mix64((uint64_t)c * 0xD6E8FEB86659FD93ULL + 3)));
+  return (double)(h >> 11) * (2.0 / 9007199254740992.0) - 1.0;
+}
+
+static double sstep(double t) {
+  t = t < 0 ? 0 : t > 1 ? 1 : t;
+  return t * t * (3 - 2 * t);
+}
+
+/* value noise in [-1, 1] with quintic interpolation (C2 smooth) */
+static double noise3(uint64_t seed, double x, double y, double z) {
+  double fx = floor(x), fy = floor(y), fz = floor(z);
+  int64_t ix = (int64_t)fx, iy = (int64_t)fy, iz = (int64_t)fz;
+  double u[3] = {x - fx, y - fy, z - fz};
+  for (int k = 0; k < 3; k++) u[k] = u[k] * u[k] * u[k] * (u[k] * (u[k] * 6 - 15) + 10);
+  double v = 0;
+  for (int c = 0; c < 8; c++) {
+    double w = ((c & 1) ? u[0] : 1 - u[0]) * ((c & 2) ? u[1] : 1 - u[1]) *
+               ((c & 4) ? u[2] : 1 - u[2]);
+    v += w * lat(seed, ix + (c & 1), iy + ((c >> 1) & 1), iz + ((c >> 2) & 1));
+  }
+  return v;
+}
+
+static double clamp01(double t) { return t < 0 ? 0 : t > 1 ? 1 : t; }
+static double logistic(double x) { return 1.0 / (1.0 + exp(-x)); }
+
+/* a soft rectangle: ~1 inside |x-cx| < ax, |y-cy| < ay, falling over w */
+static double soft_rect(double x, double y, double cx, double cy, double ax, double ay,
+                        double w) {
+  return logistic((ax - fabs(x - cx)) / w) * logistic((ay - fabs(y - cy)) / w);
+}
+
+static double gauss2(double x, double y, double cx, double cy, double sg) {
+  double dx = x - cx, dy = y - cy;
+  return exp(-(dx * dx + dy * dy) / (2 * sg * sg));
+}
+
+/* ---- make ---------------------------------------------------------------- */
+
+hearth_status synth_field_make(const synth_object *obj, const char *state, uint64_t seed,
+                               double ambient_c, synth_field *f, hearth_err *err) {
+  if (!obj || !f) return hearth_err_set(err, HEARTH_E_ARG, "synth_field_make: NULL argument");
+  int st = -1;
+  for (int i = 0; i < 5; i++)
+    if (state && strcmp(state, k_states[i]) == 0) st = i;
+  if (st < 0)
+    return hearth_err_set(err, HEARTH_E_ARG,
+                          "synth_field_make(%s): unknown state '%s': expected "
+                          "neutral|hot|warm|iced|used",
+                          obj->category, state ? state : "(null)");
+  if (!(ambient_c > -40 && ambient_c < 60))
+    return hearth_err_set(err, HEARTH_E_RANGE,
+                          "synth_field_make(%s): ambient %g degC: expected -40..60",
+                          obj->category, ambient_c);
+  if (obj->n_parts < 0 || obj->n_parts > SYNTH_MAX_PARTS)
+    return hearth_err_set(err, HEARTH_E_RANGE, "synth_field_make(%s): %d parts: expected <= %d",
+                          obj->category, obj->n_parts, SYNTH_MAX_PARTS);
+  memset(f, 0, sizeof *f);
+  snprintf(f->state, sizeof f->state, "%s", k_states[st]);
+  f->ambient_c = ambient_c;
+  f->seed = seed;
+  double *P = f->params;
+  int cat = fcat(obj->category);
+  P[P_CAT] = cat;
+  P[P_STATE] = st;
+  for (int k = 0; k < obj->n_parts; k++) P[P_ROLE + k] = role_of(obj->part_names[k]);
+
+  /* geometry the fields need: height, liquid line, body radius (without
+   * handles and spouts), overall radius */
+  const hearth_mesh *m = &obj->mesh;
+  double H = obj->height > 0 ? obj->height : 0.1, rb = 0, rmax = 0;
+  for (size_t t = 0; t < m->n_triangles; t++) {
+    int part = obj->part_of_tri && obj->part_of_tri[t] < obj->n_parts ? obj->part_of_tri[t] : 0;
+    int role = (int)P[P_ROLE + part];
+    for (int k = 0; k < 3; k++) {
+      const float *p = m->positions + 3 * (size_t)m->indices[3 * t + k];
+      double r = hypot(p[0], p[1]);
+      if (r > rmax) rmax = r;
+      if (role != R_HANDLE && role != R_SPOUT && r > rb) rb = r;
+    }
+  }
+  if (rmax <= rb) rmax = rb + 1e-3;
+  P[P_H] = H;
+  /* half extents in x and y (the phone's screen and battery layout) */
+  double ax = 1e-3, by = 1e-3;
+  for (size_t v = 0; v < m->n_vertices; v++) {
+    ax = fmax(ax, fabs(m->positions[3 * v]));
+    by = fmax(by, fabs(m->positions[3 * v + 1]));
+  }
+  P[P_ZF] = (obj->fill_level > 0 ? obj->fill_level : 0.8) * H;
+  P[P_RB] = rb;
+  P[P_RMAX] = rmax;
+
+  hearth_rng root, r;
+  hearth_rng_seed(&root, seed);
+  hearth_rng_fork(&root, 0x6669656c64ULL + (uint64_t)st * 131 + (uint64_t)cat, &r);
+  P[P_NAMP] = hearth_rng_range(&r, 0.15, 0.3);
+  P[P_GRAD] = hearth_rng_range(&r, -0.15, 0.15);
+  double *T = P + P_T0;
+  switch (st) {
+  case ST_HOT:
+    switch (cat) {
+    case F_CUP:
+      T[0] = hearth_rng_range(&r, 55, 62);      /* body below the liquid line */
+      T[1] = hearth_rng_range(&r, 35, 40);      /* near the rim */
+      T[2] = hearth_rng_range(&r, 34, 38);      /* handle at the body */
+      T[3] = hearth_rng_range(&r, 29.5, 32);    /* handle far end */
+      T[4] = hearth_rng_range(&r, 0.003, 0.005); /* liquid-line transition width, m */
+      T[5] = hearth_rng_range(&r, 3, 6);        /* bottom cooler by */
+      break;
+    case F_KETTLE:
+      T[0] = hearth_rng_range(&r, 80, 90);
+      T[1] = hearth_rng_range(&r, 68, 76);
+      T[2] = hearth_rng_range(&r, 60, 70);      /* lid */
+      T[3] = hearth_rng_range(&r, 30, 35);      /* handle */
+      T[4] = hearth_rng_range(&r, 30, 38);      /* base */
+      T[5] = hearth_rng_range(&r, 60, 72);      /* spout */
+      T[6] = hearth_rng_range(&r, 0.005, 0.008);
+      break;
+    case F_POT:
+      T[0] = hearth_rng_range(&r, 65, 80);
+      T[1] = hearth_rng_range(&r, 52, 62);
+      T[2] = hearth_rng_range(&r, 40, 48);      /* handle at the body */
+      T[3] = hearth_rng_range(&r, 32, 37);      /* handle far end */
+      T[4] = hearth_rng_range(&r, 55, 66);      /* lid */
+      T[5] = hearth_rng_range(&r, 0.004, 0.007);
+      break;
+    case F_SPONGE:
+      T[0] = hearth_rng_range(&r, 45, 50);
+      T[1] = hearth_rng_range(&r, 3, 6);        /* moist patches cooler by */
+      T[2] = hearth_rng_range(&r, 1, 2.5);      /* pad cooler by */
+      break;
+    case F_PHONE:
+      T[0] = hearth_rng_range(&r, 30, 33);
+      T[1] = hearth_rng_range(&r, 42, 46);
+      T[2] = hearth_rng_range(&r, 43, 47);
+      T[3] = hearth_rng_range(&r, 36, 39);
+      T[4] = ax;
+      T[5] = by;
+      break;
+    default:
+      T[0] = hearth_rng_range(&r, 45, 60);
+      T[1] = hearth_rng_range(&r, 3, 8);        /* top cooler by */
+      break;
+    }
+    break;
+  case ST_ICED:
+    switch (cat) {
+    case F_ORANGE:
+      T[0] = hearth_rng_range(&r, 5, 8);
+      T[1] = hearth_rng_range(&r, 1, 2.5);
+      break;
+    default: /* cans, bottles and anything else chilled */
+      T[0] = hearth_rng_range(&r, 2, 6);        /* bottom */
+      T[1] = hearth_rng_range(&r, 8, 12);       /* top */
+      break;
+    }
+    break;
+  case ST_WARM:
+    switch (cat) {
+    case F_PHONE:
+      T[0] = hearth_rng_range(&r, 27, 29);      /* edges */
+      T[1] = hearth_rng_range(&r, 36, 40);      /* battery on the back */
+      T[2] = hearth_rng_range(&r, 37, 41);      /* SoC spot */
+      T[3] = hearth_rng_range(&r, 31, 33);      /* screen */
+      T[4] = ax;
+      T[5] = by;
+      break;
+    case F_LAPTOP:
+      T[0] = hearth_rng_range(&r, 12, 16);      /* under the CPU, above ambient */
+      T[1] = hearth_rng_range(&r, 3, 5);        /* rest of the base */
+      T[2] = hearth_rng_range(&r, 2, 4);        /* lid */
+      break;
+    default:
+      T[0] = hearth_rng_range(&r, 8, 14);
+      break;
+    }
+    break;
+  case ST_USED:
+    T[0] = hearth_rng_range(&r, 3, 7);          /* mild warmth */
+    T[1] = hearth_rng_range(&r, 7, 11);         /* where a hand or head was */
+    break;
+  default:
+    break;
+  }
+  return HEARTH_OK;
+}
+
+/* ---- eval ---------------------------------------------------------------- */
+
+/* temperature above a liquid line: hot below, cooling towards `top` at the
+ * top, joined by a logistic of width w */
+static double liquid_line(double z, double zf, double H, double hot, double top, double w) {
+  double above = top + (hot - 4 - top) * (1 - clamp01((z - zf) / fmax(H - zf, 1e-3)));
+  double s = logistic((zf - z) / w);
+  return s * hot + (1 - s) * above;
+}
+
+double synth_field_eval(const synth_field *f, const synth_object *obj, uint32_t tri,
+                        const double p[3]) {
+  const double *P = f->params, *T = P + P_T0;
+  int part = (obj && obj->part_of_tri && tri < obj->mesh.n_triangles) ? obj->part_of_tri[tri] : 0;
+  if (part >= SYNTH_MAX_PARTS) part = 0;
+  int role = (int)P[P_ROLE + part];
+  int cat = (int)P[P_CAT], st = (int)P[P_STATE];
+  double amb = f->ambient_c, H = P[P_H], zf = P[P_ZF], rb = P[P_RB], rmax = P[P_RMAX];
+  double x = p[0], y = p[1], z = p[2], r = hypot(x, y);
+  double nz = noise3(f->seed, x / 0.05, y / 0.05, z / 0.05);
+  double small = P[P_NAMP] * nz;
+  double zr = clamp01(z / H);
+
+  if (st == ST_NEUTRAL) return amb + small + P[P_GRAD] * (zr - 0.5);
+
+  if (st == ST_HOT) {
+    switch (cat) {
+    case F_CUP: {
+      double hot = T[0], rim = T[1], w = T[4];
+      switch (role) {
+      case R_HANDLE: {
+        double t = clamp01((r - rb) / (rmax - rb));
+        return T[2] + (T[3] - T[2]) * sstep(t) + 0.3 * small;
+      }
+      case R_RIM: return rim + 0.3 * small;
+      case R_INNER:
+        return liquid_line(z, zf, H, hot + 1.5, rim + 3, w) + 0.3 * small;
+      case R_BOTTOM: return hot - T[5] * (1 - sstep(r / rb)) + 0.3 * small;
+      default: return liquid_line(z, zf, H, hot, rim, w) + 0.3 * small;
+      }
+    }
+    case F_KETTLE: {
+      switch (role) {
+      case R_HANDLE: return T[3] + 0.5 * small;
+      case R_BASE: return T[4] + 2 * clamp01(z / 0.02) + 0.3 * small;
+      case R_LID: /* the plastic knob is cooler than the lid */
+        return T[2] + (amb + 12 - T[2]) * sstep((0.02 - r) / 0.008) + 0.5 * small;
+      case R_SPOUT: return T[5] + 0.5 * small;
+      default: return liquid_line(z, zf, H, T[0], T[1], T[6]) + 0.4 * small;
+      }
+    }
+    case F_POT: {
+      switch (role) {
+      case R_HANDLE: {
+        double t = clamp01((r - rb) / (rmax - rb));
+        return T[2] + (T[3] - T[2]) * sstep(t) + 0.3 * small;
+      }
+      case R_LID: return T[4] + (amb + 15 - T[4]) * sstep((0.021 - r) / 0.008) + 0.5 * small;
+      case R_RIM: return T[1] + 0.3 * small;
+      case R_INNER: return liquid_line(z, zf, H, T[0] + 2, T[1] + 3, T[5]) + 0.3 * small;
+      default: return liquid_line(z, zf, H, T[0], T[1], T[5]) + 0.4 * small;
+      }
+    }
+    case F_SPONGE: {
+      double moist = sstep((noise3(f->seed + 17, x / 0.03, y / 0.03, z / 0.03) - 0.05) / 0.5);
+      double t = T[0] - T[1] * moist;
+      if (role == R_PAD) t -= T[2];
+      return t + 0.2 * small;
+    }
+    case F_PHONE:
+      break; /* same pattern as warm, hotter */
+    default:
+      return T[0] - T[1] * zr + 0.5 * small;
+    }
+  }
+
+  if (st == ST_ICED) {
+    if (cat == F_ORANGE) return T[0] + T[1] * zr + 0.4 * small;
+    double t = T[0] + (T[1] - T[0]) * pow(zr, 0.8);
+    if (role == R_TOP) t += 0.5;
+    if (role == R_CAP) t += 2.0;
+    if (role == R_NECK) t += 1.0;
+    return t + 0.2 * small;
+  }
+
+  if ((st == ST_WARM || st == ST_HOT) && cat == F_PHONE) {
+    /* phone: long axis along y, screen on top (+z) */
+    double edge = T[0], bat = T[1], soc = T[2], scr = T[3];
+    double ax = T[4], by = T[5];
+    double g_bat = soft_rect(x, y, 0, -0.1 * by, 0.7 * ax, 0.45 * by, 0.006);
+    double g_soc = gauss2(x, y, 0.25 * ax, 0.55 * by, 0.015);
+    double g_in = soft_rect(x, y, 0, 0, 0.8 * ax, 0.88 * by, 0.006);
+    switch (role) {
+    case R_BACK: return edge + (bat - edge) * g_bat + (soc - edge) * 0.7 * g_soc * (1 - g_bat) +
+                        0.2 * small;
+    case R_SCREEN: return edge + (scr - edge) * g_in + (soc - scr) * g_soc * g_in + 0.2 * small;
+    default: return edge + 1.5 * g_soc + 0.2 * small;
+    }
+  }
+
+  if (st == ST_WARM) {
+    if (cat == F_LAPTOP) {
+      if (role == R_LID) return amb + T[2] + 0.3 * small;
+      return amb + T[1] + T[0] * gauss2(x, y, 0.04, 0.03, 0.05) + 0.3 * small;
+    }
+    return amb + T[0] * (0.8 + 0.2 * (1 - zr)) + 0.4 * small;
+  }
+
+  /* used: mild warmth, more where hands, palms or heads were */
+  double blob = sstep(0.5 + 0.8 * noise3(f->seed + 29, x / 0.04, y / 0.04, z / 0.04));
+  if (cat == F_HEADSET && role == R_CUSHION) return amb + T[1] + 0.3 * small;
+  if (cat == F_MOUSE && (role == R_SHELL || role == R_TOP))
+    return amb + T[0] + (T[1] - T[0]) * sstep(-y / 0.05 + 0.2) + 0.3 * small;
+  return amb + T[0] * (0.4 + 0.6 * blob) + 0.3 * small;
+}

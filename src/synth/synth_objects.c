@@ -1,0 +1,1781 @@
+/* Procedural objects of the virtual rig: UV-mapped closed meshes for the
+ * paper's categories, with per-triangle part labels and a procedural albedo
+ * texture drawn in UV space.
+ *
+ * Every shape is a union of closed components of two kinds:
+ *  - sweeps: a closed profile (from the axis, round the outside, back to the
+ *    axis) swept round a planar outline (a circle for revolved bodies, a
+ *    rounded rectangle for slabs). Profile segments become UV islands: a
+ *    strip (with one seam) or, where a segment touches the axis, a disk with
+ *    a planar projection.
+ *  - tubes: an elliptic cross-section swept along a planar path (handles,
+ *    spouts, head bands), one strip island and two end-cap disks.
+ * Islands are packed into [0,1]^2 by a shelf packer with gutters. The
+ * tessellation edge length is found by bisection on a count-only pass so the
+ * triangle count follows target_triangles. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "synth/synth_object.h"
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+/* ---- categories ---------------------------------------------------------- */
+
+enum {
+  C_CUP, C_CAN, C_BOTTLE, C_ORANGE, C_PHONE, C_SPONGE, C_KETTLE, C_POT, C_MOUSE, C_ERASER,
+  C_LAPTOP, C_WALLET, C_TISSUE, C_GLASSES, C_PILLOW, C_CUSHION, C_BAG, C_HEADSET, C_COUNT
+};
+
+static const char *const k_cat_names[C_COUNT] = {
+    "cup",    "canned_drink", "bottled_drink", "orange",       "smartphone", "sponge",
+    "electric_kettle", "pot", "mouse",         "eraser",       "laptop",     "wallet",
+    "tissue", "glasses_case", "pillow",        "cushion",      "storage_bag", "headset"};
+
+/* second captured state per category (NULL: room temperature only); 11
+ * categories have one, as in the paper */
+static const char *const k_cat_state2[C_COUNT] = {
+    "hot", "iced", "iced", "iced", "warm", "hot", "hot", "hot", "used", NULL,
+    "warm", NULL, NULL, NULL, NULL, NULL, NULL, "used"};
+
+size_t synth_object_categories(const char **names, size_t max) {
+  size_t n = 0;
+  for (int c = 0; c < C_COUNT; c++) {
+    if (names && n < max) names[n] = k_cat_names[c];
+    n++;
+  }
+  return n;
+}
+
+static int cat_code(const char *name) {
+  if (!name) return -1;
+  for (int c = 0; c < C_COUNT; c++)
+    if (strcmp(name, k_cat_names[c]) == 0) return c;
+  return -1;
+}
+
+size_t synth_category_states(const char *category, const char **states, size_t max) {
+  int c = cat_code(category);
+  size_t n = 0;
+  if (states && max > 0) states[0] = "neutral";
+  n = 1;
+  if (c >= 0 && k_cat_state2[c]) {
+    if (states && max > 1) states[1] = k_cat_state2[c];
+    n = 2;
+  }
+  return n;
+}
+
+/* ---- stateless noise ----------------------------------------------------- */
+
+static uint64_t mix64(uint64_t x) {
+  x ^= x >> 30;
+  x *= 0xbf58476d1ce4e5b9ULL;
+  x ^= x >> 27;
+  x *= 0x94d049bb133111ebULL;
+  x ^= x >> 31;
+  return x;
+}
+
+static double hash3(uint64_t seed, int64_t a, int64_t b, int64_t c) {
+  uint64_t h = mix64(seed ^ mix64((uint64_t)a * 0x9E3779B97F4A7C15ULL ^
+                                  mix64((uint64_t)b + 0x632BE59BD9B4E019ULL) ^
+                                  mix64((uint64_t)c * 0xD6E8FEB86659FD93ULL + 7)));
+  return (double)(h >> 11) * (1.0 / 9007199254740992.0); /* [0,1) */
+}
+
+static double sstep(double t) { return t * t * (3.0 - 2.0 * t); }
+
+/* value noise in [-1, 1] */
+static double vnoise2(uint64_t seed, double x, double y) {
+  double fx = floor(x), fy = floor(y);
+  int64_t ix = (int64_t)fx, iy = (int64_t)fy;
+  double tx = sstep(x - fx), ty = sstep(y - fy);
+  double a = hash3(seed, ix, iy, 0), b = hash3(seed, ix + 1, iy, 0);
+  double c = hash3(seed, ix, iy + 1, 0), d = hash3(seed, ix + 1, iy + 1, 0);
+  double v = (a + (b - a) * tx) + ((c + (d - c) * tx) - (a + (b - a) * tx)) * ty;
+  return 2.0 * v - 1.0;
+}
+
+static double vnoise3(uint64_t seed, double x, double y, double z) {
+  double fx = floor(x), fy = floor(y), fz = floor(z);
+  int64_t ix = (int64_t)fx, iy = (int64_t)fy, iz = (int64_t)fz;
+  double tx = sstep(x - fx), ty = sstep(y - fy), tz = sstep(z - fz);
+  double v[2];
+  for (int k = 0; k < 2; k++) {
+    double a = hash3(seed, ix, iy, iz + k), b = hash3(seed, ix + 1, iy, iz + k);
+    double c = hash3(seed, ix, iy + 1, iz + k), d = hash3(seed, ix + 1, iy + 1, iz + k);
+    double ab = a + (b - a) * tx, cd = c + (d - c) * tx;
+    v[k] = ab + (cd - ab) * ty;
+  }
+  return 2.0 * (v[0] + (v[1] - v[0]) * tz) - 1.0;
+}
+
+static double fbm2(uint64_t seed, double x, double y, int oct) {
+  double s = 0, amp = 0.5, norm = 0;
+  for (int o = 0; o < oct; o++) {
+    s += amp * vnoise2(seed + (uint64_t)o * 101, x, y);
+    norm += amp;
+    x *= 2.03;
+    y *= 2.03;
+    amp *= 0.5;
+  }
+  return s / norm;
+}
+
+/* ---- mesh builder -------------------------------------------------------- */
+
+enum { K_STRIP, K_DISK };
+
+typedef struct patch {
+  int part, style, kind;
+  size_t v0, v1;       /* vertex range of the island */
+  double ox, oy, w, h; /* native coordinates: origin and extent (metres) */
+  double pu, pv, ps;   /* packed placement: uv = p + (native - o) * ps */
+  int swap;            /* native x runs along v */
+} patch;
+
+#define MAX_PATCHES 64
+
+typedef struct builder {
+  int count_only;
+  size_t nv, nt;
+  float *pos, *uv;  /* uv holds native coordinates until packing */
+  uint32_t *idx;
+  uint8_t *part;
+  patch patches[MAX_PATCHES];
+  int np;
+  const char *part_names[SYNTH_MAX_PARTS];
+  int n_parts;
+  int overflow;     /* too many patches/parts: a bug in a builder */
+} builder;
+
+static int b_part(builder *b, const char *name) {
+  for (int i = 0; i < b->n_parts; i++)
+    if (strcmp(b->part_names[i], name) == 0) return i;
+  if (b->n_parts >= SYNTH_MAX_PARTS) {
+    b->overflow = 1;
+    return 0;
+  }
+  b->part_names[b->n_parts] = name;
+  return b->n_parts++;
+}
+
+static patch *b_patch(builder *b, int part, int style, int kind) {
+  if (b->np >= MAX_PATCHES) {
+    b->overflow = 1;
+    return &b->patches[MAX_PATCHES - 1];
+  }
+  patch *p = &b->patches[b->np++];
+  memset(p, 0, sizeof *p);
+  p->part = part;
+  p->style = style;
+  p->kind = kind;
+  p->v0 = b->nv;
+  return p;
+}
+
+static uint32_t b_vert(builder *b, const double p[3], double nx, double ny) {
+  size_t i = b->nv++;
+  if (!b->count_only) {
+    b->pos[3 * i] = (float)p[0];
+    b->pos[3 * i + 1] = (float)p[1];
+    b->pos[3 * i + 2] = (float)p[2];
+    b->uv[2 * i] = (float)nx;
+    b->uv[2 * i + 1] = (float)ny;
+  }
+  return (uint32_t)i;
+}
+
+static void b_tri(builder *b, uint32_t a, uint32_t c, uint32_t d, int part) {
+  size_t t = b->nt++;
+  if (!b->count_only) {
+    b->idx[3 * t] = a;
+    b->idx[3 * t + 1] = c;
+    b->idx[3 * t + 2] = d;
+    b->part[t] = (uint8_t)part;
+  }
+}
+
+/* extent of an island in native coordinates */
+static void patch_close(builder *b, patch *p) {
+  p->v1 = b->nv;
+  if (b->count_only) return;
+  double lo[2] = {1e30, 1e30}, hi[2] = {-1e30, -1e30};
+  for (size_t v = p->v0; v < p->v1; v++)
+    for (int k = 0; k < 2; k++) {
+      double x = b->uv[2 * v + k];
+      if (x < lo[k]) lo[k] = x;
+      if (x > hi[k]) hi[k] = x;
+    }
+  p->ox = lo[0];
+  p->oy = lo[1];
+  p->w = hi[0] - lo[0] > 1e-6 ? hi[0] - lo[0] : 1e-6;
+  p->h = hi[1] - lo[1] > 1e-6 ? hi[1] - lo[1] : 1e-6;
+}
+
+/* make a closed component's triangles [t0, nt) face outwards */
+static void b_orient(builder *b, size_t t0) {
+  if (b->count_only) return;
+  double vol = 0;
+  for (size_t t = t0; t < b->nt; t++) {
+    const float *a = b->pos + 3 * b->idx[3 * t], *c = b->pos + 3 * b->idx[3 * t + 1];
+    const float *d = b->pos + 3 * b->idx[3 * t + 2];
+    vol += (double)a[0] * ((double)c[1] * d[2] - (double)c[2] * d[1]) -
+           (double)a[1] * ((double)c[0] * d[2] - (double)c[2] * d[0]) +
+           (double)a[2] * ((double)c[0] * d[1] - (double)c[1] * d[0]);
+  }
+  if (vol >= 0) return;
+  for (size_t t = t0; t < b->nt; t++) {
+    uint32_t s = b->idx[3 * t + 1];
+    b->idx[3 * t + 1] = b->idx[3 * t + 2];
+    b->idx[3 * t + 2] = s;
+  }
+}
+
+/* ---- outlines and profiles ---------------------------------------------- */
+
+typedef struct outline {
+  size_t n;
+  double *c, *nr; /* 2n each: curve points and outward normals, counter-clockwise */
+  double rref;    /* a typical radius, for sample counts */
+} outline;
+
+static void outline_free(outline *o) {
+  free(o->c);
+  free(o->nr);
+  memset(o, 0, sizeof *o);
+}
+
+static size_t nseg(double len, double h, size_t nmin) {
+  double n = ceil(len / h - 1e-9);
+  if (n < (double)nmin) n = (double)nmin;
+  if (n > 1e7) n = 1e7;
+  return (size_t)n;
+}
+
+/* circle outline: c = 0, profile d is the radius */
+static int outline_circle(outline *o, double rmax, double h) {
+  o->n = nseg(2 * M_PI * rmax, h, 12);
+  o->c = calloc(2 * o->n, sizeof(double));
+  o->nr = calloc(2 * o->n, sizeof(double));
+  if (!o->c || !o->nr) return -1;
+  for (size_t j = 0; j < o->n; j++) {
+    double a = 2 * M_PI * (double)j / (double)o->n;
+    o->nr[2 * j] = cos(a);
+    o->nr[2 * j + 1] = sin(a);
+  }
+  o->rref = 0;
+  return 0;
+}
+
+/* rounded rectangle with half extents A, B and corner radius rc */
+static int outline_rrect(outline *o, double A, double B, double rc, double h) {
+  double sx = 2 * (A - rc), sy = 2 * (B - rc), arc = 0.5 * M_PI * rc;
+  size_t nx = sx > 1e-9 ? nseg(sx, h, 1) : 0, ny = sy > 1e-9 ? nseg(sy, h, 1) : 0;
+  size_t nc = nseg(arc, h, 3);
+  o->n = 2 * nx + 2 * ny + 4 * nc;
+  o->c = calloc(2 * o->n, sizeof(double));
+  o->nr = calloc(2 * o->n, sizeof(double));
+  if (!o->c || !o->nr) return -1;
+  o->rref = 0.5 * (A + B);
+  size_t j = 0;
+  double cx[4] = {A - rc, -(A - rc), -(A - rc), A - rc};
+  double cy[4] = {B - rc, B - rc, -(B - rc), -(B - rc)};
+  for (int side = 0; side < 4; side++) {
+    /* straight piece (right, top, left, bottom), then the corner after it */
+    size_t ns = (side % 2 == 0) ? ny : nx;
+    double a0 = side * 0.5 * M_PI;
+    double nxv = cos(a0), nyv = sin(a0);
+    int prev = (side + 3) % 4;
+    double x0 = cx[prev] + rc * nxv, y0 = cy[prev] + rc * nyv;
+    double x1 = cx[side] + rc * nxv, y1 = cy[side] + rc * nyv;
+    for (size_t k = 0; k < ns; k++) {
+      double t = (double)k / (double)ns;
+      o->c[2 * j] = x0 + (x1 - x0) * t;
+      o->c[2 * j + 1] = y0 + (y1 - y0) * t;
+      o->nr[2 * j] = nxv;
+      o->nr[2 * j + 1] = nyv;
+      j++;
+    }
+    for (size_t k = 0; k < nc; k++) {
+      double a = a0 + 0.5 * M_PI * (double)k / (double)nc;
+      o->c[2 * j] = cx[side] + rc * cos(a);
+      o->c[2 * j + 1] = cy[side] + rc * sin(a);
+      o->nr[2 * j] = cos(a);
+      o->nr[2 * j + 1] = sin(a);
+      j++;
+    }
+  }
+  return 0;
+}
+
+typedef struct prow { double s, d, z; } prow;
+typedef struct pseg { size_t i0, i1; int part, style; } pseg;
+
+#define MAX_SEGS 24
+typedef struct profile {
+  prow *r;
+  size_t n, cap;
+  pseg seg[MAX_SEGS];
+  int nseg;
+  size_t mark;
+  double rref, h;
+  int oom;
+} profile;
+
+static void prof_init(profile *pf, double rref, double h) {
+  memset(pf, 0, sizeof *pf);
+  pf->rref = rref;
+  pf->h = h;
+}
+
+static void prof_push(profile *pf, double s, double d, double z) {
+  if (pf->n == pf->cap) {
+    size_t nc = pf->cap ? 2 * pf->cap : 64;
+    prow *nr = realloc(pf->r, nc * sizeof *nr);
+    if (!nr) {
+      pf->oom = 1;
+      return;
+    }
+    pf->r = nr;
+    pf->cap = nc;
+  }
+  pf->r[pf->n++] = (prow){s, d, z};
+}
+
+/* an equivalent radius for lengths along the profile */
+static double prof_req(const profile *pf, double s, double d) { return s * (pf->rref + d); }
+
+static void prof_line(profile *pf, double s, double d, double z) {
+  if (pf->n == 0) {
+    prof_push(pf, s, d, z);
+    return;
+  }
+  prow a = pf->r[pf->n - 1];
+  double len = hypot(prof_req(pf, s, d) - prof_req(pf, a.s, a.d), z - a.z);
+  size_t n = nseg(len, pf->h, 1);
+  for (size_t k = 1; k <= n; k++) {
+    double t = (double)k / (double)n;
+    prof_push(pf, a.s + (s - a.s) * t, a.d + (d - a.d) * t, a.z + (z - a.z) * t);
+  }
+}
+
+/* arc in (d, z) at s = 1 around (cd, cz) from angle a0 to a1; the current
+ * last row is taken as the arc's start */
+static void prof_arc(profile *pf, double cd, double cz, double rad, double a0, double a1,
+                     size_t nmin) {
+  size_t n = nseg(fabs(a1 - a0) * rad, pf->h, nmin);
+  for (size_t k = 1; k <= n; k++) {
+    double a = a0 + (a1 - a0) * (double)k / (double)n;
+    prof_push(pf, 1.0, cd + rad * cos(a), cz + rad * sin(a));
+  }
+}
+
+static void prof_seg(profile *pf, int part, int style) {
+  if (pf->nseg >= MAX_SEGS || pf->n == 0) {
+    pf->oom = 1;
+    return;
+  }
+  pf->seg[pf->nseg++] = (pseg){pf->mark, pf->n - 1, part, style};
+  pf->mark = pf->n - 1;
+}
+
+static void prof_free(profile *pf) { free(pf->r); }
+
+typedef void (*disp_fn)(const void *ctx, double p[3]);
+
+/* sweep a closed profile (first and last rows on the axis) round an outline;
+ * M (3x4 row-major, optional) places the component */
+static int sweep_build(builder *b, const outline *ol, const profile *pf, const double *M,
+                       disp_fn disp, const void *dctx) {
+  if (pf->oom || pf->n < 3) return -1;
+  size_t N = ol->n, R = pf->n;
+  size_t t0 = b->nt;
+  double *G = NULL, *L = NULL;
+  if (!b->count_only) {
+    G = hearth_alloc_array(R * N * 3, sizeof(double));
+    L = hearth_alloc_array(R * N * 2, sizeof(double));
+    if (!G || !L) {
+      free(G);
+      free(L);
+      return -1;
+    }
+    for (size_t i = 0; i < R; i++) {
+      prow r = pf->r[i];
+      for (size_t j = 0; j < N; j++) {
+        double x = r.s * (ol->c[2 * j] + r.d * ol->nr[2 * j]);
+        double y = r.s * (ol->c[2 * j + 1] + r.d * ol->nr[2 * j + 1]);
+        double p[3] = {x, y, r.z};
+        if (disp) disp(dctx, p);
+        L[2 * (i * N + j)] = p[0];
+        L[2 * (i * N + j) + 1] = p[1];
+        double *g = G + 3 * (i * N + j);
+        if (M) {
+          for (int k = 0; k < 3; k++)
+            g[k] = M[4 * k] * p[0] + M[4 * k + 1] * p[1] + M[4 * k + 2] * p[2] + M[4 * k + 3];
+        } else {
+          g[0] = p[0];
+          g[1] = p[1];
+          g[2] = p[2];
+        }
+      }
+    }
+  }
+  for (int si = 0; si < pf->nseg; si++) {
+    pseg sg = pf->seg[si];
+    int start_pole = sg.i0 == 0, end_pole = sg.i1 == R - 1;
+    if (start_pole || end_pole) {
+      /* a disk: pole vertex + rings, planar native coordinates */
+      patch *pp = b_patch(b, sg.part, sg.style, K_DISK);
+      size_t pole_row = start_pole ? 0 : R - 1;
+      size_t r0 = start_pole ? 1 : sg.i0, r1 = start_pole ? sg.i1 : R - 2;
+      double zero[3] = {0, 0, 0};
+      const double *pg = G ? G + 3 * (pole_row * N) : zero;
+      uint32_t pole = b_vert(b, pg, L ? L[2 * pole_row * N] : 0, L ? L[2 * pole_row * N + 1] : 0);
+      uint32_t base = (uint32_t)b->nv;
+      for (size_t i = r0; i <= r1; i++)
+        for (size_t j = 0; j < N; j++)
+          b_vert(b, G ? G + 3 * (i * N + j) : zero, L ? L[2 * (i * N + j)] : 0,
+                 L ? L[2 * (i * N + j) + 1] : 0);
+      size_t nr = r1 - r0 + 1;
+      for (size_t i = 0; i + 1 < nr; i++)
+        for (size_t j = 0; j < N; j++) {
+          size_t jn = (j + 1) % N;
+          uint32_t a = base + (uint32_t)(i * N + j), c = base + (uint32_t)(i * N + jn);
+          uint32_t d = base + (uint32_t)((i + 1) * N + jn), e = base + (uint32_t)((i + 1) * N + j);
+          b_tri(b, a, c, d, sg.part);
+          b_tri(b, a, d, e, sg.part);
+        }
+      for (size_t j = 0; j < N; j++) {
+        size_t jn = (j + 1) % N;
+        if (start_pole) {
+          b_tri(b, pole, base + (uint32_t)jn, base + (uint32_t)j, sg.part);
+        } else {
+          size_t i = nr - 1;
+          b_tri(b, base + (uint32_t)(i * N + j), base + (uint32_t)(i * N + jn), pole, sg.part);
+        }
+      }
+      patch_close(b, pp);
+    } else {
+      /* a strip with a seam column duplicated; native x along the outline,
+       * y along the profile (both from the undisplaced profile, so the count
+       * pass and the fill pass agree). A long thin band is cut into a few
+       * chunks so the packer can use the texture. */
+      double lt = 0, ltot = 0;
+      for (size_t i = sg.i0; i <= sg.i1; i++) {
+        prow rw = pf->r[i];
+        double per = 0, px = rw.s * (ol->c[0] + rw.d * ol->nr[0]);
+        double py = rw.s * (ol->c[1] + rw.d * ol->nr[1]);
+        for (size_t j = 1; j <= N; j++) {
+          size_t jj = j % N;
+          double qx = rw.s * (ol->c[2 * jj] + rw.d * ol->nr[2 * jj]);
+          double qy = rw.s * (ol->c[2 * jj + 1] + rw.d * ol->nr[2 * jj + 1]);
+          per += hypot(qx - px, qy - py);
+          px = qx;
+          py = qy;
+        }
+        if (per > lt) lt = per;
+        if (i > sg.i0) {
+          prow q = pf->r[i - 1];
+          ltot += hypot(rw.s * (ol->c[0] + rw.d * ol->nr[0]) - q.s * (ol->c[0] + q.d * ol->nr[0]),
+                        hypot(rw.s * (ol->c[1] + rw.d * ol->nr[1]) -
+                                  q.s * (ol->c[1] + q.d * ol->nr[1]),
+                              rw.z - q.z));
+        }
+      }
+      size_t nch = 1;
+      if (ltot > 0) {
+        double asp = lt / ltot;
+        nch = asp > 24 ? 4 : asp > 10 ? 3 : asp > 5 ? 2 : 1;
+      }
+      if (nch > N / 4) nch = 1;
+      size_t nr = sg.i1 - sg.i0 + 1;
+      for (size_t ch = 0; ch < nch; ch++) {
+        size_t j0 = N * ch / nch, j1 = N * (ch + 1) / nch, nc = j1 - j0;
+        patch *pp = b_patch(b, sg.part, sg.style, K_STRIP);
+        uint32_t base = (uint32_t)b->nv;
+        double acc = 0;
+        for (size_t i = sg.i0; i <= sg.i1; i++) {
+          if (i > sg.i0) {
+            prow rw = pf->r[i], q = pf->r[i - 1];
+            acc += hypot(rw.s * (ol->c[0] + rw.d * ol->nr[0]) - q.s * (ol->c[0] + q.d * ol->nr[0]),
+                         hypot(rw.s * (ol->c[1] + rw.d * ol->nr[1]) -
+                                   q.s * (ol->c[1] + q.d * ol->nr[1]),
+                               rw.z - q.z));
+          }
+          for (size_t j = j0; j <= j1; j++) {
+            double zero[3] = {0, 0, 0};
+            b_vert(b, G ? G + 3 * (i * N + j % N) : zero, lt * (double)j / (double)N, acc);
+          }
+        }
+        for (size_t i = 0; i + 1 < nr; i++)
+          for (size_t j = 0; j < nc; j++) {
+            uint32_t a = base + (uint32_t)(i * (nc + 1) + j), c = a + 1;
+            uint32_t e = base + (uint32_t)((i + 1) * (nc + 1) + j), d = e + 1;
+            b_tri(b, a, c, d, sg.part);
+            b_tri(b, a, d, e, sg.part);
+          }
+        patch_close(b, pp);
+      }
+    }
+  }
+  free(G);
+  free(L);
+  b_orient(b, t0);
+  return 0;
+}
+
+/* a tube along a planar path: path(t) for t in [0,1], half-axes a (along
+ * the plane normal bn) and c (in the plane) */
+typedef struct tube_def {
+  double p[4][3];   /* cubic Bezier control points */
+  double bn[3];     /* unit normal of the path's plane */
+  double a0, a1, c0, c1; /* half-axes at the start and end */
+} tube_def;
+
+static void bez(const tube_def *td, double t, double out[3]) {
+  double u = 1 - t, w0 = u * u * u, w1 = 3 * u * u * t, w2 = 3 * u * t * t, w3 = t * t * t;
+  for (int k = 0; k < 3; k++)
+    out[k] = w0 * td->p[0][k] + w1 * td->p[1][k] + w2 * td->p[2][k] + w3 * td->p[3][k];
+}
+
+static int tube_build(builder *b, const tube_def *td, int part, int style_side,
+                      int style_cap, double h) {
+  double len = 0, prev[3], cur[3];
+  bez(td, 0, prev);
+  for (int k = 1; k <= 64; k++) {
+    bez(td, k / 64.0, cur);
+    len += sqrt((cur[0] - prev[0]) * (cur[0] - prev[0]) + (cur[1] - prev[1]) * (cur[1] - prev[1]) +
+                (cur[2] - prev[2]) * (cur[2] - prev[2]));
+    memcpy(prev, cur, sizeof cur);
+  }
+  double amax = fmax(td->a0, td->a1), cmax = fmax(td->c0, td->c1);
+  double per = 2 * M_PI * sqrt(0.5 * (amax * amax + cmax * cmax));
+  size_t M = nseg(len, h, 6), K = nseg(per, h, 8);
+  size_t t0 = b->nt;
+  double *G = NULL, *X = NULL;
+  if (!b->count_only) {
+    G = hearth_alloc_array((M + 1) * K * 3, sizeof(double));
+    X = hearth_alloc_array(2 * K * 2, sizeof(double));
+    if (!G || !X) {
+      free(G);
+      free(X);
+      return -1;
+    }
+    for (size_t i = 0; i <= M; i++) {
+      double t = (double)i / (double)M, p[3], q0[3], q1[3], tg[3], nrm[3];
+      bez(td, t, p);
+      bez(td, fmax(0, t - 1e-4), q0);
+      bez(td, fmin(1, t + 1e-4), q1);
+      double tl = 0;
+      for (int k = 0; k < 3; k++) {
+        tg[k] = q1[k] - q0[k];
+        tl += tg[k] * tg[k];
+      }
+      tl = sqrt(tl);
+      for (int k = 0; k < 3; k++) tg[k] /= tl;
+      nrm[0] = td->bn[1] * tg[2] - td->bn[2] * tg[1];
+      nrm[1] = td->bn[2] * tg[0] - td->bn[0] * tg[2];
+      nrm[2] = td->bn[0] * tg[1] - td->bn[1] * tg[0];
+      double a = td->a0 + (td->a1 - td->a0) * t, c = td->c0 + (td->c1 - td->c0) * t;
+      for (size_t k = 0; k < K; k++) {
+        double ph = 2 * M_PI * (double)k / (double)K, ca = a * cos(ph), sc = c * sin(ph);
+        for (int m = 0; m < 3; m++) G[3 * (i * K + k) + m] = p[m] + ca * td->bn[m] + sc * nrm[m];
+        if (i == 0 || i == M) {
+          size_t e = (i == 0) ? 0 : 1;
+          X[2 * (e * K + k)] = ca;
+          X[2 * (e * K + k) + 1] = sc;
+        }
+      }
+    }
+  }
+  double zero[3] = {0, 0, 0};
+  /* side strip */
+  patch *pp = b_patch(b, part, style_side, K_STRIP);
+  uint32_t base = (uint32_t)b->nv;
+  for (size_t i = 0; i <= M; i++)
+    for (size_t k = 0; k <= K; k++)
+      b_vert(b, G ? G + 3 * (i * K + k % K) : zero, per * (double)k / (double)K,
+             len * (double)i / (double)M);
+  for (size_t i = 0; i < M; i++)
+    for (size_t k = 0; k < K; k++) {
+      uint32_t a = base + (uint32_t)(i * (K + 1) + k), c = a + 1;
+      uint32_t e = base + (uint32_t)((i + 1) * (K + 1) + k), d = e + 1;
+      b_tri(b, a, c, d, part);
+      b_tri(b, a, d, e, part);
+    }
+  patch_close(b, pp);
+  /* end caps: fans round the path's end points */
+  for (int e = 0; e < 2; e++) {
+    patch *cp = b_patch(b, part, style_cap, K_DISK);
+    double pc[3];
+    bez(td, (double)e, pc);
+    uint32_t c = b_vert(b, pc, 0, 0);
+    uint32_t rb = (uint32_t)b->nv;
+    size_t i = e ? M : 0;
+    for (size_t k = 0; k < K; k++)
+      b_vert(b, G ? G + 3 * (i * K + k) : zero, X ? X[2 * (e * K + k)] : 0,
+             X ? X[2 * (e * K + k) + 1] : 0);
+    for (size_t k = 0; k < K; k++) {
+      uint32_t j0 = rb + (uint32_t)k, j1 = rb + (uint32_t)((k + 1) % K);
+      if (e == 0)
+        b_tri(b, c, j1, j0, part);
+      else
+        b_tri(b, c, j0, j1, part);
+    }
+    patch_close(b, cp);
+  }
+  free(G);
+  free(X);
+  b_orient(b, t0);
+  return 0;
+}
+
+/* a handle-like tube in the vertical plane at azimuth phi: from radius r0 at
+ * height z0 out by `reach` and back to radius r1 at z1, leaving and meeting
+ * the body horizontally */
+static void tube_handle(tube_def *td, double phi, double r0, double z0, double r1, double z1,
+                        double reach, double a, double c) {
+  double cx = cos(phi), cy = sin(phi);
+  double rr[4] = {r0, r0 + reach, r1 + reach, r1}, zz[4] = {z0, z0, z1, z1};
+  for (int k = 0; k < 4; k++) {
+    td->p[k][0] = rr[k] * cx;
+    td->p[k][1] = rr[k] * cy;
+    td->p[k][2] = zz[k];
+  }
+  td->bn[0] = -cy;
+  td->bn[1] = cx;
+  td->bn[2] = 0;
+  td->a0 = td->a1 = a;
+  td->c0 = td->c1 = c;
+}
+
+/* ---- shapes ------------------------------------------------------------- */
+
+/* styles of albedo */
+enum {
+  S_PLAIN, S_GLAZE, S_UNGLAZED, S_CAN_LABEL, S_ALU, S_ALU_TOP, S_CLEAR, S_BOTTLE_LABEL, S_CAP,
+  S_PEEL, S_PEEL_TOP, S_SCREEN, S_FRAME, S_PHONE_BACK, S_FOAM, S_PAD, S_STEEL, S_STEEL_DARK,
+  S_BLACK, S_MOUSE_TOP, S_RUBBER, S_SLEEVE, S_LAPTOP_LID, S_LAPTOP_BASE, S_LEATHER, S_TISSUE_BOX,
+  S_TISSUE_TOP, S_CASE, S_FABRIC, S_FABRIC_CHECK, S_BAG, S_BAG_ZIP, S_CUSHION_PAD
+};
+
+typedef struct shape {
+  int cat;
+  double R, R2, H, H2, t, t2, e, rc, W, L, a, c, reach, fillz;
+  int flag;
+  double col[4][3];
+  uint64_t tseed;
+} shape;
+
+static void pick_col(hearth_rng *r, double out[3], const double *choices, int n) {
+  int k = (int)(hearth_rng_uniform(r) * n);
+  if (k >= n) k = n - 1;
+  for (int m = 0; m < 3; m++) out[m] = choices[3 * k + m];
+}
+
+static void shape_draw(shape *s, int cat, hearth_rng *r) {
+  memset(s, 0, sizeof *s);
+  s->cat = cat;
+  s->tseed = hearth_rng_u64(r);
+  static const double vivid[] = {0.80, 0.10, 0.12, 0.10, 0.30, 0.75, 0.95, 0.75, 0.10,
+                                 0.10, 0.55, 0.25, 0.55, 0.15, 0.55, 0.95, 0.45, 0.10,
+                                 0.85, 0.85, 0.88, 0.10, 0.10, 0.12};
+  static const double dark[] = {0.08, 0.08, 0.09, 0.20, 0.22, 0.25, 0.12, 0.16, 0.30,
+                                0.35, 0.18, 0.10, 0.85, 0.85, 0.86, 0.75, 0.60, 0.55};
+  static const double pastel[] = {0.92, 0.90, 0.85, 0.80, 0.86, 0.93, 0.93, 0.82, 0.84,
+                                  0.82, 0.90, 0.80, 0.95, 0.93, 0.78, 0.70, 0.72, 0.75};
+  for (int k = 0; k < 4; k++) pick_col(r, s->col[k], vivid, 8);
+  switch (cat) {
+  case C_CUP:
+    s->R = hearth_rng_range(r, 0.038, 0.043);       /* top outer radius */
+    s->R2 = s->R * hearth_rng_range(r, 0.80, 0.92); /* bottom outer radius */
+    s->H = hearth_rng_range(r, 0.090, 0.100);
+    s->t = hearth_rng_range(r, 0.0035, 0.0045);     /* wall */
+    s->t2 = hearth_rng_range(r, 0.006, 0.008);      /* bottom */
+    s->a = hearth_rng_range(r, 0.0055, 0.0070);     /* handle half-width */
+    s->c = hearth_rng_range(r, 0.0032, 0.0040);     /* handle half-thickness */
+    s->reach = hearth_rng_range(r, 0.033, 0.040);
+    s->fillz = hearth_rng_range(r, 0.78, 0.88);
+    s->flag = hearth_rng_uniform(r) < 0.5;          /* a coloured band */
+    break;
+  case C_CAN:
+    s->R = hearth_rng_range(r, 0.0325, 0.0335);
+    s->H = hearth_rng_range(r, 0.119, 0.123);
+    s->fillz = 0.92;
+    break;
+  case C_BOTTLE:
+    s->R = hearth_rng_range(r, 0.030, 0.034);
+    s->H = hearth_rng_range(r, 0.20, 0.23);
+    s->R2 = hearth_rng_range(r, 0.0125, 0.0135); /* neck */
+    s->fillz = 0.85;
+    pick_col(r, s->col[1], vivid, 6);
+    break;
+  case C_ORANGE:
+    s->R = hearth_rng_range(r, 0.036, 0.042);
+    s->H = 2 * s->R * hearth_rng_range(r, 0.90, 0.96);
+    break;
+  case C_PHONE:
+    s->W = hearth_rng_range(r, 0.070, 0.076);
+    s->L = hearth_rng_range(r, 0.145, 0.160);
+    s->H = hearth_rng_range(r, 0.0075, 0.0090);
+    s->rc = hearth_rng_range(r, 0.008, 0.011);
+    s->e = hearth_rng_range(r, 0.0022, 0.0030);
+    pick_col(r, s->col[0], dark, 6);
+    break;
+  case C_SPONGE:
+    s->W = hearth_rng_range(r, 0.070, 0.095);
+    s->L = hearth_rng_range(r, 0.100, 0.150);
+    s->H2 = hearth_rng_range(r, 0.020, 0.030);  /* foam */
+    s->H = s->H2 + hearth_rng_range(r, 0.005, 0.008);
+    s->rc = 0.006;
+    s->e = 0.0025;
+    break;
+  case C_KETTLE:
+    s->R = hearth_rng_range(r, 0.070, 0.085);
+    s->H2 = hearth_rng_range(r, 0.17, 0.21);    /* body height above the base */
+    s->t = hearth_rng_range(r, 0.018, 0.024);   /* base height */
+    s->reach = hearth_rng_range(r, 0.055, 0.065);
+    s->fillz = hearth_rng_range(r, 0.5, 0.7);
+    s->flag = hearth_rng_uniform(r) < 0.6;      /* steel (else white plastic) */
+    break;
+  case C_POT:
+    s->R = hearth_rng_range(r, 0.090, 0.115);
+    s->H2 = hearth_rng_range(r, 0.095, 0.14);
+    s->t = 0.003;
+    s->fillz = hearth_rng_range(r, 0.5, 0.7);
+    s->flag = hearth_rng_uniform(r) < 0.5;      /* has a lid */
+    break;
+  case C_MOUSE:
+    s->W = hearth_rng_range(r, 0.058, 0.066);
+    s->L = hearth_rng_range(r, 0.100, 0.120);
+    s->H = hearth_rng_range(r, 0.033, 0.040);
+    s->rc = s->W * 0.45;
+    s->e = 0.003;
+    pick_col(r, s->col[0], dark, 4);
+    break;
+  case C_ERASER:
+    s->W = hearth_rng_range(r, 0.020, 0.025);
+    s->L = hearth_rng_range(r, 0.045, 0.065);
+    s->H = hearth_rng_range(r, 0.010, 0.013);
+    s->rc = 0.002;
+    s->e = 0.0012;
+    break;
+  case C_LAPTOP:
+    s->W = hearth_rng_range(r, 0.30, 0.34);
+    s->L = hearth_rng_range(r, 0.21, 0.235);
+    s->H = hearth_rng_range(r, 0.015, 0.019);
+    s->H2 = s->H * 0.55;
+    s->rc = 0.010;
+    s->e = 0.004;
+    break;
+  case C_WALLET:
+    s->W = hearth_rng_range(r, 0.105, 0.120);
+    s->L = hearth_rng_range(r, 0.085, 0.095);
+    s->H = hearth_rng_range(r, 0.012, 0.020);
+    s->rc = 0.008;
+    s->e = s->H * 0.35;
+    pick_col(r, s->col[0], dark, 6);
+    break;
+  case C_TISSUE:
+    s->W = hearth_rng_range(r, 0.22, 0.24);
+    s->L = hearth_rng_range(r, 0.11, 0.125);
+    s->H = hearth_rng_range(r, 0.075, 0.095);
+    s->rc = 0.004;
+    s->e = 0.002;
+    pick_col(r, s->col[0], pastel, 6);
+    break;
+  case C_GLASSES:
+    s->W = hearth_rng_range(r, 0.155, 0.170);
+    s->L = hearth_rng_range(r, 0.055, 0.065);
+    s->H = hearth_rng_range(r, 0.035, 0.045);
+    s->rc = s->L * 0.45;
+    s->e = s->H * 0.45;
+    pick_col(r, s->col[0], dark, 6);
+    break;
+  case C_PILLOW:
+    s->W = hearth_rng_range(r, 0.45, 0.55);
+    s->L = hearth_rng_range(r, 0.30, 0.36);
+    s->H = hearth_rng_range(r, 0.10, 0.14);
+    s->rc = 0.05;
+    s->e = 0.035;
+    pick_col(r, s->col[0], pastel, 6);
+    break;
+  case C_CUSHION:
+    s->W = hearth_rng_range(r, 0.38, 0.45);
+    s->L = s->W;
+    s->H = hearth_rng_range(r, 0.09, 0.13);
+    s->rc = 0.04;
+    s->e = 0.03;
+    break;
+  case C_BAG:
+    s->W = hearth_rng_range(r, 0.17, 0.27);
+    s->L = hearth_rng_range(r, 0.15, 0.24);
+    s->H = hearth_rng_range(r, 0.012, 0.025);
+    s->rc = 0.012;
+    s->e = s->H * 0.45;
+    break;
+  case C_HEADSET:
+    s->R = hearth_rng_range(r, 0.038, 0.048);  /* ear cup radius */
+    s->t = hearth_rng_range(r, 0.028, 0.036);  /* cup thickness */
+    s->W = hearth_rng_range(r, 0.14, 0.17);    /* distance between cup centres */
+    s->a = hearth_rng_range(r, 0.014, 0.019);
+    s->c = hearth_rng_range(r, 0.004, 0.006);
+    pick_col(r, s->col[0], dark, 4);
+    break;
+  default:
+    break;
+  }
+}
+
+/* orange peel bumps: a small radial displacement from smooth 3D noise */
+typedef struct orange_disp { double zc, amp; uint64_t seed; } orange_disp;
+static void orange_displace(const void *ctx, double p[3]) {
+  const orange_disp *od = ctx;
+  double q[3] = {p[0], p[1], p[2] - od->zc};
+  double r = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+  if (r < 1e-9) return;
+  double n = vnoise3(od->seed, q[0] / 0.006, q[1] / 0.006, q[2] / 0.006) * 0.6 +
+             vnoise3(od->seed + 1, q[0] / 0.0025, q[1] / 0.0025, q[2] / 0.0025) * 0.4;
+  double k = 1 + od->amp * n / r;
+  p[0] = q[0] * k;
+  p[1] = q[1] * k;
+  p[2] = q[2] * k + od->zc;
+}
+
+/* a rounded slab profile: bottom face, edge round, side, edge round, top
+ * face; split at z = zsplit (0: no split) into a lower and an upper part */
+static void prof_slab(profile *pf, double H, double e, double bulge, double zsplit, int p_lo,
+                      int s_lo, int p_bot, int s_bot, int p_hi, int s_hi, int p_top, int s_top) {
+  size_t nf = nseg(pf->rref, pf->h, 2);
+  /* bottom face from the centre out (bulging downward for soft items) */
+  for (size_t k = 0; k <= nf; k++) {
+    double s = (double)k / (double)nf;
+    prof_push(pf, s, -e, 0.0);
+  }
+  prof_seg(pf, p_bot, s_bot);
+  prof_arc(pf, -e, e, e, -0.5 * M_PI, 0, 2);
+  if (zsplit > e && zsplit < H - e) {
+    prof_line(pf, 1, 0, zsplit);
+    prof_seg(pf, p_lo, s_lo);
+    prof_line(pf, 1, 0, H - e);
+    prof_arc(pf, -e, H - e, e, 0, 0.5 * M_PI, 2);
+    prof_seg(pf, p_hi, s_hi);
+  } else {
+    prof_line(pf, 1, 0, H - e);
+    prof_arc(pf, -e, H - e, e, 0, 0.5 * M_PI, 2);
+    prof_seg(pf, p_lo, s_lo);
+  }
+  /* top face from the rim in to the centre, optionally domed */
+  for (size_t k = 1; k <= nf; k++) {
+    double s = 1 - (double)k / (double)nf;
+    prof_push(pf, s, -e, H + bulge * (1 - s * s));
+  }
+  prof_seg(pf, p_top, s_top);
+}
+
+/* build a shape at edge length h; returns -1 on allocation failure */
+static int shape_build(builder *b, const shape *s, double h) {
+  outline ol = {0};
+  profile pf;
+  int rc = 0;
+  switch (s->cat) {
+  case C_CUP: {
+    int pb = b_part(b, "body"), pbot = b_part(b, "bottom"), prim = b_part(b, "rim");
+    int pin = b_part(b, "inner"), ph = b_part(b, "handle");
+    double R = s->R, Rb = s->R2, H = s->H, tw = s->t, tb = s->t2, f = 0.003;
+    if (outline_circle(&ol, R, h)) return -1;
+    prof_init(&pf, 0, h);
+    prof_push(&pf, 1, 0, 0);
+    prof_line(&pf, 1, Rb - f, 0);
+    prof_seg(&pf, pbot, S_UNGLAZED);
+    prof_arc(&pf, Rb - f, f, f, -0.5 * M_PI, 0, 2);
+    prof_line(&pf, 1, R, H - 0.5 * tw);
+    prof_seg(&pf, pb, S_GLAZE);
+    prof_arc(&pf, R - 0.5 * tw, H - 0.5 * tw, 0.5 * tw, 0, M_PI, 3);
+    prof_seg(&pf, prim, S_GLAZE);
+    double rib = Rb - tw + (R - Rb) * tb / H;
+    prof_line(&pf, 1, rib, tb + 0.004);
+    prof_arc(&pf, rib - 0.004, tb + 0.004, 0.004, 0, -0.5 * M_PI, 2);
+    prof_seg(&pf, pin, S_GLAZE);
+    prof_line(&pf, 1, 0, tb);
+    prof_seg(&pf, pin, S_GLAZE);
+    rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
+    prof_free(&pf);
+    if (rc) break;
+    /* handle: ends buried half-way into the wall */
+    double z0 = H * 0.78, z1 = H * 0.28;
+    double r0 = Rb + (R - Rb) * z0 / H - 0.5 * tw, r1 = Rb + (R - Rb) * z1 / H - 0.5 * tw;
+    tube_def td;
+    tube_handle(&td, 0, r0, z0, r1, z1, s->reach * 1.33, s->a, s->c);
+    rc = tube_build(b, &td, ph, S_GLAZE, S_GLAZE, h);
+    break;
+  }
+  case C_CAN: {
+    int pb = b_part(b, "body"), pt = b_part(b, "top"), pbot = b_part(b, "bottom");
+    double R = s->R, H = s->H;
+    if (outline_circle(&ol, R, h)) return -1;
+    prof_init(&pf, 0, h);
+    prof_push(&pf, 1, 0, 0.004);
+    prof_line(&pf, 1, R - 0.008, 0.0);
+    prof_seg(&pf, pbot, S_ALU_TOP);
+    prof_line(&pf, 1, R - 0.0065, 0.0);
+    prof_line(&pf, 1, R, 0.010);
+    prof_seg(&pf, pbot, S_ALU);
+    prof_line(&pf, 1, R, H - 0.013);
+    prof_seg(&pf, pb, S_CAN_LABEL);
+    prof_line(&pf, 1, R - 0.0045, H - 0.002);
+    prof_line(&pf, 1, R - 0.0045, H);
+    prof_line(&pf, 1, R - 0.0065, H);
+    prof_line(&pf, 1, R - 0.0065, H - 0.003);
+    prof_seg(&pf, pt, S_ALU);
+    prof_line(&pf, 1, 0, H - 0.003);
+    prof_seg(&pf, pt, S_ALU_TOP);
+    rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
+    prof_free(&pf);
+    break;
+  }
+  case C_BOTTLE: {
+    int pb = b_part(b, "body"), pl = b_part(b, "label"), pn = b_part(b, "neck");
+    int pc = b_part(b, "cap"), pbot = b_part(b, "bottom");
+    double R = s->R, H = s->H, rn = s->R2, rcap = rn + 0.0015, hc = 0.02;
+    double zs = H * 0.62, zn = H * 0.84, zl0 = H * 0.25, zl1 = H * 0.50;
+    if (outline_circle(&ol, R, h)) return -1;
+    prof_init(&pf, 0, h);
+    prof_push(&pf, 1, 0, 0.003);
+    prof_line(&pf, 1, R - 0.006, 0);
+    prof_seg(&pf, pbot, S_CLEAR);
+    prof_arc(&pf, R - 0.006, 0.006, 0.006, -0.5 * M_PI, 0, 3);
+    prof_line(&pf, 1, R, zl0);
+    prof_seg(&pf, pb, S_CLEAR);
+    prof_line(&pf, 1, R, zl1);
+    prof_seg(&pf, pl, S_BOTTLE_LABEL);
+    prof_line(&pf, 1, R, zs);
+    {
+      size_t n = nseg(hypot(R - rn, zn - zs) * 1.2, h, 6);
+      for (size_t k = 1; k <= n; k++) {
+        double t = (double)k / (double)n;
+        prof_push(&pf, 1, rn + (R - rn) * 0.5 * (1 + cos(M_PI * t)), zs + (zn - zs) * t);
+      }
+    }
+    prof_seg(&pf, pb, S_CLEAR);
+    prof_line(&pf, 1, rn, H - hc);
+    prof_seg(&pf, pn, S_CLEAR);
+    prof_line(&pf, 1, rcap, H - hc);
+    prof_line(&pf, 1, rcap, H - 0.0015);
+    prof_arc(&pf, rcap - 0.0015, H - 0.0015, 0.0015, 0, 0.5 * M_PI, 2);
+    prof_seg(&pf, pc, S_CAP);
+    prof_line(&pf, 1, 0, H);
+    prof_seg(&pf, pc, S_CAP);
+    rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
+    prof_free(&pf);
+    break;
+  }
+  case C_ORANGE: {
+    int pp = b_part(b, "peel"), pt = b_part(b, "stem_end");
+    double R = s->R, Hz = 0.5 * s->H, cap = 0.35;
+    if (outline_circle(&ol, R, h)) return -1;
+    prof_init(&pf, 0, h);
+    size_t n1 = nseg(cap * R, h, 2), n2 = nseg((M_PI - 2 * cap) * R, h, 6);
+    prof_push(&pf, 1, 0, 0);
+    for (size_t k = 1; k <= n1; k++) {
+      double a = -0.5 * M_PI + cap * (double)k / (double)n1;
+      prof_push(&pf, 1, R * cos(a), Hz * (1 + sin(a)));
+    }
+    prof_seg(&pf, pp, S_PEEL);
+    for (size_t k = 1; k <= n2; k++) {
+      double a = -0.5 * M_PI + cap + (M_PI - 2 * cap) * (double)k / (double)n2;
+      prof_push(&pf, 1, R * cos(a), Hz * (1 + sin(a)));
+    }
+    prof_seg(&pf, pp, S_PEEL);
+    for (size_t k = 1; k <= n1; k++) {
+      double a = 0.5 * M_PI - cap + cap * (double)k / (double)n1;
+      prof_push(&pf, 1, k == n1 ? 0 : R * cos(a), Hz * (1 + sin(a)));
+    }
+    prof_seg(&pf, pt, S_PEEL_TOP);
+    orange_disp od = {Hz, 0.0004, s->tseed};
+    rc = sweep_build(b, &ol, &pf, NULL, orange_displace, &od);
+    prof_free(&pf);
+    break;
+  }
+  case C_PHONE: case C_SPONGE: case C_ERASER: case C_LAPTOP: case C_WALLET: case C_TISSUE:
+  case C_GLASSES: case C_PILLOW: case C_CUSHION: case C_BAG: case C_MOUSE: {
+    double A = 0.5 * s->W, B = 0.5 * s->L;
+    if (outline_rrect(&ol, A, B, s->rc, h)) return -1;
+    prof_init(&pf, 0.5 * (A + B), h);
+    int p1, p2, p3, p4, s1, s2, s3, s4;
+    double zsplit = 0, bulge = 0;
+    switch (s->cat) {
+    case C_PHONE:
+      p3 = b_part(b, "back"); p1 = p2 = b_part(b, "frame"); p4 = b_part(b, "screen");
+      s3 = S_PHONE_BACK; s1 = s2 = S_FRAME; s4 = S_SCREEN;
+      break;
+    case C_SPONGE:
+      p3 = p1 = b_part(b, "foam"); p2 = p4 = b_part(b, "pad");
+      s3 = s1 = S_FOAM; s2 = s4 = S_PAD; zsplit = s->H2;
+      break;
+    case C_ERASER:
+      p3 = p1 = p4 = b_part(b, "body"); p2 = b_part(b, "sleeve");
+      s3 = s1 = s4 = S_RUBBER; s2 = S_SLEEVE; zsplit = 0;
+      break;
+    case C_LAPTOP:
+      p3 = p1 = b_part(b, "base"); p2 = p4 = b_part(b, "lid");
+      s3 = s1 = S_LAPTOP_BASE; s2 = S_STEEL; s4 = S_LAPTOP_LID; zsplit = s->H2;
+      break;
+    case C_TISSUE:
+      p3 = p1 = b_part(b, "box"); p4 = p2 = b_part(b, "top");
+      s3 = s1 = S_TISSUE_BOX; s4 = S_TISSUE_TOP; s2 = S_TISSUE_BOX; zsplit = s->H * 0.85;
+      break;
+    case C_MOUSE:
+      p3 = b_part(b, "bottom"); p1 = p2 = b_part(b, "side"); p4 = b_part(b, "shell");
+      s3 = S_BLACK; s1 = s2 = S_MOUSE_TOP; s4 = S_MOUSE_TOP;
+      bulge = s->H - 0.012;
+      break;
+    case C_GLASSES:
+      p3 = p1 = b_part(b, "shell"); p4 = p2 = b_part(b, "lid");
+      s3 = s1 = s4 = s2 = S_CASE; zsplit = s->H * 0.5;
+      break;
+    case C_PILLOW: case C_CUSHION:
+      p3 = p1 = p4 = p2 = b_part(b, "fabric");
+      s3 = s1 = s4 = s2 = s->cat == C_PILLOW ? S_FABRIC : S_FABRIC_CHECK;
+      bulge = s->H * 0.25;
+      break;
+    case C_BAG:
+      p3 = p1 = p4 = b_part(b, "bag"); p2 = b_part(b, "zip");
+      s3 = s1 = s4 = S_BAG; s2 = S_BAG_ZIP; zsplit = s->H * 0.5;
+      break;
+    default: /* wallet */
+      p3 = p1 = p4 = p2 = b_part(b, "leather");
+      s3 = s1 = s4 = s2 = S_LEATHER;
+      break;
+    }
+    double H = s->H - bulge;
+    if (s->cat == C_ERASER) {
+      /* the sleeve covers the middle of the side band */
+      prof_slab(&pf, H, s->e, 0, H * 0.5, p1, s1, p3, s3, p2, s2, p4, s4);
+    } else {
+      prof_slab(&pf, H, s->e, bulge, zsplit, p1, s1, p3, s3, p2, s2, p4, s4);
+    }
+    rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
+    prof_free(&pf);
+    break;
+  }
+  case C_KETTLE: {
+    int pbase = b_part(b, "base"), pb = b_part(b, "body"), pl = b_part(b, "lid");
+    int ph = b_part(b, "handle"), psp = b_part(b, "spout");
+    int sb = s->flag ? S_STEEL : S_PLAIN;
+    double R = s->R, zb = s->t, Hb = s->H2, Rt = R * 0.82;
+    /* base plate */
+    if (outline_circle(&ol, R + 0.01, h)) return -1;
+    prof_init(&pf, 0, h);
+    prof_push(&pf, 1, 0, 0);
+    prof_line(&pf, 1, R + 0.004, 0);
+    prof_seg(&pf, pbase, S_BLACK);
+    prof_arc(&pf, R + 0.004, 0.004, 0.004, -0.5 * M_PI, 0, 2);
+    prof_line(&pf, 1, R + 0.008, zb - 0.004);
+    prof_arc(&pf, R + 0.004, zb - 0.004, 0.004, 0, 0.5 * M_PI, 2);
+    prof_seg(&pf, pbase, S_BLACK);
+    prof_line(&pf, 1, 0, zb);
+    prof_seg(&pf, pbase, S_BLACK);
+    rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
+    prof_free(&pf);
+    if (rc) break;
+    /* body with a domed lid and knob */
+    prof_init(&pf, 0, h);
+    /* the body floats 0.3 mm above the base so the two never share a vertex */
+    zb += 0.0003;
+    prof_push(&pf, 1, 0, zb);
+    prof_line(&pf, 1, R - 0.01, zb);
+    prof_seg(&pf, pb, sb);
+    prof_arc(&pf, R - 0.01, zb + 0.01, 0.01, -0.5 * M_PI, 0, 3);
+    prof_line(&pf, 1, Rt + 0.012, zb + Hb - 0.012);
+    prof_arc(&pf, Rt, zb + Hb - 0.012, 0.012, 0, 0.5 * M_PI, 3);
+    prof_seg(&pf, pb, sb);
+    {
+      size_t n = nseg(Rt, h, 4);
+      double rk = 0.014, hd = 0.012;
+      for (size_t k = 1; k <= n; k++) {
+        double t = (double)k / (double)n, r = Rt + (rk - Rt) * t;
+        prof_push(&pf, 1, r, zb + Hb + hd * sin(0.5 * M_PI * t));
+      }
+      prof_seg(&pf, pl, sb);
+      prof_line(&pf, 1, rk, zb + Hb + hd + 0.012);
+      prof_seg(&pf, pl, S_BLACK);
+      prof_line(&pf, 1, 0, zb + Hb + hd + 0.012);
+      prof_seg(&pf, pl, S_BLACK);
+    }
+    double Rr = R, Rmid = R;
+    ol.n = 0;
+    outline_free(&ol);
+    if (outline_circle(&ol, Rr, h)) {
+      prof_free(&pf);
+      return -1;
+    }
+    rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
+    prof_free(&pf);
+    if (rc) break;
+    (void)Rmid;
+    /* handle at the back, ends inside the body */
+    double z0 = zb + Hb * 0.85, z1 = zb + Hb * 0.25;
+    double rz0 = R - (R - Rt) * 0.85 - 0.015, rz1 = R - (R - Rt) * 0.25 - 0.015;
+    tube_def td;
+    tube_handle(&td, M_PI, rz0, z0, rz1, z1, s->reach * 1.33, 0.012, 0.010);
+    rc = tube_build(b, &td, ph, S_BLACK, S_BLACK, h);
+    if (rc) break;
+    /* spout at the front: up and out, tapering */
+    double zs = zb + Hb * 0.78, rs = R - (R - Rt) * 0.78 - 0.012;
+    tube_def sp = {{{rs, 0, zs}, {rs + 0.03, 0, zs + 0.004}, {rs + 0.04, 0, zs + 0.025},
+                    {rs + 0.045, 0, zs + 0.04}},
+                   {0, 1, 0}, 0.014, 0.008, 0.012, 0.006};
+    rc = tube_build(b, &sp, psp, sb, sb, h);
+    break;
+  }
+  case C_POT: {
+    int pb = b_part(b, "body"), pbot = b_part(b, "bottom"), prim = b_part(b, "rim");
+    int pin = b_part(b, "inner"), ph = b_part(b, "handle");
+    double R = s->R, H = s->H2, tw = s->t, tb = 0.005;
+    if (outline_circle(&ol, R + 0.004, h)) return -1;
+    prof_init(&pf, 0, h);
+    prof_push(&pf, 1, 0, 0);
+    prof_line(&pf, 1, R - 0.008, 0);
+    prof_seg(&pf, pbot, S_STEEL_DARK);
+    prof_arc(&pf, R - 0.008, 0.008, 0.008, -0.5 * M_PI, 0, 3);
+    prof_line(&pf, 1, R, H - 0.5 * tw);
+    prof_seg(&pf, pb, S_STEEL);
+    prof_arc(&pf, R - 0.5 * tw, H - 0.5 * tw, 0.5 * tw, 0, M_PI, 3);
+    prof_seg(&pf, prim, S_STEEL);
+    prof_line(&pf, 1, R - tw, tb + 0.006);
+    prof_arc(&pf, R - tw - 0.006, tb + 0.006, 0.006, 0, -0.5 * M_PI, 2);
+    prof_seg(&pf, pin, S_STEEL_DARK);
+    prof_line(&pf, 1, 0, tb);
+    prof_seg(&pf, pin, S_STEEL_DARK);
+    rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
+    prof_free(&pf);
+    if (rc) break;
+    for (int k = 0; k < 2; k++) {
+      double zh = H - 0.025;
+      tube_def td;
+      tube_handle(&td, k * M_PI, R - 0.5 * tw, zh + 0.011, R - 0.5 * tw, zh - 0.011, 0.035,
+                  0.009, 0.0045);
+      rc = tube_build(b, &td, ph, S_BLACK, S_BLACK, h);
+      if (rc) break;
+    }
+    if (rc || !s->flag) break;
+    /* lid resting on the rim */
+    int pl = b_part(b, "lid");
+    double Rl = R + 0.002, zl = H + 0.0002;
+    prof_init(&pf, 0, h);
+    prof_push(&pf, 1, 0, zl);
+    prof_line(&pf, 1, Rl, zl);
+    prof_seg(&pf, pl, S_STEEL);
+    prof_line(&pf, 1, Rl, zl + 0.004);
+    {
+      size_t n = nseg(Rl, h, 4);
+      double rk = 0.016, hd = 0.015;
+      for (size_t k = 1; k <= n; k++) {
+        double t = (double)k / (double)n;
+        prof_push(&pf, 1, Rl + (rk - Rl) * t, zl + 0.004 + hd * sin(0.5 * M_PI * t));
+      }
+      prof_seg(&pf, pl, S_STEEL);
+      prof_line(&pf, 1, rk, zl + 0.004 + hd + 0.02);
+      prof_seg(&pf, pl, S_BLACK);
+      prof_line(&pf, 1, 0, zl + 0.004 + hd + 0.02);
+      prof_seg(&pf, pl, S_BLACK);
+    }
+    rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
+    prof_free(&pf);
+    break;
+  }
+  case C_HEADSET: {
+    int pcup = b_part(b, "cup"), pcu = b_part(b, "cushion"), pband = b_part(b, "band");
+    double R = s->R, T = s->t, e = 0.006;
+    if (outline_circle(&ol, R, h)) return -1;
+    prof_init(&pf, 0, h);
+    prof_push(&pf, 1, 0, 0);
+    prof_line(&pf, 1, R - e, 0);
+    prof_seg(&pf, pcup, S_BLACK);
+    prof_arc(&pf, R - e, e, e, -0.5 * M_PI, 0, 2);
+    prof_line(&pf, 1, R, T - e);
+    prof_seg(&pf, pcup, S_BLACK);
+    prof_arc(&pf, R - e, T - e, e, 0, 0.5 * M_PI, 2);
+    prof_line(&pf, 1, 0, T);
+    prof_seg(&pf, pcu, S_CUSHION_PAD);
+    for (int k = 0; k < 2; k++) {
+      /* cups stand on edge with their axes along x, cushions facing in */
+      double sx = k ? -1.0 : 1.0, x0 = k ? 0.5 * s->W + 0.5 * T : -0.5 * s->W - 0.5 * T;
+      double M[12] = {0, 0, sx, x0, 0, 1, 0, 0, -sx, 0, 0, R};
+      rc = sweep_build(b, &ol, &pf, M, NULL, NULL);
+      if (rc) break;
+    }
+    prof_free(&pf);
+    if (rc) break;
+    /* band over the top, its ends inside the cups */
+    double hw = 0.5 * s->W, zc = R, k4 = 0.5523 * 2;
+    tube_def td = {{{-hw, 0, zc}, {-hw, 0, zc + hw * k4 * 1.3}, {hw, 0, zc + hw * k4 * 1.3},
+                    {hw, 0, zc}},
+                   {0, 1, 0}, s->a, s->a, s->c, s->c};
+    rc = tube_build(b, &td, pband, S_BLACK, S_BLACK, h);
+    break;
+  }
+  default:
+    rc = -1;
+  }
+  outline_free(&ol);
+  return rc;
+}
+
+/* ---- UV packing ---------------------------------------------------------- */
+
+#define UV_GAP (12.0 / 1024.0)
+#define UV_MARGIN (6.0 / 1024.0)
+
+static int cmp_patch_h(const void *a, const void *b, const patch *P) {
+  const int ia = *(const int *)a, ib = *(const int *)b;
+  double ha = P[ia].swap ? P[ia].w : P[ia].h, hb = P[ib].swap ? P[ib].w : P[ib].h;
+  if (ha > hb) return -1;
+  if (ha < hb) return 1;
+  return ia - ib;
+}
+
+/* shelf packing at scale sc; returns 1 if everything fits */
+static int pack_try(patch *P, const int *order, int n, double sc, int commit) {
+  double x = UV_MARGIN, y = UV_MARGIN, shelf = 0;
+  for (int k = 0; k < n; k++) {
+    patch *p = &P[order[k]];
+    double w = (p->swap ? p->h : p->w) * sc, hh = (p->swap ? p->w : p->h) * sc;
+    if (x + w > 1 - UV_MARGIN && x > UV_MARGIN) {
+      y += shelf + UV_GAP;
+      x = UV_MARGIN;
+      shelf = 0;
+    }
+    if (x + w > 1 - UV_MARGIN || y + hh > 1 - UV_MARGIN) return 0;
+    if (commit) {
+      p->pu = x;
+      p->pv = y;
+      p->ps = sc;
+    }
+    x += w + UV_GAP;
+    if (hh > shelf) shelf = hh;
+  }
+  return 1;
+}
+
+static void pack_islands(builder *b) {
+  int n = b->np, order[MAX_PATCHES];
+  for (int i = 0; i < n; i++) {
+    b->patches[i].swap = b->patches[i].h > b->patches[i].w;
+    order[i] = i;
+  }
+  /* insertion sort by packed height (n is small) */
+  for (int i = 1; i < n; i++)
+    for (int j = i; j > 0 && cmp_patch_h(&order[j], &order[j - 1], b->patches) < 0; j--) {
+      int t = order[j];
+      order[j] = order[j - 1];
+      order[j - 1] = t;
+    }
+  double lo = 0, hi = 1e4;
+  for (int it = 0; it < 60; it++) {
+    double mid = 0.5 * (lo + hi);
+    if (pack_try(b->patches, order, n, mid, 0))
+      lo = mid;
+    else
+      hi = mid;
+  }
+  pack_try(b->patches, order, n, lo, 1);
+  for (int i = 0; i < n; i++) {
+    patch *p = &b->patches[i];
+    for (size_t v = p->v0; v < p->v1; v++) {
+      double x = (b->uv[2 * v] - p->ox) * p->ps, y = (b->uv[2 * v + 1] - p->oy) * p->ps;
+      b->uv[2 * v] = (float)(p->pu + (p->swap ? y : x));
+      b->uv[2 * v + 1] = (float)(p->pv + (p->swap ? x : y));
+    }
+  }
+}
+
+/* ---- albedo -------------------------------------------------------------- */
+
+static void mixc(double out[3], const double a[3], const double c[3], double t) {
+  for (int k = 0; k < 3; k++) out[k] = a[k] + (c[k] - a[k]) * t;
+}
+static void setc(double out[3], double r, double g, double b) {
+  out[0] = r;
+  out[1] = g;
+  out[2] = b;
+}
+
+/* a text-like block pattern: rows of short dark bars */
+static double textish(uint64_t seed, double x, double y, double lh) {
+  double row = floor(y / lh), fy = y / lh - row;
+  if (fy < 0.25 || fy > 0.8) return 0;
+  double word = floor(x / (lh * 0.9) + hash3(seed, (int64_t)row, 3, 0) * 7);
+  if (hash3(seed, (int64_t)row, (int64_t)word, 1) < 0.25) return 0;
+  double fx = x / (lh * 0.9) - floor(x / (lh * 0.9));
+  return (fx > 0.1 && fx < 0.92) ? 1 : 0;
+}
+
+/* colour of native point (x, y) of an island; texture detail from s->tseed */
+static void shade(const shape *s, const patch *p, double x, double y, double out[3]) {
+  uint64_t ts = s->tseed + (uint64_t)p->style * 977;
+  double n1 = fbm2(ts, x / 0.01, y / 0.01, 3);
+  double lx = x - p->ox, ly = y - p->oy;
+  switch (p->style) {
+  case S_GLAZE:
+    setc(out, 0.93, 0.93, 0.91);
+    if (s->flag && p->kind == K_STRIP && s->cat == C_CUP && p->part == 0) {
+      /* a coloured band round the body */
+      double t = ly / p->h;
+      if (t > 0.55 && t < 0.70) mixc(out, out, s->col[0], 0.85);
+    }
+    for (int k = 0; k < 3; k++) out[k] += 0.015 * n1;
+    break;
+  case S_UNGLAZED:
+    setc(out, 0.82, 0.76, 0.66);
+    for (int k = 0; k < 3; k++) out[k] += 0.04 * n1;
+    break;
+  case S_CAN_LABEL: {
+    double t = ly / p->h, u = lx / p->w;
+    mixc(out, s->col[0], s->col[0], 0);
+    if (t < 0.08 || t > 0.92) setc(out, 0.75, 0.76, 0.78);
+    else if (fabs(t - 0.3) < 0.04) mixc(out, s->col[1], s->col[1], 0);
+    else if (t > 0.42 && t < 0.75 && u > 0.1 && u < 0.45) {
+      /* a logo block with white lettering */
+      double q = textish(ts, lx, ly, 0.012);
+      mixc(out, s->col[0], (const double[3]){1, 1, 1}, q);
+    } else if (t > 0.45 && t < 0.65 && u > 0.6 && u < 0.9) {
+      double q = textish(ts + 5, lx, ly, 0.004);
+      mixc(out, out, (const double[3]){0.05, 0.05, 0.05}, q * 0.8);
+    }
+    break;
+  }
+  case S_ALU:
+  case S_ALU_TOP: {
+    double r = hypot(x, y);
+    double v = 0.74 + 0.05 * vnoise2(ts, r / 0.0006, 0.5) + 0.02 * n1;
+    setc(out, v, v + 0.005, v + 0.015);
+    if (p->style == S_ALU_TOP && p->kind == K_DISK && x > 0.004 && x < 0.02 && fabs(y) < 0.006)
+      setc(out, 0.55, 0.56, 0.58); /* tab */
+    break;
+  }
+  case S_CLEAR:
+    setc(out, 0.78, 0.86, 0.88);
+    for (int k = 0; k < 3; k++) out[k] += 0.03 * n1;
+    break;
+  case S_BOTTLE_LABEL: {
+    double t = ly / p->h;
+    mixc(out, s->col[0], s->col[0], 0);
+    if (t < 0.12 || t > 0.88) setc(out, 0.95, 0.95, 0.95);
+    double q = textish(ts, lx, ly, 0.008);
+    if (t > 0.3 && t < 0.7) mixc(out, out, (const double[3]){1, 1, 1}, q);
+    break;
+  }
+  case S_CAP: {
+    mixc(out, s->col[1], s->col[1], 0);
+    if (p->kind == K_STRIP) {
+      double rib = 0.5 + 0.5 * sin(lx / 0.0008 * 2 * M_PI);
+      for (int k = 0; k < 3; k++) out[k] *= 0.85 + 0.15 * rib;
+    }
+    break;
+  }
+  case S_PEEL:
+  case S_PEEL_TOP: {
+    setc(out, 0.96, 0.55, 0.10);
+    double pores = vnoise2(ts, x / 0.0009, y / 0.0009);
+    double k = 0.06 * n1 - (pores > 0.55 ? 0.12 * (pores - 0.55) / 0.45 : 0);
+    for (int m = 0; m < 3; m++) out[m] += k * out[m] * 2;
+    if (p->style == S_PEEL_TOP) {
+      double r = hypot(x, y);
+      if (r < 0.004) mixc(out, out, (const double[3]){0.35, 0.40, 0.12}, 1 - r / 0.004);
+    }
+    break;
+  }
+  case S_SCREEN: {
+    double A = 0.5 * s->W - s->e - 0.0025, B = 0.5 * s->L - s->e - 0.004;
+    if (fabs(x) < A && fabs(y) < B) {
+      double g = 0.04 + 0.03 * (x / A + y / B + 2) / 4;
+      setc(out, g, g, g + 0.01);
+    } else {
+      setc(out, 0.02, 0.02, 0.02);
+    }
+    if (hypot(x, y - (0.5 * s->L - 0.009)) < 0.0018) setc(out, 0.10, 0.10, 0.14);
+    break;
+  }
+  case S_FRAME: {
+    double v = 0.55 + 0.04 * n1;
+    mixc(out, s->col[0], (const double[3]){v, v, v}, 0.6);
+    break;
+  }
+  case S_PHONE_BACK: {
+    mixc(out, s->col[0], s->col[0], 0);
+    for (int k = 0; k < 3; k++) out[k] += 0.01 * n1;
+    double cx = -(0.5 * s->W - 0.02), cy = 0.5 * s->L - 0.02;
+    if (fabs(x - cx) < 0.015 && fabs(y - cy) < 0.015) {
+      mixc(out, out, (const double[3]){0.15, 0.15, 0.16}, 0.7);
+      for (int l = 0; l < 2; l++)
+        if (hypot(x - cx + 0.005, y - cy - 0.006 + 0.012 * l) < 0.0045)
+          setc(out, 0.03, 0.03, 0.05);
+    }
+    break;
+  }
+  case S_FOAM: {
+    setc(out, 0.97, 0.82, 0.22);
+    double pores = vnoise2(ts, x / 0.0007, y / 0.0007);
+    if (pores > 0.5) mixc(out, out, (const double[3]){0.75, 0.58, 0.10}, (pores - 0.5) * 1.6);
+    break;
+  }
+  case S_PAD: {
+    setc(out, 0.12, 0.45, 0.18);
+    double f = vnoise2(ts, x / 0.0004, y / 0.003) * 0.5 + vnoise2(ts + 9, x / 0.003, y / 0.0004) * 0.5;
+    for (int k = 0; k < 3; k++) out[k] *= 0.8 + 0.35 * f;
+    break;
+  }
+  case S_STEEL:
+  case S_STEEL_DARK: {
+    double v = (p->style == S_STEEL ? 0.72 : 0.55) + 0.06 * vnoise2(ts, lx / 0.03, ly / 0.0004) +
+               0.03 * n1;
+    if (p->kind == K_STRIP) v += 0.08 * sin(2 * M_PI * lx / p->w * 2);
+    setc(out, v, v + 0.005, v + 0.012);
+    break;
+  }
+  case S_BLACK:
+    setc(out, 0.07, 0.07, 0.075);
+    for (int k = 0; k < 3; k++) out[k] += 0.015 * n1;
+    break;
+  case S_MOUSE_TOP: {
+    mixc(out, s->col[0], s->col[0], 0);
+    if (p->kind == K_DISK && fabs(x) < 0.0006 && y > s->L * 0.1) setc(out, 0.02, 0.02, 0.02);
+    if (p->kind == K_DISK && hypot(x, y - s->L * 0.3) < 0.004) setc(out, 0.2, 0.2, 0.22);
+    break;
+  }
+  case S_RUBBER:
+    setc(out, 0.95, 0.95, 0.93);
+    for (int k = 0; k < 3; k++) out[k] += 0.02 * n1;
+    break;
+  case S_SLEEVE: {
+    mixc(out, s->col[0], s->col[0], 0);
+    double q = textish(ts, lx, ly, 0.003);
+    mixc(out, out, (const double[3]){1, 1, 1}, q);
+    break;
+  }
+  case S_LAPTOP_LID:
+    setc(out, 0.70, 0.71, 0.73);
+    if (hypot(x, y) < 0.012) setc(out, 0.82, 0.83, 0.85);
+    break;
+  case S_LAPTOP_BASE:
+    setc(out, 0.60, 0.61, 0.63);
+    if (p->kind == K_DISK && fabs(fabs(x) - 0.5 * s->W + 0.03) < 0.008 &&
+        fabs(fabs(y) - 0.5 * s->L + 0.03) < 0.008)
+      setc(out, 0.1, 0.1, 0.1);
+    break;
+  case S_LEATHER: {
+    mixc(out, s->col[0], (const double[3]){0.40, 0.22, 0.10}, 0.5);
+    for (int k = 0; k < 3; k++) out[k] += 0.05 * fbm2(ts, x / 0.002, y / 0.002, 2);
+    if (p->kind == K_DISK) {
+      double dx = 0.5 * s->W - s->e - fabs(x), dy = 0.5 * s->L - s->e - fabs(y);
+      double d = fmin(dx, dy);
+      if (d > 0.003 && d < 0.0038 && fmod(fabs(x + y) / 0.003, 1.0) < 0.6)
+        setc(out, 0.85, 0.78, 0.60);
+    }
+    break;
+  }
+  case S_TISSUE_BOX: {
+    mixc(out, s->col[0], s->col[0], 0);
+    double fl = vnoise2(ts, lx / 0.02, ly / 0.02);
+    if (fl > 0.45) mixc(out, out, s->col[1], 0.7);
+    break;
+  }
+  case S_TISSUE_TOP: {
+    mixc(out, s->col[0], s->col[0], 0);
+    double ex = x / (0.5 * s->W * 0.6), ey = y / (0.5 * s->L * 0.35);
+    if (ex * ex + ey * ey < 1) setc(out, 0.97, 0.97, 0.97);
+    break;
+  }
+  case S_CASE:
+    mixc(out, s->col[0], s->col[0], 0);
+    for (int k = 0; k < 3; k++) out[k] += 0.03 * n1;
+    break;
+  case S_FABRIC:
+  case S_FABRIC_CHECK: {
+    mixc(out, s->col[p->style == S_FABRIC ? 0 : 1], s->col[0], 0);
+    double weave = 0.5 + 0.5 * sin(lx / 0.0012 * M_PI) * sin(ly / 0.0012 * M_PI);
+    for (int k = 0; k < 3; k++) out[k] *= 0.92 + 0.08 * weave;
+    if (p->style == S_FABRIC_CHECK && ((int)floor(lx / 0.04) + (int)floor(ly / 0.04)) % 2)
+      for (int k = 0; k < 3; k++) out[k] *= 0.75;
+    break;
+  }
+  case S_BAG:
+    setc(out, 0.86, 0.89, 0.92);
+    for (int k = 0; k < 3; k++) out[k] += 0.03 * n1;
+    break;
+  case S_BAG_ZIP:
+    setc(out, 0.86, 0.89, 0.92);
+    if (fabs(ly - 0.5 * p->h) < 0.002) mixc(out, s->col[0], s->col[0], 0);
+    break;
+  case S_CUSHION_PAD:
+    setc(out, 0.16, 0.16, 0.17);
+    for (int k = 0; k < 3; k++) out[k] += 0.04 * fbm2(ts, x / 0.002, y / 0.002, 2);
+    break;
+  default: /* S_PLAIN */
+    setc(out, 0.94, 0.94, 0.93);
+    for (int k = 0; k < 3; k++) out[k] += 0.02 * n1;
+    break;
+  }
+}
+
+typedef struct tex_job {
+  const shape *s;
+  const builder *b;
+  hearth_image *img;
+} tex_job;
+
+static void tex_rows(void *ctx, size_t r0, size_t r1, int thread_index) {
+  const tex_job *j = ctx;
+  size_t R = j->img->width;
+  uint8_t *px = j->img->data;
+  double g = 0.5 * UV_GAP;
+  for (size_t row = r0; row < r1; row++)
+    for (size_t col = 0; col < R; col++) {
+      double u = ((double)col + 0.5) / (double)R, v = ((double)row + 0.5) / (double)R;
+      double c[3] = {0.5, 0.5, 0.5};
+      for (int k = 0; k < j->b->np; k++) {
+        const patch *p = &j->b->patches[k];
+        double pw = (p->swap ? p->h : p->w) * p->ps, ph = (p->swap ? p->w : p->h) * p->ps;
+        if (u < p->pu - g || u > p->pu + pw + g || v < p->pv - g || v > p->pv + ph + g) continue;
+        double a = (u - p->pu) / p->ps, bb = (v - p->pv) / p->ps;
+        double x = p->swap ? bb : a, y = p->swap ? a : bb;
+        x = fmin(fmax(x, 0), p->w) + p->ox;
+        y = fmin(fmax(y, 0), p->h) + p->oy;
+        shade(j->s, p, x, y, c);
+        break;
+      }
+      for (int m = 0; m < 3; m++) {
+        double q = c[m] < 0 ? 0 : c[m] > 1 ? 1 : c[m];
+        px[3 * (row * R + col) + m] = (uint8_t)lround(q * 255.0);
+      }
+    }
+}
+
+/* ---- public entry points ------------------------------------------------- */
+
+void synth_object_free(synth_object *obj) {
+  if (!obj) return;
+  hearth_mesh_free(&obj->mesh);
+  free(obj->part_of_tri);
+  hearth_image_free(&obj->albedo);
+  memset(obj, 0, sizeof *obj);
+}
+
+static size_t count_at(const shape *s, double h, int *fail) {
+  builder cb;
+  memset(&cb, 0, sizeof cb);
+  cb.count_only = 1;
+  if (shape_build(&cb, s, h)) *fail = 1;
+  return cb.nt;
+}
+
+static void obj_extent(synth_object *obj) {
+  double hz = 0, rr = 0;
+  for (size_t v = 0; v < obj->mesh.n_vertices; v++) {
+    const float *p = obj->mesh.positions + 3 * v;
+    double r = hypot(p[0], p[1]);
+    if (p[2] > hz) hz = p[2];
+    if (r > rr) rr = r;
+  }
+  obj->height = hz;
+  obj->radius = rr;
+}
+
+hearth_status synth_object_make(const char *category, uint64_t seed, size_t target_triangles,
+                                size_t texture_size, synth_object *obj, hearth_err *err) {
+  if (!obj) return hearth_err_set(err, HEARTH_E_ARG, "synth_object_make: obj is NULL");
+  memset(obj, 0, sizeof *obj);
+  int cat = cat_code(category);
+  if (cat < 0)
+    return hearth_err_set(err, HEARTH_E_ARG,
+                          "synth_object_make: unknown category '%s': expected one of cup, "
+                          "canned_drink, bottled_drink, orange, smartphone, sponge, "
+                          "electric_kettle, pot, mouse, eraser, laptop, wallet, tissue, "
+                          "glasses_case, pillow, cushion, storage_bag, headset",
+                          category ? category : "(null)");
+  if (target_triangles < 200 || target_triangles > 5000000)
+    return hearth_err_set(err, HEARTH_E_RANGE,
+                          "synth_object_make(%s): target_triangles %zu: expected 200..5000000",
+                          category, target_triangles);
+  if (texture_size < 16 || texture_size > 8192)
+    return hearth_err_set(err, HEARTH_E_RANGE,
+                          "synth_object_make(%s): texture_size %zu: expected 16..8192", category,
+                          texture_size);
+  hearth_rng root, r;
+  hearth_rng_seed(&root, seed);
+  hearth_rng_fork(&root, 0x6f626a00u + (uint64_t)cat, &r);
+  shape s;
+  shape_draw(&s, cat, &r);
+
+  /* edge length by bisection on log(h) against the counted triangles */
+  int fail = 0;
+  double lo = log(2e-4), hi = log(0.2), best_h = 0.01;
+  size_t best_n = 0;
+  double best_err = 1e300;
+  for (int it = 0; it < 48 && !fail; it++) {
+    double mid = 0.5 * (lo + hi), h = exp(mid);
+    size_t n = count_at(&s, h, &fail);
+    double e = fabs((double)n - (double)target_triangles);
+    if (e < best_err) {
+      best_err = e;
+      best_h = h;
+      best_n = n;
+    }
+    if (n > target_triangles)
+      lo = mid;
+    else
+      hi = mid;
+    if (e < 0.02 * (double)target_triangles) break;
+  }
+  if (fail)
+    return hearth_err_set(err, HEARTH_E_NOMEM, "synth_object_make(%s): out of memory", category);
+  (void)best_n;
+
+  builder cb;
+  memset(&cb, 0, sizeof cb);
+  cb.count_only = 1;
+  shape_build(&cb, &s, best_h);
+  hearth_status st = hearth_mesh_alloc(&obj->mesh, cb.nv, cb.nt, 1, err);
+  if (st) return st;
+  obj->part_of_tri = malloc(cb.nt ? cb.nt : 1);
+  if (!obj->part_of_tri) {
+    synth_object_free(obj);
+    return hearth_err_set(err, HEARTH_E_NOMEM, "synth_object_make(%s): out of memory", category);
+  }
+  builder *b = calloc(1, sizeof *b);
+  if (!b) {
+    synth_object_free(obj);
+    return hearth_err_set(err, HEARTH_E_NOMEM, "synth_object_make(%s): out of memory", category);
+  }
+  b->pos = obj->mesh.positions;
+  b->uv = obj->mesh.uvs;
+  b->idx = obj->mesh.indices;
+  b->part = obj->part_of_tri;
+  if (shape_build(b, &s, best_h) || b->overflow || b->nv != cb.nv || b->nt != cb.nt) {
+    free(b);
+    synth_object_free(obj);
+    return hearth_err_set(err, HEARTH_E_NOMEM, "synth_object_make(%s): building the mesh failed",
+                          category);
+  }
+  pack_islands(b);
+  /* rest on z = 0 exactly (bumps may dip below the nominal bottom) */
+  {
+    float zmin = 1e30f;
+    for (size_t v = 0; v < cb.nv; v++) zmin = fminf(zmin, obj->mesh.positions[3 * v + 2]);
+    if (zmin != 0.0f)
+      for (size_t v = 0; v < cb.nv; v++) obj->mesh.positions[3 * v + 2] -= zmin;
+  }
+
+  snprintf(obj->category, sizeof obj->category, "%s", k_cat_names[cat]);
+  obj->n_parts = b->n_parts;
+  for (int k = 0; k < b->n_parts; k++) obj->part_names[k] = b->part_names[k];
+  obj_extent(obj);
+  obj->fill_level = s.fillz;
+  if (cat == C_CUP) obj->fill_level = s.fillz;
+  if (cat == C_KETTLE) obj->fill_level = (s.t + s.H2 * s.fillz) / obj->height;
+  if (cat == C_POT) obj->fill_level = s.H2 * s.fillz / obj->height;
+
+  st = hearth_image_alloc(&obj->albedo, texture_size, texture_size, 3, HEARTH_PIX_U8, err);
+  if (st) {
+    free(b);
+    synth_object_free(obj);
+    return st;
+  }
+  tex_job job = {&s, b, &obj->albedo};
+  hearth_parallel_for(texture_size, 0, tex_rows, &job);
+  free(b);
+  return HEARTH_OK;
+}
+
+/* bilinear sample of a U8 image (any channel count) as RGB in [0,1] */
+static void sample_rgb(const hearth_image *im, double u, double v, double out[3]) {
+  double x = u * (double)im->width - 0.5, y = v * (double)im->height - 0.5;
+  double fx = floor(x), fy = floor(y), tx = x - fx, ty = y - fy;
+  const uint8_t *d = im->data;
+  int ch = im->channels;
+  double acc[3] = {0, 0, 0};
+  for (int k = 0; k < 4; k++) {
+    long xi = (long)fx + (k & 1), yi = (long)fy + (k >> 1);
+    if (xi < 0) xi = 0;
+    if (yi < 0) yi = 0;
+    if (xi >= (long)im->width) xi = (long)im->width - 1;
+    if (yi >= (long)im->height) yi = (long)im->height - 1;
+    double w = ((k & 1) ? tx : 1 - tx) * ((k >> 1) ? ty : 1 - ty);
+    const uint8_t *p = d + ((size_t)yi * im->width + (size_t)xi) * (size_t)ch;
+    for (int m = 0; m < 3; m++) acc[m] += w * p[ch >= 3 ? m : 0] / 255.0;
+  }
+  memcpy(out, acc, sizeof acc);
+}
+
+hearth_status synth_object_from_mesh(const hearth_mesh *m, double size_m, const char *category,
+                                     size_t texture_size, synth_object *obj, hearth_err *err) {
+  if (!obj) return hearth_err_set(err, HEARTH_E_ARG, "synth_object_from_mesh: obj is NULL");
+  memset(obj, 0, sizeof *obj);
+  if (!m || !m->positions || !m->indices || m->n_triangles == 0)
+    return hearth_err_set(err, HEARTH_E_ARG, "synth_object_from_mesh: empty mesh");
+  if (!m->uvs)
+    return hearth_err_set(err, HEARTH_E_NOT_FOUND,
+                          "synth_object_from_mesh: the mesh has no UV coordinates");
+  if (!(size_m > 0) || size_m > 100)
+    return hearth_err_set(err, HEARTH_E_RANGE,
+                          "synth_object_from_mesh: size %g m: expected (0, 100]", size_m);
+  if (texture_size < 16 || texture_size > 8192)
+    return hearth_err_set(err, HEARTH_E_RANGE,
+                          "synth_object_from_mesh: texture_size %zu: expected 16..8192",
+                          texture_size);
+  hearth_status st = hearth_mesh_validate(m, "synth_object_from_mesh", err);
+  if (st) return st;
+  const hearth_image *tx = &m->texture;
+  if (tx->data && (tx->type != HEARTH_PIX_U8 || tx->channels < 1 || tx->channels > 4 ||
+                   !tx->width || !tx->height))
+    return hearth_err_set(err, HEARTH_E_UNSUPPORTED,
+                          "synth_object_from_mesh: texture must be 8-bit with 1-4 channels");
+  st = hearth_mesh_copy(m, &obj->mesh, err);
+  if (st) return st;
+  hearth_image_free(&obj->mesh.texture);
+  double lo[3], hi[3];
+  hearth_mesh_bounds(&obj->mesh, lo, hi);
+  double ext = fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
+  if (!(ext > 0)) {
+    synth_object_free(obj);
+    return hearth_err_set(err, HEARTH_E_RANGE, "synth_object_from_mesh: the mesh has no extent");
+  }
+  double sc = size_m / ext;
+  double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  double t[3] = {-0.5 * (lo[0] + hi[0]) * sc, -0.5 * (lo[1] + hi[1]) * sc, -lo[2] * sc};
+  hearth_mesh_transform(&obj->mesh, sc, I, t);
+  obj->part_of_tri = calloc(m->n_triangles, 1);
+  if (!obj->part_of_tri) {
+    synth_object_free(obj);
+    return hearth_err_set(err, HEARTH_E_NOMEM, "synth_object_from_mesh: out of memory");
+  }
+  obj->n_parts = 1;
+  obj->part_names[0] = "body";
+  snprintf(obj->category, sizeof obj->category, "%s", category ? category : "object");
+  obj_extent(obj);
+  int cat = cat_code(category);
+  obj->fill_level = cat == C_CUP ? 0.8 : (cat == C_KETTLE || cat == C_POT) ? 0.6 : 0;
+  st = hearth_image_alloc(&obj->albedo, texture_size, texture_size, 3, HEARTH_PIX_U8, err);
+  if (st) {
+    synth_object_free(obj);
+    return st;
+  }
+  uint8_t *px = obj->albedo.data;
+  for (size_t row = 0; row < texture_size; row++)
+    for (size_t col = 0; col < texture_size; col++) {
+      double c[3] = {0.8, 0.8, 0.8};
+      if (tx->data)
+        sample_rgb(tx, ((double)col + 0.5) / (double)texture_size,
+                   ((double)row + 0.5) / (double)texture_size, c);
+      for (int k = 0; k < 3; k++)
+        px[3 * (row * texture_size + col) + k] = (uint8_t)lround(fmin(fmax(c[k], 0), 1) * 255);
+    }
+  return HEARTH_OK;
+}
