@@ -82,6 +82,11 @@ int hearth_raycast(const hearth_raycaster *rc, const double org[3], const double
 /* Cast n rays (org/dir 3*n floats); hits[i].prim = UINT32_MAX where none. */
 void hearth_raycast_batch(const hearth_raycaster *rc, size_t n, const float *org,
                           const float *dir, float tnear, float tfar, hearth_ray_hit *hits);
+/* The same with an explicit worker count (0 = hearth_default_threads(),
+ * 1 = the calling thread only, for callers that are already parallel). */
+void hearth_raycast_batch_mt(const hearth_raycaster *rc, size_t n, const float *org,
+                             const float *dir, float tnear, float tfar, hearth_ray_hit *hits,
+                             int nthreads);
 
 /* ---- UV islands and texel rasterisation ----------------------------------- */
 /* Label connected UV islands: triangles sharing an edge in UV space (same two

@@ -58,6 +58,7 @@ typedef struct map_ctx {
   const uint32_t *pix_index; /* image pixel index of grid pixel */
   /* per-thread scratch, indexed by thread */
   int n_threads;
+  int cast_threads; /* threads for ray casting when views are processed serially */
   double **sum, **wsum;
   uint32_t **touched;
   uint8_t **touched_flag;
@@ -93,7 +94,9 @@ static void cast_view(map_ctx *m, size_t v, int t) {
       dir[3 * p + i] = (float)(T->R[3 * i] * d[0] + T->R[3 * i + 1] * d[1] + T->R[3 * i + 2] * d[2]);
     }
   }
-  hearth_raycast_batch(m->rc, n, org, dir, 0.0f, INFINITY, hits);
+  /* views already run in parallel: cast on this thread only, unless there
+     is a single worker for all views */
+  hearth_raycast_batch_mt(m->rc, n, org, dir, 0.0f, INFINITY, hits, m->n_threads > 1 ? 1 : m->cast_threads);
   float *ht = m->hit_t + (size_t)t * n, *b1 = m->hit_b1 + (size_t)t * n, *b2 = m->hit_b2 + (size_t)t * n;
   uint32_t *tri = m->hit_tri + (size_t)t * n;
   for (size_t p = 0; p < n; p++) {
@@ -426,7 +429,8 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
                 .n_views = n_views, .opts = &opts, .R = R, .C = C, .tri_of_texel = tri_of_texel,
                 .island_of_tri = island_of_tri, .tri_normal = tri_normal, .n_pix = np,
                 .pix_w = pw, .pix_h = ph, .pix_dir = pix_dir, .pix_index = pix_index,
-                .n_threads = nt};
+                .n_threads = nt,
+                .cast_threads = opts.threads > 0 ? opts.threads : hearth_default_threads()};
   m.sum = calloc((size_t)nt, sizeof *m.sum);
   m.wsum = calloc((size_t)nt, sizeof *m.wsum);
   m.touched = calloc((size_t)nt, sizeof *m.touched);

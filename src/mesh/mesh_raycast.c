@@ -335,13 +335,19 @@ static void batch_packets(void *vctx, size_t begin, size_t end, int thread_index
 
 void hearth_raycast_batch(const hearth_raycaster *rc, size_t n, const float *org,
                           const float *dir, float tnear, float tfar, hearth_ray_hit *hits) {
+  hearth_raycast_batch_mt(rc, n, org, dir, tnear, tfar, hits, 0);
+}
+
+void hearth_raycast_batch_mt(const hearth_raycaster *rc, size_t n, const float *org,
+                             const float *dir, float tnear, float tfar, hearth_ray_hit *hits,
+                             int nthreads) {
   batch_ctx b = {rc, org, dir, tnear, tfar, hits};
   /* each ray's result depends only on the ray, so the output is the same
    * for any thread count; small batches stay on the calling thread */
-  if (n < 8192) {
+  if (n < 8192 || nthreads == 1) {
     batch_range(&b, 0, n, 0);
     return;
   }
   packet_ctx p = {&b, n};
-  hearth_parallel_for((n + 15) / 16, 0, batch_packets, &p);
+  hearth_parallel_for((n + 15) / 16, nthreads, batch_packets, &p);
 }
