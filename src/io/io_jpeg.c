@@ -1,0 +1,231 @@
+/* JPEG reading and writing through libjpeg(-turbo).
+ *
+ * libjpeg's default error handler exits the process; ours formats the
+ * message and longjmps back. Warnings (premature end of data, corrupt
+ * entropy data) are treated as errors: a damaged file is never accepted.
+ * As in io_png.c, setjmp sits in a small function whose changing state lives
+ * in a context struct owned by the caller. */
+#include <setjmp.h>
+#include <stdlib.h>
+#include <string.h>
+/* jpeglib.h needs size_t and FILE declared first */
+#include <stdio.h>
+#include <jpeglib.h>
+#include "hearth/image.h"
+
+#define JPEG_MAX_FILE_BYTES ((size_t)1 << 30)
+
+typedef struct jpeg_errmgr {
+  struct jpeg_error_mgr pub;
+  jmp_buf jump;
+  char msg[JMSG_LENGTH_MAX + 64];
+} jpeg_errmgr;
+
+static void on_jpeg_error(j_common_ptr cinfo) {
+  jpeg_errmgr *e = (jpeg_errmgr *)cinfo->err;
+  if (!e->msg[0]) (*cinfo->err->format_message)(cinfo, e->msg);
+  longjmp(e->jump, 1);
+}
+
+static void on_jpeg_message(j_common_ptr cinfo, int level) {
+  /* level -1 is a warning about damaged data: fail like an error; trace
+   * messages (level >= 0) are ignored */
+  if (level < 0) on_jpeg_error(cinfo);
+}
+
+static void init_errmgr(jpeg_errmgr *e) {
+  memset(e, 0, sizeof *e);
+  jpeg_std_error(&e->pub);
+  e->pub.error_exit = on_jpeg_error;
+  e->pub.emit_message = on_jpeg_message;
+}
+
+/* ---- reading ------------------------------------------------------------------ */
+
+typedef struct jpeg_reader {
+  struct jpeg_decompress_struct cinfo;
+  jpeg_errmgr jerr;
+  const uint8_t *data;
+  size_t size;
+  hearth_status status; /* our own check failures */
+  char msg[256];
+  hearth_image img;
+} jpeg_reader;
+
+/* 0 on success, 1 after a libjpeg error (r->jerr.msg), 2 after our checks. */
+static int jpeg_decode(jpeg_reader *r) {
+  if (setjmp(r->jerr.jump)) return 1;
+  jpeg_create_decompress(&r->cinfo);
+  jpeg_mem_src(&r->cinfo, r->data, (unsigned long)r->size);
+  jpeg_read_header(&r->cinfo, TRUE);
+  size_t w = r->cinfo.image_width, h = r->cinfo.image_height;
+  if (w == 0 || h == 0 || w > HEARTH_IMAGE_MAX_DIM || h > HEARTH_IMAGE_MAX_DIM) {
+    r->status = HEARTH_E_LIMIT;
+    snprintf(r->msg, sizeof r->msg, "size %zux%zu exceeds the limit of %d per side", w, h,
+             HEARTH_IMAGE_MAX_DIM);
+    return 2;
+  }
+  if (r->cinfo.data_precision != 8) {
+    r->status = HEARTH_E_UNSUPPORTED;
+    snprintf(r->msg, sizeof r->msg, "%d-bit samples: expected 8-bit JPEG",
+             r->cinfo.data_precision);
+    return 2;
+  }
+  int channels;
+  switch (r->cinfo.jpeg_color_space) {
+    case JCS_GRAYSCALE:
+      r->cinfo.out_color_space = JCS_GRAYSCALE;
+      channels = 1;
+      break;
+    case JCS_YCbCr:
+    case JCS_RGB:
+      r->cinfo.out_color_space = JCS_RGB;
+      channels = 3;
+      break;
+    default:
+      r->status = HEARTH_E_UNSUPPORTED;
+      snprintf(r->msg, sizeof r->msg, "colour space %d (CMYK/YCCK?): expected gray or RGB",
+               (int)r->cinfo.jpeg_color_space);
+      return 2;
+  }
+  /* entropy coding needs at least about a bit per 8x8 block and component,
+   * so a small file claiming a huge image is truncated: refuse it before
+   * allocating (the bound is several times looser than the real one) */
+  if (w * h / 4096 > r->size + 4096) {
+    r->status = HEARTH_E_PARSE;
+    snprintf(r->msg, sizeof r->msg,
+             "size %zux%zu is more than %zu file bytes can hold (truncated?)", w, h, r->size);
+    return 2;
+  }
+  jpeg_start_decompress(&r->cinfo);
+  if ((int)r->cinfo.output_components != channels || r->cinfo.output_width != w ||
+      r->cinfo.output_height != h) {
+    r->status = HEARTH_E_UNSUPPORTED;
+    snprintf(r->msg, sizeof r->msg, "unexpected output layout");
+    return 2;
+  }
+  hearth_err aerr;
+  if (hearth_image_alloc(&r->img, w, h, channels, HEARTH_PIX_U8, &aerr) != HEARTH_OK) {
+    r->status = aerr.status;
+    snprintf(r->msg, sizeof r->msg, "%s", aerr.msg);
+    return 2;
+  }
+  size_t stride = w * (size_t)channels;
+  while (r->cinfo.output_scanline < r->cinfo.output_height) {
+    JSAMPROW row = (JSAMPROW)r->img.data + (size_t)r->cinfo.output_scanline * stride;
+    if (jpeg_read_scanlines(&r->cinfo, &row, 1) != 1) {
+      r->status = HEARTH_E_PARSE;
+      snprintf(r->msg, sizeof r->msg, "image data ends at row %u of %zu",
+               (unsigned)r->cinfo.output_scanline, h);
+      return 2;
+    }
+  }
+  /* reads up to EOI: missing trailing data raises the premature-end warning */
+  jpeg_finish_decompress(&r->cinfo);
+  return 0;
+}
+
+hearth_status hearth_jpeg_read_mem(const void *data, size_t size, const char *name,
+                                   hearth_image *img, hearth_err *err) {
+  if (!name) name = "<memory>";
+  memset(img, 0, sizeof *img);
+  if (size < 3 || !data || memcmp(data, "\xff\xd8\xff", 3) != 0)
+    return hearth_err_set(err, HEARTH_E_PARSE, "%s: not a JPEG file (bad signature)", name);
+  if (size > (size_t)(unsigned long)-1)
+    return hearth_err_set(err, HEARTH_E_LIMIT, "%s: too large", name);
+  jpeg_reader *r = calloc(1, sizeof *r);
+  if (!r) return hearth_err_set(err, HEARTH_E_NOMEM, "%s: cannot allocate decoder", name);
+  r->data = data;
+  r->size = size;
+  init_errmgr(&r->jerr);
+  r->cinfo.err = &r->jerr.pub;
+  int rc = jpeg_decode(r);
+  /* safe even if creation failed: the struct was zeroed (no memory manager) */
+  jpeg_destroy_decompress(&r->cinfo);
+  hearth_status s = HEARTH_OK;
+  if (rc == 1)
+    s = hearth_err_set(err, HEARTH_E_PARSE, "%s: invalid JPEG: %s", name, r->jerr.msg);
+  else if (rc == 2)
+    s = hearth_err_set(err, r->status, "%s: %s", name, r->msg);
+  if (s) hearth_image_free(&r->img);
+  else *img = r->img;
+  free(r);
+  return s;
+}
+
+hearth_status hearth_jpeg_read(const char *path, hearth_image *img, hearth_err *err) {
+  memset(img, 0, sizeof *img);
+  uint8_t *buf;
+  size_t n;
+  hearth_status s = hearth_read_file(path, JPEG_MAX_FILE_BYTES, &buf, &n, err);
+  if (s) return s;
+  s = hearth_jpeg_read_mem(buf, n, path, img, err);
+  free(buf);
+  return s;
+}
+
+/* ---- writing ------------------------------------------------------------------ */
+
+typedef struct jpeg_writer {
+  struct jpeg_compress_struct cinfo;
+  jpeg_errmgr jerr;
+} jpeg_writer;
+
+static int jpeg_encode(jpeg_writer *w, const hearth_image *img, int quality, FILE *fp) {
+  if (setjmp(w->jerr.jump)) return 1;
+  jpeg_create_compress(&w->cinfo);
+  jpeg_stdio_dest(&w->cinfo, fp);
+  w->cinfo.image_width = (JDIMENSION)img->width;
+  w->cinfo.image_height = (JDIMENSION)img->height;
+  if (img->channels == 1) {
+    w->cinfo.input_components = 1;
+    w->cinfo.in_color_space = JCS_GRAYSCALE;
+  } else {
+    w->cinfo.input_components = 3;
+    w->cinfo.in_color_space = JCS_RGB;
+  }
+  jpeg_set_defaults(&w->cinfo);
+  jpeg_set_quality(&w->cinfo, quality, TRUE);
+  jpeg_start_compress(&w->cinfo, TRUE);
+  size_t stride = img->width * (size_t)img->channels;
+  while (w->cinfo.next_scanline < w->cinfo.image_height) {
+    JSAMPROW row = (JSAMPROW)img->data + (size_t)w->cinfo.next_scanline * stride;
+    jpeg_write_scanlines(&w->cinfo, &row, 1);
+  }
+  jpeg_finish_compress(&w->cinfo);
+  return 0;
+}
+
+hearth_status hearth_jpeg_write(const char *path, const hearth_image *img, int quality,
+                                hearth_err *err) {
+  if (!img || !img->data) return hearth_err_set(err, HEARTH_E_ARG, "%s: no image to write", path);
+  if (img->type != HEARTH_PIX_U8 || (img->channels != 1 && img->channels != 3))
+    return hearth_err_set(err, HEARTH_E_UNSUPPORTED,
+                          "%s: JPEG stores U8 gray or RGB, not %d channels of %d bytes", path,
+                          img->channels, (int)img->type);
+  if (quality < 1 || quality > 100)
+    return hearth_err_set(err, HEARTH_E_RANGE, "%s: quality %d: expected 1..100", path, quality);
+  if (img->width < 1 || img->height < 1 || img->width > 65500 || img->height > 65500)
+    return hearth_err_set(err, HEARTH_E_SIZE, "%s: image size %zux%zu: JPEG allows 1..65500",
+                          path, img->width, img->height);
+  hearth_atomic_file af;
+  hearth_status s = hearth_atomic_open(&af, path, err);
+  if (s) return s;
+  jpeg_writer *w = calloc(1, sizeof *w);
+  if (!w) {
+    hearth_atomic_abort(&af);
+    return hearth_err_set(err, HEARTH_E_NOMEM, "%s: cannot allocate encoder", path);
+  }
+  init_errmgr(&w->jerr);
+  w->cinfo.err = &w->jerr.pub;
+  int rc = jpeg_encode(w, img, quality, af.fp);
+  jpeg_destroy_compress(&w->cinfo);
+  if (rc) {
+    s = hearth_err_set(err, HEARTH_E_IO, "%s: cannot encode JPEG: %s", path, w->jerr.msg);
+    free(w);
+    hearth_atomic_abort(&af);
+    return s;
+  }
+  free(w);
+  return hearth_atomic_commit(&af, err);
+}
