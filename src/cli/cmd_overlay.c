@@ -1,0 +1,120 @@
+/* hearth overlay ROOT: mesh outline over the thermal images, before/after refinement. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "cli/cli.h"
+#include "hearth/refine.h"
+
+static const char *k_help =
+    "usage: hearth overlay ROOT [--instance ID] [--state S] [options]\n"
+    "\n"
+    "Draws the projected outline of the metric mesh (silhouette and depth edges) on\n"
+    "each Turbo-coloured thermal image so alignment can be checked at a glance:\n"
+    "derived/overlay/<state>/vNN.png (zoomed; white = derived/poses_thermal.json,\n"
+    "magenta = the transferred start poses) and derived/overlay/<state>/contact_sheet.png\n"
+    "(every view, before on the left, after on the right).\n"
+    "\n"
+    "  --instance ID      only this instance (default: all in release.json)\n"
+    "  --state S          only this state (default: all states)\n"
+    "  --before FILE      poses drawn as 'before' (default derived/poses_thermal_transferred.json)\n"
+    "  --after FILE       poses drawn as 'after' (default derived/poses_thermal.json)\n"
+    "  --mesh FILE        metric mesh (default derived/mesh.glb)\n"
+    "  --rig FILE         rig (default calibration/rig.json)\n"
+    "  --zoom K           per-view image magnification (default 3)\n"
+    "  --range LO,HI      Turbo range in degC (default: 2..98 % of each image)\n";
+
+int hearth_cmd_overlay(int argc, char **argv) {
+  const char *root = NULL, *instance = NULL, *state = NULL;
+  hearth_overlay_job job = {0};
+  job.zoom = 3;
+  for (int i = 1; i < argc; i++) {
+    const char *v = NULL;
+    int r;
+    long lv;
+    if (cli_is_help(argv[i])) {
+      fputs(k_help, stdout);
+      return 0;
+    } else if ((r = cli_opt(argc, argv, &i, "--instance", &v))) {
+      if (r < 0) goto missing;
+      instance = v;
+    } else if ((r = cli_opt(argc, argv, &i, "--state", &v))) {
+      if (r < 0) goto missing;
+      state = v;
+    } else if ((r = cli_opt(argc, argv, &i, "--before", &v))) {
+      if (r < 0) goto missing;
+      job.before_path = v;
+    } else if ((r = cli_opt(argc, argv, &i, "--after", &v))) {
+      if (r < 0) goto missing;
+      job.after_path = v;
+    } else if ((r = cli_opt(argc, argv, &i, "--mesh", &v))) {
+      if (r < 0) goto missing;
+      job.mesh_path = v;
+    } else if ((r = cli_opt(argc, argv, &i, "--rig", &v))) {
+      if (r < 0) goto missing;
+      job.rig_path = v;
+    } else if ((r = cli_opt(argc, argv, &i, "--zoom", &v))) {
+      if (r < 0) goto missing;
+      if (!cli_parse_int(v, 1, 16, &lv)) goto bad;
+      job.zoom = (int)lv;
+    } else if ((r = cli_opt(argc, argv, &i, "--range", &v))) {
+      if (r < 0) goto missing;
+      const char *comma = strchr(v, ',');
+      if (!comma || hearth_parse_double(v, (size_t)(comma - v), 0, &job.lo) ||
+          !cli_parse_num(comma + 1, &job.hi) || !(job.lo < job.hi))
+        goto bad;
+    } else if (argv[i][0] == '-') {
+      fprintf(stderr, "hearth overlay: unknown option '%s'\n%s", argv[i], k_help);
+      return 2;
+    } else if (!root) {
+      root = argv[i];
+    } else {
+      fprintf(stderr, "hearth overlay: unexpected argument '%s'\n", argv[i]);
+      return 2;
+    }
+    continue;
+  missing:
+    fprintf(stderr, "hearth overlay: option '%s' needs a value\n", argv[i]);
+    return 2;
+  bad:
+    fprintf(stderr, "hearth overlay: bad value '%s' for option '%s'\n", v, argv[i - 1]);
+    return 2;
+  }
+  if (!root) {
+    fprintf(stderr, "hearth overlay: missing ROOT\n%s", k_help);
+    return 2;
+  }
+  hearth_err err = {0};
+  cli_names *inst = malloc(sizeof *inst), *states = malloc(sizeof *states);
+  int rc = 0;
+  if (!inst || !states) {
+    free(inst);
+    free(states);
+    return 1;
+  }
+  if (cli_instances(root, instance, inst, &err)) {
+    rc = cli_fail("overlay", &err);
+    goto out;
+  }
+  for (size_t k = 0; k < inst->n; k++) {
+    if (cli_states(root, inst->names[k], state, states, &err)) {
+      rc = cli_fail("overlay", &err);
+      continue;
+    }
+    for (size_t j = 0; j < states->n; j++) {
+      job.root = root;
+      job.instance = inst->names[k];
+      job.state = states->names[j];
+      size_t n = 0;
+      if (hearth_overlay_run(&job, &n, &err)) {
+        rc = cli_fail("overlay", &err);
+        continue;
+      }
+      printf("overlay %s/%s: %zu images in derived/overlay/%s/\n", inst->names[k], states->names[j], n,
+             states->names[j]);
+    }
+  }
+out:
+  free(inst);
+  free(states);
+  return rc;
+}

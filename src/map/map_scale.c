@@ -1,0 +1,412 @@
+/* Metric scale recovery: rendered reconstruction depth vs recorded depth
+ * maps (include/hearth/refine.h).
+ *
+ * Rendering the metric mesh (s * recon) from metric poses gives depths
+ * s * z_recon, so for every pixel where both exist, z_measured = s z_recon.
+ * The depth camera's centre in the recon frame depends on s itself (the
+ * factory baseline is metric), so the cast is repeated with the latest s
+ * until it settles; the baseline is small, so this fixed point converges in
+ * a few rounds. */
+#include <jansson.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "hearth/release.h"
+#include "map/map_refine_priv.h"
+
+#define SCALE_MAX_ROUNDS 6
+
+void hearth_scale_opts_default(hearth_scale_opts *o) {
+  memset(o, 0, sizeof *o);
+  o->pixel_stride = 2;
+  o->edge_rel = 0.02;
+  o->inlier_sigmas = 3.0;
+  o->min_band_mm = 1.0;
+  o->min_pixels_per_view = 50;
+}
+
+/* one candidate pixel: measured and rendered depth */
+typedef struct zpair {
+  float zm;  /* metres */
+  float zr;  /* recon units */
+} zpair;
+
+typedef struct scale_ctx {
+  const hearth_raycaster *rc;
+  const hearth_scale_view *views;
+  const hearth_scale_opts *o;
+  double s;            /* current estimate (for the baseline) */
+  float **dirs;        /* per view: cached pixel rays (3 per sampled pixel) */
+  zpair **pairs;       /* per view */
+  size_t *n_pairs;
+  int failed;
+} scale_ctx;
+
+static uint16_t depth_at(const hearth_image *d, size_t x, size_t y) {
+  return ((const uint16_t *)d->data)[y * d->width + x];
+}
+
+/* cast one view's sampled pixels and keep the pairs that are off edges */
+static void scale_view(scale_ctx *c, size_t v) {
+  const hearth_scale_view *sv = &c->views[v];
+  const hearth_image *D = sv->depth;
+  size_t st = (size_t)(c->o->pixel_stride > 0 ? c->o->pixel_stride : 1);
+  size_t gw = (D->width + st - 1) / st, gh = (D->height + st - 1) / st, n = gw * gh;
+  float *zr = hearth_alloc_array(n, sizeof *zr);
+  zpair *out = hearth_alloc_array(n ? n : 1, sizeof *out);
+  if (!c->dirs[v] && (c->dirs[v] = hearth_alloc_array(n ? n : 1, 3 * sizeof(float)))) {
+    /* undistorted rays of the sampled pixels, once per view (NaN: not invertible) */
+    for (size_t gy = 0; gy < gh; gy++)
+      for (size_t gx = 0; gx < gw; gx++) {
+        double dc[3];
+        float *d = c->dirs[v] + 3 * (gy * gw + gx);
+        if (hearth_camera_ray(&sv->depth_cam, (double)(gx * st), (double)(gy * st), dc) < 0)
+          d[0] = d[1] = d[2] = NAN;
+        else
+          for (int i = 0; i < 3; i++) d[i] = (float)dc[i];
+      }
+  }
+  if (!zr || !out || !c->dirs[v]) {
+    free(zr);
+    free(out);
+    c->failed = 1;
+    return;
+  }
+  /* depth camera pose in recon units: the metric baseline divided by s */
+  hearth_rigid T_rgb_from_depth, Tb = sv->T_depth_from_rgb, T_world_from_depth;
+  for (int i = 0; i < 3; i++) Tb.t[i] /= c->s;
+  hearth_rigid_inverse(&Tb, &T_rgb_from_depth);
+  hearth_rigid_compose(&sv->T_world_from_rgb, &T_rgb_from_depth, &T_world_from_depth);
+  for (size_t gy = 0; gy < gh; gy++)
+    for (size_t gx = 0; gx < gw; gx++) {
+      double dc[3], dw[3];
+      const float *d = c->dirs[v] + 3 * (gy * gw + gx);
+      zr[gy * gw + gx] = INFINITY;
+      if (isnan(d[0])) continue;
+      for (int i = 0; i < 3; i++) dc[i] = (double)d[i];
+      hearth_rigid_rotate(&T_world_from_depth, dc, dw);
+      hearth_ray_hit h;
+      if (hearth_raycast(c->rc, T_world_from_depth.t, dw, 0.0, INFINITY, &h) && h.front)
+        zr[gy * gw + gx] = (float)((double)h.t * dc[2]);
+    }
+  double er = c->o->edge_rel;
+  size_t k = 0;
+  for (size_t gy = 0; gy < gh; gy++)
+    for (size_t gx = 0; gx < gw; gx++) {
+      float z = zr[gy * gw + gx];
+      uint16_t dm = depth_at(D, gx * st, gy * st);
+      if (!isfinite(z) || z <= 0 || dm == 0) continue;
+      /* edges: a neighbour (rendered or measured) missing or at another depth */
+      int edge = 0;
+      const long dx[4] = {-1, 1, 0, 0}, dy[4] = {0, 0, -1, 1};
+      for (int j = 0; j < 4 && !edge; j++) {
+        long nx = (long)gx + dx[j], ny = (long)gy + dy[j];
+        if (nx < 0 || ny < 0 || nx >= (long)gw || ny >= (long)gh) continue;
+        float zn = zr[(size_t)ny * gw + (size_t)nx];
+        uint16_t dn = depth_at(D, (size_t)nx * st, (size_t)ny * st);
+        if (!isfinite(zn) || fabs((double)zn - (double)z) > er * (double)z) edge = 1;
+        else if (dn == 0 || fabs((double)dn - (double)dm) > er * (double)dm) edge = 1;
+      }
+      if (edge) continue;
+      out[k++] = (zpair){(float)(dm * 1e-3), z};
+    }
+  free(zr);
+  c->pairs[v] = out;
+  c->n_pairs[v] = k;
+}
+
+static void scale_range(void *ctx, size_t b, size_t e, int t) {
+  (void)t;
+  for (size_t v = b; v < e; v++) scale_view(ctx, v);
+}
+
+static int cmp_double(const void *a, const void *b) {
+  double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
+/* the q-quantile of a[0..n) (sorts a) */
+static double quantile(double *a, size_t n, double q) {
+  if (!n) return 0.0;
+  qsort(a, n, sizeof *a, cmp_double);
+  double pos = q * (double)(n - 1);
+  size_t i = (size_t)pos;
+  if (i + 1 >= n) return a[n - 1];
+  return a[i] + (pos - (double)i) * (a[i + 1] - a[i]);
+}
+
+/* robust fit of zm = s zr over all pairs: median ratio, then trimmed least
+ * squares with a MAD-based band; fills res (scale, inliers, residuals) */
+static void robust_fit(zpair *const *pairs, const size_t *n_pairs, size_t n_views,
+                       const hearth_scale_opts *o, double *tmp, hearth_scale_result *res) {
+  size_t n = 0;
+  for (size_t v = 0; v < n_views; v++)
+    for (size_t i = 0; i < n_pairs[v]; i++) tmp[n++] = (double)pairs[v][i].zm / (double)pairs[v][i].zr;
+  res->n_candidates = n;
+  double s = quantile(tmp, n, 0.5);
+  double band = 0;
+  for (int it = 0; it < 4; it++) {
+    /* band from the residuals of every candidate around the current fit */
+    size_t m = 0;
+    for (size_t v = 0; v < n_views; v++)
+      for (size_t i = 0; i < n_pairs[v]; i++)
+        tmp[m++] = fabs((double)pairs[v][i].zm - s * (double)pairs[v][i].zr);
+    double mad = quantile(tmp, m, 0.5);
+    band = o->inlier_sigmas * 1.4826 * mad;
+    if (band < o->min_band_mm * 1e-3) band = o->min_band_mm * 1e-3;
+    double sxy = 0, sxx = 0;
+    for (size_t v = 0; v < n_views; v++)
+      for (size_t i = 0; i < n_pairs[v]; i++) {
+        double zm = pairs[v][i].zm, zr = pairs[v][i].zr;
+        if (fabs(zm - s * zr) > band) continue;
+        sxy += zm * zr;
+        sxx += zr * zr;
+      }
+    if (sxx > 0) s = sxy / sxx;
+  }
+  /* final statistics over inliers */
+  size_t m = 0;
+  double ss = 0;
+  int used = 0;
+  for (size_t v = 0; v < n_views; v++) {
+    size_t nv = 0;
+    for (size_t i = 0; i < n_pairs[v]; i++) {
+      double e = fabs((double)pairs[v][i].zm - s * (double)pairs[v][i].zr);
+      if (e > band) continue;
+      tmp[m++] = e * 1e3;
+      ss += e * e * 1e6;
+      nv++;
+    }
+    if (nv >= (size_t)o->min_pixels_per_view) used++;
+  }
+  res->scale = s;
+  res->n_inliers = m;
+  res->views_used = used;
+  res->inlier_fraction = n ? (double)m / (double)n : 0.0;
+  res->residual_rms_mm = m ? sqrt(ss / (double)m) : 0.0;
+  res->residual_p90_mm = quantile(tmp, m, 0.9);
+  res->residual_median_mm = quantile(tmp, m, 0.5);
+}
+
+hearth_status hearth_scale_estimate(const hearth_mesh *recon_mesh, const hearth_raycaster *rc,
+                                    const hearth_scale_view *views, size_t n_views,
+                                    const hearth_scale_opts *opts, hearth_scale_result *out,
+                                    hearth_err *err) {
+  hearth_scale_opts def;
+  if (!opts) {
+    hearth_scale_opts_default(&def);
+    opts = &def;
+  }
+  memset(out, 0, sizeof *out);
+  if (!recon_mesh || !views || !n_views)
+    return hearth_err_set(err, HEARTH_E_ARG, "scale: a mesh and at least one depth view are needed");
+  for (size_t v = 0; v < n_views; v++) {
+    const hearth_image *D = views[v].depth;
+    if (!D || D->type != HEARTH_PIX_U16 || D->channels != 1)
+      return hearth_err_set(err, HEARTH_E_UNSUPPORTED,
+                            "scale: depth view %zu: expected a 16-bit single-channel image", v);
+    if (D->width != (size_t)views[v].depth_cam.width || D->height != (size_t)views[v].depth_cam.height)
+      return hearth_err_set(err, HEARTH_E_SIZE,
+                            "scale: depth view %zu: image is %zux%zu, its intrinsics say %dx%d", v,
+                            D->width, D->height, views[v].depth_cam.width, views[v].depth_cam.height);
+  }
+  hearth_raycaster *own = NULL;
+  hearth_status s = HEARTH_OK;
+  if (!rc) {
+    if ((s = hearth_raycaster_new(recon_mesh, &own, err))) return s;
+    rc = own;
+  }
+  zpair **pairs = calloc(n_views, sizeof *pairs);
+  float **dirs = calloc(n_views, sizeof *dirs);
+  size_t *n_pairs = calloc(n_views, sizeof *n_pairs);
+  double *tmp = NULL;
+  if (!pairs || !n_pairs || !dirs) {
+    s = hearth_err_set(err, HEARTH_E_NOMEM, "scale: out of memory");
+    goto done;
+  }
+  /* first round: the baseline taken as if recon units were metres; each
+     later round uses the latest scale */
+  double scale = 1.0;
+  for (int round = 0; round < SCALE_MAX_ROUNDS; round++) {
+    scale_ctx c = {rc, views, opts, scale, dirs, pairs, n_pairs, 0};
+    for (size_t v = 0; v < n_views; v++) {
+      free(pairs[v]);
+      pairs[v] = NULL;
+      n_pairs[v] = 0;
+    }
+    if ((s = hearth_parallel_for(n_views, opts->threads, scale_range, &c))) {
+      hearth_err_set(err, s, "scale: cannot start worker threads");
+      goto done;
+    }
+    if (c.failed) {
+      s = hearth_err_set(err, HEARTH_E_NOMEM, "scale: out of memory");
+      goto done;
+    }
+    size_t total = 0;
+    for (size_t v = 0; v < n_views; v++) total += n_pairs[v];
+    if (total < 10) {
+      s = hearth_err_set(err, HEARTH_E_INCONSISTENT,
+                         "scale: only %zu depth pixels see the mesh away from edges (expected at "
+                         "least 10): do the poses, depth frames and mesh belong together?", total);
+      goto done;
+    }
+    free(tmp);
+    tmp = hearth_alloc_array(total, sizeof *tmp);
+    if (!tmp) {
+      s = hearth_err_set(err, HEARTH_E_NOMEM, "scale: out of memory");
+      goto done;
+    }
+    robust_fit(pairs, n_pairs, n_views, opts, tmp, out);
+    out->iterations = round + 1;
+    if (!(out->scale > 0) || !isfinite(out->scale)) {
+      s = hearth_err_set(err, HEARTH_E_NUMERIC, "scale: the fit gave a non-positive scale");
+      goto done;
+    }
+    double change = fabs(out->scale - scale) / out->scale;
+    scale = out->scale;
+    if (round > 0 && change < 1e-8) break;
+  }
+done:
+  for (size_t v = 0; v < n_views; v++) {
+    if (pairs) free(pairs[v]);
+    if (dirs) free(dirs[v]);
+  }
+  free(dirs);
+  free(pairs);
+  free(n_pairs);
+  free(tmp);
+  hearth_raycaster_free(own);
+  return s;
+}
+
+/* ---- the release stage ------------------------------------------------------ */
+
+static hearth_status write_scale_json(const char *path, const hearth_scale_result *r,
+                                      size_t n_frames, hearth_err *err) {
+  json_t *o = json_object();
+  json_object_set_new(o, "scale", json_real(r->scale));
+  json_object_set_new(o, "views_used", json_integer(r->views_used));
+  json_object_set_new(o, "residual_median_mm", json_real(r->residual_median_mm));
+  json_object_set_new(o, "residual_rms_mm", json_real(r->residual_rms_mm));
+  json_object_set_new(o, "residual_p90_mm", json_real(r->residual_p90_mm));
+  json_object_set_new(o, "depth_frames", json_integer((json_int_t)n_frames));
+  json_object_set_new(o, "candidate_pixels", json_integer((json_int_t)r->n_candidates));
+  json_object_set_new(o, "inlier_pixels", json_integer((json_int_t)r->n_inliers));
+  json_object_set_new(o, "inlier_fraction", json_real(r->inlier_fraction));
+  json_object_set_new(o, "method", json_string("median of z_measured/z_rendered, then trimmed "
+                                               "least squares; edges, holes and background excluded"));
+  char *text = json_dumps(o, JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(17));
+  json_decref(o);
+  if (!text) return hearth_err_set(err, HEARTH_E_NOMEM, "%s: cannot encode", path);
+  size_t len = strlen(text);
+  /* the document must pass the release reader before it is written */
+  hearth_scale_doc chk;
+  hearth_status s = hearth_scale_parse(text, len, path, &chk, err);
+  if (!s) s = hearth_write_file_atomic(path, text, len, err);
+  free(text);
+  return s;
+}
+
+hearth_status hearth_scale_run(const hearth_scale_job *job, hearth_scale_result *res,
+                               hearth_err *err) {
+  if (!job || !job->root || !job->instance)
+    return hearth_err_set(err, HEARTH_E_ARG, "scale: root and instance are required");
+  const char *root = job->root, *inst = job->instance;
+  char path[RF_PATH], dir[RF_PATH], poses_path[RF_PATH];
+  hearth_instance_doc idoc;
+  hearth_poses poses = {0};
+  hearth_mesh mesh = {0};
+  hearth_manifest man[HEARTH_MAX_STATES];
+  memset(man, 0, sizeof man);
+  size_t n_states = 0, n_frames = 0;
+  hearth_image *depths = NULL;
+  hearth_scale_view *views = NULL;
+  hearth_scale_result r;
+  hearth_status s;
+  if ((s = rf_pathf(path, "%s/instances/%s/instance.json", root, inst)))
+    return hearth_err_set(err, s, "%s: path too long", root);
+  if ((s = hearth_instance_read(path, &idoc, err))) return s;
+  rf_pathf(poses_path, "%s/instances/%s/recon/poses_rgb.json", root, inst);
+  if ((s = hearth_poses_read(poses_path, &poses, err))) goto done;
+  rf_pathf(path, "%s/instances/%s/recon/mesh.glb", root, inst);
+  hearth_glb_read_opts gopts = {.require_uvs = 0, .load_texture = 1};
+  if ((s = hearth_glb_read(path, &gopts, &mesh, err))) goto done;
+  /* manifests of the states to use */
+  for (size_t k = 0; k < idoc.n_states; k++) {
+    if (job->state && strcmp(job->state, idoc.states[k])) continue;
+    rf_pathf(path, "%s/instances/%s/raw/%s/manifest.json", root, inst, idoc.states[k]);
+    if ((s = hearth_manifest_read(path, &man[n_states], err))) goto done;
+    n_frames += man[n_states].n_views;
+    n_states++;
+  }
+  if (!n_states) {
+    s = hearth_err_set(err, HEARTH_E_NOT_FOUND, "%s/instances/%s/instance.json: no state '%s'", root,
+                       inst, job->state ? job->state : "");
+    goto done;
+  }
+  depths = calloc(n_frames ? n_frames : 1, sizeof *depths);
+  views = calloc(n_frames ? n_frames : 1, sizeof *views);
+  if (!depths || !views) {
+    s = hearth_err_set(err, HEARTH_E_NOMEM, "scale: out of memory");
+    goto done;
+  }
+  size_t f = 0;
+  for (size_t k = 0; k < n_states; k++)
+    for (size_t i = 0; i < man[k].n_views; i++, f++) {
+      const hearth_view_files *vf = &man[k].views[i];
+      const hearth_view_pose *vp = hearth_poses_find(&poses, man[k].state, vf->view);
+      if (!vp) {
+        s = hearth_err_set(err, HEARTH_E_NOT_FOUND, "%s: no pose for state '%s' view '%s'",
+                           poses_path, man[k].state, vf->view);
+        goto done;
+      }
+      rf_pathf(path, "%s/instances/%s/raw/%s/%s", root, inst, man[k].state, vf->depth);
+      if ((s = hearth_png_read(path, &depths[f], err))) goto done;
+      if (depths[f].type != HEARTH_PIX_U16 || depths[f].channels != 1) {
+        s = hearth_err_set(err, HEARTH_E_UNSUPPORTED, "%s: expected a 16-bit grey depth PNG", path);
+        goto done;
+      }
+      hearth_depth_intrinsics di;
+      rf_pathf(path, "%s/instances/%s/raw/%s/%s", root, inst, man[k].state, vf->depth_intrinsics);
+      if ((s = hearth_depth_intrinsics_read(path, &di, err))) goto done;
+      if (depths[f].width != (size_t)di.depth.width || depths[f].height != (size_t)di.depth.height) {
+        s = hearth_err_set(err, HEARTH_E_SIZE, "%s: says %dx%d but depth image %s is %zux%zu", path,
+                           di.depth.width, di.depth.height, vf->depth, depths[f].width,
+                           depths[f].height);
+        goto done;
+      }
+      views[f] = (hearth_scale_view){&depths[f], di.depth, di.T_depth_from_rgb, vp->T_world_from_cam};
+    }
+  if ((s = hearth_scale_estimate(&mesh, NULL, views, n_frames, &job->opts, &r, err))) {
+    hearth_err_prefix(err, "%s", inst);
+    goto done;
+  }
+  /* metric mesh (texture from recon/rgb_texture.png when not embedded) */
+  if (!mesh.texture.data) {
+    rf_pathf(path, "%s/instances/%s/recon/rgb_texture.png", root, inst);
+    if (hearth_path_exists(path) && (s = hearth_png_read(path, &mesh.texture, err))) goto done;
+  }
+  const double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, z[3] = {0, 0, 0};
+  hearth_mesh_transform(&mesh, r.scale, I, z);
+  for (size_t i = 0; i < poses.n; i++)
+    for (int j = 0; j < 3; j++) poses.views[i].T_world_from_cam.t[j] *= r.scale;
+  rf_pathf(dir, "%s/instances/%s/derived", root, inst);
+  if ((s = hearth_mkdirs(dir, err))) goto done;
+  rf_pathf(path, "%s/mesh.glb", dir);
+  if ((s = hearth_glb_write(path, &mesh, err))) goto done;
+  rf_pathf(path, "%s/poses_rgb.json", dir);
+  if ((s = hearth_poses_write(path, &poses, err))) goto done;
+  /* scale.json last: its presence says the other two are consistent with it */
+  rf_pathf(path, "%s/scale.json", dir);
+  if ((s = write_scale_json(path, &r, n_frames, err))) goto done;
+  if (res) *res = r;
+done:
+  if (depths)
+    for (size_t i = 0; i < n_frames; i++) hearth_image_free(&depths[i]);
+  free(depths);
+  free(views);
+  for (size_t k = 0; k < n_states; k++) hearth_manifest_free(&man[k]);
+  hearth_mesh_free(&mesh);
+  hearth_poses_free(&poses);
+  return s;
+}
