@@ -1,0 +1,139 @@
+/* Private to the virtual rig: its cameras, its own lens model and the
+ * renderers (synth_rig.c, synth_render.c, synth_plate.c, synth_release.c).
+ *
+ * The lens functions here are deliberately written apart from
+ * hearth_camera_project/undistort: the rig is the test oracle of the
+ * pipeline, so a mistake shared by both must not cancel out. */
+#ifndef HEARTH_SYNTH_RIG_H
+#define HEARTH_SYNTH_RIG_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "hearth/camera.h"
+#include "hearth/core.h"
+#include "hearth/geom.h"
+#include "hearth/image.h"
+#include "hearth/mesh.h"
+#include "hearth/release.h"
+#include "hearth/synth.h"
+#include "synth/synth_object.h"
+
+/* ---- lens (synth_rig.c) --------------------------------------------------- */
+/* Brown-Conrady [k1 k2 p1 p2 k3] on normalised coordinates. */
+void synth_lens_distort(const double dist[5], double x, double y, double *xd, double *yd);
+/* Camera-frame point -> pixel; 0 if behind the camera. */
+int synth_lens_project(const hearth_camera *c, const double Xc[3], double uv[2]);
+/* Pixel -> ideal normalised (x, y); returns the residual in pixels. */
+double synth_lens_unproject(const hearth_camera *c, double u, double v, double xy[2]);
+/* Unit ray (camera frame) through pixel (u, v). */
+void synth_lens_ray(const hearth_camera *c, double u, double v, double dir[3]);
+/* Table of unit camera-frame rays for ss x ss sub-samples per pixel: entry
+ * ((y * W + x) * ss * ss + j * ss + i) * 3 is the ray through
+ * (x + (i + 0.5) / ss - 0.5, y + (j + 0.5) / ss - 0.5). malloc'ed. */
+float *synth_ray_table(const hearth_camera *c, int ss, int threads);
+
+/* The rig drawn from a seed (realistic Femto Bolt + Mini2 ranges). */
+void synth_rig_draw(uint64_t seed, hearth_rig *rig);
+/* OpenCV-axes camera at eye looking at target, world z up. */
+void synth_look_at(const double eye[3], const double target[3], hearth_rigid *T_world_from_cam);
+/* Cheap approximately normal noise (sum of four 16-bit uniforms, unit
+ * variance, tails cut at ~3.5 sigma) for the millions of pixel samples of
+ * sensor noise where Box-Muller would dominate the run time. */
+static inline double synth_fast_normal(hearth_rng *r) {
+  uint64_t u = hearth_rng_u64(r);
+  double s = (double)(u & 0xFFFF) + (double)((u >> 16) & 0xFFFF) + (double)((u >> 32) & 0xFFFF) +
+             (double)(u >> 48);
+  return (s - 131070.0) * (1.0 / 37837.23);
+}
+/* A 64-bit stream id for a name (FNV-1a). */
+uint64_t synth_hash(const char *s);
+
+/* ---- scene and renderers (synth_render.c) ----------------------------------- */
+typedef struct synth_scene {
+  const synth_object *obj;
+  hearth_rigid T_world_from_obj;
+  hearth_mesh world;        /* object mesh placed in the world (no texture) */
+  float *normals;           /* per-vertex normals, world, 3 per vertex */
+  hearth_raycaster *rc;
+  double centre[3], radius; /* bounding sphere of the object, world */
+  double turntable_radius;
+  double ambient_c;
+} synth_scene;
+
+hearth_status synth_scene_init(synth_scene *s, const synth_object *obj,
+                               const hearth_rigid *T_world_from_obj, double ambient_c,
+                               hearth_err *err);
+void synth_scene_free(synth_scene *s);
+
+/* Everything a view render needs. Tables come from synth_ray_table:
+ * thermal with ss = 4, rgb and depth with ss = 1. */
+typedef struct synth_view_job {
+  const synth_scene *scene;
+  const synth_field *field;
+  const hearth_rig *rig;
+  const float *thermal_rays, *rgb_rays, *depth_rays;
+  hearth_rigid T_world_from_rgb;
+  uint64_t noise_seed;   /* per view */
+  double netd_c;
+  int threads;
+} synth_view_job;
+
+/* Outputs: thermal 1-channel F32 (degC), rgb 3-channel U8, mask 1-channel
+ * U8 (255 object, 0 background), depth 1-channel U16 (mm). */
+hearth_status synth_render_thermal(const synth_view_job *job, hearth_image *out, hearth_err *err);
+hearth_status synth_render_rgb(const synth_view_job *job, hearth_image *rgb, hearth_image *mask,
+                               hearth_err *err);
+hearth_status synth_render_depth(const synth_view_job *job, hearth_image *out, hearth_err *err);
+
+/* Separable Gaussian blur of a 1-channel F32 image (edge clamped). */
+hearth_status synth_blur_f32(hearth_image *img, double sigma, hearth_err *err);
+
+/* ---- calibration captures (synth_plate.c) ------------------------------------ */
+/* Write calibration/captures/... and ground_truth/calibration/detections.json
+ * under root for the rig. */
+hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
+                                      const hearth_synth_opts *o, uint64_t seed,
+                                      const float *thermal_rays, const float *rgb_rays,
+                                      double ambient_c, hearth_err *err);
+/* Plate coordinates of the pattern centre (metres). */
+void synth_plate_centre(double c[3]);
+/* True centres of the 84 holes in camera c for T_cam_from_plate; returns
+ * how many are wholly inside the image. */
+int synth_plate_truth(const hearth_camera *c, const hearth_rigid *T_cam_from_plate,
+                      double centres[HEARTH_PLATE_HOLES][2]);
+
+/* ---- instances (synth_release.c) ---------------------------------------------- */
+/* One instance as the rig captures it; shared with the tests so they can
+ * check the files against the scene they came from. */
+typedef struct synth_view_def {
+  char name[8];              /* "v07" */
+  int index, elevation_index, azimuth_index;
+  hearth_rigid T_world_from_rgb;
+} synth_view_def;
+
+typedef struct synth_instance {
+  char id[HEARTH_NAME_MAX];
+  char category[HEARTH_NAME_MAX];
+  uint64_t seed;
+  synth_object obj;
+  hearth_rigid T_world_from_obj;
+  double ambient_c;
+  size_t n_states;
+  char states[HEARTH_MAX_STATES][HEARTH_NAME_MAX];
+  synth_field fields[HEARTH_MAX_STATES];
+  size_t n_views;
+  synth_view_def views[HEARTH_MAX_STATES][30];
+  /* recon frame: x_derived = T_derived_from_world x_world, x_recon = x_derived / scale */
+  hearth_rigid T_derived_from_world;
+  double scale;
+} synth_instance;
+
+/* Build instance k (0-based) of category for the options (object, fields,
+ * placement, views, recon similarity), deterministic in (o->seed, category,
+ * k). mesh may be NULL (procedural). */
+hearth_status synth_instance_make(const hearth_synth_opts *o, const hearth_rig *rig,
+                                  const char *category, int k, const hearth_mesh *mesh,
+                                  synth_instance *inst, hearth_err *err);
+void synth_instance_free(synth_instance *inst);
+
+#endif
