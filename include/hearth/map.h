@@ -42,6 +42,9 @@ typedef struct hearth_map_opts {
   hearth_fusion fusion;   /* default HEARTH_FUSE_MAX */
   double min_cos;         /* reject hits seen more obliquely than this cosine; default 0 */
   int pixel_stride;       /* cast every k-th pixel in x and y (colour baking); default 1 */
+  int keep_edges;         /* 1: also use pixels at depth discontinuities (the paper's literal
+                             rule); default 0: such pixels mix two surfaces through the
+                             lens blur and are skipped (always skipped by ROBUST) */
   int threads;            /* 0 = hearth_default_threads() */
 } hearth_map_opts;
 void hearth_map_opts_default(hearth_map_opts *o);

@@ -120,18 +120,20 @@ static void cast_view(map_ctx *m, size_t v, int t) {
   }
 }
 
-/* 1 if grid pixel p is at a silhouette: a 4-neighbour misses the surface or
- * lies at a clearly different depth */
+/* 1 if grid pixel p lies within 2 pixels of a silhouette: a pixel in its
+ * 5x5 neighbourhood misses the surface or lies at a clearly different
+ * depth. The lens blur and the pixel footprint mix the two sides of such an
+ * edge, so these pixels do not measure one surface. */
 static int is_silhouette(const map_ctx *m, const float *ht, size_t p) {
-  size_t x = p % m->pix_w, y = p / m->pix_w;
+  long x = (long)(p % m->pix_w), y = (long)(p / m->pix_w);
   float t0 = ht[p];
-  const long dx[4] = {-1, 1, 0, 0}, dy[4] = {0, 0, -1, 1};
-  for (int k = 0; k < 4; k++) {
-    long nx = (long)x + dx[k], ny = (long)y + dy[k];
-    if (nx < 0 || ny < 0 || nx >= (long)m->pix_w || ny >= (long)m->pix_h) continue;
-    float tn = ht[(size_t)ny * m->pix_w + (size_t)nx];
-    if (!isfinite(tn) || fabsf(tn - t0) > 0.03f * t0) return 1;
-  }
+  for (long dy = -2; dy <= 2; dy++)
+    for (long dx = -2; dx <= 2; dx++) {
+      long nx = x + dx, ny = y + dy;
+      if (nx < 0 || ny < 0 || nx >= (long)m->pix_w || ny >= (long)m->pix_h) continue;
+      float tn = ht[(size_t)ny * m->pix_w + (size_t)nx];
+      if (!isfinite(tn) || fabsf(tn - t0) > 0.03f * t0) return 1;
+    }
   return 0;
 }
 
@@ -157,7 +159,8 @@ static void process_view(map_ctx *m, size_t v, int t) {
     const float *nrm = m->tri_normal + 3 * (size_t)tri, *d = dirs + 3 * p;
     float cosv = -(nrm[0] * d[0] + nrm[1] * d[1] + nrm[2] * d[2]);
     if (cosv < (float)m->opts->min_cos) continue;
-    if (m->opts->fusion == HEARTH_FUSE_ROBUST && is_silhouette(m, ht, p)) continue;
+    if ((m->opts->fusion == HEARTH_FUSE_ROBUST || !m->opts->keep_edges) && is_silhouette(m, ht, p))
+      continue;
     hits++;
     /* UV of the hit point */
     const uint32_t *ix = mesh->indices + 3 * (size_t)tri;
