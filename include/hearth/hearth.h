@@ -13,4 +13,7 @@
 #include "hearth/calib.h"
 #include "hearth/map.h"
 #include "hearth/pipeline.h"
+#include "hearth/release_tools.h"
+#include "hearth/refine.h"
+#include "hearth/sim.h"
 #endif

@@ -1,0 +1,138 @@
+/* hearth/sim.h - the paper's three temperature-aware pick-and-place tasks
+ * (H1 study table: hot/normal cup; H2 kitchen: iced/normal can; H3 kitchen:
+ * hot phone/hot sponge) on MuJoCo, with hearth assets, a Panda arm under an
+ * operational-space pose controller, three rendered views (front RGB, front
+ * thermal, wrist RGB), a scripted expert and a LIBERO-layout HDF5 writer.
+ * Facts and conventions: docs/simulation.md (spec/simulation.md).
+ *
+ * Frames: world z up, table top centre at (0, 0, HEARTH_SIM_TABLE_Z), the
+ * robot base behind the table at x = -0.66 facing +x. Images are RGB U8 in
+ * OpenGL row order (bottom row first), as LIBERO stores them. */
+#ifndef HEARTH_SIM_H
+#define HEARTH_SIM_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "hearth/core.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define HEARTH_SIM_TABLE_Z 0.90
+#define HEARTH_SIM_CONTROL_HZ 20
+#define HEARTH_SIM_TIMESTEP 0.002
+
+typedef enum hearth_sim_task { HEARTH_SIM_H1 = 1, HEARTH_SIM_H2 = 2, HEARTH_SIM_H3 = 3 } hearth_sim_task;
+
+/* Parse "H1".."H3" (case-insensitive); 0 if unknown. */
+hearth_sim_task hearth_sim_task_parse(const char *s);
+const char *hearth_sim_task_name(hearth_sim_task t);
+/* The instruction (0 or 1) of a task: "pick up the hot cup and place it on
+ * the mat", ...; never NULL for valid arguments. */
+const char *hearth_sim_instruction_text(hearth_sim_task t, int instruction);
+
+/* Where the assets come from. A release root holds the instances of the
+ * categories a task needs (cup, canned_drink, electric_kettle, eraser,
+ * orange, smartphone, sponge) in the states it needs (neutral, hot, iced).
+ * With use_ground_truth (virtual-rig releases) the metric mesh is
+ * ground_truth/instances/<id>/mesh.glb and temperatures come from
+ * <state>/temperature_true.npy; otherwise derived/mesh.glb and
+ * derived/<state>/thermal_turbo.png. */
+typedef struct hearth_sim_opts {
+  hearth_sim_task task;
+  const char *release_root;
+  int use_ground_truth;
+  int width, height;     /* rendered size of every view; default 256 */
+  int max_steps;         /* time limit in control steps; default 400 */
+  int render_wrist;      /* default 1 */
+  const char *work_dir;  /* scratch for the MJCF/mesh files; NULL = a fresh dir under /tmp */
+} hearth_sim_opts;
+void hearth_sim_opts_default(hearth_sim_opts *o);
+
+typedef struct hearth_sim_env hearth_sim_env;
+
+/* Build the scene (model, renderer) for a task. Rendering uses OSMesa, or
+ * EGL when HEARTH_GL=egl and the build has it. */
+hearth_status hearth_sim_env_new(const hearth_sim_opts *o, hearth_sim_env **out, hearth_err *err);
+void hearth_sim_env_free(hearth_sim_env *env);
+
+/* Start an episode: layout `layout` of the stream `seed` (object positions
+ * and the candidate-to-slot assignment, identical for both instructions),
+ * asking for `instruction` (0 or 1). */
+hearth_status hearth_sim_reset(hearth_sim_env *env, uint64_t seed, uint64_t layout,
+                               int instruction, hearth_err *err);
+
+/* One control step (25 physics steps): action [dx dy dz dax day daz grip] in
+ * [-1, 1] (clipped), 1.0 = 0.05 m / 0.5 rad; grip -1 open, +1 closed. */
+hearth_status hearth_sim_step(hearth_sim_env *env, const double action[7], hearth_err *err);
+
+typedef struct hearth_sim_obs {
+  int width, height;
+  uint8_t *agentview_rgb;      /* width*height*3, owned by the env, valid until next observe */
+  uint8_t *agentview_thermal;
+  uint8_t *eye_in_hand_rgb;    /* NULL if the wrist view is off */
+  double joint_states[7];
+  double gripper_states[2];    /* finger joint positions */
+  double ee_pos[3];
+  double ee_ori[3];            /* axis-angle of the end-effector rotation */
+  double ee_quat[4];           /* w x y z */
+} hearth_sim_obs;
+
+/* Render the views and read the robot state. */
+hearth_status hearth_sim_observe(hearth_sim_env *env, hearth_sim_obs *obs, hearth_err *err);
+
+/* 1 when the target rests on the mat, released by the gripper. */
+int hearth_sim_success(const hearth_sim_env *env);
+/* Control steps since reset; the time limit. */
+int hearth_sim_steps(const hearth_sim_env *env);
+int hearth_sim_max_steps(const hearth_sim_env *env);
+const char *hearth_sim_instruction(const hearth_sim_env *env);
+/* Full simulator state [time, qpos, qvel]; returns its length, writes up to max. */
+size_t hearth_sim_state(const hearth_sim_env *env, double *state, size_t max);
+/* Fraction of the target candidate's and the other candidate's pixels
+ * visible in the front view at the current state (privileged; collection
+ * checks). */
+hearth_status hearth_sim_visibility(hearth_sim_env *env, double *target_frac, double *other_frac,
+                                    hearth_err *err);
+/* Pixel boxes [x0 y0 x1 y1] (OpenGL rows) of the two candidates in the
+ * front view, slot A then slot B (privileged; tests and audits). */
+hearth_status hearth_sim_candidate_boxes(hearth_sim_env *env, int boxes[2][4], hearth_err *err);
+
+/* The scripted expert (privileged state): approach, grasp, lift, transport,
+ * release. Call once per step after reset. */
+void hearth_sim_expert_action(hearth_sim_env *env, double action[7]);
+
+/* ---- demonstration collection (LIBERO HDF5) ------------------------------- */
+typedef struct hearth_sim_collect_opts {
+  hearth_sim_task task;
+  const char *release_root;
+  int use_ground_truth;
+  int layouts;          /* default 200: 2 instructions each */
+  uint64_t seed;        /* default 1 */
+  int image_size;       /* stored image side; default 128 (LIBERO) */
+  int max_steps;        /* default 400 */
+  int keep_failures;    /* store failed demos too (default 0: retry with the next layout) */
+  int quiet;
+  const char *out_path; /* .hdf5, written atomically */
+} hearth_sim_collect_opts;
+void hearth_sim_collect_opts_default(hearth_sim_collect_opts *o);
+
+typedef struct hearth_sim_collect_stats {
+  int attempts[2], successes[2]; /* per instruction */
+  int demos;
+  long steps;
+  double seconds;
+} hearth_sim_collect_stats;
+hearth_status hearth_sim_collect(const hearth_sim_collect_opts *o, hearth_sim_collect_stats *stats,
+                                 hearth_err *err);
+
+/* Render the task's scene (layout 0) to <out_prefix>_rgb.png,
+ * <out_prefix>_thermal.png and <out_prefix>_wrist.png, top row first. */
+hearth_status hearth_sim_render_scene(const hearth_sim_opts *o, uint64_t seed,
+                                      const char *out_prefix, hearth_err *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,235 @@
+/* hearth sim: the temperature-aware manipulation tasks (render, collect) */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "cli/cli.h"
+#include "hearth/hearth.h"
+#include "hearth/sim.h"
+
+static const char *k_usage =
+    "usage: hearth sim <subcommand> [options]\n"
+    "\n"
+    "The paper's LIBERO-derived tasks on MuJoCo with hearth assets:\n"
+    "  H1 study table: hot / normal cup (distractors: hot kettle, eraser)\n"
+    "  H2 kitchen table: iced / normal can (distractors: iced orange, cup)\n"
+    "  H3 kitchen table: hot phone / hot sponge (distractors: orange, hot cup)\n"
+    "\n"
+    "subcommands:\n"
+    "  render    write PNGs of each task's scene: front RGB, front thermal, wrist RGB\n"
+    "  collect   collect scripted-expert demonstrations into a LIBERO HDF5 file\n"
+    "\n"
+    "Run `hearth sim <subcommand> --help` for its options.\n";
+
+static const char *k_usage_render =
+    "usage: hearth sim render --out DIR [options]\n"
+    "\n"
+    "Render layout 0 of each task into DIR/<task>_rgb.png, <task>_thermal.png and\n"
+    "<task>_wrist.png (top row first).\n"
+    "\n"
+    "options:\n"
+    "  --out DIR         output directory (created)\n"
+    "  --task H1|H2|H3   only this task (default: all three)\n"
+    "  --release ROOT    assets from a release (derived/ meshes and thermal_turbo.png);\n"
+    "                    default: a small release made by the virtual rig\n"
+    "  --size N          image side in pixels (default 256)\n"
+    "  --seed N          layout seed (default 1)\n"
+    "  -h, --help        this text\n";
+
+static const char *k_usage_collect =
+    "usage: hearth sim collect --task H1|H2|H3 --out FILE.hdf5 [options]\n"
+    "\n"
+    "Run the scripted expert (privileged state: approach, grasp, lift, transport,\n"
+    "release) on N layouts x 2 instructions and store the successful demonstrations\n"
+    "in LIBERO's HDF5 layout with obs/agentview_thermal added. Same seed, same file.\n"
+    "\n"
+    "options:\n"
+    "  --task H1|H2|H3   the task (required)\n"
+    "  --out FILE.hdf5   output file (written atomically)\n"
+    "  --layouts N       layouts (default 200, as in the paper: 400 demos per task)\n"
+    "  --seed N          layout seed (default 1)\n"
+    "  --size N          stored image side (default 128, LIBERO's)\n"
+    "  --max-steps N     time limit per episode in control steps (default 400)\n"
+    "  --release ROOT    assets from a release (derived/); default: virtual rig\n"
+    "  --keep-failures   also store episodes that did not succeed\n"
+    "  --quiet           no progress output\n"
+    "  -h, --help        this text\n";
+
+/* assets: a release root given, or a tiny virtual-rig release in a temp dir */
+static int make_assets(const char *release, char *root, size_t rootsz, char *tmpdir, size_t tsz,
+                       int *use_gt, int quiet) {
+  tmpdir[0] = 0;
+  if (release) {
+    snprintf(root, rootsz, "%s", release);
+    *use_gt = 0;
+    return 0;
+  }
+  const char *t = getenv("TMPDIR");
+  snprintf(tmpdir, tsz, "%s/hearth_sim_assets_XXXXXX", t && *t ? t : "/tmp");
+  if (!mkdtemp(tmpdir)) {
+    fprintf(stderr, "hearth sim: cannot create a temporary directory %s\n", tmpdir);
+    tmpdir[0] = 0;
+    return 1;
+  }
+  snprintf(root, rootsz, "%s/release", tmpdir);
+  hearth_synth_opts so;
+  hearth_synth_opts_default(&so);
+  so.out_root = root;
+  const char *cats[] = {"cup", "canned_drink", "electric_kettle", "eraser", "orange", "smartphone", "sponge"};
+  so.n_categories = 7;
+  for (int i = 0; i < 7; i++) so.categories[i] = cats[i];
+  so.n_states = 3;
+  so.states[0] = "neutral", so.states[1] = "hot", so.states[2] = "iced";
+  so.n_views = 6; /* 2 azimuths per elevation: enough for the up direction */
+  so.triangles = 4000;
+  so.texture_size = 256;
+  so.map_resolution = 256;
+  so.calibration = 0;
+  so.quiet = 1;
+  if (!quiet) fprintf(stderr, "hearth sim: making assets with the virtual rig...\n");
+  hearth_err err = {0};
+  if (hearth_synth_release(&so, &err)) return cli_fail("sim", &err);
+  *use_gt = 1;
+  return 0;
+}
+
+static void drop_assets(const char *tmpdir) {
+  if (tmpdir[0]) hearth_remove_tree(tmpdir, NULL);
+}
+
+static int cmd_render(int argc, char **argv) {
+  const char *out = NULL, *release = NULL, *v;
+  hearth_sim_task only = 0;
+  long size = 256;
+  uint64_t seed = 1;
+  for (int i = 1; i < argc; i++) {
+    int r;
+    if (cli_is_help(argv[i])) {
+      fputs(k_usage_render, stdout);
+      return 0;
+    }
+    if ((r = cli_opt(argc, argv, &i, "--out", &v)) == 1) out = v;
+    else if (r == 0 && (r = cli_opt(argc, argv, &i, "--release", &v)) == 1) release = v;
+    else if (r == 0 && (r = cli_opt(argc, argv, &i, "--task", &v)) == 1) {
+      if (!(only = hearth_sim_task_parse(v))) {
+        fprintf(stderr, "hearth sim render: --task must be H1, H2 or H3, got '%s'\n", v);
+        return 2;
+      }
+    } else if (r == 0 && (r = cli_opt(argc, argv, &i, "--size", &v)) == 1) {
+      if (!cli_parse_int(v, 16, 4096, &size)) {
+        fprintf(stderr, "hearth sim render: --size must be 16..4096\n");
+        return 2;
+      }
+    } else if (r == 0 && (r = cli_opt(argc, argv, &i, "--seed", &v)) == 1) {
+      if (!cli_parse_u64(v, &seed)) {
+        fprintf(stderr, "hearth sim render: bad --seed '%s'\n", v);
+        return 2;
+      }
+    }
+    if (r == -1) {
+      fprintf(stderr, "hearth sim render: %s needs a value\n", argv[i]);
+      return 2;
+    }
+    if (r == 0) {
+      fprintf(stderr, "hearth sim render: unknown option '%s'\n%s", argv[i], k_usage_render);
+      return 2;
+    }
+  }
+  if (!out) {
+    fprintf(stderr, "hearth sim render: --out is required\n%s", k_usage_render);
+    return 2;
+  }
+  hearth_err err = {0};
+  if (hearth_mkdirs(out, &err)) return cli_fail("sim render", &err);
+  char root[4096], tmpdir[4096];
+  int use_gt;
+  if (make_assets(release, root, sizeof root, tmpdir, sizeof tmpdir, &use_gt, 0)) return 1;
+  int rc = 0;
+  for (int t = 1; t <= 3 && !rc; t++) {
+    if (only && t != (int)only) continue;
+    hearth_sim_opts o;
+    hearth_sim_opts_default(&o);
+    o.task = (hearth_sim_task)t;
+    o.release_root = root;
+    o.use_ground_truth = use_gt;
+    o.width = o.height = (int)size;
+    char prefix[4200];
+    snprintf(prefix, sizeof prefix, "%s/%s", out, hearth_sim_task_name(o.task));
+    if (hearth_sim_render_scene(&o, seed, prefix, &err)) rc = cli_fail("sim render", &err);
+    else printf("%s_{rgb,thermal,wrist}.png\n", prefix);
+  }
+  drop_assets(tmpdir);
+  return rc;
+}
+
+static int cmd_collect(int argc, char **argv) {
+  hearth_sim_collect_opts o;
+  hearth_sim_collect_opts_default(&o);
+  o.task = 0;
+  const char *release = NULL, *v;
+  for (int i = 1; i < argc; i++) {
+    int r;
+    long n;
+    if (cli_is_help(argv[i])) {
+      fputs(k_usage_collect, stdout);
+      return 0;
+    }
+    if (strcmp(argv[i], "--quiet") == 0) { o.quiet = 1; continue; }
+    if (strcmp(argv[i], "--keep-failures") == 0) { o.keep_failures = 1; continue; }
+    if ((r = cli_opt(argc, argv, &i, "--out", &v)) == 1) o.out_path = v;
+    else if (r == 0 && (r = cli_opt(argc, argv, &i, "--release", &v)) == 1) release = v;
+    else if (r == 0 && (r = cli_opt(argc, argv, &i, "--task", &v)) == 1) {
+      if (!(o.task = hearth_sim_task_parse(v))) {
+        fprintf(stderr, "hearth sim collect: --task must be H1, H2 or H3, got '%s'\n", v);
+        return 2;
+      }
+    } else if (r == 0 && (r = cli_opt(argc, argv, &i, "--layouts", &v)) == 1) {
+      if (!cli_parse_int(v, 1, 100000, &n)) { fprintf(stderr, "hearth sim collect: --layouts must be 1..100000\n"); return 2; }
+      o.layouts = (int)n;
+    } else if (r == 0 && (r = cli_opt(argc, argv, &i, "--size", &v)) == 1) {
+      if (!cli_parse_int(v, 16, 1024, &n)) { fprintf(stderr, "hearth sim collect: --size must be 16..1024\n"); return 2; }
+      o.image_size = (int)n;
+    } else if (r == 0 && (r = cli_opt(argc, argv, &i, "--max-steps", &v)) == 1) {
+      if (!cli_parse_int(v, 1, 100000, &n)) { fprintf(stderr, "hearth sim collect: --max-steps must be 1..100000\n"); return 2; }
+      o.max_steps = (int)n;
+    } else if (r == 0 && (r = cli_opt(argc, argv, &i, "--seed", &v)) == 1) {
+      if (!cli_parse_u64(v, &o.seed)) { fprintf(stderr, "hearth sim collect: bad --seed '%s'\n", v); return 2; }
+    }
+    if (r == -1) { fprintf(stderr, "hearth sim collect: %s needs a value\n", argv[i]); return 2; }
+    if (r == 0) { fprintf(stderr, "hearth sim collect: unknown option '%s'\n%s", argv[i], k_usage_collect); return 2; }
+  }
+  if (!o.task || !o.out_path) {
+    fprintf(stderr, "hearth sim collect: --task and --out are required\n%s", k_usage_collect);
+    return 2;
+  }
+  char root[4096], tmpdir[4096];
+  if (make_assets(release, root, sizeof root, tmpdir, sizeof tmpdir, &o.use_ground_truth, o.quiet)) return 1;
+  o.release_root = root;
+  hearth_err err = {0};
+  hearth_sim_collect_stats s;
+  hearth_status st = hearth_sim_collect(&o, &s, &err);
+  drop_assets(tmpdir);
+  if (st) return cli_fail("sim collect", &err);
+  for (int i = 0; i < 2; i++)
+    printf("instruction %d \"%s\": %d/%d successful\n", i + 1, hearth_sim_instruction_text(o.task, i),
+           s.successes[i], s.attempts[i]);
+  printf("%d demos, %ld steps, %.1f s (%.1f steps/s) -> %s\n", s.demos, s.steps, s.seconds,
+         s.seconds > 0 ? s.steps / s.seconds : 0.0, o.out_path);
+  return 0;
+}
+
+/* `hearth sim eval` lives in cmd_sim_eval.c (policy evaluation) */
+extern int hearth_cmd_sim_eval(int argc, char **argv) __attribute__((weak));
+
+int hearth_cmd_sim(int argc, char **argv) {
+  if (argc < 2 || cli_is_help(argv[1])) {
+    fputs(k_usage, argc < 2 ? stderr : stdout);
+    return argc < 2 ? 2 : 0;
+  }
+  if (strcmp(argv[1], "render") == 0) return cmd_render(argc - 1, argv + 1);
+  if (strcmp(argv[1], "collect") == 0) return cmd_collect(argc - 1, argv + 1);
+  if (strcmp(argv[1], "eval") == 0 && hearth_cmd_sim_eval) return hearth_cmd_sim_eval(argc - 1, argv + 1);
+  fprintf(stderr, "hearth sim: unknown subcommand '%s'\n%s", argv[1], k_usage);
+  return 2;
+}

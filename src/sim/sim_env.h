@@ -1,0 +1,36 @@
+/* private: the env struct shared by the sim sources */
+#ifndef HEARTH_SIM_ENV_H
+#define HEARTH_SIM_ENV_H
+
+#include "sim/sim_internal.h"
+
+#define SIM_NOBJ 4
+#define SIM_MAXNV 64
+
+typedef struct sim_render sim_render;
+
+struct hearth_sim_env {
+  hearth_sim_task task;
+  int width, height, max_steps, render_wrist;
+  char work_dir[4096];
+  int own_work_dir;
+  sim_asset assets[SIM_NOBJ]; /* 0, 1: candidates (instruction i targets i); 2, 3: distractors */
+  mjModel *m;
+  mjData *d;
+  int site_grip, cam_front, cam_wrist, mat_geom;
+  int arm_qadr[7], arm_dadr[7], fing_qadr[2], pad_geom[2];
+  int obj_body[SIM_NOBJ], obj_qadr[SIM_NOBJ], obj_dadr[SIM_NOBJ];
+  int obj_geom_rgb[SIM_NOBJ], obj_geom_th[SIM_NOBJ];
+  /* episode */
+  int swap, instruction, target, steps;
+  double goal_pos[3], goal_R[9], R0[9], grip_cmd;
+  int phase, phase_steps;
+  sim_render *rnd;
+};
+
+void sim_osc(hearth_sim_env *e);
+void sim_layout(uint64_t seed, uint64_t layout, double pos[SIM_NOBJ][2], int *swap);
+hearth_status sim_render_init(hearth_sim_env *e, hearth_err *err);
+void sim_render_free(hearth_sim_env *e);
+
+#endif

@@ -1,0 +1,240 @@
+/* off-screen rendering of the three views with MuJoCo's OpenGL renderer on
+ * an OSMesa (CPU) context: front RGB, front thermal (object-attached Turbo
+ * textures, unlit; everything else at room temperature), wrist RGB */
+#include <GL/osmesa.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "hearth/geom.h"
+#include "sim/sim_env.h"
+
+struct sim_render {
+  OSMesaContext gl;
+  unsigned char *glbuf;
+  mjvScene scn;
+  mjvCamera cam;
+  mjvOption opt;
+  mjrContext con;
+  int have_scn, have_con;
+  uint8_t *front, *thermal, *wrist, *seg; /* width*height*3 */
+};
+
+enum { VIEW_RGB = 0, VIEW_THERMAL = 1, VIEW_SEGMENT = 2 };
+
+hearth_status sim_render_init(hearth_sim_env *e, hearth_err *err) {
+  const char *gl = getenv("HEARTH_GL");
+  if (gl && *gl && strcmp(gl, "osmesa") != 0)
+    return hearth_err_set(err, HEARTH_E_UNSUPPORTED,
+                          "sim: HEARTH_GL=%s: this build renders with OSMesa only (HEARTH_GL=osmesa)", gl);
+  sim_render *r = calloc(1, sizeof *r);
+  if (!r) return hearth_err_set(err, HEARTH_E_NOMEM, "sim: out of memory");
+  e->rnd = r;
+  size_t px = (size_t)e->width * (size_t)e->height;
+  r->glbuf = malloc(px * 4);
+  r->front = malloc(px * 3), r->thermal = malloc(px * 3), r->wrist = malloc(px * 3), r->seg = malloc(px * 3);
+  if (!r->glbuf || !r->front || !r->thermal || !r->wrist || !r->seg)
+    return hearth_err_set(err, HEARTH_E_NOMEM, "sim: out of memory for %dx%d images", e->width, e->height);
+  r->gl = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);
+  if (!r->gl) return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "sim: OSMesa context creation failed");
+  if (!OSMesaMakeCurrent(r->gl, r->glbuf, GL_UNSIGNED_BYTE, e->width, e->height))
+    return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "sim: OSMesaMakeCurrent failed");
+  mjv_defaultScene(&r->scn);
+  mjv_defaultCamera(&r->cam);
+  mjv_defaultOption(&r->opt);
+  mjr_defaultContext(&r->con);
+  mjv_makeScene(e->m, &r->scn, 2000);
+  r->have_scn = 1;
+  mjr_makeContext(e->m, &r->con, mjFONTSCALE_100);
+  r->have_con = 1;
+  mjr_setBuffer(mjFB_OFFSCREEN, &r->con);
+  if (r->con.currentBuffer != mjFB_OFFSCREEN)
+    return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "sim: no off-screen framebuffer");
+  return HEARTH_OK;
+}
+
+void sim_render_free(hearth_sim_env *e) {
+  sim_render *r = e->rnd;
+  if (!r) return;
+  if (r->gl) OSMesaMakeCurrent(r->gl, r->glbuf, GL_UNSIGNED_BYTE, e->width, e->height);
+  if (r->have_con) mjr_freeContext(&r->con);
+  if (r->have_scn) mjv_freeScene(&r->scn);
+  if (r->gl) OSMesaDestroyContext(r->gl);
+  free(r->glbuf);
+  free(r->front), free(r->thermal), free(r->wrist), free(r->seg);
+  free(r);
+  e->rnd = NULL;
+}
+
+static int is_obj_geom(const hearth_sim_env *e, int g, const int *list) {
+  for (int k = 0; k < SIM_NOBJ; k++)
+    if (list[k] == g) return 1;
+  return 0;
+}
+
+/* render one camera; `only_geom` >= 0 keeps just that model geom */
+static void render_view(hearth_sim_env *e, int cam, int mode, int only_geom, uint8_t *out) {
+  sim_render *r = e->rnd;
+  mjModel *m = e->m;
+  OSMesaMakeCurrent(r->gl, r->glbuf, GL_UNSIGNED_BYTE, e->width, e->height);
+  r->cam.type = mjCAMERA_FIXED;
+  r->cam.fixedcamid = cam;
+  r->opt.geomgroup[2] = mode != VIEW_THERMAL;
+  r->opt.geomgroup[3] = mode == VIEW_THERMAL;
+  mjv_updateScene(m, e->d, &r->opt, NULL, &r->cam, mjCAT_ALL, &r->scn);
+  mjvScene *s = &r->scn;
+  for (int f = 0; f < mjNRNDFLAG; f++) s->flags[f] = 0;
+  s->flags[mjRND_CULL_FACE] = 1;
+  int headlight = m->vis.headlight.active;
+  if (mode == VIEW_RGB) {
+    s->flags[mjRND_SHADOW] = 1;
+  } else {
+    s->nlight = 0;
+    m->vis.headlight.active = 0;
+  }
+  if (mode == VIEW_SEGMENT) s->flags[mjRND_SEGMENT] = s->flags[mjRND_IDCOLOR] = 1;
+  if (only_geom >= 0) {
+    int n = 0;
+    for (int i = 0; i < s->ngeom; i++)
+      if (s->geoms[i].objtype == mjOBJ_GEOM && s->geoms[i].objid == only_geom) s->geoms[n++] = s->geoms[i];
+    s->ngeom = n;
+  }
+  if (mode == VIEW_THERMAL) {
+    /* everything but the assets' thermal geoms shows room temperature,
+     * unlit; emission 1 saturates the lighting sum so colours are exact */
+    uint8_t room[3];
+    sim_room_rgb(room);
+    for (int i = 0; i < s->ngeom; i++) {
+      mjvGeom *g = &s->geoms[i];
+      g->specular = g->shininess = g->reflectance = 0;
+      g->emission = 1;
+      if (g->objtype == mjOBJ_GEOM && is_obj_geom(e, g->objid, e->obj_geom_th)) {
+        g->rgba[0] = g->rgba[1] = g->rgba[2] = g->rgba[3] = 1;
+        continue;
+      }
+      g->texid = -1;
+      for (int c = 0; c < 3; c++) g->rgba[c] = room[c] / 255.0f;
+      g->rgba[3] = 1;
+    }
+  }
+  mjrRect vp = {0, 0, e->width, e->height};
+  mjr_render(vp, s, &r->con);
+  mjr_readPixels(out, NULL, vp, &r->con);
+  m->vis.headlight.active = headlight;
+}
+
+/* model geom id behind a segmentation pixel, -1 for background */
+static int seg_geom(const hearth_sim_env *e, const uint8_t *px) {
+  int id = px[0] + 256 * px[1] + 65536 * px[2] - 1;
+  const mjvScene *s = &e->rnd->scn;
+  if (id < 0) return -1;
+  /* segid survives the compaction done for single-geom renders */
+  if (id < s->ngeom && s->geoms[id].segid == id)
+    return s->geoms[id].objtype == mjOBJ_GEOM ? s->geoms[id].objid : -1;
+  for (int i = 0; i < s->ngeom; i++)
+    if (s->geoms[i].segid == id) return s->geoms[i].objtype == mjOBJ_GEOM ? s->geoms[i].objid : -1;
+  return -1;
+}
+
+hearth_status hearth_sim_observe(hearth_sim_env *e, hearth_sim_obs *o, hearth_err *err) {
+  sim_render *r = e->rnd;
+  memset(o, 0, sizeof *o);
+  o->width = e->width, o->height = e->height;
+  render_view(e, e->cam_front, VIEW_RGB, -1, r->front);
+  render_view(e, e->cam_front, VIEW_THERMAL, -1, r->thermal);
+  o->agentview_rgb = r->front, o->agentview_thermal = r->thermal;
+  if (e->render_wrist) {
+    render_view(e, e->cam_wrist, VIEW_RGB, -1, r->wrist);
+    o->eye_in_hand_rgb = r->wrist;
+  }
+  const mjData *d = e->d;
+  for (int i = 0; i < 7; i++) o->joint_states[i] = d->qpos[e->arm_qadr[i]];
+  for (int s = 0; s < 2; s++) o->gripper_states[s] = d->qpos[e->fing_qadr[s]] * (s ? -1 : 1);
+  for (int i = 0; i < 3; i++) o->ee_pos[i] = d->site_xpos[3 * e->site_grip + i];
+  const double *R = d->site_xmat + 9 * e->site_grip;
+  hearth_matrix_to_rotvec(R, o->ee_ori);
+  mju_mat2Quat(o->ee_quat, R);
+  return HEARTH_OK;
+}
+
+static long count_geom(const hearth_sim_env *e, const uint8_t *img, int geom, int box[4]) {
+  long n = 0;
+  if (box) box[0] = box[1] = 1 << 30, box[2] = box[3] = -1;
+  for (int y = 0; y < e->height; y++)
+    for (int x = 0; x < e->width; x++)
+      if (seg_geom(e, img + 3 * ((size_t)y * e->width + x)) == geom) {
+        n++;
+        if (box) {
+          if (x < box[0]) box[0] = x;
+          if (y < box[1]) box[1] = y;
+          if (x > box[2]) box[2] = x;
+          if (y > box[3]) box[3] = y;
+        }
+      }
+  return n;
+}
+
+hearth_status hearth_sim_visibility(hearth_sim_env *e, double *tf, double *of, hearth_err *err) {
+  sim_render *r = e->rnd;
+  double frac[2];
+  for (int c = 0; c < 2; c++) {
+    int k = c == 0 ? e->target : 1 - e->target, g = e->obj_geom_rgb[k];
+    render_view(e, e->cam_front, VIEW_SEGMENT, -1, r->seg);
+    long vis = count_geom(e, r->seg, g, NULL);
+    render_view(e, e->cam_front, VIEW_SEGMENT, g, r->seg);
+    long all = count_geom(e, r->seg, g, NULL);
+    frac[c] = all > 0 ? (double)vis / (double)all : 0.0;
+  }
+  if (tf) *tf = frac[0];
+  if (of) *of = frac[1];
+  return HEARTH_OK;
+}
+
+hearth_status hearth_sim_candidate_boxes(hearth_sim_env *e, int boxes[2][4], hearth_err *err) {
+  sim_render *r = e->rnd;
+  render_view(e, e->cam_front, VIEW_SEGMENT, -1, r->seg);
+  for (int slot = 0; slot < 2; slot++) {
+    int k = slot ^ e->swap;
+    if (count_geom(e, r->seg, e->obj_geom_rgb[k], boxes[slot]) == 0)
+      return hearth_err_set(err, HEARTH_E_NOT_FOUND, "sim: candidate in slot %c not visible", 'A' + slot);
+  }
+  return HEARTH_OK;
+}
+
+/* flip to top-row-first and write */
+static hearth_status write_view(const char *path, const uint8_t *img, int w, int h, hearth_err *err) {
+  hearth_image im;
+  hearth_status st = hearth_image_alloc(&im, (size_t)w, (size_t)h, 3, HEARTH_PIX_U8, err);
+  if (st) return st;
+  for (int y = 0; y < h; y++)
+    memcpy((uint8_t *)im.data + (size_t)y * w * 3, img + (size_t)(h - 1 - y) * w * 3, (size_t)w * 3);
+  st = hearth_png_write(path, &im, err);
+  hearth_image_free(&im);
+  return st;
+}
+
+hearth_status hearth_sim_render_scene(const hearth_sim_opts *o, uint64_t seed, const char *prefix,
+                                      hearth_err *err) {
+  hearth_sim_env *e = NULL;
+  hearth_status st = hearth_sim_env_new(o, &e, err);
+  if (st) return st;
+  hearth_sim_obs ob;
+  st = hearth_sim_reset(e, seed, 0, 0, err);
+  if (!st) st = hearth_sim_observe(e, &ob, err);
+  char p[4200];
+  if (!st) {
+    snprintf(p, sizeof p, "%s_rgb.png", prefix);
+    st = write_view(p, ob.agentview_rgb, ob.width, ob.height, err);
+  }
+  if (!st) {
+    snprintf(p, sizeof p, "%s_thermal.png", prefix);
+    st = write_view(p, ob.agentview_thermal, ob.width, ob.height, err);
+  }
+  if (!st && ob.eye_in_hand_rgb) {
+    snprintf(p, sizeof p, "%s_wrist.png", prefix);
+    st = write_view(p, ob.eye_in_hand_rgb, ob.width, ob.height, err);
+  }
+  hearth_sim_env_free(e);
+  return st;
+}
