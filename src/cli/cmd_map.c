@@ -21,6 +21,9 @@ static const char *k_help =
     "  --fusion F         max (paper, default) | robust (silhouette pixels rejected,\n"
     "                     weighted median across views; for iced objects)\n"
     "  --min-cos C        ignore surface seen more obliquely than this cosine (default 0)\n"
+    "  --keep-edges       also use pixels within 2 px of a depth discontinuity (the\n"
+    "                     paper's literal rule; by default they are skipped because the\n"
+    "                     lens blur mixes the two surfaces in them)\n"
     "  --views LIST       comma-separated view names to use (default: all)\n"
     "  --mesh FILE        metric mesh instead of derived/mesh.glb\n"
     "  --poses FILE       thermal poses instead of derived/poses_thermal.json\n"
@@ -75,6 +78,8 @@ int hearth_cmd_map(int argc, char **argv) {
       if (r < 0) goto missing;
       if (!cli_parse_int(v, 1, 1024, &lv)) goto bad;
       job.map.threads = (int)lv;
+    } else if (!strcmp(argv[i], "--keep-edges")) {
+      job.map.keep_edges = 1;
     } else if (!strcmp(argv[i], "--rgb")) {
       rgb = 1;
     } else if (argv[i][0] == '-') {

@@ -1,0 +1,302 @@
+/* A static HTML report of a built release: per state, the thermal texture
+ * beside the colour texture, the ground truth and the error (virtual rig),
+ * the before/after overlays, and the numbers. Everything it links is copied
+ * or drawn into the report directory, so it opens from disk in any browser. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "hearth/image.h"
+#include "hearth/npy.h"
+#include "hearth/release.h"
+#include "hearth/release_tools.h"
+
+#define PATH_SZ 4096
+
+void hearth_report_free(hearth_report *r) {
+  if (!r) return;
+  free(r->entries);
+  memset(r, 0, sizeof *r);
+}
+
+static hearth_status copy_file(const char *from, const char *to, hearth_err *err) {
+  uint8_t *d = NULL;
+  size_t n = 0;
+  hearth_status s = hearth_read_file(from, (size_t)256 << 20, &d, &n, err);
+  if (s) return s;
+  s = hearth_write_file_atomic(to, d, n, err);
+  free(d);
+  return s;
+}
+
+static int cmp_double(const void *a, const void *b) {
+  double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
+/* the k-th smallest of n sorted values at quantile q (nearest rank) */
+static double quantile(const double *v, size_t n, double q) {
+  if (!n) return NAN;
+  size_t k = (size_t)ceil(q * (double)n);
+  if (k < 1) k = 1;
+  if (k > n) k = n;
+  return v[k - 1];
+}
+
+/* a float map as a Turbo PNG over [lo, hi]; texels where keep is 0 get bg */
+static hearth_status write_turbo(const char *path, const float *v, const uint8_t *keep, size_t R,
+                                 double lo, double hi, const uint8_t bg[3], hearth_err *err) {
+  hearth_image img = {0};
+  hearth_status s = hearth_image_alloc(&img, R, R, 3, HEARTH_PIX_U8, err);
+  if (s) return s;
+  uint8_t *px = img.data;
+  for (size_t i = 0; i < R * R; i++) {
+    if ((keep && !keep[i]) || !isfinite(v[i])) memcpy(px + 3 * i, bg, 3);
+    else hearth_turbo((v[i] - lo) / (hi - lo), px + 3 * i);
+  }
+  s = hearth_png_write(path, &img, err);
+  hearth_image_free(&img);
+  return s;
+}
+
+/* numbers and images of one state; names of written files go to the html */
+static hearth_status report_state(const char *root, const char *out_dir, const char *inst,
+                                  const char *state, hearth_report_entry *e, int *have_truth_png,
+                                  int *have_overlay, hearth_err *err) {
+  char path[PATH_SZ], dst[PATH_SZ];
+  hearth_npy mask = {0}, obs = {0}, truth = {0};
+  hearth_status s;
+  memset(e, 0, sizeof *e);
+  snprintf(e->instance, sizeof e->instance, "%s", inst);
+  snprintf(e->state, sizeof e->state, "%s", state);
+  e->median_abs_c = e->p95_abs_c = e->mean_signed_c = NAN;
+  *have_truth_png = *have_overlay = 0;
+  snprintf(path, sizeof path, "%s/instances/%s/derived/%s/mask.npy", root, inst, state);
+  if ((s = hearth_npy_read(path, &mask, err))) return s;
+  snprintf(path, sizeof path, "%s/instances/%s/derived/%s/temperature_observed.npy", root, inst, state);
+  if ((s = hearth_npy_read(path, &obs, err))) goto done;
+  if (mask.ndim != 2 || obs.ndim != 2 || mask.shape[0] != obs.shape[0] || mask.dtype != HEARTH_NPY_U8 ||
+      obs.dtype != HEARTH_NPY_F32 || mask.shape[0] != mask.shape[1]) {
+    s = hearth_err_set(err, HEARTH_E_SIZE, "%s: maps of %s/%s have inconsistent shapes", path, inst, state);
+    goto done;
+  }
+  size_t R = mask.shape[0], n = R * R;
+  e->R = R;
+  const uint8_t *m = mask.data;
+  const float *o = obs.data;
+  for (size_t i = 0; i < n; i++) {
+    if (m[i] != 0) e->n_surface++;
+    if (m[i] == 1) e->n_observed++;
+  }
+  e->coverage = e->n_surface ? (double)e->n_observed / (double)e->n_surface : 0.0;
+  snprintf(path, sizeof path, "%s/instances/%s/derived/%s/thermal_turbo.png", root, inst, state);
+  snprintf(dst, sizeof dst, "%s/%s_%s_thermal.png", out_dir, inst, state);
+  if ((s = copy_file(path, dst, err))) goto done;
+
+  /* ground truth: the same UV layout at the same R */
+  snprintf(path, sizeof path, "%s/ground_truth/instances/%s/%s/temperature_true.npy", root, inst, state);
+  if (hearth_path_exists(path)) {
+    if ((s = hearth_npy_read(path, &truth, err))) goto done;
+    if (truth.ndim == 2 && truth.dtype == HEARTH_NPY_F32 && truth.shape[0] == R && truth.shape[1] == R) {
+      e->has_truth = 1;
+      const float *t = truth.data;
+      double *ad = hearth_alloc_array(e->n_observed ? e->n_observed : 1, sizeof *ad);
+      float *errmap = hearth_alloc_array(n, sizeof *errmap);
+      uint8_t *keep = hearth_alloc_array(n, 1);
+      if (!ad || !errmap || !keep) {
+        free(ad);
+        free(errmap);
+        free(keep);
+        s = hearth_err_set(err, HEARTH_E_NOMEM, "report: out of memory");
+        goto done;
+      }
+      double sum = 0;
+      for (size_t i = 0; i < n; i++) {
+        keep[i] = m[i] == 1 && isfinite(t[i]) && isfinite(o[i]);
+        errmap[i] = keep[i] ? fabsf(o[i] - t[i]) : NAN;
+        if (keep[i]) {
+          ad[e->n_compared++] = fabs((double)o[i] - (double)t[i]);
+          sum += (double)o[i] - (double)t[i];
+        }
+      }
+      qsort(ad, e->n_compared, sizeof *ad, cmp_double);
+      e->median_abs_c = quantile(ad, e->n_compared, 0.5);
+      e->p95_abs_c = quantile(ad, e->n_compared, 0.95);
+      e->mean_signed_c = e->n_compared ? sum / (double)e->n_compared : NAN;
+      const uint8_t black[3] = {0, 0, 0}, grey[3] = {60, 60, 60};
+      uint8_t *surf = keep; /* reuse: surface texels of the truth */
+      for (size_t i = 0; i < n; i++) surf[i] = isfinite(t[i]);
+      snprintf(dst, sizeof dst, "%s/%s_%s_truth.png", out_dir, inst, state);
+      s = write_turbo(dst, t, surf, R, 10.0, 60.0, black, err);
+      if (!s) {
+        snprintf(dst, sizeof dst, "%s/%s_%s_error.png", out_dir, inst, state);
+        /* error 0..5 degC; texels not observed stay grey */
+        for (size_t i = 0; i < n; i++) surf[i] = isfinite(errmap[i]);
+        s = write_turbo(dst, errmap, surf, R, 0.0, 5.0, grey, err);
+      }
+      free(ad);
+      free(errmap);
+      free(keep);
+      if (s) goto done;
+      *have_truth_png = 1;
+    }
+  }
+  snprintf(path, sizeof path, "%s/instances/%s/derived/overlay/%s/contact_sheet.png", root, inst, state);
+  if (hearth_path_exists(path)) {
+    snprintf(dst, sizeof dst, "%s/%s_%s_overlay.png", out_dir, inst, state);
+    if ((s = copy_file(path, dst, err))) goto done;
+    *have_overlay = 1;
+  }
+done:
+  hearth_npy_free(&mask);
+  hearth_npy_free(&obs);
+  hearth_npy_free(&truth);
+  return s;
+}
+
+static void html_escape(FILE *f, const char *s) {
+  for (; *s; s++) {
+    if (*s == '<') fputs("&lt;", f);
+    else if (*s == '>') fputs("&gt;", f);
+    else if (*s == '&') fputs("&amp;", f);
+    else fputc(*s, f);
+  }
+}
+
+static void fmt2(char *buf, size_t n, double x) {
+  if (!isfinite(x)) snprintf(buf, n, "n/a");
+  else hearth_format_fixed(buf, n, x, 2);
+}
+
+hearth_status hearth_report_write(const char *root, const char *out_dir, const char *title,
+                                  const char *validate_text, hearth_report *rep, hearth_err *err) {
+  memset(rep, 0, sizeof *rep);
+  char path[PATH_SZ];
+  hearth_status s = hearth_mkdirs(out_dir, err);
+  if (s) return s;
+  snprintf(path, sizeof path, "%s/release.json", root);
+  hearth_release_doc rel = {0};
+  if ((s = hearth_release_read(path, &rel, err))) return s;
+  size_t cap = rel.n_instances * HEARTH_MAX_STATES;
+  rep->entries = calloc(cap ? cap : 1, sizeof *rep->entries);
+  int *truth_png = calloc(cap ? cap : 1, sizeof *truth_png), *overlay = calloc(cap ? cap : 1, sizeof *overlay);
+  int *colour = calloc(rel.n_instances ? rel.n_instances : 1, sizeof *colour);
+  if (!rep->entries || !truth_png || !overlay || !colour) {
+    s = hearth_err_set(err, HEARTH_E_NOMEM, "report: out of memory");
+    goto done;
+  }
+  for (size_t i = 0; i < rel.n_instances; i++) {
+    const char *inst = rel.instances[i];
+    hearth_instance_doc doc;
+    snprintf(path, sizeof path, "%s/instances/%s/instance.json", root, inst);
+    if ((s = hearth_instance_read(path, &doc, err))) goto done;
+    /* the colour texture: baked if present, else the reconstruction's */
+    char dst[PATH_SZ];
+    snprintf(dst, sizeof dst, "%s/%s_colour.png", out_dir, inst);
+    snprintf(path, sizeof path, "%s/instances/%s/derived/rgb_texture.png", root, inst);
+    if (!hearth_path_exists(path))
+      snprintf(path, sizeof path, "%s/instances/%s/recon/rgb_texture.png", root, inst);
+    if (hearth_path_exists(path)) {
+      if ((s = copy_file(path, dst, err))) goto done;
+      colour[i] = 1;
+    }
+    for (size_t k = 0; k < doc.n_states; k++) {
+      size_t j = rep->n;
+      if ((s = report_state(root, out_dir, inst, doc.states[k], &rep->entries[j], &truth_png[j],
+                            &overlay[j], err)))
+        goto done;
+      rep->n++;
+    }
+  }
+
+  /* the page */
+  snprintf(path, sizeof path, "%s/index.html", out_dir);
+  hearth_atomic_file af;
+  if ((s = hearth_atomic_open(&af, path, err))) goto done;
+  FILE *f = af.fp;
+  fputs("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>", f);
+  html_escape(f, title ? title : "hearth report");
+  fputs("</title>\n<style>\n"
+        "body{font-family:sans-serif;margin:24px;background:#fafafa;color:#222}\n"
+        "table.n{border-collapse:collapse;margin:8px 0}\n"
+        "table.n td,table.n th{border:1px solid #bbb;padding:3px 8px;text-align:right}\n"
+        "table.n th{background:#eee}\n"
+        ".row{display:flex;flex-wrap:wrap;gap:12px;align-items:flex-start}\n"
+        "figure{margin:0;background:#fff;border:1px solid #ddd;padding:6px}\n"
+        "figure img{width:256px;height:256px;image-rendering:pixelated;display:block}\n"
+        "figure.wide img{width:auto;height:auto;max-width:780px}\n"
+        "figcaption{font-size:12px;color:#555;max-width:256px}\n"
+        ".bar{height:12px;width:256px;background:linear-gradient(to right,"
+        "#30123b,#4662d7,#36aaf9,#1ae4b6,#72fe5e,#c8ef34,#faba39,#f66b19,#ca2a04,#7a0403)}\n"
+        "pre{background:#fff;border:1px solid #ddd;padding:8px;white-space:pre-wrap}\n"
+        "</style></head><body>\n<h1>", f);
+  html_escape(f, title ? title : "hearth report");
+  fputs("</h1>\n<p>Release: <code>", f);
+  html_escape(f, root);
+  fputs("</code>. Thermal textures use the Turbo colour map over a fixed 10&ndash;60 &deg;C "
+        "(<span style=\"display:inline-block;vertical-align:middle\" class=\"bar\"></span>); "
+        "error maps show |observed &minus; true| over 0&ndash;5 &deg;C on observed texels "
+        "(grey: not observed). Every texture is in the mesh's UV layout (row 0 at v = 0), so "
+        "thermal, colour and ground truth line up texel for texel.</p>\n", f);
+  fputs("<h2>Summary</h2>\n<table class=\"n\"><tr><th>instance</th><th>state</th><th>R</th>"
+        "<th>surface texels</th><th>observed</th><th>median |err| &deg;C</th>"
+        "<th>p95 |err| &deg;C</th><th>mean err &deg;C</th></tr>\n", f);
+  for (size_t j = 0; j < rep->n; j++) {
+    const hearth_report_entry *e = &rep->entries[j];
+    char cov[32], med[32], p95[32], mean[32];
+    hearth_format_fixed(cov, sizeof cov, 100.0 * e->coverage, 1);
+    fmt2(med, sizeof med, e->median_abs_c);
+    fmt2(p95, sizeof p95, e->p95_abs_c);
+    fmt2(mean, sizeof mean, e->mean_signed_c);
+    fprintf(f, "<tr><td style=\"text-align:left\"><a href=\"#%s_%s\">%s</a></td><td style=\"text-align:left\">%s</td>"
+            "<td>%zu</td><td>%zu</td><td>%s %%</td><td>%s</td><td>%s</td><td>%s</td></tr>\n",
+            e->instance, e->state, e->instance, e->state, e->R, e->n_surface, cov, med, p95, mean);
+  }
+  fputs("</table>\n", f);
+  if (validate_text) {
+    fputs("<h2>Validation</h2>\n<pre>", f);
+    html_escape(f, validate_text);
+    fputs("</pre>\n", f);
+  }
+  size_t j = 0;
+  for (size_t i = 0; i < rel.n_instances; i++) {
+    const char *inst = rel.instances[i];
+    for (; j < rep->n && !strcmp(rep->entries[j].instance, inst); j++) {
+      const hearth_report_entry *e = &rep->entries[j];
+      char cov[32], med[32], p95[32];
+      hearth_format_fixed(cov, sizeof cov, 100.0 * e->coverage, 1);
+      fmt2(med, sizeof med, e->median_abs_c);
+      fmt2(p95, sizeof p95, e->p95_abs_c);
+      fprintf(f, "<h2 id=\"%s_%s\">%s &mdash; %s</h2>\n<p>%s %% of the surface observed; "
+              "median |error| %s &deg;C, p95 %s &deg;C against ground truth.</p>\n<div class=\"row\">\n",
+              e->instance, e->state, e->instance, e->state, cov, med, p95);
+      fprintf(f, "<figure><img src=\"%s_%s_thermal.png\" alt=\"thermal texture\"><figcaption>thermal "
+              "texture (Turbo, 10&ndash;60 &deg;C), derived/%s/thermal_turbo.png</figcaption></figure>\n",
+              inst, e->state, e->state);
+      if (colour[i])
+        fprintf(f, "<figure><img src=\"%s_colour.png\" alt=\"colour texture\"><figcaption>colour "
+                "texture, same UV layout</figcaption></figure>\n", inst);
+      if (truth_png[j]) {
+        fprintf(f, "<figure><img src=\"%s_%s_truth.png\" alt=\"ground truth\"><figcaption>ground "
+                "truth temperature (Turbo, 10&ndash;60 &deg;C)</figcaption></figure>\n", inst, e->state);
+        fprintf(f, "<figure><img src=\"%s_%s_error.png\" alt=\"error\"><figcaption>|observed &minus; "
+                "true| (Turbo, 0&ndash;5 &deg;C; grey not observed)</figcaption></figure>\n", inst, e->state);
+      }
+      fputs("</div>\n", f);
+      if (overlay[j])
+        fprintf(f, "<div class=\"row\"><figure class=\"wide\"><img src=\"%s_%s_overlay.png\" "
+                "alt=\"overlays\"><figcaption style=\"max-width:780px\">mesh outlines on the thermal "
+                "views: before (transferred poses) and after refinement</figcaption></figure></div>\n",
+                inst, e->state);
+    }
+  }
+  fputs("<p style=\"color:#777;font-size:12px\">Made by hearth " HEARTH_VERSION
+        ". Static page: open it from disk, no server needed.</p>\n</body></html>\n", f);
+  s = hearth_atomic_commit(&af, err);
+done:
+  free(truth_png);
+  free(overlay);
+  free(colour);
+  hearth_release_free(&rel);
+  return s;
+}
