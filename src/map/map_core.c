@@ -7,6 +7,7 @@
  * view order. Within a view, pixels are visited in raster order by one
  * thread. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include "hearth/map.h"
@@ -263,47 +264,79 @@ static float weighted_median(vw *a, size_t n) {
 
 /* nearest-observed fill restricted to islands: repeated forward/backward
  * sweeps propagate the nearest seed (Euclidean distance in texels) through
- * texels of the same island; ties go to the lower seed index */
+ * texels of the same island; ties go to the lower seed index. Rows without
+ * a texel to fill are skipped; seed coordinates are kept beside the index
+ * so the inner loop does no division. */
 static void fill_islands(size_t R, const uint32_t *island_of_texel, uint8_t *mask, int32_t *seed) {
   size_t N = R * R;
-  for (size_t q = 0; q < N; q++) seed[q] = mask[q] == HEARTH_TEXEL_OBSERVED ? (int32_t)q : -1;
+  int32_t *sx = malloc(N * sizeof *sx), *sy = malloc(N * sizeof *sy);
+  uint8_t *row_active = calloc(R, 1);
+  if (!sx || !sy || !row_active) {
+    /* without scratch nothing is filled: every unobserved texel stays so */
+    for (size_t q = 0; q < N; q++) seed[q] = mask[q] == HEARTH_TEXEL_OBSERVED ? (int32_t)q : -1;
+    free(sx);
+    free(sy);
+    free(row_active);
+    return;
+  }
+  for (size_t y = 0; y < R; y++)
+    for (size_t x = 0; x < R; x++) {
+      size_t q = y * R + x;
+      int obs = mask[q] == HEARTH_TEXEL_OBSERVED;
+      seed[q] = obs ? (int32_t)q : -1;
+      sx[q] = obs ? (int32_t)x : 0;
+      sy[q] = obs ? (int32_t)y : 0;
+      if (!obs && island_of_texel[q] != UINT32_MAX) row_active[y] = 1;
+    }
   static const int fdx[4] = {-1, -1, 0, 1}, fdy[4] = {0, -1, -1, -1};
-  int changed = 1;
-  for (int pass = 0; changed && pass < 64; pass++) {
+  int changed = 1, pass = 0;
+  for (pass = 0; changed && pass < 64; pass++) {
     changed = 0;
     for (int dir = 0; dir < 2; dir++) {
-      for (size_t k = 0; k < N; k++) {
-        size_t q = dir == 0 ? k : N - 1 - k;
-        uint32_t isl = island_of_texel[q];
-        if (isl == UINT32_MAX || mask[q] == HEARTH_TEXEL_OBSERVED) continue;
-        long x = (long)(q % R), y = (long)(q / R);
-        int32_t best = seed[q];
-        double bd = 0;
-        if (best >= 0) {
-          double sx = (double)(best % (int32_t)R) - (double)x, sy = (double)(best / (int32_t)R) - (double)y;
-          bd = sx * sx + sy * sy;
-        }
-        for (int j = 0; j < 4; j++) {
-          long nx = x + (dir == 0 ? fdx[j] : -fdx[j]), ny = y + (dir == 0 ? fdy[j] : -fdy[j]);
-          if (nx < 0 || ny < 0 || nx >= (long)R || ny >= (long)R) continue;
-          size_t nq = (size_t)ny * R + (size_t)nx;
-          if (island_of_texel[nq] != isl) continue;
-          int32_t s = seed[nq];
-          if (s < 0) continue;
-          double sx = (double)(s % (int32_t)R) - (double)x, sy = (double)(s / (int32_t)R) - (double)y;
-          double d = sx * sx + sy * sy;
-          if (best < 0 || d < bd || (d == bd && s < best)) {
-            best = s;
-            bd = d;
+      int sg = dir == 0 ? 1 : -1;
+      for (size_t k = 0; k < R; k++) {
+        long y = dir == 0 ? (long)k : (long)(R - 1 - k);
+        if (!row_active[y]) continue;
+        for (size_t kx = 0; kx < R; kx++) {
+          long x = dir == 0 ? (long)kx : (long)(R - 1 - kx);
+          size_t q = (size_t)y * R + (size_t)x;
+          uint32_t isl = island_of_texel[q];
+          if (isl == UINT32_MAX || mask[q] == HEARTH_TEXEL_OBSERVED) continue;
+          int32_t best = seed[q];
+          double bd = 0;
+          if (best >= 0) {
+            double ex = (double)(sx[q] - x), ey = (double)(sy[q] - y);
+            bd = ex * ex + ey * ey;
           }
-        }
-        if (best != seed[q]) {
-          seed[q] = best;
-          changed = 1;
+          int32_t bx = sx[q], by = sy[q];
+          for (int j = 0; j < 4; j++) {
+            long nx = x + sg * fdx[j], ny = y + sg * fdy[j];
+            if (nx < 0 || ny < 0 || nx >= (long)R || ny >= (long)R) continue;
+            size_t nq = (size_t)ny * R + (size_t)nx;
+            int32_t s = seed[nq];
+            if (s < 0 || island_of_texel[nq] != isl) continue;
+            double ex = (double)(sx[nq] - x), ey = (double)(sy[nq] - y);
+            double d = ex * ex + ey * ey;
+            if (best < 0 || d < bd || (d == bd && s < best)) {
+              best = s;
+              bd = d;
+              bx = sx[nq];
+              by = sy[nq];
+            }
+          }
+          if (best != seed[q]) {
+            seed[q] = best;
+            sx[q] = bx;
+            sy[q] = by;
+            changed = 1;
+          }
         }
       }
     }
   }
+  free(sx);
+  free(sy);
+  free(row_active);
 }
 
 static void free_scratch(map_ctx *m) {
