@@ -1,0 +1,197 @@
+#!/usr/bin/python3
+"""Calibration check: hearth detect + calibrate against the virtual rig's
+ground truth and against OpenCV (cv2.calibrateCamera / cv2.stereoCalibrate)
+on the same detected points, with the time ratio.
+
+usage: /usr/bin/python3 bench/calib_vs_opencv.py ROOT [--hearth PATH] [--runs N]
+
+ROOT is a release with calibration/captures and calibration/factory.json
+(a virtual-rig release also has ground_truth/). The script runs
+`hearth detect ROOT --no-overlays` and `hearth calibrate ROOT`, so it
+rewrites calibration/detections.json, rig.json, rig_opencv.yaml and
+calibration_report.json (the default calibration is left in place at the
+end). The OpenCV comparison runs hearth with --no-perspective-correction so
+both solvers see exactly the same points and frames. Exit status 1 if a
+Done-means figure fails.
+"""
+import json
+import math
+import os
+import subprocess
+import sys
+import time
+
+import numpy as np
+import cv2
+
+PITCH, ROW = 0.012, 0.0103923
+
+
+def plate_points():
+    pts = []
+    for r in range(8):
+        for c in range(11 if r % 2 == 0 else 10):
+            pts.append([PITCH * c + (PITCH / 2 if r % 2 else 0.0), ROW * r, 0.0])
+    return np.array(pts, dtype=np.float32)
+
+
+def cam(block):
+    return np.array(block["K"], dtype=np.float64), np.array(block["dist"], dtype=np.float64)
+
+
+def rot_angle_deg(Ra, Rb):
+    c = (np.trace(Ra.T @ Rb) - 1) / 2
+    return math.degrees(math.acos(max(-1.0, min(1.0, c))))
+
+
+def run(cmd):
+    t0 = time.perf_counter()
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    dt = time.perf_counter() - t0
+    if p.returncode != 0:
+        sys.stderr.write(p.stdout + p.stderr)
+        sys.exit("command failed: " + " ".join(cmd))
+    return dt
+
+
+def main():
+    args = sys.argv[1:]
+    if not args or args[0] in ("-h", "--help"):
+        print(__doc__)
+        return 0
+    root = args[0]
+    exe = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "build", "hearth")
+    runs = 3
+    i = 1
+    while i < len(args):
+        if args[i] == "--hearth":
+            exe = args[i + 1]
+            i += 2
+        elif args[i] == "--runs":
+            runs = int(args[i + 1])
+            i += 2
+        else:
+            sys.exit("unknown option " + args[i])
+    if not os.access(exe, os.X_OK):
+        sys.exit("no hearth executable at %s (use --hearth PATH)" % exe)
+    ok = True
+
+    # ---- hearth: detection + calibration, timed (best of runs) ----
+    t_det = min(run([exe, "detect", root, "--no-overlays", "--quiet"]) for _ in range(runs))
+    t_cal = min(run([exe, "calibrate", root, "--quiet"]) for _ in range(runs))
+    cal = os.path.join(root, "calibration")
+    det = json.load(open(os.path.join(cal, "detections.json")))
+    rig = json.load(open(os.path.join(cal, "rig.json")))
+    fac = json.load(open(os.path.join(cal, "factory.json")))
+    rep = json.load(open(os.path.join(cal, "calibration_report.json")))
+    fs = cv2.FileStorage(os.path.join(cal, "rig_opencv.yaml"), cv2.FILE_STORAGE_READ)
+    yK = fs.getNode("thermal_K").mat()
+    fs.release()
+    Kt, Dt = cam(rig["thermal"])
+    print("rig_opencv.yaml: cv2.FileStorage reads thermal_K, max diff vs rig.json %.2e"
+          % np.abs(yK - Kt).max())
+    ok &= bool(np.abs(yK - Kt).max() < 1e-9)
+    frames = {(f["frame"], f["camera"]): f for f in det["frames"]}
+
+    # ---- against ground truth ----
+    gt_path = os.path.join(root, "ground_truth", "calibration", "detections.json")
+    if os.path.exists(gt_path):
+        gt = json.load(open(gt_path))
+        full = [f for f in gt["frames"] if f["found"]]
+        found = [f for f in full if frames.get((f["frame"], f["camera"]), {}).get("found")]
+        false_pos = [f for f in gt["frames"] if not f["found"]
+                     and frames.get((f["frame"], f["camera"]), {}).get("found")]
+        err = {"thermal": [], "rgb": []}
+        misordered = 0
+        for f in found:
+            a = np.array(frames[(f["frame"], f["camera"])]["centres"])
+            b = np.array(f["centres"])
+            d = np.linalg.norm(a - b, axis=1)
+            # mis-ordered: a centre nearer another hole's truth than its own
+            nn = np.argmin(np.linalg.norm(a[:, None, :] - b[None, :, :], axis=2), axis=1)
+            if np.any(nn != np.arange(len(b))):
+                misordered += 1
+                continue
+            err[f["camera"]].extend((d ** 2).tolist())
+        rate = len(found) / max(1, len(full))
+        rms_t = math.sqrt(np.mean(err["thermal"])) if err["thermal"] else float("nan")
+        rms_c = math.sqrt(np.mean(err["rgb"])) if err["rgb"] else float("nan")
+        print("detection: %d of %d full-view frames found (%.1f%%), %d partial frames accepted, "
+              "%d mis-ordered" % (len(found), len(full), 100 * rate, len(false_pos), misordered))
+        print("centre error vs truth: thermal %.4f px RMS, colour %.4f px RMS" % (rms_t, rms_c))
+        ok &= rate >= 0.98 and misordered == 0 and rms_t <= 0.05 and rms_c <= 0.1
+        ok &= len(false_pos) == 0
+        grig = json.load(open(os.path.join(root, "ground_truth", "rig.json")))
+        Kg, Dg = cam(grig["thermal"])
+        efx = abs(Kt[0, 0] / Kg[0, 0] - 1) * 100
+        efy = abs(Kt[1, 1] / Kg[1, 1] - 1) * 100
+        ecx, ecy = abs(Kt[0, 2] - Kg[0, 2]), abs(Kt[1, 2] - Kg[1, 2])
+        print("thermal intrinsics vs truth: fx %.3f%%, fy %.3f%%, cx %.3f px, cy %.3f px"
+              % (efx, efy, ecx, ecy))
+        ok &= efx <= 0.2 and efy <= 0.2 and ecx <= 0.5 and ecy <= 0.5
+        Rg = np.array(grig["T_thermal_from_rgb"]["R"])
+        tg = np.array(grig["T_thermal_from_rgb"]["t"])
+        R = np.array(rig["T_thermal_from_rgb"]["R"])
+        t = np.array(rig["T_thermal_from_rgb"]["t"])
+        ang = rot_angle_deg(R, Rg)
+        dt = np.linalg.norm(t - tg) * 1000
+        print("stereo vs truth: rotation %.4f deg, translation %.3f mm; stereo RMS %.4f px, "
+              "thermal RMS %.4f px" % (ang, dt, rig["stereo_rms_px"], rig["thermal_rms_px"]))
+        ok &= ang <= 0.05 and dt <= 0.5 and rig["stereo_rms_px"] <= 0.3
+
+    # ---- OpenCV on the same points: hearth without its perspective
+    # correction (OpenCV has none), same frames and pairs ----
+    run([exe, "calibrate", root, "--quiet", "--no-perspective-correction"])
+    rig = json.load(open(os.path.join(cal, "rig.json")))
+    rep = json.load(open(os.path.join(cal, "calibration_report.json")))
+    Kt, Dt = cam(rig["thermal"])
+    obj = plate_points()
+    used_t = [f["frame"] for f in rep["thermal_frames"] if f["used"]]
+    used_p = [f["frame"] for f in rep["stereo_pairs"] if f["used"]]
+    ipts = [np.array(frames[(n, "thermal")]["centres"], dtype=np.float32).reshape(-1, 1, 2)
+            for n in used_t]
+    crit = (cv2.TERM_CRITERIA_COUNT + cv2.TERM_CRITERIA_EPS, 100, 1e-15)
+    Ka, Da = cam(fac["rgb"])
+    pa = [np.array(frames[(n, "rgb")]["centres"], dtype=np.float32).reshape(-1, 1, 2)
+          for n in used_p]
+    pb = [np.array(frames[(n, "thermal")]["centres"], dtype=np.float32).reshape(-1, 1, 2)
+          for n in used_p]
+
+    def opencv_all():
+        rms, K, D, _, _ = cv2.calibrateCamera([obj] * len(ipts), ipts, (256, 192), None, None,
+                                              flags=0, criteria=crit)
+        srms, _, _, _, _, R, T, _, _ = cv2.stereoCalibrate(
+            [obj] * len(pa), pa, pb, Ka, Da, Kt, Dt, (1920, 1080),
+            flags=cv2.CALIB_FIX_INTRINSIC, criteria=crit)
+        return rms, K, D, srms, R, T
+
+    times = []
+    for _ in range(runs):
+        t0 = time.perf_counter()
+        rms, K, D, srms, R, T = opencv_all()
+        times.append(time.perf_counter() - t0)
+    t_cv = min(times)
+    d_rms = abs(rms - rig["thermal_rms_px"])
+    d_srms = abs(srms - rig["stereo_rms_px"])
+    d_K = np.abs(K - Kt).max()
+    print("OpenCV calibrateCamera (%d frames): RMS %.6f vs hearth %.6f (diff %.2e px); "
+          "max |K diff| %.2e px; max |dist diff| %.2e"
+          % (len(ipts), rms, rig["thermal_rms_px"], d_rms, d_K, np.abs(D.ravel() - Dt).max()))
+    tR = np.array(rig["T_thermal_from_rgb"]["R"])
+    tT = np.array(rig["T_thermal_from_rgb"]["t"])
+    print("OpenCV stereoCalibrate (%d pairs, intrinsics fixed): RMS %.6f vs hearth %.6f "
+          "(diff %.2e px); R %.2e deg, T %.2e mm apart"
+          % (len(pa), srms, rig["stereo_rms_px"], d_srms, rot_angle_deg(R, tR),
+             np.linalg.norm(T.ravel() - tT) * 1000))
+    ok &= d_rms <= 1e-3 and d_srms <= 1e-3 and d_K <= 1e-2
+    print("time: hearth detect %.3f s + calibrate %.3f s = %.3f s; OpenCV calibration alone "
+          "%.3f s; ratio hearth/OpenCV %.2f (best of %d)"
+          % (t_det, t_cal, t_det + t_cal, t_cv, (t_det + t_cal) / t_cv, runs))
+    # leave the default calibration in place
+    run([exe, "calibrate", root, "--quiet"])
+    print("RESULT:", "PASS" if ok else "FAIL")
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

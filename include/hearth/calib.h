@@ -1,0 +1,140 @@
+/* hearth/calib.h - the 84-hole plate: hole-centre detection in colour and
+ * thermal images, thermal intrinsics (Zhang + Levenberg-Marquardt) and the
+ * RGB-thermal stereo transform, plus the release-level `detect` and
+ * `calibrate` stages.
+ *
+ * Detection never alters its input: thermal enhancement (percentile clip,
+ * 8-bit, upsampling) works on a private copy and the final centres are
+ * intensity-weighted centroids on the raw matrix, in native pixels.
+ * Centres come out in plate order (hearth_plate_hole), so index i is the same
+ * hole in every frame and camera; a frame that cannot be ordered with
+ * certainty is reported found = 0 with a reason, never guessed. */
+#ifndef HEARTH_CALIB_H
+#define HEARTH_CALIB_H
+
+#include <stddef.h>
+#include "hearth/core.h"
+#include "hearth/camera.h"
+#include "hearth/geom.h"
+#include "hearth/image.h"
+#include "hearth/release.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---- detection ------------------------------------------------------------- */
+typedef struct hearth_detect_opts {
+  int upsample;       /* thermal upsampling before blob detection; default 4 */
+  double clip_lo_pct; /* thermal percentile clip bounds; default 1 and 99.5 */
+  double clip_hi_pct;
+  double max_blur_frac; /* reject frames whose estimated blur sigma exceeds this
+                           fraction of the hole radius; default 0.4 (the
+                           estimate reads low: 2.5 px blur on 3 px holes gives 0.28,
+                           the virtual rig 1.3 px blurred frames up to 0.28) */
+} hearth_detect_opts;
+void hearth_detect_opts_default(hearth_detect_opts *o);
+
+/* Thermal matrix (1-channel F32, degC), holes warmer than the plate. Fills
+ * det->found, det->reason, det->centres (native pixels); det->frame and
+ * det->camera are left to the caller. Errors only for invalid arguments. */
+hearth_status hearth_detect_plate_thermal(const hearth_image *temps, const hearth_detect_opts *o,
+                                          hearth_detection *det, hearth_err *err);
+/* Colour or gray U8 image (1, 3 or 4 channels), holes darker than the plate. */
+hearth_status hearth_detect_plate_color(const hearth_image *img, const hearth_detect_opts *o,
+                                        hearth_detection *det, hearth_err *err);
+
+/* Order n candidate centres (pixels, any order, possibly with outliers) by
+ * the plate's lattice and row structure. Returns 1 and fills centres[84] if
+ * exactly the plate's 84 holes were identified, else 0 with a reason. */
+int hearth_plate_order(const double (*pts)[2], size_t n, double centres[HEARTH_PLATE_HOLES][2],
+                       char *reason, size_t reason_size);
+
+/* ---- calibration ------------------------------------------------------------- */
+typedef struct hearth_calib_opts {
+  int max_iterations;    /* Levenberg-Marquardt; default 100 */
+  double outlier_factor; /* stereo: reject pairs whose RMS > factor * median ... */
+  double outlier_min_px; /* ... and above this floor; defaults 2.5 and 0.01 px */
+  /* release stage only: correct the perspective bias of hole centroids (the
+   * centroid of a tilted hole's image is not the image of its centre) from
+   * the estimated poses, and re-solve; default 1 */
+  int perspective_correction;
+  double hole_radius_m; /* default 0.004 */
+} hearth_calib_opts;
+void hearth_calib_opts_default(hearth_calib_opts *o);
+
+/* Intrinsics and 5-parameter distortion from n_frames views of n_pts known
+ * planar points (obj z = 0). img holds n_frames * n_pts (u, v) pairs, frame
+ * after frame. Zhang's closed form initialises, then LM refines intrinsics,
+ * distortion and every pose. Outputs: cam (width/height set from the
+ * arguments), rms_px = sqrt(mean squared point error), optionally per-frame
+ * RMS (n_frames) and T_cam_from_plate (n_frames). */
+hearth_status hearth_calib_intrinsics(const double (*obj)[3], size_t n_pts, const double *img,
+                                      size_t n_frames, int width, int height,
+                                      const hearth_calib_opts *o, hearth_camera *cam,
+                                      double *rms_px, double *frame_rms,
+                                      hearth_rigid *T_cam_from_plate, hearth_err *err);
+
+/* Pose of a plate seen by a calibrated camera (homography start + LM). */
+hearth_status hearth_calib_pose(const hearth_camera *cam, const double (*obj)[3], size_t n_pts,
+                                const double *img, hearth_rigid *T_cam_from_plate, double *rms_px,
+                                hearth_err *err);
+
+/* Stereo with both intrinsics fixed: T_b_from_a from n_pairs views of the
+ * plate (img_a, img_b laid out as in hearth_calib_intrinsics). Jointly
+ * refines T_b_from_a and the per-pair plate poses in camera a. Pairs whose
+ * RMS exceeds the outlier rule are dropped and the solve repeated.
+ * rms_px = sqrt(mean squared point error over both cameras and the pairs
+ * used). pair_rms (n_pairs) and pair_used (n_pairs) may be NULL. */
+hearth_status hearth_calib_stereo(const hearth_camera *cam_a, const hearth_camera *cam_b,
+                                  const double (*obj)[3], size_t n_pts, const double *img_a,
+                                  const double *img_b, size_t n_pairs, const hearth_calib_opts *o,
+                                  hearth_rigid *T_b_from_a, double *rms_px, double *pair_rms,
+                                  int *pair_used, hearth_err *err);
+
+/* ---- release stages ----------------------------------------------------------- */
+/* Detect the plate in every capture under <root>/calibration/captures and
+ * write <root>/calibration/detections.json and, if overlays, the
+ * calibration/overlays/<frame>_<camera>.png images. Frames are listed
+ * thermal fNNN first, then each stereo pair pNNN (rgb, thermal). */
+typedef struct hearth_detect_run {
+  hearth_detect_opts detect;
+  int overlays; /* default 1 */
+  int threads;  /* 0 = hearth_default_threads() */
+  int quiet;
+} hearth_detect_run;
+void hearth_detect_run_default(hearth_detect_run *r);
+hearth_status hearth_calib_detect_release(const char *root, const hearth_detect_run *r,
+                                          hearth_detections *out, hearth_err *err);
+
+/* What `calibrate` did, frame by frame. */
+typedef struct hearth_calib_frame_report {
+  char frame[HEARTH_NAME_MAX];
+  int used;      /* 0: not found in detection, or rejected as an outlier */
+  double rms_px; /* per-frame RMS (stereo: both cameras), NAN if unused */
+  char note[96];
+} hearth_calib_frame_report;
+
+typedef struct hearth_calib_report {
+  size_t n_thermal, n_pairs;
+  hearth_calib_frame_report *thermal; /* owned */
+  hearth_calib_frame_report *pairs;   /* owned */
+  hearth_rig rig;
+  double t_calib_s;       /* seconds spent reading, solving (not writing) */
+} hearth_calib_report;
+void hearth_calib_report_free(hearth_calib_report *r);
+
+/* Read calibration/detections.json and calibration/factory.json, calibrate,
+ * write calibration/rig.json, calibration/rig_opencv.yaml and
+ * calibration/calibration_report.json (all atomically, all or nothing). */
+hearth_status hearth_calib_calibrate_release(const char *root, const hearth_calib_opts *o,
+                                             hearth_calib_report *rep, hearth_err *err);
+
+/* An OpenCV FileStorage YAML of the rig (cv2.FileStorage reads it). */
+hearth_status hearth_calib_write_opencv_yaml(const char *path, const hearth_rig *rig,
+                                             hearth_err *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,564 @@
+/* Hole-centre detection on the 84-hole plate.
+ *
+ * Colour: the holes are dark blobs on the white plate. Thermal: the holes
+ * show the warmed backing; the matrix is percentile-clipped, scaled to 8
+ * bits and upsampled (a private copy) so blob detection has smooth shapes to
+ * work with. Either way the blobs are ordered by the plate lattice
+ * (calib_order.c) and each centre is then refined as an intensity-weighted
+ * centroid on the raw values (thermal: the untouched matrix, native pixels)
+ * inside an elliptical window shaped by the blob's own second moments. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "calib/calib_internal.h"
+
+void hearth_detect_opts_default(hearth_detect_opts *o) {
+  memset(o, 0, sizeof *o);
+  o->upsample = 4;
+  o->clip_lo_pct = 1.0;
+  o->clip_hi_pct = 99.5;
+  o->max_blur_frac = 0.4;
+}
+
+typedef struct blob {
+  double area;          /* in the detection image's pixels */
+  double cx, cy;        /* native pixels */
+  double sxx, sxy, syy; /* covariance, native pixels^2 */
+  int touches_border;
+} blob;
+
+/* Otsu threshold of a 256-bin histogram */
+static int otsu(const size_t hist[256]) {
+  double total = 0, sum = 0;
+  for (int i = 0; i < 256; i++) {
+    total += (double)hist[i];
+    sum += (double)i * (double)hist[i];
+  }
+  double wb = 0, sb = 0, best = -1;
+  int thr = 128;
+  for (int t = 0; t < 256; t++) {
+    wb += (double)hist[t];
+    if (wb == 0) continue;
+    double wf = total - wb;
+    if (wf == 0) break;
+    sb += (double)t * (double)hist[t];
+    double mb = sb / wb, mf = (sum - sb) / wf;
+    double between = wb * wf * (mb - mf) * (mb - mf);
+    if (between > best) {
+      best = between;
+      thr = t;
+    }
+  }
+  return thr;
+}
+
+/* connected components (8-connected) of pixels > thr in a U8 image, by
+ * runs: each row's foreground runs are joined to overlapping runs of the row
+ * above with union-find, and the moments are summed in closed form per run.
+ * Blob statistics are converted to native pixels: native = (j + 0.5) s - 0.5. */
+typedef struct run_t {
+  int32_t parent;
+  int32_t x0, x1; /* inclusive */
+  int32_t y;
+} run_t;
+
+static int32_t run_find(run_t *r, int32_t i) {
+  while (r[i].parent != i) {
+    r[i].parent = r[r[i].parent].parent;
+    i = r[i].parent;
+  }
+  return i;
+}
+
+static hearth_status find_blobs(const uint8_t *img, size_t w, size_t h, int thr, double s,
+                                blob **out, size_t *n_out, hearth_err *err) {
+  size_t cap = 4096, nr = 0;
+  run_t *runs = malloc(sizeof(run_t) * cap);
+  if (!runs) return hearth_err_set(err, HEARTH_E_NOMEM, "blob detection: out of memory");
+  size_t prev_begin = 0, prev_end = 0;
+  for (size_t y = 0; y < h; y++) {
+    const uint8_t *row = img + y * w;
+    size_t cur_begin = nr, p = prev_begin;
+    size_t x = 0;
+    while (x < w) {
+      while (x < w && row[x] <= thr) x++;
+      if (x >= w) break;
+      size_t x0 = x;
+      while (x < w && row[x] > thr) x++;
+      if (nr == cap) {
+        run_t *nrs = realloc(runs, sizeof(run_t) * cap * 2);
+        if (!nrs) {
+          free(runs);
+          return hearth_err_set(err, HEARTH_E_NOMEM, "blob detection: out of memory");
+        }
+        runs = nrs;
+        cap *= 2;
+      }
+      run_t *r = &runs[nr];
+      r->parent = (int32_t)nr;
+      r->x0 = (int32_t)x0;
+      r->x1 = (int32_t)(x - 1);
+      r->y = (int32_t)y;
+      /* previous-row runs touching [x0 - 1, x] (8-connectivity) */
+      while (p < prev_end && runs[p].x1 < (int32_t)x0 - 1) p++;
+      for (size_t q = p; q < prev_end && runs[q].x0 <= (int32_t)x; q++) {
+        int32_t a = run_find(runs, (int32_t)q), b = run_find(runs, (int32_t)nr);
+        if (a != b) runs[a > b ? a : b].parent = a < b ? a : b;
+      }
+      nr++;
+    }
+    prev_begin = cur_begin;
+    prev_end = nr;
+  }
+  /* accumulate moments per root */
+  double *acc = hearth_calloc_array(nr ? nr : 1, 7 * sizeof(double));
+  if (!acc) {
+    free(runs);
+    return hearth_err_set(err, HEARTH_E_NOMEM, "blob detection: out of memory");
+  }
+  for (size_t i = 0; i < nr; i++) {
+    int32_t root = run_find(runs, (int32_t)i);
+    double a = runs[i].x0, b = runs[i].x1, y = runs[i].y, n = b - a + 1;
+    double sx = (a + b) * n / 2;
+    double sxx = (b * (b + 1) * (2 * b + 1) - (a - 1) * a * (2 * a - 1)) / 6;
+    double *m = acc + 7 * (size_t)root;
+    m[0] += n;
+    m[1] += sx;
+    m[2] += n * y;
+    m[3] += sxx;
+    m[4] += y * sx;
+    m[5] += n * y * y;
+    if (runs[i].x0 == 0 || runs[i].x1 == (int32_t)w - 1 || runs[i].y == 0 ||
+        runs[i].y == (int32_t)h - 1)
+      m[6] = 1;
+  }
+  size_t n = 0, bcap = 256;
+  blob *bl = malloc(sizeof(blob) * bcap);
+  if (!bl) {
+    free(runs);
+    free(acc);
+    return hearth_err_set(err, HEARTH_E_NOMEM, "blob detection: out of memory");
+  }
+  for (size_t i = 0; i < nr; i++) {
+    if (runs[i].parent != (int32_t)i) continue;
+    const double *m = acc + 7 * i;
+    double a = m[0];
+    if (a < 4) continue;
+    if (n == bcap) {
+      blob *nb = realloc(bl, sizeof(blob) * bcap * 2);
+      if (!nb) {
+        free(runs);
+        free(acc);
+        free(bl);
+        return hearth_err_set(err, HEARTH_E_NOMEM, "blob detection: out of memory");
+      }
+      bl = nb;
+      bcap *= 2;
+    }
+    blob *b = &bl[n++];
+    double mx = m[1] / a, my = m[2] / a;
+    b->area = a;
+    b->cx = (mx + 0.5) * s - 0.5;
+    b->cy = (my + 0.5) * s - 0.5;
+    b->sxx = (m[3] / a - mx * mx + 1.0 / 12) * s * s;
+    b->sxy = (m[4] / a - mx * my) * s * s;
+    b->syy = (m[5] / a - my * my + 1.0 / 12) * s * s;
+    b->touches_border = m[6] != 0;
+  }
+  free(runs);
+  free(acc);
+  *out = bl;
+  *n_out = n;
+  return HEARTH_OK;
+}
+
+/* k-th smallest of v[0..n) (v reordered) */
+static double select_kth(double *v, size_t n, size_t k) {
+  size_t lo = 0, hi = n - 1;
+  while (lo < hi) {
+    double piv = v[lo + (hi - lo) / 2];
+    size_t i = lo, j = hi;
+    while (i <= j) {
+      while (v[i] < piv) i++;
+      while (v[j] > piv) j--;
+      if (i <= j) {
+        double t = v[i];
+        v[i] = v[j];
+        v[j] = t;
+        i++;
+        if (j == 0) break;
+        j--;
+      }
+    }
+    if (k <= j)
+      hi = j;
+    else if (k >= i)
+      lo = i;
+    else
+      return v[k];
+  }
+  return v[k];
+}
+
+static int cmp_double(const void *a, const void *b) {
+  double x = *(const double *)a, y = *(const double *)b;
+  return x < y ? -1 : x > y;
+}
+
+/* keep hole-like blobs: not on the border, area within 5x of the median */
+static size_t filter_blobs(blob *bl, size_t n) {
+  if (!n) return 0;
+  double *areas = malloc(sizeof(double) * n);
+  if (!areas) return 0;
+  size_t m = 0;
+  for (size_t i = 0; i < n; i++)
+    if (!bl[i].touches_border && bl[i].area >= 12) areas[m++] = bl[i].area;
+  if (!m) {
+    free(areas);
+    return 0;
+  }
+  qsort(areas, m, sizeof(double), cmp_double);
+  double med = areas[m / 2];
+  free(areas);
+  size_t k = 0;
+  for (size_t i = 0; i < n; i++) {
+    blob *b = &bl[i];
+    if (b->touches_border || b->area < 12 || b->area < med / 5 || b->area > med * 5) continue;
+    /* a hole's moments describe a proper ellipse */
+    double det = b->sxx * b->syy - b->sxy * b->sxy;
+    if (!(det > 0)) continue;
+    bl[k++] = *b;
+  }
+  return k;
+}
+
+/* the raw values refinement reads: a float matrix, or 8-bit colour read as
+ * luma on the fly (no full-size gray copy of a 1080p frame) */
+typedef struct pixsrc {
+  const float *f;
+  const uint8_t *u8;
+  int ch;
+} pixsrc;
+
+static inline double px_at(const pixsrc *P, size_t i) {
+  if (P->f) return P->f[i];
+  const uint8_t *q = P->u8 + i * (size_t)P->ch;
+  return P->ch >= 3 ? 0.299 * q[0] + 0.587 * q[1] + 0.114 * q[2] : q[0];
+}
+
+/* refine one hole: intensity-weighted centroid of s * (I - bg) inside the
+ * ellipse 1.5x the hole, bg the median of the ring 1.35..1.75x; returns the
+ * blur estimate (sigma / radius) or NAN if the hole vanished */
+static double refine_centre(const pixsrc *I, size_t w, size_t h, double sign, const double S[3],
+                            double c[2], double *scratch, size_t scratch_n) {
+  /* ellipse metric: d^2 = x^T (4 S)^-1 x, 1 at the hole edge */
+  double a = 4 * S[0], b = 4 * S[1], d = 4 * S[2];
+  double det = a * d - b * b;
+  if (!(det > 0)) return NAN;
+  double ia = d / det, ib = -b / det, id = a / det;
+  double ex = sqrt(a), ey = sqrt(d);
+  double cx = c[0], cy = c[1], var = NAN, bg = 0;
+  for (int it = 0; it < 8; it++) {
+    /* background: median of the ring 1.35..1.75 (clipped to the image);
+     * after two rounds the window no longer moves enough to change it */
+    if (it < 2) {
+      long x0 = (long)floor(cx - 1.75 * ex - 1), x1 = (long)ceil(cx + 1.75 * ex + 1);
+      long y0 = (long)floor(cy - 1.75 * ey - 1), y1 = (long)ceil(cy + 1.75 * ey + 1);
+      if (x0 < 0) x0 = 0;
+      if (y0 < 0) y0 = 0;
+      if (x1 >= (long)w) x1 = (long)w - 1;
+      if (y1 >= (long)h) y1 = (long)h - 1;
+      size_t m = 0;
+      for (long y = y0; y <= y1; y++)
+        for (long x = x0; x <= x1; x++) {
+          double dx = (double)x - cx, dy = (double)y - cy;
+          double q = ia * dx * dx + 2 * ib * dx * dy + id * dy * dy;
+          if (q >= 1.35 * 1.35 && q <= 1.75 * 1.75 && m < scratch_n)
+            scratch[m++] = px_at(I, (size_t)y * w + (size_t)x);
+        }
+      if (m < 8) return NAN;
+      bg = select_kth(scratch, m, m / 2);
+    }
+    /* the centroid window must lie wholly inside the image */
+    long x0 = (long)floor(cx - 1.5 * ex), x1 = (long)ceil(cx + 1.5 * ex);
+    long y0 = (long)floor(cy - 1.5 * ey), y1 = (long)ceil(cy + 1.5 * ey);
+    if (x0 < 0 || y0 < 0 || x1 >= (long)w || y1 >= (long)h) return NAN;
+    double sw = 0, sx = 0, sy = 0, sq = 0;
+    for (long y = y0; y <= y1; y++) {
+      double dy = (double)y - cy;
+      for (long x = x0; x <= x1; x++) {
+        double dx = (double)x - cx;
+        double q = ia * dx * dx + 2 * ib * dx * dy + id * dy * dy;
+        if (q > 1.5 * 1.5) continue;
+        double wt = sign * (px_at(I, (size_t)y * w + (size_t)x) - bg);
+        if (wt <= 0) continue;
+        sw += wt;
+        sx += wt * dx;
+        sy += wt * dy;
+        sq += wt * q;
+      }
+    }
+    if (!(sw > 0)) return NAN;
+    double mx = sx / sw, my = sy / sw;
+    var = sq / sw;
+    cx += mx;
+    cy += my;
+    if (hypot(mx, my) < 1e-4) break;
+  }
+  c[0] = cx;
+  c[1] = cy;
+  /* unit disc: E[q] = 1/2; blur sigma (in radii) adds 2 sigma^2 */
+  double s2 = (var - 0.5) / 2;
+  return s2 > 0 ? sqrt(s2) : 0.0;
+}
+
+/* common tail: blobs -> ordered, refined centres on the raw image */
+static hearth_status finish(blob *bl, size_t nb, const pixsrc *raw, size_t w, size_t h, double sign,
+                            const hearth_detect_opts *o, hearth_detection *det, hearth_err *err) {
+  det->found = 0;
+  det->reason[0] = 0;
+  memset(det->centres, 0, sizeof det->centres);
+  double(*pts)[2] = malloc(sizeof(double) * 2 * (nb ? nb : 1));
+  if (!pts) return hearth_err_set(err, HEARTH_E_NOMEM, "detection: out of memory");
+  for (size_t i = 0; i < nb; i++) {
+    pts[i][0] = bl[i].cx;
+    pts[i][1] = bl[i].cy;
+  }
+  double ord[HEARTH_PLATE_HOLES][2];
+  if (!hearth_plate_order((const double(*)[2])pts, nb, ord, det->reason, sizeof det->reason)) {
+    free(pts);
+    return HEARTH_OK;
+  }
+  /* match ordered points back to their blobs for the window shapes */
+  double scratch[4096];
+  double blur[HEARTH_PLATE_HOLES];
+  for (int i = 0; i < HEARTH_PLATE_HOLES; i++) {
+    size_t bi = 0;
+    for (size_t j = 0; j < nb; j++)
+      if (pts[j][0] == ord[i][0] && pts[j][1] == ord[i][1]) {
+        bi = j;
+        break;
+      }
+    double S[3] = {bl[bi].sxx, bl[bi].sxy, bl[bi].syy};
+    double c[2] = {ord[i][0], ord[i][1]};
+    blur[i] = refine_centre(raw, w, h, sign, S, c, scratch, 4096);
+    if (isnan(blur[i])) {
+      snprintf(det->reason, sizeof det->reason,
+               "hole %d at (%.1f, %.1f) could not be refined (too close to the edge)", i, ord[i][0],
+               ord[i][1]);
+      free(pts);
+      return HEARTH_OK;
+    }
+    det->centres[i][0] = c[0];
+    det->centres[i][1] = c[1];
+  }
+  free(pts);
+  qsort(blur, HEARTH_PLATE_HOLES, sizeof(double), cmp_double);
+  double med_blur = 0.5 * (blur[41] + blur[42]);
+  if (med_blur > o->max_blur_frac) {
+    snprintf(det->reason, sizeof det->reason,
+             "blurred: edge spread %.2f of the hole radius (limit %.2f)", med_blur,
+             o->max_blur_frac);
+    return HEARTH_OK;
+  }
+  det->found = 1;
+  return HEARTH_OK;
+}
+
+/* blob detection at a few thresholds: Otsu first, then fixed fractions
+ * between the typical level (median) and the blob peaks (99.5th
+ * percentile). Blurred plates defeat Otsu (the valley fills in); the first
+ * threshold that yields the whole ordered plate wins. */
+static hearth_status detect_multi(const uint8_t *U, size_t W, size_t H, double scale,
+                                  const pixsrc *raw, size_t w, size_t h, double sign,
+                                  const hearth_detect_opts *o, hearth_detection *det,
+                                  hearth_err *err) {
+  size_t hist[256] = {0}, n = W * H;
+  for (size_t i = 0; i < n; i++) hist[U[i]]++;
+  int med = 0, p995 = 255;
+  size_t acc = 0;
+  for (int i = 0; i < 256; i++) {
+    acc += hist[i];
+    if (acc * 2 <= n) med = i + 1;
+    if (acc * 1000 < n * 995) p995 = i + 1;
+  }
+  enum { NT = 9 };
+  int thr[NT] = {otsu(hist)};
+  static const int frac[NT - 1] = {50, 35, 65, 75, 85, 25, 45, 55};
+  for (int k = 1; k < NT; k++) thr[k] = med + (p995 - med) * frac[k - 1] / 100;
+  char first_reason[256] = "";
+  for (int k = 0; k < NT; k++) {
+    int dup = 0;
+    for (int q = 0; q < k; q++) dup |= thr[q] == thr[k];
+    if (dup || thr[k] < 0 || thr[k] >= 255) continue;
+    blob *bl = NULL;
+    size_t nb = 0;
+    hearth_status st = find_blobs(U, W, H, thr[k], scale, &bl, &nb, err);
+    if (st) return st;
+    nb = filter_blobs(bl, nb);
+    st = finish(bl, nb, raw, w, h, sign, o, det, err);
+    free(bl);
+    if (st) return st;
+    if (det->found || !strncmp(det->reason, "blurred", 7)) return HEARTH_OK;
+    if (!first_reason[0]) snprintf(first_reason, sizeof first_reason, "%s", det->reason);
+  }
+  snprintf(det->reason, sizeof det->reason, "%s", first_reason);
+  return HEARTH_OK;
+}
+
+hearth_status hearth_detect_plate_thermal(const hearth_image *temps, const hearth_detect_opts *o,
+                                          hearth_detection *det, hearth_err *err) {
+  hearth_detect_opts def;
+  if (!o) {
+    hearth_detect_opts_default(&def);
+    o = &def;
+  }
+  if (!temps || !det || !temps->data)
+    return hearth_err_set(err, HEARTH_E_ARG, "thermal detection: missing argument");
+  if (temps->type != HEARTH_PIX_F32 || temps->channels != 1)
+    return hearth_err_set(err, HEARTH_E_ARG,
+                          "thermal detection: expected a 1-channel float matrix");
+  size_t w = temps->width, h = temps->height, npx = w * h;
+  int up = o->upsample >= 1 && o->upsample <= 8 ? o->upsample : 4;
+  if (w < 16 || h < 16 || w > 4096 || h > 4096)
+    return hearth_err_set(err, HEARTH_E_SIZE, "thermal detection: %zux%zu matrix", w, h);
+  const float *T = temps->data;
+  hearth_status st = HEARTH_OK;
+  uint8_t *g8 = malloc(npx);
+  uint8_t *U = hearth_alloc_array(npx * (size_t)up, (size_t)up);
+  if (!g8 || !U) {
+    st = hearth_err_set(err, HEARTH_E_NOMEM, "thermal detection: out of memory");
+    goto done;
+  }
+  /* per-frame percentile clip -> 8 bit (a copy; the matrix is untouched) */
+  {
+    float mn = T[0], mx = T[0];
+    for (size_t i = 0; i < npx; i++) {
+      if (!(T[i] >= mn)) mn = T[i];
+      if (!(T[i] <= mx)) mx = T[i];
+    }
+    if (!isfinite(mn) || !isfinite(mx)) {
+      st = hearth_err_set(err, HEARTH_E_RANGE, "thermal detection: non-finite temperatures");
+      goto done;
+    }
+    /* 4096-bin histogram percentiles (exact enough for a display clip) */
+    size_t hist[4096] = {0};
+    double span = (double)mx - (double)mn;
+    for (size_t i = 0; i < npx; i++) {
+      size_t b = span > 0 ? (size_t)(((double)T[i] - mn) / span * 4095.0) : 0;
+      hist[b]++;
+    }
+    double lo = mn, hi = mx;
+    size_t acc = 0, klo = (size_t)(o->clip_lo_pct / 100.0 * (double)npx),
+           khi = (size_t)(o->clip_hi_pct / 100.0 * (double)npx);
+    int got_lo = 0;
+    for (int b = 0; b < 4096; b++) {
+      acc += hist[b];
+      if (!got_lo && acc > klo) {
+        lo = mn + span * b / 4095.0;
+        got_lo = 1;
+      }
+      if (acc > khi || b == 4095) {
+        hi = mn + span * (b + 1) / 4095.0;
+        break;
+      }
+    }
+    if (!(hi > lo)) {
+      det->found = 0;
+      snprintf(det->reason, sizeof det->reason, "flat image: no plate");
+      goto done;
+    }
+    for (size_t i = 0; i < npx; i++) {
+      double v = ((double)T[i] - lo) / (hi - lo) * 255.0;
+      g8[i] = (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : v + 0.5);
+    }
+  }
+  /* bilinear upsampling: up pixel j samples native (j + 0.5) / up - 0.5;
+   * column taps and weights are shared by every row */
+  size_t W = w * (size_t)up, H = h * (size_t)up;
+  {
+    size_t *cx0 = hearth_alloc_array(W, sizeof(size_t) * 2);
+    float *cw = hearth_alloc_array(W, sizeof(float));
+    if (!cx0 || !cw) {
+      free(cx0);
+      free(cw);
+      st = hearth_err_set(err, HEARTH_E_NOMEM, "thermal detection: out of memory");
+      goto done;
+    }
+    for (size_t x = 0; x < W; x++) {
+      double fx = ((double)x + 0.5) / up - 0.5;
+      if (fx < 0) fx = 0;
+      if (fx > (double)(w - 1)) fx = (double)(w - 1);
+      size_t x0 = (size_t)fx;
+      cx0[2 * x] = x0;
+      cx0[2 * x + 1] = x0 + 1 < w ? x0 + 1 : x0;
+      cw[x] = (float)(fx - (double)x0);
+    }
+    for (size_t y = 0; y < H; y++) {
+      double fy = ((double)y + 0.5) / up - 0.5;
+      if (fy < 0) fy = 0;
+      if (fy > (double)(h - 1)) fy = (double)(h - 1);
+      size_t y0 = (size_t)fy, y1 = y0 + 1 < h ? y0 + 1 : y0;
+      float ty = (float)(fy - (double)y0);
+      const uint8_t *g0 = g8 + y0 * w, *g1 = g8 + y1 * w;
+      uint8_t *dst = U + y * W;
+      for (size_t x = 0; x < W; x++) {
+        size_t a0 = cx0[2 * x], a1 = cx0[2 * x + 1];
+        float tx = cw[x];
+        float top = g0[a0] + tx * (float)(g0[a1] - g0[a0]);
+        float bot = g1[a0] + tx * (float)(g1[a1] - g1[a0]);
+        dst[x] = (uint8_t)(top + ty * (bot - top) + 0.5f);
+      }
+    }
+    free(cx0);
+    free(cw);
+  }
+  pixsrc src = {T, NULL, 1};
+  st = detect_multi(U, W, H, 1.0 / up, &src, w, h, +1.0, o, det, err);
+done:
+  free(g8);
+  free(U);
+  return st;
+}
+
+hearth_status hearth_detect_plate_color(const hearth_image *img, const hearth_detect_opts *o,
+                                        hearth_detection *det, hearth_err *err) {
+  hearth_detect_opts def;
+  if (!o) {
+    hearth_detect_opts_default(&def);
+    o = &def;
+  }
+  if (!img || !det || !img->data)
+    return hearth_err_set(err, HEARTH_E_ARG, "colour detection: missing argument");
+  if (img->type != HEARTH_PIX_U8 || img->channels < 1 || img->channels > 4 || img->channels == 2)
+    return hearth_err_set(err, HEARTH_E_ARG,
+                          "colour detection: expected an 8-bit gray or RGB(A) image");
+  size_t w = img->width, h = img->height;
+  if (w < 16 || h < 16 || w > HEARTH_IMAGE_MAX_DIM || h > HEARTH_IMAGE_MAX_DIM)
+    return hearth_err_set(err, HEARTH_E_SIZE, "colour detection: %zux%zu image", w, h);
+  /* blobs are found at half resolution (2 x 2 mean of the luma, inverted so
+   * the dark holes are bright); centres are refined at full resolution */
+  hearth_status st = HEARTH_OK;
+  size_t hw = w / 2, hh = h / 2;
+  uint8_t *inv = malloc(hw * hh);
+  if (!inv) return hearth_err_set(err, HEARTH_E_NOMEM, "colour detection: out of memory");
+  const uint8_t *p = img->data;
+  int ch = img->channels;
+  for (size_t y = 0; y < hh; y++)
+    for (size_t x = 0; x < hw; x++) {
+      int sum = 0;
+      for (int dy = 0; dy < 2; dy++)
+        for (int dx = 0; dx < 2; dx++) {
+          const uint8_t *q = p + ((2 * y + (size_t)dy) * w + 2 * x + (size_t)dx) * (size_t)ch;
+          /* integer luma, weights 77/150/29 of 256 */
+          sum += ch >= 3 ? (77 * q[0] + 150 * q[1] + 29 * q[2]) : 256 * q[0];
+        }
+      inv[y * hw + x] = (uint8_t)(255 - (sum + 512) / 1024);
+    }
+  pixsrc src = {NULL, p, ch};
+  /* half-res pixel j sits at full-res 2 j + 0.5: up = 1/2 in find_blobs terms */
+  st = detect_multi(inv, hw, hh, 2.0, &src, w, h, -1.0, o, det, err);
+  free(inv);
+  return st;
+}

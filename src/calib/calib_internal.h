@@ -1,0 +1,50 @@
+/* Private to the calibration area: small dense linear algebra, the plane
+ * homography and Zhang's closed form, shared by the solvers and tests. */
+#ifndef HEARTH_CALIB_INTERNAL_H
+#define HEARTH_CALIB_INTERNAL_H
+
+#include <stddef.h>
+#include "hearth/calib.h"
+
+/* Solve A x = b for a symmetric positive definite n x n A (row-major, n <= 16)
+ * by Cholesky; A and b are overwritten (b becomes x). Returns 0 if A is not
+ * positive definite. */
+int calib_chol_solve(double *A, double *b, int n);
+/* Invert a symmetric positive definite n x n matrix in place (n <= 16). */
+int calib_chol_invert(double *A, int n);
+
+/* Homography H (row-major 3x3, H[8] = 1 scale not imposed) mapping plane
+ * points (X, Y) to image points (u, v), by the normalised DLT. pts are
+ * interleaved pairs. Returns 0 if degenerate. */
+int calib_homography(const double *plane_xy, const double *img_uv, size_t n, double H[9]);
+
+/* Zhang's closed-form intrinsics from n >= 3 homographies (skew solved then
+ * dropped). Returns 0 if the system is degenerate or not positive. */
+int calib_zhang_intrinsics(const double *H, size_t n, double *fx, double *fy, double *cx,
+                           double *cy);
+
+/* Plate pose from a homography of plane -> normalised image coordinates
+ * (i.e. K^-1 H). Returns 0 if degenerate. */
+int calib_pose_from_homography(const double Hn[9], hearth_rigid *T);
+
+/* Plate (x, y, z) and pixel pairs -> interleaved helpers. */
+void calib_plate_points(double obj[HEARTH_PLATE_HOLES][3]);
+
+/* Rotation vector + translation <-> rigid. */
+void calib_rigid_from_params(const double p[6], hearth_rigid *T);
+void calib_params_from_rigid(const hearth_rigid *T, double p[6]);
+
+/* Residual and Jacobian of one projected point with respect to a pose
+ * (rotvec w, translation t): Xc = R(w) X + t. Returns 0 if behind camera.
+ * d_pose: 2 x 6 row-major (dw then dt); jac from hearth_camera_project.
+ * Xc_out may be NULL. */
+int calib_project_pose(const hearth_camera *cam, const double R[9], const double dR[27],
+                       const double t[3], const double X[3], double uv[2], hearth_project_jac *jac,
+                       double d_pose[12], double Xc_out[3]);
+
+/* Per-point bias (n x 2) of a circle's image centroid over the projected
+ * centre, for circles of `radius` (metres) around obj on the plate plane. */
+void calib_circle_bias(const hearth_camera *cam, const hearth_rigid *T, const double (*obj)[3],
+                       size_t n, double radius, double *bias);
+
+#endif

@@ -1,0 +1,263 @@
+/* Calibration solvers against known cameras: Zhang's closed form on exact
+ * points, the LM Jacobians against finite differences, full intrinsics with
+ * noise, and stereo recovering a known transform with an outlier pair. */
+#include <math.h>
+#include <stdlib.h>
+#include "calib/calib_internal.h"
+#include "calib_test_data.h"
+#include "test_util.h"
+
+#define NP HEARTH_PLATE_HOLES
+
+static void test_zhang_exact(void) {
+  /* no distortion: the closed form must be exact */
+  hearth_camera c;
+  td_thermal_cam(&c);
+  for (int k = 0; k < 5; k++) c.dist[k] = 0;
+  hearth_rng rng;
+  hearth_rng_seed(&rng, 11);
+  enum { NV = 8 };
+  hearth_rigid T[NV];
+  static double uv[NV * NP * 2];
+  CHECK(td_views(&rng, &c, NV, 0.7, T, uv) == NV);
+  double obj[NP][3], plane[NP * 2], H[NV * 9];
+  calib_plate_points(obj);
+  for (int i = 0; i < NP; i++) {
+    plane[2 * i] = obj[i][0];
+    plane[2 * i + 1] = obj[i][1];
+  }
+  for (int v = 0; v < NV; v++) CHECK(calib_homography(plane, uv + v * NP * 2, NP, H + 9 * v));
+  double fx, fy, cx, cy;
+  CHECK(calib_zhang_intrinsics(H, NV, &fx, &fy, &cx, &cy));
+  CHECK_NEAR(fx / c.fx, 1.0, 1e-6);
+  CHECK_NEAR(fy / c.fy, 1.0, 1e-6);
+  CHECK_NEAR(cx / c.cx, 1.0, 1e-6);
+  CHECK_NEAR(cy / c.cy, 1.0, 1e-6);
+  /* poses from K^-1 H */
+  double Kinv[9] = {1 / fx, 0, -cx / fx, 0, 1 / fy, -cy / fy, 0, 0, 1};
+  for (int v = 0; v < NV; v++) {
+    double Hn[9];
+    hearth_rigid P;
+    hearth_mat3_mul(Kinv, H + 9 * v, Hn);
+    CHECK(calib_pose_from_homography(Hn, &P));
+    CHECK(hearth_rotation_angle_between(P.R, T[v].R) < 1e-6);
+    for (int i = 0; i < 3; i++) CHECK_NEAR(P.t[i], T[v].t[i], 1e-8);
+  }
+  /* too few views is refused */
+  CHECK(!calib_zhang_intrinsics(H, 2, &fx, &fy, &cx, &cy));
+}
+
+static void test_jacobians(void) {
+  hearth_camera c;
+  td_thermal_cam(&c);
+  double w[3] = {0.3, -0.2, 0.1}, t[3] = {-0.05, 0.02, 0.3}, X[3] = {0.04, 0.03, 0};
+  double R[9], dR[27], uv[2], dp[12];
+  hearth_project_jac jac;
+  hearth_rotvec_to_matrix_jac(w, R, dR);
+  CHECK(calib_project_pose(&c, R, dR, t, X, uv, &jac, dp, NULL));
+  /* pose parameters */
+  for (int k = 0; k < 6; k++) {
+    double h = 1e-7, wp[3], tp[3], wm[3], tm[3], up[2], um[2], Rp[9], Rm[9], dd[27];
+    memcpy(wp, w, sizeof wp);
+    memcpy(tp, t, sizeof tp);
+    memcpy(wm, w, sizeof wm);
+    memcpy(tm, t, sizeof tm);
+    if (k < 3) {
+      wp[k] += h;
+      wm[k] -= h;
+    } else {
+      tp[k - 3] += h;
+      tm[k - 3] -= h;
+    }
+    hearth_rotvec_to_matrix_jac(wp, Rp, dd);
+    hearth_rotvec_to_matrix_jac(wm, Rm, dd);
+    calib_project_pose(&c, Rp, dd, tp, X, up, NULL, NULL, NULL);
+    calib_project_pose(&c, Rm, dd, tm, X, um, NULL, NULL, NULL);
+    for (int r = 0; r < 2; r++) {
+      double fd = (up[r] - um[r]) / (2 * h);
+      CHECK_NEAR(dp[6 * r + k], fd, 1e-4 * (1 + fabs(fd)));
+    }
+  }
+  /* intrinsics and distortion */
+  double Xc[3];
+  for (int i = 0; i < 3; i++)
+    Xc[i] = R[3 * i] * X[0] + R[3 * i + 1] * X[1] + R[3 * i + 2] * X[2] + t[i];
+  for (int k = 0; k < 9; k++) {
+    hearth_camera cp = c, cm = c;
+    double h = k < 4 ? 1e-4 : 1e-7;
+    double *pp = k < 4 ? (&cp.fx) + k : cp.dist + (k - 4);
+    double *pm = k < 4 ? (&cm.fx) + k : cm.dist + (k - 4);
+    *pp += h;
+    *pm -= h;
+    double up[2], um[2];
+    hearth_camera_project(&cp, Xc, up, NULL);
+    hearth_camera_project(&cm, Xc, um, NULL);
+    for (int r = 0; r < 2; r++) {
+      double fd = (up[r] - um[r]) / (2 * h);
+      double an = k < 4 ? jac.d_intr[4 * r + k] : jac.d_dist[5 * r + k - 4];
+      CHECK_NEAR(an, fd, 1e-5 * (1 + fabs(fd)));
+    }
+  }
+}
+
+static void test_intrinsics(void) {
+  hearth_camera c;
+  td_thermal_cam(&c);
+  hearth_rng rng;
+  hearth_rng_seed(&rng, 5);
+  enum { NV = 20 };
+  hearth_rigid T[NV];
+  static double uv[NV * NP * 2];
+  CHECK(td_views(&rng, &c, NV, 0.7, T, uv) == NV);
+  double obj[NP][3];
+  calib_plate_points(obj);
+  /* exact points: the minimum is the truth */
+  hearth_camera e;
+  double rms, frms[NV];
+  hearth_rigid P[NV];
+  hearth_err err = {0};
+  CHECK_OK(hearth_calib_intrinsics((const double(*)[3])obj, NP, uv, NV, 256, 192, NULL, &e, &rms,
+                                   frms, P, &err),
+           &err);
+  CHECK(rms < 1e-7);
+  CHECK_NEAR(e.fx / c.fx, 1, 1e-8);
+  CHECK_NEAR(e.fy / c.fy, 1, 1e-8);
+  CHECK_NEAR(e.cx, c.cx, 1e-6);
+  CHECK_NEAR(e.cy, c.cy, 1e-6);
+  for (int k = 0; k < 5; k++) CHECK_NEAR(e.dist[k], c.dist[k], 1e-6);
+  CHECK(hearth_rotation_angle_between(P[3].R, T[3].R) < 1e-8);
+  CHECK(e.width == 256 && e.height == 192);
+  /* 0.03 px noise: residual close to the noise, parameters close to truth */
+  hearth_rng_seed(&rng, 6);
+  for (int i = 0; i < NV * NP * 2; i++) uv[i] += 0.03 * hearth_rng_normal(&rng);
+  CHECK_OK(hearth_calib_intrinsics((const double(*)[3])obj, NP, uv, NV, 256, 192, NULL, &e, &rms,
+                                   frms, P, &err),
+           &err);
+  CHECK(rms > 0.02 && rms < 0.045);
+  CHECK(fabs(e.fx / c.fx - 1) < 2e-3);
+  CHECK(fabs(e.cx - c.cx) < 0.5 && fabs(e.cy - c.cy) < 0.5);
+  /* bad arguments */
+  CHECK(hearth_calib_intrinsics((const double(*)[3])obj, NP, uv, 2, 256, 192, NULL, &e, &rms, NULL,
+                                NULL, &err) == HEARTH_E_SIZE);
+  CHECK(strstr(err.msg, "at least 3") != NULL);
+}
+
+static void test_stereo(void) {
+  hearth_camera ca, cb;
+  td_rgb_cam(&ca);
+  td_thermal_cam(&cb);
+  /* thermal a few cm beside the colour camera, slightly rotated */
+  hearth_rigid Tba;
+  double w[3] = {0.01, -0.02, 0.005};
+  hearth_rotvec_to_matrix(w, Tba.R);
+  Tba.t[0] = -0.045;
+  Tba.t[1] = 0.012;
+  Tba.t[2] = 0.003;
+  hearth_rng rng;
+  hearth_rng_seed(&rng, 9);
+  enum { NV = 10 };
+  static double ua[NV * NP * 2], ub[NV * NP * 2];
+  hearth_rigid Tb[NV];
+  CHECK(td_views(&rng, &cb, NV, 0.6, Tb, ub) == NV);
+  hearth_rigid Tbai;
+  hearth_rigid_inverse(&Tba, &Tbai);
+  for (int v = 0; v < NV; v++) {
+    hearth_rigid Ta;
+    hearth_rigid_compose(&Tbai, &Tb[v], &Ta);
+    CHECK(td_project(&ca, &Ta, ua + v * NP * 2, 0) == NP);
+  }
+  double obj[NP][3];
+  calib_plate_points(obj);
+  for (int i = 0; i < NV * NP * 2; i++) {
+    ua[i] += 0.1 * hearth_rng_normal(&rng);
+    ub[i] += 0.05 * hearth_rng_normal(&rng);
+  }
+  /* pair 4 is an outlier: its thermal half shifted by 3 px */
+  for (int i = 0; i < NP; i++) ub[4 * NP * 2 + 2 * i] += 3.0;
+  hearth_rigid E;
+  double rms, prms[NV];
+  int used[NV];
+  hearth_err err = {0};
+  CHECK_OK(hearth_calib_stereo(&ca, &cb, (const double(*)[3])obj, NP, ua, ub, NV, NULL, &E, &rms,
+                               prms, used, &err),
+           &err);
+  CHECK(!used[4]);
+  for (int v = 0; v < NV; v++)
+    if (v != 4) CHECK(used[v]);
+  CHECK(prms[4] > 1.0);
+  /* expected sqrt((2 * 0.1^2 + 2 * 0.05^2) / 2) = 0.112 */
+  CHECK(rms > 0.095 && rms < 0.13);
+  double ang = hearth_rotation_angle_between(E.R, Tba.R) * 180 / M_PI;
+  CHECK_MSG(ang < 0.02, "rotation error %g deg", ang);
+  for (int i = 0; i < 3; i++) CHECK_NEAR(E.t[i], Tba.t[i], 3e-4);
+  /* no pairs */
+  CHECK(hearth_calib_stereo(&ca, &cb, (const double(*)[3])obj, NP, ua, ub, 0, NULL, &E, &rms, NULL,
+                            NULL, &err) == HEARTH_E_SIZE);
+}
+
+/* the perspective bias of a hole's image centroid against an independent
+ * area integral: a fine image-space grid, each sample back-projected onto
+ * the plate and tested against the hole */
+static void test_circle_bias(void) {
+  hearth_camera c;
+  td_thermal_cam(&c);
+  hearth_rigid T;
+  double w[3] = {0.5, -0.3, 0.1};
+  hearth_rotvec_to_matrix(w, T.R);
+  T.t[0] = -0.07;
+  T.t[1] = -0.03;
+  T.t[2] = 0.25;
+  double obj[NP][3], bias[2 * NP];
+  calib_plate_points(obj);
+  calib_circle_bias(&c, &T, (const double(*)[3])obj, NP, 0.004, bias);
+  hearth_rigid Ti;
+  hearth_rigid_inverse(&T, &Ti);
+  double n[3] = {T.R[2], T.R[5], T.R[8]}, d = hearth_dot3(n, T.t);
+  int holes[3] = {0, 40, 83};
+  double maxb = 0;
+  for (int k = 0; k < 3; k++) {
+    int i = holes[k];
+    double Xc[3], uv[2];
+    hearth_rigid_apply(&T, obj[i], Xc);
+    hearth_camera_project(&c, Xc, uv, NULL);
+    double sa = 0, su = 0, sv = 0, step = 0.02;
+    for (double v = uv[1] - 6; v <= uv[1] + 6; v += step)
+      for (double u = uv[0] - 6; u <= uv[0] + 6; u += step) {
+        double dir[3], P[3], Q[3];
+        hearth_camera_ray(&c, u, v, dir);
+        double s = d / hearth_dot3(n, dir);
+        for (int q = 0; q < 3; q++) P[q] = s * dir[q];
+        hearth_rigid_apply(&Ti, P, Q);
+        double dx = Q[0] - obj[i][0], dy = Q[1] - obj[i][1];
+        if (dx * dx + dy * dy < 0.004 * 0.004) {
+          sa += 1;
+          su += u - uv[0];
+          sv += v - uv[1];
+        }
+      }
+    CHECK_NEAR(bias[2 * i], su / sa, 2e-3);
+    CHECK_NEAR(bias[2 * i + 1], sv / sa, 2e-3);
+    maxb = fmax(maxb, hypot(bias[2 * i], bias[2 * i + 1]));
+  }
+  /* the effect is real at this tilt (otherwise the test proves nothing) */
+  CHECK(maxb > 0.01);
+  /* fronto-parallel on the axis, no distortion: no bias */
+  hearth_camera c0 = c;
+  memset(c0.dist, 0, sizeof c0.dist);
+  hearth_rigid_identity(&T);
+  T.t[0] = -obj[40][0];
+  T.t[1] = -obj[40][1];
+  T.t[2] = 0.3;
+  calib_circle_bias(&c0, &T, (const double(*)[3])obj, NP, 0.004, bias);
+  CHECK_NEAR(bias[80], 0, 1e-9);
+  CHECK_NEAR(bias[81], 0, 1e-9);
+}
+
+int main(void) {
+  test_circle_bias();
+  test_zhang_exact();
+  test_jacobians();
+  test_intrinsics();
+  test_stereo();
+  TEST_MAIN_END();
+}
