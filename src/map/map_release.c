@@ -111,39 +111,59 @@ static const char *fusion_name(hearth_fusion f) {
   return f == HEARTH_FUSE_MAX ? "max" : f == HEARTH_FUSE_ROBUST ? "robust" : "mean";
 }
 
+/* path relative to the release root when it lies inside it */
+static const char *rel_to_root(const char *root, const char *path) {
+  size_t n = strlen(root);
+  while (n > 1 && root[n - 1] == '/') n--;
+  if (!strncmp(path, root, n) && path[n] == '/') return path + n + 1;
+  return path;
+}
+
+static json_t *camera_json(const hearth_camera *c) {
+  json_t *o = json_object();
+  double K[9];
+  hearth_camera_K(c, K);
+  json_object_set_new(o, "width", json_integer(c->width));
+  json_object_set_new(o, "height", json_integer(c->height));
+  json_object_set_new(o, "K", mat3_json(K));
+  json_object_set_new(o, "dist", vec_json(c->dist, 5));
+  return o;
+}
+
 static hearth_status write_provenance(const char *path, const hearth_map_job *job,
                                       const hearth_manifest *man, const size_t *idx, size_t n,
                                       const hearth_map_result *r, const hearth_rig *rig,
                                       const char *rig_path, const char *poses_path,
                                       const char *mesh_path, hearth_err *err) {
+  const char *root = job->root;
   json_t *o = json_object();
   json_object_set_new(o, "instance", json_string(job->instance));
   json_object_set_new(o, "state", json_string(job->state));
+  /* views that contributed at least one texel, in manifest order */
   json_t *sv = json_array(), *hits = json_object();
   for (size_t k = 0; k < n; k++) {
     const char *name = man->views[idx[k]].view;
-    json_array_append_new(sv, json_string(name));
+    if (r->view_hits[k] > 0) json_array_append_new(sv, json_string(name));
     json_object_set_new(hits, name, json_integer(r->view_hits[k]));
   }
   json_object_set_new(o, "source_views", sv);
   json_object_set_new(o, "surface_pixels_per_view", hits);
   json_t *rj = json_object();
-  json_object_set_new(rj, "path", json_string(rig_path));
-  double K[9];
-  hearth_camera_K(&rig->thermal, K);
-  json_object_set_new(rj, "thermal_K", mat3_json(K));
-  json_object_set_new(rj, "thermal_dist", vec_json(rig->thermal.dist, 5));
-  json_object_set_new(rj, "T_thermal_from_rgb_R", mat3_json(rig->T_thermal_from_rgb.R));
-  json_object_set_new(rj, "T_thermal_from_rgb_t", vec_json(rig->T_thermal_from_rgb.t, 3));
+  json_object_set_new(rj, "path", json_string(rel_to_root(root, rig_path)));
+  json_object_set_new(rj, "thermal", camera_json(&rig->thermal));
+  json_t *tj = json_object();
+  json_object_set_new(tj, "R", mat3_json(rig->T_thermal_from_rgb.R));
+  json_object_set_new(tj, "t", vec_json(rig->T_thermal_from_rgb.t, 3));
+  json_object_set_new(rj, "T_thermal_from_rgb", tj);
   json_object_set_new(o, "rig", rj);
-  json_object_set_new(o, "poses", json_string(poses_path));
-  json_object_set_new(o, "mesh", json_string(mesh_path));
+  json_object_set_new(o, "poses", json_string(rel_to_root(root, poses_path)));
+  json_object_set_new(o, "mesh", json_string(rel_to_root(root, mesh_path)));
   json_t *pj = json_object();
   json_object_set_new(pj, "resolution", json_integer((json_int_t)r->R));
   json_object_set_new(pj, "fusion", json_string(fusion_name(job->map.fusion)));
   json_object_set_new(pj, "min_cos", json_real(job->map.min_cos));
-  json_object_set_new(pj, "keep_edges", json_boolean(job->map.keep_edges));
   json_object_set_new(pj, "views", json_string(job->views && *job->views ? job->views : "all"));
+  json_object_set_new(pj, "keep_edges", json_boolean(job->map.keep_edges));
   json_object_set_new(pj, "turbo_range_c", vec_json((double[]){job->turbo_lo, job->turbo_hi}, 2));
   json_object_set_new(pj, "splat", json_string("bilinear"));
   json_object_set_new(pj, "fill", json_string("nearest observed texel within the UV island"));
@@ -160,9 +180,7 @@ static hearth_status write_provenance(const char *path, const hearth_map_job *jo
   char *text = json_dumps(o, JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(17));
   json_decref(o);
   if (!text) return hearth_err_set(err, HEARTH_E_NOMEM, "%s: cannot encode", path);
-  size_t len = strlen(text);
-  text[len] = 0;
-  hearth_status s = hearth_write_file_atomic(path, text, len, err);
+  hearth_status s = hearth_write_file_atomic(path, text, strlen(text), err);
   free(text);
   return s;
 }

@@ -18,12 +18,11 @@ static int run(const char *cmd, char *out, size_t cap) {
   return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
-/* sha256 of every file except stamps and the refinement report (which
- * records per-view timings) */
+/* sha256 of every file except the stamps (they record input mtimes) */
 static int tree_hash(const char *root, const char *out_file) {
   char cmd[4096];
   snprintf(cmd, sizeof cmd,
-           "cd '%s' && find . -type f ! -path '*/.stamps/*' ! -name refine_report.json | sort | "
+           "cd '%s' && find . -type f ! -path '*/.stamps/*' | sort | "
            "xargs sha256sum > '%s'", root, out_file);
   return system(cmd);
 }
