@@ -264,44 +264,36 @@ static float weighted_median(vw *a, size_t n) {
 
 /* nearest-observed fill restricted to islands: repeated forward/backward
  * sweeps propagate the nearest seed (Euclidean distance in texels) through
- * texels of the same island; ties go to the lower seed index. Rows without
- * a texel to fill are skipped; seed coordinates are kept beside the index
- * so the inner loop does no division. */
-static void fill_islands(size_t R, const uint32_t *island_of_texel, uint8_t *mask, int32_t *seed) {
-  size_t N = R * R;
-  int32_t *sx = malloc(N * sizeof *sx), *sy = malloc(N * sizeof *sy);
-  uint8_t *row_active = calloc(R, 1);
-  if (!sx || !sy || !row_active) {
-    /* without scratch nothing is filled: every unobserved texel stays so */
-    for (size_t q = 0; q < N; q++) seed[q] = mask[q] == HEARTH_TEXEL_OBSERVED ? (int32_t)q : -1;
-    free(sx);
-    free(sy);
-    free(row_active);
-    return;
-  }
-  for (size_t y = 0; y < R; y++)
-    for (size_t x = 0; x < R; x++) {
-      size_t q = y * R + x;
-      int obs = mask[q] == HEARTH_TEXEL_OBSERVED;
-      seed[q] = obs ? (int32_t)q : -1;
-      sx[q] = obs ? (int32_t)x : 0;
-      sy[q] = obs ? (int32_t)y : 0;
-      if (!obs && island_of_texel[q] != UINT32_MAX) row_active[y] = 1;
-    }
+ * texels of the same island; ties go to the lower seed index. Islands are
+ * independent, so each is swept alone within its bounding box, in parallel;
+ * the result does not depend on the thread count. Seed coordinates are kept
+ * beside the index so the inner loop does no division. */
+typedef struct fill_ctx {
+  size_t R;
+  const uint32_t *island_of_texel;
+  const uint8_t *mask;
+  int32_t *seed, *sx, *sy;
+  const uint32_t *box; /* 4 per island: x0 y0 x1 y1 (inclusive), x0 > x1 if empty */
+} fill_ctx;
+
+static void fill_one_island(const fill_ctx *c, uint32_t isl) {
+  const uint32_t *b = c->box + 4 * (size_t)isl;
+  if (b[0] > b[2]) return;
+  size_t R = c->R;
+  long x0 = (long)b[0], y0 = (long)b[1], x1 = (long)b[2], y1 = (long)b[3];
+  int32_t *seed = c->seed, *sx = c->sx, *sy = c->sy;
   static const int fdx[4] = {-1, -1, 0, 1}, fdy[4] = {0, -1, -1, -1};
-  int changed = 1, pass = 0;
-  for (pass = 0; changed && pass < 64; pass++) {
+  int changed = 1;
+  for (int pass = 0; changed && pass < 64; pass++) {
     changed = 0;
     for (int dir = 0; dir < 2; dir++) {
       int sg = dir == 0 ? 1 : -1;
-      for (size_t k = 0; k < R; k++) {
-        long y = dir == 0 ? (long)k : (long)(R - 1 - k);
-        if (!row_active[y]) continue;
-        for (size_t kx = 0; kx < R; kx++) {
-          long x = dir == 0 ? (long)kx : (long)(R - 1 - kx);
+      for (long ky = y0; ky <= y1; ky++) {
+        long y = dir == 0 ? ky : y1 - (ky - y0);
+        for (long kx = x0; kx <= x1; kx++) {
+          long x = dir == 0 ? kx : x1 - (kx - x0);
           size_t q = (size_t)y * R + (size_t)x;
-          uint32_t isl = island_of_texel[q];
-          if (isl == UINT32_MAX || mask[q] == HEARTH_TEXEL_OBSERVED) continue;
+          if (c->island_of_texel[q] != isl || c->mask[q] == HEARTH_TEXEL_OBSERVED) continue;
           int32_t best = seed[q];
           double bd = 0;
           if (best >= 0) {
@@ -311,10 +303,10 @@ static void fill_islands(size_t R, const uint32_t *island_of_texel, uint8_t *mas
           int32_t bx = sx[q], by = sy[q];
           for (int j = 0; j < 4; j++) {
             long nx = x + sg * fdx[j], ny = y + sg * fdy[j];
-            if (nx < 0 || ny < 0 || nx >= (long)R || ny >= (long)R) continue;
+            if (nx < x0 || ny < y0 || nx > x1 || ny > y1) continue;
             size_t nq = (size_t)ny * R + (size_t)nx;
             int32_t s = seed[nq];
-            if (s < 0 || island_of_texel[nq] != isl) continue;
+            if (s < 0 || c->island_of_texel[nq] != isl) continue;
             double ex = (double)(sx[nq] - x), ey = (double)(sy[nq] - y);
             double d = ex * ex + ey * ey;
             if (best < 0 || d < bd || (d == bd && s < best)) {
@@ -334,9 +326,48 @@ static void fill_islands(size_t R, const uint32_t *island_of_texel, uint8_t *mas
       }
     }
   }
+}
+
+static void fill_range(void *ctx, size_t b, size_t e, int t) {
+  for (size_t i = b; i < e; i++) fill_one_island(ctx, (uint32_t)i);
+}
+
+static hearth_status fill_islands(size_t R, const uint32_t *island_of_texel, uint32_t n_islands,
+                                  const uint8_t *mask, int32_t *seed, int nthreads) {
+  size_t N = R * R;
+  int32_t *sx = malloc(N * sizeof *sx), *sy = malloc(N * sizeof *sy);
+  uint32_t *box = hearth_alloc_array(n_islands ? n_islands : 1, 4 * sizeof *box);
+  if (!sx || !sy || !box) {
+    free(sx);
+    free(sy);
+    free(box);
+    return HEARTH_E_NOMEM;
+  }
+  for (uint32_t i = 0; i < n_islands; i++) {
+    box[4 * i] = box[4 * i + 1] = UINT32_MAX;
+    box[4 * i + 2] = box[4 * i + 3] = 0;
+  }
+  for (size_t y = 0; y < R; y++)
+    for (size_t x = 0; x < R; x++) {
+      size_t q = y * R + x;
+      int obs = mask[q] == HEARTH_TEXEL_OBSERVED;
+      seed[q] = obs ? (int32_t)q : -1;
+      sx[q] = obs ? (int32_t)x : 0;
+      sy[q] = obs ? (int32_t)y : 0;
+      uint32_t isl = island_of_texel[q];
+      if (isl == UINT32_MAX) continue;
+      uint32_t *b = box + 4 * (size_t)isl;
+      if (x < b[0]) b[0] = (uint32_t)x;
+      if (y < b[1]) b[1] = (uint32_t)y;
+      if (x > b[2]) b[2] = (uint32_t)x;
+      if (y > b[3]) b[3] = (uint32_t)y;
+    }
+  fill_ctx c = {R, island_of_texel, mask, seed, sx, sy, box};
+  hearth_parallel_for(n_islands, nthreads, fill_range, &c);
   free(sx);
   free(sy);
-  free(row_active);
+  free(box);
+  return HEARTH_OK;
 }
 
 static void free_scratch(map_ctx *m) {
@@ -606,7 +637,10 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
   }
   double t_fill0 = hearth_now();
   if (timing) timing->fuse = t_fill0 - t_fuse0;
-  fill_islands(R, island_of_texel, out->mask, seed);
+  if (fill_islands(R, island_of_texel, n_islands, out->mask, seed, nt)) {
+    s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory while filling");
+    goto done;
+  }
   for (size_t q = 0; q < N; q++) {
     uint8_t mk = out->mask[q];
     for (int c = 0; c < C; c++) out->filled[q * (size_t)C + (size_t)c] = NAN;
