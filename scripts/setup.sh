@@ -15,12 +15,14 @@ pkgs="build-essential cmake pkg-config clang libclang-rt-14-dev git
   libembree-dev libjansson-dev libpng-dev libjpeg62-turbo-dev
   liblapacke-dev liblapack-dev libblas-dev libhdf5-dev
   libmujoco-dev libosmesa6-dev
-  python3 python3-numpy python3-h5py python3-opencv python3-websockets python3-msgpack
-  nodejs npm"
+  python3 python3-numpy python3-h5py python3-opencv python3-websockets python3-msgpack"
 missing=""
 for p in $pkgs; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
 done
+# node + npm run the Khronos glTF validator; any install of them will do
+command -v node >/dev/null 2>&1 || missing="$missing nodejs"
+command -v npm >/dev/null 2>&1 || missing="$missing npm"
 if [ -n "$missing" ]; then
   echo "setup: installing$missing"
   SUDO=""; [ "$(id -u)" = 0 ] || SUDO=sudo
