@@ -228,10 +228,32 @@ static void tmap_rows(void *vctx, size_t b, size_t e, int ti) {
 }
 
 /* ---- one instance ------------------------------------------------------------------- */
+/* nearest-neighbour 4x enlargement of a draft render to the full frame */
+static hearth_status enlarge4(const hearth_image *src, size_t W, size_t H, hearth_image *dst,
+                              hearth_err *err) {
+  hearth_status st = hearth_image_alloc(dst, W, H, src->channels, HEARTH_PIX_U8, err);
+  if (st) return st;
+  size_t c = (size_t)src->channels;
+  const uint8_t *a = src->data;
+  uint8_t *b = dst->data;
+  for (size_t y = 0; y < H; y++) {
+    size_t sy = y / 4 < src->height ? y / 4 : src->height - 1;
+    for (size_t x = 0; x < W; x++) {
+      size_t sx = x / 4 < src->width ? x / 4 : src->width - 1;
+      memcpy(b + (y * W + x) * c, a + (sy * src->width + sx) * c, c);
+    }
+  }
+  return HEARTH_OK;
+}
+
 typedef struct render_ctx {
   const hearth_synth_opts *o;
   const hearth_rig *rig;
   const float *thermal_rays, *rgb_rays, *depth_rays;
+  /* draft colour (rgb_full_size == 0, for tests): a quarter-size colour
+     camera whose renders are enlarged 4x to the full frame */
+  const hearth_rig *draft_rig;
+  const float *draft_rgb_rays;
   hearth_progress *prog;
   int threads;
 } render_ctx;
@@ -314,7 +336,19 @@ static hearth_status render_state(const render_ctx *rc, const char *root, synth_
       snprintf(p, sizeof p, "%s/%s", dir, vf->thermal);
       st = hearth_thermal_write_csv(p, &th, 2, err);
     }
-    if (!st) st = synth_render_rgb(&job, &rgb, &mask, err);
+    if (!st && rc->draft_rig) {
+      synth_view_job jd = job;
+      jd.rig = rc->draft_rig;
+      jd.rgb_rays = rc->draft_rgb_rays;
+      hearth_image small = {0}, small_mask = {0};
+      st = synth_render_rgb(&jd, &small, &small_mask, err);
+      if (!st) st = enlarge4(&small, (size_t)rc->rig->rgb.width, (size_t)rc->rig->rgb.height, &rgb, err);
+      if (!st) st = enlarge4(&small_mask, (size_t)rc->rig->rgb.width, (size_t)rc->rig->rgb.height, &mask, err);
+      hearth_image_free(&small);
+      hearth_image_free(&small_mask);
+    } else if (!st) {
+      st = synth_render_rgb(&job, &rgb, &mask, err);
+    }
     if (!st) {
       snprintf(p, sizeof p, "%s/%s", dir, vf->rgb);
       st = hearth_jpeg_write(p, &rgb, 92, err);
@@ -559,6 +593,7 @@ static hearth_status build_tree(const hearth_synth_opts *o, const char *root, he
   float *trays = synth_ray_table(&rig.thermal, 4, threads);
   float *crays = synth_ray_table(&rig.rgb, 1, threads);
   float *drays = synth_ray_table(&rig.depth, 1, threads);
+  float *draft_rays = NULL;
   hearth_mesh given = {0};
   const char *defaults[64];
   const char *const *cats = o->categories;
@@ -607,7 +642,24 @@ static hearth_status build_tree(const hearth_synth_opts *o, const char *root, he
   }
   hearth_progress prog;
   hearth_progress_begin(&prog, "rendering views", total_views, o->quiet);
-  render_ctx rc = {o, &rig, trays, crays, drays, &prog, threads};
+  render_ctx rc = {o, &rig, trays, crays, drays, NULL, NULL, &prog, threads};
+  hearth_rig draft_rig = rig;
+  if (!o->rgb_full_size) {
+    hearth_camera *dc = &draft_rig.rgb;
+    dc->width /= 4;
+    dc->height /= 4;
+    dc->fx /= 4.0;
+    dc->fy /= 4.0;
+    dc->cx = (dc->cx + 0.5) / 4.0 - 0.5;
+    dc->cy = (dc->cy + 0.5) / 4.0 - 0.5;
+    draft_rays = synth_ray_table(dc, 1, threads);
+    if (!draft_rays) {
+      st = hearth_err_set(err, HEARTH_E_NOMEM, "synth: ray tables: out of memory");
+      goto done;
+    }
+    rc.draft_rig = &draft_rig;
+    rc.draft_rgb_rays = draft_rays;
+  }
   for (size_t ci = 0; ci < ncat && !st; ci++)
     for (int k = 0; k < per && !st; k++) {
       synth_instance *inst = malloc(sizeof *inst);
@@ -634,6 +686,7 @@ done:
   free(trays);
   free(crays);
   free(drays);
+  free(draft_rays);
   return st;
 }
 

@@ -43,7 +43,7 @@ int main(void) {
   /* 10 instances, 2 views per state, tiny meshes and maps; the true rig
      stands in for calibration (no captures: no release-level stages) */
   snprintf(cmd, sizeof cmd,
-           "'%s' synth --out '%s' --seed 11 --categories cup,canned_drink --instances 5 --views 2 "
+           "'%s' synth --out '%s' --draft-rgb --seed 11 --categories cup,canned_drink --instances 5 --views 2 "
            "--triangles 600 --texture 64 --map-res 32 --no-calibration --threads 2 --quiet && "
            "cp '%s/ground_truth/rig.json' '%s/calibration/rig.json' && cp -a '%s' '%s'",
            HEARTH_EXE, root, root, root, root, pristine);

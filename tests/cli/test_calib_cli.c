@@ -32,6 +32,7 @@ int main(void) {
   o.n_thermal_frames = 10;
   o.n_stereo_pairs = 8;
   o.quiet = 1;
+  o.rgb_full_size = 0; /* draft object views; plate frames are always full quality */
   hearth_err err = {0};
   CHECK_OK(hearth_synth_release(&o, &err), &err);
 

@@ -31,6 +31,7 @@ static void small_opts(hearth_synth_opts *o, const char *root, int threads) {
   o->n_stereo_pairs = 1;
   o->threads = threads;
   o->quiet = 1;
+  o->rgb_full_size = 0; /* draft colour keeps the test fast; test_synth_cli covers full size */
 }
 
 static int exists(const char *root, const char *rel) {
