@@ -76,7 +76,7 @@ hearth_status hearth_scale_run(const hearth_scale_job *job, hearth_scale_result 
 
 /* ---- refinement ------------------------------------------------------------ */
 typedef struct hearth_refine_opts {
-  double search_px;        /* first edge-search half window; default 8 */
+  double search_px;        /* first edge-search half window; default 14 */
   int iterations;          /* Gauss-Newton iterations; default 12 */
   size_t max_samples;      /* silhouette samples per iteration; default 400 */
   double min_contrast_c;   /* |object - background| below this: pose kept; default 1.5 */

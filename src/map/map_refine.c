@@ -22,10 +22,13 @@
 #define RF_TRUNC 1.5          /* px: truncation of the criterion */
 #define RF_HUBER 1.0          /* px */
 #define RF_STEP 0.5           /* px: profile sampling step */
+#define RF_COARSE 4           /* px: coarse grid of the hit mask */
+#define RF_MAX_NODES 4096
+#define RF_PRIOR_PX 0.1       /* px: see the prior in refine_one */
 
 void hearth_refine_opts_default(hearth_refine_opts *o) {
   memset(o, 0, sizeof *o);
-  o->search_px = 8.0;
+  o->search_px = 14.0;
   o->iterations = 12;
   o->max_samples = 400;
   o->min_contrast_c = 1.5;
@@ -144,6 +147,16 @@ static int cast_px(const rf_ctx *c, const hearth_rigid *T, size_t p, size_t q, d
   return 1;
 }
 
+/* 1 if the ray of pixel (x, y) from T hits the mesh */
+static uint8_t cast_hit(const rf_ctx *c, const hearth_rigid *T, int x, int y) {
+  const float *d = c->rays + 3 * ((size_t)y * (size_t)c->cam->width + (size_t)x);
+  if (isnan(d[0])) return 0;
+  double dc[3] = {d[0], d[1], d[2]}, dw[3];
+  hearth_rigid_rotate(T, dc, dw);
+  hearth_ray_hit h;
+  return (uint8_t)hearth_raycast(c->rc, T->t, dw, 0.0, INFINITY, &h);
+}
+
 /* the outer silhouette of the mesh seen from T: samples in s (at most max) */
 static size_t extract_contour(const rf_ctx *c, rf_scratch *sc, const hearth_rigid *T, size_t max) {
   const hearth_camera *cam = c->cam;
@@ -151,18 +164,38 @@ static size_t extract_contour(const rf_ctx *c, rf_scratch *sc, const hearth_rigi
   if (!rf_mesh_box(c->mesh, cam, T, 3, box)) return 0;
   memcpy(sc->box, box, sizeof box);
   size_t W = (size_t)cam->width;
-  for (int y = box[1]; y < box[3]; y++)
-    for (int x = box[0]; x < box[2]; x++) {
-      const float *d = c->rays + 3 * ((size_t)y * W + (size_t)x);
-      uint8_t hv = 0;
-      if (!isnan(d[0])) {
-        double dc[3] = {d[0], d[1], d[2]}, dw[3];
-        hearth_rigid_rotate(T, dc, dw);
-        hearth_ray_hit h;
-        hv = (uint8_t)hearth_raycast(c->rc, T->t, dw, 0.0, INFINITY, &h);
-      }
-      sc->hit[(size_t)y * W + (size_t)x] = hv;
-    }
+  /* coarse-to-fine hit mask: cast a grid every RF_COARSE pixels; cells whose
+     four corners agree take that value, the others (the silhouette's cells)
+     are cast pixel by pixel. Inferred cells are written first so that exact
+     casts on shared cell borders win. */
+  int xs[RF_MAX_NODES], ys[RF_MAX_NODES], nx = 0, ny = 0;
+  for (int x = box[0]; x < box[2] && nx < RF_MAX_NODES - 1; x += RF_COARSE) xs[nx++] = x;
+  if (xs[nx - 1] != box[2] - 1) xs[nx++] = box[2] - 1;
+  for (int y = box[1]; y < box[3] && ny < RF_MAX_NODES - 1; y += RF_COARSE) ys[ny++] = y;
+  if (ys[ny - 1] != box[3] - 1) ys[ny++] = box[3] - 1;
+  int exact = nx >= RF_MAX_NODES - 1 || ny >= RF_MAX_NODES - 1 || nx < 2 || ny < 2;
+  if (exact) { /* huge box: cast everything */
+    for (int y = box[1]; y < box[3]; y++)
+      for (int x = box[0]; x < box[2]; x++) sc->hit[(size_t)y * W + (size_t)x] = cast_hit(c, T, x, y);
+  } else {
+    for (int j = 0; j < ny; j++)
+      for (int i = 0; i < nx; i++) sc->hit[(size_t)ys[j] * W + (size_t)xs[i]] = cast_hit(c, T, xs[i], ys[j]);
+    for (int pass = 0; pass < 2; pass++)
+      for (int j = 0; j + 1 < ny; j++)
+        for (int i = 0; i + 1 < nx; i++) {
+          uint8_t a = sc->hit[(size_t)ys[j] * W + (size_t)xs[i]], b = sc->hit[(size_t)ys[j] * W + (size_t)xs[i + 1]],
+                  cc = sc->hit[(size_t)ys[j + 1] * W + (size_t)xs[i]],
+                  dd = sc->hit[(size_t)ys[j + 1] * W + (size_t)xs[i + 1]];
+          int uniform = a == b && a == cc && a == dd;
+          if (uniform != (pass == 0)) continue;
+          for (int y = ys[j]; y <= ys[j + 1]; y++)
+            for (int x = xs[i]; x <= xs[i + 1]; x++) {
+              int node = (x == xs[i] || x == xs[i + 1]) && (y == ys[j] || y == ys[j + 1]);
+              if (node) continue;
+              sc->hit[(size_t)y * W + (size_t)x] = uniform ? a : cast_hit(c, T, x, y);
+            }
+        }
+  }
   /* count hit/miss pairs first so the subsampling is even and deterministic */
   const int dx[4] = {1, -1, 0, 0}, dy[4] = {0, 0, 1, -1};
   size_t n_pairs = 0;
@@ -394,6 +427,17 @@ static void apply_twist(const hearth_rigid *T, const double d[6], hearth_rigid *
   hearth_rigid_compose(T, &D, out);
 }
 
+/* twist d with b = a * (R(d_rot), d_t) */
+static void twist_between(const hearth_rigid *a, const hearth_rigid *b, double d[6]) {
+  hearth_rigid ai, D;
+  hearth_rigid_inverse(a, &ai);
+  hearth_rigid_compose(&ai, b, &D);
+  hearth_matrix_to_rotvec(D.R, d);
+  d[3] = D.t[0];
+  d[4] = D.t[1];
+  d[5] = D.t[2];
+}
+
 static void pose_change(const hearth_rigid *a, const hearth_rigid *b, double *rot_deg, double *t_mm) {
   *rot_deg = hearth_rotation_angle_between(a->R, b->R) * 180.0 / M_PI;
   double d[3] = {a->t[0] - b->t[0], a->t[1] - b->t[1], a->t[2] - b->t[2]};
@@ -479,6 +523,22 @@ static void refine_one(rf_ctx *c, size_t v, int t) {
       b[p] = -g[p];
     }
     (void)zsum;
+    /* prior: the start is off by about a degree and a few millimetres, so a
+       soft pull towards it (1 deg or 5 mm cost as much as RF_PRIOR_PX on every
+       sample) pins
+       the directions the silhouette cannot see (rotation about a body of
+       revolution's axis) without biasing the ones it sees */
+    {
+      double dev[6];
+      twist_between(&T0, &T, dev);
+      const double lr = wsum * RF_PRIOR_PX * RF_PRIOR_PX / pow(M_PI / 180.0, 2),
+                   lt = wsum * RF_PRIOR_PX * RF_PRIOR_PX / (0.005 * 0.005);
+      for (int p = 0; p < 6; p++) {
+        double l = p < 3 ? lr : lt;
+        A[7 * p] += l;
+        b[p] -= l * dev[p];
+      }
+    }
     if (!chol6(A, b, d)) break;
     hearth_rigid Tn;
     apply_twist(&T, d, &Tn);

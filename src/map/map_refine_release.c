@@ -305,6 +305,18 @@ hearth_status hearth_refine_run(const hearth_refine_job *job, hearth_refine_summ
                        inst, job->state ? job->state : "");
     goto done;
   }
+  /* the outputs' folders (derived/ need not exist yet with --start/--mesh elsewhere) */
+  {
+    const char *outs[2] = {out_path, rep_path};
+    for (int k = 0; k < 2; k++) {
+      snprintf(path, RF_PATH, "%s", outs[k]);
+      char *slash = strrchr(path, '/');
+      if (slash && slash != path) {
+        *slash = 0;
+        if ((s = hearth_mkdirs(path, err))) goto done;
+      }
+    }
+  }
   if ((s = hearth_poses_write(out_path, &outp, err))) goto done;
   {
     json_t *doc = json_object();
