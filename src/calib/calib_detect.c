@@ -71,6 +71,17 @@ static int32_t run_find(run_t *r, int32_t i) {
   return i;
 }
 
+/* bit 7 of each byte of the result is set where that byte of p[0..8) is
+ * > t: the low 7 bits are compared by an add that cannot carry across
+ * bytes, then combined with the top bits */
+static inline uint64_t gt8(const uint8_t *p, int t) {
+  const uint64_t ones = 0x0101010101010101ULL, tops = 0x8080808080808080ULL;
+  uint64_t x;
+  memcpy(&x, p, 8);
+  uint64_t c = (x & ~tops) + ones * (uint64_t)(0x7f - (t & 0x7f));
+  return (t < 128 ? (x | c) : (x & c)) & tops;
+}
+
 static hearth_status find_blobs(const uint8_t *img, size_t w, size_t h, int thr, double s,
                                 blob **out, size_t *n_out, hearth_err *err) {
   size_t cap = 4096, nr = 0;
@@ -82,9 +93,12 @@ static hearth_status find_blobs(const uint8_t *img, size_t w, size_t h, int thr,
     size_t cur_begin = nr, p = prev_begin;
     size_t x = 0;
     while (x < w) {
+      /* eight bytes at a time through plain background and run interiors */
+      while (x + 8 <= w && gt8(row + x, thr) == 0) x += 8;
       while (x < w && row[x] <= thr) x++;
       if (x >= w) break;
       size_t x0 = x;
+      while (x + 8 <= w && gt8(row + x, thr) == 0x8080808080808080ULL) x += 8;
       while (x < w && row[x] > thr) x++;
       if (nr == cap) {
         run_t *nrs = realloc(runs, sizeof(run_t) * cap * 2);
@@ -241,17 +255,41 @@ typedef struct pixsrc {
   int ch;
 } pixsrc;
 
-static inline double px_at(const pixsrc *P, size_t i) {
-  if (P->f) return P->f[i];
-  const uint8_t *q = P->u8 + i * (size_t)P->ch;
-  return P->ch >= 3 ? 0.299 * q[0] + 0.587 * q[1] + 0.114 * q[2] : q[0];
+/* one row span [x0, x1] of the raw values as floats (colour: luma) */
+static void px_row(const pixsrc *P, size_t w, long y, long x0, long x1, float *out) {
+  size_t base = (size_t)y * w + (size_t)x0, n = (size_t)(x1 - x0 + 1);
+  if (P->f) {
+    memcpy(out, P->f + base, n * sizeof(float));
+  } else if (P->ch >= 3) {
+    const uint8_t *q = P->u8 + base * (size_t)P->ch;
+    for (size_t i = 0; i < n; i++, q += P->ch)
+      out[i] = (float)(0.299 * q[0] + 0.587 * q[1] + 0.114 * q[2]);
+  } else {
+    const uint8_t *q = P->u8 + base * (size_t)P->ch;
+    for (size_t i = 0; i < n; i++) out[i] = q[i * (size_t)P->ch];
+  }
+}
+
+/* columns of row offset dy where ia dx^2 + 2 ib dx dy + id dy^2 <= r2
+ * (dx = x - cx), widened by a pixel each side against rounding; 0 if the
+ * row misses the ellipse (with the same slack) */
+static int ellipse_span(double ia, double ib, double id, double dy, double r2, double cx,
+                        long *x0, long *x1) {
+  double disc = ib * ib * dy * dy - ia * (id * dy * dy - r2);
+  if (disc < 0) disc = 0;
+  double sq = sqrt(disc), lo = (-ib * dy - sq) / ia, hi = (-ib * dy + sq) / ia;
+  /* rows just outside still get a short span around the nearest point:
+   * the exact per-pixel test rejects them */
+  *x0 = (long)floor(cx + lo) - 1;
+  *x1 = (long)ceil(cx + hi) + 1;
+  return 1;
 }
 
 /* refine one hole: intensity-weighted centroid of s * (I - bg) inside the
  * ellipse 1.5x the hole, bg the median of the ring 1.35..1.75x; returns the
  * blur estimate (sigma / radius) or NAN if the hole vanished */
 static double refine_centre(const pixsrc *I, size_t w, size_t h, double sign, const double S[3],
-                            double c[2], double *scratch, size_t scratch_n) {
+                            double c[2], double *scratch, size_t scratch_n, float *row) {
   /* ellipse metric: d^2 = x^T (4 S)^-1 x, 1 at the hole edge */
   double a = 4 * S[0], b = 4 * S[1], d = 4 * S[2];
   double det = a * d - b * b;
@@ -270,13 +308,36 @@ static double refine_centre(const pixsrc *I, size_t w, size_t h, double sign, co
       if (x1 >= (long)w) x1 = (long)w - 1;
       if (y1 >= (long)h) y1 = (long)h - 1;
       size_t m = 0;
-      for (long y = y0; y <= y1; y++)
-        for (long x = x0; x <= x1; x++) {
-          double dx = (double)x - cx, dy = (double)y - cy;
-          double q = ia * dx * dx + 2 * ib * dx * dy + id * dy * dy;
-          if (q >= 1.35 * 1.35 && q <= 1.75 * 1.75 && m < scratch_n)
-            scratch[m++] = px_at(I, (size_t)y * w + (size_t)x);
+      for (long y = y0; y <= y1; y++) {
+        /* only the columns near the ring: the outer span of this row, less
+         * the inside of the inner one (a pixel of slack each side, the
+         * exact test decides) */
+        double dy = (double)y - cy;
+        long a1, b1, a0, b0;
+        if (!ellipse_span(ia, ib, id, dy, 1.75 * 1.75, cx, &a1, &b1)) continue;
+        if (a1 < x0) a1 = x0;
+        if (b1 > x1) b1 = x1;
+        if (a1 > b1) continue;
+        if (!ellipse_span(ia, ib, id, dy, 1.35 * 1.35, cx, &a0, &b0) || a0 + 2 > b0 - 2) {
+          a0 = b1 + 1;
+          b0 = b1;
+        } else {
+          a0 += 2;
+          b0 -= 2;
+          if (a0 < a1) a0 = a1;
+          if (a0 > b0) a0 = b1 + 1;
         }
+        px_row(I, w, y, a1, b1, row);
+        for (long x = a1; x <= b1; x++) {
+          if (x == a0) {
+            x = b0;
+            continue;
+          }
+          double dx = (double)x - cx;
+          double q = ia * dx * dx + 2 * ib * dx * dy + id * dy * dy;
+          if (q >= 1.35 * 1.35 && q <= 1.75 * 1.75 && m < scratch_n) scratch[m++] = row[x - a1];
+        }
+      }
       if (m < 8) return NAN;
       bg = select_kth(scratch, m, m / 2);
     }
@@ -287,11 +348,17 @@ static double refine_centre(const pixsrc *I, size_t w, size_t h, double sign, co
     double sw = 0, sx = 0, sy = 0, sq = 0;
     for (long y = y0; y <= y1; y++) {
       double dy = (double)y - cy;
-      for (long x = x0; x <= x1; x++) {
+      long xa, xb;
+      if (!ellipse_span(ia, ib, id, dy, 1.5 * 1.5, cx, &xa, &xb)) continue;
+      if (xa < x0) xa = x0;
+      if (xb > x1) xb = x1;
+      if (xa > xb) continue;
+      px_row(I, w, y, xa, xb, row);
+      for (long x = xa; x <= xb; x++) {
         double dx = (double)x - cx;
         double q = ia * dx * dx + 2 * ib * dx * dy + id * dy * dy;
         if (q > 1.5 * 1.5) continue;
-        double wt = sign * (px_at(I, (size_t)y * w + (size_t)x) - bg);
+        double wt = sign * ((double)row[x - xa] - bg);
         if (wt <= 0) continue;
         sw += wt;
         sx += wt * dx;
@@ -333,6 +400,11 @@ static hearth_status finish(blob *bl, size_t nb, const pixsrc *raw, size_t w, si
   /* match ordered points back to their blobs for the window shapes */
   double scratch[4096];
   double blur[HEARTH_PLATE_HOLES];
+  float *row = malloc(sizeof(float) * w);
+  if (!row) {
+    free(pts);
+    return hearth_err_set(err, HEARTH_E_NOMEM, "detection: out of memory");
+  }
   for (int i = 0; i < HEARTH_PLATE_HOLES; i++) {
     size_t bi = 0;
     for (size_t j = 0; j < nb; j++)
@@ -342,18 +414,20 @@ static hearth_status finish(blob *bl, size_t nb, const pixsrc *raw, size_t w, si
       }
     double S[3] = {bl[bi].sxx, bl[bi].sxy, bl[bi].syy};
     double c[2] = {ord[i][0], ord[i][1]};
-    blur[i] = refine_centre(raw, w, h, sign, S, c, scratch, 4096);
+    blur[i] = refine_centre(raw, w, h, sign, S, c, scratch, 4096, row);
     if (isnan(blur[i])) {
       snprintf(det->reason, sizeof det->reason,
                "hole %d at (%.1f, %.1f) could not be refined (too close to the edge)", i, ord[i][0],
                ord[i][1]);
       free(pts);
+      free(row);
       return HEARTH_OK;
     }
     det->centres[i][0] = c[0];
     det->centres[i][1] = c[1];
   }
   free(pts);
+  free(row);
   qsort(blur, HEARTH_PLATE_HOLES, sizeof(double), cmp_double);
   double med_blur = 0.5 * (blur[41] + blur[42]);
   if (med_blur > o->max_blur_frac) {
@@ -374,8 +448,23 @@ static hearth_status detect_multi(const uint8_t *U, size_t W, size_t H, double s
                                   const pixsrc *raw, size_t w, size_t h, double sign,
                                   const hearth_detect_opts *o, hearth_detection *det,
                                   hearth_err *err) {
+  /* four interleaved histograms: consecutive equal pixels would otherwise
+   * serialise on one counter */
   size_t hist[256] = {0}, n = W * H;
-  for (size_t i = 0; i < n; i++) hist[U[i]]++;
+  {
+    uint32_t h4[4][256];
+    memset(h4, 0, sizeof h4);
+    size_t i = 0;
+    for (; i + 4 <= n; i += 4) {
+      h4[0][U[i]]++;
+      h4[1][U[i + 1]]++;
+      h4[2][U[i + 2]]++;
+      h4[3][U[i + 3]]++;
+    }
+    for (; i < n; i++) h4[0][U[i]]++;
+    for (int k = 0; k < 256; k++)
+      hist[k] = (size_t)h4[0][k] + h4[1][k] + h4[2][k] + h4[3][k];
+  }
   int med = 0, p995 = 255;
   size_t acc = 0;
   for (int i = 0; i < 256; i++) {
@@ -426,7 +515,8 @@ hearth_status hearth_detect_plate_thermal(const hearth_image *temps, const heart
   const float *T = temps->data;
   hearth_status st = HEARTH_OK;
   uint8_t *g8 = malloc(npx);
-  uint8_t *U = hearth_alloc_array(npx * (size_t)up, (size_t)up);
+  /* 16 bytes of slack: the upsampling writes whole blocks of 16 */
+  uint8_t *U = malloc(npx * (size_t)up * (size_t)up + 16);
   if (!g8 || !U) {
     st = hearth_err_set(err, HEARTH_E_NOMEM, "thermal detection: out of memory");
     goto done;
@@ -474,15 +564,19 @@ hearth_status hearth_detect_plate_thermal(const hearth_image *temps, const heart
       g8[i] = (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : v + 0.5);
     }
   }
-  /* bilinear upsampling: up pixel j samples native (j + 0.5) / up - 0.5;
-   * column taps and weights are shared by every row */
+  /* bilinear upsampling: up pixel j samples native (j + 0.5) / up - 0.5.
+   * Separable and in fixed point (weights in 1/256): every native row is
+   * interpolated along x once, then each output row blends two of those */
   size_t W = w * (size_t)up, H = h * (size_t)up;
   {
-    size_t *cx0 = hearth_alloc_array(W, sizeof(size_t) * 2);
-    float *cw = hearth_alloc_array(W, sizeof(float));
-    if (!cx0 || !cw) {
+    uint32_t *cx0 = hearth_alloc_array(W, sizeof(uint32_t) * 2);
+    uint16_t *cw = hearth_alloc_array(W, sizeof(uint16_t));
+    size_t Wp = (W + 15) / 16 * 16;
+    uint16_t *hx = hearth_calloc_array(Wp * h, sizeof(uint16_t));
+    if (!cx0 || !cw || !hx) {
       free(cx0);
       free(cw);
+      free(hx);
       st = hearth_err_set(err, HEARTH_E_NOMEM, "thermal detection: out of memory");
       goto done;
     }
@@ -491,28 +585,34 @@ hearth_status hearth_detect_plate_thermal(const hearth_image *temps, const heart
       if (fx < 0) fx = 0;
       if (fx > (double)(w - 1)) fx = (double)(w - 1);
       size_t x0 = (size_t)fx;
-      cx0[2 * x] = x0;
-      cx0[2 * x + 1] = x0 + 1 < w ? x0 + 1 : x0;
-      cw[x] = (float)(fx - (double)x0);
+      cx0[2 * x] = (uint32_t)x0;
+      cx0[2 * x + 1] = (uint32_t)(x0 + 1 < w ? x0 + 1 : x0);
+      cw[x] = (uint16_t)lround((fx - (double)x0) * 256.0);
+    }
+    for (size_t y = 0; y < h; y++) {
+      const uint8_t *restrict g = g8 + y * w;
+      uint16_t *restrict d = hx + y * Wp;
+      for (size_t x = 0; x < W; x++)
+        d[x] = (uint16_t)(g[cx0[2 * x]] * (256u - cw[x]) + g[cx0[2 * x + 1]] * (uint32_t)cw[x]);
     }
     for (size_t y = 0; y < H; y++) {
       double fy = ((double)y + 0.5) / up - 0.5;
       if (fy < 0) fy = 0;
       if (fy > (double)(h - 1)) fy = (double)(h - 1);
       size_t y0 = (size_t)fy, y1 = y0 + 1 < h ? y0 + 1 : y0;
-      float ty = (float)(fy - (double)y0);
-      const uint8_t *g0 = g8 + y0 * w, *g1 = g8 + y1 * w;
-      uint8_t *dst = U + y * W;
-      for (size_t x = 0; x < W; x++) {
-        size_t a0 = cx0[2 * x], a1 = cx0[2 * x + 1];
-        float tx = cw[x];
-        float top = g0[a0] + tx * (float)(g0[a1] - g0[a0]);
-        float bot = g1[a0] + tx * (float)(g1[a1] - g1[a0]);
-        dst[x] = (uint8_t)(top + ty * (bot - top) + 0.5f);
-      }
+      uint32_t wy = (uint32_t)lround((fy - (double)y0) * 256.0), wy0 = 256u - wy;
+      const uint16_t *restrict h0 = hx + y0 * Wp, *restrict h1 = hx + y1 * Wp;
+      /* a block past the row end spills into the next row (rewritten
+       * next) or the slack */
+      uint8_t *restrict dst = U + y * W;
+      /* fixed blocks of 16 (the rows are padded) so the compiler vectorises */
+      for (size_t xb = 0; xb < Wp; xb += 16)
+        for (size_t k = 0; k < 16; k++)
+          dst[xb + k] = (uint8_t)((h0[xb + k] * wy0 + h1[xb + k] * wy + 32768u) >> 16);
     }
     free(cx0);
     free(cw);
+    free(hx);
   }
   pixsrc src = {T, NULL, 1};
   st = detect_multi(U, W, H, 1.0 / up, &src, w, h, +1.0, o, det, err);
@@ -545,17 +645,29 @@ hearth_status hearth_detect_plate_color(const hearth_image *img, const hearth_de
   if (!inv) return hearth_err_set(err, HEARTH_E_NOMEM, "colour detection: out of memory");
   const uint8_t *p = img->data;
   int ch = img->channels;
-  for (size_t y = 0; y < hh; y++)
-    for (size_t x = 0; x < hw; x++) {
-      int sum = 0;
-      for (int dy = 0; dy < 2; dy++)
-        for (int dx = 0; dx < 2; dx++) {
-          const uint8_t *q = p + ((2 * y + (size_t)dy) * w + 2 * x + (size_t)dx) * (size_t)ch;
-          /* integer luma, weights 77/150/29 of 256 */
-          sum += ch >= 3 ? (77 * q[0] + 150 * q[1] + 29 * q[2]) : 256 * q[0];
-        }
-      inv[y * hw + x] = (uint8_t)(255 - (sum + 512) / 1024);
+  if (ch == 1) {
+    /* gray (the luma plane of a JPEG): the same rounding as below */
+    for (size_t y = 0; y < hh; y++) {
+      const uint8_t *restrict r0 = p + 2 * y * w, *restrict r1 = r0 + w;
+      uint8_t *restrict d = inv + y * hw;
+      for (size_t x = 0; x < hw; x++) {
+        unsigned sum = (unsigned)r0[2 * x] + r0[2 * x + 1] + r1[2 * x] + r1[2 * x + 1];
+        d[x] = (uint8_t)(255u - (sum + 2u) / 4u);
+      }
     }
+  } else {
+    for (size_t y = 0; y < hh; y++)
+      for (size_t x = 0; x < hw; x++) {
+        int sum = 0;
+        for (int dy = 0; dy < 2; dy++)
+          for (int dx = 0; dx < 2; dx++) {
+            const uint8_t *q = p + ((2 * y + (size_t)dy) * w + 2 * x + (size_t)dx) * (size_t)ch;
+            /* integer luma, weights 77/150/29 of 256 */
+            sum += ch >= 3 ? (77 * q[0] + 150 * q[1] + 29 * q[2]) : 256 * q[0];
+          }
+        inv[y * hw + x] = (uint8_t)(255 - (sum + 512) / 1024);
+      }
+  }
   pixsrc src = {NULL, p, ch};
   /* half-res pixel j sits at full-res 2 j + 0.5: up = 1/2 in find_blobs terms */
   st = detect_multi(inv, hw, hh, 2.0, &src, w, h, -1.0, o, det, err);

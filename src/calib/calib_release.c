@@ -85,13 +85,19 @@ static void det_range(void *vctx, size_t b, size_t e, int ti) {
       j->st = hearth_thermal_read_csv(j->path, NULL, &j->img, &j->err);
       if (!j->st) j->st = hearth_detect_plate_thermal(&j->img, &c->run->detect, &j->det, &j->err);
     } else {
-      j->st = hearth_jpeg_read(j->path, &j->img, &j->err);
+      /* detection reads the luma plane only (no chroma work); the overlay,
+       * if wanted, decodes the colour image too */
+      j->st = calib_jpeg_read_luma(j->path, &j->img, &j->err);
       if (!j->st && c->want_rgb_w > 0 &&
           (j->img.width != (size_t)c->want_rgb_w || j->img.height != (size_t)c->want_rgb_h))
         j->st = hearth_err_set(&j->err, HEARTH_E_SIZE,
                                "%s: image is %zux%zu, the colour camera (factory.json) is %dx%d",
                                j->path, j->img.width, j->img.height, c->want_rgb_w, c->want_rgb_h);
       if (!j->st) j->st = hearth_detect_plate_color(&j->img, &c->run->detect, &j->det, &j->err);
+      if (!j->st && c->run->overlays) {
+        hearth_image_free(&j->img);
+        j->st = hearth_jpeg_read(j->path, &j->img, &j->err);
+      }
     }
     /* every error names its file */
     if (j->st && !strstr(j->err.msg, j->path)) hearth_err_prefix(&j->err, "%s", j->path);
