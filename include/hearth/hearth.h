@@ -16,4 +16,7 @@
 #include "hearth/release_tools.h"
 #include "hearth/refine.h"
 #include "hearth/sim.h"
+#include "hearth/eval.h"
+#include "hearth/msgpack.h"
+#include "hearth/ws.h"
 #endif

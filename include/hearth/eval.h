@@ -1,0 +1,122 @@
+/* hearth/eval.h - scoring policies on the sim tasks H1-H3 the way the paper
+ * does (10 episodes per instruction, 20 per task, 60 per policy; success =
+ * target on the mat within the time limit), for policies running anywhere:
+ * the scripted expert (an upper bound), a replay of an HDF5 demonstration
+ * (a determinism check) and an openpi policy server over WebSocket.
+ *
+ * Held-out layouts: evaluation episode e of a task uses layout
+ * HEARTH_EVAL_LAYOUT_BASE + e of the seed stream, never reached by
+ * collection (which uses layouts 0, 1, 2, ... up to at most 100000 + retries);
+ * both instructions of an episode index share the layout, as in the paper. */
+#ifndef HEARTH_EVAL_H
+#define HEARTH_EVAL_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "hearth/core.h"
+#include "hearth/sim.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define HEARTH_EVAL_LAYOUT_BASE ((uint64_t)1 << 32)
+/* Time limits in control steps (policy steps; the 10 no-op steps of the
+ * openpi client come on top, as in openpi's LIBERO example). LIBERO uses
+ * 220 (spatial), 280 (object), 300 (goal) and 520 (long); our tasks are
+ * single pick-and-place like LIBERO-Object, and the scripted expert needs
+ * about 130-170 steps, so 280 for each. */
+int hearth_eval_time_limit(hearth_sim_task t);
+
+/* ---- openpi WebSocket client ----------------------------------------------
+ * ws://HOST:PORT[/PATH]; every wait is bounded by the timeout (poll). */
+typedef struct hearth_ws hearth_ws;
+hearth_status hearth_ws_connect(const char *url, double timeout_s, hearth_ws **out, hearth_err *err);
+/* Send one message (HEARTH_WS_BINARY or HEARTH_WS_TEXT), masked, in
+ * fragments of at most frag_size bytes (0 = one frame). */
+hearth_status hearth_ws_send(hearth_ws *c, int opcode, const void *data, size_t n, size_t frag_size,
+                             hearth_err *err);
+/* Receive one whole message (fragments joined, pings answered). A close
+ * frame from the server is an error naming its code and reason. *data is
+ * malloc'd (NUL-terminated for convenience). */
+hearth_status hearth_ws_recv(hearth_ws *c, uint8_t **data, size_t *n, int *opcode, double timeout_s,
+                             hearth_err *err);
+/* Send a ping with payload and wait for the matching pong. */
+hearth_status hearth_ws_ping(hearth_ws *c, const void *payload, size_t n, double timeout_s, hearth_err *err);
+/* Close handshake with `code` (bounded wait), then free. NULL is fine. */
+void hearth_ws_close(hearth_ws *c, int code);
+/* Close code and reason of the server's close frame, if one came (else 0). */
+int hearth_ws_close_code(const hearth_ws *c, const char **reason);
+
+/* ---- openpi observations ----------------------------------------------------
+ * openpi's image_tools.resize_with_pad: scale to fit out_w x out_h keeping
+ * the aspect ratio (bilinear), centre, pad with zeros. RGB U8. */
+void hearth_eval_resize_with_pad(const uint8_t *in, int w, int h, uint8_t *out, int out_w, int out_h);
+/* Build the openpi LIBERO request (msgpack map): observation/image,
+ * observation/wrist_image (and observation/thermal_image if thermal), each
+ * rotated 180 degrees from OpenGL order and resized with padding to
+ * size x size; observation/state (8 x <f8: ee pos, axis-angle, gripper);
+ * prompt. The caller frees the writer. */
+struct hearth_mp_writer;
+hearth_status hearth_eval_encode_obs(const hearth_sim_obs *obs, const char *prompt, int thermal, int size,
+                                     struct hearth_mp_writer *w, hearth_err *err);
+
+/* ---- evaluation ------------------------------------------------------------ */
+typedef struct hearth_eval_opts {
+  unsigned tasks;          /* bit (1 << task): default all three */
+  const char *policy;      /* "oracle", "replay:FILE.hdf5[#K]", "ws://HOST:PORT" */
+  int episodes;            /* per instruction; default 10 */
+  int thermal;             /* send observation/thermal_image; default 1 */
+  uint64_t seed;           /* layout stream; default 1 (collection's default) */
+  uint64_t layout_base;    /* episode k uses layout layout_base + k; default HEARTH_EVAL_LAYOUT_BASE */
+  const char *release_root;
+  int use_ground_truth;
+  int render_size;         /* sim view side; default 256 */
+  int image_size;          /* policy image side; default 224 */
+  int max_steps;           /* 0 = hearth_eval_time_limit(task) */
+  int replan_steps;        /* default 5 */
+  int wait_steps;          /* no-op steps before querying; default 10 */
+  double timeout_s;        /* per server reply and connect; default 120 */
+  const char *video_dir;   /* animated PNG per episode if set */
+  int video_every;         /* keep every k-th frame; default 2 */
+  int quiet;
+} hearth_eval_opts;
+void hearth_eval_opts_default(hearth_eval_opts *o);
+
+typedef struct hearth_eval_episode {
+  hearth_sim_task task;
+  int instruction, episode;
+  uint64_t seed, layout;
+  int success, steps;
+  int error;               /* the policy failed (server gone, bad reply ...) */
+  char reason[512];        /* why it failed ("time limit", the error) */
+  double state_diff;       /* replay: max |state - stored state| at the last stored step; else -1 */
+  int expected_success;    /* replay: 1 (the stored demo succeeded), else -1 */
+} hearth_eval_episode;
+
+typedef struct hearth_eval_results {
+  hearth_eval_episode *eps;
+  size_t n;
+  char policy[256];
+  int thermal;
+  double seconds;
+  char metadata[512];      /* server metadata (JSON-ish summary), if any */
+} hearth_eval_results;
+
+hearth_status hearth_eval_run(const hearth_eval_opts *o, hearth_eval_results *r, hearth_err *err);
+void hearth_eval_results_free(hearth_eval_results *r);
+
+/* Success rates: per (task, instruction) and task (NaN where no episode);
+ * overall over every episode. Returns the overall fraction. */
+double hearth_eval_rates(const hearth_eval_results *r, double per_instr[4][2], double per_task[4]);
+/* The paper's table (Task, Thermal, Instr. 1, Instr. 2, Average) as text
+ * (ends with a line "overall <pct> (k/n)"), Markdown and JSON (with every
+ * episode). malloc'd strings. */
+char *hearth_eval_format_text(const hearth_eval_results *r);
+char *hearth_eval_format_markdown(const hearth_eval_results *r);
+char *hearth_eval_format_json(const hearth_eval_results *r);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,61 @@
+/* hearth/ws.h - the pieces of RFC 6455 (WebSocket) that parse untrusted
+ * bytes, written here (no third-party code): SHA-1 and base64 for the
+ * Sec-WebSocket-Accept check, the handshake response check and the frame
+ * header parser/builder. The socket client that uses them is in eval.h. */
+#ifndef HEARTH_WS_H
+#define HEARTH_WS_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "hearth/core.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+void hearth_sha1(const void *data, size_t len, uint8_t out[20]);
+/* Standard base64 with padding; writes 4*ceil(n/3) chars and a NUL; returns
+ * the length, or 0 if out is too small. */
+size_t hearth_base64_encode(const uint8_t *in, size_t n, char *out, size_t outsz);
+/* Sec-WebSocket-Accept for a Sec-WebSocket-Key: base64(SHA-1(key + GUID)). */
+void hearth_ws_accept(const char *key, char out[29]);
+
+/* Check an HTTP handshake response (up to and including the blank line):
+ * status 101, Upgrade: websocket, Connection: upgrade and the accept value
+ * for `key`; no extension may be negotiated. Errors name the line. */
+hearth_status hearth_ws_check_handshake(const char *resp, size_t len, const char *key, hearth_err *err);
+
+enum {
+  HEARTH_WS_CONT = 0x0,
+  HEARTH_WS_TEXT = 0x1,
+  HEARTH_WS_BINARY = 0x2,
+  HEARTH_WS_CLOSE = 0x8,
+  HEARTH_WS_PING = 0x9,
+  HEARTH_WS_PONG = 0xA
+};
+
+typedef struct hearth_ws_header {
+  int fin, opcode, masked;
+  uint8_t mask[4];
+  uint64_t payload_len;
+  size_t header_len;
+} hearth_ws_header;
+
+/* Parse a frame header at buf[0..len). *need > 0: that many more bytes are
+ * needed (nothing parsed). Protocol errors: reserved bits set, unknown
+ * opcode, control frame fragmented or over 125 bytes, a mask when
+ * !allow_masked (frames from a server), a non-minimal or 64-bit length with
+ * the top bit set, a payload over max_payload. */
+hearth_status hearth_ws_parse_header(const uint8_t *buf, size_t len, int allow_masked,
+                                     uint64_t max_payload, hearth_ws_header *h, size_t *need,
+                                     hearth_err *err);
+/* Write a frame header (2..14 bytes) into out; mask NULL for unmasked. */
+size_t hearth_ws_build_header(uint8_t out[14], int fin, int opcode, uint64_t payload_len,
+                              const uint8_t mask[4]);
+/* XOR p[0..n) with the mask, the payload starting at byte `offset`. */
+void hearth_ws_apply_mask(uint8_t *p, size_t n, const uint8_t mask[4], uint64_t offset);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
