@@ -226,7 +226,10 @@ void hearth_release_stats_print(const hearth_release_stats *st, FILE *out) {
   fprintf(out, " (%zu object states)\n", st->n_states);
   if (st->views_min == st->views_max) fprintf(out, "%-*s %zu", w, "Views per object state", st->views_max);
   else fprintf(out, "%-*s %zu-%zu", w, "Views per object state", st->views_min, st->views_max);
-  fprintf(out, " (%zu elevations x %zu azimuths)\n", st->n_elevations, st->n_azimuths);
+  /* a subset of the turntable grid says so, rather than implying the full grid */
+  fprintf(out, " (%s%zu elevations x %zu azimuths)\n",
+          st->views_max == st->n_elevations * st->n_azimuths ? "" : "drawn from ", st->n_elevations,
+          st->n_azimuths);
   fprintf(out, "%-*s %zu (%zu object states", w, "RGB-thermal pairs", st->n_pairs, st->n_states);
   if (st->views_min == st->views_max) fprintf(out, " x %zu views", st->views_max);
   fprintf(out, ")\n");
