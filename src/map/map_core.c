@@ -271,16 +271,21 @@ static float weighted_median(vw *a, size_t n) {
 typedef struct fill_ctx {
   size_t R;
   const uint32_t *island_of_texel;
-  const uint8_t *mask;
   int32_t *seed, *sx, *sy;
-  const uint32_t *box; /* 4 per island: x0 y0 x1 y1 (inclusive), x0 > x1 if empty */
+  const uint32_t *todo;       /* texels to fill (surface, not observed), grouped by island,
+                                 ascending index within each island */
+  const int32_t *todo_xy;     /* their (x, y), so the sweep does no division */
+  const size_t *todo_start;   /* n_islands + 1 offsets into todo */
 } fill_ctx;
 
+/* forward sweeps look at the already visited neighbours (left, up-left, up,
+   up-right), backward sweeps at the mirrored ones; visiting only the texels
+   to fill, in index order, is the same sweep as visiting every texel because
+   observed texels never change */
 static void fill_one_island(const fill_ctx *c, uint32_t isl) {
-  const uint32_t *b = c->box + 4 * (size_t)isl;
-  if (b[0] > b[2]) return;
+  size_t a = c->todo_start[isl], b = c->todo_start[isl + 1];
+  if (a == b) return;
   size_t R = c->R;
-  long x0 = (long)b[0], y0 = (long)b[1], x1 = (long)b[2], y1 = (long)b[3];
   int32_t *seed = c->seed, *sx = c->sx, *sy = c->sy;
   static const int fdx[4] = {-1, -1, 0, 1}, fdy[4] = {0, -1, -1, -1};
   int changed = 1;
@@ -288,40 +293,37 @@ static void fill_one_island(const fill_ctx *c, uint32_t isl) {
     changed = 0;
     for (int dir = 0; dir < 2; dir++) {
       int sg = dir == 0 ? 1 : -1;
-      for (long ky = y0; ky <= y1; ky++) {
-        long y = dir == 0 ? ky : y1 - (ky - y0);
-        for (long kx = x0; kx <= x1; kx++) {
-          long x = dir == 0 ? kx : x1 - (kx - x0);
-          size_t q = (size_t)y * R + (size_t)x;
-          if (c->island_of_texel[q] != isl || c->mask[q] == HEARTH_TEXEL_OBSERVED) continue;
-          int32_t best = seed[q];
-          double bd = 0;
-          if (best >= 0) {
-            double ex = (double)(sx[q] - x), ey = (double)(sy[q] - y);
-            bd = ex * ex + ey * ey;
+      for (size_t k = a; k < b; k++) {
+        size_t kk = dir == 0 ? k : b - 1 - (k - a);
+        size_t q = c->todo[kk];
+        int32_t x = c->todo_xy[2 * kk], y = c->todo_xy[2 * kk + 1];
+        int32_t best = seed[q];
+        int64_t bd = 0;
+        if (best >= 0) {
+          int64_t ex = sx[q] - x, ey = sy[q] - y;
+          bd = ex * ex + ey * ey;
+        }
+        int32_t bx = sx[q], by = sy[q];
+        for (int j = 0; j < 4; j++) {
+          int32_t nx = x + sg * fdx[j], ny = y + sg * fdy[j];
+          if (nx < 0 || ny < 0 || nx >= (int32_t)R || ny >= (int32_t)R) continue;
+          size_t nq = (size_t)ny * R + (size_t)nx;
+          int32_t s = seed[nq];
+          if (s < 0 || c->island_of_texel[nq] != isl) continue;
+          int64_t ex = sx[nq] - x, ey = sy[nq] - y;
+          int64_t d = ex * ex + ey * ey;
+          if (best < 0 || d < bd || (d == bd && s < best)) {
+            best = s;
+            bd = d;
+            bx = sx[nq];
+            by = sy[nq];
           }
-          int32_t bx = sx[q], by = sy[q];
-          for (int j = 0; j < 4; j++) {
-            long nx = x + sg * fdx[j], ny = y + sg * fdy[j];
-            if (nx < x0 || ny < y0 || nx > x1 || ny > y1) continue;
-            size_t nq = (size_t)ny * R + (size_t)nx;
-            int32_t s = seed[nq];
-            if (s < 0 || c->island_of_texel[nq] != isl) continue;
-            double ex = (double)(sx[nq] - x), ey = (double)(sy[nq] - y);
-            double d = ex * ex + ey * ey;
-            if (best < 0 || d < bd || (d == bd && s < best)) {
-              best = s;
-              bd = d;
-              bx = sx[nq];
-              by = sy[nq];
-            }
-          }
-          if (best != seed[q]) {
-            seed[q] = best;
-            sx[q] = bx;
-            sy[q] = by;
-            changed = 1;
-          }
+        }
+        if (best != seed[q]) {
+          seed[q] = best;
+          sx[q] = bx;
+          sy[q] = by;
+          changed = 1;
         }
       }
     }
@@ -336,17 +338,12 @@ static hearth_status fill_islands(size_t R, const uint32_t *island_of_texel, uin
                                   const uint8_t *mask, int32_t *seed, int nthreads) {
   size_t N = R * R;
   int32_t *sx = malloc(N * sizeof *sx), *sy = malloc(N * sizeof *sy);
-  uint32_t *box = hearth_alloc_array(n_islands ? n_islands : 1, 4 * sizeof *box);
-  if (!sx || !sy || !box) {
-    free(sx);
-    free(sy);
-    free(box);
-    return HEARTH_E_NOMEM;
-  }
-  for (uint32_t i = 0; i < n_islands; i++) {
-    box[4 * i] = box[4 * i + 1] = UINT32_MAX;
-    box[4 * i + 2] = box[4 * i + 3] = 0;
-  }
+  size_t *start = calloc((size_t)n_islands + 2, sizeof *start);
+  uint32_t *todo = NULL;
+  int32_t *todo_xy = NULL;
+  if (!sx || !sy || !start) goto oom;
+  /* counting sort of the texels to fill by island */
+  size_t n_todo = 0;
   for (size_t y = 0; y < R; y++)
     for (size_t x = 0; x < R; x++) {
       size_t q = y * R + x;
@@ -355,19 +352,43 @@ static hearth_status fill_islands(size_t R, const uint32_t *island_of_texel, uin
       sx[q] = obs ? (int32_t)x : 0;
       sy[q] = obs ? (int32_t)y : 0;
       uint32_t isl = island_of_texel[q];
-      if (isl == UINT32_MAX) continue;
-      uint32_t *b = box + 4 * (size_t)isl;
-      if (x < b[0]) b[0] = (uint32_t)x;
-      if (y < b[1]) b[1] = (uint32_t)y;
-      if (x > b[2]) b[2] = (uint32_t)x;
-      if (y > b[3]) b[3] = (uint32_t)y;
+      if (isl != UINT32_MAX && !obs) {
+        start[isl + 1]++;
+        n_todo++;
+      }
     }
-  fill_ctx c = {R, island_of_texel, mask, seed, sx, sy, box};
+  for (uint32_t i = 0; i < n_islands; i++) start[i + 1] += start[i];
+  todo = hearth_alloc_array(n_todo ? n_todo : 1, sizeof *todo);
+  todo_xy = hearth_alloc_array(n_todo ? n_todo : 1, 2 * sizeof *todo_xy);
+  if (!todo || !todo_xy) goto oom;
+  size_t *cur = malloc(((size_t)n_islands + 1) * sizeof *cur);
+  if (!cur) goto oom;
+  memcpy(cur, start, ((size_t)n_islands + 1) * sizeof *cur);
+  for (size_t q = 0; q < N; q++) {
+    uint32_t isl = island_of_texel[q];
+    if (isl != UINT32_MAX && mask[q] != HEARTH_TEXEL_OBSERVED) {
+      size_t k = cur[isl]++;
+      todo[k] = (uint32_t)q;
+      todo_xy[2 * k] = (int32_t)(q % R);
+      todo_xy[2 * k + 1] = (int32_t)(q / R);
+    }
+  }
+  free(cur);
+  fill_ctx c = {R, island_of_texel, seed, sx, sy, todo, todo_xy, start};
   hearth_parallel_for(n_islands, nthreads, fill_range, &c);
   free(sx);
   free(sy);
-  free(box);
+  free(start);
+  free(todo);
+  free(todo_xy);
   return HEARTH_OK;
+oom:
+  free(sx);
+  free(sy);
+  free(start);
+  free(todo);
+  free(todo_xy);
+  return HEARTH_E_NOMEM;
 }
 
 static void free_scratch(map_ctx *m) {
