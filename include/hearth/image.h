@@ -49,6 +49,9 @@ hearth_status hearth_png_encode(const hearth_image *img, uint8_t **out, size_t *
 hearth_status hearth_jpeg_read(const char *path, hearth_image *img, hearth_err *err);
 hearth_status hearth_jpeg_read_mem(const void *data, size_t size, const char *name,
                                    hearth_image *img, hearth_err *err);
+/* Luma only (1 channel): the stored Y plane of a colour JPEG, decoded
+ * without chroma or colour conversion (fast; for detection). */
+hearth_status hearth_jpeg_read_gray(const char *path, hearth_image *img, hearth_err *err);
 hearth_status hearth_jpeg_write(const char *path, const hearth_image *img, int quality,
                                 hearth_err *err);
 

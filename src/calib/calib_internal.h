@@ -47,8 +47,4 @@ int calib_project_pose(const hearth_camera *cam, const double R[9], const double
 void calib_circle_bias(const hearth_camera *cam, const hearth_rigid *T, const double (*obj)[3],
                        size_t n, double radius, double *bias);
 
-/* A JPEG's luma plane as a 1-channel U8 image (gray output: no chroma
- * decoding or colour conversion). Errors name the path. */
-hearth_status calib_jpeg_read_luma(const char *path, hearth_image *img, hearth_err *err);
-
 #endif

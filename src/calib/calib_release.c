@@ -87,7 +87,7 @@ static void det_range(void *vctx, size_t b, size_t e, int ti) {
     } else {
       /* detection reads the luma plane only (no chroma work); the overlay,
        * if wanted, decodes the colour image too */
-      j->st = calib_jpeg_read_luma(j->path, &j->img, &j->err);
+      j->st = hearth_jpeg_read_gray(j->path, &j->img, &j->err);
       if (!j->st && c->want_rgb_w > 0 &&
           (j->img.width != (size_t)c->want_rgb_w || j->img.height != (size_t)c->want_rgb_h))
         j->st = hearth_err_set(&j->err, HEARTH_E_SIZE,

@@ -49,6 +49,7 @@ typedef struct jpeg_reader {
   size_t size;
   hearth_status status; /* our own check failures */
   char msg[256];
+  int want_gray;         /* decode to luma only (Y of a YCbCr file) */
   hearth_image img;
 } jpeg_reader;
 
@@ -79,8 +80,10 @@ static int jpeg_decode(jpeg_reader *r) {
       break;
     case JCS_YCbCr:
     case JCS_RGB:
-      r->cinfo.out_color_space = JCS_RGB;
-      channels = 3;
+      /* libjpeg returns the stored Y plane for grayscale output of a YCbCr
+         file, skipping chroma decoding and colour conversion */
+      r->cinfo.out_color_space = r->want_gray ? JCS_GRAYSCALE : JCS_RGB;
+      channels = r->want_gray ? 1 : 3;
       break;
     default:
       r->status = HEARTH_E_UNSUPPORTED;
@@ -125,7 +128,7 @@ static int jpeg_decode(jpeg_reader *r) {
   return 0;
 }
 
-hearth_status hearth_jpeg_read_mem(const void *data, size_t size, const char *name,
+static hearth_status jpeg_read_mem(const void *data, size_t size, const char *name, int want_gray,
                                    hearth_image *img, hearth_err *err) {
   if (!name) name = "<memory>";
   memset(img, 0, sizeof *img);
@@ -137,6 +140,7 @@ hearth_status hearth_jpeg_read_mem(const void *data, size_t size, const char *na
   if (!r) return hearth_err_set(err, HEARTH_E_NOMEM, "%s: cannot allocate decoder", name);
   r->data = data;
   r->size = size;
+  r->want_gray = want_gray;
   init_errmgr(&r->jerr);
   r->cinfo.err = &r->jerr.pub;
   int rc = jpeg_decode(r);
@@ -153,15 +157,29 @@ hearth_status hearth_jpeg_read_mem(const void *data, size_t size, const char *na
   return s;
 }
 
-hearth_status hearth_jpeg_read(const char *path, hearth_image *img, hearth_err *err) {
+hearth_status hearth_jpeg_read_mem(const void *data, size_t size, const char *name,
+                                   hearth_image *img, hearth_err *err) {
+  return jpeg_read_mem(data, size, name, 0, img, err);
+}
+
+static hearth_status jpeg_read_file(const char *path, int want_gray, hearth_image *img,
+                                    hearth_err *err) {
   memset(img, 0, sizeof *img);
   uint8_t *buf;
   size_t n;
   hearth_status s = hearth_read_file(path, JPEG_MAX_FILE_BYTES, &buf, &n, err);
   if (s) return s;
-  s = hearth_jpeg_read_mem(buf, n, path, img, err);
+  s = jpeg_read_mem(buf, n, path, want_gray, img, err);
   free(buf);
   return s;
+}
+
+hearth_status hearth_jpeg_read(const char *path, hearth_image *img, hearth_err *err) {
+  return jpeg_read_file(path, 0, img, err);
+}
+
+hearth_status hearth_jpeg_read_gray(const char *path, hearth_image *img, hearth_err *err) {
+  return jpeg_read_file(path, 1, img, err);
 }
 
 /* ---- writing ------------------------------------------------------------------ */

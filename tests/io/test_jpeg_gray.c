@@ -1,12 +1,12 @@
-/* The detector's JPEG luma reader: the Y plane must match the luma of the
- * full RGB decode (0.299/0.587/0.114) to within the chroma round trip, a
- * gray JPEG must come back unchanged in layout, and damaged files must fail
- * with the path named. */
+/* hearth_jpeg_read_gray: the Y plane must match the luma of the full RGB
+ * decode (0.299/0.587/0.114) to within the chroma round trip, a gray JPEG
+ * must come back unchanged in layout, and damaged files must fail with the
+ * path named. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include "calib/calib_internal.h"
+#include "hearth/image.h"
 #include "test_util.h"
 
 static void test_luma_matches_rgb(const char *dir) {
@@ -27,7 +27,7 @@ static void test_luma_matches_rgb(const char *dir) {
     }
   CHECK_OK(hearth_jpeg_write(path, &img, 95, &err), &err);
   CHECK_OK(hearth_jpeg_read(path, &rgb, &err), &err);
-  CHECK_OK(calib_jpeg_read_luma(path, &y, &err), &err);
+  CHECK_OK(hearth_jpeg_read_gray(path, &y, &err), &err);
   CHECK(y.channels == 1 && y.type == HEARTH_PIX_U8 && y.width == w && y.height == h);
   if (y.data && rgb.data && y.width == w && y.height == h) {
     const uint8_t *q = rgb.data, *g = y.data;
@@ -56,7 +56,7 @@ static void test_luma_errors(const char *dir) {
   CHECK_OK(hearth_image_alloc(&img, 64, 48, 1, HEARTH_PIX_U8, &err), &err);
   for (size_t k = 0; k < 64 * 48; k++) ((uint8_t *)img.data)[k] = (uint8_t)(k * 7);
   CHECK_OK(hearth_jpeg_write(path, &img, 90, &err), &err);
-  CHECK_OK(calib_jpeg_read_luma(path, &y, &err), &err);
+  CHECK_OK(hearth_jpeg_read_gray(path, &y, &err), &err);
   CHECK(y.width == 64 && y.height == 48 && y.channels == 1);
   hearth_image_free(&y);
   hearth_image_free(&img);
@@ -72,7 +72,7 @@ static void test_luma_errors(const char *dir) {
     fclose(fp);
   }
   free(buf);
-  CHECK(calib_jpeg_read_luma(bad, &y, &err) != HEARTH_OK);
+  CHECK(hearth_jpeg_read_gray(bad, &y, &err) != HEARTH_OK);
   CHECK_MSG(strstr(err.msg, bad) != NULL, "message: %s", err.msg);
   CHECK(y.data == NULL);
   /* not a JPEG at all */
@@ -83,16 +83,16 @@ static void test_luma_errors(const char *dir) {
     fputs("hello", fp);
     fclose(fp);
   }
-  CHECK(calib_jpeg_read_luma(bad, &y, &err) == HEARTH_E_PARSE);
+  CHECK(hearth_jpeg_read_gray(bad, &y, &err) == HEARTH_E_PARSE);
   CHECK_MSG(strstr(err.msg, bad) != NULL && strstr(err.msg, "not a JPEG"), "message: %s", err.msg);
   /* missing file */
   snprintf(bad, sizeof bad, "%s/none.jpg", dir);
-  CHECK(calib_jpeg_read_luma(bad, &y, &err) != HEARTH_OK);
+  CHECK(hearth_jpeg_read_gray(bad, &y, &err) != HEARTH_OK);
   CHECK_MSG(strstr(err.msg, bad) != NULL, "message: %s", err.msg);
 }
 
 int main(void) {
-  const char *dir = test_tmpdir("hearth_calib_luma");
+  const char *dir = test_tmpdir("io_jpeg_gray");
   char d[1024];
   snprintf(d, sizeof d, "%s", dir);
   test_luma_matches_rgb(d);
