@@ -32,4 +32,16 @@ hearth_status cli_instances(const char *root, const char *only, cli_names *out, 
 hearth_status cli_states(const char *root, const char *instance, const char *only, cli_names *out,
                          hearth_err *err);
 
+/* Call fn for every instance (or just `only`) / every state of every
+ * instance (or just the named ones). A failure is printed as
+ * "hearth <cmd>: ..." and the loop goes on; returns 0 if every call
+ * succeeded, else 1 (the exit status). */
+typedef hearth_status (*cli_instance_fn)(void *ctx, const char *instance, hearth_err *err);
+typedef hearth_status (*cli_state_fn)(void *ctx, const char *instance, const char *state,
+                                      hearth_err *err);
+int cli_each_instance(const char *cmd, const char *root, const char *only, cli_instance_fn fn,
+                      void *ctx);
+int cli_each_state(const char *cmd, const char *root, const char *only_instance,
+                   const char *only_state, cli_state_fn fn, void *ctx);
+
 #endif

@@ -1,5 +1,6 @@
 /* Iterating the instances and states of a release for pipeline commands. */
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include "cli/cli.h"
 #include "hearth/release.h"
@@ -38,4 +39,58 @@ hearth_status cli_states(const char *root, const char *instance, const char *onl
   for (size_t i = 0; i < doc.n_states && out->n < CLI_MAX_NAMES; i++)
     snprintf(out->names[out->n++], sizeof out->names[0], "%s", doc.states[i]);
   return HEARTH_OK;
+}
+
+int cli_each_instance(const char *cmd, const char *root, const char *only, cli_instance_fn fn,
+                      void *ctx) {
+  hearth_err err = {0};
+  cli_names *inst = malloc(sizeof *inst);
+  if (!inst) {
+    fprintf(stderr, "hearth %s: out of memory\n", cmd);
+    return 1;
+  }
+  int rc = 0;
+  if (cli_instances(root, only, inst, &err)) {
+    rc = cli_fail(cmd, &err);
+  } else {
+    for (size_t k = 0; k < inst->n; k++)
+      if (fn(ctx, inst->names[k], &err)) rc = cli_fail(cmd, &err);
+  }
+  free(inst);
+  return rc;
+}
+
+typedef struct each_state_ctx {
+  const char *cmd, *root, *only_state;
+  cli_state_fn fn;
+  void *ctx;
+  cli_names *states;
+} each_state_ctx;
+
+static hearth_status each_state_of(void *vctx, const char *instance, hearth_err *err) {
+  each_state_ctx *c = vctx;
+  hearth_status s = cli_states(c->root, instance, c->only_state, c->states, err);
+  if (s) return s;
+  /* report every state's failure, return the instance's last */
+  hearth_status last = HEARTH_OK;
+  for (size_t j = 0; j < c->states->n; j++) {
+    hearth_status sj = c->fn(c->ctx, instance, c->states->names[j], err);
+    if (sj) {
+      if (j + 1 < c->states->n) cli_fail(c->cmd, err);
+      last = sj;
+    }
+  }
+  return last;
+}
+
+int cli_each_state(const char *cmd, const char *root, const char *only_instance,
+                   const char *only_state, cli_state_fn fn, void *ctx) {
+  each_state_ctx c = {cmd, root, only_state, fn, ctx, malloc(sizeof(cli_names))};
+  if (!c.states) {
+    fprintf(stderr, "hearth %s: out of memory\n", cmd);
+    return 1;
+  }
+  int rc = cli_each_instance(cmd, root, only_instance, each_state_of, &c);
+  free(c.states);
+  return rc;
 }

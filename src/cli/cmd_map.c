@@ -32,6 +32,32 @@ static const char *k_help =
     "                     derived/rgb_texture.png and derived/mesh.glb\n"
     "  --threads N        worker threads (default: all cores)\n";
 
+static hearth_status bake_one(void *ctx, const char *instance, hearth_err *err) {
+  const hearth_map_job *job = ctx;
+  hearth_bake_job bj = {job->root, instance, NULL, 1024, 2, job->mesh_path, NULL, job->rig_path,
+                        job->map.threads};
+  double t0 = hearth_now();
+  hearth_status s = hearth_bake_rgb_run(&bj, err);
+  if (!s) printf("map %s: colour texture baked (%.2f s)\n", instance, hearth_now() - t0);
+  return s;
+}
+
+static hearth_status map_one(void *ctx, const char *instance, const char *state, hearth_err *err) {
+  hearth_map_job *job = ctx;
+  job->instance = instance;
+  job->state = state;
+  hearth_map_result st;
+  double t0 = hearth_now();
+  hearth_status s = hearth_map_run(job, &st, err);
+  if (s) return s;
+  double n = st.n_surface ? (double)st.n_surface : 1.0;
+  printf("map %s/%s: %zu views, surface %zu texels: %.1f%% observed, %.1f%% filled, "
+         "%.1f%% unobserved (%.2f s)\n",
+         instance, state, st.n_views, st.n_surface, 100.0 * (double)st.n_observed / n,
+         100.0 * (double)st.n_filled / n, 100.0 * (double)st.n_unobserved / n, hearth_now() - t0);
+  return HEARTH_OK;
+}
+
 int hearth_cmd_map(int argc, char **argv) {
   const char *root = NULL, *instance = NULL, *state = NULL;
   hearth_map_job job;
@@ -104,53 +130,8 @@ int hearth_cmd_map(int argc, char **argv) {
     return 2;
   }
   job.root = root;
-  hearth_err err = {0};
-  cli_names *inst = malloc(sizeof *inst), *states = malloc(sizeof *states);
   int rc = 0;
-  if (!inst || !states) {
-    free(inst);
-    free(states);
-    return 1;
-  }
-  if (cli_instances(root, instance, inst, &err)) {
-    rc = cli_fail("map", &err);
-    goto out;
-  }
-  for (size_t k = 0; k < inst->n; k++) {
-    if (cli_states(root, inst->names[k], state, states, &err)) {
-      rc = cli_fail("map", &err);
-      continue;
-    }
-    job.instance = inst->names[k];
-    if (rgb) {
-      hearth_bake_job bj = {root, inst->names[k], NULL, 1024, 2, job.mesh_path, NULL, job.rig_path,
-                            job.map.threads};
-      double t0 = hearth_now();
-      if (hearth_bake_rgb_run(&bj, &err)) {
-        rc = cli_fail("map", &err);
-        continue;
-      }
-      printf("map %s: colour texture baked (%.2f s)\n", inst->names[k], hearth_now() - t0);
-    }
-    for (size_t j = 0; j < states->n; j++) {
-      job.state = states->names[j];
-      hearth_map_result st;
-      double t0 = hearth_now();
-      if (hearth_map_run(&job, &st, &err)) {
-        rc = cli_fail("map", &err);
-        continue;
-      }
-      printf("map %s/%s: %zu views, surface %zu texels: %.1f%% observed, %.1f%% filled, "
-             "%.1f%% unobserved (%.2f s)\n",
-             inst->names[k], states->names[j], st.n_views, st.n_surface,
-             st.n_surface ? 100.0 * (double)st.n_observed / (double)st.n_surface : 0.0,
-             st.n_surface ? 100.0 * (double)st.n_filled / (double)st.n_surface : 0.0,
-             st.n_surface ? 100.0 * (double)st.n_unobserved / (double)st.n_surface : 0.0,
-             hearth_now() - t0);
-    }
-  }
-out:
-  free(inst);
-  free(states);
+  if (rgb) rc |= cli_each_instance("map", root, instance, bake_one, &job);
+  rc |= cli_each_state("map", root, instance, state, map_one, &job);
   return rc;
 }

@@ -23,6 +23,17 @@ static const char *k_help =
     "  --zoom K           per-view image magnification (default 3)\n"
     "  --range LO,HI      Turbo range in degC (default: 2..98 % of each image)\n";
 
+static hearth_status overlay_one(void *ctx, const char *instance, const char *state,
+                                 hearth_err *err) {
+  hearth_overlay_job *job = ctx;
+  job->instance = instance;
+  job->state = state;
+  size_t n = 0;
+  hearth_status s = hearth_overlay_run(job, &n, err);
+  if (!s) printf("overlay %s/%s: %zu images in derived/overlay/%s/\n", instance, state, n, state);
+  return s;
+}
+
 int hearth_cmd_overlay(int argc, char **argv) {
   const char *root = NULL, *instance = NULL, *state = NULL;
   hearth_overlay_job job = {0};
@@ -83,38 +94,6 @@ int hearth_cmd_overlay(int argc, char **argv) {
     fprintf(stderr, "hearth overlay: missing ROOT\n%s", k_help);
     return 2;
   }
-  hearth_err err = {0};
-  cli_names *inst = malloc(sizeof *inst), *states = malloc(sizeof *states);
-  int rc = 0;
-  if (!inst || !states) {
-    free(inst);
-    free(states);
-    return 1;
-  }
-  if (cli_instances(root, instance, inst, &err)) {
-    rc = cli_fail("overlay", &err);
-    goto out;
-  }
-  for (size_t k = 0; k < inst->n; k++) {
-    if (cli_states(root, inst->names[k], state, states, &err)) {
-      rc = cli_fail("overlay", &err);
-      continue;
-    }
-    for (size_t j = 0; j < states->n; j++) {
-      job.root = root;
-      job.instance = inst->names[k];
-      job.state = states->names[j];
-      size_t n = 0;
-      if (hearth_overlay_run(&job, &n, &err)) {
-        rc = cli_fail("overlay", &err);
-        continue;
-      }
-      printf("overlay %s/%s: %zu images in derived/overlay/%s/\n", inst->names[k], states->names[j], n,
-             states->names[j]);
-    }
-  }
-out:
-  free(inst);
-  free(states);
-  return rc;
+  job.root = root;
+  return cli_each_state("overlay", root, instance, state, overlay_one, &job);
 }

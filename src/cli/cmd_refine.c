@@ -44,6 +44,21 @@ static const char *k_help =
     "  --truth FILE        report the mean reprojection error of visible surface\n"
     "                      points against these poses, before and after\n";
 
+static hearth_status refine_one(void *ctx, const char *instance, hearth_err *err) {
+  hearth_refine_job *job = ctx;
+  job->instance = instance;
+  hearth_refine_summary sum;
+  double t0 = hearth_now();
+  hearth_status s = hearth_refine_run(job, &sum, err);
+  if (s) return s;
+  printf("refine %s: %zu of %zu views refined, %.1f ms per view (%.2f s)\n", instance,
+         sum.n_accepted, sum.n_views, 1e3 * sum.mean_seconds_per_view, hearth_now() - t0);
+  if (job->truth_path)
+    printf("refine %s: reprojection vs truth: start %.3f px, final %.3f px (worst view %.3f px)\n",
+           instance, sum.reproj_start_px, sum.reproj_final_px, sum.reproj_final_max_px);
+  return HEARTH_OK;
+}
+
 int hearth_cmd_refine(int argc, char **argv) {
   const char *root = NULL, *instance = NULL, *nudge_file = NULL;
   hearth_refine_job job;
@@ -170,32 +185,8 @@ int hearth_cmd_refine(int argc, char **argv) {
   }
   job.nudges = nudges;
   job.n_nudges = n_nudges;
-  cli_names *inst = malloc(sizeof *inst);
-  if (!inst) {
-    free(nudges);
-    return 1;
-  }
-  if (cli_instances(root, instance, inst, &err)) {
-    rc = cli_fail("refine", &err);
-    goto out;
-  }
-  for (size_t k = 0; k < inst->n; k++) {
-    job.root = root;
-    job.instance = inst->names[k];
-    hearth_refine_summary sum;
-    double t0 = hearth_now();
-    if (hearth_refine_run(&job, &sum, &err)) {
-      rc = cli_fail("refine", &err);
-      continue;
-    }
-    printf("refine %s: %zu of %zu views refined, %.1f ms per view (%.2f s)\n", inst->names[k],
-           sum.n_accepted, sum.n_views, 1e3 * sum.mean_seconds_per_view, hearth_now() - t0);
-    if (job.truth_path)
-      printf("refine %s: reprojection vs truth: start %.3f px, final %.3f px (worst view %.3f px)\n",
-             inst->names[k], sum.reproj_start_px, sum.reproj_final_px, sum.reproj_final_max_px);
-  }
-out:
-  free(inst);
+  job.root = root;
+  rc = cli_each_instance("refine", root, instance, refine_one, &job);
   free(nudges);
   return rc;
 }

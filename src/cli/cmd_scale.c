@@ -21,6 +21,20 @@ static const char *k_help =
     "  --edge-rel E       relative depth jump that marks an edge (default 0.02)\n"
     "  --threads N        worker threads (default: all cores)\n";
 
+static hearth_status scale_one(void *ctx, const char *instance, hearth_err *err) {
+  hearth_scale_job *job = ctx;
+  job->instance = instance;
+  hearth_scale_result res;
+  double t0 = hearth_now();
+  hearth_status s = hearth_scale_run(job, &res, err);
+  if (!s)
+    printf("scale %s: %.6f m/unit from %d views, %zu of %zu pixels inliers, residual median "
+           "%.2f mm, p90 %.2f mm (%.2f s)\n",
+           instance, res.scale, res.views_used, res.n_inliers, res.n_candidates,
+           res.residual_median_mm, res.residual_p90_mm, hearth_now() - t0);
+  return s;
+}
+
 int hearth_cmd_scale(int argc, char **argv) {
   const char *root = NULL, *instance = NULL, *state = NULL;
   hearth_scale_job job = {0};
@@ -70,29 +84,7 @@ int hearth_cmd_scale(int argc, char **argv) {
     fprintf(stderr, "hearth scale: missing ROOT\n%s", k_help);
     return 2;
   }
-  hearth_err err = {0};
-  cli_names *inst = malloc(sizeof *inst);
-  if (!inst) return 1;
-  if (cli_instances(root, instance, inst, &err)) {
-    free(inst);
-    return cli_fail("scale", &err);
-  }
-  int rc = 0;
-  for (size_t k = 0; k < inst->n; k++) {
-    job.root = root;
-    job.instance = inst->names[k];
-    job.state = state;
-    hearth_scale_result res;
-    double t0 = hearth_now();
-    if (hearth_scale_run(&job, &res, &err)) {
-      rc = cli_fail("scale", &err);
-      continue;
-    }
-    printf("scale %s: %.6f m/unit from %d views, %zu of %zu pixels inliers, residual median "
-           "%.2f mm, p90 %.2f mm (%.2f s)\n",
-           inst->names[k], res.scale, res.views_used, res.n_inliers, res.n_candidates,
-           res.residual_median_mm, res.residual_p90_mm, hearth_now() - t0);
-  }
-  free(inst);
-  return rc;
+  job.root = root;
+  job.state = state;
+  return cli_each_instance("scale", root, instance, scale_one, &job);
 }

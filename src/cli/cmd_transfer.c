@@ -18,6 +18,14 @@ static const char *k_help =
     "  --poses FILE     colour poses instead of derived/poses_rgb.json (one instance)\n"
     "  --keep-refined   leave an existing derived/poses_thermal.json in place\n";
 
+static hearth_status transfer_one(void *ctx, const char *instance, hearth_err *err) {
+  hearth_transfer_job job = *(const hearth_transfer_job *)ctx;
+  job.instance = instance;
+  hearth_status s = hearth_transfer_run(&job, err);
+  if (!s) printf("transfer %s: derived/poses_thermal_transferred.json written\n", instance);
+  return s;
+}
+
 int hearth_cmd_transfer(int argc, char **argv) {
   const char *root = NULL, *instance = NULL, *rig = NULL, *poses = NULL;
   int keep = 0;
@@ -56,22 +64,6 @@ int hearth_cmd_transfer(int argc, char **argv) {
     fprintf(stderr, "hearth transfer: missing ROOT\n%s", k_help);
     return 2;
   }
-  hearth_err err = {0};
-  cli_names *inst = malloc(sizeof *inst);
-  if (!inst) return 1;
-  if (cli_instances(root, instance, inst, &err)) {
-    free(inst);
-    return cli_fail("transfer", &err);
-  }
-  int rc = 0;
-  for (size_t k = 0; k < inst->n; k++) {
-    hearth_transfer_job job = {root, inst->names[k], rig, poses, keep};
-    if (hearth_transfer_run(&job, &err)) {
-      rc = cli_fail("transfer", &err);
-      continue;
-    }
-    printf("transfer %s: derived/poses_thermal_transferred.json written\n", inst->names[k]);
-  }
-  free(inst);
-  return rc;
+  hearth_transfer_job job = {root, NULL, rig, poses, keep};
+  return cli_each_instance("transfer", root, instance, transfer_one, &job);
 }
