@@ -59,7 +59,9 @@ void hearth_sim_env_free(hearth_sim_env *env);
 
 /* Start an episode: layout `layout` of the stream `seed` (object positions
  * and the candidate-to-slot assignment, identical for both instructions),
- * asking for `instruction` (0 or 1). */
+ * asking for `instruction` (0 or 1). Positions are redrawn from the
+ * layout's own stream until both candidates are at least 70% visible from
+ * the front camera (ray casts: independent of the image size). */
 hearth_status hearth_sim_reset(hearth_sim_env *env, uint64_t seed, uint64_t layout,
                                int instruction, hearth_err *err);
 
@@ -123,6 +125,7 @@ typedef struct hearth_sim_collect_stats {
   int demos;
   long steps;
   double seconds;
+  int rejected_layouts;          /* layouts skipped because the expert failed */
 } hearth_sim_collect_stats;
 hearth_status hearth_sim_collect(const hearth_sim_collect_opts *o, hearth_sim_collect_stats *stats,
                                  hearth_err *err);

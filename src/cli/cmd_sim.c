@@ -33,6 +33,8 @@ static const char *k_usage_render =
     "  --task H1|H2|H3   only this task (default: all three)\n"
     "  --release ROOT    assets from a release (derived/ meshes and thermal_turbo.png);\n"
     "                    default: a small release made by the virtual rig\n"
+    "  --ground-truth    with --release: a virtual-rig release's ground_truth/ meshes\n"
+    "                    and temperature_true.npy instead of derived/\n"
     "  --size N          image side in pixels (default 256)\n"
     "  --seed N          layout seed (default 1)\n"
     "  -h, --help        this text\n";
@@ -44,6 +46,18 @@ static const char *k_usage_collect =
     "release) on N layouts x 2 instructions and store the successful demonstrations\n"
     "in LIBERO's HDF5 layout with obs/agentview_thermal added. Same seed, same file.\n"
     "\n"
+    "Layouts: objects jittered in 5 x 5 cm squares around fixed spots, fixed\n"
+    "orientations, redrawn until both candidates are at least 70% visible in the\n"
+    "front view. Even layouts put the first instruction's object in slot A, odd\n"
+    "ones in slot B; a layout where the expert fails either instruction is replaced\n"
+    "by the next unused layout of the same parity, so assignments stay balanced.\n"
+    "\n"
+    "One file holds both instructions (demo_0, demo_1 from layout 1, ...). LIBERO's\n"
+    "loaders read data.attrs['problem_info']['language_instruction'] as one string:\n"
+    "it holds the first instruction; every demo has its own `language_instruction`\n"
+    "attribute, and data.attrs['instructions'] lists both (JSON). Images are stored\n"
+    "in OpenGL row order (bottom row first, data.attrs['image_row_order']).\n"
+    "\n"
     "options:\n"
     "  --task H1|H2|H3   the task (required)\n"
     "  --out FILE.hdf5   output file (written atomically)\n"
@@ -52,17 +66,18 @@ static const char *k_usage_collect =
     "  --size N          stored image side (default 128, LIBERO's)\n"
     "  --max-steps N     time limit per episode in control steps (default 400)\n"
     "  --release ROOT    assets from a release (derived/); default: virtual rig\n"
+    "  --ground-truth    with --release: a virtual-rig release's ground_truth/ assets\n"
     "  --keep-failures   also store episodes that did not succeed\n"
     "  --quiet           no progress output\n"
     "  -h, --help        this text\n";
 
 /* assets: a release root given, or a tiny virtual-rig release in a temp dir */
-static int make_assets(const char *release, char *root, size_t rootsz, char *tmpdir, size_t tsz,
-                       int *use_gt, int quiet) {
+static int make_assets(const char *release, int gt, char *root, size_t rootsz, char *tmpdir,
+                       size_t tsz, int *use_gt, int quiet) {
   tmpdir[0] = 0;
   if (release) {
     snprintf(root, rootsz, "%s", release);
-    *use_gt = 0;
+    *use_gt = gt;
     return 0;
   }
   const char *t = getenv("TMPDIR");
@@ -86,6 +101,7 @@ static int make_assets(const char *release, char *root, size_t rootsz, char *tmp
   so.texture_size = 256;
   so.map_resolution = 256;
   so.calibration = 0;
+  so.rgb_full_size = 0; /* draft raw colour frames: the sim reads none of them */
   so.quiet = 1;
   if (!quiet) fprintf(stderr, "hearth sim: making assets with the virtual rig...\n");
   hearth_err err = {0};
@@ -103,11 +119,16 @@ static int cmd_render(int argc, char **argv) {
   hearth_sim_task only = 0;
   long size = 256;
   uint64_t seed = 1;
+  int gt = 0;
   for (int i = 1; i < argc; i++) {
     int r;
     if (cli_is_help(argv[i])) {
       fputs(k_usage_render, stdout);
       return 0;
+    }
+    if (strcmp(argv[i], "--ground-truth") == 0) {
+      gt = 1;
+      continue;
     }
     if ((r = cli_opt(argc, argv, &i, "--out", &v)) == 1) out = v;
     else if (r == 0 && (r = cli_opt(argc, argv, &i, "--release", &v)) == 1) release = v;
@@ -144,7 +165,7 @@ static int cmd_render(int argc, char **argv) {
   if (hearth_mkdirs(out, &err)) return cli_fail("sim render", &err);
   char root[4096], tmpdir[4096];
   int use_gt;
-  if (make_assets(release, root, sizeof root, tmpdir, sizeof tmpdir, &use_gt, 0)) return 1;
+  if (make_assets(release, gt, root, sizeof root, tmpdir, sizeof tmpdir, &use_gt, 0)) return 1;
   int rc = 0;
   for (int t = 1; t <= 3 && !rc; t++) {
     if (only && t != (int)only) continue;
@@ -168,9 +189,11 @@ static int cmd_collect(int argc, char **argv) {
   hearth_sim_collect_opts_default(&o);
   o.task = 0;
   const char *release = NULL, *v;
+  int gt = 0;
   for (int i = 1; i < argc; i++) {
     int r;
     long n;
+    if (strcmp(argv[i], "--ground-truth") == 0) { gt = 1; continue; }
     if (cli_is_help(argv[i])) {
       fputs(k_usage_collect, stdout);
       return 0;
@@ -204,7 +227,8 @@ static int cmd_collect(int argc, char **argv) {
     return 2;
   }
   char root[4096], tmpdir[4096];
-  if (make_assets(release, root, sizeof root, tmpdir, sizeof tmpdir, &o.use_ground_truth, o.quiet)) return 1;
+  if (make_assets(release, gt, root, sizeof root, tmpdir, sizeof tmpdir, &o.use_ground_truth, o.quiet))
+    return 1;
   o.release_root = root;
   hearth_err err = {0};
   hearth_sim_collect_stats s;
@@ -214,8 +238,9 @@ static int cmd_collect(int argc, char **argv) {
   for (int i = 0; i < 2; i++)
     printf("instruction %d \"%s\": %d/%d successful\n", i + 1, hearth_sim_instruction_text(o.task, i),
            s.successes[i], s.attempts[i]);
-  printf("%d demos, %ld steps, %.1f s (%.1f steps/s) -> %s\n", s.demos, s.steps, s.seconds,
-         s.seconds > 0 ? s.steps / s.seconds : 0.0, o.out_path);
+  printf("%d demos, %d layouts replaced, %ld steps, %.1f s (%.1f steps/s) -> %s\n", s.demos,
+         s.rejected_layouts, s.steps, s.seconds, s.seconds > 0 ? s.steps / s.seconds : 0.0,
+         o.out_path);
   return 0;
 }
 

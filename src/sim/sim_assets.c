@@ -146,17 +146,31 @@ static hearth_status to_rgb(hearth_image *img, const char *name, hearth_err *err
 }
 
 /* the object's up direction from the capture poses: turntable cameras keep
- * their x axis horizontal, so -mean(camera y) points up (azimuth spread
- * cancels the horizontal parts) */
+ * their x axis horizontal, so up is normal to every camera x axis. The
+ * cross products of pairs of x axes (oriented by -mean(camera y), which
+ * points roughly up) give it exactly even from two views, where the mean
+ * of -y alone stays tilted by the elevations */
 static hearth_status capture_up(const char *poses_path, double up[3], hearth_err *err) {
   hearth_poses ps;
   memset(&ps, 0, sizeof ps);
   hearth_status st = hearth_poses_read(poses_path, &ps, err);
   if (st) return st;
+  double rough[3] = {0, 0, 0};
+  for (size_t i = 0; i < ps.n; i++)
+    for (int k = 0; k < 3; k++) rough[k] -= ps.views[i].T_world_from_cam.R[k * 3 + 1];
   up[0] = up[1] = up[2] = 0;
   for (size_t i = 0; i < ps.n; i++)
-    for (int k = 0; k < 3; k++) up[k] -= ps.views[i].T_world_from_cam.R[k * 3 + 1];
+    for (size_t j = i + 1; j < ps.n; j++) {
+      const double *Ri = ps.views[i].T_world_from_cam.R, *Rj = ps.views[j].T_world_from_cam.R;
+      double xi[3] = {Ri[0], Ri[3], Ri[6]}, xj[3] = {Rj[0], Rj[3], Rj[6]}, c[3];
+      hearth_cross3(xi, xj, c);
+      double sgn = hearth_dot3(c, rough) < 0 ? -1.0 : 1.0;
+      for (int k = 0; k < 3; k++) up[k] += sgn * c[k];
+    }
   hearth_poses_free(&ps);
+  /* views sharing one azimuth: fall back to the mean camera up */
+  if (hearth_norm3(up) < 1e-3)
+    for (int k = 0; k < 3; k++) up[k] = rough[k];
   double n = hearth_norm3(up);
   if (n < 1e-6)
     return hearth_err_set(err, HEARTH_E_NUMERIC, "%s: cannot tell the object's up direction",

@@ -200,35 +200,68 @@ hearth_status hearth_sim_collect(const hearth_sim_collect_opts *o, hearth_sim_co
   demo_buf b = {0};
   b.nstate = hearth_sim_state(e, NULL, 0);
   b.img = (size_t)o->image_size * (size_t)o->image_size * 3;
+  demo_buf b2 = {0};
+  b2.nstate = b.nstate, b2.img = b.img;
   hearth_progress pr;
   hearth_progress_begin(&pr, "collect", (size_t)o->layouts * 2, o->quiet);
   int ndemo = 0;
   long stored = 0;
-  for (int l = 0; l < o->layouts && !st; l++)
-    for (int ins = 0; ins < 2 && !st; ins++) {
-      int ok = 0;
-      st = rollout(e, o->seed, (uint64_t)l, ins, &b, &ok, err);
+  /* a layout is kept when the expert succeeds on both instructions (or
+   * with keep_failures); a rejected layout is replaced by the next unused
+   * one of the same parity, so the candidate-to-slot assignment (layout
+   * parity) stays balanced: layout k of the file has parity k & 1 */
+  uint64_t next[2] = {0, 1};
+  long max_tries = 20L * o->layouts + 100;
+  for (int k = 0; k < o->layouts && !st; k++) {
+    int par = k & 1, kept = 0;
+    while (!kept && !st) {
+      if (stats->rejected_layouts >= max_tries) {
+        st = hearth_err_set(err, HEARTH_E_NUMERIC,
+                            "sim collect %s: the expert failed on %d layouts (stored %d of %d); "
+                            "check the assets or pass --keep-failures",
+                            hearth_sim_task_name(o->task), stats->rejected_layouts, k, o->layouts);
+        break;
+      }
+      uint64_t l = next[par];
+      next[par] += 2;
+      int ok[2] = {0, 0};
+      demo_buf *bb[2] = {&b, &b2};
+      for (int ins = 0; ins < 2 && !st; ins++) {
+        st = rollout(e, o->seed, l, ins, bb[ins], &ok[ins], err);
+        if (st) break;
+        stats->attempts[ins]++;
+        stats->successes[ins] += ok[ins];
+        stats->steps += (long)bb[ins]->T;
+      }
       if (st) break;
-      stats->attempts[ins]++;
-      stats->successes[ins] += ok;
-      stats->steps += (long)b.T;
-      if (ok || o->keep_failures) {
-        if (!write_demo(data, ndemo, &b, ins, hearth_sim_instruction(e), (uint64_t)l, o->image_size))
+      if (!(ok[0] && ok[1]) && !o->keep_failures) {
+        stats->rejected_layouts++;
+        continue;
+      }
+      kept = 1;
+      for (int ins = 0; ins < 2 && !st; ins++) {
+        if (!write_demo(data, ndemo, bb[ins], ins, hearth_sim_instruction_text(o->task, ins), l,
+                        o->image_size))
           st = hearth_err_set(err, HEARTH_E_IO, "%s: writing demo_%d failed", tmp, ndemo);
         ndemo++;
-        stored += (long)b.T;
+        stored += (long)bb[ins]->T;
       }
-      hearth_progress_step(&pr, 1);
+      hearth_progress_step(&pr, 2);
     }
+  }
   hearth_progress_end(&pr);
+  demo_free(&b2);
   if (!st) {
-    /* problem_info names both instructions of the task; each demo carries
-     * its own language_instruction */
-    char pi[1024], ea[1024];
+    /* one file holds both instructions of a task. LIBERO's loaders read
+     * problem_info["language_instruction"] as one string: it names the
+     * first instruction; each demo carries its own language_instruction
+     * attribute and data/instructions lists both (JSON) */
+    char pi[1024], ea[1024], il[512];
     snprintf(pi, sizeof pi,
              "{\"problem_name\": \"hearth_%s\", \"domain_name\": \"hearth\", "
-             "\"language_instruction\": [\"%s\", \"%s\"]}",
-             hearth_sim_task_name(o->task), hearth_sim_instruction_text(o->task, 0),
+             "\"language_instruction\": \"%s\"}",
+             hearth_sim_task_name(o->task), hearth_sim_instruction_text(o->task, 0));
+    snprintf(il, sizeof il, "[\"%s\", \"%s\"]", hearth_sim_instruction_text(o->task, 0),
              hearth_sim_instruction_text(o->task, 1));
     snprintf(ea, sizeof ea,
              "{\"env_name\": \"hearth_%s\", \"type\": 1, \"env_kwargs\": {\"control_freq\": 20, "
@@ -238,6 +271,7 @@ hearth_status hearth_sim_collect(const hearth_sim_collect_opts *o, hearth_sim_co
              o->use_ground_truth ? "virtual_rig_ground_truth" : "release_derived");
     if (!h5_str_attr(data, "problem_info", pi) || !h5_str_attr(data, "env_args", ea) ||
         !h5_int_attr(data, "num_demos", ndemo) || !h5_int_attr(data, "total", stored) ||
+        !h5_str_attr(data, "instructions", il) ||
         !h5_str_attr(data, "image_row_order", "opengl_bottom_row_first") ||
         !h5_str_attr(data, "thermal_colormap", "turbo 10..60 degC"))
       st = hearth_err_set(err, HEARTH_E_IO, "%s: writing attributes failed", tmp);

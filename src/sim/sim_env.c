@@ -39,11 +39,15 @@ static const char *const k_instr[3][2] = {
      "pick up the hot sponge and place it on the mat"},
 };
 
-/* nominal spots on the table top (x towards the front camera, y left):
- * slot A, slot B, distractor 1 (far corner), distractor 2 (front right) */
-static const double k_spots[4][2] = {{0.05, 0.00}, {0.05, 0.17}, {0.20, 0.31}, {0.20, -0.07}};
+/* nominal spots on the table top (x towards the front camera, y to the
+ * image's right): slot A, slot B, distractor 1 (behind slot B, where even
+ * the kettle stays in view and clear of the hand), distractor 2 (front).
+ * The slots are 19 cm apart so the 18 cm wide hand fits beside the other
+ * candidate at any jitter */
+static const double k_spots[4][2] = {{0.05, 0.00}, {0.05, 0.19}, {-0.17, 0.29}, {0.20, -0.07}};
 static const double k_mat[2] = {-0.05, -0.22}, k_mat_half = 0.08;
 static const double k_robot_base[3] = {-0.66, 0.0, 0.912};
+static const double k_pad_half_z = 0.022;
 static const double k_q_start[7] = {0, -0.161, 0, -2.445, 0, 2.227, 0.78539816339744831};
 
 hearth_sim_task hearth_sim_task_parse(const char *s) {
@@ -162,11 +166,16 @@ static void emit_robot(sbuf *b) {
     double sign = s == 0 ? 1 : -1;
     sb_printf(b, "<body name=\"finger_%s\" pos=\"0 0 0.0584\">\n", s == 0 ? "left" : "right");
     sb_printf(b, "<inertial pos=\"0 0 0.03\" mass=\"0.03\" diaginertia=\"1e-5 1e-5 1e-5\"/>\n");
-    sb_printf(b, "<joint name=\"finger_%d\" type=\"slide\" axis=\"0 %s 0\" range=\"0 0.04\" damping=\"5\" armature=\"0.01\"/>\n",
+    /* damping caps the closing speed near 0.2 m/s (under 0.4 mm per
+     * physics step at the 15 N force limit) so the pads cannot tunnel
+     * through thin objects such as a phone; 15 N holds the heaviest
+     * candidate (0.3 kg) with a wide margin and keeps the pads from sinking
+     * into light objects' soft contacts */
+    sb_printf(b, "<joint name=\"finger_%d\" type=\"slide\" axis=\"0 %s 0\" range=\"0 0.04\" damping=\"80\" armature=\"0.01\"/>\n",
               s + 1, F(sign).s);
-    sb_printf(b, "<geom name=\"pad_%d\" type=\"box\" size=\"0.011 0.006 0.022\" pos=\"0 %s 0.045\" "
-              "friction=\"2 0.02 0.001\" condim=\"4\" material=\"robot_dark\" %s/>\n",
-              s + 1, F(sign * 0.006).s, rob);
+    sb_printf(b, "<geom name=\"pad_%d\" type=\"box\" size=\"0.011 0.006 %s\" pos=\"0 %s 0.045\" "
+              "friction=\"2 0.02 0.001\" condim=\"4\" solref=\"0.005 1\" solimp=\"0.95 0.99 0.001\" material=\"robot_dark\" %s/>\n",
+              s + 1, F(k_pad_half_z).s, F(sign * 0.006).s, rob);
     sb_printf(b, "</body>\n");
   }
   sb_printf(b, "</body>\n");
@@ -182,15 +191,21 @@ static hearth_status build_xml(hearth_sim_env *e, const char *xml_path, hearth_e
   sb_printf(&b, "<mujoco model=\"hearth_%s\">\n<compiler angle=\"radian\" autolimits=\"true\" meshdir=\"%s\" texturedir=\"%s\"/>\n",
             td->name, e->work_dir, e->work_dir);
   sb_printf(&b, "<option timestep=\"%s\" impratio=\"10\" cone=\"elliptic\"/>\n", F(HEARTH_SIM_TIMESTEP).s);
-  sb_printf(&b, "<visual><global offwidth=\"%d\" offheight=\"%d\"/><quality shadowsize=\"2048\"/>"
+  /* the shadow map is rendered on the CPU for every lit view: size it to
+   * the images (4 shadow texels per pixel across, 256..2048) */
+  int side = e->width > e->height ? e->width : e->height;
+  int shadow = side * 4 < 256 ? 256 : side * 4 > 2048 ? 2048 : side * 4;
+  sb_printf(&b, "<visual><global offwidth=\"%d\" offheight=\"%d\"/><quality shadowsize=\"%d\"/>"
             "<headlight ambient=\"0.35 0.35 0.35\" diffuse=\"0.45 0.45 0.45\" specular=\"0.1 0.1 0.1\"/></visual>\n",
-            e->width, e->height);
+            e->width, e->height, shadow);
   sb_printf(&b, "<asset>\n");
   sb_printf(&b, "<texture name=\"floor_tex\" type=\"2d\" builtin=\"checker\" rgb1=\"%s\" rgb2=\"%s\" width=\"256\" height=\"256\"/>\n",
             study ? "0.45 0.42 0.40" : "0.75 0.75 0.72", study ? "0.40 0.37 0.35" : "0.65 0.65 0.62");
   sb_printf(&b, "<material name=\"floor\" texture=\"floor_tex\" texrepeat=\"8 8\"/>\n");
   sb_printf(&b, "<material name=\"table\" rgba=\"%s\" specular=\"0.1\"/>\n",
             study ? "0.55 0.38 0.22 1" : "0.86 0.86 0.84 1");
+  sb_printf(&b, "<material name=\"wall\" rgba=\"%s\" specular=\"0\"/>\n",
+            study ? "0.78 0.74 0.66 1" : "0.85 0.87 0.88 1");
   sb_printf(&b, "<material name=\"mat\" rgba=\"0.15 0.35 0.65 1\" specular=\"0\"/>\n");
   sb_printf(&b, "<material name=\"robot_white\" rgba=\"0.92 0.92 0.92 1\" specular=\"0.3\"/>\n");
   sb_printf(&b, "<material name=\"robot_dark\" rgba=\"0.2 0.2 0.22 1\" specular=\"0.2\"/>\n");
@@ -204,6 +219,10 @@ static hearth_status build_xml(hearth_sim_env *e, const char *xml_path, hearth_e
   sb_printf(&b, "</asset>\n<worldbody>\n");
   sb_printf(&b, "<light pos=\"0.3 0.6 2.6\" dir=\"-0.2 -0.4 -1\" diffuse=\"0.5 0.5 0.5\" castshadow=\"true\"/>\n");
   sb_printf(&b, "<geom name=\"floor\" type=\"box\" size=\"3 3 0.01\" pos=\"0 0 -0.01\" material=\"floor\" group=\"0\"/>\n");
+  /* a back wall behind the robot: the front camera's upper rays pass the
+   * floor's far edge, and the thermal view must show room temperature
+   * there rather than an empty (black) background */
+  sb_printf(&b, "<geom name=\"wall\" type=\"box\" size=\"0.02 3 1.5\" pos=\"-2 0 1.5\" material=\"wall\" group=\"0\"/>\n");
   double tz = HEARTH_SIM_TABLE_Z;
   sb_printf(&b, "<geom name=\"table\" type=\"box\" size=\"0.5 0.6 0.025\" pos=\"0 0 %s\" material=\"table\" friction=\"1 0.005 0.0001\" group=\"0\"/>\n",
             F(tz - 0.025).s);
@@ -251,7 +270,7 @@ static hearth_status build_xml(hearth_sim_env *e, const char *xml_path, hearth_e
               i + 1, F(-k_tau_max[i]).s, F(k_tau_max[i]).s);
   for (int s = 0; s < 2; s++)
     sb_printf(&b, "<position name=\"g%d\" joint=\"finger_%d\" kp=\"800\" ctrllimited=\"true\" ctrlrange=\"0 0.04\" "
-              "forcelimited=\"true\" forcerange=\"-30 30\"/>\n", s + 1, s + 1);
+              "forcelimited=\"true\" forcerange=\"-15 15\"/>\n", s + 1, s + 1);
   sb_printf(&b, "</actuator>\n</mujoco>\n");
   if (b.oom) {
     free(b.p);
@@ -374,17 +393,64 @@ hearth_status hearth_sim_env_new(const hearth_sim_opts *o, hearth_sim_env **out,
 }
 
 /* ---- layouts --------------------------------------------------------------- */
-void sim_layout(uint64_t seed, uint64_t layout, double pos[SIM_NOBJ][2], int *swap) {
+void sim_layout(uint64_t seed, uint64_t layout, int attempt, double pos[SIM_NOBJ][2], int *swap) {
   hearth_rng base, r;
   hearth_rng_seed(&base, seed);
   hearth_rng_fork(&base, layout, &r);
-  for (int k = 0; k < SIM_NOBJ; k++) {
-    pos[k][0] = k_spots[k][0] + hearth_rng_range(&r, -0.025, 0.025);
-    pos[k][1] = k_spots[k][1] + hearth_rng_range(&r, -0.025, 0.025);
-  }
+  /* attempt k continues the layout's own stream, so attempt 0 is the
+   * plain draw and later attempts never depend on the image size */
+  for (int a = 0; a <= attempt; a++)
+    for (int k = 0; k < SIM_NOBJ; k++) {
+      pos[k][0] = k_spots[k][0] + hearth_rng_range(&r, -0.025, 0.025);
+      pos[k][1] = k_spots[k][1] + hearth_rng_range(&r, -0.025, 0.025);
+    }
   /* candidate identities alternate between the slots: even layouts put
    * candidate 0 in slot A, odd ones in slot B (balanced for any even N) */
   *swap = (int)(layout & 1);
+}
+
+void sim_object_pos(const hearth_sim_env *e, int k, double xyz[3]) {
+  for (int i = 0; i < 3; i++) xyz[i] = e->d->qpos[e->obj_qadr[k] + i];
+}
+
+void sim_place_object(hearth_sim_env *e, int k, const double xyz[3]) {
+  double *q = e->d->qpos + e->obj_qadr[k], *v = e->d->qvel + e->obj_dadr[k];
+  for (int i = 0; i < 3; i++) q[i] = xyz[i];
+  q[3] = 1, q[4] = q[5] = q[6] = 0;
+  for (int i = 0; i < 6; i++) v[i] = 0;
+  mj_forward(e->m, e->d);
+}
+
+/* fraction of object k's surface samples (up to 96 mesh vertices) that the
+ * front camera sees: inside its field of view and not hidden by another
+ * geom. Ray casts, so it does not depend on the rendered image size */
+double sim_visible_frac(const hearth_sim_env *e, int k) {
+  const mjModel *m = e->m;
+  const mjData *d = e->d;
+  const hearth_mesh *me = &e->assets[k].mesh;
+  const double *bp = d->xpos + 3 * e->obj_body[k], *bR = d->xmat + 9 * e->obj_body[k];
+  const double *cp = d->cam_xpos + 3 * e->cam_front, *cR = d->cam_xmat + 9 * e->cam_front;
+  double th = tan(0.5 * m->cam_fovy[e->cam_front] * M_PI / 180.0);
+  double aspect = (double)e->width / (double)e->height;
+  /* robot, scene and colour meshes; not the thermal copies or the boxes */
+  mjtByte groups[mjNGROUP] = {1, 1, 1, 0, 0, 0};
+  size_t n = me->n_vertices, stride = n > 96 ? n / 96 : 1;
+  int total = 0, seen = 0;
+  for (size_t i = 0; i < n && total < 96; i += stride) {
+    const float *v = me->positions + 3 * i;
+    double p[3], dir[3], c[3];
+    for (int r = 0; r < 3; r++)
+      p[r] = bp[r] + bR[3 * r] * v[0] + bR[3 * r + 1] * v[1] + bR[3 * r + 2] * v[2];
+    for (int r = 0; r < 3; r++) dir[r] = p[r] - cp[r];
+    /* camera frame: columns of cam_xmat are its x, y, z axes; it looks along -z */
+    for (int r = 0; r < 3; r++) c[r] = cR[r] * dir[0] + cR[3 + r] * dir[1] + cR[6 + r] * dir[2];
+    total++;
+    if (c[2] > -1e-6 || fabs(c[0] / -c[2]) > th * aspect || fabs(c[1] / -c[2]) > th) continue;
+    int gid = -1;
+    mjtNum x = mj_ray(m, d, cp, dir, groups, 1, -1, &gid);
+    if (gid < 0 || x > 1.0 - 0.01 / hearth_norm3(dir) || m->geom_bodyid[gid] == e->obj_body[k]) seen++;
+  }
+  return total ? (double)seen / total : 0.0;
 }
 
 hearth_status hearth_sim_reset(hearth_sim_env *e, uint64_t seed, uint64_t layout, int instruction,
@@ -394,21 +460,42 @@ hearth_status hearth_sim_reset(hearth_sim_env *e, uint64_t seed, uint64_t layout
   mjModel *m = e->m;
   mjData *d = e->d;
   mj_resetData(m, d);
-  double pos[SIM_NOBJ][2];
-  int swap;
-  sim_layout(seed, layout, pos, &swap);
-  e->swap = swap;
   e->instruction = instruction;
   e->target = instruction; /* object index of the target */
-  for (int k = 0; k < SIM_NOBJ; k++) {
-    int slot = k < 2 ? (k ^ swap) : k;
-    double *q = d->qpos + e->obj_qadr[k];
-    q[0] = pos[slot][0], q[1] = pos[slot][1], q[2] = HEARTH_SIM_TABLE_Z + 0.0005;
-    q[3] = 1, q[4] = q[5] = q[6] = 0;
-  }
   for (int i = 0; i < 7; i++) d->qpos[e->arm_qadr[i]] = k_q_start[i];
   for (int s = 0; s < 2; s++) d->qpos[e->fing_qadr[s]] = 0.04;
-  mj_forward(m, d);
+  /* visibility check: redraw the layout until both candidates are at
+   * least SIM_MIN_VISIBLE visible in the front view (else keep the best
+   * draw); the draw depends on (seed, layout) only, never on the
+   * instruction, so both instructions start from the same state */
+  int best = 0;
+  double best_vis = -1;
+  for (int attempt = 0; attempt < SIM_MAX_ATTEMPTS; attempt++) {
+    double pos[SIM_NOBJ][2];
+    int swap;
+    sim_layout(seed, layout, attempt, pos, &swap);
+    e->swap = swap;
+    for (int k = 0; k < SIM_NOBJ; k++) {
+      int slot = k < 2 ? (k ^ swap) : k;
+      double *q = d->qpos + e->obj_qadr[k];
+      q[0] = pos[slot][0], q[1] = pos[slot][1], q[2] = HEARTH_SIM_TABLE_Z + 0.0005;
+      q[3] = 1, q[4] = q[5] = q[6] = 0;
+    }
+    mj_forward(m, d);
+    double vis = fmin(sim_visible_frac(e, 0), sim_visible_frac(e, 1));
+    if (vis > best_vis) best_vis = vis, best = attempt;
+    if (vis >= SIM_MIN_VISIBLE) break;
+    if (attempt == SIM_MAX_ATTEMPTS - 1 && best != attempt) {
+      /* none passed: go back to the best draw */
+      sim_layout(seed, layout, best, pos, &swap);
+      for (int k = 0; k < SIM_NOBJ; k++) {
+        int slot = k < 2 ? (k ^ swap) : k;
+        d->qpos[e->obj_qadr[k]] = pos[slot][0], d->qpos[e->obj_qadr[k] + 1] = pos[slot][1];
+      }
+      mj_forward(m, d);
+    }
+  }
+  e->layout_attempts = best + 1;
   for (int i = 0; i < 3; i++) e->goal_pos[i] = d->site_xpos[3 * e->site_grip + i];
   memcpy(e->goal_R, d->site_xmat + 9 * e->site_grip, sizeof e->goal_R);
   memcpy(e->R0, e->goal_R, sizeof e->R0);
@@ -652,26 +739,36 @@ void hearth_sim_expert_action(hearth_sim_env *e, double act[7]) {
   const double *q = d->qpos + e->obj_qadr[k];
   const double *x = d->site_xpos + 3 * e->site_grip, *R = d->site_xmat + 9 * e->site_grip;
   double h = a->size[2];
-  double gz = fmax(0.5 * h, 0.012);
-  if (gz > h - 0.012 && h > 0.03) gz = h - 0.012;
+  /* grasp at half height, but keep the pads (centred on the grip site,
+   * 22 mm half height) 2 mm clear of the table: pressing them into the
+   * table stalls the descent and makes the closing pads ride up over thin
+   * objects. Tall objects: at most 6 cm up (a firm hold low on the body) */
+  double gz = fmin(fmax(0.5 * h, k_pad_half_z + 0.002), 0.06);
   double lift_z = HEARTH_SIM_TABLE_Z + 0.16 + gz;
   double tgt[3];
   double grip = -1;
   int next = 0;
   double tol = 0.01;
   switch (e->phase) {
-  case 0: /* above the target */
-    tgt[0] = q[0], tgt[1] = q[1], tgt[2] = fmax(q[2] + h + 0.08, lift_z - 0.04);
+  case 0: { /* above the target, high enough that the open pads pass over
+             * every other object (the kettle stands 20 cm tall) */
+    double tallest = 0;
+    for (int j = 0; j < SIM_NOBJ; j++)
+      if (j != k) tallest = fmax(tallest, e->assets[j].size[2]);
+    tgt[0] = q[0], tgt[1] = q[1];
+    tgt[2] = fmax(fmax(q[2] + h + 0.08, lift_z - 0.04), HEARTH_SIM_TABLE_Z + tallest + k_pad_half_z + 0.04);
     tol = 0.015;
     next = 1;
     break;
+  }
   case 1: /* down to the grasp height */
     tgt[0] = q[0], tgt[1] = q[1], tgt[2] = q[2] + gz;
     tol = 0.006;
     next = 1;
     break;
-  case 2: /* close */
-    tgt[0] = x[0], tgt[1] = x[1], tgt[2] = x[2];
+  case 2: /* close, holding the grasp height: following the hand as the
+           * closing pads push it up would let them ride over thin objects */
+    tgt[0] = x[0], tgt[1] = x[1], tgt[2] = q[2] + gz;
     grip = 1;
     next = e->phase_steps >= 8;
     break;

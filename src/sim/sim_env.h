@@ -23,13 +23,23 @@ struct hearth_sim_env {
   int obj_geom_rgb[SIM_NOBJ], obj_geom_th[SIM_NOBJ];
   /* episode */
   int swap, instruction, target, steps;
+  int layout_attempts; /* draws the visibility check needed (1 = first) */
   double goal_pos[3], goal_R[9], R0[9], grip_cmd;
   int phase, phase_steps;
   sim_render *rnd;
 };
 
 void sim_osc(hearth_sim_env *e);
-void sim_layout(uint64_t seed, uint64_t layout, double pos[SIM_NOBJ][2], int *swap);
+/* visibility rule of a layout: both candidates at least this visible */
+#define SIM_MIN_VISIBLE 0.7
+#define SIM_MAX_ATTEMPTS 20
+void sim_layout(uint64_t seed, uint64_t layout, int attempt, double pos[SIM_NOBJ][2], int *swap);
+/* privileged helpers for tests and audits: object k's position (its
+ * bottom centre) and teleporting it upright at rest to xyz */
+void sim_object_pos(const hearth_sim_env *e, int k, double xyz[3]);
+void sim_place_object(hearth_sim_env *e, int k, const double xyz[3]);
+/* fraction of object k's surface samples seen by the front camera */
+double sim_visible_frac(const hearth_sim_env *e, int k);
 hearth_status sim_render_init(hearth_sim_env *e, hearth_err *err);
 void sim_render_free(hearth_sim_env *e);
 

@@ -60,6 +60,8 @@ void sim_render_free(hearth_sim_env *e) {
   if (r->gl) OSMesaMakeCurrent(r->gl, r->glbuf, GL_UNSIGNED_BYTE, e->width, e->height);
   if (r->have_con) mjr_freeContext(&r->con);
   if (r->have_scn) mjv_freeScene(&r->scn);
+  /* unbind before destroying so Mesa can release the context's buffer */
+  if (r->gl) OSMesaMakeCurrent(NULL, NULL, GL_UNSIGNED_BYTE, 0, 0);
   if (r->gl) OSMesaDestroyContext(r->gl);
   free(r->glbuf);
   free(r->front), free(r->thermal), free(r->wrist), free(r->seg);
@@ -178,13 +180,16 @@ static long count_geom(const hearth_sim_env *e, const uint8_t *img, int geom, in
 hearth_status hearth_sim_visibility(hearth_sim_env *e, double *tf, double *of, hearth_err *err) {
   sim_render *r = e->rnd;
   double frac[2];
+  long vis[2];
+  /* pixels seen in the whole scene, then each candidate rendered alone */
+  render_view(e, e->cam_front, VIEW_SEGMENT, -1, r->seg);
+  for (int c = 0; c < 2; c++)
+    vis[c] = count_geom(e, r->seg, e->obj_geom_rgb[c == 0 ? e->target : 1 - e->target], NULL);
   for (int c = 0; c < 2; c++) {
-    int k = c == 0 ? e->target : 1 - e->target, g = e->obj_geom_rgb[k];
-    render_view(e, e->cam_front, VIEW_SEGMENT, -1, r->seg);
-    long vis = count_geom(e, r->seg, g, NULL);
+    int g = e->obj_geom_rgb[c == 0 ? e->target : 1 - e->target];
     render_view(e, e->cam_front, VIEW_SEGMENT, g, r->seg);
     long all = count_geom(e, r->seg, g, NULL);
-    frac[c] = all > 0 ? (double)vis / (double)all : 0.0;
+    frac[c] = all > 0 ? (double)vis[c] / (double)all : 0.0;
   }
   if (tf) *tf = frac[0];
   if (of) *of = frac[1];
