@@ -86,7 +86,35 @@ static void key_manifest(const void *ctx, size_t i, const char **a, const char *
   *b = NULL;
 }
 
-static hearth_status view_files_from_json(hj_ctx *c, const json_t *v, hearth_view_files *f) {
+/* Read root.key: an array of min..max records of elem_size bytes, each read
+ * by one() with the path at ".key[i]". On success *items (caller frees) and
+ * *n are set and the path stays at ".key" (its mark in *mk), so the caller
+ * can report a duplicate by index before popping. */
+typedef hearth_status (*record_fn)(hj_ctx *c, const json_t *v, void *elem);
+static hearth_status records_from_json(hj_ctx *c, const json_t *root, const char *key, size_t min,
+                                       size_t max, size_t elem_size, const char *what,
+                                       record_fn one, void **items, size_t *n, size_t *mk) {
+  json_t *arr;
+  hearth_status s;
+  if ((s = hj_member(c, root, key, &arr))) return s;
+  *mk = hj_push_key(c, key);
+  if ((s = hj_array(c, arr, min, max, n))) return s;
+  char *buf = hearth_calloc_array(*n ? *n : 1, elem_size);
+  if (!buf) return hj_fail(c, HEARTH_E_NOMEM, "cannot allocate %zu %s", *n, what);
+  for (size_t i = 0; i < *n; i++) {
+    size_t m2 = hj_push_index(c, i);
+    if ((s = one(c, json_array_get(arr, i), buf + i * elem_size))) {
+      free(buf);
+      return s;
+    }
+    hj_pop(c, m2);
+  }
+  *items = buf;
+  return HEARTH_OK;
+}
+
+static hearth_status view_files_from_json(hj_ctx *c, const json_t *v, void *elem) {
+  hearth_view_files *f = elem;
   if (!json_is_object(v))
     return hj_fail(c, HEARTH_E_PARSE, "expected an object, found %s", hj_type_name(v));
   hearth_status s;
@@ -115,21 +143,12 @@ static hearth_status manifest_from_json(hj_ctx *c, const json_t *root, void *out
   if ((s = hr_get_checked(c, root, "state", m.state, sizeof m.state, hearth_state_valid,
                           "neutral, hot, warm, iced or used")))
     return s;
-  json_t *vv;
-  if ((s = hj_member(c, root, "views", &vv))) return s;
-  size_t mk = hj_push_key(c, "views");
-  size_t n;
-  if ((s = hj_array(c, vv, 1, HEARTH_MAX_VIEWS, &n))) return s;
-  m.views = hearth_calloc_array(n, sizeof *m.views);
-  if (!m.views) return hj_fail(c, HEARTH_E_NOMEM, "cannot allocate %zu views", n);
-  for (size_t i = 0; i < n; i++) {
-    size_t m2 = hj_push_index(c, i);
-    if ((s = view_files_from_json(c, json_array_get(vv, i), &m.views[i]))) {
-      free(m.views);
-      return s;
-    }
-    hj_pop(c, m2);
-  }
+  size_t mk, n;
+  void *items;
+  if ((s = records_from_json(c, root, "views", 1, HEARTH_MAX_VIEWS, sizeof *m.views, "views",
+                             view_files_from_json, &items, &n, &mk)))
+    return s;
+  m.views = items;
   m.n_views = n;
   size_t first, second;
   if (hr_find_duplicate(n, key_manifest, &m, &first, &second)) {
@@ -230,7 +249,8 @@ static hearth_status get_fixed(hj_ctx *c, const json_t *obj, const char *key, co
   return s;
 }
 
-static hearth_status pose_from_json(hj_ctx *c, const json_t *v, hearth_view_pose *p) {
+static hearth_status pose_from_json(hj_ctx *c, const json_t *v, void *elem) {
+  hearth_view_pose *p = elem;
   if (!json_is_object(v))
     return hj_fail(c, HEARTH_E_PARSE, "expected an object, found %s", hj_type_name(v));
   hearth_status s;
@@ -253,21 +273,12 @@ static hearth_status poses_from_json(hj_ctx *c, const json_t *root, void *out) {
   hearth_status s;
   if ((s = get_fixed(c, root, "convention", HR_CONVENTION))) return s;
   if ((s = get_fixed(c, root, "units", HR_UNITS))) return s;
-  json_t *vv;
-  if ((s = hj_member(c, root, "views", &vv))) return s;
-  size_t mk = hj_push_key(c, "views");
-  size_t n;
-  if ((s = hj_array(c, vv, 0, HR_MAX_POSES, &n))) return s;
-  p.views = hearth_calloc_array(n ? n : 1, sizeof *p.views);
-  if (!p.views) return hj_fail(c, HEARTH_E_NOMEM, "cannot allocate %zu poses", n);
-  for (size_t i = 0; i < n; i++) {
-    size_t m2 = hj_push_index(c, i);
-    if ((s = pose_from_json(c, json_array_get(vv, i), &p.views[i]))) {
-      free(p.views);
-      return s;
-    }
-    hj_pop(c, m2);
-  }
+  size_t mk, n;
+  void *items;
+  if ((s = records_from_json(c, root, "views", 0, HR_MAX_POSES, sizeof *p.views, "poses",
+                             pose_from_json, &items, &n, &mk)))
+    return s;
+  p.views = items;
   p.n = n;
   size_t first, second;
   if (hr_find_duplicate(n, key_poses, &p, &first, &second)) {
@@ -378,7 +389,8 @@ static hearth_status pattern_from_json(hj_ctx *c, const json_t *root) {
   return HEARTH_OK;
 }
 
-static hearth_status detection_from_json(hj_ctx *c, const json_t *v, hearth_detection *f) {
+static hearth_status detection_from_json(hj_ctx *c, const json_t *v, void *elem) {
+  hearth_detection *f = elem;
   if (!json_is_object(v))
     return hj_fail(c, HEARTH_E_PARSE, "expected an object, found %s", hj_type_name(v));
   hearth_status s;
@@ -410,21 +422,12 @@ static hearth_status detections_from_json(hj_ctx *c, const json_t *root, void *o
   hearth_detections d = {0, NULL};
   hearth_status s;
   if ((s = pattern_from_json(c, root))) return s;
-  json_t *fv;
-  if ((s = hj_member(c, root, "frames", &fv))) return s;
-  size_t mk = hj_push_key(c, "frames");
-  size_t n;
-  if ((s = hj_array(c, fv, 0, HR_MAX_FRAMES, &n))) return s;
-  d.frames = hearth_calloc_array(n ? n : 1, sizeof *d.frames);
-  if (!d.frames) return hj_fail(c, HEARTH_E_NOMEM, "cannot allocate %zu frames", n);
-  for (size_t i = 0; i < n; i++) {
-    size_t m2 = hj_push_index(c, i);
-    if ((s = detection_from_json(c, json_array_get(fv, i), &d.frames[i]))) {
-      free(d.frames);
-      return s;
-    }
-    hj_pop(c, m2);
-  }
+  size_t mk, n;
+  void *items;
+  if ((s = records_from_json(c, root, "frames", 0, HR_MAX_FRAMES, sizeof *d.frames, "frames",
+                             detection_from_json, &items, &n, &mk)))
+    return s;
+  d.frames = items;
   d.n = n;
   size_t first, second;
   if (hr_find_duplicate(n, key_detections, &d, &first, &second)) {
