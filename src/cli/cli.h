@@ -18,6 +18,12 @@ int cli_opt(int argc, char **argv, int *i, const char *name, const char **val);
 int cli_parse_int(const char *s, long lo, long hi, long *out);
 int cli_parse_u64(const char *s, uint64_t *out);
 int cli_parse_num(const char *s, double *out);
+/* A non-option argument of a pipeline command: the first is ROOT, a second
+ * is an error; an unknown option is an error too. Returns 0 when taken,
+ * 2 (the usage exit status) after printing the problem. */
+int cli_root_arg(const char *cmd, const char *arg, const char **root, const char *help);
+/* Print "hearth <cmd>: missing ROOT" and the help; returns 2. */
+int cli_missing_root(const char *cmd, const char *help);
 /* Print "hearth <cmd>: <message>" for a failed status; returns 1. */
 int cli_fail(const char *cmd, const hearth_err *err);
 

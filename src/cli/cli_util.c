@@ -49,3 +49,21 @@ int cli_fail(const char *cmd, const hearth_err *err) {
           hearth_status_name(err->status));
   return 1;
 }
+
+int cli_root_arg(const char *cmd, const char *arg, const char **root, const char *help) {
+  if (arg[0] == '-') {
+    fprintf(stderr, "hearth %s: unknown option '%s'\n%s", cmd, arg, help);
+    return 2;
+  }
+  if (*root) {
+    fprintf(stderr, "hearth %s: unexpected argument '%s'\n", cmd, arg);
+    return 2;
+  }
+  *root = arg;
+  return 0;
+}
+
+int cli_missing_root(const char *cmd, const char *help) {
+  fprintf(stderr, "hearth %s: missing ROOT\n%s", cmd, help);
+  return 2;
+}

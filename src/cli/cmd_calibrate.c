@@ -58,13 +58,7 @@ int hearth_cmd_calibrate(int argc, char **argv) {
       if (r < 0) goto missing;
       if (!cli_parse_num(v, &f) || !(f > 0)) goto bad;
       o.outlier_min_px = f;
-    } else if (argv[i][0] == '-') {
-      fprintf(stderr, "hearth calibrate: unknown option '%s'\n%s", argv[i], k_help);
-      return 2;
-    } else if (!root) {
-      root = argv[i];
-    } else {
-      fprintf(stderr, "hearth calibrate: unexpected argument '%s'\n", argv[i]);
+    } else if (cli_root_arg("calibrate", argv[i], &root, k_help)) {
       return 2;
     }
     continue;
@@ -75,10 +69,7 @@ int hearth_cmd_calibrate(int argc, char **argv) {
     fprintf(stderr, "hearth calibrate: bad value '%s' for %s\n", v, argv[i - 1]);
     return 2;
   }
-  if (!root) {
-    fprintf(stderr, "hearth calibrate: missing ROOT\n%s", k_help);
-    return 2;
-  }
+  if (!root) return cli_missing_root("calibrate", k_help);
   hearth_err err = {0};
   hearth_calib_report rep;
   if (hearth_calib_calibrate_release(root, &o, &rep, &err)) return cli_fail("calibrate", &err);

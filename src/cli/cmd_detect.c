@@ -54,13 +54,7 @@ int hearth_cmd_detect(int argc, char **argv) {
       if (r < 0) goto missing;
       if (!cli_parse_num(v, &f) || !(f > 0)) goto bad;
       run.detect.max_blur_frac = f;
-    } else if (argv[i][0] == '-') {
-      fprintf(stderr, "hearth detect: unknown option '%s'\n%s", argv[i], k_help);
-      return 2;
-    } else if (!root) {
-      root = argv[i];
-    } else {
-      fprintf(stderr, "hearth detect: unexpected argument '%s'\n", argv[i]);
+    } else if (cli_root_arg("detect", argv[i], &root, k_help)) {
       return 2;
     }
     continue;
@@ -71,10 +65,7 @@ int hearth_cmd_detect(int argc, char **argv) {
     fprintf(stderr, "hearth detect: bad value '%s' for %s\n", v, argv[i - 1]);
     return 2;
   }
-  if (!root) {
-    fprintf(stderr, "hearth detect: missing ROOT\n%s", k_help);
-    return 2;
-  }
+  if (!root) return cli_missing_root("detect", k_help);
   hearth_err err = {0};
   hearth_detections d = {0, NULL};
   double t0 = hearth_now();

@@ -108,13 +108,7 @@ int hearth_cmd_map(int argc, char **argv) {
       job.map.keep_edges = 1;
     } else if (!strcmp(argv[i], "--rgb")) {
       rgb = 1;
-    } else if (argv[i][0] == '-') {
-      fprintf(stderr, "hearth map: unknown option '%s'\n%s", argv[i], k_help);
-      return 2;
-    } else if (!root) {
-      root = argv[i];
-    } else {
-      fprintf(stderr, "hearth map: unexpected argument '%s'\n", argv[i]);
+    } else if (cli_root_arg("map", argv[i], &root, k_help)) {
       return 2;
     }
     continue;
@@ -125,10 +119,7 @@ int hearth_cmd_map(int argc, char **argv) {
     fprintf(stderr, "hearth map: bad value '%s' for option '%s'\n", v, argv[i - (argv[i][0] != '-')]);
     return 2;
   }
-  if (!root) {
-    fprintf(stderr, "hearth map: missing ROOT\n%s", k_help);
-    return 2;
-  }
+  if (!root) return cli_missing_root("map", k_help);
   job.root = root;
   int rc = 0;
   if (rgb) rc |= cli_each_instance("map", root, instance, bake_one, &job);

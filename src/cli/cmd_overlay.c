@@ -73,13 +73,7 @@ int hearth_cmd_overlay(int argc, char **argv) {
       if (!comma || hearth_parse_double(v, (size_t)(comma - v), 0, &job.lo) ||
           !cli_parse_num(comma + 1, &job.hi) || !(job.lo < job.hi))
         goto bad;
-    } else if (argv[i][0] == '-') {
-      fprintf(stderr, "hearth overlay: unknown option '%s'\n%s", argv[i], k_help);
-      return 2;
-    } else if (!root) {
-      root = argv[i];
-    } else {
-      fprintf(stderr, "hearth overlay: unexpected argument '%s'\n", argv[i]);
+    } else if (cli_root_arg("overlay", argv[i], &root, k_help)) {
       return 2;
     }
     continue;
@@ -90,10 +84,7 @@ int hearth_cmd_overlay(int argc, char **argv) {
     fprintf(stderr, "hearth overlay: bad value '%s' for option '%s'\n", v, argv[i - 1]);
     return 2;
   }
-  if (!root) {
-    fprintf(stderr, "hearth overlay: missing ROOT\n%s", k_help);
-    return 2;
-  }
+  if (!root) return cli_missing_root("overlay", k_help);
   job.root = root;
   return cli_each_state("overlay", root, instance, state, overlay_one, &job);
 }

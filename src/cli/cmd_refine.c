@@ -139,14 +139,7 @@ int hearth_cmd_refine(int argc, char **argv) {
       if (!comma || hearth_parse_double(v, (size_t)(comma - v), 0, &job.perturb_deg) ||
           !cli_parse_num(comma + 1, &job.perturb_mm) || job.perturb_deg < 0 || job.perturb_mm < 0)
         goto bad;
-    } else if (argv[i][0] == '-') {
-      fprintf(stderr, "hearth refine: unknown option '%s'\n%s", argv[i], k_help);
-      free(nudges);
-      return 2;
-    } else if (!root) {
-      root = argv[i];
-    } else {
-      fprintf(stderr, "hearth refine: unexpected argument '%s'\n", argv[i]);
+    } else if (cli_root_arg("refine", argv[i], &root, k_help)) {
       free(nudges);
       return 2;
     }
@@ -161,9 +154,8 @@ int hearth_cmd_refine(int argc, char **argv) {
     return 2;
   }
   if (!root) {
-    fprintf(stderr, "hearth refine: missing ROOT\n%s", k_help);
     free(nudges);
-    return 2;
+    return cli_missing_root("refine", k_help);
   }
   if (nudge_file) {
     hearth_pose_nudge *fn = NULL;

@@ -63,13 +63,7 @@ int hearth_cmd_scale(int argc, char **argv) {
       if (r < 0) goto missing;
       if (!cli_parse_int(v, 1, 1024, &lv)) goto bad;
       job.opts.threads = (int)lv;
-    } else if (argv[i][0] == '-') {
-      fprintf(stderr, "hearth scale: unknown option '%s'\n%s", argv[i], k_help);
-      return 2;
-    } else if (!root) {
-      root = argv[i];
-    } else {
-      fprintf(stderr, "hearth scale: unexpected argument '%s'\n", argv[i]);
+    } else if (cli_root_arg("scale", argv[i], &root, k_help)) {
       return 2;
     }
     continue;
@@ -80,10 +74,7 @@ int hearth_cmd_scale(int argc, char **argv) {
     fprintf(stderr, "hearth scale: bad value '%s' for option '%s'\n", v, argv[i - 1]);
     return 2;
   }
-  if (!root) {
-    fprintf(stderr, "hearth scale: missing ROOT\n%s", k_help);
-    return 2;
-  }
+  if (!root) return cli_missing_root("scale", k_help);
   job.root = root;
   job.state = state;
   return cli_each_instance("scale", root, instance, scale_one, &job);

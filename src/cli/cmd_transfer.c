@@ -46,13 +46,7 @@ int hearth_cmd_transfer(int argc, char **argv) {
       poses = v;
     } else if (!strcmp(argv[i], "--keep-refined")) {
       keep = 1;
-    } else if (argv[i][0] == '-') {
-      fprintf(stderr, "hearth transfer: unknown option '%s'\n%s", argv[i], k_help);
-      return 2;
-    } else if (!root) {
-      root = argv[i];
-    } else {
-      fprintf(stderr, "hearth transfer: unexpected argument '%s'\n", argv[i]);
+    } else if (cli_root_arg("transfer", argv[i], &root, k_help)) {
       return 2;
     }
     continue;
@@ -60,10 +54,7 @@ int hearth_cmd_transfer(int argc, char **argv) {
     fprintf(stderr, "hearth transfer: option '%s' needs a value\n", argv[i]);
     return 2;
   }
-  if (!root) {
-    fprintf(stderr, "hearth transfer: missing ROOT\n%s", k_help);
-    return 2;
-  }
+  if (!root) return cli_missing_root("transfer", k_help);
   hearth_transfer_job job = {root, NULL, rig, poses, keep};
   return cli_each_instance("transfer", root, instance, transfer_one, &job);
 }
