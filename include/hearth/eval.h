@@ -72,6 +72,8 @@ typedef struct hearth_eval_opts {
   const char *release_root;
   int use_ground_truth;
   int render_size;         /* sim view side; default 256 */
+  int shadows;             /* as hearth_sim_opts.shadows; default 0 */
+  const char *gl;          /* as hearth_sim_opts.gl */
   int image_size;          /* policy image side; default 224 */
   int max_steps;           /* 0 = hearth_eval_time_limit(task) */
   int replan_steps;        /* default 5 */

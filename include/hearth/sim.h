@@ -46,6 +46,12 @@ typedef struct hearth_sim_opts {
   int width, height;     /* rendered size of every view; default 256 */
   int max_steps;         /* time limit in control steps; default 400 */
   int render_wrist;      /* default 1 */
+  int shadows;           /* shadow-mapped light in the RGB views; default 0
+                          * (3x the CPU rendering cost; the thermal view is
+                          * unlit either way) */
+  const char *gl;        /* "osmesa" (CPU, default) or "egl" (GPU through
+                          * EGL's device platform, else Mesa's surfaceless
+                          * platform); NULL: $HEARTH_GL, else "osmesa" */
   const char *work_dir;  /* scratch for the MJCF/mesh files; NULL = a fresh dir under /tmp */
 } hearth_sim_opts;
 void hearth_sim_opts_default(hearth_sim_opts *o);
@@ -56,6 +62,9 @@ typedef struct hearth_sim_env hearth_sim_env;
  * EGL when HEARTH_GL=egl and the build has it. */
 hearth_status hearth_sim_env_new(const hearth_sim_opts *o, hearth_sim_env **out, hearth_err *err);
 void hearth_sim_env_free(hearth_sim_env *env);
+/* The GL back end and renderer in use, e.g. "osmesa: llvmpipe (...)" or
+ * "egl device: NVIDIA H100 ..."; owned by the env. */
+const char *hearth_sim_renderer(const hearth_sim_env *env);
 
 /* Start an episode: layout `layout` of the stream `seed` (object positions
  * and the candidate-to-slot assignment, identical for both instructions),
@@ -115,6 +124,8 @@ typedef struct hearth_sim_collect_opts {
   int image_size;       /* stored image side; default 128 (LIBERO) */
   int max_steps;        /* default 400 */
   int keep_failures;    /* store failed demos too (default 0: retry with the next layout) */
+  int shadows;          /* as hearth_sim_opts.shadows; default 0 */
+  const char *gl;       /* as hearth_sim_opts.gl */
   int quiet;
   const char *out_path; /* .hdf5, written atomically */
 } hearth_sim_collect_opts;

@@ -37,6 +37,9 @@ static const char *k_usage_render =
     "                    and temperature_true.npy instead of derived/\n"
     "  --size N          image side in pixels (default 256)\n"
     "  --seed N          layout seed (default 1)\n"
+    "  --shadows         shadow-mapped light in the RGB views (off by default)\n"
+    "  --gl osmesa|egl   GL back end (default $HEARTH_GL, else osmesa: CPU; egl: a\n"
+    "                    GPU through EGL, else Mesa's surfaceless platform)\n"
     "  -h, --help        this text\n";
 
 static const char *k_usage_collect =
@@ -68,6 +71,8 @@ static const char *k_usage_collect =
     "  --release ROOT    assets from a release (derived/); default: virtual rig\n"
     "  --ground-truth    with --release: a virtual-rig release's ground_truth/ assets\n"
     "  --keep-failures   also store episodes that did not succeed\n"
+    "  --shadows         shadow-mapped light in the RGB views (off by default)\n"
+    "  --gl osmesa|egl   GL back end (default $HEARTH_GL, else osmesa)\n"
     "  --quiet           no progress output\n"
     "  -h, --help        this text\n";
 
@@ -119,7 +124,8 @@ static int cmd_render(int argc, char **argv) {
   hearth_sim_task only = 0;
   long size = 256;
   uint64_t seed = 1;
-  int gt = 0;
+  int gt = 0, shadows = 0;
+  const char *gl = NULL;
   for (int i = 1; i < argc; i++) {
     int r;
     if (cli_is_help(argv[i])) {
@@ -130,8 +136,13 @@ static int cmd_render(int argc, char **argv) {
       gt = 1;
       continue;
     }
+    if (strcmp(argv[i], "--shadows") == 0) {
+      shadows = 1;
+      continue;
+    }
     if ((r = cli_opt(argc, argv, &i, "--out", &v)) == 1) out = v;
     else if (r == 0 && (r = cli_opt(argc, argv, &i, "--release", &v)) == 1) release = v;
+    else if (r == 0 && (r = cli_opt(argc, argv, &i, "--gl", &v)) == 1) gl = v;
     else if (r == 0 && (r = cli_opt(argc, argv, &i, "--task", &v)) == 1) {
       if (!(only = hearth_sim_task_parse(v))) {
         fprintf(stderr, "hearth sim render: --task must be H1, H2 or H3, got '%s'\n", v);
@@ -175,6 +186,8 @@ static int cmd_render(int argc, char **argv) {
     o.release_root = root;
     o.use_ground_truth = use_gt;
     o.width = o.height = (int)size;
+    o.shadows = shadows;
+    o.gl = gl;
     char prefix[4200];
     snprintf(prefix, sizeof prefix, "%s/%s", out, hearth_sim_task_name(o.task));
     if (hearth_sim_render_scene(&o, seed, prefix, &err)) rc = cli_fail("sim render", &err);
@@ -200,8 +213,10 @@ static int cmd_collect(int argc, char **argv) {
     }
     if (strcmp(argv[i], "--quiet") == 0) { o.quiet = 1; continue; }
     if (strcmp(argv[i], "--keep-failures") == 0) { o.keep_failures = 1; continue; }
+    if (strcmp(argv[i], "--shadows") == 0) { o.shadows = 1; continue; }
     if ((r = cli_opt(argc, argv, &i, "--out", &v)) == 1) o.out_path = v;
     else if (r == 0 && (r = cli_opt(argc, argv, &i, "--release", &v)) == 1) release = v;
+    else if (r == 0 && (r = cli_opt(argc, argv, &i, "--gl", &v)) == 1) o.gl = v;
     else if (r == 0 && (r = cli_opt(argc, argv, &i, "--task", &v)) == 1) {
       if (!(o.task = hearth_sim_task_parse(v))) {
         fprintf(stderr, "hearth sim collect: --task must be H1, H2 or H3, got '%s'\n", v);

@@ -38,6 +38,8 @@ static const char *k_usage =
     "  --seed N             layout seed (default 1, as collection)\n"
     "  --release ROOT       assets from a release (derived/); default: virtual rig\n"
     "  --size N             rendered view side (default 256)\n"
+    "  --shadows            shadow-mapped light in the RGB views (as at collection)\n"
+    "  --gl osmesa|egl      GL back end (default $HEARTH_GL, else osmesa)\n"
     "  --image-size N       policy image side (default 224)\n"
     "  --max-steps N        time limit in control steps (default 280)\n"
     "  --replan N           actions executed per chunk (default 5)\n"
@@ -128,6 +130,11 @@ int hearth_cmd_sim_eval(int argc, char **argv) {
       }
     } else if (OPT("--episodes")) {
       INTV("--episodes", 1, 100000, o.episodes);
+    } else if (strcmp(argv[i], "--shadows") == 0) {
+      o.shadows = 1;
+    } else if (OPT("--gl")) {
+      NEEDV("--gl");
+      o.gl = v;
     } else if (strcmp(argv[i], "--no-thermal") == 0) {
       o.thermal = 0;
     } else if (OPT("--seed")) {

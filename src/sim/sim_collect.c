@@ -182,9 +182,12 @@ hearth_status hearth_sim_collect(const hearth_sim_collect_opts *o, hearth_sim_co
   so.use_ground_truth = o->use_ground_truth;
   so.width = so.height = o->image_size;
   so.max_steps = o->max_steps;
+  so.shadows = o->shadows;
+  so.gl = o->gl;
   hearth_sim_env *e = NULL;
   hearth_status st = hearth_sim_env_new(&so, &e, err);
   if (st) return st;
+  if (!o->quiet) fprintf(stderr, "renderer: %s\n", hearth_sim_renderer(e));
   double t0 = hearth_now();
   char tmp[4200];
   snprintf(tmp, sizeof tmp, "%s.tmp%ld", o->out_path, (long)getpid());
@@ -266,9 +269,10 @@ hearth_status hearth_sim_collect(const hearth_sim_collect_opts *o, hearth_sim_co
     snprintf(ea, sizeof ea,
              "{\"env_name\": \"hearth_%s\", \"type\": 1, \"env_kwargs\": {\"control_freq\": 20, "
              "\"camera_heights\": %d, \"camera_widths\": %d, \"controller\": \"OSC_POSE\", "
-             "\"seed\": %llu, \"asset_source\": \"%s\"}}",
+             "\"seed\": %llu, \"asset_source\": \"%s\", \"shadows\": %s, \"renderer\": \"%s\"}}",
              hearth_sim_task_name(o->task), o->image_size, o->image_size, (unsigned long long)o->seed,
-             o->use_ground_truth ? "virtual_rig_ground_truth" : "release_derived");
+             o->use_ground_truth ? "virtual_rig_ground_truth" : "release_derived",
+             o->shadows ? "true" : "false", e->gl);
     if (!h5_str_attr(data, "problem_info", pi) || !h5_str_attr(data, "env_args", ea) ||
         !h5_int_attr(data, "num_demos", ndemo) || !h5_int_attr(data, "total", stored) ||
         !h5_str_attr(data, "instructions", il) ||

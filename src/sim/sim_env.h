@@ -11,7 +11,8 @@ typedef struct sim_render sim_render;
 
 struct hearth_sim_env {
   hearth_sim_task task;
-  int width, height, max_steps, render_wrist;
+  int width, height, max_steps, render_wrist, shadows;
+  char gl[16];
   char work_dir[4096];
   int own_work_dir;
   sim_asset assets[SIM_NOBJ]; /* 0, 1: candidates (instruction i targets i); 2, 3: distractors */

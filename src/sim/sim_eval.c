@@ -675,6 +675,8 @@ hearth_status hearth_eval_run(const hearth_eval_opts *o, hearth_eval_results *r,
     so.release_root = o->release_root;
     so.use_ground_truth = o->use_ground_truth;
     so.width = so.height = o->render_size;
+    so.shadows = o->shadows;
+    so.gl = o->gl;
     int limit = o->max_steps > 0 ? o->max_steps : hearth_eval_time_limit(so.task);
     so.max_steps = limit + o->wait_steps;
     if (is_replay)

@@ -1,7 +1,15 @@
-/* off-screen rendering of the three views with MuJoCo's OpenGL renderer on
- * an OSMesa (CPU) context: front RGB, front thermal (object-attached Turbo
- * textures, unlit; everything else at room temperature), wrist RGB */
+/* off-screen rendering of the three views with MuJoCo's OpenGL renderer:
+ * front RGB, front thermal (object-attached Turbo textures, unlit;
+ * everything else at room temperature), wrist RGB. Two GL back ends: an
+ * OSMesa context (CPU, linked) and EGL (a GPU through the device platform,
+ * else Mesa's surfaceless platform), loaded at run time so that machines
+ * without libEGL still run the CPU path. MuJoCo resolves GL entry points
+ * through eglGetProcAddress when libEGL is in the global scope and through
+ * OSMesaGetProcAddress otherwise, so one process uses one back end. */
+#include <EGL/egl.h>
+#include <EGL/eglext.h>
 #include <GL/osmesa.h>
+#include <dlfcn.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -10,9 +18,31 @@
 #include "hearth/geom.h"
 #include "sim/sim_env.h"
 
+typedef struct egl_api {
+  void *lib;
+  PFNEGLGETPROCADDRESSPROC get_proc;
+  PFNEGLQUERYDEVICESEXTPROC query_devices;
+  PFNEGLQUERYDEVICESTRINGEXTPROC query_device_string;
+  PFNEGLGETPLATFORMDISPLAYEXTPROC platform_display;
+  PFNEGLINITIALIZEPROC initialize;
+  PFNEGLTERMINATEPROC terminate;
+  PFNEGLBINDAPIPROC bind_api;
+  PFNEGLCHOOSECONFIGPROC choose_config;
+  PFNEGLCREATECONTEXTPROC create_context;
+  PFNEGLDESTROYCONTEXTPROC destroy_context;
+  PFNEGLMAKECURRENTPROC make_current;
+  PFNEGLQUERYSTRINGPROC query_string;
+  PFNEGLGETERRORPROC get_error;
+} egl_api;
+
 struct sim_render {
+  int egl;
   OSMesaContext gl;
   unsigned char *glbuf;
+  egl_api api;
+  EGLDisplay dpy;
+  EGLContext ctx;
+  char renderer[160];
   mjvScene scn;
   mjvCamera cam;
   mjvOption opt;
@@ -23,23 +53,115 @@ struct sim_render {
 
 enum { VIEW_RGB = 0, VIEW_THERMAL = 1, VIEW_SEGMENT = 2 };
 
-hearth_status sim_render_init(hearth_sim_env *e, hearth_err *err) {
-  const char *gl = getenv("HEARTH_GL");
-  if (gl && *gl && strcmp(gl, "osmesa") != 0)
+static int make_current(hearth_sim_env *e) {
+  sim_render *r = e->rnd;
+  if (r->egl) return r->api.make_current(r->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, r->ctx) == EGL_TRUE;
+  return OSMesaMakeCurrent(r->gl, r->glbuf, GL_UNSIGNED_BYTE, e->width, e->height) != 0;
+}
+
+static hearth_status egl_load(egl_api *a, hearth_err *err) {
+  a->lib = dlopen("libEGL.so.1", RTLD_NOW | RTLD_GLOBAL);
+  if (!a->lib)
     return hearth_err_set(err, HEARTH_E_UNSUPPORTED,
-                          "sim: HEARTH_GL=%s: this build renders with OSMesa only (HEARTH_GL=osmesa)", gl);
+                          "sim: EGL renderer: libEGL.so.1 not found (Debian: libegl1 libegl-mesa0)");
+  a->get_proc = (PFNEGLGETPROCADDRESSPROC)dlsym(a->lib, "eglGetProcAddress");
+  if (!a->get_proc) return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "sim: libEGL.so.1 has no eglGetProcAddress");
+#define EGL_FN(field, type, name)                                                              \
+  if (!(a->field = (type)a->get_proc(name)))                                                   \
+    return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "sim: EGL renderer: %s not available", name);
+  EGL_FN(initialize, PFNEGLINITIALIZEPROC, "eglInitialize")
+  EGL_FN(terminate, PFNEGLTERMINATEPROC, "eglTerminate")
+  EGL_FN(bind_api, PFNEGLBINDAPIPROC, "eglBindAPI")
+  EGL_FN(choose_config, PFNEGLCHOOSECONFIGPROC, "eglChooseConfig")
+  EGL_FN(create_context, PFNEGLCREATECONTEXTPROC, "eglCreateContext")
+  EGL_FN(destroy_context, PFNEGLDESTROYCONTEXTPROC, "eglDestroyContext")
+  EGL_FN(make_current, PFNEGLMAKECURRENTPROC, "eglMakeCurrent")
+  EGL_FN(query_string, PFNEGLQUERYSTRINGPROC, "eglQueryString")
+  EGL_FN(get_error, PFNEGLGETERRORPROC, "eglGetError")
+  EGL_FN(platform_display, PFNEGLGETPLATFORMDISPLAYEXTPROC, "eglGetPlatformDisplayEXT")
+#undef EGL_FN
+  /* optional: without device enumeration only the surfaceless platform */
+  a->query_devices = (PFNEGLQUERYDEVICESEXTPROC)a->get_proc("eglQueryDevicesEXT");
+  a->query_device_string = (PFNEGLQUERYDEVICESTRINGEXTPROC)a->get_proc("eglQueryDeviceStringEXT");
+  return HEARTH_OK;
+}
+
+/* a display with desktop OpenGL: the first hardware device, else Mesa's
+ * surfaceless platform (llvmpipe on a machine without a GPU) */
+static hearth_status egl_open(sim_render *r, hearth_err *err) {
+  egl_api *a = &r->api;
+  hearth_status st = egl_load(a, err);
+  if (st) return st;
+  r->dpy = EGL_NO_DISPLAY;
+  const char *kind = "";
+  if (a->query_devices && a->query_device_string) {
+    EGLDeviceEXT dev[16];
+    EGLint n = 0;
+    if (a->query_devices(16, dev, &n) == EGL_TRUE) {
+      for (EGLint i = 0; i < n && r->dpy == EGL_NO_DISPLAY; i++) {
+        const char *ext = a->query_device_string(dev[i], EGL_EXTENSIONS);
+        if (ext && strstr(ext, "EGL_MESA_device_software")) continue;
+        EGLDisplay d = a->platform_display(EGL_PLATFORM_DEVICE_EXT, dev[i], NULL);
+        if (d != EGL_NO_DISPLAY && a->initialize(d, NULL, NULL) == EGL_TRUE) r->dpy = d, kind = "device";
+      }
+    }
+  }
+  if (r->dpy == EGL_NO_DISPLAY) {
+    EGLDisplay d = a->platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, NULL);
+    if (d != EGL_NO_DISPLAY && a->initialize(d, NULL, NULL) == EGL_TRUE) r->dpy = d, kind = "surfaceless";
+  }
+  if (r->dpy == EGL_NO_DISPLAY)
+    return hearth_err_set(err, HEARTH_E_UNSUPPORTED,
+                          "sim: EGL renderer: no GPU device and no surfaceless platform (EGL error 0x%x)",
+                          (unsigned)a->get_error());
+  const char *ext = a->query_string(r->dpy, EGL_EXTENSIONS);
+  if (!ext || !strstr(ext, "EGL_KHR_surfaceless_context"))
+    return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "sim: EGL renderer: display lacks EGL_KHR_surfaceless_context");
+  if (a->bind_api(EGL_OPENGL_API) != EGL_TRUE)
+    return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "sim: EGL renderer: desktop OpenGL not available");
+  const EGLint want[] = {EGL_RED_SIZE, 8, EGL_GREEN_SIZE, 8, EGL_BLUE_SIZE, 8, EGL_ALPHA_SIZE, 8,
+                         EGL_DEPTH_SIZE, 24, EGL_STENCIL_SIZE, 8, EGL_SURFACE_TYPE, 0,
+                         EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
+  EGLConfig cfg;
+  EGLint ncfg = 0;
+  if (a->choose_config(r->dpy, want, &cfg, 1, &ncfg) != EGL_TRUE || ncfg < 1)
+    return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "sim: EGL renderer: no RGBA8/depth24 OpenGL config");
+  /* MuJoCo's renderer uses the compatibility profile (the default) */
+  r->ctx = a->create_context(r->dpy, cfg, EGL_NO_CONTEXT, NULL);
+  if (r->ctx == EGL_NO_CONTEXT)
+    return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "sim: EGL renderer: context creation failed (0x%x)",
+                          (unsigned)a->get_error());
+  if (a->make_current(r->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, r->ctx) != EGL_TRUE)
+    return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "sim: EGL renderer: eglMakeCurrent failed (0x%x)",
+                          (unsigned)a->get_error());
+  typedef const unsigned char *(*get_string_fn)(unsigned);
+  get_string_fn gs = (get_string_fn)a->get_proc("glGetString");
+  const unsigned char *name = gs ? gs(GL_RENDERER) : NULL;
+  snprintf(r->renderer, sizeof r->renderer, "egl %s: %s", kind, name ? (const char *)name : "?");
+  return HEARTH_OK;
+}
+
+hearth_status sim_render_init(hearth_sim_env *e, hearth_err *err) {
   sim_render *r = calloc(1, sizeof *r);
   if (!r) return hearth_err_set(err, HEARTH_E_NOMEM, "sim: out of memory");
   e->rnd = r;
   size_t px = (size_t)e->width * (size_t)e->height;
-  r->glbuf = malloc(px * 4);
   r->front = malloc(px * 3), r->thermal = malloc(px * 3), r->wrist = malloc(px * 3), r->seg = malloc(px * 3);
-  if (!r->glbuf || !r->front || !r->thermal || !r->wrist || !r->seg)
+  if (!r->front || !r->thermal || !r->wrist || !r->seg)
     return hearth_err_set(err, HEARTH_E_NOMEM, "sim: out of memory for %dx%d images", e->width, e->height);
-  r->gl = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);
-  if (!r->gl) return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "sim: OSMesa context creation failed");
-  if (!OSMesaMakeCurrent(r->gl, r->glbuf, GL_UNSIGNED_BYTE, e->width, e->height))
-    return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "sim: OSMesaMakeCurrent failed");
+  r->egl = strcmp(e->gl, "egl") == 0;
+  if (r->egl) {
+    hearth_status st = egl_open(r, err);
+    if (st) return st;
+  } else {
+    r->glbuf = malloc(px * 4);
+    if (!r->glbuf) return hearth_err_set(err, HEARTH_E_NOMEM, "sim: out of memory for %dx%d images", e->width, e->height);
+    r->gl = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);
+    if (!r->gl) return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "sim: OSMesa context creation failed");
+    if (!make_current(e)) return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "sim: OSMesaMakeCurrent failed");
+    const GLubyte *name = glGetString(GL_RENDERER);
+    snprintf(r->renderer, sizeof r->renderer, "osmesa: %s", name ? (const char *)name : "?");
+  }
   mjv_defaultScene(&r->scn);
   mjv_defaultCamera(&r->cam);
   mjv_defaultOption(&r->opt);
@@ -54,15 +176,27 @@ hearth_status sim_render_init(hearth_sim_env *e, hearth_err *err) {
   return HEARTH_OK;
 }
 
+const char *hearth_sim_renderer(const hearth_sim_env *e) {
+  return e && e->rnd ? e->rnd->renderer : "";
+}
+
 void sim_render_free(hearth_sim_env *e) {
   sim_render *r = e->rnd;
   if (!r) return;
-  if (r->gl) OSMesaMakeCurrent(r->gl, r->glbuf, GL_UNSIGNED_BYTE, e->width, e->height);
-  if (r->have_con) mjr_freeContext(&r->con);
+  int current = (r->egl ? r->ctx != NULL && r->ctx != EGL_NO_CONTEXT : r->gl != NULL) && make_current(e);
+  if (current && r->have_con) mjr_freeContext(&r->con);
   if (r->have_scn) mjv_freeScene(&r->scn);
-  /* unbind before destroying so Mesa can release the context's buffer */
-  if (r->gl) OSMesaMakeCurrent(NULL, NULL, GL_UNSIGNED_BYTE, 0, 0);
-  if (r->gl) OSMesaDestroyContext(r->gl);
+  if (r->egl) {
+    if (r->api.make_current && r->dpy != EGL_NO_DISPLAY)
+      r->api.make_current(r->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    if (r->ctx != NULL && r->ctx != EGL_NO_CONTEXT) r->api.destroy_context(r->dpy, r->ctx);
+    if (r->dpy != NULL && r->dpy != EGL_NO_DISPLAY) r->api.terminate(r->dpy);
+    /* libEGL stays loaded: MuJoCo holds its entry points */
+  } else {
+    /* unbind before destroying so Mesa can release the context's buffer */
+    if (r->gl) OSMesaMakeCurrent(NULL, NULL, GL_UNSIGNED_BYTE, 0, 0);
+    if (r->gl) OSMesaDestroyContext(r->gl);
+  }
   free(r->glbuf);
   free(r->front), free(r->thermal), free(r->wrist), free(r->seg);
   free(r);
@@ -79,7 +213,7 @@ static int is_obj_geom(const hearth_sim_env *e, int g, const int *list) {
 static void render_view(hearth_sim_env *e, int cam, int mode, int only_geom, uint8_t *out) {
   sim_render *r = e->rnd;
   mjModel *m = e->m;
-  OSMesaMakeCurrent(r->gl, r->glbuf, GL_UNSIGNED_BYTE, e->width, e->height);
+  make_current(e);
   r->cam.type = mjCAMERA_FIXED;
   r->cam.fixedcamid = cam;
   r->opt.geomgroup[2] = mode != VIEW_THERMAL;
@@ -90,7 +224,7 @@ static void render_view(hearth_sim_env *e, int cam, int mode, int only_geom, uin
   s->flags[mjRND_CULL_FACE] = 1;
   int headlight = m->vis.headlight.active;
   if (mode == VIEW_RGB) {
-    s->flags[mjRND_SHADOW] = 1;
+    s->flags[mjRND_SHADOW] = e->shadows;
   } else {
     s->nlight = 0;
     m->vis.headlight.active = 0;
