@@ -1,9 +1,11 @@
 /* hearth - the command-line tool: a table of (name, function, summary).
  * A subcommand exists in a build when its cmd_<name>.c is compiled in; the
  * weak references below let areas add commands without touching this file. */
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #include "cli/cli.h"
 
 typedef int (*cmd_fn)(int argc, char **argv);
@@ -21,8 +23,31 @@ HEARTH_CMD(build)
 HEARTH_CMD(validate)
 HEARTH_CMD(stats)
 HEARTH_CMD(demo)
-HEARTH_CMD(sim)
 HEARTH_CMD(inspect)
+
+/* `hearth sim ...` runs hearth-sim (next to this executable) with the
+ * arguments after "sim" */
+static int run_sim(int argc, char **argv) {
+  char self[4096];
+  ssize_t n = readlink("/proc/self/exe", self, sizeof self - 16);
+  if (n <= 0) {
+    fprintf(stderr, "hearth sim: cannot locate this executable: %s\n", strerror(errno));
+    return 2;
+  }
+  self[n] = 0;
+  char *slash = strrchr(self, '/');
+  if (!slash) return 2;
+  snprintf(slash + 1, sizeof self - (size_t)(slash + 1 - self), "hearth-sim");
+  char **args = calloc((size_t)argc + 1, sizeof *args);
+  if (!args) return 2;
+  args[0] = self;
+  for (int i = 1; i < argc; i++) args[i] = argv[i];
+  execv(self, args);
+  fprintf(stderr, "hearth sim: cannot run %s (%s): this build has no simulation (HEARTH_SIM=OFF)\n"
+                  "or hearth-sim was not installed next to hearth\n", self, strerror(errno));
+  free(args);
+  return 2;
+}
 
 typedef struct command {
   const char *name;
@@ -59,7 +84,7 @@ int main(int argc, char **argv) {
       {"validate", hearth_cmd_validate, "check a release against the layout contract"},
       {"stats", hearth_cmd_stats, "dataset overview table of a release"},
       {"demo", hearth_cmd_demo, "make, build and report a small virtual release"},
-      {"sim", hearth_cmd_sim, "temperature-aware manipulation tasks (render, collect, eval)"},
+      {"sim", run_sim, "temperature-aware manipulation tasks (render, collect, eval)"},
   };
   size_t n = sizeof cmds / sizeof cmds[0];
   if (argc < 2) return usage(stderr, cmds, n);

@@ -84,7 +84,7 @@ int main(void) {
   /* interrupted: start from the pristine tree, kill -9 after a few stages */
   snprintf(cmd, sizeof cmd,
            "rm -rf '%s' && cp -a '%s' '%s' && ('%s' build '%s' %s > '%s/log' 2>&1 & pid=$!; "
-           "for i in $(seq 1 600); do grep -q 'build \\[12/' '%s/log' && break; sleep 0.05; done; "
+           "for i in $(seq 1 6000); do grep -q 'build \\[12/' '%s/log' && break; sleep 0.05; done; "
            "kill -9 $pid; wait $pid; true)",
            root, pristine, root, HEARTH_EXE, root, opts, base, base);
   CHECK(run(cmd, out, sizeof out) == 0);
