@@ -98,6 +98,8 @@ def main():
     # ---- hearth: detection + calibration, timed (best of runs) ----
     t_det, c_det = timed([exe, "detect", root, "--no-overlays", "--quiet"], runs)
     t_cal, c_cal = timed([exe, "calibrate", root, "--quiet"], runs)
+    # the same work in one process (calibrate --detect)
+    t_one, c_one = timed([exe, "calibrate", root, "--detect", "--no-overlays", "--quiet"], runs)
     cal = os.path.join(root, "calibration")
     det = json.load(open(os.path.join(cal, "detections.json")))
     rig = json.load(open(os.path.join(cal, "rig.json")))
@@ -210,6 +212,9 @@ def main():
     print("cpu: hearth detect %.3f s + calibrate %.3f s = %.3f s; OpenCV %.3f s; ratio %.2f "
           "(user + sys over all threads, best of %d)"
           % (c_det, c_cal, c_det + c_cal, c_cv, (c_det + c_cal) / c_cv, runs))
+    print("one process (hearth calibrate --detect): wall %.3f s, ratio to OpenCV %.2f; "
+          "cpu %.3f s, ratio %.2f"
+          % (t_one, t_one / t_cv, c_one, c_one / c_cv))
     # leave the default calibration in place
     run([exe, "calibrate", root, "--quiet"])
     print("RESULT:", "PASS" if ok else "FAIL")

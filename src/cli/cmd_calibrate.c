@@ -7,11 +7,12 @@
 #include "hearth/calib.h"
 
 static const char *k_help =
-    "usage: hearth calibrate ROOT [--max-iterations N] [--outlier-factor F]\n"
-    "                             [--outlier-min PX] [--no-perspective-correction]\n"
-    "                             [--quiet]\n"
+    "usage: hearth calibrate ROOT [--detect [--no-overlays]] [--max-iterations N]\n"
+    "                             [--outlier-factor F] [--outlier-min PX]\n"
+    "                             [--no-perspective-correction] [--quiet]\n"
     "\n"
-    "From ROOT/calibration/detections.json (run `hearth detect` first) and the\n"
+    "From ROOT/calibration/detections.json (run `hearth detect` first, or pass\n"
+    "--detect to run it in the same process with its default options) and the\n"
     "factory colour/depth calibration ROOT/calibration/factory.json:\n"
     "  1. thermal intrinsics + 5-parameter distortion from the thermal-only frames\n"
     "     (Zhang's closed form, then Levenberg-Marquardt over all poses);\n"
@@ -20,6 +21,8 @@ static const char *k_help =
     "the solve repeated. Writes calibration/rig.json, calibration/rig_opencv.yaml\n"
     "(cv2.FileStorage) and calibration/calibration_report.json (per-frame RMS).\n"
     "\n"
+    "  --detect             detect the plate first (as `hearth detect ROOT`)\n"
+    "  --no-overlays        with --detect: skip the overlay images\n"
     "  --max-iterations N   Levenberg-Marquardt iterations (default 100)\n"
     "  --outlier-factor F   default 2.5\n"
     "  --outlier-min PX     default 0.01\n"
@@ -31,7 +34,7 @@ static const char *k_help =
 
 int hearth_cmd_calibrate(int argc, char **argv) {
   const char *root = NULL;
-  int quiet = 0;
+  int quiet = 0, detect = 0, overlays = 1;
   hearth_calib_opts o;
   hearth_calib_opts_default(&o);
   for (int i = 1; i < argc; i++) {
@@ -44,6 +47,10 @@ int hearth_cmd_calibrate(int argc, char **argv) {
       return 0;
     } else if (!strcmp(argv[i], "--quiet")) {
       quiet = 1;
+    } else if (!strcmp(argv[i], "--detect")) {
+      detect = 1;
+    } else if (!strcmp(argv[i], "--no-overlays")) {
+      overlays = 0;
     } else if (!strcmp(argv[i], "--no-perspective-correction")) {
       o.perspective_correction = 0;
     } else if ((r = cli_opt(argc, argv, &i, "--max-iterations", &v))) {
@@ -71,6 +78,22 @@ int hearth_cmd_calibrate(int argc, char **argv) {
   }
   if (!root) return cli_missing_root("calibrate", k_help);
   hearth_err err = {0};
+  if (!overlays && !detect) {
+    fprintf(stderr, "hearth calibrate: --no-overlays only applies with --detect\n");
+    return 2;
+  }
+  if (detect) {
+    hearth_detect_run run;
+    hearth_detect_run_default(&run);
+    run.overlays = overlays;
+    run.quiet = 1;
+    hearth_detections d = {0, NULL};
+    if (hearth_calib_detect_release(root, &run, &d, &err)) return cli_fail("calibrate", &err);
+    size_t found = 0;
+    for (size_t i = 0; i < d.n; i++) found += (size_t)d.frames[i].found;
+    printf("detect: plate found in %zu of %zu frames; calibration/detections.json written\n", found, d.n);
+    hearth_detections_free(&d);
+  }
   hearth_calib_report rep;
   if (hearth_calib_calibrate_release(root, &o, &rep, &err)) return cli_fail("calibrate", &err);
   if (!quiet) {
