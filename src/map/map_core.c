@@ -50,19 +50,21 @@ typedef struct map_ctx {
   size_t R;
   int C;
   /* layout */
-  const uint32_t *tri_of_texel;
+  const uint32_t *island_of_texel; /* UINT32_MAX off the surface */
   const uint32_t *island_of_tri;
   const float *tri_normal; /* 3 per triangle, unit */
   /* pixel grid */
   size_t n_pix, pix_w, pix_h;
   const float *pix_dir; /* 3 per pixel, camera frame, unit */
   const uint32_t *pix_index; /* image pixel index of grid pixel */
+  const uint32_t *tile_order; /* grid pixels in 4x4 tiles: coherent packets of 16 */
+  double sphere[4];           /* mesh bounding sphere: rays that miss it are not cast */
   /* per-thread scratch, indexed by thread */
   int n_threads;
   int cast_threads; /* threads for ray casting when views are processed serially */
-  double **sum, **wsum;
+  float **acc; /* per texel: weight sum, best cosine, C value sums */
   uint32_t **touched;
-  uint8_t **touched_flag;
+  uint8_t **sil; /* per thread: n_pix silhouette flags */
   float **fmax, **fcos;
   int64_t **isum, **iw;
   float *hit_t; /* per thread: n_pix */
@@ -82,17 +84,31 @@ static float image_value(const hearth_image *img, size_t idx, int c) {
   return (float)((const uint8_t *)img->data)[idx * (size_t)img->channels + (size_t)c];
 }
 
-/* cast every grid pixel of view v; fill hit_* arrays of thread t */
+/* cast every grid pixel of view v; fill hit_* arrays of thread t. Rays go
+ * to Embree in 4x4 pixel tiles (packets of nearly parallel rays); rays that
+ * miss the mesh's bounding sphere are not cast at all. */
 static void cast_view(map_ctx *m, size_t v, int t) {
   const hearth_rigid *T = &m->views[v].T_world_from_cam;
   size_t n = m->n_pix;
   float *org = m->ray_org + (size_t)t * 3 * n, *dir = m->ray_dir + (size_t)t * 3 * n;
   hearth_ray_hit *hits = m->hits + (size_t)t * n;
-  for (size_t p = 0; p < n; p++) {
+  const double *S = m->sphere;
+  double oc[3] = {S[0] - T->t[0], S[1] - T->t[1], S[2] - T->t[2]};
+  double oc2 = oc[0] * oc[0] + oc[1] * oc[1] + oc[2] * oc[2];
+  double r2 = S[3] * S[3];
+  for (size_t i = 0; i < n; i++) {
+    size_t p = m->tile_order[i];
     const float *d = m->pix_dir + 3 * p;
-    for (int i = 0; i < 3; i++) {
-      org[3 * p + i] = (float)T->t[i];
-      dir[3 * p + i] = (float)(T->R[3 * i] * d[0] + T->R[3 * i + 1] * d[1] + T->R[3 * i + 2] * d[2]);
+    double w[3];
+    for (int k = 0; k < 3; k++) w[k] = T->R[3 * k] * d[0] + T->R[3 * k + 1] * d[1] + T->R[3 * k + 2] * d[2];
+    /* squared distance of the sphere centre from the ray (unit direction),
+     * or from the origin when the centre lies behind it */
+    double along = oc[0] * w[0] + oc[1] * w[1] + oc[2] * w[2];
+    double dist2 = along > 0 ? oc2 - along * along : oc2;
+    int skip = dist2 > r2;
+    for (int k = 0; k < 3; k++) {
+      org[3 * i + k] = (float)T->t[k];
+      dir[3 * i + k] = skip ? 0.0f : (float)w[k]; /* a zero direction is not cast */
     }
   }
   /* views already run in parallel: cast on this thread only, unless there
@@ -100,12 +116,13 @@ static void cast_view(map_ctx *m, size_t v, int t) {
   hearth_raycast_batch_mt(m->rc, n, org, dir, 0.0f, INFINITY, hits, m->n_threads > 1 ? 1 : m->cast_threads);
   float *ht = m->hit_t + (size_t)t * n, *b1 = m->hit_b1 + (size_t)t * n, *b2 = m->hit_b2 + (size_t)t * n;
   uint32_t *tri = m->hit_tri + (size_t)t * n;
-  for (size_t p = 0; p < n; p++) {
-    hearth_ray_hit h = hits[p];
+  for (size_t i = 0; i < n; i++) {
+    size_t p = m->tile_order[i];
+    hearth_ray_hit h = hits[i];
     /* back faces are culled: continue the ray behind them */
     for (int k = 0; k < MAX_BACKFACE_SKIPS && h.prim != UINT32_MAX && !h.front; k++) {
-      double o[3] = {org[3 * p], org[3 * p + 1], org[3 * p + 2]};
-      double d[3] = {dir[3 * p], dir[3 * p + 1], dir[3 * p + 2]};
+      double o[3] = {org[3 * i], org[3 * i + 1], org[3 * i + 2]};
+      double d[3] = {dir[3 * i], dir[3 * i + 1], dir[3 * i + 2]};
       double tn = (double)h.t * (1.0 + 1e-6) + 1e-7;
       if (!hearth_raycast(m->rc, o, d, tn, INFINITY, &h)) h.prim = UINT32_MAX;
     }
@@ -121,47 +138,86 @@ static void cast_view(map_ctx *m, size_t v, int t) {
   }
 }
 
-/* 1 if grid pixel p lies within 2 pixels of a silhouette: a pixel in its
- * 5x5 neighbourhood misses the surface or lies at a clearly different
- * depth. The lens blur and the pixel footprint mix the two sides of such an
- * edge, so these pixels do not measure one surface. */
-static int is_silhouette(const map_ctx *m, const float *ht, size_t p) {
-  long x = (long)(p % m->pix_w), y = (long)(p / m->pix_w);
-  float t0 = ht[p];
-  for (long dy = -2; dy <= 2; dy++)
-    for (long dx = -2; dx <= 2; dx++) {
-      long nx = x + dx, ny = y + dy;
-      if (nx < 0 || ny < 0 || nx >= (long)m->pix_w || ny >= (long)m->pix_h) continue;
-      float tn = ht[(size_t)ny * m->pix_w + (size_t)nx];
-      if (!isfinite(tn) || fabsf(tn - t0) > 0.03f * t0) return 1;
+/* silhouette flags: 1 if a grid pixel lies within 2 pixels of a
+ * silhouette, i.e. a pixel in its 5x5 neighbourhood (clipped to the image)
+ * misses the surface or lies at a clearly different depth (more than 3%).
+ * The lens blur and the pixel footprint mix the two sides of such an edge,
+ * so these pixels do not measure one surface. Computed with separable 5x5
+ * minimum and maximum filters of the hit distance (a miss is +inf). */
+static void silhouettes(const map_ctx *m, const float *ht, float *lo, float *hi, float *tmp_lo,
+                        float *tmp_hi, uint8_t *sil) {
+  size_t W = m->pix_w, H = m->pix_h;
+  for (size_t y = 0; y < H; y++) {
+    const float *r = ht + y * W;
+    for (size_t x = 0; x < W; x++) {
+      size_t a = x >= 2 ? x - 2 : 0, b = x + 2 < W ? x + 2 : W - 1;
+      float mn = r[a], mx = r[a];
+      for (size_t k = a + 1; k <= b; k++) {
+        mn = r[k] < mn ? r[k] : mn;
+        mx = r[k] > mx ? r[k] : mx;
+      }
+      tmp_lo[y * W + x] = mn;
+      tmp_hi[y * W + x] = mx;
     }
-  return 0;
+  }
+  for (size_t y = 0; y < H; y++) {
+    size_t a = y >= 2 ? y - 2 : 0, b = y + 2 < H ? y + 2 : H - 1;
+    for (size_t x = 0; x < W; x++) {
+      float mn = tmp_lo[a * W + x], mx = tmp_hi[a * W + x];
+      for (size_t k = a + 1; k <= b; k++) {
+        float l = tmp_lo[k * W + x], h = tmp_hi[k * W + x];
+        mn = l < mn ? l : mn;
+        mx = h > mx ? h : mx;
+      }
+      lo[y * W + x] = mn;
+      hi[y * W + x] = mx;
+    }
+  }
+  for (size_t p = 0; p < W * H; p++) {
+    float t0 = ht[p];
+    if (!isfinite(t0)) {
+      sil[p] = 1;
+      continue;
+    }
+    float tol = 0.03f * t0;
+    sil[p] = !isfinite(hi[p]) || hi[p] - t0 > tol || t0 - lo[p] > tol;
+  }
 }
 
 static void process_view(map_ctx *m, size_t v, int t) {
   const hearth_mesh *mesh = m->mesh;
   size_t R = m->R, n = m->n_pix;
   int C = m->C;
-  double *sum = m->sum[t], *wsum = m->wsum[t];
+  size_t S = 2 + (size_t)C; /* accumulator stride: weight, cosine, C sums */
+  float *acc = m->acc[t];
   uint32_t *touched = m->touched[t];
-  uint8_t *tflag = m->touched_flag[t];
   size_t n_touched = 0;
   cast_view(m, v, t);
   const float *ht = m->hit_t + (size_t)t * n, *hb1 = m->hit_b1 + (size_t)t * n,
               *hb2 = m->hit_b2 + (size_t)t * n;
   const uint32_t *htri = m->hit_tri + (size_t)t * n;
-  const float *dirs = m->ray_dir + (size_t)t * 3 * n;
   const hearth_image *img = m->views[v].image;
+  int edges = m->opts->fusion == HEARTH_FUSE_ROBUST || !m->opts->keep_edges;
+  uint8_t *sil = m->sil[t];
+  if (edges) {
+    /* the ray arrays are free again: scratch for the filters */
+    float *scratch = m->ray_org + (size_t)t * 3 * n;
+    float *scratch2 = m->ray_dir + (size_t)t * 3 * n;
+    silhouettes(m, ht, scratch, scratch + n, scratch2, scratch2 + n, sil);
+  }
+  const float *pd = m->pix_dir;
+  const double *Rw = m->views[v].T_world_from_cam.R;
   uint32_t hits = 0;
-  float *fcos = m->fcos[t];
+  float min_cos = (float)m->opts->min_cos;
   for (size_t p = 0; p < n; p++) {
     uint32_t tri = htri[p];
     if (tri == UINT32_MAX) continue;
-    const float *nrm = m->tri_normal + 3 * (size_t)tri, *d = dirs + 3 * p;
+    if (edges && sil[p]) continue;
+    const float *nrm = m->tri_normal + 3 * (size_t)tri, *dc = pd + 3 * p;
+    float d[3];
+    for (int k = 0; k < 3; k++) d[k] = (float)(Rw[3 * k] * dc[0] + Rw[3 * k + 1] * dc[1] + Rw[3 * k + 2] * dc[2]);
     float cosv = -(nrm[0] * d[0] + nrm[1] * d[1] + nrm[2] * d[2]);
-    if (cosv < (float)m->opts->min_cos) continue;
-    if ((m->opts->fusion == HEARTH_FUSE_ROBUST || !m->opts->keep_edges) && is_silhouette(m, ht, p))
-      continue;
+    if (cosv < min_cos) continue;
     hits++;
     /* UV of the hit point */
     const uint32_t *ix = mesh->indices + 3 * (size_t)tri;
@@ -175,48 +231,55 @@ static void process_view(map_ctx *m, size_t v, int t) {
     long x0 = (long)x0f, y0 = (long)y0f;
     uint32_t island = m->island_of_tri[tri];
     size_t src = m->pix_index[p];
+    float val[3];
+    for (int c = 0; c < C; c++) val[c] = image_value(img, src, c);
     for (int k = 0; k < 4; k++) {
       long tx = x0 + (k & 1), ty = y0 + (k >> 1);
       if (tx < 0 || ty < 0 || tx >= (long)R || ty >= (long)R) continue;
-      double w = ((k & 1) ? fx : 1.0 - fx) * ((k >> 1) ? fy : 1.0 - fy);
-      if (w <= 0.0) continue;
+      float w = (float)(((k & 1) ? fx : 1.0 - fx) * ((k >> 1) ? fy : 1.0 - fy));
+      if (!(w > 0.0f)) continue;
       size_t q = (size_t)ty * R + (size_t)tx;
-      uint32_t qt = m->tri_of_texel[q];
       /* splat only into surface texels of the same island */
-      if (qt == UINT32_MAX || m->island_of_tri[qt] != island) continue;
-      if (!tflag[q]) {
-        tflag[q] = 1;
+      if (m->island_of_texel[q] != island) continue;
+      float *a = acc + q * S;
+      if (a[0] == 0.0f) {
+        /* first touch in this view (weights are > 0) */
         touched[n_touched++] = (uint32_t)q;
-        wsum[q] = 0.0;
-        for (int c = 0; c < C; c++) sum[q * (size_t)C + (size_t)c] = 0.0;
+        a[1] = cosv;
+        for (int c = 0; c < C; c++) a[2 + c] = 0.0f;
+      } else if (cosv > a[1]) {
+        a[1] = cosv;
       }
-      wsum[q] += w;
-      for (int c = 0; c < C; c++) sum[q * (size_t)C + (size_t)c] += w * (double)image_value(img, src, c);
-      if (cosv > fcos[q]) fcos[q] = cosv;
+      a[0] += w;
+      for (int c = 0; c < C; c++) a[2 + c] += w * val[c];
     }
   }
   m->view_hits[v] = hits;
   /* fold this view's per-texel means into the thread's fusion state */
+  float *fcos = m->fcos[t];
+  for (size_t i = 0; i < n_touched; i++) {
+    uint32_t q = touched[i];
+    if (acc[q * S + 1] > fcos[q]) fcos[q] = acc[q * S + 1];
+  }
   if (m->opts->fusion == HEARTH_FUSE_ROBUST) {
     view_record *rec = malloc((n_touched ? n_touched : 1) * sizeof *rec);
     if (!rec) {
       m->failed = 1;
     } else {
-      /* records in texel order: scan flags over the touched range */
-      size_t k = 0;
       for (size_t i = 0; i < n_touched; i++) {
-        uint32_t q = touched[i];
-        rec[k++] = (view_record){q, (float)(sum[q] / wsum[q]), (float)wsum[q]};
+        const float *a = acc + (size_t)touched[i] * S;
+        rec[i] = (view_record){touched[i], a[2] / a[0], a[0]};
       }
       m->records[v] = rec;
-      m->n_records[v] = k;
+      m->n_records[v] = n_touched;
     }
   } else if (m->opts->fusion == HEARTH_FUSE_MAX) {
     float *fmax = m->fmax[t];
     for (size_t i = 0; i < n_touched; i++) {
       uint32_t q = touched[i];
+      const float *a = acc + (size_t)q * S;
       for (int c = 0; c < C; c++) {
-        float mean = (float)(sum[q * (size_t)C + (size_t)c] / wsum[q]);
+        float mean = a[2 + c] / a[0];
         if (mean > fmax[q * (size_t)C + (size_t)c]) fmax[q * (size_t)C + (size_t)c] = mean;
       }
     }
@@ -224,13 +287,13 @@ static void process_view(map_ctx *m, size_t v, int t) {
     int64_t *isum = m->isum[t], *iw = m->iw[t];
     for (size_t i = 0; i < n_touched; i++) {
       uint32_t q = touched[i];
+      const float *a = acc + (size_t)q * S;
       /* each view counts with its total weight at this texel */
-      iw[q] += (int64_t)llround(wsum[q] * FIX_SCALE);
-      for (int c = 0; c < C; c++)
-        isum[q * (size_t)C + (size_t)c] += (int64_t)llround(sum[q * (size_t)C + (size_t)c] * FIX_SCALE);
+      iw[q] += (int64_t)llround((double)a[0] * FIX_SCALE);
+      for (int c = 0; c < C; c++) isum[q * (size_t)C + (size_t)c] += (int64_t)llround((double)a[2 + c] * FIX_SCALE);
     }
   }
-  for (size_t i = 0; i < n_touched; i++) tflag[touched[i]] = 0;
+  for (size_t i = 0; i < n_touched; i++) acc[(size_t)touched[i] * S] = 0.0f;
 }
 
 static void views_range(void *ctx, size_t b, size_t e, int t) {
@@ -393,19 +456,17 @@ oom:
 
 static void free_scratch(map_ctx *m) {
   for (int t = 0; t < m->n_threads; t++) {
-    if (m->sum) free(m->sum[t]);
-    if (m->wsum) free(m->wsum[t]);
+    if (m->acc) free(m->acc[t]);
     if (m->touched) free(m->touched[t]);
-    if (m->touched_flag) free(m->touched_flag[t]);
+    if (m->sil) free(m->sil[t]);
     if (m->fmax) free(m->fmax[t]);
     if (m->fcos) free(m->fcos[t]);
     if (m->isum) free(m->isum[t]);
     if (m->iw) free(m->iw[t]);
   }
-  free(m->sum);
-  free(m->wsum);
+  free(m->acc);
   free(m->touched);
-  free(m->touched_flag);
+  free(m->sil);
   free(m->fmax);
   free(m->fcos);
   free(m->isum);
@@ -462,7 +523,8 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
   map_ctx m;
   memset(&m, 0, sizeof m);
   hearth_raycaster *own_rc = NULL;
-  uint32_t *tri_of_texel = NULL, *island_of_tri = NULL, *island_of_texel = NULL, *pix_index = NULL;
+  uint32_t *tri_of_texel = NULL, *island_of_tri = NULL, *island_of_texel = NULL, *pix_index = NULL,
+           *tile_order = NULL;
   float *tri_normal = NULL, *pix_dir = NULL;
   int32_t *seed = NULL;
   size_t N = R * R;
@@ -477,6 +539,15 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
   if ((s = hearth_uv_rasterize(mesh, R, tri_of_texel, NULL, err))) goto done;
   uint32_t n_islands = 0;
   if ((s = hearth_uv_islands(mesh, island_of_tri, &n_islands, err))) goto done;
+  island_of_texel = hearth_alloc_array(N, sizeof *island_of_texel);
+  if (!island_of_texel) {
+    s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory for R=%zu", R);
+    goto done;
+  }
+  for (size_t q = 0; q < N; q++) {
+    uint32_t tq = tri_of_texel[q];
+    island_of_texel[q] = tq == UINT32_MAX ? UINT32_MAX : island_of_tri[tq];
+  }
   for (size_t i = 0; i < mesh->n_triangles; i++) {
     const uint32_t *ix = mesh->indices + 3 * i;
     const float *a = mesh->positions + 3 * ix[0], *b = mesh->positions + 3 * ix[1],
@@ -498,7 +569,8 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
   size_t np = pw * ph;
   pix_dir = hearth_alloc_array(np, 3 * sizeof *pix_dir);
   pix_index = hearth_alloc_array(np, sizeof *pix_index);
-  if (!pix_dir || !pix_index) {
+  tile_order = hearth_alloc_array(np, sizeof *tile_order);
+  if (!pix_dir || !pix_index || !tile_order) {
     s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
     goto done;
   }
@@ -510,19 +582,41 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
       for (int k = 0; k < 3; k++) pix_dir[3 * p + k] = (float)d[k];
       pix_index[p] = (uint32_t)(y * st * (size_t)cam->width + x * st);
     }
+  {
+    size_t k = 0;
+    for (size_t ty = 0; ty < ph; ty += 4)
+      for (size_t tx = 0; tx < pw; tx += 4)
+        for (size_t y = ty; y < ty + 4 && y < ph; y++)
+          for (size_t x = tx; x < tx + 4 && x < pw; x++) tile_order[k++] = (uint32_t)(y * pw + x);
+  }
+  /* bounding sphere: the box centre and the farthest vertex from it,
+   * padded so that rounding can never cull a ray that touches the mesh */
+  double sphere[4] = {0, 0, 0, 0};
+  {
+    double lo[3], hi[3], r2 = 0;
+    hearth_mesh_bounds(mesh, lo, hi);
+    for (int k = 0; k < 3; k++) sphere[k] = 0.5 * (lo[k] + hi[k]);
+    for (size_t i = 0; i < mesh->n_vertices; i++) {
+      const float *pv = mesh->positions + 3 * i;
+      double dx = pv[0] - sphere[0], dy = pv[1] - sphere[1], dz = pv[2] - sphere[2];
+      double d2 = dx * dx + dy * dy + dz * dz;
+      if (d2 > r2) r2 = d2;
+    }
+    sphere[3] = sqrt(r2) * (1.0 + 1e-3) + 1e-6;
+  }
 
   int nt = opts.threads > 0 ? opts.threads : hearth_default_threads();
   if ((size_t)nt > n_views) nt = n_views ? (int)n_views : 1;
   m = (map_ctx){.mesh = mesh, .rc = rc_in ? rc_in : own_rc, .cam = cam, .views = views,
-                .n_views = n_views, .opts = &opts, .R = R, .C = C, .tri_of_texel = tri_of_texel,
+                .n_views = n_views, .opts = &opts, .R = R, .C = C, .island_of_texel = island_of_texel,
                 .island_of_tri = island_of_tri, .tri_normal = tri_normal, .n_pix = np,
                 .pix_w = pw, .pix_h = ph, .pix_dir = pix_dir, .pix_index = pix_index,
+                .tile_order = tile_order, .sphere = {sphere[0], sphere[1], sphere[2], sphere[3]},
                 .n_threads = nt,
                 .cast_threads = opts.threads > 0 ? opts.threads : hearth_default_threads()};
-  m.sum = calloc((size_t)nt, sizeof *m.sum);
-  m.wsum = calloc((size_t)nt, sizeof *m.wsum);
+  m.acc = calloc((size_t)nt, sizeof *m.acc);
+  m.sil = calloc((size_t)nt, sizeof *m.sil);
   m.touched = calloc((size_t)nt, sizeof *m.touched);
-  m.touched_flag = calloc((size_t)nt, sizeof *m.touched_flag);
   m.fmax = calloc((size_t)nt, sizeof *m.fmax);
   m.fcos = calloc((size_t)nt, sizeof *m.fcos);
   m.isum = calloc((size_t)nt, sizeof *m.isum);
@@ -535,7 +629,7 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
   m.ray_dir = hearth_alloc_array(np * (size_t)nt, 3 * sizeof(float));
   m.hits = hearth_alloc_array(np * (size_t)nt, sizeof(hearth_ray_hit));
   m.view_hits = calloc(n_views ? n_views : 1, sizeof *m.view_hits);
-  int bad = !m.sum || !m.wsum || !m.touched || !m.touched_flag || !m.fmax || !m.fcos || !m.isum ||
+  int bad = !m.acc || !m.sil || !m.touched || !m.fmax || !m.fcos || !m.isum ||
             !m.iw || !m.hit_t || !m.hit_tri || !m.hit_b1 || !m.hit_b2 || !m.ray_org ||
             !m.ray_dir || !m.hits || !m.view_hits;
   if (opts.fusion == HEARTH_FUSE_ROBUST) {
@@ -544,12 +638,11 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
     bad |= !m.records || !m.n_records;
   }
   for (int t = 0; !bad && t < nt; t++) {
-    m.sum[t] = hearth_alloc_array(N, (size_t)C * sizeof(double));
-    m.wsum[t] = hearth_alloc_array(N, sizeof(double));
+    m.acc[t] = hearth_calloc_array(N, (2 + (size_t)C) * sizeof(float));
+    m.sil[t] = hearth_alloc_array(np, 1);
     m.touched[t] = hearth_alloc_array(N, sizeof(uint32_t));
-    m.touched_flag[t] = calloc(N, 1);
     m.fcos[t] = calloc(N, sizeof(float));
-    bad |= !m.sum[t] || !m.wsum[t] || !m.touched[t] || !m.touched_flag[t] || !m.fcos[t];
+    bad |= !m.acc[t] || !m.sil[t] || !m.touched[t] || !m.fcos[t];
     if (bad) break;
     if (opts.fusion == HEARTH_FUSE_MAX) {
       m.fmax[t] = hearth_alloc_array(N, (size_t)C * sizeof(float));
@@ -584,15 +677,13 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
   out->best_cos = calloc(N, sizeof(float));
   out->view_hits = m.view_hits;
   m.view_hits = NULL;
-  island_of_texel = hearth_alloc_array(N, sizeof *island_of_texel);
   seed = hearth_alloc_array(N, sizeof *seed);
-  if (!out->observed || !out->filled || !out->mask || !out->best_cos || !island_of_texel || !seed) {
+  if (!out->observed || !out->filled || !out->mask || !out->best_cos || !seed) {
     s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
     goto done;
   }
   for (size_t q = 0; q < N; q++) {
     uint32_t tq = tri_of_texel[q];
-    island_of_texel[q] = tq == UINT32_MAX ? UINT32_MAX : island_of_tri[tq];
     float bc = 0;
     for (int t = 0; t < nt; t++)
       if (m.fcos[t][q] > bc) bc = m.fcos[t][q];
@@ -695,6 +786,7 @@ done:
   free(tri_normal);
   free(pix_dir);
   free(pix_index);
+  free(tile_order);
   free(seed);
   if (s) hearth_map_result_free(out);
   return s;

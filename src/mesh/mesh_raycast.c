@@ -254,6 +254,12 @@ static void batch_range(void *vctx, size_t begin, size_t end, int thread_index) 
       rh.ray.tnear[k] = tn;
       rh.ray.tfar[k] = b->tfar;
     }
+    int any = 0;
+    for (size_t k = 0; k < n; k++) any |= valid[k];
+    if (!any) {
+      for (size_t k = 0; k < n; k++) no_hit(b->hits + i0 + k);
+      continue;
+    }
     /* packets pay off when the directions are nearly parallel (camera or
      * texel-to-camera rays); scattered rays go one at a time (measured
      * faster on a 100k-triangle mesh) */
