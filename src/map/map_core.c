@@ -331,14 +331,20 @@ static float weighted_median(vw *a, size_t n) {
  * independent, so each is swept alone within its bounding box, in parallel;
  * the result does not depend on the thread count. Seed coordinates are kept
  * beside the index so the inner loop does no division. */
+typedef struct fill_rec {
+  int32_t seed;   /* nearest observed texel so far, -1 none */
+  int16_t sx, sy; /* its coordinates (R <= 16384) */
+} fill_rec;
+
 typedef struct fill_ctx {
   size_t R;
   const uint32_t *island_of_texel;
-  int32_t *seed, *sx, *sy;
+  fill_rec *rec;              /* per texel */
   const uint32_t *todo;       /* texels to fill (surface, not observed), grouped by island,
                                  ascending index within each island */
   const int32_t *todo_xy;     /* their (x, y), so the sweep does no division */
   const size_t *todo_start;   /* n_islands + 1 offsets into todo */
+  const uint8_t *has_seed;    /* per island: any observed texel */
 } fill_ctx;
 
 /* forward sweeps look at the already visited neighbours (left, up-left, up,
@@ -347,9 +353,9 @@ typedef struct fill_ctx {
    observed texels never change */
 static void fill_one_island(const fill_ctx *c, uint32_t isl) {
   size_t a = c->todo_start[isl], b = c->todo_start[isl + 1];
-  if (a == b) return;
+  if (a == b || !c->has_seed[isl]) return; /* nothing to fill from */
   size_t R = c->R;
-  int32_t *seed = c->seed, *sx = c->sx, *sy = c->sy;
+  fill_rec *rec = c->rec;
   static const int fdx[4] = {-1, -1, 0, 1}, fdy[4] = {0, -1, -1, -1};
   int changed = 1;
   for (int pass = 0; changed && pass < 64; pass++) {
@@ -360,32 +366,30 @@ static void fill_one_island(const fill_ctx *c, uint32_t isl) {
         size_t kk = dir == 0 ? k : b - 1 - (k - a);
         size_t q = c->todo[kk];
         int32_t x = c->todo_xy[2 * kk], y = c->todo_xy[2 * kk + 1];
-        int32_t best = seed[q];
+        fill_rec cur = rec[q];
+        int32_t best = cur.seed;
         int64_t bd = 0;
         if (best >= 0) {
-          int64_t ex = sx[q] - x, ey = sy[q] - y;
+          int64_t ex = cur.sx - x, ey = cur.sy - y;
           bd = ex * ex + ey * ey;
         }
-        int32_t bx = sx[q], by = sy[q];
+        fill_rec nb = cur;
         for (int j = 0; j < 4; j++) {
           int32_t nx = x + sg * fdx[j], ny = y + sg * fdy[j];
           if (nx < 0 || ny < 0 || nx >= (int32_t)R || ny >= (int32_t)R) continue;
           size_t nq = (size_t)ny * R + (size_t)nx;
-          int32_t s = seed[nq];
-          if (s < 0 || c->island_of_texel[nq] != isl) continue;
-          int64_t ex = sx[nq] - x, ey = sy[nq] - y;
+          fill_rec r = rec[nq];
+          if (r.seed < 0 || c->island_of_texel[nq] != isl) continue;
+          int64_t ex = r.sx - x, ey = r.sy - y;
           int64_t d = ex * ex + ey * ey;
-          if (best < 0 || d < bd || (d == bd && s < best)) {
-            best = s;
+          if (best < 0 || d < bd || (d == bd && r.seed < best)) {
+            best = r.seed;
             bd = d;
-            bx = sx[nq];
-            by = sy[nq];
+            nb = r;
           }
         }
-        if (best != seed[q]) {
-          seed[q] = best;
-          sx[q] = bx;
-          sy[q] = by;
+        if (best != cur.seed) {
+          rec[q] = nb;
           changed = 1;
         }
       }
@@ -400,22 +404,24 @@ static void fill_range(void *ctx, size_t b, size_t e, int t) {
 static hearth_status fill_islands(size_t R, const uint32_t *island_of_texel, uint32_t n_islands,
                                   const uint8_t *mask, int32_t *seed, int nthreads) {
   size_t N = R * R;
-  int32_t *sx = malloc(N * sizeof *sx), *sy = malloc(N * sizeof *sy);
+  fill_rec *rec = hearth_alloc_array(N, sizeof *rec);
   size_t *start = calloc((size_t)n_islands + 2, sizeof *start);
+  uint8_t *has_seed = calloc((size_t)n_islands + 1, 1);
   uint32_t *todo = NULL;
   int32_t *todo_xy = NULL;
-  if (!sx || !sy || !start) goto oom;
+  if (!rec || !start || !has_seed) goto oom;
   /* counting sort of the texels to fill by island */
   size_t n_todo = 0;
   for (size_t y = 0; y < R; y++)
     for (size_t x = 0; x < R; x++) {
       size_t q = y * R + x;
       int obs = mask[q] == HEARTH_TEXEL_OBSERVED;
-      seed[q] = obs ? (int32_t)q : -1;
-      sx[q] = obs ? (int32_t)x : 0;
-      sy[q] = obs ? (int32_t)y : 0;
+      rec[q] = obs ? (fill_rec){(int32_t)q, (int16_t)x, (int16_t)y} : (fill_rec){-1, 0, 0};
       uint32_t isl = island_of_texel[q];
-      if (isl != UINT32_MAX && !obs) {
+      if (isl == UINT32_MAX) continue;
+      if (obs) {
+        has_seed[isl] = 1;
+      } else {
         start[isl + 1]++;
         n_todo++;
       }
@@ -437,18 +443,19 @@ static hearth_status fill_islands(size_t R, const uint32_t *island_of_texel, uin
     }
   }
   free(cur);
-  fill_ctx c = {R, island_of_texel, seed, sx, sy, todo, todo_xy, start};
+  fill_ctx c = {R, island_of_texel, rec, todo, todo_xy, start, has_seed};
   hearth_parallel_for(n_islands, nthreads, fill_range, &c);
-  free(sx);
-  free(sy);
+  for (size_t q = 0; q < N; q++) seed[q] = rec[q].seed;
+  free(rec);
   free(start);
+  free(has_seed);
   free(todo);
   free(todo_xy);
   return HEARTH_OK;
 oom:
-  free(sx);
-  free(sy);
+  free(rec);
   free(start);
+  free(has_seed);
   free(todo);
   free(todo_xy);
   return HEARTH_E_NOMEM;

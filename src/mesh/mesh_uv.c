@@ -175,6 +175,27 @@ static double edge_fn(double ax, double ay, double bx, double by, double px, dou
   return swap ? -e : e;
 }
 
+/* edge_fn split in two: the endpoint order (and sign) fixed per edge,
+ * then evaluated per point with the same operations */
+typedef struct edge_c {
+  double ax, ay, dx, dy, sign;
+} edge_c;
+static void edge_setup(double ax, double ay, double bx, double by, edge_c *e) {
+  int swap = (ax > bx) || (ax == bx && ay > by);
+  if (swap) {
+    double tx = ax, ty = ay;
+    ax = bx;
+    ay = by;
+    bx = tx;
+    by = ty;
+  }
+  e->ax = ax, e->ay = ay, e->dx = bx - ax, e->dy = by - ay, e->sign = swap ? -1.0 : 1.0;
+}
+static inline double edge_eval(const edge_c *e, double px, double py) {
+  double v = e->dx * (py - e->ay) - e->dy * (px - e->ax);
+  return e->sign < 0 ? -v : v;
+}
+
 /* texel coordinates: texel (col, row) has its centre at integer (col, row) */
 static void tri_uv(const hearth_mesh *m, size_t t, size_t R, double x[3], double y[3]) {
   for (int k = 0; k < 3; k++) {
@@ -204,6 +225,12 @@ static void raster_band(void *vctx, size_t band0, size_t band1, int thread_index
       double area = edge_fn(x[0], y[0], x[1], y[1], x[2], y[2]);
       if (area == 0.0 || !isfinite(area)) continue;
       double sgn = area > 0.0 ? 1.0 : -1.0, inv = 1.0 / area;
+      /* the three edge functions with their canonical endpoints fixed once
+       * per triangle: the same arithmetic as edge_fn, texel by texel */
+      edge_c e[3];
+      edge_setup(x[1], y[1], x[2], y[2], &e[0]);
+      edge_setup(x[2], y[2], x[0], y[0], &e[1]);
+      edge_setup(x[0], y[0], x[1], y[1], &e[2]);
       for (int64_t row = row0; row <= row1; row++) {
         double py = (double)row;
         for (int64_t col = bb[0]; col <= bb[1]; col++) {
@@ -211,9 +238,9 @@ static void raster_band(void *vctx, size_t band0, size_t band1, int thread_index
           if (c->tri_of_texel[idx] != UINT32_MAX) continue;
           double px = (double)col;
           /* w_k: edge opposite vertex k, positive inside for either winding */
-          double w0 = edge_fn(x[1], y[1], x[2], y[2], px, py);
-          double w1 = edge_fn(x[2], y[2], x[0], y[0], px, py);
-          double w2 = edge_fn(x[0], y[0], x[1], y[1], px, py);
+          double w0 = edge_eval(&e[0], px, py);
+          double w1 = edge_eval(&e[1], px, py);
+          double w2 = edge_eval(&e[2], px, py);
           if (w0 * sgn < 0.0 || w1 * sgn < 0.0 || w2 * sgn < 0.0) continue;
           c->tri_of_texel[idx] = (uint32_t)t;
           if (c->bary) {
