@@ -157,6 +157,12 @@ int main(int argc, char **argv) {
   printf("    fusion              %6.1f ms (%4.1f%%)\n", 1e3 * best.fuse, 100 * best.fuse / best.total);
   printf("    fill                %6.1f ms (%4.1f%%)\n", 1e3 * best.fill, 100 * best.fill / best.total);
   printf("  reading: 30 CSVs %.1f ms, mesh + documents %.1f ms\n", 1e3 * t_csv, 1e3 * t_mesh);
+  double rest = t_all - (t_csv + t_mesh + t_bvh + best.total);
+  printf("  end to end by phase: read %.0f%%, build %.0f%%, raster+islands %.0f%%, cast+splat %.0f%%, "
+         "fusion %.0f%%, fill %.0f%%, writing and the rest %.0f%% (%.1f ms)\n",
+         100 * (t_csv + t_mesh) / t_all, 100 * t_bvh / t_all, 100 * best.raster / t_all,
+         100 * best.cast / t_all, 100 * best.fuse / t_all, 100 * best.fill / t_all, 100 * rest / t_all,
+         1e3 * rest);
   printf("  reference: the same %zu rays cast alone %.1f ms; mapping/reference = %.2f\n", nr, 1e3 * t_ref,
          best.total / t_ref);
   return 0;

@@ -205,6 +205,29 @@ static hearth_status swap_dir(const char *tmp_dir, const char *final_dir, hearth
   return HEARTH_OK;
 }
 
+typedef struct csv_jobs {
+  const char *root, *inst, *state;
+  const hearth_manifest *man;
+  const size_t *idx;
+  hearth_image *imgs;
+  hearth_csv_opts opts;
+  hearth_status *st;
+  hearth_err *errs;
+} csv_jobs;
+
+static void read_csv_range(void *ctx, size_t b, size_t e, int t) {
+  csv_jobs *c = ctx;
+  (void)t;
+  for (size_t k = b; k < e; k++) {
+    char path[PATH_SZ];
+    if (joinf(path, "%s/instances/%s/raw/%s/%s", c->root, c->inst, c->state, c->man->views[c->idx[k]].thermal)) {
+      c->st[k] = hearth_err_set(&c->errs[k], HEARTH_E_ARG, "map: path too long");
+      continue;
+    }
+    c->st[k] = hearth_thermal_read_csv(path, &c->opts, &c->imgs[k], &c->errs[k]);
+  }
+}
+
 hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats, hearth_err *err) {
   if (!job || !job->root || !job->instance || !job->state)
     return hearth_err_set(err, HEARTH_E_ARG, "map: root, instance and state are required");
@@ -249,7 +272,6 @@ hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats
     goto done;
   }
   if ((s = select_views(&man, job->views, man_path, idx, &n, err))) goto done;
-  hearth_csv_opts copts = {(size_t)rig.thermal.width, (size_t)rig.thermal.height};
   for (size_t k = 0; k < n; k++) {
     const hearth_view_files *vf = &man.views[idx[k]];
     const hearth_view_pose *vp = hearth_poses_find(&poses, job->state, vf->view);
@@ -258,10 +280,30 @@ hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats
                          job->state, vf->view);
       goto done;
     }
-    joinf(path, "%s/instances/%s/raw/%s/%s", root, inst, job->state, vf->thermal);
-    if ((s = hearth_thermal_read_csv(path, &copts, &imgs[k], err))) goto done;
     views[k].image = &imgs[k];
     views[k].T_world_from_cam = vp->T_world_from_cam;
+  }
+  /* the CSVs in parallel; the first failing view (in order) is reported */
+  {
+    csv_jobs cj = {root, inst, job->state, &man, idx, imgs, {(size_t)rig.thermal.width, (size_t)rig.thermal.height}, NULL, NULL};
+    cj.st = calloc(n ? n : 1, sizeof *cj.st);
+    cj.errs = calloc(n ? n : 1, sizeof *cj.errs);
+    if (!cj.st || !cj.errs) {
+      free(cj.st);
+      free(cj.errs);
+      s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
+      goto done;
+    }
+    int nt = job->map.threads > 0 ? job->map.threads : hearth_default_threads();
+    hearth_parallel_for(n, nt, read_csv_range, &cj);
+    for (size_t k = 0; k < n && !s; k++)
+      if (cj.st[k]) {
+        s = cj.st[k];
+        *err = cj.errs[k];
+      }
+    free(cj.st);
+    free(cj.errs);
+    if (s) goto done;
   }
   if ((s = hearth_map_views(&mesh, NULL, &rig.thermal, views, n, &job->map, &r, err))) {
     hearth_err_prefix(err, "%s/%s", inst, job->state);

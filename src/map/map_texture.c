@@ -22,12 +22,26 @@ hearth_status hearth_map_texture(const hearth_map_result *r, double lo, double h
     hearth_image_free(out);
     return hearth_err_set(err, HEARTH_E_NOMEM, "texture: out of memory");
   }
+  /* Turbo through a 4096-entry table (0.012 degC steps over 10-60 degC,
+   * finer than the 8-bit colours resolve) */
+  enum { LUT_N = 4096 };
+  uint8_t(*lut)[3] = C == 1 ? malloc(sizeof(uint8_t[LUT_N][3])) : NULL;
+  if (C == 1 && !lut) {
+    free(have);
+    free(next);
+    free(tmp);
+    hearth_image_free(out);
+    return hearth_err_set(err, HEARTH_E_NOMEM, "texture: out of memory");
+  }
+  for (int i = 0; C == 1 && i < LUT_N; i++) hearth_turbo((double)i / (LUT_N - 1), lut[i]);
+  double scale = (LUT_N - 1) / (hi - lo);
   for (size_t q = 0; q < N; q++) {
     uint8_t *p = px + 3 * q;
     if (r->mask[q] == HEARTH_TEXEL_OBSERVED || r->mask[q] == HEARTH_TEXEL_FILLED) {
       if (C == 1) {
-        double t = (r->filled[q] - lo) / (hi - lo);
-        hearth_turbo(t, p);
+        double u = ((double)r->filled[q] - lo) * scale;
+        int k = !(u > 0) ? 0 : u >= LUT_N - 1 ? LUT_N - 1 : (int)(u + 0.5);
+        memcpy(p, lut[k], 3);
       } else {
         for (int c = 0; c < 3; c++) {
           double v = r->filled[q * (size_t)C + (size_t)c];
@@ -44,9 +58,8 @@ hearth_status hearth_map_texture(const hearth_map_result *r, double lo, double h
   for (int round = 0; round < pad; round++) {
     memcpy(next, have, N);
     memcpy(tmp, px, 3 * N);
-    for (size_t q = 0; q < N; q++) {
+    for (size_t q = 0, x = 0, y = 0; q < N; q++, x = x + 1 == R ? (y++, 0) : x + 1) {
       if (have[q]) continue;
-      size_t x = q % R, y = q / R;
       int acc[3] = {0, 0, 0}, n = 0;
       size_t nb[4];
       int k = 0;
@@ -70,5 +83,6 @@ hearth_status hearth_map_texture(const hearth_map_result *r, double lo, double h
   free(have);
   free(next);
   free(tmp);
+  free(lut);
   return HEARTH_OK;
 }
