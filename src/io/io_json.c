@@ -2,6 +2,7 @@
  * pretty printer, shared by the documents of a release (io_release.c). */
 #include "io/io_json.h"
 
+#include <locale.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -529,9 +530,41 @@ static void hb_quoted(hj_buf *b, const char *s, size_t n) {
   hb_put(b, "\"", 1);
 }
 
+/* x as "%.*g" with jansson's clean-up (".0" appended when the text would
+ * read as an integer; no '+' or leading zeros in the exponent); 0 when the
+ * locale's decimal point is not '.' or the text does not fit */
+static int real_text(char *buf, size_t size, double x, int prec) {
+  const char *point = localeconv()->decimal_point;
+  if (!point || point[0] != '.' || point[1]) return 0;
+  int n = snprintf(buf, size, "%.*g", prec, x);
+  if (n < 0 || (size_t)n + 3 > size) return 0;
+  if (!strchr(buf, '.') && !strchr(buf, 'e')) {
+    memcpy(buf + n, ".0", 3);
+    n += 2;
+  }
+  char *e = strchr(buf, 'e');
+  if (e) {
+    char *d = e + 1, *src = e + 1;
+    if (*src == '-') d++, src++;
+    else if (*src == '+') src++;
+    while (*src == '0' && src[1]) src++;
+    if (src != d) memmove(d, src, strlen(src) + 1);
+  }
+  return 1;
+}
+
 /* the shortest of %.15g/%.16g/%.17g (jansson's locale-independent
  * formatting) that parses back to exactly x */
 static void hb_real(hj_buf *b, double x) {
+  char fast[40];
+  for (int p = 15; p <= 17 && isfinite(x); p++) {
+    if (!real_text(fast, sizeof fast, x, p)) break;
+    double y = strtod(fast, NULL);
+    if (p == 17 || memcmp(&x, &y, sizeof x) == 0) {
+      hb_str(b, fast);
+      return;
+    }
+  }
   for (int p = 15; p <= 17; p++) {
     json_t *r = json_real(x);
     char *s = r ? json_dumps(r, JSON_ENCODE_ANY | JSON_REAL_PRECISION(p)) : NULL;
