@@ -61,6 +61,8 @@ hearth_status hearth_err_prefix(hearth_err *err, const char *fmt, ...)
 int hearth_mul_size(size_t a, size_t b, size_t *out);
 /* malloc of n * size bytes with overflow check; NULL on failure. */
 void *hearth_alloc_array(size_t n, size_t size);
+/* The same, zeroed; the memory is written at once (no lazily mapped zero
+ * pages, whose first write after a read costs a copy-on-write fault). */
 void *hearth_calloc_array(size_t n, size_t size);
 
 /* ---- files ----------------------------------------------------------------- */

@@ -68,7 +68,8 @@ static double reproj_residual(const hearth_camera *cam, double x, double y, doub
   /* residual in distorted normalised coordinates, scored in pixels */
   *ex = xd - tu;
   *ey = yd - tv;
-  return hypot(cam->fx * *ex, cam->fy * *ey);
+  double a = cam->fx * *ex, b = cam->fy * *ey;
+  return sqrt(a * a + b * b); /* residuals are far from overflow: no hypot */
 }
 
 double hearth_camera_undistort(const hearth_camera *cam, double u, double v, double xy[2]) {
@@ -95,7 +96,10 @@ double hearth_camera_undistort(const hearth_camera *cam, double u, double v, dou
     }
     double lam = 1.0, nres = res, nx = x, ny = y, nex = ex, ney = ey;
     int accepted = 0;
-    for (int h = 0; h < 60; h++) {
+    /* near the floating-point floor a failed full step means no descent
+     * is left: a few halvings, not sixty */
+    int max_halvings = res < 1e-11 ? 3 : 60;
+    for (int h = 0; h < max_halvings; h++) {
       nx = x + lam * dx;
       ny = y + lam * dy;
       nres = reproj_residual(cam, nx, ny, tu, tv, &nex, &ney);

@@ -648,7 +648,7 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
     m.acc[t] = hearth_calloc_array(N, (2 + (size_t)C) * sizeof(float));
     m.sil[t] = hearth_alloc_array(np, 1);
     m.touched[t] = hearth_alloc_array(N, sizeof(uint32_t));
-    m.fcos[t] = calloc(N, sizeof(float));
+    m.fcos[t] = hearth_calloc_array(N, sizeof(float));
     bad |= !m.acc[t] || !m.sil[t] || !m.touched[t] || !m.fcos[t];
     if (bad) break;
     if (opts.fusion == HEARTH_FUSE_MAX) {
@@ -657,8 +657,8 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
       if (!bad)
         for (size_t i = 0; i < N * (size_t)C; i++) m.fmax[t][i] = -INFINITY;
     } else if (opts.fusion == HEARTH_FUSE_MEAN) {
-      m.isum[t] = calloc(N * (size_t)C, sizeof(int64_t));
-      m.iw[t] = calloc(N, sizeof(int64_t));
+      m.isum[t] = hearth_calloc_array(N * (size_t)C, sizeof(int64_t));
+      m.iw[t] = hearth_calloc_array(N, sizeof(int64_t));
       bad |= !m.isum[t] || !m.iw[t];
     }
   }
@@ -680,8 +680,8 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
   out->n_views = n_views;
   out->observed = hearth_alloc_array(N, (size_t)C * sizeof(float));
   out->filled = hearth_alloc_array(N, (size_t)C * sizeof(float));
-  out->mask = calloc(N, 1);
-  out->best_cos = calloc(N, sizeof(float));
+  out->mask = hearth_calloc_array(N, 1);
+  out->best_cos = hearth_calloc_array(N, sizeof(float));
   out->view_hits = m.view_hits;
   m.view_hits = NULL;
   seed = hearth_alloc_array(N, sizeof *seed);

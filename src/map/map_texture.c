@@ -13,7 +13,7 @@ hearth_status hearth_map_texture(const hearth_map_result *r, double lo, double h
   if (s) return s;
   uint8_t *px = out->data;
   /* have[q]: 1 if q carries a colour (value or padding) */
-  uint8_t *have = calloc(N, 1), *next = calloc(N, 1);
+  uint8_t *have = hearth_calloc_array(N, 1), *next = hearth_calloc_array(N, 1);
   uint8_t *tmp = hearth_alloc_array(N, 3);
   if (!have || !next || !tmp) {
     free(have);
