@@ -397,9 +397,33 @@ static void fill_one_island(const fill_ctx *c, uint32_t isl) {
   }
 }
 
-static void fill_range(void *ctx, size_t b, size_t e, int t) {
-  for (size_t i = b; i < e; i++) fill_one_island(ctx, (uint32_t)i);
+typedef struct isl_size {
+  size_t todo;
+  uint32_t island;
+} isl_size;
+/* largest first, ties by island index: a total order */
+static int cmp_isl_size(const void *a, const void *b) {
+  const isl_size *x = a, *y = b;
+  if (x->todo != y->todo) return x->todo > y->todo ? -1 : 1;
+  return (x->island > y->island) - (x->island < y->island);
 }
+
+/* islands are dealt to the workers largest first, each to the least loaded
+ * (islands are independent, so the assignment cannot change the result) */
+typedef struct fill_bins {
+  const fill_ctx *c;
+  const uint32_t *order; /* islands, largest first */
+  const int *bin;        /* worker of each entry of order */
+  uint32_t n;
+} fill_bins;
+
+static void fill_range(void *ctx, size_t b, size_t e, int t) {
+  const fill_bins *fb = ctx;
+  for (size_t w = b; w < e; w++)
+    for (uint32_t i = 0; i < fb->n; i++)
+      if (fb->bin[i] == (int)w) fill_one_island(fb->c, fb->order[i]);
+}
+
 
 static hearth_status fill_islands(size_t R, const uint32_t *island_of_texel, uint32_t n_islands,
                                   const uint8_t *mask, int32_t *seed, int nthreads) {
@@ -444,7 +468,41 @@ static hearth_status fill_islands(size_t R, const uint32_t *island_of_texel, uin
   }
   free(cur);
   fill_ctx c = {R, island_of_texel, rec, todo, todo_xy, start, has_seed};
-  hearth_parallel_for(n_islands, nthreads, fill_range, &c);
+  {
+    int nw = nthreads > 0 ? nthreads : hearth_default_threads();
+    uint32_t *order = hearth_alloc_array((size_t)n_islands + 1, sizeof *order);
+    int *bin = hearth_alloc_array((size_t)n_islands + 1, sizeof *bin);
+    size_t *load = calloc((size_t)nw, sizeof *load);
+    if (!order || !bin || !load) {
+      free(order);
+      free(bin);
+      free(load);
+      goto oom;
+    }
+    isl_size *sz = hearth_alloc_array((size_t)n_islands + 1, sizeof *sz);
+    if (!sz) {
+      free(order);
+      free(bin);
+      free(load);
+      goto oom;
+    }
+    for (uint32_t i = 0; i < n_islands; i++) sz[i] = (isl_size){start[i + 1] - start[i], i};
+    qsort(sz, n_islands, sizeof *sz, cmp_isl_size);
+    for (uint32_t i = 0; i < n_islands; i++) order[i] = sz[i].island;
+    free(sz);
+    for (uint32_t i = 0; i < n_islands; i++) {
+      int best = 0;
+      for (int w = 1; w < nw; w++)
+        if (load[w] < load[best]) best = w;
+      bin[i] = best;
+      load[best] += start[order[i] + 1] - start[order[i]];
+    }
+    fill_bins fb = {&c, order, bin, n_islands};
+    hearth_parallel_for((size_t)nw, nw, fill_range, &fb);
+    free(order);
+    free(bin);
+    free(load);
+  }
   for (size_t q = 0; q < N; q++) seed[q] = rec[q].seed;
   free(rec);
   free(start);
