@@ -228,6 +228,42 @@ static void read_csv_range(void *ctx, size_t b, size_t e, int t) {
   }
 }
 
+typedef struct out_jobs {
+  const char *dir;
+  const hearth_map_result *r;
+  double lo, hi;
+  hearth_status st[2];
+  hearth_err errs[2];
+} out_jobs;
+
+/* job 0: the three .npy maps; job 1: the Turbo texture PNG */
+static void write_outputs(void *ctx, size_t b, size_t e, int t) {
+  out_jobs *o = ctx;
+  (void)t;
+  for (size_t k = b; k < e; k++) {
+    char path[PATH_SZ];
+    hearth_err *err = &o->errs[k];
+    hearth_status s = HEARTH_OK;
+    size_t shape[2] = {o->r->R, o->r->R};
+    if (k == 0) {
+      if (!(s = joinf(path, "%s/temperature_observed.npy", o->dir)))
+        s = hearth_npy_write(path, HEARTH_NPY_F32, 2, shape, o->r->observed, err);
+      if (!s && !(s = joinf(path, "%s/temperature_filled.npy", o->dir)))
+        s = hearth_npy_write(path, HEARTH_NPY_F32, 2, shape, o->r->filled, err);
+      if (!s && !(s = joinf(path, "%s/mask.npy", o->dir)))
+        s = hearth_npy_write(path, HEARTH_NPY_U8, 2, shape, o->r->mask, err);
+    } else {
+      hearth_image tex = {0};
+      const uint8_t black[3] = {0, 0, 0};
+      s = hearth_map_texture(o->r, o->lo, o->hi, 4, black, &tex, err);
+      if (!s && !(s = joinf(path, "%s/thermal_turbo.png", o->dir))) s = hearth_png_write(path, &tex, err);
+      hearth_image_free(&tex);
+    }
+    if (s && !err->msg[0]) hearth_err_set(err, s, "%s: path too long", o->dir);
+    o->st[k] = s;
+  }
+}
+
 hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats, hearth_err *err) {
   if (!job || !job->root || !job->instance || !job->state)
     return hearth_err_set(err, HEARTH_E_ARG, "map: root, instance and state are required");
@@ -319,20 +355,19 @@ hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats
     tmp_dir[0] = 0;
     goto done;
   }
-  size_t shape[2] = {r.R, r.R};
-  joinf(path, "%s/temperature_observed.npy", tmp_dir);
-  if ((s = hearth_npy_write(path, HEARTH_NPY_F32, 2, shape, r.observed, err))) goto done;
-  joinf(path, "%s/temperature_filled.npy", tmp_dir);
-  if ((s = hearth_npy_write(path, HEARTH_NPY_F32, 2, shape, r.filled, err))) goto done;
-  joinf(path, "%s/mask.npy", tmp_dir);
-  if ((s = hearth_npy_write(path, HEARTH_NPY_U8, 2, shape, r.mask, err))) goto done;
-  hearth_image tex = {0};
-  const uint8_t grey[3] = {0, 0, 0};
-  if ((s = hearth_map_texture(&r, job->turbo_lo, job->turbo_hi, 4, grey, &tex, err))) goto done;
-  joinf(path, "%s/thermal_turbo.png", tmp_dir);
-  s = hearth_png_write(path, &tex, err);
-  hearth_image_free(&tex);
-  if (s) goto done;
+  {
+    /* the maps and the Turbo texture (colouring, padding, PNG compression)
+     * are written side by side */
+    out_jobs oj = {tmp_dir, &r, job->turbo_lo, job->turbo_hi, {HEARTH_OK, HEARTH_OK}, {{0}, {0}}};
+    int nt = job->map.threads > 0 ? job->map.threads : hearth_default_threads();
+    hearth_parallel_for(2, nt, write_outputs, &oj);
+    for (int k = 0; k < 2 && !s; k++)
+      if (oj.st[k]) {
+        s = oj.st[k];
+        *err = oj.errs[k];
+      }
+    if (s) goto done;
+  }
   joinf(path, "%s/provenance.json", tmp_dir);
   if ((s = write_provenance(path, job, &man, idx, n, &r, &rig, rig_path, poses_path, mesh_path, err)))
     goto done;
