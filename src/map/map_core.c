@@ -14,6 +14,8 @@
 
 #define FIX_SCALE 1048576.0 /* 2^20: fixed-point resolution of mean fusion */
 #define MAX_BACKFACE_SKIPS 8
+/* floats per texel in a thread's accumulator record (see map_ctx.acc) */
+#define ACC_STRIDE(C) (4 + 2 * (size_t)(C))
 
 void hearth_map_opts_default(hearth_map_opts *o) {
   memset(o, 0, sizeof *o);
@@ -62,10 +64,13 @@ typedef struct map_ctx {
   /* per-thread scratch, indexed by thread */
   int n_threads;
   int cast_threads; /* threads for ray casting when views are processed serially */
-  float **acc; /* per texel: weight sum, best cosine, C value sums */
+  /* per thread, per texel, one record of ACC_STRIDE(C) floats: the texel's
+   * island (bits), this view's weight sum, best cosine and C value sums,
+   * then the fused maximum (C) and the best cosine over views; everything
+   * a splat or a fold touches shares a cache line */
+  float **acc;
   uint32_t **touched;
   uint8_t **sil; /* per thread: n_pix silhouette flags */
-  float **fmax, **fcos;
   int64_t **isum, **iw;
   float *hit_t; /* per thread: n_pix */
   uint32_t *hit_tri;
@@ -188,7 +193,7 @@ static void process_view(map_ctx *m, size_t v, int t) {
   const hearth_mesh *mesh = m->mesh;
   size_t R = m->R, n = m->n_pix;
   int C = m->C;
-  size_t S = 2 + (size_t)C; /* accumulator stride: weight, cosine, C sums */
+  size_t S = ACC_STRIDE(C);
   float *acc = m->acc[t];
   uint32_t *touched = m->touched[t];
   size_t n_touched = 0;
@@ -240,26 +245,27 @@ static void process_view(map_ctx *m, size_t v, int t) {
       if (!(w > 0.0f)) continue;
       size_t q = (size_t)ty * R + (size_t)tx;
       /* splat only into surface texels of the same island */
-      if (m->island_of_texel[q] != island) continue;
       float *a = acc + q * S;
-      if (a[0] == 0.0f) {
+      uint32_t qi;
+      memcpy(&qi, a, sizeof qi);
+      if (qi != island) continue;
+      if (a[1] == 0.0f) {
         /* first touch in this view (weights are > 0) */
         touched[n_touched++] = (uint32_t)q;
-        a[1] = cosv;
-        for (int c = 0; c < C; c++) a[2 + c] = 0.0f;
-      } else if (cosv > a[1]) {
-        a[1] = cosv;
+        a[2] = cosv;
+        for (int c = 0; c < C; c++) a[3 + c] = 0.0f;
+      } else if (cosv > a[2]) {
+        a[2] = cosv;
       }
-      a[0] += w;
-      for (int c = 0; c < C; c++) a[2 + c] += w * val[c];
+      a[1] += w;
+      for (int c = 0; c < C; c++) a[3 + c] += w * val[c];
     }
   }
   m->view_hits[v] = hits;
   /* fold this view's per-texel means into the thread's fusion state */
-  float *fcos = m->fcos[t];
   for (size_t i = 0; i < n_touched; i++) {
-    uint32_t q = touched[i];
-    if (acc[q * S + 1] > fcos[q]) fcos[q] = acc[q * S + 1];
+    float *a = acc + (size_t)touched[i] * S;
+    if (a[2] > a[3 + 2 * C]) a[3 + 2 * C] = a[2];
   }
   if (m->opts->fusion == HEARTH_FUSE_ROBUST) {
     view_record *rec = malloc((n_touched ? n_touched : 1) * sizeof *rec);
@@ -268,19 +274,17 @@ static void process_view(map_ctx *m, size_t v, int t) {
     } else {
       for (size_t i = 0; i < n_touched; i++) {
         const float *a = acc + (size_t)touched[i] * S;
-        rec[i] = (view_record){touched[i], a[2] / a[0], a[0]};
+        rec[i] = (view_record){touched[i], a[3] / a[1], a[1]};
       }
       m->records[v] = rec;
       m->n_records[v] = n_touched;
     }
   } else if (m->opts->fusion == HEARTH_FUSE_MAX) {
-    float *fmax = m->fmax[t];
     for (size_t i = 0; i < n_touched; i++) {
-      uint32_t q = touched[i];
-      const float *a = acc + (size_t)q * S;
+      float *a = acc + (size_t)touched[i] * S;
       for (int c = 0; c < C; c++) {
-        float mean = a[2 + c] / a[0];
-        if (mean > fmax[q * (size_t)C + (size_t)c]) fmax[q * (size_t)C + (size_t)c] = mean;
+        float mean = a[3 + c] / a[1];
+        if (mean > a[3 + C + c]) a[3 + C + c] = mean;
       }
     }
   } else {
@@ -289,11 +293,11 @@ static void process_view(map_ctx *m, size_t v, int t) {
       uint32_t q = touched[i];
       const float *a = acc + (size_t)q * S;
       /* each view counts with its total weight at this texel */
-      iw[q] += (int64_t)llround((double)a[0] * FIX_SCALE);
-      for (int c = 0; c < C; c++) isum[q * (size_t)C + (size_t)c] += (int64_t)llround((double)a[2 + c] * FIX_SCALE);
+      iw[q] += (int64_t)llround((double)a[1] * FIX_SCALE);
+      for (int c = 0; c < C; c++) isum[q * (size_t)C + (size_t)c] += (int64_t)llround((double)a[3 + c] * FIX_SCALE);
     }
   }
-  for (size_t i = 0; i < n_touched; i++) acc[(size_t)touched[i] * S] = 0.0f;
+  for (size_t i = 0; i < n_touched; i++) acc[(size_t)touched[i] * S + 1] = 0.0f;
 }
 
 static void views_range(void *ctx, size_t b, size_t e, int t) {
@@ -524,16 +528,12 @@ static void free_scratch(map_ctx *m) {
     if (m->acc) free(m->acc[t]);
     if (m->touched) free(m->touched[t]);
     if (m->sil) free(m->sil[t]);
-    if (m->fmax) free(m->fmax[t]);
-    if (m->fcos) free(m->fcos[t]);
     if (m->isum) free(m->isum[t]);
     if (m->iw) free(m->iw[t]);
   }
   free(m->acc);
   free(m->touched);
   free(m->sil);
-  free(m->fmax);
-  free(m->fcos);
   free(m->isum);
   free(m->iw);
   free(m->hit_t);
@@ -682,8 +682,6 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
   m.acc = calloc((size_t)nt, sizeof *m.acc);
   m.sil = calloc((size_t)nt, sizeof *m.sil);
   m.touched = calloc((size_t)nt, sizeof *m.touched);
-  m.fmax = calloc((size_t)nt, sizeof *m.fmax);
-  m.fcos = calloc((size_t)nt, sizeof *m.fcos);
   m.isum = calloc((size_t)nt, sizeof *m.isum);
   m.iw = calloc((size_t)nt, sizeof *m.iw);
   m.hit_t = hearth_alloc_array(np * (size_t)nt, sizeof(float));
@@ -694,7 +692,7 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
   m.ray_dir = hearth_alloc_array(np * (size_t)nt, 3 * sizeof(float));
   m.hits = hearth_alloc_array(np * (size_t)nt, sizeof(hearth_ray_hit));
   m.view_hits = calloc(n_views ? n_views : 1, sizeof *m.view_hits);
-  int bad = !m.acc || !m.sil || !m.touched || !m.fmax || !m.fcos || !m.isum ||
+  int bad = !m.acc || !m.sil || !m.touched || !m.isum ||
             !m.iw || !m.hit_t || !m.hit_tri || !m.hit_b1 || !m.hit_b2 || !m.ray_org ||
             !m.ray_dir || !m.hits || !m.view_hits;
   if (opts.fusion == HEARTH_FUSE_ROBUST) {
@@ -703,18 +701,21 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
     bad |= !m.records || !m.n_records;
   }
   for (int t = 0; !bad && t < nt; t++) {
-    m.acc[t] = hearth_calloc_array(N, (2 + (size_t)C) * sizeof(float));
+    m.acc[t] = hearth_alloc_array(N, ACC_STRIDE(C) * sizeof(float));
     m.sil[t] = hearth_alloc_array(np, 1);
     m.touched[t] = hearth_alloc_array(N, sizeof(uint32_t));
-    m.fcos[t] = hearth_calloc_array(N, sizeof(float));
-    bad |= !m.acc[t] || !m.sil[t] || !m.touched[t] || !m.fcos[t];
+    bad |= !m.acc[t] || !m.sil[t] || !m.touched[t];
     if (bad) break;
-    if (opts.fusion == HEARTH_FUSE_MAX) {
-      m.fmax[t] = hearth_alloc_array(N, (size_t)C * sizeof(float));
-      bad |= !m.fmax[t];
-      if (!bad)
-        for (size_t i = 0; i < N * (size_t)C; i++) m.fmax[t][i] = -INFINITY;
-    } else if (opts.fusion == HEARTH_FUSE_MEAN) {
+    {
+      size_t S = ACC_STRIDE(C);
+      float *a = m.acc[t];
+      for (size_t q = 0; q < N; q++, a += S) {
+        memcpy(a, &island_of_texel[q], sizeof(uint32_t));
+        for (size_t k = 1; k < S; k++) a[k] = 0.0f;
+        for (int c = 0; c < C; c++) a[3 + C + c] = -INFINITY;
+      }
+    }
+    if (opts.fusion == HEARTH_FUSE_MEAN) {
       m.isum[t] = hearth_calloc_array(N * (size_t)C, sizeof(int64_t));
       m.iw[t] = hearth_calloc_array(N, sizeof(int64_t));
       bad |= !m.isum[t] || !m.iw[t];
@@ -751,7 +752,7 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
     uint32_t tq = tri_of_texel[q];
     float bc = 0;
     for (int t = 0; t < nt; t++)
-      if (m.fcos[t][q] > bc) bc = m.fcos[t][q];
+      if (m.acc[t][q * ACC_STRIDE(C) + 3 + 2 * (size_t)C] > bc) bc = m.acc[t][q * ACC_STRIDE(C) + 3 + 2 * (size_t)C];
     out->best_cos[q] = bc;
     for (int c = 0; c < C; c++) out->observed[q * (size_t)C + (size_t)c] = NAN;
     out->mask[q] = tq == UINT32_MAX ? HEARTH_TEXEL_NONE : HEARTH_TEXEL_UNOBSERVED;
@@ -761,7 +762,8 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
       for (int c = 0; c < C; c++) {
         float best = -INFINITY;
         for (int t = 0; t < nt; t++)
-          if (m.fmax[t][q * (size_t)C + (size_t)c] > best) best = m.fmax[t][q * (size_t)C + (size_t)c];
+          if (m.acc[t][q * ACC_STRIDE(C) + 3 + (size_t)C + (size_t)c] > best)
+            best = m.acc[t][q * ACC_STRIDE(C) + 3 + (size_t)C + (size_t)c];
         if (best > -INFINITY) {
           out->observed[q * (size_t)C + (size_t)c] = best;
           out->mask[q] = HEARTH_TEXEL_OBSERVED;
