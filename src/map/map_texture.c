@@ -14,11 +14,9 @@ hearth_status hearth_map_texture(const hearth_map_result *r, double lo, double h
   uint8_t *px = out->data;
   /* have[q]: 1 if q carries a colour (value or padding) */
   uint8_t *have = hearth_calloc_array(N, 1), *next = hearth_calloc_array(N, 1);
-  uint8_t *tmp = hearth_alloc_array(N, 3);
-  if (!have || !next || !tmp) {
+  if (!have || !next) {
     free(have);
     free(next);
-    free(tmp);
     hearth_image_free(out);
     return hearth_err_set(err, HEARTH_E_NOMEM, "texture: out of memory");
   }
@@ -29,7 +27,6 @@ hearth_status hearth_map_texture(const hearth_map_result *r, double lo, double h
   if (C == 1 && !lut) {
     free(have);
     free(next);
-    free(tmp);
     hearth_image_free(out);
     return hearth_err_set(err, HEARTH_E_NOMEM, "texture: out of memory");
   }
@@ -54,12 +51,35 @@ hearth_status hearth_map_texture(const hearth_map_result *r, double lo, double h
     }
   }
   /* padding: each round, a texel without colour takes the mean of its
-     coloured 4-neighbours (deterministic: reads the previous round only) */
-  for (int round = 0; round < pad; round++) {
-    memcpy(next, have, N);
-    memcpy(tmp, px, 3 * N);
-    for (size_t q = 0, x = 0, y = 0; q < N; q++, x = x + 1 == R ? (y++, 0) : x + 1) {
-      if (have[q]) continue;
+     coloured 4-neighbours (deterministic: reads the previous round only).
+     Only the frontier is visited: round 0's candidates are the uncoloured
+     texels next to a coloured one, and each later round's are the
+     uncoloured neighbours of the texels the previous round coloured */
+  uint32_t *cand = hearth_alloc_array(N, sizeof *cand), *fresh = hearth_alloc_array(N, sizeof *fresh);
+  uint8_t *rgb = hearth_alloc_array(N, 3);
+  if (!cand || !fresh || !rgb) {
+    free(cand);
+    free(fresh);
+    free(rgb);
+    free(have);
+    free(next);
+    free(lut);
+    hearth_image_free(out);
+    return hearth_err_set(err, HEARTH_E_NOMEM, "texture: out of memory");
+  }
+  /* next[] marks texels already listed as candidates for the coming round */
+  size_t nc = 0;
+  for (size_t q = 0, x = 0, y = 0; pad > 0 && q < N; q++, x = x + 1 == R ? (y++, 0) : x + 1) {
+    if (have[q]) continue;
+    if ((x > 0 && have[q - 1]) || (x + 1 < R && have[q + 1]) || (y > 0 && have[q - R]) ||
+        (y + 1 < R && have[q + R])) {
+      cand[nc++] = (uint32_t)q;
+      next[q] = 1;
+    }
+  }
+  for (int round = 0; round < pad && nc; round++) {
+    for (size_t i = 0; i < nc; i++) {
+      size_t q = cand[i], x = q % R, y = q / R;
       int acc[3] = {0, 0, 0}, n = 0;
       size_t nb[4];
       int k = 0;
@@ -72,17 +92,37 @@ hearth_status hearth_map_texture(const hearth_map_result *r, double lo, double h
           for (int c = 0; c < 3; c++) acc[c] += px[3 * nb[j] + (size_t)c];
           n++;
         }
-      if (n) {
-        for (int c = 0; c < 3; c++) tmp[3 * q + (size_t)c] = (uint8_t)((acc[c] + n / 2) / n);
-        next[q] = 1;
-      }
+      for (int c = 0; c < 3; c++) rgb[3 * i + (size_t)c] = (uint8_t)((acc[c] + n / 2) / (n ? n : 1));
     }
-    memcpy(have, next, N);
-    memcpy(px, tmp, 3 * N);
+    for (size_t i = 0; i < nc; i++) {
+      memcpy(px + 3 * (size_t)cand[i], rgb + 3 * i, 3);
+      have[cand[i]] = 1;
+    }
+    size_t nf = 0;
+    for (size_t i = 0; i < nc && round + 1 < pad; i++) {
+      size_t q = cand[i], x = q % R, y = q / R;
+      size_t nb[4];
+      int k = 0;
+      if (x > 0) nb[k++] = q - 1;
+      if (x + 1 < R) nb[k++] = q + 1;
+      if (y > 0) nb[k++] = q - R;
+      if (y + 1 < R) nb[k++] = q + R;
+      for (int j = 0; j < k; j++)
+        if (!have[nb[j]] && !next[nb[j]]) {
+          next[nb[j]] = 1;
+          fresh[nf++] = (uint32_t)nb[j];
+        }
+    }
+    uint32_t *t = cand;
+    cand = fresh;
+    fresh = t;
+    nc = nf;
   }
+  free(cand);
+  free(fresh);
+  free(rgb);
   free(have);
   free(next);
-  free(tmp);
   free(lut);
   return HEARTH_OK;
 }
