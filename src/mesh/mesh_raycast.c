@@ -270,14 +270,17 @@ static void batch_range(void *vctx, size_t begin, size_t end, int thread_index) 
       for (size_t k = 0; k < n && coherent; k++) {
         if (!valid[k]) continue;
         double dx = rh.ray.dir_x[k], dy = rh.ray.dir_y[k], dz = rh.ray.dir_z[k];
-        double len = sqrt(dx * dx + dy * dy + dz * dz);
+        double len2 = dx * dx + dy * dy + dz * dz;
         if (first < 0) {
+          double len = sqrt(len2);
           first = (int)k;
           f[0] = dx / len;
           f[1] = dy / len;
           f[2] = dz / len;
-        } else if (f[0] * dx + f[1] * dy + f[2] * dz < 0.995 * len) {
-          coherent = 0;
+        } else {
+          /* f . d >= 0.995 |d|, without a square root per ray */
+          double dot = f[0] * dx + f[1] * dy + f[2] * dz;
+          if (dot < 0 || dot * dot < 0.995 * 0.995 * len2) coherent = 0;
         }
       }
     }
