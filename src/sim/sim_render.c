@@ -25,7 +25,6 @@ typedef struct egl_api {
   PFNEGLQUERYDEVICESTRINGEXTPROC query_device_string;
   PFNEGLGETPLATFORMDISPLAYEXTPROC platform_display;
   PFNEGLINITIALIZEPROC initialize;
-  PFNEGLTERMINATEPROC terminate;
   PFNEGLBINDAPIPROC bind_api;
   PFNEGLCHOOSECONFIGPROC choose_config;
   PFNEGLCREATECONTEXTPROC create_context;
@@ -70,7 +69,6 @@ static hearth_status egl_load(egl_api *a, hearth_err *err) {
   if (!(a->field = (type)a->get_proc(name)))                                                   \
     return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "sim: EGL renderer: %s not available", name);
   EGL_FN(initialize, PFNEGLINITIALIZEPROC, "eglInitialize")
-  EGL_FN(terminate, PFNEGLTERMINATEPROC, "eglTerminate")
   EGL_FN(bind_api, PFNEGLBINDAPIPROC, "eglBindAPI")
   EGL_FN(choose_config, PFNEGLCHOOSECONFIGPROC, "eglChooseConfig")
   EGL_FN(create_context, PFNEGLCREATECONTEXTPROC, "eglCreateContext")
@@ -190,8 +188,9 @@ void sim_render_free(hearth_sim_env *e) {
     if (r->api.make_current && r->dpy != EGL_NO_DISPLAY)
       r->api.make_current(r->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     if (r->ctx != NULL && r->ctx != EGL_NO_CONTEXT) r->api.destroy_context(r->dpy, r->ctx);
-    if (r->dpy != NULL && r->dpy != EGL_NO_DISPLAY) r->api.terminate(r->dpy);
-    /* libEGL stays loaded: MuJoCo holds its entry points */
+    /* the display stays initialised: EGL displays are per process, not per
+     * env (terminating it would pull it from under another env), and
+     * libEGL stays loaded: MuJoCo holds its entry points */
   } else {
     /* unbind before destroying so Mesa can release the context's buffer */
     if (r->gl) OSMesaMakeCurrent(NULL, NULL, GL_UNSIGNED_BYTE, 0, 0);
