@@ -69,6 +69,7 @@ typedef struct map_ctx {
    * then the fused maximum (C) and the best cosine over views; everything
    * a splat or a fold touches shares a cache line */
   float **acc;
+  uint8_t *acc_ready; /* per thread: records initialised */
   uint32_t **touched;
   uint8_t **sil; /* per thread: n_pix silhouette flags */
   int64_t **isum, **iw;
@@ -300,8 +301,22 @@ static void process_view(map_ctx *m, size_t v, int t) {
   for (size_t i = 0; i < n_touched; i++) acc[(size_t)touched[i] * S + 1] = 0.0f;
 }
 
+/* a thread's records: its island, zero sums, maximum -inf, best cosine 0;
+ * written by the thread that uses them (first touch, in parallel) */
+static void init_acc(map_ctx *m, int t) {
+  size_t S = ACC_STRIDE(m->C), N = m->R * m->R;
+  float *a = m->acc[t];
+  for (size_t q = 0; q < N; q++, a += S) {
+    memcpy(a, &m->island_of_texel[q], sizeof(uint32_t));
+    for (size_t k = 1; k < S; k++) a[k] = 0.0f;
+    for (int c = 0; c < m->C; c++) a[3 + m->C + c] = -INFINITY;
+  }
+  m->acc_ready[t] = 1;
+}
+
 static void views_range(void *ctx, size_t b, size_t e, int t) {
   map_ctx *m = ctx;
+  if (!m->acc_ready[t]) init_acc(m, t);
   for (size_t v = b; v < e; v++) process_view(m, v, t);
 }
 
@@ -532,6 +547,7 @@ static void free_scratch(map_ctx *m) {
     if (m->iw) free(m->iw[t]);
   }
   free(m->acc);
+  free(m->acc_ready);
   free(m->touched);
   free(m->sil);
   free(m->isum);
@@ -681,6 +697,7 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
                 .cast_threads = opts.threads > 0 ? opts.threads : hearth_default_threads()};
   m.acc = calloc((size_t)nt, sizeof *m.acc);
   m.sil = calloc((size_t)nt, sizeof *m.sil);
+  m.acc_ready = calloc((size_t)nt, 1);
   m.touched = calloc((size_t)nt, sizeof *m.touched);
   m.isum = calloc((size_t)nt, sizeof *m.isum);
   m.iw = calloc((size_t)nt, sizeof *m.iw);
@@ -692,7 +709,7 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
   m.ray_dir = hearth_alloc_array(np * (size_t)nt, 3 * sizeof(float));
   m.hits = hearth_alloc_array(np * (size_t)nt, sizeof(hearth_ray_hit));
   m.view_hits = calloc(n_views ? n_views : 1, sizeof *m.view_hits);
-  int bad = !m.acc || !m.sil || !m.touched || !m.isum ||
+  int bad = !m.acc || !m.acc_ready || !m.sil || !m.touched || !m.isum ||
             !m.iw || !m.hit_t || !m.hit_tri || !m.hit_b1 || !m.hit_b2 || !m.ray_org ||
             !m.ray_dir || !m.hits || !m.view_hits;
   if (opts.fusion == HEARTH_FUSE_ROBUST) {
@@ -706,15 +723,6 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
     m.touched[t] = hearth_alloc_array(N, sizeof(uint32_t));
     bad |= !m.acc[t] || !m.sil[t] || !m.touched[t];
     if (bad) break;
-    {
-      size_t S = ACC_STRIDE(C);
-      float *a = m.acc[t];
-      for (size_t q = 0; q < N; q++, a += S) {
-        memcpy(a, &island_of_texel[q], sizeof(uint32_t));
-        for (size_t k = 1; k < S; k++) a[k] = 0.0f;
-        for (int c = 0; c < C; c++) a[3 + C + c] = -INFINITY;
-      }
-    }
     if (opts.fusion == HEARTH_FUSE_MEAN) {
       m.isum[t] = hearth_calloc_array(N * (size_t)C, sizeof(int64_t));
       m.iw[t] = hearth_calloc_array(N, sizeof(int64_t));
@@ -726,6 +734,8 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
     goto done;
   }
   hearth_parallel_for(n_views, nt, views_range, &m);
+  for (int t = 0; t < nt; t++)
+    if (!m.acc_ready[t]) init_acc(&m, t); /* a thread that had no views */
   if (m.failed) {
     s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory while fusing views");
     goto done;
