@@ -15,6 +15,10 @@ int cli_is_help(const char *arg);
  * is option `name` (advancing *i past a separate value), -1 if the value is
  * missing, 0 otherwise. */
 int cli_opt(int argc, char **argv, int *i, const char *name, const char **val);
+/* The option whose value cli_opt just returned in val, for messages: the
+ * word before a separate value, or the part of "--name=value" before '='
+ * (copied into buf). */
+const char *cli_opt_name(char **argv, int i, const char *val, char *buf, size_t bufsz);
 int cli_parse_int(const char *s, long lo, long hi, long *out);
 int cli_parse_u64(const char *s, uint64_t *out);
 int cli_parse_num(const char *s, double *out);

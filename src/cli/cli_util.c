@@ -21,6 +21,16 @@ int cli_opt(int argc, char **argv, int *i, const char *name, const char **val) {
   return 1;
 }
 
+const char *cli_opt_name(char **argv, int i, const char *val, char *buf, size_t bufsz) {
+  if (val == argv[i] && i > 0) return argv[i - 1];
+  const char *eq = strchr(argv[i], '=');
+  size_t n = eq ? (size_t)(eq - argv[i]) : strlen(argv[i]);
+  if (n >= bufsz) n = bufsz - 1;
+  memcpy(buf, argv[i], n);
+  buf[n] = 0;
+  return buf;
+}
+
 int cli_parse_int(const char *s, long lo, long hi, long *out) {
   char *end;
   errno = 0;

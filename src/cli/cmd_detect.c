@@ -61,8 +61,9 @@ int hearth_cmd_detect(int argc, char **argv) {
   missing:
     fprintf(stderr, "hearth detect: option '%s' needs a value\n", argv[i]);
     return 2;
-  bad:
-    fprintf(stderr, "hearth detect: bad value '%s' for %s\n", v, argv[i - 1]);
+  bad:;
+    char optbuf[64];
+    fprintf(stderr, "hearth detect: bad value '%s' for %s\n", v, cli_opt_name(argv, i, v, optbuf, sizeof optbuf));
     return 2;
   }
   if (!root) return cli_missing_root("detect", k_help);

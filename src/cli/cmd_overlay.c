@@ -80,8 +80,9 @@ int hearth_cmd_overlay(int argc, char **argv) {
   missing:
     fprintf(stderr, "hearth overlay: option '%s' needs a value\n", argv[i]);
     return 2;
-  bad:
-    fprintf(stderr, "hearth overlay: bad value '%s' for option '%s'\n", v, argv[i - 1]);
+  bad:;
+    char optbuf[64];
+    fprintf(stderr, "hearth overlay: bad value '%s' for option '%s'\n", v, cli_opt_name(argv, i, v, optbuf, sizeof optbuf));
     return 2;
   }
   if (!root) return cli_missing_root("overlay", k_help);

@@ -148,8 +148,9 @@ int hearth_cmd_refine(int argc, char **argv) {
     fprintf(stderr, "hearth refine: option '%s' needs a value\n", argv[i]);
     free(nudges);
     return 2;
-  bad:
-    fprintf(stderr, "hearth refine: bad value '%s' for option '%s'\n", v, argv[i - 1]);
+  bad:;
+    char optbuf[64];
+    fprintf(stderr, "hearth refine: bad value '%s' for option '%s'\n", v, cli_opt_name(argv, i, v, optbuf, sizeof optbuf));
     free(nudges);
     return 2;
   }

@@ -70,8 +70,9 @@ int hearth_cmd_scale(int argc, char **argv) {
   missing:
     fprintf(stderr, "hearth scale: option '%s' needs a value\n", argv[i]);
     return 2;
-  bad:
-    fprintf(stderr, "hearth scale: bad value '%s' for option '%s'\n", v, argv[i - 1]);
+  bad:;
+    char optbuf[64];
+    fprintf(stderr, "hearth scale: bad value '%s' for option '%s'\n", v, cli_opt_name(argv, i, v, optbuf, sizeof optbuf));
     return 2;
   }
   if (!root) return cli_missing_root("scale", k_help);

@@ -39,5 +39,15 @@ int main(void) {
     snprintf(want, sizeof want, "usage: hearth %s", c);
     CHECK_MSG(strstr(out, want), "%s --help: %s", c, out);
   }
+  /* a bad value names its option in both spellings, --opt=value and --opt value */
+  const char *bad[][2] = {{"detect", "--upsample"}, {"calibrate", "--max-iterations"}};
+  for (int k = 0; k < 2; k++)
+    for (int joined = 0; joined < 2; joined++) {
+      snprintf(cmd, sizeof cmd, "'%s' %s /nonexistent %s%s0 2>&1", HEARTH_EXE, bad[k][0], bad[k][1],
+               joined ? "=" : " ");
+      CHECK_MSG(run(cmd, out, sizeof out) == 2, "%s", cmd);
+      snprintf(want, sizeof want, "bad value '0' for %s\n", bad[k][1]);
+      CHECK_MSG(strstr(out, want), "%s: %s", cmd, out);
+    }
   TEST_MAIN_END();
 }
