@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include "cli/cli.h"
+#include "cli/cli_sim.h"
 #include "hearth/hearth.h"
 #include "hearth/sim.h"
 
@@ -77,8 +78,8 @@ static const char *k_usage_collect =
     "  -h, --help        this text\n";
 
 /* assets: a release root given, or a tiny virtual-rig release in a temp dir */
-static int make_assets(const char *release, int gt, char *root, size_t rootsz, char *tmpdir,
-                       size_t tsz, int *use_gt, int quiet) {
+int sim_cli_assets(const char *release, int gt, char *root, size_t rootsz, char *tmpdir, size_t tsz,
+                   int *use_gt, int quiet) {
   tmpdir[0] = 0;
   if (release) {
     snprintf(root, rootsz, "%s", release);
@@ -110,12 +111,17 @@ static int make_assets(const char *release, int gt, char *root, size_t rootsz, c
   so.quiet = 1;
   if (!quiet) fprintf(stderr, "hearth sim: making assets with the virtual rig...\n");
   hearth_err err = {0};
-  if (hearth_synth_release(&so, &err)) return cli_fail("sim", &err);
+  if (hearth_synth_release(&so, &err)) {
+    /* nothing half-made is left behind */
+    hearth_remove_tree(tmpdir, NULL);
+    tmpdir[0] = 0;
+    return cli_fail("sim", &err);
+  }
   *use_gt = 1;
   return 0;
 }
 
-static void drop_assets(const char *tmpdir) {
+void sim_cli_drop_assets(const char *tmpdir) {
   if (tmpdir[0]) hearth_remove_tree(tmpdir, NULL);
 }
 
@@ -176,7 +182,7 @@ static int cmd_render(int argc, char **argv) {
   if (hearth_mkdirs(out, &err)) return cli_fail("sim render", &err);
   char root[4096], tmpdir[4096];
   int use_gt;
-  if (make_assets(release, gt, root, sizeof root, tmpdir, sizeof tmpdir, &use_gt, 0)) return 1;
+  if (sim_cli_assets(release, gt, root, sizeof root, tmpdir, sizeof tmpdir, &use_gt, 0)) return 1;
   int rc = 0;
   for (int t = 1; t <= 3 && !rc; t++) {
     if (only && t != (int)only) continue;
@@ -193,7 +199,7 @@ static int cmd_render(int argc, char **argv) {
     if (hearth_sim_render_scene(&o, seed, prefix, &err)) rc = cli_fail("sim render", &err);
     else printf("%s_{rgb,thermal,wrist}.png\n", prefix);
   }
-  drop_assets(tmpdir);
+  sim_cli_drop_assets(tmpdir);
   return rc;
 }
 
@@ -242,13 +248,13 @@ static int cmd_collect(int argc, char **argv) {
     return 2;
   }
   char root[4096], tmpdir[4096];
-  if (make_assets(release, gt, root, sizeof root, tmpdir, sizeof tmpdir, &o.use_ground_truth, o.quiet))
+  if (sim_cli_assets(release, gt, root, sizeof root, tmpdir, sizeof tmpdir, &o.use_ground_truth, o.quiet))
     return 1;
   o.release_root = root;
   hearth_err err = {0};
   hearth_sim_collect_stats s;
   hearth_status st = hearth_sim_collect(&o, &s, &err);
-  drop_assets(tmpdir);
+  sim_cli_drop_assets(tmpdir);
   if (st) return cli_fail("sim collect", &err);
   for (int i = 0; i < 2; i++)
     printf("instruction %d \"%s\": %d/%d successful\n", i + 1, hearth_sim_instruction_text(o.task, i),
@@ -259,8 +265,6 @@ static int cmd_collect(int argc, char **argv) {
   return 0;
 }
 
-/* `hearth sim eval` lives in cmd_sim_eval.c (policy evaluation) */
-extern int hearth_cmd_sim_eval(int argc, char **argv) __attribute__((weak));
 
 int hearth_cmd_sim(int argc, char **argv) {
   if (argc < 2 || cli_is_help(argv[1])) {
@@ -269,7 +273,7 @@ int hearth_cmd_sim(int argc, char **argv) {
   }
   if (strcmp(argv[1], "render") == 0) return cmd_render(argc - 1, argv + 1);
   if (strcmp(argv[1], "collect") == 0) return cmd_collect(argc - 1, argv + 1);
-  if (strcmp(argv[1], "eval") == 0 && hearth_cmd_sim_eval) return hearth_cmd_sim_eval(argc - 1, argv + 1);
+  if (strcmp(argv[1], "eval") == 0) return hearth_cmd_sim_eval(argc - 1, argv + 1);
   fprintf(stderr, "hearth sim: unknown subcommand '%s'\n%s", argv[1], k_usage);
   return 2;
 }

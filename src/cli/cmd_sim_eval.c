@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include "cli/cli.h"
+#include "cli/cli_sim.h"
 #include "hearth/hearth.h"
 
 static const char *k_usage =
@@ -50,36 +51,6 @@ static const char *k_usage =
     "  --video-every K      keep every K-th step in videos (default 2)\n"
     "  --quiet              no per-episode lines on stderr\n"
     "  -h, --help           this text\n";
-
-static int make_assets(char *root, size_t rootsz, char *tmpdir, size_t tsz, int quiet) {
-  const char *t = getenv("TMPDIR");
-  snprintf(tmpdir, tsz, "%s/hearth_eval_assets_XXXXXX", t && *t ? t : "/tmp");
-  if (!mkdtemp(tmpdir)) {
-    fprintf(stderr, "hearth sim eval: cannot create a temporary directory %s\n", tmpdir);
-    tmpdir[0] = 0;
-    return 1;
-  }
-  snprintf(root, rootsz, "%s/release", tmpdir);
-  /* the same virtual-rig assets as `hearth sim collect` makes by default */
-  hearth_synth_opts so;
-  hearth_synth_opts_default(&so);
-  so.out_root = root;
-  const char *cats[] = {"cup", "canned_drink", "electric_kettle", "eraser", "orange", "smartphone", "sponge"};
-  so.n_categories = 7;
-  for (int i = 0; i < 7; i++) so.categories[i] = cats[i];
-  so.n_states = 3;
-  so.states[0] = "neutral", so.states[1] = "hot", so.states[2] = "iced";
-  so.n_views = 6;
-  so.triangles = 4000;
-  so.texture_size = 256;
-  so.map_resolution = 256;
-  so.calibration = 0;
-  so.quiet = 1;
-  if (!quiet) fprintf(stderr, "hearth sim eval: making assets with the virtual rig...\n");
-  hearth_err err = {0};
-  if (hearth_synth_release(&so, &err)) return cli_fail("sim eval", &err);
-  return 0;
-}
 
 static int write_text(const char *dir, const char *name, const char *s) {
   char path[4200];
@@ -184,18 +155,14 @@ int hearth_cmd_sim_eval(int argc, char **argv) {
     }
   }
   char root[4200], tmpdir[4200] = "";
-  if (release) o.release_root = release, o.use_ground_truth = 0;
-  else {
-    if (make_assets(root, sizeof root, tmpdir, sizeof tmpdir, o.quiet)) {
-      if (tmpdir[0]) hearth_remove_tree(tmpdir, NULL);
-      return 1;
-    }
-    o.release_root = root, o.use_ground_truth = 1;
-  }
+  /* the same virtual-rig assets as `hearth sim collect` makes by default */
+  if (sim_cli_assets(release, 0, root, sizeof root, tmpdir, sizeof tmpdir, &o.use_ground_truth, o.quiet))
+    return 1;
+  o.release_root = root;
   hearth_eval_results res;
   hearth_err err = {0};
   hearth_status st = hearth_eval_run(&o, &res, &err);
-  if (tmpdir[0]) hearth_remove_tree(tmpdir, NULL);
+  sim_cli_drop_assets(tmpdir);
   if (st) return cli_fail("sim eval", &err);
   char *txt = hearth_eval_format_text(&res);
   int rc = 0;

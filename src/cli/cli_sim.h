@@ -1,0 +1,18 @@
+/* shared by the hearth-sim commands (cmd_sim.c, cmd_sim_eval.c) */
+#ifndef HEARTH_CLI_SIM_H
+#define HEARTH_CLI_SIM_H
+#include <stddef.h>
+
+/* Asset release for the tasks: `release` as given (ground-truth assets if
+ * gt), or, when NULL, the default virtual-rig assets made under a fresh
+ * temporary directory (returned in tmpdir, "" otherwise; the assets are
+ * ground truth). Prints the error and returns non-zero on failure, leaving
+ * no temporary directory behind. */
+int sim_cli_assets(const char *release, int gt, char *root, size_t rootsz, char *tmpdir, size_t tsz,
+                   int *use_gt, int quiet);
+/* Removes what sim_cli_assets made (nothing for a given release). */
+void sim_cli_drop_assets(const char *tmpdir);
+
+int hearth_cmd_sim_eval(int argc, char **argv);
+
+#endif
