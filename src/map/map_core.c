@@ -14,7 +14,12 @@
 
 #define FIX_SCALE 1048576.0 /* 2^20: fixed-point resolution of mean fusion */
 #define MAX_BACKFACE_SKIPS 8
-/* floats per texel in a thread's accumulator record (see map_ctx.acc) */
+/* a thread's accumulator record per texel (see map_ctx.acc): offsets of
+ * the island bits, this view's weight sum, best cosine and C sums, the
+ * fused maximum (C) and the best cosine over views; floats per record */
+enum { ACC_ISLAND = 0, ACC_W = 1, ACC_COS = 2, ACC_SUM = 3 };
+#define ACC_MAX(C) (3 + (size_t)(C))
+#define ACC_BEST_COS(C) (3 + 2 * (size_t)(C))
 #define ACC_STRIDE(C) (4 + 2 * (size_t)(C))
 
 void hearth_map_opts_default(hearth_map_opts *o) {
@@ -248,25 +253,25 @@ static void process_view(map_ctx *m, size_t v, int t) {
       /* splat only into surface texels of the same island */
       float *a = acc + q * S;
       uint32_t qi;
-      memcpy(&qi, a, sizeof qi);
+      memcpy(&qi, a + ACC_ISLAND, sizeof qi);
       if (qi != island) continue;
-      if (a[1] == 0.0f) {
+      if (a[ACC_W] == 0.0f) {
         /* first touch in this view (weights are > 0) */
         touched[n_touched++] = (uint32_t)q;
-        a[2] = cosv;
-        for (int c = 0; c < C; c++) a[3 + c] = 0.0f;
-      } else if (cosv > a[2]) {
-        a[2] = cosv;
+        a[ACC_COS] = cosv;
+        for (int c = 0; c < C; c++) a[ACC_SUM + c] = 0.0f;
+      } else if (cosv > a[ACC_COS]) {
+        a[ACC_COS] = cosv;
       }
-      a[1] += w;
-      for (int c = 0; c < C; c++) a[3 + c] += w * val[c];
+      a[ACC_W] += w;
+      for (int c = 0; c < C; c++) a[ACC_SUM + c] += w * val[c];
     }
   }
   m->view_hits[v] = hits;
   /* fold this view's per-texel means into the thread's fusion state */
   for (size_t i = 0; i < n_touched; i++) {
     float *a = acc + (size_t)touched[i] * S;
-    if (a[2] > a[3 + 2 * C]) a[3 + 2 * C] = a[2];
+    if (a[ACC_COS] > a[ACC_BEST_COS(C)]) a[ACC_BEST_COS(C)] = a[ACC_COS];
   }
   if (m->opts->fusion == HEARTH_FUSE_ROBUST) {
     view_record *rec = malloc((n_touched ? n_touched : 1) * sizeof *rec);
@@ -275,7 +280,7 @@ static void process_view(map_ctx *m, size_t v, int t) {
     } else {
       for (size_t i = 0; i < n_touched; i++) {
         const float *a = acc + (size_t)touched[i] * S;
-        rec[i] = (view_record){touched[i], a[3] / a[1], a[1]};
+        rec[i] = (view_record){touched[i], a[ACC_SUM] / a[ACC_W], a[ACC_W]};
       }
       m->records[v] = rec;
       m->n_records[v] = n_touched;
@@ -284,8 +289,8 @@ static void process_view(map_ctx *m, size_t v, int t) {
     for (size_t i = 0; i < n_touched; i++) {
       float *a = acc + (size_t)touched[i] * S;
       for (int c = 0; c < C; c++) {
-        float mean = a[3 + c] / a[1];
-        if (mean > a[3 + C + c]) a[3 + C + c] = mean;
+        float mean = a[ACC_SUM + c] / a[ACC_W];
+        if (mean > a[ACC_MAX(C) + c]) a[ACC_MAX(C) + c] = mean;
       }
     }
   } else {
@@ -294,8 +299,8 @@ static void process_view(map_ctx *m, size_t v, int t) {
       uint32_t q = touched[i];
       const float *a = acc + (size_t)q * S;
       /* each view counts with its total weight at this texel */
-      iw[q] += (int64_t)llround((double)a[1] * FIX_SCALE);
-      for (int c = 0; c < C; c++) isum[q * (size_t)C + (size_t)c] += (int64_t)llround((double)a[3 + c] * FIX_SCALE);
+      iw[q] += (int64_t)llround((double)a[ACC_W] * FIX_SCALE);
+      for (int c = 0; c < C; c++) isum[q * (size_t)C + (size_t)c] += (int64_t)llround((double)a[ACC_SUM + c] * FIX_SCALE);
     }
   }
   for (size_t i = 0; i < n_touched; i++) acc[(size_t)touched[i] * S + 1] = 0.0f;
@@ -307,9 +312,9 @@ static void init_acc(map_ctx *m, int t) {
   size_t S = ACC_STRIDE(m->C), N = m->R * m->R;
   float *a = m->acc[t];
   for (size_t q = 0; q < N; q++, a += S) {
-    memcpy(a, &m->island_of_texel[q], sizeof(uint32_t));
-    for (size_t k = 1; k < S; k++) a[k] = 0.0f;
-    for (int c = 0; c < m->C; c++) a[3 + m->C + c] = -INFINITY;
+    memcpy(a + ACC_ISLAND, &m->island_of_texel[q], sizeof(uint32_t));
+    for (size_t k = ACC_W; k < S; k++) a[k] = 0.0f;
+    for (int c = 0; c < m->C; c++) a[ACC_MAX(m->C) + c] = -INFINITY;
   }
   m->acc_ready[t] = 1;
 }
@@ -762,7 +767,7 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
     uint32_t tq = tri_of_texel[q];
     float bc = 0;
     for (int t = 0; t < nt; t++)
-      if (m.acc[t][q * ACC_STRIDE(C) + 3 + 2 * (size_t)C] > bc) bc = m.acc[t][q * ACC_STRIDE(C) + 3 + 2 * (size_t)C];
+      if (m.acc[t][q * ACC_STRIDE(C) + ACC_BEST_COS(C)] > bc) bc = m.acc[t][q * ACC_STRIDE(C) + ACC_BEST_COS(C)];
     out->best_cos[q] = bc;
     for (int c = 0; c < C; c++) out->observed[q * (size_t)C + (size_t)c] = NAN;
     out->mask[q] = tq == UINT32_MAX ? HEARTH_TEXEL_NONE : HEARTH_TEXEL_UNOBSERVED;
@@ -772,8 +777,8 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
       for (int c = 0; c < C; c++) {
         float best = -INFINITY;
         for (int t = 0; t < nt; t++)
-          if (m.acc[t][q * ACC_STRIDE(C) + 3 + (size_t)C + (size_t)c] > best)
-            best = m.acc[t][q * ACC_STRIDE(C) + 3 + (size_t)C + (size_t)c];
+          if (m.acc[t][q * ACC_STRIDE(C) + ACC_MAX(C) + (size_t)c] > best)
+            best = m.acc[t][q * ACC_STRIDE(C) + ACC_MAX(C) + (size_t)c];
         if (best > -INFINITY) {
           out->observed[q * (size_t)C + (size_t)c] = best;
           out->mask[q] = HEARTH_TEXEL_OBSERVED;

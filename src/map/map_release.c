@@ -205,6 +205,18 @@ static hearth_status swap_dir(const char *tmp_dir, const char *final_dir, hearth
   return HEARTH_OK;
 }
 
+/* the first failing job, in job order, as the run's error (parallel jobs
+ * each keep their own status and message) */
+static hearth_status first_failure(const hearth_status *st, const hearth_err *errs, size_t n,
+                                   hearth_err *err) {
+  for (size_t k = 0; k < n; k++)
+    if (st[k]) {
+      *err = errs[k];
+      return st[k];
+    }
+  return HEARTH_OK;
+}
+
 typedef struct csv_jobs {
   const char *root, *inst, *state;
   const hearth_manifest *man;
@@ -221,7 +233,7 @@ static void read_csv_range(void *ctx, size_t b, size_t e, int t) {
   for (size_t k = b; k < e; k++) {
     char path[PATH_SZ];
     if (joinf(path, "%s/instances/%s/raw/%s/%s", c->root, c->inst, c->state, c->man->views[c->idx[k]].thermal)) {
-      c->st[k] = hearth_err_set(&c->errs[k], HEARTH_E_ARG, "map: path too long");
+      c->st[k] = hearth_err_set(&c->errs[k], HEARTH_E_LIMIT, "%s/instances/%s/raw/%s: path too long", c->root, c->inst, c->state);
       continue;
     }
     c->st[k] = hearth_thermal_read_csv(path, &c->opts, &c->imgs[k], &c->errs[k]);
@@ -332,11 +344,7 @@ hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats
     }
     int nt = job->map.threads > 0 ? job->map.threads : hearth_default_threads();
     hearth_parallel_for(n, nt, read_csv_range, &cj);
-    for (size_t k = 0; k < n && !s; k++)
-      if (cj.st[k]) {
-        s = cj.st[k];
-        *err = cj.errs[k];
-      }
+    s = first_failure(cj.st, cj.errs, n, err);
     free(cj.st);
     free(cj.errs);
     if (s) goto done;
@@ -361,12 +369,7 @@ hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats
     out_jobs oj = {tmp_dir, &r, job->turbo_lo, job->turbo_hi, {HEARTH_OK, HEARTH_OK}, {{0}, {0}}};
     int nt = job->map.threads > 0 ? job->map.threads : hearth_default_threads();
     hearth_parallel_for(2, nt, write_outputs, &oj);
-    for (int k = 0; k < 2 && !s; k++)
-      if (oj.st[k]) {
-        s = oj.st[k];
-        *err = oj.errs[k];
-      }
-    if (s) goto done;
+    if ((s = first_failure(oj.st, oj.errs, 2, err))) goto done;
   }
   joinf(path, "%s/provenance.json", tmp_dir);
   if ((s = write_provenance(path, job, &man, idx, n, &r, &rig, rig_path, poses_path, mesh_path, err)))

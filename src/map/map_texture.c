@@ -5,6 +5,17 @@
 #include <string.h>
 #include "hearth/map.h"
 
+/* the 4-neighbours of texel q inside the R x R map; returns their count */
+static int neighbours4(size_t q, size_t R, size_t nb[4]) {
+  size_t x = q % R, y = q / R;
+  int k = 0;
+  if (x > 0) nb[k++] = q - 1;
+  if (x + 1 < R) nb[k++] = q + 1;
+  if (y > 0) nb[k++] = q - R;
+  if (y + 1 < R) nb[k++] = q + R;
+  return k;
+}
+
 hearth_status hearth_map_texture(const hearth_map_result *r, double lo, double hi, int pad,
                                  const uint8_t nan_rgb[3], hearth_image *out, hearth_err *err) {
   size_t R = r->R, N = R * R;
@@ -13,10 +24,10 @@ hearth_status hearth_map_texture(const hearth_map_result *r, double lo, double h
   if (s) return s;
   uint8_t *px = out->data;
   /* have[q]: 1 if q carries a colour (value or padding) */
-  uint8_t *have = hearth_calloc_array(N, 1), *next = hearth_calloc_array(N, 1);
-  if (!have || !next) {
+  uint8_t *have = hearth_calloc_array(N, 1), *listed = hearth_calloc_array(N, 1);
+  if (!have || !listed) {
     free(have);
-    free(next);
+    free(listed);
     hearth_image_free(out);
     return hearth_err_set(err, HEARTH_E_NOMEM, "texture: out of memory");
   }
@@ -26,7 +37,7 @@ hearth_status hearth_map_texture(const hearth_map_result *r, double lo, double h
   uint8_t(*lut)[3] = C == 1 ? malloc(sizeof(uint8_t[LUT_N][3])) : NULL;
   if (C == 1 && !lut) {
     free(have);
-    free(next);
+    free(listed);
     hearth_image_free(out);
     return hearth_err_set(err, HEARTH_E_NOMEM, "texture: out of memory");
   }
@@ -62,31 +73,25 @@ hearth_status hearth_map_texture(const hearth_map_result *r, double lo, double h
     free(fresh);
     free(rgb);
     free(have);
-    free(next);
+    free(listed);
     free(lut);
     hearth_image_free(out);
     return hearth_err_set(err, HEARTH_E_NOMEM, "texture: out of memory");
   }
-  /* next[] marks texels already listed as candidates for the coming round */
+  /* listed[]: texels already taken as candidates (by this or an earlier round) */
   size_t nc = 0;
   for (size_t q = 0, x = 0, y = 0; pad > 0 && q < N; q++, x = x + 1 == R ? (y++, 0) : x + 1) {
     if (have[q]) continue;
     if ((x > 0 && have[q - 1]) || (x + 1 < R && have[q + 1]) || (y > 0 && have[q - R]) ||
         (y + 1 < R && have[q + R])) {
       cand[nc++] = (uint32_t)q;
-      next[q] = 1;
+      listed[q] = 1;
     }
   }
   for (int round = 0; round < pad && nc; round++) {
     for (size_t i = 0; i < nc; i++) {
-      size_t q = cand[i], x = q % R, y = q / R;
-      int acc[3] = {0, 0, 0}, n = 0;
-      size_t nb[4];
-      int k = 0;
-      if (x > 0) nb[k++] = q - 1;
-      if (x + 1 < R) nb[k++] = q + 1;
-      if (y > 0) nb[k++] = q - R;
-      if (y + 1 < R) nb[k++] = q + R;
+      size_t q = cand[i], nb[4];
+      int acc[3] = {0, 0, 0}, n = 0, k = neighbours4(q, R, nb);
       for (int j = 0; j < k; j++)
         if (have[nb[j]]) {
           for (int c = 0; c < 3; c++) acc[c] += px[3 * nb[j] + (size_t)c];
@@ -100,16 +105,11 @@ hearth_status hearth_map_texture(const hearth_map_result *r, double lo, double h
     }
     size_t nf = 0;
     for (size_t i = 0; i < nc && round + 1 < pad; i++) {
-      size_t q = cand[i], x = q % R, y = q / R;
       size_t nb[4];
-      int k = 0;
-      if (x > 0) nb[k++] = q - 1;
-      if (x + 1 < R) nb[k++] = q + 1;
-      if (y > 0) nb[k++] = q - R;
-      if (y + 1 < R) nb[k++] = q + R;
+      int k = neighbours4(cand[i], R, nb);
       for (int j = 0; j < k; j++)
-        if (!have[nb[j]] && !next[nb[j]]) {
-          next[nb[j]] = 1;
+        if (!have[nb[j]] && !listed[nb[j]]) {
+          listed[nb[j]] = 1;
           fresh[nf++] = (uint32_t)nb[j];
         }
     }
@@ -122,7 +122,7 @@ hearth_status hearth_map_texture(const hearth_map_result *r, double lo, double h
   free(fresh);
   free(rgb);
   free(have);
-  free(next);
+  free(listed);
   free(lut);
   return HEARTH_OK;
 }
