@@ -87,6 +87,15 @@ typedef struct hearth_atomic_file {
 hearth_status hearth_atomic_open(hearth_atomic_file *af, const char *path, hearth_err *err);
 hearth_status hearth_atomic_commit(hearth_atomic_file *af, hearth_err *err);
 void hearth_atomic_abort(hearth_atomic_file *af);
+/* 1 if name has the shape of what an interrupted atomic write leaves: a
+ * temporary "<name>.tmp-" plus six letters or digits (a file, or a directory
+ * written whole), or a directory moved aside for replacement,
+ * "<name>.old-<pid>". */
+int hearth_is_atomic_temp(const char *name);
+/* Remove such leftovers (files and whole directories) from dir, not
+ * recursively; a missing dir is not an error. *n_removed (optional) counts
+ * them. Only for directories no other process is writing to. */
+hearth_status hearth_remove_stale_temps(const char *dir, size_t *n_removed, hearth_err *err);
 
 /* mkdir -p. */
 hearth_status hearth_mkdirs(const char *path, hearth_err *err);

@@ -151,6 +151,7 @@ typedef struct hearth_build_report {
   size_t n_instances;         /* of this shard */
   hearth_build_instance *instances; /* owned */
   size_t stages_run, stages_up_to_date;
+  size_t temps_removed;       /* temporaries of killed runs removed before re-running stages */
   int release_failed;         /* a release-level stage failed (no instance was built) */
   char release_reason[1024];
   double seconds;

@@ -93,6 +93,68 @@ void hearth_atomic_abort(hearth_atomic_file *af) {
   af->tmp_path[0] = 0;
 }
 
+/* the suffix after the last occurrence of tag in name, NULL without one or
+ * when tag starts the name */
+static const char *suffix_after(const char *name, const char *tag) {
+  const char *t = strstr(name, tag);
+  if (!t || t == name) return NULL;
+  for (const char *u; (u = strstr(t + 1, tag));) t = u;
+  return t + strlen(tag);
+}
+
+int hearth_is_atomic_temp(const char *name) {
+  const char *x = suffix_after(name, ".tmp-");
+  if (x) {
+    size_t n = 0;
+    for (; x[n]; n++) {
+      char ch = x[n];
+      if (!((ch >= '0' && ch <= '9') || (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z')))
+        return 0;
+    }
+    return n == 6;
+  }
+  if ((x = suffix_after(name, ".old-"))) {
+    size_t n = 0;
+    for (; x[n]; n++)
+      if (x[n] < '0' || x[n] > '9') return 0;
+    return n >= 1 && n <= 10;
+  }
+  return 0;
+}
+
+hearth_status hearth_remove_stale_temps(const char *dir, size_t *n_removed, hearth_err *err) {
+  if (n_removed) *n_removed = 0;
+  DIR *d = opendir(dir);
+  if (!d) {
+    if (errno == ENOENT || errno == ENOTDIR) return HEARTH_OK;
+    return hearth_err_set(err, HEARTH_E_IO, "%s: cannot list: %s", dir, strerror(errno));
+  }
+  hearth_status s = HEARTH_OK;
+  struct dirent *e;
+  char path[4096];
+  while ((e = readdir(d))) {
+    if (!hearth_is_atomic_temp(e->d_name)) continue;
+    if ((s = hearth_path_join(path, sizeof path, dir, e->d_name))) {
+      hearth_err_set(err, s, "%s/%s: path too long", dir, e->d_name);
+      break;
+    }
+    struct stat st;
+    if (lstat(path, &st) != 0) continue;
+    if (S_ISDIR(st.st_mode)) {
+      if ((s = hearth_remove_tree(path, err))) break;
+    } else if (!S_ISREG(st.st_mode)) {
+      continue;
+    } else if (unlink(path) != 0 && errno != ENOENT) {
+      s = hearth_err_set(err, HEARTH_E_IO, "%s: cannot remove a stale temporary file: %s", path,
+                         strerror(errno));
+      break;
+    }
+    if (n_removed) (*n_removed)++;
+  }
+  closedir(d);
+  return s;
+}
+
 hearth_status hearth_write_file_atomic(const char *path, const void *data, size_t size,
                                        hearth_err *err) {
   hearth_atomic_file af;

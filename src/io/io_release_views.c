@@ -144,7 +144,7 @@ static hearth_status manifest_from_json(hj_ctx *c, const json_t *root, void *out
                           "neutral, hot, warm, iced or used")))
     return s;
   size_t mk, n;
-  void *items;
+  void *items = NULL;
   if ((s = records_from_json(c, root, "views", 1, HEARTH_MAX_VIEWS, sizeof *m.views, "views",
                              view_files_from_json, &items, &n, &mk)))
     return s;
@@ -274,7 +274,7 @@ static hearth_status poses_from_json(hj_ctx *c, const json_t *root, void *out) {
   if ((s = get_fixed(c, root, "convention", HR_CONVENTION))) return s;
   if ((s = get_fixed(c, root, "units", HR_UNITS))) return s;
   size_t mk, n;
-  void *items;
+  void *items = NULL;
   if ((s = records_from_json(c, root, "views", 0, HR_MAX_POSES, sizeof *p.views, "poses",
                              pose_from_json, &items, &n, &mk)))
     return s;
@@ -423,7 +423,7 @@ static hearth_status detections_from_json(hj_ctx *c, const json_t *root, void *o
   hearth_status s;
   if ((s = pattern_from_json(c, root))) return s;
   size_t mk, n;
-  void *items;
+  void *items = NULL;
   if ((s = records_from_json(c, root, "frames", 0, HR_MAX_FRAMES, sizeof *d.frames, "frames",
                              detection_from_json, &items, &n, &mk)))
     return s;

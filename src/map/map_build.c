@@ -7,6 +7,9 @@
  * differs, or an output is missing. Stamps are written atomically after the
  * stage's outputs, which are themselves written atomically, so a killed run
  * leaves no stamp for the unfinished stage and a re-run redoes exactly that.
+ * Before a stage runs, the temporaries a killed writer left in its output
+ * directories are removed, so a resumed build ends with the same files as an
+ * uninterrupted one.
  * Instances run in parallel (one worker per job); each stage gets
  * threads / jobs workers. Stages are deterministic for any thread count, so
  * the bytes do not depend on -j. */
@@ -52,6 +55,47 @@ hearth_status hearth_build_files_add(hearth_build_files *f, const char *fmt, ...
   if (!(f->paths[f->n] = strdup(buf))) return HEARTH_E_NOMEM;
   f->n++;
   return HEARTH_OK;
+}
+
+/* Remove what interrupted writes left (temporary files, whole temporary
+ * directories, directories moved aside) from the directories of a stage's
+ * outputs (relative to root) and of its stamp (absolute) and, with parents,
+ * from the directories holding those (a temperature map's state directory is
+ * written whole next to the old one). An instance stage's directories belong
+ * to the one instance this worker is building, so no live writer of another
+ * worker or shard is in them. */
+static hearth_status sweep_temps(const char *root, const hearth_build_files *out, const char *stamp,
+                                 int parents, size_t *n_removed, hearth_err *err) {
+  size_t nd = 0, cap = 2 * (out->n + 1);
+  char(*dirs)[PATH_SZ] = malloc(cap * sizeof *dirs);
+  if (!dirs) return hearth_err_set(err, HEARTH_E_NOMEM, "build: out of memory");
+  hearth_status s = HEARTH_OK;
+  for (size_t i = 0; i <= out->n && !s; i++) {
+    char dir[PATH_SZ];
+    if (i < out->n) {
+      if (hearth_path_join(dir, sizeof dir, root, out->paths[i]))
+        s = hearth_err_set(err, HEARTH_E_LIMIT, "%s/%s: path too long", root, out->paths[i]);
+    } else {
+      snprintf(dir, sizeof dir, "%s", stamp);
+    }
+    for (int up = 0; up <= parents && !s; up++) {
+      char *slash = strrchr(dir, '/');
+      if (!slash) break;
+      *slash = 0;
+      int seen = 0;
+      for (size_t j = 0; j < nd && !seen; j++) seen = !strcmp(dirs[j], dir);
+      if (!seen) memcpy(dirs[nd++], dir, strlen(dir) + 1);
+    }
+  }
+  size_t total = 0;
+  for (size_t j = 0; j < nd && !s; j++) {
+    size_t n = 0;
+    s = hearth_remove_stale_temps(dirs[j], &n, err);
+    total += n;
+  }
+  free(dirs);
+  *n_removed = total;
+  return s;
 }
 
 /* ---- stamps ------------------------------------------------------------------- */
@@ -180,7 +224,7 @@ typedef struct build_ctx {
   hearth_build_instance *res;
   size_t n, next;
   size_t units_total, units_done;
-  size_t stages_run, stages_fresh;
+  size_t stages_run, stages_fresh, temps_removed;
   hearth_progress prog;
   int tty;
   FILE *log;
@@ -401,7 +445,13 @@ static int do_stage(build_ctx *c, size_t idx, int st, size_t k) {
     goto done;
   }
   double t0 = hearth_now();
-  size_t mapped = 0;
+  size_t mapped = 0, swept = 0;
+  if ((s = sweep_temps(c->root, &out, stamp, 1, &swept, &err))) goto fail;
+  if (swept) {
+    pthread_mutex_lock(&c->mu);
+    c->temps_removed += swept;
+    pthread_mutex_unlock(&c->mu);
+  }
   if ((s = stage_run(c, p, st, k, &mapped, &err))) goto fail;
   if ((s = stamp_write(c->root, stamp, k_stage_names[st], what, params, &in, &out, &err))) goto fail;
   r->states_mapped += mapped;
@@ -492,7 +542,7 @@ static void plan_instance(const char *root, inst_plan *p) {
 
 static hearth_status run_release_stage(const char *root, const hearth_build_stage *bs,
                                        const hearth_build_opts *o, int threads, FILE *log,
-                                       int *ran, hearth_err *err) {
+                                       int *ran, size_t *swept, hearth_err *err) {
   hearth_build_files in = {0}, out = {0};
   char stamp[PATH_SZ];
   snprintf(stamp, sizeof stamp, "%s/calibration/.stamps/%s.json", root, bs->name);
@@ -509,6 +559,7 @@ static hearth_status run_release_stage(const char *root, const hearth_build_stag
     goto done;
   }
   double t0 = hearth_now();
+  if ((s = sweep_temps(root, &out, stamp, 0, swept, err))) goto done;
   if ((s = bs->run(bs->ctx, root, threads, err))) {
     hearth_err_prefix(err, "%s", bs->name);
     goto done;
@@ -546,7 +597,10 @@ hearth_status hearth_build_release(const char *root, const hearth_build_opts *o_
   /* release-level stages (detection, calibration) once, with every thread */
   for (size_t i = 0; i < o.n_release_stages; i++) {
     int ran = 0;
-    if ((s = run_release_stage(root, &o.release_stages[i], &o, threads, log, &ran, err))) {
+    size_t swept = 0;
+    s = run_release_stage(root, &o.release_stages[i], &o, threads, log, &ran, &swept, err);
+    rep->temps_removed += swept;
+    if (s) {
       rep->release_failed = 1;
       snprintf(rep->release_reason, sizeof rep->release_reason, "%s", err->msg);
       hearth_release_free(&rel);
@@ -628,6 +682,7 @@ hearth_status hearth_build_release(const char *root, const hearth_build_opts *o_
   rep->instances = c.res;
   rep->stages_run += c.stages_run;
   rep->stages_up_to_date += c.stages_fresh;
+  rep->temps_removed += c.temps_removed;
   rep->seconds = hearth_now() - t_start;
   return HEARTH_OK;
 }
@@ -643,6 +698,8 @@ void hearth_build_report_print(const hearth_build_report *r, FILE *out) {
   fprintf(out, "build summary: %zu instance(s): %zu complete, %zu failed; %zu/%zu state(s) mapped; "
           "%zu stage(s) run, %zu up to date; %.1f s\n", r->n_instances, ok, failed, mapped, states,
           r->stages_run, r->stages_up_to_date, r->seconds);
+  if (r->temps_removed)
+    fprintf(out, "  removed %zu temporary file(s)/folder(s) left by an interrupted run\n", r->temps_removed);
   if (r->release_failed) fprintf(out, "  release: FAILED: %s\n", r->release_reason);
   for (size_t i = 0; i < r->n_instances; i++)
     if (r->instances[i].failed)

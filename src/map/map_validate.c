@@ -378,11 +378,50 @@ static void check_state_maps(hearth_problems *p, const char *dir, const char *in
   hearth_npy_free(&fil);
 }
 
+/* leftovers of interrupted atomic writes anywhere under dir (a killed build
+ * or capture tool); they are not part of the release. Sorted per directory
+ * for a deterministic problem order. */
+static int cmp_str(const void *a, const void *b) {
+  return strcmp(*(const char *const *)a, *(const char *const *)b);
+}
+
+static void check_leftovers(hearth_problems *p, const char *dir, int depth) {
+  DIR *d = opendir(dir);
+  if (!d) return;
+  char **names = NULL;
+  size_t n = 0, cap = 0;
+  struct dirent *e;
+  while ((e = readdir(d))) {
+    if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..")) continue;
+    if (n == cap) {
+      char **q = realloc(names, (cap = cap ? 2 * cap : 16) * sizeof *q);
+      if (!q) break;
+      names = q;
+    }
+    if (!(names[n] = strdup(e->d_name))) break;
+    n++;
+  }
+  closedir(d);
+  if (n) qsort(names, n, sizeof *names, cmp_str);
+  for (size_t i = 0; i < n; i++) {
+    char path[PATH_SZ];
+    struct stat st;
+    snprintf(path, sizeof path, "%s/%s", dir, names[i]);
+    if (hearth_is_atomic_temp(names[i]))
+      hearth_problems_add(p, path, "left by an interrupted write (hearth build removes it)");
+    else if (depth < 8 && lstat(path, &st) == 0 && S_ISDIR(st.st_mode))
+      check_leftovers(p, path, depth + 1);
+    free(names[i]);
+  }
+  free(names);
+}
+
 static void check_instance(const char *root, const char *id, const hearth_validate_opts *o,
                            hearth_problems *p, size_t *nfiles) {
   char path[PATH_SZ], dir[PATH_SZ];
   hearth_err e = {0};
   snprintf(dir, sizeof dir, "%s/instances/%s", root, id);
+  check_leftovers(p, dir, 0);
   snprintf(path, sizeof path, "%s/instance.json", dir);
   hearth_instance_doc doc;
   (*nfiles)++;
@@ -511,6 +550,8 @@ static void check_calibration(const char *root, const hearth_validate_opts *o, h
   char path[PATH_SZ];
   hearth_err e = {0};
   hearth_rig rig;
+  snprintf(path, sizeof path, "%s/calibration", root);
+  check_leftovers(p, path, 0);
   snprintf(path, sizeof path, "%s/calibration/rig.json", root);
   (*nfiles)++;
   if (!file_exists(path)) {

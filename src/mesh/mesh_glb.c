@@ -164,7 +164,7 @@ static hearth_status get_elem(glb_ctx *c, json_t *arr, const char *arr_name, siz
 /* Resolve accessors[idx] down to bytes in the BIN chunk, checking every bound. */
 static hearth_status resolve_accessor(glb_ctx *c, size_t idx, const char *where, glb_acc *a) {
   hearth_status s;
-  json_t *acc;
+  json_t *acc = NULL;
   char at[48];
   memset(a, 0, sizeof *a);
   if ((s = get_elem(c, c->accessors, "accessors", idx, where, &acc))) return s;
@@ -582,7 +582,7 @@ static hearth_status resolve_primitive(glb_ctx *c, size_t mesh, size_t p, json_t
 static void to_rgb8(hearth_image *img);
 static hearth_status load_base_color(glb_ctx *c, json_t *prim, hearth_image *tex, int *done) {
   hearth_status s;
-  size_t mat_idx, tex_idx, img_idx, view_idx;
+  size_t mat_idx = 0, tex_idx = 0, img_idx = 0, view_idx = 0;
   int has;
   char at[48];
   if ((s = get_uint(c, prim, "material", "primitive", 0, &mat_idx, &has)) || !has) return s;

@@ -75,11 +75,30 @@ int main(void) {
   CHECK(strstr(out, "\"instances\": 10") && strstr(out, "\"object_states\": 20") &&
         strstr(out, "\"temperature_maps\": 20") && strstr(out, "\"rgb_thermal_pairs\": 40"));
 
-  /* an output removed: exactly its stage re-runs */
-  snprintf(cmd, sizeof cmd, "rm '%s/instances/cup_03/derived/hot/mask.npy' && '%s' build '%s' %s",
-           root, HEARTH_EXE, root, opts);
+  /* an output removed: exactly its stage re-runs. Temporaries a killed
+     writer would leave (in its output and stamp directories) go before it
+     runs; a look-alike that is not one stays, as do those of fresh stages. */
+  const char *d3 = "instances/cup_03/derived";
+  snprintf(cmd, sizeof cmd,
+           "cd '%s' && rm %s/hot/mask.npy && mkdir %s/hot.tmp-Qw3Er5 %s/hot.old-4242 && "
+           "touch %s/hot/mask.npy.tmp-Ab12Cd %s/hot.tmp-Qw3Er5/mask.npy %s/hot.old-4242/mask.npy "
+           "%s/.stamps/map-hot.json.tmp-q9Z0xY %s/notes.tmp-1234567 "
+           "%s/overlay/neutral/v00.png.tmp-Zz9y8X && '%s' build '%s' %s",
+           root, d3, d3, d3, d3, d3, d3, d3, d3, d3, HEARTH_EXE, root, opts);
   rc = run(cmd, out, sizeof out);
   CHECK_MSG(rc == 0 && strstr(out, " 1 stage(s) run") && strstr(out, "cup_03 map hot: done"), "%s", out);
+  CHECK_MSG(strstr(out, "removed 4 temporary file(s)/folder(s)"), "%s", out);
+  snprintf(cmd, sizeof cmd,
+           "cd '%s' && test ! -e %s/hot/mask.npy.tmp-Ab12Cd && test ! -e %s/.stamps/map-hot.json.tmp-q9Z0xY "
+           "&& test ! -e %s/hot.tmp-Qw3Er5 && test ! -e %s/hot.old-4242 "
+           "&& test -e %s/notes.tmp-1234567 && test -e %s/overlay/neutral/v00.png.tmp-Zz9y8X",
+           root, d3, d3, d3, d3, d3, d3);
+  CHECK_MSG(system(cmd) == 0, "stale temporaries: wrong files removed");
+  /* validate names the one left (its stage did not run) */
+  snprintf(cmd, sizeof cmd, "'%s' validate '%s'", HEARTH_EXE, root);
+  rc = run(cmd, out, sizeof out);
+  CHECK_MSG(rc != 0 && strstr(out, "overlay/neutral/v00.png.tmp-Zz9y8X: left by an interrupted write") &&
+                !strstr(out, "notes.tmp-1234567"), "validate: %s", out);
 
   /* interrupted: start from the pristine tree, kill -9 after a few stages */
   snprintf(cmd, sizeof cmd,

@@ -45,6 +45,34 @@ int main(void) {
   snprintf(sub, sizeof sub, "%s/x", dir);
   CHECK_OK(hearth_remove_tree(sub, &err), &err);
   CHECK(!hearth_path_exists(sub));
+  /* what a killed writer leaves, and names that only look like it */
+  CHECK(hearth_is_atomic_temp("mask.npy.tmp-Ab12Cd") && hearth_is_atomic_temp("hot.tmp-000000"));
+  CHECK(hearth_is_atomic_temp("a.tmp-x.tmp-Zz9y8X") && hearth_is_atomic_temp("hot.old-4242"));
+  CHECK(!hearth_is_atomic_temp("mask.npy") && !hearth_is_atomic_temp(".tmp-Ab12Cd"));
+  CHECK(!hearth_is_atomic_temp("a.tmp-Ab12C") && !hearth_is_atomic_temp("a.tmp-Ab12Cde"));
+  CHECK(!hearth_is_atomic_temp("a.tmp-Ab_2Cd") && !hearth_is_atomic_temp("a.old-") &&
+        !hearth_is_atomic_temp("a.old-12x") && !hearth_is_atomic_temp("a.tmp-Ab12Cd.png"));
+  /* a real one, from an atomic write abandoned without abort, is swept with
+     a whole temporary directory; other files stay */
+  snprintf(sub, sizeof sub, "%s/sweep", dir);
+  CHECK_OK(hearth_mkdirs(sub, &err), &err);
+  char keep[1300], tdir[1300];
+  snprintf(keep, sizeof keep, "%s/keep.tmp-1234567", sub);
+  CHECK_OK(hearth_write_file_atomic(keep, "k", 1, &err), &err);
+  snprintf(tdir, sizeof tdir, "%s/state.tmp-AAAAAA/inner", sub);
+  CHECK_OK(hearth_mkdirs(tdir, &err), &err);
+  snprintf(keep, sizeof keep, "%s/b.npy", sub);
+  CHECK_OK(hearth_atomic_open(&af, keep, &err), &err);
+  fputs("half", af.fp);
+  fflush(af.fp);
+  CHECK(count_entries(sub) == 3); /* keep.tmp-1234567, state.tmp-AAAAAA, b.npy.tmp-?????? */
+  size_t removed = 0;
+  CHECK_OK(hearth_remove_stale_temps(sub, &removed, &err), &err);
+  CHECK(removed == 2 && count_entries(sub) == 1);
+  fclose(af.fp);
+  snprintf(keep, sizeof keep, "%s/no-such-dir", dir);
+  CHECK_OK(hearth_remove_stale_temps(keep, &removed, &err), &err);
+  CHECK(removed == 0);
   CHECK(hearth_read_file("/nonexistent/file", 10, &data, &n, &err) == HEARTH_E_IO);
   CHECK(strstr(err.msg, "/nonexistent/file") != NULL);
   TEST_MAIN_END();
