@@ -106,6 +106,9 @@ hearth_status hearth_remove_tree(const char *path, hearth_err *err);
 /* snprintf into buf, joining parts with '/'. Returns HEARTH_E_LIMIT if it
  * does not fit. */
 hearth_status hearth_path_join(char *buf, size_t bufsz, const char *a, const char *b);
+/* path relative to root when it lies under root (textually), else path
+ * itself: what documents record, so a moved release keeps its bytes. */
+const char *hearth_path_under(const char *root, const char *path);
 
 /* ---- threads --------------------------------------------------------------- */
 /* Number of worker threads to use when a caller passes 0: $HEARTH_THREADS if

@@ -222,6 +222,13 @@ hearth_status hearth_remove_tree(const char *path, hearth_err *err) {
   return HEARTH_OK;
 }
 
+const char *hearth_path_under(const char *root, const char *path) {
+  size_t n = strlen(root);
+  while (n > 1 && root[n - 1] == '/') n--;
+  if (n && !strncmp(path, root, n) && path[n] == '/') return path + n + 1;
+  return path;
+}
+
 hearth_status hearth_path_join(char *buf, size_t bufsz, const char *a, const char *b) {
   size_t la = strlen(a);
   int slash = la > 0 && a[la - 1] != '/';

@@ -321,7 +321,7 @@ hearth_status hearth_refine_run(const hearth_refine_job *job, hearth_refine_summ
   {
     json_t *doc = json_object();
     json_object_set_new(doc, "instance", json_string(inst));
-    json_object_set_new(doc, "start", json_string(start_path));
+    json_object_set_new(doc, "start", json_string(hearth_path_under(root, start_path)));
     json_object_set_new(doc, "criterion",
                         json_string("mean over silhouette samples of min(d, 1.5 px)^2, d = distance "
                                     "to the strongest thermal edge within 3 px along the normal"));

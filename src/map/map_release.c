@@ -112,13 +112,6 @@ static const char *fusion_name(hearth_fusion f) {
 }
 
 /* path relative to the release root when it lies inside it */
-static const char *rel_to_root(const char *root, const char *path) {
-  size_t n = strlen(root);
-  while (n > 1 && root[n - 1] == '/') n--;
-  if (!strncmp(path, root, n) && path[n] == '/') return path + n + 1;
-  return path;
-}
-
 static json_t *camera_json(const hearth_camera *c) {
   json_t *o = json_object();
   double K[9];
@@ -149,15 +142,15 @@ static hearth_status write_provenance(const char *path, const hearth_map_job *jo
   json_object_set_new(o, "source_views", sv);
   json_object_set_new(o, "surface_pixels_per_view", hits);
   json_t *rj = json_object();
-  json_object_set_new(rj, "path", json_string(rel_to_root(root, rig_path)));
+  json_object_set_new(rj, "path", json_string(hearth_path_under(root, rig_path)));
   json_object_set_new(rj, "thermal", camera_json(&rig->thermal));
   json_t *tj = json_object();
   json_object_set_new(tj, "R", mat3_json(rig->T_thermal_from_rgb.R));
   json_object_set_new(tj, "t", vec_json(rig->T_thermal_from_rgb.t, 3));
   json_object_set_new(rj, "T_thermal_from_rgb", tj);
   json_object_set_new(o, "rig", rj);
-  json_object_set_new(o, "poses", json_string(rel_to_root(root, poses_path)));
-  json_object_set_new(o, "mesh", json_string(rel_to_root(root, mesh_path)));
+  json_object_set_new(o, "poses", json_string(hearth_path_under(root, poses_path)));
+  json_object_set_new(o, "mesh", json_string(hearth_path_under(root, mesh_path)));
   json_t *pj = json_object();
   json_object_set_new(pj, "resolution", json_integer((json_int_t)r->R));
   json_object_set_new(pj, "fusion", json_string(fusion_name(job->map.fusion)));
