@@ -349,198 +349,184 @@ static float weighted_median(vw *a, size_t n) {
   return a[n - 1].v;
 }
 
-/* nearest-observed fill restricted to islands: repeated forward/backward
- * sweeps propagate the nearest seed (Euclidean distance in texels) through
- * texels of the same island; ties go to the lower seed index. Islands are
- * independent, so each is swept alone within its bounding box, in parallel;
- * the result does not depend on the thread count. Seed coordinates are kept
- * beside the index so the inner loop does no division. */
-typedef struct fill_rec {
-  int32_t seed;   /* nearest observed texel so far, -1 none */
-  int16_t sx, sy; /* its coordinates (R <= 16384) */
-} fill_rec;
+/* Nearest-observed fill within islands: every surface texel that was not
+ * observed takes the observed texel of its own island at the smallest
+ * Euclidean distance between texel centres. This is an exact distance
+ * transform with feature indices, run per island over its bounding box in
+ * two separable passes: the nearest seed row in every column (a downward and
+ * an upward sweep), then along every row the lower envelope of the parabolas
+ * (x - c)^2 + (row - seed_row(c))^2. Ties go to a fixed rule (the upper
+ * seed within a column, the left parabola along a row). Islands are
+ * independent and each is done whole by one worker, so the result does not
+ * depend on the thread count. The cost is the sum of the islands'
+ * bounding-box areas (about the surface for packed atlases). */
+typedef struct island_box {
+  int32_t x0, y0, x1, y1; /* inclusive; x1 < x0 for an island without texels */
+  size_t n_todo;          /* surface texels to fill */
+  uint8_t has_seed;       /* any observed texel */
+} island_box;
 
 typedef struct fill_ctx {
   size_t R;
   const uint32_t *island_of_texel;
-  fill_rec *rec;              /* per texel */
-  const uint32_t *todo;       /* texels to fill (surface, not observed), grouped by island,
-                                 ascending index within each island */
-  const int32_t *todo_xy;     /* their (x, y), so the sweep does no division */
-  const size_t *todo_start;   /* n_islands + 1 offsets into todo */
-  const uint8_t *has_seed;    /* per island: any observed texel */
+  const uint8_t *mask;
+  const island_box *box;
+  const uint32_t *order; /* islands with work, largest box first */
+  const int *bin;        /* worker of each entry of order */
+  uint32_t n;
+  int32_t *seed; /* out: nearest observed texel of each filled texel */
+  int *failed;   /* per worker: out of memory */
 } fill_ctx;
 
-/* forward sweeps look at the already visited neighbours (left, up-left, up,
-   up-right), backward sweeps at the mirrored ones; visiting only the texels
-   to fill, in index order, is the same sweep as visiting every texel because
-   observed texels never change */
-static void fill_one_island(const fill_ctx *c, uint32_t isl) {
-  size_t a = c->todo_start[isl], b = c->todo_start[isl + 1];
-  if (a == b || !c->has_seed[isl]) return; /* nothing to fill from */
-  size_t R = c->R;
-  fill_rec *rec = c->rec;
-  static const int fdx[4] = {-1, -1, 0, 1}, fdy[4] = {0, -1, -1, -1};
-  int changed = 1;
-  for (int pass = 0; changed && pass < 64; pass++) {
-    changed = 0;
-    for (int dir = 0; dir < 2; dir++) {
-      int sg = dir == 0 ? 1 : -1;
-      for (size_t k = a; k < b; k++) {
-        size_t kk = dir == 0 ? k : b - 1 - (k - a);
-        size_t q = c->todo[kk];
-        int32_t x = c->todo_xy[2 * kk], y = c->todo_xy[2 * kk + 1];
-        fill_rec cur = rec[q];
-        int32_t best = cur.seed;
-        int64_t bd = 0;
-        if (best >= 0) {
-          int64_t ex = cur.sx - x, ey = cur.sy - y;
-          bd = ex * ex + ey * ey;
-        }
-        fill_rec nb = cur;
-        for (int j = 0; j < 4; j++) {
-          int32_t nx = x + sg * fdx[j], ny = y + sg * fdy[j];
-          if (nx < 0 || ny < 0 || nx >= (int32_t)R || ny >= (int32_t)R) continue;
-          size_t nq = (size_t)ny * R + (size_t)nx;
-          fill_rec r = rec[nq];
-          if (r.seed < 0 || c->island_of_texel[nq] != isl) continue;
-          int64_t ex = r.sx - x, ey = r.sy - y;
-          int64_t d = ex * ex + ey * ey;
-          if (best < 0 || d < bd || (d == bd && r.seed < best)) {
-            best = r.seed;
-            bd = d;
-            nb = r;
-          }
-        }
-        if (best != cur.seed) {
-          rec[q] = nb;
-          changed = 1;
-        }
-      }
-    }
-  }
+static size_t box_area(const island_box *b) {
+  return (size_t)(b->x1 - b->x0 + 1) * (size_t)(b->y1 - b->y0 + 1);
 }
 
-typedef struct isl_size {
-  size_t todo;
+static int fill_one_island(const fill_ctx *c, uint32_t isl) {
+  const island_box *b = &c->box[isl];
+  size_t R = c->R, W = (size_t)(b->x1 - b->x0 + 1), H = (size_t)(b->y1 - b->y0 + 1);
+  const uint32_t *iot = c->island_of_texel;
+  const uint8_t *mask = c->mask;
+  int32_t *srow = hearth_alloc_array(W * H, sizeof *srow); /* nearest seed row in the column, -1 none */
+  int32_t *cur = hearth_alloc_array(W, sizeof *cur);
+  int32_t *env = hearth_alloc_array(W, sizeof *env);       /* columns on the lower envelope */
+  double *z = hearth_alloc_array(W + 1, sizeof *z);        /* where each takes over */
+  if (!srow || !cur || !env || !z) {
+    free(srow);
+    free(cur);
+    free(env);
+    free(z);
+    return 0;
+  }
+#define IS_SEED(q) (iot[q] == isl && mask[q] == HEARTH_TEXEL_OBSERVED)
+  /* pass 1: the nearest seed row above (downward sweep), then below */
+  for (size_t x = 0; x < W; x++) cur[x] = -1;
+  for (size_t r = 0; r < H; r++) {
+    const size_t q0 = ((size_t)b->y0 + r) * R + (size_t)b->x0;
+    int32_t *row = srow + r * W;
+    for (size_t x = 0; x < W; x++) {
+      if (IS_SEED(q0 + x)) cur[x] = (int32_t)r;
+      row[x] = cur[x];
+    }
+  }
+  for (size_t x = 0; x < W; x++) cur[x] = -1;
+  for (size_t r = H; r-- > 0;) {
+    const size_t q0 = ((size_t)b->y0 + r) * R + (size_t)b->x0;
+    int32_t *row = srow + r * W;
+    for (size_t x = 0; x < W; x++) {
+      if (IS_SEED(q0 + x)) cur[x] = (int32_t)r;
+      int32_t up = row[x], dn = cur[x];
+      if (dn >= 0 && (up < 0 || dn - (int32_t)r < (int32_t)r - up)) row[x] = dn;
+    }
+  }
+  /* pass 2: along each row, the lower envelope of the columns' parabolas */
+  for (size_t r = 0; r < H; r++) {
+    const size_t q0 = ((size_t)b->y0 + r) * R + (size_t)b->x0;
+    const int32_t *row = srow + r * W;
+    long k = -1;
+    for (size_t x = 0; x < W; x++) {
+      if (row[x] < 0) continue;
+      double dy = (double)row[x] - (double)r, fx = dy * dy + (double)x * (double)x;
+      double sx = -INFINITY;
+      while (k >= 0) {
+        double v = (double)env[k], dv = (double)row[env[k]] - (double)r;
+        sx = (fx - (dv * dv + v * v)) / (2.0 * ((double)x - v));
+        if (sx > z[k]) break;
+        k--;
+      }
+      if (k < 0) sx = -INFINITY;
+      env[++k] = (int32_t)x;
+      z[k] = sx;
+    }
+    if (k < 0) continue; /* no seed in any column: only possible when the island has none */
+    long j = 0;
+    for (size_t x = 0; x < W; x++) {
+      size_t q = q0 + x;
+      if (iot[q] != isl || mask[q] == HEARTH_TEXEL_OBSERVED) continue;
+      while (j < k && z[j + 1] <= (double)x) j++;
+      size_t sc = (size_t)env[j];
+      c->seed[q] = (int32_t)(((size_t)b->y0 + (size_t)row[sc]) * R + (size_t)b->x0 + sc);
+    }
+  }
+#undef IS_SEED
+  free(srow);
+  free(cur);
+  free(env);
+  free(z);
+  return 1;
+}
+
+typedef struct isl_work {
+  size_t work;
   uint32_t island;
-} isl_size;
+} isl_work;
 /* largest first, ties by island index: a total order */
-static int cmp_isl_size(const void *a, const void *b) {
-  const isl_size *x = a, *y = b;
-  if (x->todo != y->todo) return x->todo > y->todo ? -1 : 1;
+static int cmp_isl_work(const void *a, const void *b) {
+  const isl_work *x = a, *y = b;
+  if (x->work != y->work) return x->work > y->work ? -1 : 1;
   return (x->island > y->island) - (x->island < y->island);
 }
 
-/* islands are dealt to the workers largest first, each to the least loaded
- * (islands are independent, so the assignment cannot change the result) */
-typedef struct fill_bins {
-  const fill_ctx *c;
-  const uint32_t *order; /* islands, largest first */
-  const int *bin;        /* worker of each entry of order */
-  uint32_t n;
-} fill_bins;
-
 static void fill_range(void *ctx, size_t b, size_t e, int t) {
-  const fill_bins *fb = ctx;
+  const fill_ctx *c = ctx;
+  (void)t;
   for (size_t w = b; w < e; w++)
-    for (uint32_t i = 0; i < fb->n; i++)
-      if (fb->bin[i] == (int)w) fill_one_island(fb->c, fb->order[i]);
+    for (uint32_t i = 0; i < c->n; i++)
+      if (c->bin[i] == (int)w && !fill_one_island(c, c->order[i])) c->failed[w] = 1;
 }
-
 
 static hearth_status fill_islands(size_t R, const uint32_t *island_of_texel, uint32_t n_islands,
                                   const uint8_t *mask, int32_t *seed, int nthreads) {
-  size_t N = R * R;
-  fill_rec *rec = hearth_alloc_array(N, sizeof *rec);
-  size_t *start = calloc((size_t)n_islands + 2, sizeof *start);
-  uint8_t *has_seed = calloc((size_t)n_islands + 1, 1);
-  uint32_t *todo = NULL;
-  int32_t *todo_xy = NULL;
-  if (!rec || !start || !has_seed) goto oom;
-  /* counting sort of the texels to fill by island */
-  size_t n_todo = 0;
+  int nw = nthreads > 0 ? nthreads : hearth_default_threads();
+  island_box *box = hearth_alloc_array((size_t)n_islands + 1, sizeof *box);
+  isl_work *work = hearth_alloc_array((size_t)n_islands + 1, sizeof *work);
+  uint32_t *order = hearth_alloc_array((size_t)n_islands + 1, sizeof *order);
+  int *bin = hearth_alloc_array((size_t)n_islands + 1, sizeof *bin);
+  size_t *load = calloc((size_t)nw, sizeof *load);
+  int *failed = calloc((size_t)nw, sizeof *failed);
+  hearth_status s = HEARTH_E_NOMEM;
+  if (!box || !work || !order || !bin || !load || !failed) goto done;
+  for (uint32_t i = 0; i < n_islands; i++) box[i] = (island_box){INT32_MAX, INT32_MAX, -1, -1, 0, 0};
   for (size_t y = 0; y < R; y++)
     for (size_t x = 0; x < R; x++) {
       size_t q = y * R + x;
-      int obs = mask[q] == HEARTH_TEXEL_OBSERVED;
-      rec[q] = obs ? (fill_rec){(int32_t)q, (int16_t)x, (int16_t)y} : (fill_rec){-1, 0, 0};
+      seed[q] = -1;
       uint32_t isl = island_of_texel[q];
       if (isl == UINT32_MAX) continue;
-      if (obs) {
-        has_seed[isl] = 1;
-      } else {
-        start[isl + 1]++;
-        n_todo++;
-      }
+      island_box *bx = &box[isl];
+      if ((int32_t)x < bx->x0) bx->x0 = (int32_t)x;
+      if ((int32_t)x > bx->x1) bx->x1 = (int32_t)x;
+      if ((int32_t)y < bx->y0) bx->y0 = (int32_t)y;
+      bx->y1 = (int32_t)y;
+      if (mask[q] == HEARTH_TEXEL_OBSERVED) bx->has_seed = 1;
+      else bx->n_todo++;
     }
-  for (uint32_t i = 0; i < n_islands; i++) start[i + 1] += start[i];
-  todo = hearth_alloc_array(n_todo ? n_todo : 1, sizeof *todo);
-  todo_xy = hearth_alloc_array(n_todo ? n_todo : 1, 2 * sizeof *todo_xy);
-  if (!todo || !todo_xy) goto oom;
-  size_t *cur = malloc(((size_t)n_islands + 1) * sizeof *cur);
-  if (!cur) goto oom;
-  memcpy(cur, start, ((size_t)n_islands + 1) * sizeof *cur);
-  for (size_t q = 0; q < N; q++) {
-    uint32_t isl = island_of_texel[q];
-    if (isl != UINT32_MAX && mask[q] != HEARTH_TEXEL_OBSERVED) {
-      size_t k = cur[isl]++;
-      todo[k] = (uint32_t)q;
-      todo_xy[2 * k] = (int32_t)(q % R);
-      todo_xy[2 * k + 1] = (int32_t)(q / R);
-    }
+  uint32_t n = 0;
+  for (uint32_t i = 0; i < n_islands; i++)
+    if (box[i].has_seed && box[i].n_todo) work[n++] = (isl_work){box_area(&box[i]), i};
+  qsort(work, n, sizeof *work, cmp_isl_work);
+  /* dealt largest first, each to the least loaded worker */
+  for (uint32_t i = 0; i < n; i++) {
+    int best = 0;
+    for (int w = 1; w < nw; w++)
+      if (load[w] < load[best]) best = w;
+    order[i] = work[i].island;
+    bin[i] = best;
+    load[best] += work[i].work;
   }
-  free(cur);
-  fill_ctx c = {R, island_of_texel, rec, todo, todo_xy, start, has_seed};
-  {
-    int nw = nthreads > 0 ? nthreads : hearth_default_threads();
-    uint32_t *order = hearth_alloc_array((size_t)n_islands + 1, sizeof *order);
-    int *bin = hearth_alloc_array((size_t)n_islands + 1, sizeof *bin);
-    size_t *load = calloc((size_t)nw, sizeof *load);
-    if (!order || !bin || !load) {
-      free(order);
-      free(bin);
-      free(load);
-      goto oom;
-    }
-    isl_size *sz = hearth_alloc_array((size_t)n_islands + 1, sizeof *sz);
-    if (!sz) {
-      free(order);
-      free(bin);
-      free(load);
-      goto oom;
-    }
-    for (uint32_t i = 0; i < n_islands; i++) sz[i] = (isl_size){start[i + 1] - start[i], i};
-    qsort(sz, n_islands, sizeof *sz, cmp_isl_size);
-    for (uint32_t i = 0; i < n_islands; i++) order[i] = sz[i].island;
-    free(sz);
-    for (uint32_t i = 0; i < n_islands; i++) {
-      int best = 0;
-      for (int w = 1; w < nw; w++)
-        if (load[w] < load[best]) best = w;
-      bin[i] = best;
-      load[best] += start[order[i] + 1] - start[order[i]];
-    }
-    fill_bins fb = {&c, order, bin, n_islands};
-    hearth_parallel_for((size_t)nw, nw, fill_range, &fb);
-    free(order);
-    free(bin);
-    free(load);
-  }
-  for (size_t q = 0; q < N; q++) seed[q] = rec[q].seed;
-  free(rec);
-  free(start);
-  free(has_seed);
-  free(todo);
-  free(todo_xy);
-  return HEARTH_OK;
-oom:
-  free(rec);
-  free(start);
-  free(has_seed);
-  free(todo);
-  free(todo_xy);
-  return HEARTH_E_NOMEM;
+  fill_ctx c = {R, island_of_texel, mask, box, order, bin, n, seed, failed};
+  hearth_parallel_for((size_t)nw, nw, fill_range, &c);
+  s = HEARTH_OK;
+  for (int w = 0; w < nw; w++)
+    if (failed[w]) s = HEARTH_E_NOMEM;
+done:
+  free(box);
+  free(work);
+  free(order);
+  free(bin);
+  free(load);
+  free(failed);
+  return s;
 }
 
 static void free_scratch(map_ctx *m) {
