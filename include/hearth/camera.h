@@ -12,6 +12,7 @@
 #ifndef HEARTH_CAMERA_H
 #define HEARTH_CAMERA_H
 
+#include <stddef.h>
 #include "hearth/geom.h"
 
 #ifdef __cplusplus
@@ -52,6 +53,15 @@ double hearth_camera_undistort(const hearth_camera *cam, double u, double v, dou
 /* The unit ray direction (camera frame) through pixel (u, v). Returns the
  * undistortion residual as above. */
 double hearth_camera_ray(const hearth_camera *cam, double u, double v, double dir[3]);
+
+/* Unit ray directions (camera frame, 3 floats each, row-major) through the
+ * pixels (x * stride, y * stride), x < ceil(width / stride), y < ceil(height /
+ * stride): hearth_camera_ray for a whole grid, faster (each solve starts
+ * where its neighbours' roots point). A pixel that cannot be undistorted to
+ * within HEARTH_GRID_MAX_RESIDUAL pixels (outside the invertible part of the
+ * lens model) gets NaN; returns how many did. */
+#define HEARTH_GRID_MAX_RESIDUAL 1e-6
+size_t hearth_camera_ray_grid(const hearth_camera *cam, size_t stride, float *dirs);
 
 /* K as a row-major 3x3. */
 void hearth_camera_K(const hearth_camera *cam, double K[9]);

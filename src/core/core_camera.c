@@ -72,15 +72,13 @@ static double reproj_residual(const hearth_camera *cam, double x, double y, doub
   return sqrt(a * a + b * b); /* residuals are far from overflow: no hypot */
 }
 
-double hearth_camera_undistort(const hearth_camera *cam, double u, double v, double xy[2]) {
-  if (!isfinite(u) || !isfinite(v) || !(cam->fx != 0.0) || !(cam->fy != 0.0)) return -1.0;
-  double tu = (u - cam->cx) / cam->fx, tv = (v - cam->cy) / cam->fy;
-  /* start at the distorted point itself: for radial models r * radial(r) is
-   * monotone on the valid part of the image, and Newton from there stays on
-   * the branch that contains the origin */
-  double x = tu, y = tv, ex, ey;
+/* Newton from (x, y) towards the ideal point whose distortion is (tu, tv),
+ * until the residual is at most tol pixels */
+static double undistort_from(const hearth_camera *cam, double tu, double tv, double x, double y,
+                             double tol, double xy[2]) {
+  double ex, ey;
   double res = reproj_residual(cam, x, y, tu, tv, &ex, &ey);
-  for (int it = 0; it < 100 && res > 1e-13; it++) {
+  for (int it = 0; it < 100 && res > tol; it++) {
     double xd, yd, J[4];
     hearth_distort(cam->dist, x, y, &xd, &yd, J);
     double det = J[0] * J[3] - J[1] * J[2];
@@ -89,7 +87,8 @@ double hearth_camera_undistort(const hearth_camera *cam, double u, double v, dou
     double dy = -(-J[2] * ex + J[0] * ey) / det;
     /* step control: never move farther than the current radius + 1 in one
      * step, then halve until the residual decreases */
-    double len = hypot(dx, dy), cap = 1.0 + hypot(x, y);
+    double len = sqrt(dx * dx + dy * dy), cap = 1.0 + sqrt(x * x + y * y);
+    if (!isfinite(len)) len = hypot(dx, dy);
     if (len > cap) {
       dx *= cap / len;
       dy *= cap / len;
@@ -118,13 +117,69 @@ double hearth_camera_undistort(const hearth_camera *cam, double u, double v, dou
   }
   if (!isfinite(res)) return -1.0;
   /* a root where the distortion map folds over (det <= 0) lies outside the
-   * region where the lens model is invertible */
-  double xd, yd, J[4];
+   * region where the lens model is invertible; so does one where the radial
+   * factor is not positive (the model has turned the point through the
+   * centre: det can be positive again beyond the fold) */
+  double xd, yd, J[4], r2 = x * x + y * y;
   hearth_distort(cam->dist, x, y, &xd, &yd, J);
   if (!(J[0] * J[3] - J[1] * J[2] > 0.0)) return -1.0;
+  if (!(1.0 + r2 * (cam->dist[0] + r2 * (cam->dist[1] + r2 * cam->dist[4])) > 0.0)) return -1.0;
   xy[0] = x;
   xy[1] = y;
   return res;
+}
+
+double hearth_camera_undistort(const hearth_camera *cam, double u, double v, double xy[2]) {
+  if (!isfinite(u) || !isfinite(v) || !(cam->fx != 0.0) || !(cam->fy != 0.0)) return -1.0;
+  double tu = (u - cam->cx) / cam->fx, tv = (v - cam->cy) / cam->fy;
+  /* start at the distorted point itself: for radial models r * radial(r) is
+   * monotone on the valid part of the image, and Newton from there stays on
+   * the branch that contains the origin */
+  return undistort_from(cam, tu, tv, tu, tv, 1e-13, xy);
+}
+
+static void unit_ray(const double xy[2], float *dir) {
+  double n = sqrt(xy[0] * xy[0] + xy[1] * xy[1] + 1.0);
+  dir[0] = (float)(xy[0] / n);
+  dir[1] = (float)(xy[1] / n);
+  dir[2] = (float)(1.0 / n);
+}
+
+size_t hearth_camera_ray_grid(const hearth_camera *cam, size_t stride, float *dirs) {
+  if (stride < 1) stride = 1;
+  size_t gw = ((size_t)(cam->width > 0 ? cam->width : 0) + stride - 1) / stride;
+  size_t gh = ((size_t)(cam->height > 0 ? cam->height : 0) + stride - 1) / stride, failed = 0;
+  int ok = isfinite(cam->fx) && isfinite(cam->fy) && cam->fx != 0.0 && cam->fy != 0.0;
+  for (size_t gy = 0; gy < gh; gy++) {
+    /* along a row each solve starts where the last two roots point (linear
+     * extrapolation, a small fraction of a pixel off) and stops at 1e-9 px,
+     * far below what a float direction resolves (about 1e-5 px): one Newton
+     * step instead of three to five */
+    int warm = 0;
+    double prev[2] = {0, 0}, step[2] = {0, 0};
+    for (size_t gx = 0; gx < gw; gx++) {
+      float *d = dirs + 3 * (gy * gw + gx);
+      double tu = ((double)(gx * stride) - cam->cx) / cam->fx, tv = ((double)(gy * stride) - cam->cy) / cam->fy;
+      double xy[2], res = -1.0;
+      if (ok && warm == 2) res = undistort_from(cam, tu, tv, prev[0] + step[0], prev[1] + step[1], 1e-9, xy);
+      if (ok && !(res >= 0.0 && res <= HEARTH_GRID_MAX_RESIDUAL)) res = undistort_from(cam, tu, tv, tu, tv, 1e-9, xy);
+      if (!(res >= 0.0 && res <= HEARTH_GRID_MAX_RESIDUAL)) {
+        d[0] = d[1] = d[2] = NAN;
+        failed++;
+        warm = 0;
+        continue;
+      }
+      unit_ray(xy, d);
+      if (warm) {
+        step[0] = xy[0] - prev[0];
+        step[1] = xy[1] - prev[1];
+      }
+      prev[0] = xy[0];
+      prev[1] = xy[1];
+      warm = warm ? 2 : 1;
+    }
+  }
+  return failed;
 }
 
 double hearth_camera_ray(const hearth_camera *cam, double u, double v, double dir[3]) {

@@ -646,14 +646,12 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
     s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
     goto done;
   }
+  /* a pixel the lens model cannot invert gets a zero direction: never cast */
+  if (hearth_camera_ray_grid(cam, st, pix_dir))
+    for (size_t k = 0; k < 3 * np; k++)
+      if (isnan(pix_dir[k])) pix_dir[k] = 0.0f;
   for (size_t y = 0; y < ph; y++)
-    for (size_t x = 0; x < pw; x++) {
-      size_t p = y * pw + x;
-      double d[3];
-      hearth_camera_ray(cam, (double)(x * st), (double)(y * st), d);
-      for (int k = 0; k < 3; k++) pix_dir[3 * p + k] = (float)d[k];
-      pix_index[p] = (uint32_t)(y * st * (size_t)cam->width + x * st);
-    }
+    for (size_t x = 0; x < pw; x++) pix_index[y * pw + x] = (uint32_t)(y * st * (size_t)cam->width + x * st);
   {
     size_t k = 0;
     for (size_t ty = 0; ty < ph; ty += 4)

@@ -40,12 +40,7 @@ float *rf_pixel_rays(const hearth_camera *cam) {
   size_t n = (size_t)cam->width * (size_t)cam->height;
   float *d = hearth_alloc_array(n ? n : 1, 3 * sizeof *d);
   if (!d) return NULL;
-  for (size_t p = 0; p < n; p++) {
-    double r[3];
-    if (hearth_camera_ray(cam, (double)(p % (size_t)cam->width), (double)(p / (size_t)cam->width), r) < 0)
-      r[0] = r[1] = r[2] = NAN;
-    for (int k = 0; k < 3; k++) d[3 * p + k] = (float)r[k];
-  }
+  hearth_camera_ray_grid(cam, 1, d);
   return d;
 }
 

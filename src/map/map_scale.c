@@ -56,15 +56,7 @@ static void scale_view(scale_ctx *c, size_t v) {
   zpair *out = hearth_alloc_array(n ? n : 1, sizeof *out);
   if (!c->dirs[v] && (c->dirs[v] = hearth_alloc_array(n ? n : 1, 3 * sizeof(float)))) {
     /* undistorted rays of the sampled pixels, once per view (NaN: not invertible) */
-    for (size_t gy = 0; gy < gh; gy++)
-      for (size_t gx = 0; gx < gw; gx++) {
-        double dc[3];
-        float *d = c->dirs[v] + 3 * (gy * gw + gx);
-        if (hearth_camera_ray(&sv->depth_cam, (double)(gx * st), (double)(gy * st), dc) < 0)
-          d[0] = d[1] = d[2] = NAN;
-        else
-          for (int i = 0; i < 3; i++) d[i] = (float)dc[i];
-      }
+    hearth_camera_ray_grid(&sv->depth_cam, st, c->dirs[v]);
   }
   if (!zr || !out || !c->dirs[v]) {
     free(zr);

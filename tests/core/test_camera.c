@@ -71,6 +71,24 @@ int main(void) {
     CHECK_NEAR(yd, -0.2 + 0.01 * (0.13 + 2 * 0.04) + 2 * -0.02 * 0.3 * -0.2, 1e-15);
   }
 
+  /* a lens folding over inside the image: the grid marks with NaN exactly
+     the pixels hearth_camera_ray cannot undistort to within the grid's
+     residual bound */
+  {
+    hearth_camera fold = {64, 48, 40.0, 40.0, 31.5, 23.5, {-0.9, 0.0, 0.0, 0.0, 0.0}};
+    float *g = malloc(64 * 48 * 3 * sizeof *g);
+    size_t nfail = hearth_camera_ray_grid(&fold, 1, g), nref = 0, agree = 0;
+    for (size_t p = 0; p < 64 * 48; p++) {
+      double dir[3];
+      double res = hearth_camera_ray(&fold, (double)(p % 64), (double)(p / 64), dir);
+      int bad = !(res >= 0 && res <= HEARTH_GRID_MAX_RESIDUAL);
+      nref += bad;
+      agree += bad == (isnan(g[3 * p]) != 0);
+    }
+    CHECK(nfail > 0 && nfail == nref && agree == 64 * 48);
+    free(g);
+  }
+
   hearth_rng rng;
   hearth_rng_seed(&rng, 7);
   for (size_t li = 0; li < NLENS; li++) {
@@ -130,6 +148,23 @@ int main(void) {
       double X[3] = {dir[0] * 3.7, dir[1] * 3.7, dir[2] * 3.7};
       CHECK(hearth_camera_project(cam, X, uv, NULL));
       CHECK(hypot(uv[0] - u, uv[1] - v) < 1e-9);
+    }
+
+    /* the grid form: the same rays as hearth_camera_ray, pixel by pixel, for
+       strides 1 and 3 (float directions: within 1e-7) */
+    for (size_t st = 1; st <= 3; st += 2) {
+      size_t gw = ((size_t)cam->width + st - 1) / st, gh = ((size_t)cam->height + st - 1) / st;
+      float *g = malloc(gw * gh * 3 * sizeof *g);
+      CHECK(hearth_camera_ray_grid(cam, st, g) == 0);
+      double gworst = 0;
+      for (size_t y = 0; y < gh; y++)
+        for (size_t x = 0; x < gw; x++) {
+          double dir[3];
+          CHECK(hearth_camera_ray(cam, (double)(x * st), (double)(y * st), dir) >= 0);
+          for (int k = 0; k < 3; k++) gworst = fmax(gworst, fabs(g[3 * (y * gw + x) + k] - dir[k]));
+        }
+      CHECK_MSG(gworst < 1e-7, "%s: grid rays differ by %.3g", LENSES[li].name, gworst);
+      free(g);
     }
 
     /* analytic Jacobians vs central differences at random in-image points */
