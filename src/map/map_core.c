@@ -47,6 +47,18 @@ typedef struct view_record {
   float weight;
 } view_record;
 
+/* one hit pixel's splat, prepared before any accumulator is touched so the
+ * records can be prefetched a few splats ahead (the scatter into the R x R
+ * records is otherwise one cache miss after another) */
+typedef struct splat {
+  double fx, fy;  /* bilinear fractions */
+  int32_t x0, y0; /* lower-left texel of the 2 x 2 footprint */
+  uint32_t island;
+  float cosv;
+  float val[3];
+} splat;
+#define SPLAT_AHEAD 8
+
 typedef struct map_ctx {
   const hearth_mesh *mesh;
   const hearth_raycaster *rc;
@@ -76,6 +88,7 @@ typedef struct map_ctx {
   float **acc;
   uint8_t *acc_ready; /* per thread: records initialised */
   uint32_t **touched;
+  splat **splats; /* per thread: n_pix */
   uint8_t **sil; /* per thread: n_pix silhouette flags */
   int64_t **isum, **iw;
   float *hit_t; /* per thread: n_pix */
@@ -220,6 +233,8 @@ static void process_view(map_ctx *m, size_t v, int t) {
   const double *Rw = m->views[v].T_world_from_cam.R;
   uint32_t hits = 0;
   float min_cos = (float)m->opts->min_cos;
+  splat *sp = m->splats[t];
+  size_t n_sp = 0;
   for (size_t p = 0; p < n; p++) {
     uint32_t tri = htri[p];
     if (tri == UINT32_MAX) continue;
@@ -238,12 +253,31 @@ static void process_view(map_ctx *m, size_t v, int t) {
                b2 * mesh->uvs[2 * ix[2] + 1];
     double x = (double)u * (double)R - 0.5, y = (double)vv * (double)R - 0.5;
     double x0f = floor(x), y0f = floor(y);
-    double fx = x - x0f, fy = y - y0f;
-    long x0 = (long)x0f, y0 = (long)y0f;
-    uint32_t island = m->island_of_tri[tri];
+    /* footprints entirely off the map add nothing */
+    if (!(x0f >= -1.0 && y0f >= -1.0 && x0f < (double)R && y0f < (double)R)) continue;
+    splat *e = &sp[n_sp++];
+    e->fx = x - x0f;
+    e->fy = y - y0f;
+    e->x0 = (int32_t)x0f;
+    e->y0 = (int32_t)y0f;
+    e->island = m->island_of_tri[tri];
+    e->cosv = cosv;
     size_t src = m->pix_index[p];
-    float val[3];
-    for (int c = 0; c < C; c++) val[c] = image_value(img, src, c);
+    for (int c = 0; c < C; c++) e->val[c] = image_value(img, src, c);
+  }
+  for (size_t i = 0; i < n_sp; i++) {
+    if (i + SPLAT_AHEAD < n_sp) {
+      const splat *f = &sp[i + SPLAT_AHEAD];
+      size_t fx0 = f->x0 < 0 ? 0 : (size_t)f->x0, fy0 = f->y0 < 0 ? 0 : (size_t)f->y0;
+      __builtin_prefetch(acc + (fy0 * R + fx0) * S, 1);
+      if (fy0 + 1 < R) __builtin_prefetch(acc + ((fy0 + 1) * R + fx0) * S, 1);
+    }
+    const splat *e = &sp[i];
+    double fx = e->fx, fy = e->fy;
+    long x0 = e->x0, y0 = e->y0;
+    uint32_t island = e->island;
+    float cosv = e->cosv;
+    const float *val = e->val;
     for (int k = 0; k < 4; k++) {
       long tx = x0 + (k & 1), ty = y0 + (k >> 1);
       if (tx < 0 || ty < 0 || tx >= (long)R || ty >= (long)R) continue;
@@ -533,6 +567,7 @@ static void free_scratch(map_ctx *m) {
   for (int t = 0; t < m->n_threads; t++) {
     if (m->acc) free(m->acc[t]);
     if (m->touched) free(m->touched[t]);
+    if (m->splats) free(m->splats[t]);
     if (m->sil) free(m->sil[t]);
     if (m->isum) free(m->isum[t]);
     if (m->iw) free(m->iw[t]);
@@ -540,6 +575,7 @@ static void free_scratch(map_ctx *m) {
   free(m->acc);
   free(m->acc_ready);
   free(m->touched);
+  free(m->splats);
   free(m->sil);
   free(m->isum);
   free(m->iw);
@@ -688,6 +724,7 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
   m.sil = calloc((size_t)nt, sizeof *m.sil);
   m.acc_ready = calloc((size_t)nt, 1);
   m.touched = calloc((size_t)nt, sizeof *m.touched);
+  m.splats = calloc((size_t)nt, sizeof *m.splats);
   m.isum = calloc((size_t)nt, sizeof *m.isum);
   m.iw = calloc((size_t)nt, sizeof *m.iw);
   m.hit_t = hearth_alloc_array(np * (size_t)nt, sizeof(float));
@@ -698,7 +735,7 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
   m.ray_dir = hearth_alloc_array(np * (size_t)nt, 3 * sizeof(float));
   m.hits = hearth_alloc_array(np * (size_t)nt, sizeof(hearth_ray_hit));
   m.view_hits = calloc(n_views ? n_views : 1, sizeof *m.view_hits);
-  int bad = !m.acc || !m.acc_ready || !m.sil || !m.touched || !m.isum ||
+  int bad = !m.acc || !m.acc_ready || !m.sil || !m.touched || !m.splats || !m.isum ||
             !m.iw || !m.hit_t || !m.hit_tri || !m.hit_b1 || !m.hit_b2 || !m.ray_org ||
             !m.ray_dir || !m.hits || !m.view_hits;
   if (opts.fusion == HEARTH_FUSE_ROBUST) {
@@ -710,7 +747,8 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
     m.acc[t] = hearth_alloc_array(N, ACC_STRIDE(C) * sizeof(float));
     m.sil[t] = hearth_alloc_array(np, 1);
     m.touched[t] = hearth_alloc_array(N, sizeof(uint32_t));
-    bad |= !m.acc[t] || !m.sil[t] || !m.touched[t];
+    m.splats[t] = hearth_alloc_array(np, sizeof(splat));
+    bad |= !m.acc[t] || !m.sil[t] || !m.touched[t] || !m.splats[t];
     if (bad) break;
     if (opts.fusion == HEARTH_FUSE_MEAN) {
       m.isum[t] = hearth_calloc_array(N * (size_t)C, sizeof(int64_t));
