@@ -563,6 +563,73 @@ done:
   return s;
 }
 
+/* per-texel passes over whole rows, in parallel (each texel is written by
+ * one worker, from its own inputs: the result does not depend on the split) */
+typedef struct texel_pass {
+  const map_ctx *m;
+  hearth_map_result *out;
+  const uint32_t *tri_of_texel;
+  const int32_t *seed;
+  size_t (*counts)[4]; /* per worker: observed, filled, unobserved, surface */
+} texel_pass;
+
+/* best cosine over the workers' records, mask NONE / UNOBSERVED, observed
+ * NaN, and for max fusion the maximum over the workers' records */
+static void fuse_rows(void *ctx, size_t b, size_t e, int t) {
+  const texel_pass *tp = ctx;
+  const map_ctx *m = tp->m;
+  hearth_map_result *out = tp->out;
+  size_t R = m->R, S = ACC_STRIDE(m->C), C = (size_t)m->C;
+  int nt = m->n_threads, fmax = m->opts->fusion == HEARTH_FUSE_MAX;
+  (void)t;
+  for (size_t q = b * R; q < e * R; q++) {
+    float bc = 0;
+    for (int k = 0; k < nt; k++) {
+      float v = m->acc[k][q * S + ACC_BEST_COS(m->C)];
+      if (v > bc) bc = v;
+    }
+    out->best_cos[q] = bc;
+    out->mask[q] = tp->tri_of_texel[q] == UINT32_MAX ? HEARTH_TEXEL_NONE : HEARTH_TEXEL_UNOBSERVED;
+    for (size_t c = 0; c < C; c++) {
+      float best = -INFINITY;
+      if (fmax)
+        for (int k = 0; k < nt; k++) {
+          float v = m->acc[k][q * S + ACC_MAX(m->C) + c];
+          if (v > best) best = v;
+        }
+      if (best > -INFINITY) {
+        out->observed[q * C + c] = best;
+        out->mask[q] = HEARTH_TEXEL_OBSERVED;
+      } else {
+        out->observed[q * C + c] = NAN;
+      }
+    }
+  }
+}
+
+/* the filled map from the observed one and the fill seeds; final mask */
+static void finish_rows(void *ctx, size_t b, size_t e, int t) {
+  const texel_pass *tp = ctx;
+  hearth_map_result *out = tp->out;
+  size_t R = tp->m->R, C = (size_t)tp->m->C, *cnt = tp->counts[t];
+  for (size_t q = b * R; q < e * R; q++) {
+    uint8_t mk = out->mask[q];
+    for (size_t c = 0; c < C; c++) out->filled[q * C + c] = NAN;
+    if (mk == HEARTH_TEXEL_NONE) continue;
+    if (mk == HEARTH_TEXEL_OBSERVED) {
+      cnt[0]++;
+      for (size_t c = 0; c < C; c++) out->filled[q * C + c] = out->observed[q * C + c];
+    } else if (tp->seed[q] >= 0) {
+      out->mask[q] = HEARTH_TEXEL_FILLED;
+      cnt[1]++;
+      for (size_t c = 0; c < C; c++) out->filled[q * C + c] = out->observed[(size_t)tp->seed[q] * C + c];
+    } else {
+      cnt[2]++;
+    }
+    cnt[3]++;
+  }
+}
+
 static void free_scratch(map_ctx *m) {
   for (int t = 0; t < m->n_threads; t++) {
     if (m->acc) free(m->acc[t]);
@@ -785,28 +852,12 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
     s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
     goto done;
   }
-  for (size_t q = 0; q < N; q++) {
-    uint32_t tq = tri_of_texel[q];
-    float bc = 0;
-    for (int t = 0; t < nt; t++)
-      if (m.acc[t][q * ACC_STRIDE(C) + ACC_BEST_COS(C)] > bc) bc = m.acc[t][q * ACC_STRIDE(C) + ACC_BEST_COS(C)];
-    out->best_cos[q] = bc;
-    for (int c = 0; c < C; c++) out->observed[q * (size_t)C + (size_t)c] = NAN;
-    out->mask[q] = tq == UINT32_MAX ? HEARTH_TEXEL_NONE : HEARTH_TEXEL_UNOBSERVED;
+  {
+    /* the maximum fusion is done here too, row by row */
+    texel_pass tp = {&m, out, tri_of_texel, NULL, NULL};
+    hearth_parallel_for(R, nt, fuse_rows, &tp);
   }
-  if (opts.fusion == HEARTH_FUSE_MAX) {
-    for (size_t q = 0; q < N; q++)
-      for (int c = 0; c < C; c++) {
-        float best = -INFINITY;
-        for (int t = 0; t < nt; t++)
-          if (m.acc[t][q * ACC_STRIDE(C) + ACC_MAX(C) + (size_t)c] > best)
-            best = m.acc[t][q * ACC_STRIDE(C) + ACC_MAX(C) + (size_t)c];
-        if (best > -INFINITY) {
-          out->observed[q * (size_t)C + (size_t)c] = best;
-          out->mask[q] = HEARTH_TEXEL_OBSERVED;
-        }
-      }
-  } else if (opts.fusion == HEARTH_FUSE_MEAN) {
+  if (opts.fusion == HEARTH_FUSE_MEAN) {
     for (size_t q = 0; q < N; q++) {
       int64_t w = 0;
       for (int t = 0; t < nt; t++) w += m.iw[t][q];
@@ -818,7 +869,7 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
       }
       out->mask[q] = HEARTH_TEXEL_OBSERVED;
     }
-  } else {
+  } else if (opts.fusion == HEARTH_FUSE_ROBUST) {
     /* robust: gather every view's record per texel in view order */
     size_t total = 0;
     for (size_t v = 0; v < n_views; v++) total += m.n_records[v];
@@ -857,23 +908,21 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
     s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory while filling");
     goto done;
   }
-  for (size_t q = 0; q < N; q++) {
-    uint8_t mk = out->mask[q];
-    for (int c = 0; c < C; c++) out->filled[q * (size_t)C + (size_t)c] = NAN;
-    if (mk == HEARTH_TEXEL_NONE) continue;
-    if (mk == HEARTH_TEXEL_OBSERVED) {
-      out->n_observed++;
-      for (int c = 0; c < C; c++)
-        out->filled[q * (size_t)C + (size_t)c] = out->observed[q * (size_t)C + (size_t)c];
-    } else if (seed[q] >= 0) {
-      out->mask[q] = HEARTH_TEXEL_FILLED;
-      out->n_filled++;
-      for (int c = 0; c < C; c++)
-        out->filled[q * (size_t)C + (size_t)c] = out->observed[(size_t)seed[q] * (size_t)C + (size_t)c];
-    } else {
-      out->n_unobserved++;
+  {
+    texel_pass tp = {&m, out, tri_of_texel, seed, NULL};
+    tp.counts = calloc((size_t)nt, sizeof *tp.counts);
+    if (!tp.counts) {
+      s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
+      goto done;
     }
-    out->n_surface++;
+    hearth_parallel_for(R, nt, finish_rows, &tp);
+    for (int t = 0; t < nt; t++) {
+      out->n_observed += tp.counts[t][0];
+      out->n_filled += tp.counts[t][1];
+      out->n_unobserved += tp.counts[t][2];
+      out->n_surface += tp.counts[t][3];
+    }
+    free(tp.counts);
   }
   if (timing) {
     timing->fill = hearth_now() - t_fill0;
