@@ -7,6 +7,7 @@
  * view order. Within a view, pixels are visited in raster order by one
  * thread. */
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -630,6 +631,21 @@ static void finish_rows(void *ctx, size_t b, size_t e, int t) {
   }
 }
 
+/* the ray caster built on a thread of its own while the UV layout is
+ * rasterised (the two only read the mesh) */
+typedef struct rc_build {
+  const hearth_mesh *mesh;
+  hearth_raycaster *rc;
+  hearth_status s;
+  hearth_err err;
+} rc_build;
+
+static void *rc_build_run(void *arg) {
+  rc_build *b = arg;
+  b->s = hearth_raycaster_new(b->mesh, &b->rc, &b->err);
+  return NULL;
+}
+
 static void free_scratch(map_ctx *m) {
   for (int t = 0; t < m->n_threads; t++) {
     if (m->acc) free(m->acc[t]);
@@ -704,6 +720,13 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
   int32_t *seed = NULL;
   size_t N = R * R;
   double t_raster0 = hearth_now();
+  rc_build bld = {mesh, NULL, HEARTH_OK, {0}};
+  pthread_t bld_tid;
+  int bld_started = 0;
+  if (!rc_in) {
+    bld_started = pthread_create(&bld_tid, NULL, rc_build_run, &bld) == 0;
+    if (!bld_started) rc_build_run(&bld); /* no thread: build here */
+  }
   tri_of_texel = hearth_alloc_array(N, sizeof *tri_of_texel);
   island_of_tri = hearth_alloc_array(mesh->n_triangles, sizeof *island_of_tri);
   tri_normal = hearth_alloc_array(mesh->n_triangles, 3 * sizeof *tri_normal);
@@ -735,9 +758,6 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
   }
   double t_cast0 = hearth_now();
   if (timing) timing->raster = t_cast0 - t_raster0;
-  if (!rc_in) {
-    if ((s = hearth_raycaster_new(mesh, &own_rc, err))) goto done;
-  }
   /* pixel grid: undistorted centres of every stride-th pixel */
   size_t st = (size_t)opts.pixel_stride;
   size_t pw = ((size_t)cam->width + st - 1) / st, ph = ((size_t)cam->height + st - 1) / st;
@@ -778,6 +798,18 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
     sphere[3] = sqrt(r2) * (1.0 + 1e-3) + 1e-6;
   }
 
+  /* the ray caster, built meanwhile */
+  if (bld_started) {
+    pthread_join(bld_tid, NULL);
+    bld_started = 0;
+  }
+  own_rc = bld.rc;
+  bld.rc = NULL;
+  if (!rc_in && bld.s) {
+    if (err) *err = bld.err;
+    s = bld.s;
+    goto done;
+  }
   int nt = opts.threads > 0 ? opts.threads : hearth_default_threads();
   if ((size_t)nt > n_views) nt = n_views ? (int)n_views : 1;
   m = (map_ctx){.mesh = mesh, .rc = rc_in ? rc_in : own_rc, .cam = cam, .views = views,
@@ -930,6 +962,8 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
   }
   s = HEARTH_OK;
 done:
+  if (bld_started) pthread_join(bld_tid, NULL);
+  hearth_raycaster_free(bld.rc);
   free_scratch(&m);
   free(m.view_hits);
   hearth_raycaster_free(own_rc);
