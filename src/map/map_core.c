@@ -8,6 +8,7 @@
  * thread. */
 #include <math.h>
 #include <pthread.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -15,13 +16,41 @@
 
 #define FIX_SCALE 1048576.0 /* 2^20: fixed-point resolution of mean fusion */
 #define MAX_BACKFACE_SKIPS 8
-/* a thread's accumulator record per texel (see map_ctx.acc): offsets of
- * the island bits, this view's weight sum, best cosine and C sums, the
- * fused maximum (C) and the best cosine over views; floats per record */
-enum { ACC_ISLAND = 0, ACC_W = 1, ACC_COS = 2, ACC_SUM = 3 };
-#define ACC_MAX(C) (3 + (size_t)(C))
-#define ACC_BEST_COS(C) (3 + 2 * (size_t)(C))
-#define ACC_STRIDE(C) (4 + 2 * (size_t)(C))
+/* One texel's sums within one view, in a worker's open-addressing table
+ * (the texels a view touches are few next to R x R: the table stays in
+ * cache where a per-texel array would not) */
+typedef struct vslot {
+  uint32_t key;    /* texel + 1; 0 empty */
+  uint32_t island; /* the texel's island */
+  float w, cosv;   /* weight sum, best cosine */
+  float sum[3];    /* weighted value sums (C used) */
+  float pad;
+} vslot;
+
+static size_t slot_of(uint32_t q, size_t mask) {
+  return (size_t)((q * 2654435761u) ^ (q >> 15)) & mask;
+}
+
+/* fused results shared by the workers: maximum and best cosine as atomic
+ * maxima (exact and order-independent), the mean's fixed-point sums as
+ * atomic additions (integer addition is associative) */
+static void atomic_max_f32(_Atomic uint32_t *a, float v) {
+  uint32_t old = atomic_load_explicit(a, memory_order_relaxed), nv;
+  memcpy(&nv, &v, sizeof nv);
+  for (;;) {
+    float f;
+    memcpy(&f, &old, sizeof f);
+    if (!(v > f)) return;
+    if (atomic_compare_exchange_weak_explicit(a, &old, nv, memory_order_relaxed, memory_order_relaxed)) return;
+  }
+}
+
+static float atomic_get_f32(_Atomic uint32_t *a) {
+  uint32_t u = atomic_load_explicit(a, memory_order_relaxed);
+  float f;
+  memcpy(&f, &u, sizeof f);
+  return f;
+}
 
 void hearth_map_opts_default(hearth_map_opts *o) {
   memset(o, 0, sizeof *o);
@@ -82,16 +111,17 @@ typedef struct map_ctx {
   /* per-thread scratch, indexed by thread */
   int n_threads;
   int cast_threads; /* threads for ray casting when views are processed serially */
-  /* per thread, per texel, one record of ACC_STRIDE(C) floats: the texel's
-   * island (bits), this view's weight sum, best cosine and C value sums,
-   * then the fused maximum (C) and the best cosine over views; everything
-   * a splat or a fold touches shares a cache line */
-  float **acc;
-  uint8_t *acc_ready; /* per thread: records initialised */
-  uint32_t **touched;
+  /* per thread: this view's table of touched texels and its used slots in
+   * first-touch order */
+  vslot **tab;
+  size_t *tab_cap;
+  uint32_t **used;
+  /* shared fused state: per texel the maximum of the view means (C) and the
+   * best cosine over views; mean fusion's fixed-point sums */
+  _Atomic uint32_t *fmax, *fcos;
+  _Atomic int64_t *msum, *mw;
   splat **splats; /* per thread: n_pix */
   uint8_t **sil; /* per thread: n_pix silhouette flags */
-  int64_t **isum, **iw;
   float *hit_t; /* per thread: n_pix */
   uint32_t *hit_tri;
   float *hit_b1, *hit_b2;
@@ -213,9 +243,6 @@ static void process_view(map_ctx *m, size_t v, int t) {
   const hearth_mesh *mesh = m->mesh;
   size_t R = m->R, n = m->n_pix;
   int C = m->C;
-  size_t S = ACC_STRIDE(C);
-  float *acc = m->acc[t];
-  uint32_t *touched = m->touched[t];
   size_t n_touched = 0;
   cast_view(m, v, t);
   const float *ht = m->hit_t + (size_t)t * n, *hb1 = m->hit_b1 + (size_t)t * n,
@@ -266,12 +293,42 @@ static void process_view(map_ctx *m, size_t v, int t) {
     size_t src = m->pix_index[p];
     for (int c = 0; c < C; c++) e->val[c] = image_value(img, src, c);
   }
+  /* a table with room for every texel this view can touch, at most half full */
+  size_t need = 1024;
+  while (need < 8 * n_sp) need *= 2;
+  if (m->tab_cap[t] < need) {
+    free(m->tab[t]);
+    free(m->used[t]);
+    m->tab[t] = hearth_calloc_array(need, sizeof(vslot));
+    m->used[t] = hearth_alloc_array(need / 2, sizeof(uint32_t));
+    m->tab_cap[t] = need;
+    if (!m->tab[t] || !m->used[t]) {
+      free(m->tab[t]);
+      free(m->used[t]);
+      m->tab[t] = NULL;
+      m->used[t] = NULL;
+      m->tab_cap[t] = 0;
+      m->failed = 1;
+      return;
+    }
+  }
+  vslot *tab = m->tab[t];
+  uint32_t *used = m->used[t];
+  size_t mask = m->tab_cap[t] - 1;
+  const uint32_t *iot = m->island_of_texel;
   for (size_t i = 0; i < n_sp; i++) {
     if (i + SPLAT_AHEAD < n_sp) {
       const splat *f = &sp[i + SPLAT_AHEAD];
       size_t fx0 = f->x0 < 0 ? 0 : (size_t)f->x0, fy0 = f->y0 < 0 ? 0 : (size_t)f->y0;
-      __builtin_prefetch(acc + (fy0 * R + fx0) * S, 1);
-      if (fy0 + 1 < R) __builtin_prefetch(acc + ((fy0 + 1) * R + fx0) * S, 1);
+      if (fy0 < R && fx0 < R) {
+        uint32_t q0 = (uint32_t)(fy0 * R + fx0);
+        __builtin_prefetch(&tab[slot_of(q0, mask)], 1);
+        __builtin_prefetch(&tab[slot_of(q0 + 1, mask)], 1);
+        if (fy0 + 1 < R) {
+          __builtin_prefetch(&tab[slot_of(q0 + (uint32_t)R, mask)], 1);
+          __builtin_prefetch(&tab[slot_of(q0 + (uint32_t)R + 1, mask)], 1);
+        }
+      }
     }
     const splat *e = &sp[i];
     double fx = e->fx, fy = e->fy;
@@ -284,79 +341,87 @@ static void process_view(map_ctx *m, size_t v, int t) {
       if (tx < 0 || ty < 0 || tx >= (long)R || ty >= (long)R) continue;
       float w = (float)(((k & 1) ? fx : 1.0 - fx) * ((k >> 1) ? fy : 1.0 - fy));
       if (!(w > 0.0f)) continue;
-      size_t q = (size_t)ty * R + (size_t)tx;
-      /* splat only into surface texels of the same island */
-      float *a = acc + q * S;
-      uint32_t qi;
-      memcpy(&qi, a + ACC_ISLAND, sizeof qi);
-      if (qi != island) continue;
-      if (a[ACC_W] == 0.0f) {
-        /* first touch in this view (weights are > 0) */
-        touched[n_touched++] = (uint32_t)q;
-        a[ACC_COS] = cosv;
-        for (int c = 0; c < C; c++) a[ACC_SUM + c] = 0.0f;
-      } else if (cosv > a[ACC_COS]) {
-        a[ACC_COS] = cosv;
+      uint32_t q = (uint32_t)((size_t)ty * R + (size_t)tx);
+      size_t h = slot_of(q, mask);
+      while (tab[h].key && tab[h].key != q + 1) h = (h + 1) & mask;
+      vslot *a = &tab[h];
+      if (!a->key) {
+        /* first touch in this view: splat only into surface texels of the
+           same island */
+        if (iot[q] != island) continue;
+        a->key = q + 1;
+        a->island = island;
+        a->w = 0.0f;
+        a->cosv = cosv;
+        for (int c = 0; c < C; c++) a->sum[c] = 0.0f;
+        used[n_touched++] = (uint32_t)h;
+      } else if (a->island != island) {
+        continue;
+      } else if (cosv > a->cosv) {
+        a->cosv = cosv;
       }
-      a[ACC_W] += w;
-      for (int c = 0; c < C; c++) a[ACC_SUM + c] += w * val[c];
+      a->w += w;
+      for (int c = 0; c < C; c++) a->sum[c] += w * val[c];
     }
   }
   m->view_hits[v] = hits;
-  /* fold this view's per-texel means into the thread's fusion state */
-  for (size_t i = 0; i < n_touched; i++) {
-    float *a = acc + (size_t)touched[i] * S;
-    if (a[ACC_COS] > a[ACC_BEST_COS(C)]) a[ACC_BEST_COS(C)] = a[ACC_COS];
-  }
+  /* fold this view's per-texel means into the shared fused state */
   if (m->opts->fusion == HEARTH_FUSE_ROBUST) {
     view_record *rec = malloc((n_touched ? n_touched : 1) * sizeof *rec);
     if (!rec) {
       m->failed = 1;
     } else {
       for (size_t i = 0; i < n_touched; i++) {
-        const float *a = acc + (size_t)touched[i] * S;
-        rec[i] = (view_record){touched[i], a[ACC_SUM] / a[ACC_W], a[ACC_W]};
+        const vslot *a = &tab[used[i]];
+        rec[i] = (view_record){a->key - 1, a->sum[0] / a->w, a->w};
       }
       m->records[v] = rec;
       m->n_records[v] = n_touched;
     }
-  } else if (m->opts->fusion == HEARTH_FUSE_MAX) {
-    for (size_t i = 0; i < n_touched; i++) {
-      float *a = acc + (size_t)touched[i] * S;
-      for (int c = 0; c < C; c++) {
-        float mean = a[ACC_SUM + c] / a[ACC_W];
-        if (mean > a[ACC_MAX(C) + c]) a[ACC_MAX(C) + c] = mean;
-      }
-    }
-  } else {
-    int64_t *isum = m->isum[t], *iw = m->iw[t];
-    for (size_t i = 0; i < n_touched; i++) {
-      uint32_t q = touched[i];
-      const float *a = acc + (size_t)q * S;
-      /* each view counts with its total weight at this texel */
-      iw[q] += (int64_t)llround((double)a[ACC_W] * FIX_SCALE);
-      for (int c = 0; c < C; c++) isum[q * (size_t)C + (size_t)c] += (int64_t)llround((double)a[ACC_SUM + c] * FIX_SCALE);
-    }
   }
-  for (size_t i = 0; i < n_touched; i++) acc[(size_t)touched[i] * S + 1] = 0.0f;
+  for (size_t i = 0; i < n_touched; i++) {
+    vslot *a = &tab[used[i]];
+    size_t q = a->key - 1;
+    atomic_max_f32(&m->fcos[q], a->cosv);
+    if (m->opts->fusion == HEARTH_FUSE_MAX) {
+      for (int c = 0; c < C; c++) {
+        /* + 0.0f: a negative zero becomes +0, so equal means cannot make
+           the maximum's bits depend on which view came first */
+        float mean = a->sum[c] / a->w + 0.0f;
+        atomic_max_f32(&m->fmax[q * (size_t)C + (size_t)c], mean);
+      }
+    } else if (m->opts->fusion == HEARTH_FUSE_MEAN) {
+      /* each view counts with its total weight at this texel */
+      atomic_fetch_add_explicit(&m->mw[q], (int64_t)llround((double)a->w * FIX_SCALE), memory_order_relaxed);
+      for (int c = 0; c < C; c++)
+        atomic_fetch_add_explicit(&m->msum[q * (size_t)C + (size_t)c],
+                                  (int64_t)llround((double)a->sum[c] * FIX_SCALE), memory_order_relaxed);
+    }
+    a->key = 0;
+  }
 }
 
-/* a thread's records: its island, zero sums, maximum -inf, best cosine 0;
- * written by the thread that uses them (first touch, in parallel) */
-static void init_acc(map_ctx *m, int t) {
-  size_t S = ACC_STRIDE(m->C), N = m->R * m->R;
-  float *a = m->acc[t];
-  for (size_t q = 0; q < N; q++, a += S) {
-    memcpy(a + ACC_ISLAND, &m->island_of_texel[q], sizeof(uint32_t));
-    for (size_t k = ACC_W; k < S; k++) a[k] = 0.0f;
-    for (int c = 0; c < m->C; c++) a[ACC_MAX(m->C) + c] = -INFINITY;
+/* the shared fused state: maxima -inf, best cosines 0, mean sums 0; rows
+ * in parallel */
+static void init_fused(void *ctx, size_t b, size_t e, int t) {
+  map_ctx *m = ctx;
+  size_t R = m->R, C = (size_t)m->C;
+  uint32_t minf;
+  float f = -INFINITY;
+  memcpy(&minf, &f, sizeof minf);
+  (void)t;
+  for (size_t q = b * R; q < e * R; q++) {
+    atomic_init(&m->fcos[q], 0u);
+    for (size_t c = 0; c < C; c++) atomic_init(&m->fmax[q * C + c], minf);
+    if (m->mw) {
+      atomic_init(&m->mw[q], 0);
+      for (size_t c = 0; c < C; c++) atomic_init(&m->msum[q * C + c], 0);
+    }
   }
-  m->acc_ready[t] = 1;
 }
 
 static void views_range(void *ctx, size_t b, size_t e, int t) {
   map_ctx *m = ctx;
-  if (!m->acc_ready[t]) init_acc(m, t);
   for (size_t v = b; v < e; v++) process_view(m, v, t);
 }
 
@@ -574,30 +639,20 @@ typedef struct texel_pass {
   size_t (*counts)[4]; /* per worker: observed, filled, unobserved, surface */
 } texel_pass;
 
-/* best cosine over the workers' records, mask NONE / UNOBSERVED, observed
- * NaN, and for max fusion the maximum over the workers' records */
+/* best cosine, mask NONE / UNOBSERVED, observed NaN, and for max fusion
+ * the maximum over the views */
 static void fuse_rows(void *ctx, size_t b, size_t e, int t) {
   const texel_pass *tp = ctx;
   const map_ctx *m = tp->m;
   hearth_map_result *out = tp->out;
-  size_t R = m->R, S = ACC_STRIDE(m->C), C = (size_t)m->C;
-  int nt = m->n_threads, fmax = m->opts->fusion == HEARTH_FUSE_MAX;
+  size_t R = m->R, C = (size_t)m->C;
+  int fmax = m->opts->fusion == HEARTH_FUSE_MAX;
   (void)t;
   for (size_t q = b * R; q < e * R; q++) {
-    float bc = 0;
-    for (int k = 0; k < nt; k++) {
-      float v = m->acc[k][q * S + ACC_BEST_COS(m->C)];
-      if (v > bc) bc = v;
-    }
-    out->best_cos[q] = bc;
+    out->best_cos[q] = atomic_get_f32(&m->fcos[q]);
     out->mask[q] = tp->tri_of_texel[q] == UINT32_MAX ? HEARTH_TEXEL_NONE : HEARTH_TEXEL_UNOBSERVED;
     for (size_t c = 0; c < C; c++) {
-      float best = -INFINITY;
-      if (fmax)
-        for (int k = 0; k < nt; k++) {
-          float v = m->acc[k][q * S + ACC_MAX(m->C) + c];
-          if (v > best) best = v;
-        }
+      float best = fmax ? atomic_get_f32(&m->fmax[q * C + c]) : -INFINITY;
       if (best > -INFINITY) {
         out->observed[q * C + c] = best;
         out->mask[q] = HEARTH_TEXEL_OBSERVED;
@@ -648,20 +703,20 @@ static void *rc_build_run(void *arg) {
 
 static void free_scratch(map_ctx *m) {
   for (int t = 0; t < m->n_threads; t++) {
-    if (m->acc) free(m->acc[t]);
-    if (m->touched) free(m->touched[t]);
+    if (m->tab) free(m->tab[t]);
+    if (m->used) free(m->used[t]);
     if (m->splats) free(m->splats[t]);
     if (m->sil) free(m->sil[t]);
-    if (m->isum) free(m->isum[t]);
-    if (m->iw) free(m->iw[t]);
   }
-  free(m->acc);
-  free(m->acc_ready);
-  free(m->touched);
+  free(m->tab);
+  free(m->tab_cap);
+  free(m->used);
+  free((void *)m->fmax);
+  free((void *)m->fcos);
+  free((void *)m->msum);
+  free((void *)m->mw);
   free(m->splats);
   free(m->sil);
-  free(m->isum);
-  free(m->iw);
   free(m->hit_t);
   free(m->hit_tri);
   free(m->hit_b1);
@@ -819,13 +874,17 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
                 .tile_order = tile_order, .sphere = {sphere[0], sphere[1], sphere[2], sphere[3]},
                 .n_threads = nt,
                 .cast_threads = opts.threads > 0 ? opts.threads : hearth_default_threads()};
-  m.acc = calloc((size_t)nt, sizeof *m.acc);
+  m.tab = calloc((size_t)nt, sizeof *m.tab);
+  m.tab_cap = calloc((size_t)nt, sizeof *m.tab_cap);
+  m.used = calloc((size_t)nt, sizeof *m.used);
   m.sil = calloc((size_t)nt, sizeof *m.sil);
-  m.acc_ready = calloc((size_t)nt, 1);
-  m.touched = calloc((size_t)nt, sizeof *m.touched);
   m.splats = calloc((size_t)nt, sizeof *m.splats);
-  m.isum = calloc((size_t)nt, sizeof *m.isum);
-  m.iw = calloc((size_t)nt, sizeof *m.iw);
+  m.fmax = hearth_alloc_array(N * (size_t)C, sizeof *m.fmax);
+  m.fcos = hearth_alloc_array(N, sizeof *m.fcos);
+  if (opts.fusion == HEARTH_FUSE_MEAN) {
+    m.msum = hearth_alloc_array(N * (size_t)C, sizeof *m.msum);
+    m.mw = hearth_alloc_array(N, sizeof *m.mw);
+  }
   m.hit_t = hearth_alloc_array(np * (size_t)nt, sizeof(float));
   m.hit_tri = hearth_alloc_array(np * (size_t)nt, sizeof(uint32_t));
   m.hit_b1 = hearth_alloc_array(np * (size_t)nt, sizeof(float));
@@ -834,8 +893,8 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
   m.ray_dir = hearth_alloc_array(np * (size_t)nt, 3 * sizeof(float));
   m.hits = hearth_alloc_array(np * (size_t)nt, sizeof(hearth_ray_hit));
   m.view_hits = calloc(n_views ? n_views : 1, sizeof *m.view_hits);
-  int bad = !m.acc || !m.acc_ready || !m.sil || !m.touched || !m.splats || !m.isum ||
-            !m.iw || !m.hit_t || !m.hit_tri || !m.hit_b1 || !m.hit_b2 || !m.ray_org ||
+  int bad = !m.tab || !m.tab_cap || !m.used || !m.sil || !m.splats || !m.fmax || !m.fcos ||
+            (opts.fusion == HEARTH_FUSE_MEAN && (!m.msum || !m.mw)) || !m.hit_t || !m.hit_tri || !m.hit_b1 || !m.hit_b2 || !m.ray_org ||
             !m.ray_dir || !m.hits || !m.view_hits;
   if (opts.fusion == HEARTH_FUSE_ROBUST) {
     m.records = calloc(n_views ? n_views : 1, sizeof *m.records);
@@ -843,25 +902,16 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
     bad |= !m.records || !m.n_records;
   }
   for (int t = 0; !bad && t < nt; t++) {
-    m.acc[t] = hearth_alloc_array(N, ACC_STRIDE(C) * sizeof(float));
     m.sil[t] = hearth_alloc_array(np, 1);
-    m.touched[t] = hearth_alloc_array(N, sizeof(uint32_t));
     m.splats[t] = hearth_alloc_array(np, sizeof(splat));
-    bad |= !m.acc[t] || !m.sil[t] || !m.touched[t] || !m.splats[t];
-    if (bad) break;
-    if (opts.fusion == HEARTH_FUSE_MEAN) {
-      m.isum[t] = hearth_calloc_array(N * (size_t)C, sizeof(int64_t));
-      m.iw[t] = hearth_calloc_array(N, sizeof(int64_t));
-      bad |= !m.isum[t] || !m.iw[t];
-    }
+    bad |= !m.sil[t] || !m.splats[t];
   }
   if (bad) {
     s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory for %d threads at R=%zu", nt, R);
     goto done;
   }
+  hearth_parallel_for(R, nt, init_fused, &m);
   hearth_parallel_for(n_views, nt, views_range, &m);
-  for (int t = 0; t < nt; t++)
-    if (!m.acc_ready[t]) init_acc(&m, t); /* a thread that had no views */
   if (m.failed) {
     s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory while fusing views");
     goto done;
@@ -891,12 +941,10 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
   }
   if (opts.fusion == HEARTH_FUSE_MEAN) {
     for (size_t q = 0; q < N; q++) {
-      int64_t w = 0;
-      for (int t = 0; t < nt; t++) w += m.iw[t][q];
+      int64_t w = atomic_load_explicit(&m.mw[q], memory_order_relaxed);
       if (w <= 0) continue;
       for (int c = 0; c < C; c++) {
-        int64_t sm = 0;
-        for (int t = 0; t < nt; t++) sm += m.isum[t][q * (size_t)C + (size_t)c];
+        int64_t sm = atomic_load_explicit(&m.msum[q * (size_t)C + (size_t)c], memory_order_relaxed);
         out->observed[q * (size_t)C + (size_t)c] = (float)((double)sm / (double)w);
       }
       out->mask[q] = HEARTH_TEXEL_OBSERVED;
