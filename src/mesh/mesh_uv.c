@@ -7,52 +7,23 @@
 
 /* ---- islands ---------------------------------------------------------------- */
 
-/* a 64-bit key with the index of its vertex (UV weld) or triangle (edges) */
-typedef struct key_id {
-  uint64_t key;
-  uint32_t id;
-} key_id;
-
-/* sort by key, then id, for arrays built in increasing id order: a stable
- * LSD radix sort over 16-bit digits (digits that are equal in every key
- * are skipped); 10x faster than qsort on a 100k-triangle mesh */
-static int sort_key_id(key_id *a, size_t n) {
-  if (n < 2) return 1;
-  key_id *tmp = hearth_alloc_array(n, sizeof *tmp);
-  uint32_t *count = calloc(4 * 65536, sizeof *count);
-  if (!tmp || !count) {
-    free(tmp);
-    free(count);
-    return 0;
-  }
-  for (size_t i = 0; i < n; i++)
-    for (int d = 0; d < 4; d++) count[d * 65536 + ((a[i].key >> (16 * d)) & 0xFFFF)]++;
-  key_id *src = a, *dst = tmp;
-  for (int d = 0; d < 4; d++) {
-    uint32_t *c = count + d * 65536;
-    if (c[(src[0].key >> (16 * d)) & 0xFFFF] == n) continue; /* one digit value throughout */
-    uint32_t sum = 0;
-    for (int k = 0; k < 65536; k++) {
-      uint32_t x = c[k];
-      c[k] = sum;
-      sum += x;
-    }
-    for (size_t i = 0; i < n; i++) dst[c[(src[i].key >> (16 * d)) & 0xFFFF]++] = src[i];
-    key_id *t = src;
-    src = dst;
-    dst = t;
-  }
-  if (src != a) memcpy(a, src, n * sizeof *a);
-  free(tmp);
-  free(count);
-  return 1;
-}
-
 static uint32_t float_bits(float f) {
   if (f == 0.0f) f = 0.0f; /* -0 and +0 are the same coordinate */
   uint32_t u;
   memcpy(&u, &f, sizeof u);
   return u;
+}
+
+static int cmp_u64(const void *a, const void *b) {
+  uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+  return (x > y) - (x < y);
+}
+
+static uint64_t mix64(uint64_t k) {
+  k ^= k >> 33;
+  k *= 0xff51afd7ed558ccdULL;
+  k ^= k >> 33;
+  return k;
 }
 
 static uint32_t uf_find(uint32_t *parent, uint32_t x) {
@@ -83,55 +54,78 @@ hearth_status hearth_uv_islands(const hearth_mesh *m, uint32_t *island_of_tri,
   size_t nv = m->n_vertices, nt = m->n_triangles, ne;
   if (!hearth_mul_size(nt, 3, &ne))
     return hearth_err_set(err, HEARTH_E_NOMEM, "UV islands: size overflow");
-  key_id *uk = hearth_alloc_array(nv ? nv : 1, sizeof *uk);
+  /* weld: vertices with bit-identical UVs share one id (an open-addressing
+   * table of the UV bits; ids in order of first appearance) */
+  size_t cap = 16;
+  while (cap < 2 * nv) cap *= 2;
+  uint64_t *hkey = hearth_alloc_array(cap, sizeof *hkey);
+  uint32_t *hid = hearth_alloc_array(cap, sizeof *hid);
   uint32_t *uv_id = hearth_alloc_array(nv ? nv : 1, sizeof *uv_id);
-  key_id *ek = hearth_alloc_array(ne ? ne : 1, sizeof *ek);
   uint32_t *parent = hearth_alloc_array(nt ? nt : 1, sizeof *parent);
-  if (!uk || !uv_id || !ek || !parent) {
-    free(uk);
-    free(uv_id);
-    free(ek);
-    free(parent);
-    return hearth_err_set(err, HEARTH_E_NOMEM, "UV islands: out of memory for %zu triangles", nt);
-  }
-  /* weld: vertices with bit-identical UVs share one id */
+  uint32_t *start = NULL, *other = NULL, *tri = NULL;
+  if (!hkey || !hid || !uv_id || !parent) goto oom;
+  for (size_t i = 0; i < cap; i++) hid[i] = UINT32_MAX;
+  uint32_t n_uv = 0;
   for (size_t i = 0; i < nv; i++) {
-    uk[i].key = ((uint64_t)float_bits(m->uvs[2 * i]) << 32) | float_bits(m->uvs[2 * i + 1]);
-    uk[i].id = (uint32_t)i;
+    uint64_t key = ((uint64_t)float_bits(m->uvs[2 * i]) << 32) | float_bits(m->uvs[2 * i + 1]);
+    size_t h = (size_t)mix64(key) & (cap - 1);
+    while (hid[h] != UINT32_MAX && hkey[h] != key) h = (h + 1) & (cap - 1);
+    if (hid[h] == UINT32_MAX) {
+      hkey[h] = key;
+      hid[h] = n_uv++;
+    }
+    uv_id[i] = hid[h];
   }
-  int sorted = sort_key_id(uk, nv);
-  uint32_t next = 0;
-  for (size_t i = 0; i < nv; i++) {
-    if (i > 0 && uk[i].key != uk[i - 1].key) next++;
-    uv_id[uk[i].id] = next;
-  }
-  /* edges in UV space; a degenerate edge (both ends welded) joins nothing */
-  size_t n_e = 0;
+  free(hkey);
+  free(hid);
+  hkey = NULL;
+  hid = NULL;
+  /* edges in UV space, grouped by their lower end (a counting sort); two
+   * triangles with the same edge join. A degenerate edge (both ends welded)
+   * joins nothing. Island labels do not depend on the order of the unions. */
+  start = calloc((size_t)n_uv + 1, sizeof *start);
+  other = hearth_alloc_array(ne ? ne : 1, sizeof *other);
+  tri = hearth_alloc_array(ne ? ne : 1, sizeof *tri);
+  if (!start || !other || !tri) goto oom;
   for (size_t t = 0; t < nt; t++) {
     parent[t] = (uint32_t)t;
     for (int k = 0; k < 3; k++) {
       uint32_t a = uv_id[m->indices[t * 3 + k]], b = uv_id[m->indices[t * 3 + (k + 1) % 3]];
-      if (a == b) continue;
-      if (a > b) {
-        uint32_t tmp = a;
-        a = b;
-        b = tmp;
-      }
-      ek[n_e].key = ((uint64_t)a << 32) | b;
-      ek[n_e].id = (uint32_t)t;
-      n_e++;
+      if (a != b) start[(a < b ? a : b) + 1]++;
     }
   }
-  sorted = sorted && sort_key_id(ek, n_e);
-  for (size_t i = 1; sorted && i < n_e; i++)
-    if (ek[i].key == ek[i - 1].key) uf_union(parent, ek[i - 1].id, ek[i].id);
-  if (!sorted) {
-    free(uk);
-    free(uv_id);
-    free(ek);
-    free(parent);
-    return hearth_err_set(err, HEARTH_E_NOMEM, "UV islands: out of memory for %zu triangles", nt);
+  for (uint32_t i = 0; i < n_uv; i++) start[i + 1] += start[i];
+  for (size_t t = 0; t < nt; t++)
+    for (int k = 0; k < 3; k++) {
+      uint32_t a = uv_id[m->indices[t * 3 + k]], b = uv_id[m->indices[t * 3 + (k + 1) % 3]];
+      if (a == b) continue;
+      uint32_t lo = a < b ? a : b, hi = a < b ? b : a, at = start[lo]++;
+      other[at] = hi;
+      tri[at] = (uint32_t)t;
+    }
+  /* start[i] is now the end of group i, the beginning of group i + 1.
+   * Groups are a vertex's edges (a handful); a large one (a fan's centre)
+   * is sorted by the far end instead of compared pair by pair. */
+  for (uint32_t g = 0, b0 = 0; g < n_uv; b0 = start[g], g++) {
+    uint32_t len = start[g] - b0;
+    if (len <= 32) {
+      for (uint32_t i = b0; i < start[g]; i++)
+        for (uint32_t j = i + 1; j < start[g]; j++)
+          if (other[i] == other[j]) uf_union(parent, tri[i], tri[j]);
+      continue;
+    }
+    uint64_t *pairs = hearth_alloc_array(len, sizeof *pairs);
+    if (!pairs) goto oom;
+    for (uint32_t i = 0; i < len; i++) pairs[i] = ((uint64_t)other[b0 + i] << 32) | tri[b0 + i];
+    qsort(pairs, len, sizeof *pairs, cmp_u64);
+    for (uint32_t i = 1; i < len; i++)
+      if (pairs[i] >> 32 == pairs[i - 1] >> 32) uf_union(parent, (uint32_t)pairs[i - 1], (uint32_t)pairs[i]);
+    free(pairs);
   }
+  free(start);
+  free(other);
+  free(tri);
+  start = other = tri = NULL;
   /* labels in order of each island's lowest triangle */
   uint32_t count = 0;
   for (size_t t = 0; t < nt; t++) {
@@ -140,11 +134,18 @@ hearth_status hearth_uv_islands(const hearth_mesh *m, uint32_t *island_of_tri,
     else island_of_tri[t] = island_of_tri[r];
   }
   *n_islands = count;
-  free(uk);
   free(uv_id);
-  free(ek);
   free(parent);
   return HEARTH_OK;
+oom:
+  free(hkey);
+  free(hid);
+  free(uv_id);
+  free(parent);
+  free(start);
+  free(other);
+  free(tri);
+  return hearth_err_set(err, HEARTH_E_NOMEM, "UV islands: out of memory for %zu triangles", nt);
 }
 
 /* ---- rasterisation ------------------------------------------------------------ */

@@ -74,6 +74,39 @@ int main(void) {
      * a shared position index */
     hearth_mesh_free(&w);
 
+    /* a fan of 200 triangles around one centre (a vertex with hundreds of
+     * edges): neighbours join along their shared spoke, except across the
+     * closing spoke, whose two sides carry different UVs (a seam), and
+     * across spoke 0-101, which triangle 99 no longer has -> two islands */
+    {
+      enum { NF = 200 };
+      hearth_mesh f;
+      CHECK_OK(hearth_mesh_alloc(&f, NF + 2, NF, 1, &err), &err);
+      f.uvs[0] = 0.5f, f.uvs[1] = 0.5f; /* centre */
+      for (int i = 0; i <= NF; i++) {   /* ring vertices 1..NF+1 (NF+1 duplicates 1 in 3-D) */
+        double a = 2.0 * 3.141592653589793 * (i % NF) / NF;
+        f.uvs[2 * (1 + i)] = (float)(0.5 + 0.4 * cos(a));
+        f.uvs[2 * (1 + i) + 1] = (float)(0.5 + 0.4 * sin(a));
+      }
+      f.uvs[2 * (NF + 1)] += 0.01f; /* the closing spoke's second copy: a seam */
+      for (size_t k = 0; k < 3 * (size_t)(NF + 2); k++) f.positions[k] = 0.0f;
+      for (int t = 0; t < NF; t++) {
+        f.indices[3 * t] = 0;
+        f.indices[3 * t + 1] = (uint32_t)(1 + t);
+        f.indices[3 * t + 2] = (uint32_t)(2 + t);
+      }
+      /* triangle 99 loses its corner 101 (degenerate now, but it still
+         shares spoke 0-100 with triangle 98) */
+      f.indices[3 * 99 + 2] = 0;
+      uint32_t fisl[NF], fn = 0;
+      CHECK_OK(hearth_uv_islands(&f, fisl, &fn, &err), &err);
+      CHECK_MSG(fn == 2, "fan: %u islands", fn);
+      int ok = 1;
+      for (int t = 0; t < NF; t++) ok &= fisl[t] == (t < 100 ? 0u : 1u);
+      CHECK(ok);
+      hearth_mesh_free(&f);
+    }
+
     /* rasterised coverage of a quad equals the closed-form texel count */
     size_t Rs[3] = {64, 100, 1024};
     for (int ri = 0; ri < 3; ri++) {
