@@ -45,6 +45,10 @@ static void atomic_max_f32(_Atomic uint32_t *a, float v) {
   }
 }
 
+#define FUSED_STRIDE(C) (2 + (size_t)(C))
+#define FUSED_MAX 1 /* then C words */
+#define FUSED_COS(C) (1 + (size_t)(C))
+
 static float atomic_get_f32(_Atomic uint32_t *a) {
   uint32_t u = atomic_load_explicit(a, memory_order_relaxed);
   float f;
@@ -116,9 +120,11 @@ typedef struct map_ctx {
   vslot **tab;
   size_t *tab_cap;
   uint32_t **used;
-  /* shared fused state: per texel the maximum of the view means (C) and the
-   * best cosine over views; mean fusion's fixed-point sums */
-  _Atomic uint32_t *fmax, *fcos;
+  /* shared fused state, FUSED_STRIDE(C) words per texel: the texel's island
+   * (read-only), the maximum of the view means (C floats) and the best
+   * cosine over views; one cache line for everything a first touch or a
+   * fold needs. Mean fusion's fixed-point sums beside it. */
+  _Atomic uint32_t *fused;
   _Atomic int64_t *msum, *mw;
   splat **splats; /* per thread: n_pix */
   uint8_t **sil; /* per thread: n_pix silhouette flags */
@@ -315,7 +321,8 @@ static void process_view(map_ctx *m, size_t v, int t) {
   vslot *tab = m->tab[t];
   uint32_t *used = m->used[t];
   size_t mask = m->tab_cap[t] - 1;
-  const uint32_t *iot = m->island_of_texel;
+  _Atomic uint32_t *fused = m->fused;
+  const size_t FS = FUSED_STRIDE(C);
   for (size_t i = 0; i < n_sp; i++) {
     if (i + SPLAT_AHEAD < n_sp) {
       const splat *f = &sp[i + SPLAT_AHEAD];
@@ -324,9 +331,11 @@ static void process_view(map_ctx *m, size_t v, int t) {
         uint32_t q0 = (uint32_t)(fy0 * R + fx0);
         __builtin_prefetch(&tab[slot_of(q0, mask)], 1);
         __builtin_prefetch(&tab[slot_of(q0 + 1, mask)], 1);
+        __builtin_prefetch(&fused[q0 * FS], 0);
         if (fy0 + 1 < R) {
           __builtin_prefetch(&tab[slot_of(q0 + (uint32_t)R, mask)], 1);
           __builtin_prefetch(&tab[slot_of(q0 + (uint32_t)R + 1, mask)], 1);
+          __builtin_prefetch(&fused[(q0 + (uint32_t)R) * FS], 0);
         }
       }
     }
@@ -348,7 +357,7 @@ static void process_view(map_ctx *m, size_t v, int t) {
       if (!a->key) {
         /* first touch in this view: splat only into surface texels of the
            same island */
-        if (iot[q] != island) continue;
+        if (atomic_load_explicit(&fused[q * FS], memory_order_relaxed) != island) continue;
         a->key = q + 1;
         a->island = island;
         a->w = 0.0f;
@@ -380,15 +389,17 @@ static void process_view(map_ctx *m, size_t v, int t) {
     }
   }
   for (size_t i = 0; i < n_touched; i++) {
+    if (i + SPLAT_AHEAD < n_touched) __builtin_prefetch(&fused[(size_t)(tab[used[i + SPLAT_AHEAD]].key - 1) * FS], 1);
     vslot *a = &tab[used[i]];
     size_t q = a->key - 1;
-    atomic_max_f32(&m->fcos[q], a->cosv);
+    _Atomic uint32_t *f = fused + q * FS;
+    atomic_max_f32(&f[FUSED_COS(C)], a->cosv);
     if (m->opts->fusion == HEARTH_FUSE_MAX) {
       for (int c = 0; c < C; c++) {
         /* + 0.0f: a negative zero becomes +0, so equal means cannot make
            the maximum's bits depend on which view came first */
         float mean = a->sum[c] / a->w + 0.0f;
-        atomic_max_f32(&m->fmax[q * (size_t)C + (size_t)c], mean);
+        atomic_max_f32(&f[FUSED_MAX + (size_t)c], mean);
       }
     } else if (m->opts->fusion == HEARTH_FUSE_MEAN) {
       /* each view counts with its total weight at this texel */
@@ -401,18 +412,20 @@ static void process_view(map_ctx *m, size_t v, int t) {
   }
 }
 
-/* the shared fused state: maxima -inf, best cosines 0, mean sums 0; rows
- * in parallel */
+/* the shared fused state: islands, maxima -inf, best cosines 0, mean sums
+ * 0; rows in parallel */
 static void init_fused(void *ctx, size_t b, size_t e, int t) {
   map_ctx *m = ctx;
   size_t R = m->R, C = (size_t)m->C;
   uint32_t minf;
-  float f = -INFINITY;
-  memcpy(&minf, &f, sizeof minf);
+  float ninf = -INFINITY;
+  memcpy(&minf, &ninf, sizeof minf);
   (void)t;
   for (size_t q = b * R; q < e * R; q++) {
-    atomic_init(&m->fcos[q], 0u);
-    for (size_t c = 0; c < C; c++) atomic_init(&m->fmax[q * C + c], minf);
+    _Atomic uint32_t *f = m->fused + q * FUSED_STRIDE(C);
+    atomic_init(&f[0], m->island_of_texel[q]);
+    for (size_t c = 0; c < C; c++) atomic_init(&f[FUSED_MAX + c], minf);
+    atomic_init(&f[FUSED_COS(C)], 0u);
     if (m->mw) {
       atomic_init(&m->mw[q], 0);
       for (size_t c = 0; c < C; c++) atomic_init(&m->msum[q * C + c], 0);
@@ -649,10 +662,11 @@ static void fuse_rows(void *ctx, size_t b, size_t e, int t) {
   int fmax = m->opts->fusion == HEARTH_FUSE_MAX;
   (void)t;
   for (size_t q = b * R; q < e * R; q++) {
-    out->best_cos[q] = atomic_get_f32(&m->fcos[q]);
+    _Atomic uint32_t *f = m->fused + q * FUSED_STRIDE(C);
+    out->best_cos[q] = atomic_get_f32(&f[FUSED_COS(C)]);
     out->mask[q] = tp->tri_of_texel[q] == UINT32_MAX ? HEARTH_TEXEL_NONE : HEARTH_TEXEL_UNOBSERVED;
     for (size_t c = 0; c < C; c++) {
-      float best = fmax ? atomic_get_f32(&m->fmax[q * C + c]) : -INFINITY;
+      float best = fmax ? atomic_get_f32(&f[FUSED_MAX + c]) : -INFINITY;
       if (best > -INFINITY) {
         out->observed[q * C + c] = best;
         out->mask[q] = HEARTH_TEXEL_OBSERVED;
@@ -711,8 +725,7 @@ static void free_scratch(map_ctx *m) {
   free(m->tab);
   free(m->tab_cap);
   free(m->used);
-  free((void *)m->fmax);
-  free((void *)m->fcos);
+  free((void *)m->fused);
   free((void *)m->msum);
   free((void *)m->mw);
   free(m->splats);
@@ -879,8 +892,7 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
   m.used = calloc((size_t)nt, sizeof *m.used);
   m.sil = calloc((size_t)nt, sizeof *m.sil);
   m.splats = calloc((size_t)nt, sizeof *m.splats);
-  m.fmax = hearth_alloc_array(N * (size_t)C, sizeof *m.fmax);
-  m.fcos = hearth_alloc_array(N, sizeof *m.fcos);
+  m.fused = hearth_alloc_array(N, FUSED_STRIDE(C) * sizeof *m.fused);
   if (opts.fusion == HEARTH_FUSE_MEAN) {
     m.msum = hearth_alloc_array(N * (size_t)C, sizeof *m.msum);
     m.mw = hearth_alloc_array(N, sizeof *m.mw);
@@ -893,7 +905,7 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
   m.ray_dir = hearth_alloc_array(np * (size_t)nt, 3 * sizeof(float));
   m.hits = hearth_alloc_array(np * (size_t)nt, sizeof(hearth_ray_hit));
   m.view_hits = calloc(n_views ? n_views : 1, sizeof *m.view_hits);
-  int bad = !m.tab || !m.tab_cap || !m.used || !m.sil || !m.splats || !m.fmax || !m.fcos ||
+  int bad = !m.tab || !m.tab_cap || !m.used || !m.sil || !m.splats || !m.fused ||
             (opts.fusion == HEARTH_FUSE_MEAN && (!m.msum || !m.mw)) || !m.hit_t || !m.hit_tri || !m.hit_b1 || !m.hit_b2 || !m.ray_org ||
             !m.ray_dir || !m.hits || !m.view_hits;
   if (opts.fusion == HEARTH_FUSE_ROBUST) {
