@@ -68,13 +68,19 @@ int main(int argc, char **argv) {
   job.map.resolution = R;
   job.map.threads = threads;
   double t_all = 1e30;
+  hearth_map_timing e2e = {0}, run;
+  job.timing = &run;
   for (int k = 0; k < reps; k++) {
     double t0 = hearth_now();
     if (hearth_map_run(&job, NULL, &err)) {
       fprintf(stderr, "map: %s\n", err.msg);
       return 1;
     }
-    t_all = best_of(t_all, hearth_now() - t0);
+    double t = hearth_now() - t0;
+    if (t < t_all) {
+      t_all = t;
+      e2e = run; /* the phases of the best run */
+    }
   }
 
   /* phases on in-memory inputs */
@@ -156,13 +162,19 @@ int main(int argc, char **argv) {
   printf("    cast + splat        %6.1f ms (%4.1f%%)\n", 1e3 * best.cast, 100 * best.cast / best.total);
   printf("    fusion              %6.1f ms (%4.1f%%)\n", 1e3 * best.fuse, 100 * best.fuse / best.total);
   printf("    fill                %6.1f ms (%4.1f%%)\n", 1e3 * best.fill, 100 * best.fill / best.total);
-  printf("  reading: 30 CSVs %.1f ms, mesh + documents %.1f ms\n", 1e3 * t_csv, 1e3 * t_mesh);
-  double rest = t_all - (t_csv + t_mesh + t_bvh + best.total);
-  printf("  end to end by phase: read %.0f%%, build %.0f%%, raster+islands %.0f%%, cast+splat %.0f%%, "
-         "fusion %.0f%%, fill %.0f%%, writing and the rest %.0f%% (%.1f ms)\n",
-         100 * (t_csv + t_mesh) / t_all, 100 * t_bvh / t_all, 100 * best.raster / t_all,
-         100 * best.cast / t_all, 100 * best.fuse / t_all, 100 * best.fill / t_all, 100 * rest / t_all,
-         1e3 * rest);
+  printf("  reading one thread: 30 CSVs %.1f ms, mesh + documents %.1f ms\n", 1e3 * t_csv, 1e3 * t_mesh);
+  /* the best end-to-end run's own phases: reading (CSVs in parallel, mesh,
+     documents); the ray caster built on its own thread while the UV layout
+     is rasterised (its time is inside raster + islands and cast + splat,
+     whichever it overlaps); writing (maps, Turbo PNG, provenance, swap) */
+  double other = e2e.total - (e2e.read + e2e.raster + e2e.cast + e2e.fuse + e2e.fill + e2e.write);
+  printf("  end to end, best run by phase: read %.1f ms (%.0f%%), raster+islands %.1f (%.0f%%), "
+         "cast+splat %.1f (%.0f%%), fusion %.1f (%.0f%%), fill %.1f (%.0f%%), write %.1f (%.0f%%), "
+         "other %.1f; ray caster build %.1f ms beside raster+islands\n",
+         1e3 * e2e.read, 100 * e2e.read / e2e.total, 1e3 * e2e.raster, 100 * e2e.raster / e2e.total,
+         1e3 * e2e.cast, 100 * e2e.cast / e2e.total, 1e3 * e2e.fuse, 100 * e2e.fuse / e2e.total,
+         1e3 * e2e.fill, 100 * e2e.fill / e2e.total, 1e3 * e2e.write, 100 * e2e.write / e2e.total,
+         1e3 * other, 1e3 * e2e.build);
   printf("  reference: the same %zu rays cast alone %.1f ms; mapping/reference = %.2f\n", nr, 1e3 * t_ref,
          best.total / t_ref);
   return 0;

@@ -77,10 +77,15 @@ hearth_status hearth_map_views(const hearth_mesh *mesh, const hearth_raycaster *
                                size_t n_views, const hearth_map_opts *opts,
                                hearth_map_result *out, hearth_err *err);
 
-/* Time spent in each phase of the last hearth_map_views call on a result
- * (seconds), for benchmarks. */
+/* Time spent in each phase (seconds), for benchmarks. hearth_map_views_timed
+ * fills raster (UV raster and islands), cast (pixel grid, waiting for the
+ * ray caster, casting and splatting), fuse, fill and total, and build: the
+ * ray caster's construction when none is given, on a thread of its own
+ * beside the raster phase (0 otherwise). hearth_map_run also fills read
+ * (inputs) and write (outputs) and sets total to the whole run. */
 typedef struct hearth_map_timing {
   double raster, cast, fuse, fill, total;
+  double build, read, write;
 } hearth_map_timing;
 hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_raycaster *rc,
                                      const hearth_camera *cam, const hearth_map_view *views,

@@ -38,6 +38,7 @@ typedef struct hearth_map_job {
   const char *views;       /* NULL: all; else comma-separated view names */
   const char *out_dir;     /* NULL: derived/<state> */
   double turbo_lo, turbo_hi; /* 10, 60 */
+  hearth_map_timing *timing; /* optional: phase times of the run */
 } hearth_map_job;
 void hearth_map_job_default(hearth_map_job *job);
 /* stats (optional) receives the result's counters (arrays not kept). */

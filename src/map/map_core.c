@@ -707,11 +707,14 @@ typedef struct rc_build {
   hearth_raycaster *rc;
   hearth_status s;
   hearth_err err;
+  double seconds;
 } rc_build;
 
 static void *rc_build_run(void *arg) {
   rc_build *b = arg;
+  double t0 = hearth_now();
   b->s = hearth_raycaster_new(b->mesh, &b->rc, &b->err);
+  b->seconds = hearth_now() - t0;
   return NULL;
 }
 
@@ -750,6 +753,7 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
                                      hearth_err *err) {
   double t_start = hearth_now();
   memset(out, 0, sizeof *out);
+  if (timing) memset(timing, 0, sizeof *timing);
   hearth_map_opts opts;
   if (opts_in) opts = *opts_in;
   else hearth_map_opts_default(&opts);
@@ -788,7 +792,7 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
   int32_t *seed = NULL;
   size_t N = R * R;
   double t_raster0 = hearth_now();
-  rc_build bld = {mesh, NULL, HEARTH_OK, {0}};
+  rc_build bld = {mesh, NULL, HEARTH_OK, {0}, 0.0};
   pthread_t bld_tid;
   int bld_started = 0;
   if (!rc_in) {
@@ -873,6 +877,7 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
   }
   own_rc = bld.rc;
   bld.rc = NULL;
+  if (timing) timing->build = bld.seconds;
   if (!rc_in && bld.s) {
     if (err) *err = bld.err;
     s = bld.s;

@@ -285,6 +285,7 @@ hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats
   if (job->out_dir) snprintf(out_dir, PATH_SZ, "%s", job->out_dir);
   else joinf(out_dir, "%s/instances/%s/derived/%s", root, inst, job->state);
 
+  double t_start = hearth_now();
   hearth_rig rig;
   hearth_manifest man = {0};
   hearth_poses poses = {0};
@@ -342,11 +343,13 @@ hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats
     free(cj.errs);
     if (s) goto done;
   }
-  if ((s = hearth_map_views(&mesh, NULL, &rig.thermal, views, n, &job->map, &r, err))) {
+  double t_read = hearth_now() - t_start;
+  if ((s = hearth_map_views_timed(&mesh, NULL, &rig.thermal, views, n, &job->map, &r, job->timing, err))) {
     hearth_err_prefix(err, "%s/%s", inst, job->state);
     goto done;
   }
   /* write everything into a temporary sibling directory, then swap it in */
+  double t_write0 = hearth_now();
   char parent[PATH_SZ];
   joinf(parent, "%s/instances/%s/derived", root, inst);
   if (!job->out_dir && (s = hearth_mkdirs(parent, err))) goto done;
@@ -369,6 +372,11 @@ hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats
     goto done;
   if ((s = swap_dir(tmp_dir, out_dir, err))) goto done;
   tmp_dir[0] = 0;
+  if (job->timing) {
+    job->timing->read = t_read;
+    job->timing->write = hearth_now() - t_write0;
+    job->timing->total = hearth_now() - t_start;
+  }
   if (stats) {
     *stats = r;
     stats->observed = stats->filled = NULL;
