@@ -145,10 +145,15 @@ static float image_value(const hearth_image *img, size_t idx, int c) {
   return (float)((const uint8_t *)img->data)[idx * (size_t)img->channels + (size_t)c];
 }
 
+/* a box of grid pixels */
+typedef struct pix_box {
+  size_t x0, x1, y0, y1; /* inclusive; x0 > x1 when empty */
+} pix_box;
+
 /* cast every grid pixel of view v; fill hit_* arrays of thread t. Rays go
  * to Embree in 4x4 pixel tiles (packets of nearly parallel rays); rays that
  * miss the mesh's bounding sphere are not cast at all. */
-static void cast_view(map_ctx *m, size_t v, int t) {
+static void cast_view(map_ctx *m, size_t v, int t, pix_box *box) {
   const hearth_rigid *T = &m->views[v].T_world_from_cam;
   size_t n = m->n_pix;
   float *org = m->ray_org + (size_t)t * 3 * n, *dir = m->ray_dir + (size_t)t * 3 * n;
@@ -188,6 +193,11 @@ static void cast_view(map_ctx *m, size_t v, int t) {
       if (!hearth_raycast(m->rc, o, d, tn, INFINITY, &h)) h.prim = UINT32_MAX;
     }
     if (h.prim != UINT32_MAX && h.front) {
+      size_t px = p % m->pix_w, py = p / m->pix_w;
+      if (px < box->x0) box->x0 = px;
+      if (px > box->x1) box->x1 = px;
+      if (py < box->y0) box->y0 = py;
+      if (py > box->y1) box->y1 = py;
       ht[p] = h.t;
       tri[p] = h.prim;
       b1[p] = h.b1;
@@ -205,12 +215,15 @@ static void cast_view(map_ctx *m, size_t v, int t) {
  * The lens blur and the pixel footprint mix the two sides of such an edge,
  * so these pixels do not measure one surface. Computed with separable 5x5
  * minimum and maximum filters of the hit distance (a miss is +inf). */
-static void silhouettes(const map_ctx *m, const float *ht, float *lo, float *hi, float *tmp_lo,
-                        float *tmp_hi, uint8_t *sil) {
+/* Only pixels inside box (the hits' bounding box) get flags; the filters
+ * read up to 2 pixels beyond it, where ht holds the misses (+inf). */
+static void silhouettes(const map_ctx *m, const float *ht, const pix_box *box, float *lo, float *hi,
+                        float *tmp_lo, float *tmp_hi, uint8_t *sil) {
   size_t W = m->pix_w, H = m->pix_h;
-  for (size_t y = 0; y < H; y++) {
+  size_t ry0 = box->y0 >= 2 ? box->y0 - 2 : 0, ry1 = box->y1 + 2 < H ? box->y1 + 2 : H - 1;
+  for (size_t y = ry0; y <= ry1; y++) {
     const float *r = ht + y * W;
-    for (size_t x = 0; x < W; x++) {
+    for (size_t x = box->x0; x <= box->x1; x++) {
       size_t a = x >= 2 ? x - 2 : 0, b = x + 2 < W ? x + 2 : W - 1;
       float mn = r[a], mx = r[a];
       for (size_t k = a + 1; k <= b; k++) {
@@ -221,9 +234,9 @@ static void silhouettes(const map_ctx *m, const float *ht, float *lo, float *hi,
       tmp_hi[y * W + x] = mx;
     }
   }
-  for (size_t y = 0; y < H; y++) {
+  for (size_t y = box->y0; y <= box->y1; y++) {
     size_t a = y >= 2 ? y - 2 : 0, b = y + 2 < H ? y + 2 : H - 1;
-    for (size_t x = 0; x < W; x++) {
+    for (size_t x = box->x0; x <= box->x1; x++) {
       float mn = tmp_lo[a * W + x], mx = tmp_hi[a * W + x];
       for (size_t k = a + 1; k <= b; k++) {
         float l = tmp_lo[k * W + x], h = tmp_hi[k * W + x];
@@ -234,15 +247,17 @@ static void silhouettes(const map_ctx *m, const float *ht, float *lo, float *hi,
       hi[y * W + x] = mx;
     }
   }
-  for (size_t p = 0; p < W * H; p++) {
-    float t0 = ht[p];
-    if (!isfinite(t0)) {
-      sil[p] = 1;
-      continue;
+  for (size_t y = box->y0; y <= box->y1; y++)
+    for (size_t x = box->x0; x <= box->x1; x++) {
+      size_t p = y * W + x;
+      float t0 = ht[p];
+      if (!isfinite(t0)) {
+        sil[p] = 1;
+        continue;
+      }
+      float tol = 0.03f * t0;
+      sil[p] = !isfinite(hi[p]) || hi[p] - t0 > tol || t0 - lo[p] > tol;
     }
-    float tol = 0.03f * t0;
-    sil[p] = !isfinite(hi[p]) || hi[p] - t0 > tol || t0 - lo[p] > tol;
-  }
 }
 
 static void process_view(map_ctx *m, size_t v, int t) {
@@ -250,7 +265,9 @@ static void process_view(map_ctx *m, size_t v, int t) {
   size_t R = m->R, n = m->n_pix;
   int C = m->C;
   size_t n_touched = 0;
-  cast_view(m, v, t);
+  pix_box box = {SIZE_MAX, 0, SIZE_MAX, 0};
+  cast_view(m, v, t, &box);
+  if (box.x0 > box.x1) box = (pix_box){1, 0, 1, 0}; /* no hit: empty */
   const float *ht = m->hit_t + (size_t)t * n, *hb1 = m->hit_b1 + (size_t)t * n,
               *hb2 = m->hit_b2 + (size_t)t * n;
   const uint32_t *htri = m->hit_tri + (size_t)t * n;
@@ -261,7 +278,7 @@ static void process_view(map_ctx *m, size_t v, int t) {
     /* the ray arrays are free again: scratch for the filters */
     float *scratch = m->ray_org + (size_t)t * 3 * n;
     float *scratch2 = m->ray_dir + (size_t)t * 3 * n;
-    silhouettes(m, ht, scratch, scratch + n, scratch2, scratch2 + n, sil);
+    if (box.x0 <= box.x1) silhouettes(m, ht, &box, scratch, scratch + n, scratch2, scratch2 + n, sil);
   }
   const float *pd = m->pix_dir;
   const double *Rw = m->views[v].T_world_from_cam.R;
@@ -269,35 +286,38 @@ static void process_view(map_ctx *m, size_t v, int t) {
   float min_cos = (float)m->opts->min_cos;
   splat *sp = m->splats[t];
   size_t n_sp = 0;
-  for (size_t p = 0; p < n; p++) {
-    uint32_t tri = htri[p];
-    if (tri == UINT32_MAX) continue;
-    if (edges && sil[p]) continue;
-    const float *nrm = m->tri_normal + 3 * (size_t)tri, *dc = pd + 3 * p;
-    float d[3];
-    for (int k = 0; k < 3; k++) d[k] = (float)(Rw[3 * k] * dc[0] + Rw[3 * k + 1] * dc[1] + Rw[3 * k + 2] * dc[2]);
-    float cosv = -(nrm[0] * d[0] + nrm[1] * d[1] + nrm[2] * d[2]);
-    if (cosv < min_cos) continue;
-    hits++;
-    /* UV of the hit point */
-    const uint32_t *ix = mesh->indices + 3 * (size_t)tri;
-    float b1 = hb1[p], b2 = hb2[p], b0 = 1.0f - b1 - b2;
-    float u = b0 * mesh->uvs[2 * ix[0]] + b1 * mesh->uvs[2 * ix[1]] + b2 * mesh->uvs[2 * ix[2]];
-    float vv = b0 * mesh->uvs[2 * ix[0] + 1] + b1 * mesh->uvs[2 * ix[1] + 1] +
-               b2 * mesh->uvs[2 * ix[2] + 1];
-    double x = (double)u * (double)R - 0.5, y = (double)vv * (double)R - 0.5;
-    double x0f = floor(x), y0f = floor(y);
-    /* footprints entirely off the map add nothing */
-    if (!(x0f >= -1.0 && y0f >= -1.0 && x0f < (double)R && y0f < (double)R)) continue;
-    splat *e = &sp[n_sp++];
-    e->fx = x - x0f;
-    e->fy = y - y0f;
-    e->x0 = (int32_t)x0f;
-    e->y0 = (int32_t)y0f;
-    e->island = m->island_of_tri[tri];
-    e->cosv = cosv;
-    size_t src = m->pix_index[p];
-    for (int c = 0; c < C; c++) e->val[c] = image_value(img, src, c);
+  /* the hits, in raster order within their bounding box */
+  for (size_t py = box.y0; py <= box.y1 && box.x0 <= box.x1; py++) {
+    for (size_t p = py * m->pix_w + box.x0; p <= py * m->pix_w + box.x1; p++) {
+      uint32_t tri = htri[p];
+      if (tri == UINT32_MAX) continue;
+      if (edges && sil[p]) continue;
+      const float *nrm = m->tri_normal + 3 * (size_t)tri, *dc = pd + 3 * p;
+      float d[3];
+      for (int k = 0; k < 3; k++) d[k] = (float)(Rw[3 * k] * dc[0] + Rw[3 * k + 1] * dc[1] + Rw[3 * k + 2] * dc[2]);
+      float cosv = -(nrm[0] * d[0] + nrm[1] * d[1] + nrm[2] * d[2]);
+      if (cosv < min_cos) continue;
+      hits++;
+      /* UV of the hit point */
+      const uint32_t *ix = mesh->indices + 3 * (size_t)tri;
+      float b1 = hb1[p], b2 = hb2[p], b0 = 1.0f - b1 - b2;
+      float u = b0 * mesh->uvs[2 * ix[0]] + b1 * mesh->uvs[2 * ix[1]] + b2 * mesh->uvs[2 * ix[2]];
+      float vv = b0 * mesh->uvs[2 * ix[0] + 1] + b1 * mesh->uvs[2 * ix[1] + 1] +
+                 b2 * mesh->uvs[2 * ix[2] + 1];
+      double x = (double)u * (double)R - 0.5, y = (double)vv * (double)R - 0.5;
+      double x0f = floor(x), y0f = floor(y);
+      /* footprints entirely off the map add nothing */
+      if (!(x0f >= -1.0 && y0f >= -1.0 && x0f < (double)R && y0f < (double)R)) continue;
+      splat *e = &sp[n_sp++];
+      e->fx = x - x0f;
+      e->fy = y - y0f;
+      e->x0 = (int32_t)x0f;
+      e->y0 = (int32_t)y0f;
+      e->island = m->island_of_tri[tri];
+      e->cosv = cosv;
+      size_t src = m->pix_index[p];
+      for (int c = 0; c < C; c++) e->val[c] = image_value(img, src, c);
+    }
   }
   /* a table with room for every texel this view can touch, at most half full */
   size_t need = 1024;
