@@ -16,20 +16,15 @@
 
 #define FIX_SCALE 1048576.0 /* 2^20: fixed-point resolution of mean fusion */
 #define MAX_BACKFACE_SKIPS 8
-/* One texel's sums within one view, in a worker's open-addressing table
- * (the texels a view touches are few next to R x R: the table stays in
- * cache where a per-texel array would not) */
-typedef struct vslot {
-  uint32_t key;    /* texel + 1; 0 empty */
-  uint32_t island; /* the texel's island */
-  float w, cosv;   /* weight sum, best cosine */
-  float sum[3];    /* weighted value sums (C used) */
-  float pad;
-} vslot;
-
-static size_t slot_of(uint32_t q, size_t mask) {
-  return (size_t)((q * 2654435761u) ^ (q >> 15)) & mask;
-}
+/* One bilinear touch of a texel by a splat within one view; a view's
+ * touches are sorted by texel (stably: pixel order within a texel) and
+ * reduced in one pass, so the shared records are visited in address order
+ * and each texel's sums add up in the same order as pixel by pixel. */
+typedef struct touch {
+  uint32_t q;     /* texel */
+  uint32_t splat; /* index into the view's splats */
+  float w;        /* bilinear weight */
+} touch;
 
 /* fused results shared by the workers: maximum and best cosine as atomic
  * maxima (exact and order-independent), the mean's fixed-point sums as
@@ -81,9 +76,8 @@ typedef struct view_record {
   float weight;
 } view_record;
 
-/* one hit pixel's splat, prepared before any accumulator is touched so the
- * records can be prefetched a few splats ahead (the scatter into the R x R
- * records is otherwise one cache miss after another) */
+/* one hit pixel's splat: its bilinear footprint, island, cosine and value;
+ * a view's splats become touches of texels (see touch) */
 typedef struct splat {
   double fx, fy;  /* bilinear fractions */
   int32_t x0, y0; /* lower-left texel of the 2 x 2 footprint */
@@ -91,7 +85,7 @@ typedef struct splat {
   float cosv;
   float val[3];
 } splat;
-#define SPLAT_AHEAD 8
+#define PREFETCH_AHEAD 8 /* touches ahead whose shared record is prefetched */
 
 typedef struct map_ctx {
   const hearth_mesh *mesh;
@@ -115,11 +109,8 @@ typedef struct map_ctx {
   /* per-thread scratch, indexed by thread */
   int n_threads;
   int cast_threads; /* threads for ray casting when views are processed serially */
-  /* per thread: this view's table of touched texels and its used slots in
-   * first-touch order */
-  vslot **tab;
-  size_t *tab_cap;
-  uint32_t **used;
+  /* per thread: a view's touches and the sort's second buffer (4 per pixel) */
+  touch **touches, **touches_tmp;
   /* shared fused state, FUSED_STRIDE(C) words per texel: the texel's island
    * (read-only), the maximum of the view means (C floats) and the best
    * cosine over views; one cache line for everything a first touch or a
@@ -319,116 +310,91 @@ static void process_view(map_ctx *m, size_t v, int t) {
       for (int c = 0; c < C; c++) e->val[c] = image_value(img, src, c);
     }
   }
-  /* a table with room for every texel this view can touch, at most half full */
-  size_t need = 1024;
-  while (need < 8 * n_sp) need *= 2;
-  if (m->tab_cap[t] < need) {
-    free(m->tab[t]);
-    free(m->used[t]);
-    m->tab[t] = hearth_calloc_array(need, sizeof(vslot));
-    m->used[t] = hearth_alloc_array(need / 2, sizeof(uint32_t));
-    m->tab_cap[t] = need;
-    if (!m->tab[t] || !m->used[t]) {
-      free(m->tab[t]);
-      free(m->used[t]);
-      m->tab[t] = NULL;
-      m->used[t] = NULL;
-      m->tab_cap[t] = 0;
+  /* the touches, in pixel order */
+  touch *tc = m->touches[t];
+  size_t n_tc = 0;
+  for (size_t i = 0; i < n_sp; i++) {
+    const splat *e = &sp[i];
+    for (int k = 0; k < 4; k++) {
+      long tx = (long)e->x0 + (k & 1), ty = (long)e->y0 + (k >> 1);
+      if (tx < 0 || ty < 0 || tx >= (long)R || ty >= (long)R) continue;
+      float w = (float)(((k & 1) ? e->fx : 1.0 - e->fx) * ((k >> 1) ? e->fy : 1.0 - e->fy));
+      if (!(w > 0.0f)) continue;
+      tc[n_tc++] = (touch){(uint32_t)((size_t)ty * R + (size_t)tx), (uint32_t)i, w};
+    }
+  }
+  /* stable LSD radix sort by texel, 11-bit digits */
+  {
+    touch *src = tc, *dst = m->touches_tmp[t];
+    size_t bits = 1;
+    while (bits < 32 && ((size_t)1 << bits) < R * R) bits++;
+    for (size_t shift = 0; shift < bits; shift += 11) {
+      size_t count[2048 + 1] = {0};
+      for (size_t i = 0; i < n_tc; i++) count[((src[i].q >> shift) & 2047) + 1]++;
+      for (size_t d = 0; d < 2048; d++) count[d + 1] += count[d];
+      for (size_t i = 0; i < n_tc; i++) dst[count[(src[i].q >> shift) & 2047]++] = src[i];
+      touch *x = src;
+      src = dst;
+      dst = x;
+    }
+    tc = src;
+  }
+  m->view_hits[v] = hits;
+  /* each texel's touches in pixel order: splat only from the texel's own
+   * island; the view's mean then folds into the shared fused state */
+  _Atomic uint32_t *fused = m->fused;
+  const size_t FS = FUSED_STRIDE(C);
+  int fusion = m->opts->fusion;
+  view_record *rec = NULL;
+  if (fusion == HEARTH_FUSE_ROBUST) {
+    /* at most one record per touch */
+    rec = malloc((n_tc ? n_tc : 1) * sizeof *rec);
+    if (!rec) {
       m->failed = 1;
       return;
     }
   }
-  vslot *tab = m->tab[t];
-  uint32_t *used = m->used[t];
-  size_t mask = m->tab_cap[t] - 1;
-  _Atomic uint32_t *fused = m->fused;
-  const size_t FS = FUSED_STRIDE(C);
-  for (size_t i = 0; i < n_sp; i++) {
-    if (i + SPLAT_AHEAD < n_sp) {
-      const splat *f = &sp[i + SPLAT_AHEAD];
-      size_t fx0 = f->x0 < 0 ? 0 : (size_t)f->x0, fy0 = f->y0 < 0 ? 0 : (size_t)f->y0;
-      if (fy0 < R && fx0 < R) {
-        uint32_t q0 = (uint32_t)(fy0 * R + fx0);
-        __builtin_prefetch(&tab[slot_of(q0, mask)], 1);
-        __builtin_prefetch(&tab[slot_of(q0 + 1, mask)], 1);
-        __builtin_prefetch(&fused[q0 * FS], 0);
-        if (fy0 + 1 < R) {
-          __builtin_prefetch(&tab[slot_of(q0 + (uint32_t)R, mask)], 1);
-          __builtin_prefetch(&tab[slot_of(q0 + (uint32_t)R + 1, mask)], 1);
-          __builtin_prefetch(&fused[(q0 + (uint32_t)R) * FS], 0);
-        }
-      }
+  for (size_t i = 0; i < n_tc;) {
+    uint32_t q = tc[i].q;
+    size_t j = i;
+    while (j < n_tc && tc[j].q == q) j++;
+    if (j + PREFETCH_AHEAD < n_tc) __builtin_prefetch(&fused[(size_t)tc[j + PREFETCH_AHEAD].q * FS], 1);
+    _Atomic uint32_t *f = fused + (size_t)q * FS;
+    uint32_t island = atomic_load_explicit(&f[0], memory_order_relaxed);
+    float wsum = 0.0f, best_cos = 0.0f, sum[3] = {0.0f, 0.0f, 0.0f};
+    int any = 0;
+    for (size_t k = i; k < j; k++) {
+      const splat *e = &sp[tc[k].splat];
+      if (e->island != island) continue;
+      if (!any || e->cosv > best_cos) best_cos = e->cosv;
+      any = 1;
+      wsum += tc[k].w;
+      for (int c = 0; c < C; c++) sum[c] += tc[k].w * e->val[c];
     }
-    const splat *e = &sp[i];
-    double fx = e->fx, fy = e->fy;
-    long x0 = e->x0, y0 = e->y0;
-    uint32_t island = e->island;
-    float cosv = e->cosv;
-    const float *val = e->val;
-    for (int k = 0; k < 4; k++) {
-      long tx = x0 + (k & 1), ty = y0 + (k >> 1);
-      if (tx < 0 || ty < 0 || tx >= (long)R || ty >= (long)R) continue;
-      float w = (float)(((k & 1) ? fx : 1.0 - fx) * ((k >> 1) ? fy : 1.0 - fy));
-      if (!(w > 0.0f)) continue;
-      uint32_t q = (uint32_t)((size_t)ty * R + (size_t)tx);
-      size_t h = slot_of(q, mask);
-      while (tab[h].key && tab[h].key != q + 1) h = (h + 1) & mask;
-      vslot *a = &tab[h];
-      if (!a->key) {
-        /* first touch in this view: splat only into surface texels of the
-           same island */
-        if (atomic_load_explicit(&fused[q * FS], memory_order_relaxed) != island) continue;
-        a->key = q + 1;
-        a->island = island;
-        a->w = 0.0f;
-        a->cosv = cosv;
-        for (int c = 0; c < C; c++) a->sum[c] = 0.0f;
-        used[n_touched++] = (uint32_t)h;
-      } else if (a->island != island) {
-        continue;
-      } else if (cosv > a->cosv) {
-        a->cosv = cosv;
-      }
-      a->w += w;
-      for (int c = 0; c < C; c++) a->sum[c] += w * val[c];
-    }
-  }
-  m->view_hits[v] = hits;
-  /* fold this view's per-texel means into the shared fused state */
-  if (m->opts->fusion == HEARTH_FUSE_ROBUST) {
-    view_record *rec = malloc((n_touched ? n_touched : 1) * sizeof *rec);
-    if (!rec) {
-      m->failed = 1;
-    } else {
-      for (size_t i = 0; i < n_touched; i++) {
-        const vslot *a = &tab[used[i]];
-        rec[i] = (view_record){a->key - 1, a->sum[0] / a->w, a->w};
-      }
-      m->records[v] = rec;
-      m->n_records[v] = n_touched;
-    }
-  }
-  for (size_t i = 0; i < n_touched; i++) {
-    if (i + SPLAT_AHEAD < n_touched) __builtin_prefetch(&fused[(size_t)(tab[used[i + SPLAT_AHEAD]].key - 1) * FS], 1);
-    vslot *a = &tab[used[i]];
-    size_t q = a->key - 1;
-    _Atomic uint32_t *f = fused + q * FS;
-    atomic_max_f32(&f[FUSED_COS(C)], a->cosv);
-    if (m->opts->fusion == HEARTH_FUSE_MAX) {
+    i = j;
+    if (!any) continue;
+    n_touched++;
+    atomic_max_f32(&f[FUSED_COS(C)], best_cos);
+    if (fusion == HEARTH_FUSE_MAX) {
       for (int c = 0; c < C; c++) {
         /* + 0.0f: a negative zero becomes +0, so equal means cannot make
            the maximum's bits depend on which view came first */
-        float mean = a->sum[c] / a->w + 0.0f;
+        float mean = sum[c] / wsum + 0.0f;
         atomic_max_f32(&f[FUSED_MAX + (size_t)c], mean);
       }
-    } else if (m->opts->fusion == HEARTH_FUSE_MEAN) {
+    } else if (fusion == HEARTH_FUSE_MEAN) {
       /* each view counts with its total weight at this texel */
-      atomic_fetch_add_explicit(&m->mw[q], (int64_t)llround((double)a->w * FIX_SCALE), memory_order_relaxed);
+      atomic_fetch_add_explicit(&m->mw[q], (int64_t)llround((double)wsum * FIX_SCALE), memory_order_relaxed);
       for (int c = 0; c < C; c++)
-        atomic_fetch_add_explicit(&m->msum[q * (size_t)C + (size_t)c],
-                                  (int64_t)llround((double)a->sum[c] * FIX_SCALE), memory_order_relaxed);
+        atomic_fetch_add_explicit(&m->msum[(size_t)q * (size_t)C + (size_t)c],
+                                  (int64_t)llround((double)sum[c] * FIX_SCALE), memory_order_relaxed);
+    } else {
+      rec[n_touched - 1] = (view_record){q, sum[0] / wsum, wsum};
     }
-    a->key = 0;
+  }
+  if (rec) {
+    m->records[v] = rec;
+    m->n_records[v] = n_touched;
   }
 }
 
@@ -740,14 +706,13 @@ static void *rc_build_run(void *arg) {
 
 static void free_scratch(map_ctx *m) {
   for (int t = 0; t < m->n_threads; t++) {
-    if (m->tab) free(m->tab[t]);
-    if (m->used) free(m->used[t]);
+    if (m->touches) free(m->touches[t]);
+    if (m->touches_tmp) free(m->touches_tmp[t]);
     if (m->splats) free(m->splats[t]);
     if (m->sil) free(m->sil[t]);
   }
-  free(m->tab);
-  free(m->tab_cap);
-  free(m->used);
+  free(m->touches);
+  free(m->touches_tmp);
   free((void *)m->fused);
   free((void *)m->msum);
   free((void *)m->mw);
@@ -912,9 +877,8 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
                 .tile_order = tile_order, .sphere = {sphere[0], sphere[1], sphere[2], sphere[3]},
                 .n_threads = nt,
                 .cast_threads = opts.threads > 0 ? opts.threads : hearth_default_threads()};
-  m.tab = calloc((size_t)nt, sizeof *m.tab);
-  m.tab_cap = calloc((size_t)nt, sizeof *m.tab_cap);
-  m.used = calloc((size_t)nt, sizeof *m.used);
+  m.touches = calloc((size_t)nt, sizeof *m.touches);
+  m.touches_tmp = calloc((size_t)nt, sizeof *m.touches_tmp);
   m.sil = calloc((size_t)nt, sizeof *m.sil);
   m.splats = calloc((size_t)nt, sizeof *m.splats);
   m.fused = hearth_alloc_array(N, FUSED_STRIDE(C) * sizeof *m.fused);
@@ -930,7 +894,7 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
   m.ray_dir = hearth_alloc_array(np * (size_t)nt, 3 * sizeof(float));
   m.hits = hearth_alloc_array(np * (size_t)nt, sizeof(hearth_ray_hit));
   m.view_hits = calloc(n_views ? n_views : 1, sizeof *m.view_hits);
-  int bad = !m.tab || !m.tab_cap || !m.used || !m.sil || !m.splats || !m.fused ||
+  int bad = !m.touches || !m.touches_tmp || !m.sil || !m.splats || !m.fused ||
             (opts.fusion == HEARTH_FUSE_MEAN && (!m.msum || !m.mw)) || !m.hit_t || !m.hit_tri || !m.hit_b1 || !m.hit_b2 || !m.ray_org ||
             !m.ray_dir || !m.hits || !m.view_hits;
   if (opts.fusion == HEARTH_FUSE_ROBUST) {
@@ -941,7 +905,9 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
   for (int t = 0; !bad && t < nt; t++) {
     m.sil[t] = hearth_alloc_array(np, 1);
     m.splats[t] = hearth_alloc_array(np, sizeof(splat));
-    bad |= !m.sil[t] || !m.splats[t];
+    m.touches[t] = hearth_alloc_array(np, 4 * sizeof(touch));
+    m.touches_tmp[t] = hearth_alloc_array(np, 4 * sizeof(touch));
+    bad |= !m.sil[t] || !m.splats[t] || !m.touches[t] || !m.touches_tmp[t];
   }
   if (bad) {
     s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory for %d threads at R=%zu", nt, R);
