@@ -574,6 +574,37 @@ static void fill_range(void *ctx, size_t b, size_t e, int t) {
       if (c->bin[i] == (int)w && !fill_one_island(c, c->order[i])) c->failed[w] = 1;
 }
 
+typedef struct box_pass {
+  size_t R;
+  const uint32_t *island_of_texel;
+  const uint8_t *mask;
+  int32_t *seed;
+  uint32_t n_islands;
+  island_box *part; /* per worker: n_islands + 1 boxes */
+} box_pass;
+
+/* per worker: the islands' boxes over its rows (grown from the empty boxes
+ * set before); every seed set to none */
+static void box_rows(void *ctx, size_t b, size_t e, int t) {
+  const box_pass *bp = ctx;
+  size_t R = bp->R;
+  island_box *box = bp->part + (size_t)t * ((size_t)bp->n_islands + 1);
+  for (size_t y = b; y < e; y++)
+    for (size_t x = 0; x < R; x++) {
+      size_t q = y * R + x;
+      bp->seed[q] = -1;
+      uint32_t isl = bp->island_of_texel[q];
+      if (isl == UINT32_MAX) continue;
+      island_box *bx = &box[isl];
+      if ((int32_t)x < bx->x0) bx->x0 = (int32_t)x;
+      if ((int32_t)x > bx->x1) bx->x1 = (int32_t)x;
+      if ((int32_t)y < bx->y0) bx->y0 = (int32_t)y;
+      bx->y1 = (int32_t)y;
+      if (bp->mask[q] == HEARTH_TEXEL_OBSERVED) bx->has_seed = 1;
+      else bx->n_todo++;
+    }
+}
+
 static hearth_status fill_islands(size_t R, const uint32_t *island_of_texel, uint32_t n_islands,
                                   const uint8_t *mask, int32_t *seed, int nthreads) {
   int nw = nthreads > 0 ? nthreads : hearth_default_threads();
@@ -585,21 +616,30 @@ static hearth_status fill_islands(size_t R, const uint32_t *island_of_texel, uin
   int *failed = calloc((size_t)nw, sizeof *failed);
   hearth_status s = HEARTH_E_NOMEM;
   if (!box || !work || !order || !bin || !load || !failed) goto done;
-  for (uint32_t i = 0; i < n_islands; i++) box[i] = (island_box){INT32_MAX, INT32_MAX, -1, -1, 0, 0};
-  for (size_t y = 0; y < R; y++)
-    for (size_t x = 0; x < R; x++) {
-      size_t q = y * R + x;
-      seed[q] = -1;
-      uint32_t isl = island_of_texel[q];
-      if (isl == UINT32_MAX) continue;
-      island_box *bx = &box[isl];
-      if ((int32_t)x < bx->x0) bx->x0 = (int32_t)x;
-      if ((int32_t)x > bx->x1) bx->x1 = (int32_t)x;
-      if ((int32_t)y < bx->y0) bx->y0 = (int32_t)y;
-      bx->y1 = (int32_t)y;
-      if (mask[q] == HEARTH_TEXEL_OBSERVED) bx->has_seed = 1;
-      else bx->n_todo++;
+  {
+    /* the islands' boxes over row bands in parallel, merged (minima,
+       maxima, sums: the same for any split) */
+    box_pass bp = {R, island_of_texel, mask, seed, n_islands,
+                   hearth_alloc_array((size_t)nw * ((size_t)n_islands + 1), sizeof(island_box))};
+    if (!bp.part) goto done;
+    for (size_t i = 0; i < (size_t)nw * ((size_t)n_islands + 1); i++)
+      bp.part[i] = (island_box){INT32_MAX, INT32_MAX, -1, -1, 0, 0};
+    hearth_parallel_for(R, nw, box_rows, &bp);
+    for (uint32_t i = 0; i < n_islands; i++) {
+      island_box b = bp.part[i];
+      for (int w = 1; w < nw; w++) {
+        const island_box *o = &bp.part[(size_t)w * ((size_t)n_islands + 1) + i];
+        if (o->x0 < b.x0) b.x0 = o->x0;
+        if (o->x1 > b.x1) b.x1 = o->x1;
+        if (o->y0 < b.y0) b.y0 = o->y0;
+        if (o->y1 > b.y1) b.y1 = o->y1;
+        b.n_todo += o->n_todo;
+        b.has_seed |= o->has_seed;
+      }
+      box[i] = b;
     }
+    free(bp.part);
+  }
   uint32_t n = 0;
   for (uint32_t i = 0; i < n_islands; i++)
     if (box[i].has_seed && box[i].n_todo) work[n++] = (isl_work){box_area(&box[i]), i};
