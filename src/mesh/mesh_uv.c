@@ -159,25 +159,11 @@ typedef struct raster_ctx {
   float *bary;
 } raster_ctx;
 
-/* Edge function of point p against the directed edge a->b, evaluated
+/* Edge function of a point against the directed edge a->b, evaluated
  * canonically (endpoints in a fixed order, sign flipped after) so two
  * triangles sharing an edge get exactly opposite values: no texel centre
- * on a shared edge falls through the crack. */
-static double edge_fn(double ax, double ay, double bx, double by, double px, double py) {
-  int swap = (ax > bx) || (ax == bx && ay > by);
-  if (swap) {
-    double tx = ax, ty = ay;
-    ax = bx;
-    ay = by;
-    bx = tx;
-    by = ty;
-  }
-  double e = (bx - ax) * (py - ay) - (by - ay) * (px - ax);
-  return swap ? -e : e;
-}
-
-/* edge_fn split in two: the endpoint order (and sign) fixed per edge,
- * then evaluated per point with the same operations */
+ * on a shared edge falls through the crack. Split in two: the endpoint
+ * order (and sign) fixed once per edge, then evaluated per point. */
 typedef struct edge_c {
   double ax, ay, dx, dy, sign;
 } edge_c;
@@ -223,15 +209,15 @@ static void raster_band(void *vctx, size_t band0, size_t band1, int thread_index
       if (row0 > row1) continue;
       double x[3], y[3];
       tri_uv(m, t, R, x, y);
-      double area = edge_fn(x[0], y[0], x[1], y[1], x[2], y[2]);
-      if (area == 0.0 || !isfinite(area)) continue;
-      double sgn = area > 0.0 ? 1.0 : -1.0, inv = 1.0 / area;
-      /* the three edge functions with their canonical endpoints fixed once
-       * per triangle: the same arithmetic as edge_fn, texel by texel */
+      /* the three edge functions, set up once per triangle; twice the
+       * signed area is vertex 2 against edge 0->1 */
       edge_c e[3];
       edge_setup(x[1], y[1], x[2], y[2], &e[0]);
       edge_setup(x[2], y[2], x[0], y[0], &e[1]);
       edge_setup(x[0], y[0], x[1], y[1], &e[2]);
+      double area = edge_eval(&e[2], x[2], y[2]);
+      if (area == 0.0 || !isfinite(area)) continue;
+      double sgn = area > 0.0 ? 1.0 : -1.0, inv = 1.0 / area;
       for (int64_t row = row0; row <= row1; row++) {
         double py = (double)row;
         for (int64_t col = bb[0]; col <= bb[1]; col++) {
