@@ -23,23 +23,20 @@ hearth_status hearth_map_texture(const hearth_map_result *r, double lo, double h
   hearth_status s = hearth_image_alloc(out, R, R, 3, HEARTH_PIX_U8, err);
   if (s) return s;
   uint8_t *px = out->data;
-  /* have[q]: 1 if q carries a colour (value or padding) */
-  uint8_t *have = hearth_calloc_array(N, 1), *listed = hearth_calloc_array(N, 1);
-  if (!have || !listed) {
-    free(have);
-    free(listed);
-    hearth_image_free(out);
-    return hearth_err_set(err, HEARTH_E_NOMEM, "texture: out of memory");
-  }
-  /* Turbo through a 4096-entry table (0.012 degC steps over 10-60 degC,
-   * finer than the 8-bit colours resolve) */
+  /* have[q]: 1 if q carries a colour (value or padding); listed[q]: q was
+   * taken as a padding candidate; cand / fresh: this and the next round's
+   * candidates, rgb their new colours. Turbo goes through a 4096-entry
+   * table (0.012 degC steps over 10-60 degC, finer than the 8-bit colours
+   * resolve). */
   enum { LUT_N = 4096 };
+  uint8_t *have = hearth_calloc_array(N, 1), *listed = hearth_calloc_array(N, 1);
   uint8_t(*lut)[3] = C == 1 ? malloc(sizeof(uint8_t[LUT_N][3])) : NULL;
-  if (C == 1 && !lut) {
-    free(have);
-    free(listed);
+  uint32_t *cand = hearth_alloc_array(N, sizeof *cand), *fresh = hearth_alloc_array(N, sizeof *fresh);
+  uint8_t *rgb = hearth_alloc_array(N, 3);
+  if (!have || !listed || (C == 1 && !lut) || !cand || !fresh || !rgb) {
     hearth_image_free(out);
-    return hearth_err_set(err, HEARTH_E_NOMEM, "texture: out of memory");
+    s = hearth_err_set(err, HEARTH_E_NOMEM, "texture: out of memory");
+    goto done;
   }
   for (int i = 0; C == 1 && i < LUT_N; i++) hearth_turbo((double)i / (LUT_N - 1), lut[i]);
   double scale = (LUT_N - 1) / (hi - lo);
@@ -66,19 +63,6 @@ hearth_status hearth_map_texture(const hearth_map_result *r, double lo, double h
      Only the frontier is visited: round 0's candidates are the uncoloured
      texels next to a coloured one, and each later round's are the
      uncoloured neighbours of the texels the previous round coloured */
-  uint32_t *cand = hearth_alloc_array(N, sizeof *cand), *fresh = hearth_alloc_array(N, sizeof *fresh);
-  uint8_t *rgb = hearth_alloc_array(N, 3);
-  if (!cand || !fresh || !rgb) {
-    free(cand);
-    free(fresh);
-    free(rgb);
-    free(have);
-    free(listed);
-    free(lut);
-    hearth_image_free(out);
-    return hearth_err_set(err, HEARTH_E_NOMEM, "texture: out of memory");
-  }
-  /* listed[]: texels already taken as candidates (by this or an earlier round) */
   size_t nc = 0;
   for (size_t q = 0, x = 0, y = 0; pad > 0 && q < N; q++, x = x + 1 == R ? (y++, 0) : x + 1) {
     if (have[q]) continue;
@@ -118,11 +102,12 @@ hearth_status hearth_map_texture(const hearth_map_result *r, double lo, double h
     fresh = t;
     nc = nf;
   }
+done:
   free(cand);
   free(fresh);
   free(rgb);
   free(have);
   free(listed);
   free(lut);
-  return HEARTH_OK;
+  return s;
 }
