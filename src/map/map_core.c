@@ -205,9 +205,9 @@ static void cast_view(map_ctx *m, size_t v, int t, pix_box *box) {
  * misses the surface or lies at a clearly different depth (more than 3%).
  * The lens blur and the pixel footprint mix the two sides of such an edge,
  * so these pixels do not measure one surface. Computed with separable 5x5
- * minimum and maximum filters of the hit distance (a miss is +inf). */
-/* Only pixels inside box (the hits' bounding box) get flags; the filters
- * read up to 2 pixels beyond it, where ht holds the misses (+inf). */
+ * minimum and maximum filters of the hit distance (a miss is +inf). Only
+ * pixels inside box (the hits' bounding box) get flags; the filters read up
+ * to 2 pixels beyond it, where ht holds the misses. */
 static void silhouettes(const map_ctx *m, const float *ht, const pix_box *box, float *lo, float *hi,
                         float *tmp_lo, float *tmp_hi, uint8_t *sil) {
   size_t W = m->pix_w, H = m->pix_h;
@@ -673,7 +673,6 @@ done:
 typedef struct texel_pass {
   const map_ctx *m;
   hearth_map_result *out;
-  const uint32_t *tri_of_texel;
   const int32_t *seed;
   size_t (*counts)[4]; /* per worker: observed, filled, unobserved, surface */
 } texel_pass;
@@ -690,7 +689,7 @@ static void fuse_rows(void *ctx, size_t b, size_t e, int t) {
   for (size_t q = b * R; q < e * R; q++) {
     _Atomic uint32_t *f = m->fused + q * FUSED_STRIDE(C);
     out->best_cos[q] = atomic_get_f32(&f[FUSED_COS(C)]);
-    out->mask[q] = tp->tri_of_texel[q] == UINT32_MAX ? HEARTH_TEXEL_NONE : HEARTH_TEXEL_UNOBSERVED;
+    out->mask[q] = m->island_of_texel[q] == UINT32_MAX ? HEARTH_TEXEL_NONE : HEARTH_TEXEL_UNOBSERVED;
     for (size_t c = 0; c < C; c++) {
       float best = fmax ? atomic_get_f32(&f[FUSED_MAX + c]) : -INFINITY;
       if (best > -INFINITY) {
@@ -968,8 +967,9 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
   out->n_views = n_views;
   out->observed = hearth_alloc_array(N, (size_t)C * sizeof(float));
   out->filled = hearth_alloc_array(N, (size_t)C * sizeof(float));
-  out->mask = hearth_calloc_array(N, 1);
-  out->best_cos = hearth_calloc_array(N, sizeof(float));
+  /* every texel of these is written by fuse_rows */
+  out->mask = hearth_alloc_array(N, 1);
+  out->best_cos = hearth_alloc_array(N, sizeof(float));
   out->view_hits = m.view_hits;
   m.view_hits = NULL;
   seed = hearth_alloc_array(N, sizeof *seed);
@@ -979,7 +979,7 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
   }
   {
     /* the maximum fusion is done here too, row by row */
-    texel_pass tp = {&m, out, tri_of_texel, NULL, NULL};
+    texel_pass tp = {&m, out, NULL, NULL};
     hearth_parallel_for(R, nt, fuse_rows, &tp);
   }
   if (opts.fusion == HEARTH_FUSE_MEAN) {
@@ -1032,7 +1032,7 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
     goto done;
   }
   {
-    texel_pass tp = {&m, out, tri_of_texel, seed, NULL};
+    texel_pass tp = {&m, out, seed, NULL};
     tp.counts = calloc((size_t)nt, sizeof *tp.counts);
     if (!tp.counts) {
       s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
