@@ -5,26 +5,10 @@
  * texels of islands never observed stay unobserved, and the result is the
  * same for 1, 2 and 3 threads. */
 #include "hearth/hearth.h"
+#include "map/quad_mesh.h"
 #include "test_util.h"
 
 #define RES 128
-
-static void add_quad(hearth_mesh *m, size_t *nv, size_t *nt, double x0, double x1, double y0,
-                     double y1, double z, double u0, double u1, double v0, double v1) {
-  size_t b = *nv;
-  double P[4][3] = {{x0, y0, z}, {x1, y0, z}, {x1, y1, z}, {x0, y1, z}};
-  double U[4][2] = {{u0, v1}, {u1, v1}, {u1, v0}, {u0, v0}};
-  for (int i = 0; i < 4; i++) {
-    for (int k = 0; k < 3; k++) m->positions[3 * (b + i) + k] = (float)P[i][k];
-    m->uvs[2 * (b + i)] = (float)U[i][0];
-    m->uvs[2 * (b + i) + 1] = (float)U[i][1];
-  }
-  uint32_t t[2][3] = {{0, 1, 2}, {0, 2, 3}};
-  for (int j = 0; j < 2; j++)
-    for (int k = 0; k < 3; k++) m->indices[3 * (*nt + j) + k] = (uint32_t)b + t[j][k];
-  *nv += 4;
-  *nt += 2;
-}
 
 /* island of a texel from the UV rectangles (0 plate, 1 occluder, 2 hidden
  * patch under the plate, -1 none) */
@@ -42,9 +26,9 @@ int main(void) {
   CHECK_OK(hearth_mesh_alloc(&m, 12, 6, 1, &err), &err);
   size_t nv = 0, nt = 0;
   /* the plate reaches past the image's sides (about +-0.16 m at 0.35 m) */
-  add_quad(&m, &nv, &nt, -0.30, 0.30, -0.10, 0.10, 0.0, 0.02, 0.98, 0.02, 0.50);
-  add_quad(&m, &nv, &nt, -0.03, 0.04, -0.04, 0.02, 0.08, 0.10, 0.30, 0.60, 0.80);
-  add_quad(&m, &nv, &nt, -0.02, 0.02, -0.02, 0.02, -0.05, 0.50, 0.70, 0.60, 0.80);
+  add_quad(&m, &nv, &nt, -0.30, 0.30, -0.10, 0.10, 0.0, 1, 0.02, 0.98, 0.02, 0.50);
+  add_quad(&m, &nv, &nt, -0.03, 0.04, -0.04, 0.02, 0.08, 1, 0.10, 0.30, 0.60, 0.80);
+  add_quad(&m, &nv, &nt, -0.02, 0.02, -0.02, 0.02, -0.05, 1, 0.50, 0.70, 0.60, 0.80);
   hearth_camera cam = {256, 192, 275.0, 276.0, 127.3, 95.8, {-0.2, 0.05, 0.0, 0.0, 0.0}};
   hearth_rigid T = {{1, 0, 0, 0, -1, 0, 0, 0, -1}, {0.0, 0.0, 0.35}};
   /* a distinct value per pixel, so a filled value names its source texel */

@@ -2,34 +2,13 @@
  * a linear temperature field, occlusion, back-face culling, max fusion,
  * island-bounded filling and thread-count determinism. */
 #include "hearth/hearth.h"
+#include "map/quad_mesh.h"
 #include "test_util.h"
 
 #define RES 320
 
 /* field on the visible quads: T = 20 + 200 x (degC, x in metres) */
 static double field(double x) { return 20.0 + 200.0 * x; }
-
-/* add an axis-aligned rectangle at height z; facing +z (up) if up else -z */
-static void add_quad(hearth_mesh *m, size_t *nv, size_t *nt, double x0, double x1, double y0,
-                     double y1, double z, int up, double u0, double u1, double v0, double v1) {
-  size_t b = *nv;
-  double P[4][3] = {{x0, y0, z}, {x1, y0, z}, {x1, y1, z}, {x0, y1, z}};
-  double U[4][2] = {{u0, v1}, {u1, v1}, {u1, v0}, {u0, v0}};
-  for (int i = 0; i < 4; i++) {
-    for (int k = 0; k < 3; k++) m->positions[3 * (b + i) + k] = (float)P[i][k];
-    m->uvs[2 * (b + i)] = (float)U[i][0];
-    m->uvs[2 * (b + i) + 1] = (float)U[i][1];
-  }
-  uint32_t t[2][3] = {{0, 1, 2}, {0, 2, 3}};
-  for (int j = 0; j < 2; j++) {
-    uint32_t *ix = m->indices + 3 * (*nt + j);
-    ix[0] = (uint32_t)b + t[j][0];
-    ix[1] = (uint32_t)b + (up ? t[j][1] : t[j][2]);
-    ix[2] = (uint32_t)b + (up ? t[j][2] : t[j][1]);
-  }
-  *nv += 4;
-  *nt += 2;
-}
 
 /* render the scene's temperatures the simple way: a ray per pixel centre
  * against the planes (independent of the ray caster) */
