@@ -33,6 +33,17 @@ typedef struct hearth_project_jac {
   double d_dist[10];   /* d(u,v) / d(k1, k2, p1, p2, k3) */
 } hearth_project_jac;
 
+/* The distortion polynomial above, (x, y) -> (xd, yd), inline for loops
+ * over many points; hearth_distort is the same with the Jacobian. */
+static inline void hearth_distort_xy(const double dist[5], double x, double y, double *xd,
+                                     double *yd) {
+  const double k1 = dist[0], k2 = dist[1], p1 = dist[2], p2 = dist[3], k3 = dist[4];
+  double x2 = x * x, y2 = y * y, xy = x * y, r2 = x2 + y2;
+  double radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
+  *xd = x * radial + 2.0 * p1 * xy + p2 * (r2 + 2.0 * x2);
+  *yd = y * radial + p1 * (r2 + 2.0 * y2) + 2.0 * p2 * xy;
+}
+
 /* Distort normalised coordinates (x, y) -> (xd, yd), optionally with the
  * 2x2 Jacobian d(xd,yd)/d(x,y) (row-major). */
 void hearth_distort(const double dist[5], double x, double y, double *xd, double *yd,

@@ -1,9 +1,12 @@
 /* hearth/map.h - temperature (and colour) mapping from camera views onto a
  * mesh's UV layout: the paper's "Temperature Mapping and Thermal Textures".
  *
- * For each view, every pixel's undistorted centre is cast into the scene;
- * the nearest front-facing surface takes that pixel's raw value unchanged,
- * splatted with bilinear weights into an R x R UV map. Within a view,
+ * For each view, every pixel's undistorted centre is cast into the scene
+ * (by rasterising the mesh through the camera's ray fan when the whole mesh
+ * lies in front of the view, by tracing rays otherwise; see
+ * include/hearth/mesh.h); the nearest front-facing surface takes that
+ * pixel's raw value unchanged, splatted with bilinear weights into an
+ * R x R UV map. Within a view,
  * contributions are averaged by weight; across views they are fused (the
  * paper's maximum by default). Unobserved surface texels are then filled
  * from the nearest observed texel of the same UV island. Conventions:
@@ -46,6 +49,8 @@ typedef struct hearth_map_opts {
                              rule); default 0: such pixels mix two surfaces through the
                              lens blur and are skipped (always skipped by ROBUST) */
   int threads;            /* 0 = hearth_default_threads() */
+  int trace_rays;         /* 1: trace every view's rays (Embree) even where the fan could
+                             rasterise it; default 0 (the same hits up to float rounding) */
 } hearth_map_opts;
 void hearth_map_opts_default(hearth_map_opts *o);
 
@@ -70,7 +75,8 @@ typedef struct hearth_map_result {
 void hearth_map_result_free(hearth_map_result *r);
 
 /* Map n views seen by one camera model onto mesh (which must have UVs).
- * rc is a ray caster built over the same mesh (or NULL to build one here).
+ * rc is a ray caster built over the same mesh, or NULL to build one here
+ * if a view needs rays.
  * Deterministic: the same bytes for any thread count. */
 hearth_status hearth_map_views(const hearth_mesh *mesh, const hearth_raycaster *rc,
                                const hearth_camera *cam, const hearth_map_view *views,
@@ -78,11 +84,11 @@ hearth_status hearth_map_views(const hearth_mesh *mesh, const hearth_raycaster *
                                hearth_map_result *out, hearth_err *err);
 
 /* Time spent in each phase (seconds), for benchmarks. hearth_map_views_timed
- * fills raster (UV raster and islands), cast (pixel grid, waiting for the
- * ray caster, casting and splatting), fuse, fill and total, and build: the
- * ray caster's construction when none is given, on a thread of its own
- * beside the raster phase (0 otherwise). hearth_map_run also fills read
- * (inputs) and write (outputs) and sets total to the whole run. */
+ * fills raster (UV raster and islands, with the pixel grid and its fan made
+ * beside them), cast (casting and splatting), fuse, fill and total, and
+ * build: the ray caster's construction where a view needs rays and none is
+ * given (0 otherwise). hearth_map_run also fills read (inputs) and write
+ * (outputs) and sets total to the whole run. */
 typedef struct hearth_map_timing {
   double raster, cast, fuse, fill, total;
   double build, read, write;

@@ -10,7 +10,9 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include "hearth/camera.h"
 #include "hearth/core.h"
+#include "hearth/geom.h"
 #include "hearth/image.h"
 
 #ifdef __cplusplus
@@ -87,6 +89,39 @@ void hearth_raycast_batch(const hearth_raycaster *rc, size_t n, const float *org
 void hearth_raycast_batch_mt(const hearth_raycaster *rc, size_t n, const float *org,
                              const float *dir, float tnear, float tfar, hearth_ray_hit *hits,
                              int nthreads);
+
+/* ---- a camera's pixel grid cast by rasterisation --------------------------- */
+/* The rays through the centres of a camera's pixel grid (every stride-th
+ * pixel, lens distortion included), cast at a mesh as a whole: for every
+ * pixel, the nearest front-facing triangle along its ray. Back faces never
+ * occlude, as with a ray caster that culls them. The front faces are
+ * rasterised in the camera's plane z = 1 against the pixels' undistorted
+ * centres, with a depth test; for each triangle only the pixels whose
+ * centre can lie in it are tested (bounded through the lens model). That is
+ * exact, needs no acceleration structure, and costs one pass over the
+ * triangles per cast: far cheaper than tracing when the triangles are
+ * small. It needs every vertex strictly in front of the camera (z > 0);
+ * otherwise cast rays. */
+typedef struct hearth_ray_fan hearth_ray_fan;
+
+hearth_status hearth_ray_fan_new(const hearth_camera *cam, size_t stride, hearth_ray_fan **out,
+                                 hearth_err *err);
+void hearth_ray_fan_free(hearth_ray_fan *f);
+/* The grid's unit directions (3 floats per pixel, row-major, w x h): those
+ * of hearth_camera_ray_grid, with zero where the lens cannot be inverted
+ * (such a pixel never hits). */
+const float *hearth_ray_fan_dirs(const hearth_ray_fan *f, size_t *w, size_t *h);
+/* Bytes of scratch one cast at a mesh of n_vertices needs (one block per
+ * concurrent cast; the fan itself is only read). */
+size_t hearth_ray_fan_scratch_size(const hearth_ray_fan *f, size_t n_vertices);
+/* Cast the grid from the pose T_world_from_cam: hits[p] for grid pixel p,
+ * t along the unit direction, front 1; prim UINT32_MAX where the ray hits
+ * nothing. Equal depths go to the lower triangle index, so the result
+ * depends only on the inputs. HEARTH_E_UNSUPPORTED (naming the vertex) if a
+ * vertex is not in front of the camera. */
+hearth_status hearth_ray_fan_cast(const hearth_ray_fan *f, const hearth_mesh *m,
+                                  const hearth_rigid *T_world_from_cam, void *scratch,
+                                  hearth_ray_hit *hits, hearth_err *err);
 
 /* ---- UV islands and texel rasterisation ----------------------------------- */
 /* Label connected UV islands: triangles sharing an edge in UV space (same two

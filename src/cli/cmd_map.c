@@ -25,6 +25,9 @@ static const char *k_help =
     "                     paper's literal rule; by default they are skipped because the\n"
     "                     lens blur mixes the two surfaces in them)\n"
     "  --views LIST       comma-separated view names to use (default: all)\n"
+    "  --trace-rays       trace every pixel's ray (Embree) instead of rasterising views\n"
+    "                     that have the whole mesh in front (the same hits up to float\n"
+    "                     rounding; slower; for comparisons)\n"
     "  --mesh FILE        metric mesh instead of derived/mesh.glb\n"
     "  --poses FILE       thermal poses instead of derived/poses_thermal.json\n"
     "  --rig FILE         rig instead of calibration/rig.json\n"
@@ -106,6 +109,8 @@ int hearth_cmd_map(int argc, char **argv) {
       job.map.threads = (int)lv;
     } else if (!strcmp(argv[i], "--keep-edges")) {
       job.map.keep_edges = 1;
+    } else if (!strcmp(argv[i], "--trace-rays")) {
+      job.map.trace_rays = 1;
     } else if (!strcmp(argv[i], "--rgb")) {
       rgb = 1;
     } else if (cli_root_arg("map", argv[i], &root, k_help)) {

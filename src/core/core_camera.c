@@ -12,11 +12,10 @@ void hearth_camera_K(const hearth_camera *cam, double K[9]) {
 void hearth_distort(const double dist[5], double x, double y, double *xd, double *yd,
                     double J[4]) {
   const double k1 = dist[0], k2 = dist[1], p1 = dist[2], p2 = dist[3], k3 = dist[4];
-  double x2 = x * x, y2 = y * y, xy = x * y, r2 = x2 + y2;
-  double radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
-  *xd = x * radial + 2.0 * p1 * xy + p2 * (r2 + 2.0 * x2);
-  *yd = y * radial + p1 * (r2 + 2.0 * y2) + 2.0 * p2 * xy;
+  hearth_distort_xy(dist, x, y, xd, yd);
   if (J) {
+    double x2 = x * x, y2 = y * y, xy = x * y, r2 = x2 + y2;
+    double radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
     /* d radial / d r2 */
     double dr = k1 + r2 * (2.0 * k2 + 3.0 * k3 * r2);
     J[0] = radial + 2.0 * x2 * dr + 2.0 * p1 * y + 6.0 * p2 * x;

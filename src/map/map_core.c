@@ -106,6 +106,9 @@ typedef struct map_ctx {
   const uint32_t *pix_index; /* image pixel index of grid pixel */
   const uint32_t *tile_order; /* grid pixels in 4x4 tiles: coherent packets of 16 */
   double sphere[4];           /* mesh bounding sphere: rays that miss it are not cast */
+  const hearth_ray_fan *fan;  /* the pixel grid as a ray fan (NULL: cast rays) */
+  const uint8_t *view_fan;    /* per view: the mesh lies in front, the fan applies */
+  void **fan_scratch;         /* per thread */
   /* per-thread scratch, indexed by thread */
   int n_threads;
   int cast_threads; /* threads for ray casting when views are processed serially */
@@ -144,9 +147,40 @@ typedef struct pix_box {
 /* cast every grid pixel of view v; fill hit_* arrays of thread t. Rays go
  * to Embree in 4x4 pixel tiles (packets of nearly parallel rays); rays that
  * miss the mesh's bounding sphere are not cast at all. */
+/* record a hit (or a miss) of grid pixel p */
+static void keep_hit(map_ctx *m, int t, size_t p, const hearth_ray_hit *h, pix_box *box) {
+  size_t n = m->n_pix;
+  float *ht = m->hit_t + (size_t)t * n, *b1 = m->hit_b1 + (size_t)t * n, *b2 = m->hit_b2 + (size_t)t * n;
+  uint32_t *tri = m->hit_tri + (size_t)t * n;
+  if (h->prim != UINT32_MAX && h->front) {
+    size_t px = p % m->pix_w, py = p / m->pix_w;
+    if (px < box->x0) box->x0 = px;
+    if (px > box->x1) box->x1 = px;
+    if (py < box->y0) box->y0 = py;
+    if (py > box->y1) box->y1 = py;
+    ht[p] = h->t;
+    tri[p] = h->prim;
+    b1[p] = h->b1;
+    b2[p] = h->b2;
+  } else {
+    ht[p] = INFINITY;
+    tri[p] = UINT32_MAX;
+  }
+}
+
 static void cast_view(map_ctx *m, size_t v, int t, pix_box *box) {
   const hearth_rigid *T = &m->views[v].T_world_from_cam;
   size_t n = m->n_pix;
+  if (m->view_fan[v]) {
+    /* the whole mesh lies in front of this view: rasterise */
+    hearth_ray_hit *hits = m->hits + (size_t)t * n;
+    if (hearth_ray_fan_cast(m->fan, m->mesh, T, m->fan_scratch[t], hits, NULL)) {
+      m->failed = 2; /* cannot happen: the bounding sphere lies in front */
+      return;
+    }
+    for (size_t p = 0; p < n; p++) keep_hit(m, t, p, &hits[p], box);
+    return;
+  }
   float *org = m->ray_org + (size_t)t * 3 * n, *dir = m->ray_dir + (size_t)t * 3 * n;
   hearth_ray_hit *hits = m->hits + (size_t)t * n;
   const double *S = m->sphere;
@@ -171,8 +205,6 @@ static void cast_view(map_ctx *m, size_t v, int t, pix_box *box) {
   /* views already run in parallel: cast on this thread only, unless there
      is a single worker for all views */
   hearth_raycast_batch_mt(m->rc, n, org, dir, 0.0f, INFINITY, hits, m->n_threads > 1 ? 1 : m->cast_threads);
-  float *ht = m->hit_t + (size_t)t * n, *b1 = m->hit_b1 + (size_t)t * n, *b2 = m->hit_b2 + (size_t)t * n;
-  uint32_t *tri = m->hit_tri + (size_t)t * n;
   for (size_t i = 0; i < n; i++) {
     size_t p = m->tile_order[i];
     hearth_ray_hit h = hits[i];
@@ -183,20 +215,7 @@ static void cast_view(map_ctx *m, size_t v, int t, pix_box *box) {
       double tn = (double)h.t * (1.0 + 1e-6) + 1e-7;
       if (!hearth_raycast(m->rc, o, d, tn, INFINITY, &h)) h.prim = UINT32_MAX;
     }
-    if (h.prim != UINT32_MAX && h.front) {
-      size_t px = p % m->pix_w, py = p / m->pix_w;
-      if (px < box->x0) box->x0 = px;
-      if (px > box->x1) box->x1 = px;
-      if (py < box->y0) box->y0 = py;
-      if (py > box->y1) box->y1 = py;
-      ht[p] = h.t;
-      tri[p] = h.prim;
-      b1[p] = h.b1;
-      b2[p] = h.b2;
-    } else {
-      ht[p] = INFINITY;
-      tri[p] = UINT32_MAX;
-    }
+    keep_hit(m, t, p, &h, box);
   }
 }
 
@@ -258,6 +277,7 @@ static void process_view(map_ctx *m, size_t v, int t) {
   size_t n_touched = 0;
   pix_box box = {SIZE_MAX, 0, SIZE_MAX, 0};
   cast_view(m, v, t, &box);
+  if (m->failed) return;
   if (box.x0 > box.x1) box = (pix_box){1, 0, 1, 0}; /* no hit: empty */
   const float *ht = m->hit_t + (size_t)t * n, *hb1 = m->hit_b1 + (size_t)t * n,
               *hb2 = m->hit_b2 + (size_t)t * n;
@@ -725,21 +745,38 @@ static void finish_rows(void *ctx, size_t b, size_t e, int t) {
   }
 }
 
-/* the ray caster built on a thread of its own while the UV layout is
- * rasterised (the two only read the mesh) */
-typedef struct rc_build {
-  const hearth_mesh *mesh;
-  hearth_raycaster *rc;
-  hearth_status s;
-  hearth_err err;
-  double seconds;
-} rc_build;
+/* the pixel grid (undistorted centres of every stride-th pixel) and its ray
+ * fan, made on a thread of their own while the UV layout is rasterised (the
+ * two only read their inputs) */
+typedef struct grid_build {
+  const hearth_camera *cam;
+  size_t stride, pw, ph;
+  float *pix_dir;
+  uint32_t *pix_index, *tile_order;
+  hearth_ray_fan *fan; /* NULL where the fan cannot hold the grid */
+  int nomem;
+} grid_build;
 
-static void *rc_build_run(void *arg) {
-  rc_build *b = arg;
-  double t0 = hearth_now();
-  b->s = hearth_raycaster_new(b->mesh, &b->rc, &b->err);
-  b->seconds = hearth_now() - t0;
+static void *grid_build_run(void *arg) {
+  grid_build *g = arg;
+  size_t st = g->stride, pw = g->pw, ph = g->ph, np = pw * ph;
+  hearth_status s = hearth_ray_fan_new(g->cam, st, &g->fan, NULL);
+  if (s == HEARTH_OK) {
+    memcpy(g->pix_dir, hearth_ray_fan_dirs(g->fan, NULL, NULL), np * 3 * sizeof *g->pix_dir);
+  } else {
+    g->nomem = s == HEARTH_E_NOMEM;
+    /* a pixel the lens model cannot invert gets a zero direction: never cast */
+    if (hearth_camera_ray_grid(g->cam, st, g->pix_dir))
+      for (size_t k = 0; k < 3 * np; k++)
+        if (isnan(g->pix_dir[k])) g->pix_dir[k] = 0.0f;
+  }
+  for (size_t y = 0; y < ph; y++)
+    for (size_t x = 0; x < pw; x++) g->pix_index[y * pw + x] = (uint32_t)(y * st * (size_t)g->cam->width + x * st);
+  size_t k = 0;
+  for (size_t ty = 0; ty < ph; ty += 4)
+    for (size_t tx = 0; tx < pw; tx += 4)
+      for (size_t y = ty; y < ty + 4 && y < ph; y++)
+        for (size_t x = tx; x < tx + 4 && x < pw; x++) g->tile_order[k++] = (uint32_t)(y * pw + x);
   return NULL;
 }
 
@@ -749,7 +786,9 @@ static void free_scratch(map_ctx *m) {
     if (m->touches_tmp) free(m->touches_tmp[t]);
     if (m->splats) free(m->splats[t]);
     if (m->sil) free(m->sil[t]);
+    if (m->fan_scratch) free(m->fan_scratch[t]);
   }
+  free(m->fan_scratch);
   free(m->touches);
   free(m->touches_tmp);
   free((void *)m->fused);
@@ -813,16 +852,29 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
   uint32_t *tri_of_texel = NULL, *island_of_tri = NULL, *island_of_texel = NULL, *pix_index = NULL,
            *tile_order = NULL;
   float *tri_normal = NULL, *pix_dir = NULL;
+  uint8_t *view_fan = NULL;
   int32_t *seed = NULL;
   size_t N = R * R;
+  grid_build gb = {0};
+  pthread_t gb_tid;
+  int gb_started = 0;
   double t_raster0 = hearth_now();
-  rc_build bld = {mesh, NULL, HEARTH_OK, {0}, 0.0};
-  pthread_t bld_tid;
-  int bld_started = 0;
-  if (!rc_in) {
-    bld_started = pthread_create(&bld_tid, NULL, rc_build_run, &bld) == 0;
-    if (!bld_started) rc_build_run(&bld); /* no thread: build here */
+  /* pixel grid: undistorted centres of every stride-th pixel, made with its
+     ray fan beside the UV raster */
+  size_t st = (size_t)opts.pixel_stride;
+  size_t pw = ((size_t)cam->width + st - 1) / st, ph = ((size_t)cam->height + st - 1) / st;
+  size_t np = pw * ph;
+  pix_dir = hearth_alloc_array(np, 3 * sizeof *pix_dir);
+  pix_index = hearth_alloc_array(np, sizeof *pix_index);
+  tile_order = hearth_alloc_array(np, sizeof *tile_order);
+  view_fan = calloc(n_views ? n_views : 1, 1);
+  if (!pix_dir || !pix_index || !tile_order || !view_fan) {
+    s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
+    goto done;
   }
+  gb = (grid_build){cam, st, pw, ph, pix_dir, pix_index, tile_order, NULL, 0};
+  gb_started = pthread_create(&gb_tid, NULL, grid_build_run, &gb) == 0;
+  if (!gb_started) grid_build_run(&gb); /* no thread: make it here */
   tri_of_texel = hearth_alloc_array(N, sizeof *tri_of_texel);
   island_of_tri = hearth_alloc_array(mesh->n_triangles, sizeof *island_of_tri);
   tri_normal = hearth_alloc_array(mesh->n_triangles, 3 * sizeof *tri_normal);
@@ -852,32 +904,6 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
     double l = hearth_norm3(nn);
     for (int k = 0; k < 3; k++) tri_normal[3 * i + k] = l > 0 ? (float)(nn[k] / l) : 0.0f;
   }
-  double t_cast0 = hearth_now();
-  if (timing) timing->raster = t_cast0 - t_raster0;
-  /* pixel grid: undistorted centres of every stride-th pixel */
-  size_t st = (size_t)opts.pixel_stride;
-  size_t pw = ((size_t)cam->width + st - 1) / st, ph = ((size_t)cam->height + st - 1) / st;
-  size_t np = pw * ph;
-  pix_dir = hearth_alloc_array(np, 3 * sizeof *pix_dir);
-  pix_index = hearth_alloc_array(np, sizeof *pix_index);
-  tile_order = hearth_alloc_array(np, sizeof *tile_order);
-  if (!pix_dir || !pix_index || !tile_order) {
-    s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
-    goto done;
-  }
-  /* a pixel the lens model cannot invert gets a zero direction: never cast */
-  if (hearth_camera_ray_grid(cam, st, pix_dir))
-    for (size_t k = 0; k < 3 * np; k++)
-      if (isnan(pix_dir[k])) pix_dir[k] = 0.0f;
-  for (size_t y = 0; y < ph; y++)
-    for (size_t x = 0; x < pw; x++) pix_index[y * pw + x] = (uint32_t)(y * st * (size_t)cam->width + x * st);
-  {
-    size_t k = 0;
-    for (size_t ty = 0; ty < ph; ty += 4)
-      for (size_t tx = 0; tx < pw; tx += 4)
-        for (size_t y = ty; y < ty + 4 && y < ph; y++)
-          for (size_t x = tx; x < tx + 4 && x < pw; x++) tile_order[k++] = (uint32_t)(y * pw + x);
-  }
   /* bounding sphere: the box centre and the farthest vertex from it,
    * padded so that rounding can never cull a ray that touches the mesh */
   double sphere[4] = {0, 0, 0, 0};
@@ -893,19 +919,31 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
     }
     sphere[3] = sqrt(r2) * (1.0 + 1e-3) + 1e-6;
   }
-
-  /* the ray caster, built meanwhile */
-  if (bld_started) {
-    pthread_join(bld_tid, NULL);
-    bld_started = 0;
+  if (gb_started) {
+    pthread_join(gb_tid, NULL);
+    gb_started = 0;
   }
-  own_rc = bld.rc;
-  bld.rc = NULL;
-  if (timing) timing->build = bld.seconds;
-  if (!rc_in && bld.s) {
-    if (err) *err = bld.err;
-    s = bld.s;
+  if (gb.nomem) {
+    s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory for the pixel grid");
     goto done;
+  }
+  double t_cast0 = hearth_now();
+  if (timing) timing->raster = t_cast0 - t_raster0;
+  /* a view whose camera has the whole mesh (its bounding sphere, with a
+     margin) in front is rasterised through the fan; any other view casts
+     rays, through a ray caster built only then */
+  int need_rays = 0;
+  for (size_t v = 0; v < n_views; v++) {
+    const hearth_rigid *T = &views[v].T_world_from_cam;
+    double d[3] = {sphere[0] - T->t[0], sphere[1] - T->t[1], sphere[2] - T->t[2]};
+    double z = T->R[2] * d[0] + T->R[5] * d[1] + T->R[8] * d[2];
+    view_fan[v] = gb.fan && !opts.trace_rays && z > sphere[3] * (1.0 + 1e-6) + 1e-9;
+    need_rays |= !view_fan[v];
+  }
+  if (need_rays && !rc_in) {
+    double t0 = hearth_now();
+    if ((s = hearth_raycaster_new(mesh, &own_rc, err))) goto done;
+    if (timing) timing->build = hearth_now() - t0;
   }
   int nt = opts.threads > 0 ? opts.threads : hearth_default_threads();
   if ((size_t)nt > n_views) nt = n_views ? (int)n_views : 1;
@@ -914,12 +952,13 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
                 .island_of_tri = island_of_tri, .tri_normal = tri_normal, .n_pix = np,
                 .pix_w = pw, .pix_h = ph, .pix_dir = pix_dir, .pix_index = pix_index,
                 .tile_order = tile_order, .sphere = {sphere[0], sphere[1], sphere[2], sphere[3]},
-                .n_threads = nt,
+                .fan = gb.fan, .view_fan = view_fan, .n_threads = nt,
                 .cast_threads = opts.threads > 0 ? opts.threads : hearth_default_threads()};
   m.touches = calloc((size_t)nt, sizeof *m.touches);
   m.touches_tmp = calloc((size_t)nt, sizeof *m.touches_tmp);
   m.sil = calloc((size_t)nt, sizeof *m.sil);
   m.splats = calloc((size_t)nt, sizeof *m.splats);
+  m.fan_scratch = calloc((size_t)nt, sizeof *m.fan_scratch);
   m.fused = hearth_alloc_array(N, FUSED_STRIDE(C) * sizeof *m.fused);
   if (opts.fusion == HEARTH_FUSE_MEAN) {
     m.msum = hearth_alloc_array(N * (size_t)C, sizeof *m.msum);
@@ -933,7 +972,7 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
   m.ray_dir = hearth_alloc_array(np * (size_t)nt, 3 * sizeof(float));
   m.hits = hearth_alloc_array(np * (size_t)nt, sizeof(hearth_ray_hit));
   m.view_hits = calloc(n_views ? n_views : 1, sizeof *m.view_hits);
-  int bad = !m.touches || !m.touches_tmp || !m.sil || !m.splats || !m.fused ||
+  int bad = !m.touches || !m.touches_tmp || !m.sil || !m.splats || !m.fan_scratch || !m.fused ||
             (opts.fusion == HEARTH_FUSE_MEAN && (!m.msum || !m.mw)) || !m.hit_t || !m.hit_tri || !m.hit_b1 || !m.hit_b2 || !m.ray_org ||
             !m.ray_dir || !m.hits || !m.view_hits;
   if (opts.fusion == HEARTH_FUSE_ROBUST) {
@@ -946,6 +985,10 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
     m.splats[t] = hearth_alloc_array(np, sizeof(splat));
     m.touches[t] = hearth_alloc_array(np, 4 * sizeof(touch));
     m.touches_tmp[t] = hearth_alloc_array(np, 4 * sizeof(touch));
+    if (gb.fan) {
+      m.fan_scratch[t] = malloc(hearth_ray_fan_scratch_size(gb.fan, mesh->n_vertices));
+      bad |= !m.fan_scratch[t];
+    }
     bad |= !m.sil[t] || !m.splats[t] || !m.touches[t] || !m.touches_tmp[t];
   }
   if (bad) {
@@ -954,6 +997,10 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
   }
   hearth_parallel_for(R, nt, init_fused, &m);
   hearth_parallel_for(n_views, nt, views_range, &m);
+  if (m.failed == 2) {
+    s = hearth_err_set(err, HEARTH_E_NUMERIC, "map: a view's camera does not have the mesh in front after all");
+    goto done;
+  }
   if (m.failed) {
     s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory while fusing views");
     goto done;
@@ -1053,8 +1100,9 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
   }
   s = HEARTH_OK;
 done:
-  if (bld_started) pthread_join(bld_tid, NULL);
-  hearth_raycaster_free(bld.rc);
+  if (gb_started) pthread_join(gb_tid, NULL);
+  hearth_ray_fan_free(gb.fan);
+  free(view_fan);
   free_scratch(&m);
   free(m.view_hits);
   hearth_raycaster_free(own_rc);

@@ -157,6 +157,8 @@ static hearth_status write_provenance(const char *path, const hearth_map_job *jo
   json_object_set_new(pj, "min_cos", json_real(job->map.min_cos));
   json_object_set_new(pj, "views", json_string(job->views && *job->views ? job->views : "all"));
   json_object_set_new(pj, "keep_edges", json_boolean(job->map.keep_edges));
+  json_object_set_new(pj, "visibility", json_string(job->map.trace_rays ? "traced rays"
+                                                                         : "rasterised where the mesh is in front"));
   json_object_set_new(pj, "turbo_range_c", vec_json((double[]){job->turbo_lo, job->turbo_hi}, 2));
   json_object_set_new(pj, "splat", json_string("bilinear"));
   json_object_set_new(pj, "fill", json_string("nearest observed texel within the UV island"));

@@ -36,20 +36,32 @@ int main(void) {
     snprintf(poses, sizeof poses, "%s/ground_truth/instances/%s/poses_thermal.json", root, inst[i]);
     const char *states[2] = {"neutral", hot[i]};
     for (int s = 0; s < 2; s++)
-      for (int f = 0; f < 2; f++) {
+      for (int f = 0; f < 3; f++) {
+        /* max and robust fusion through the ray fan; max with traced rays
+           (the fallback for views that do not have the whole mesh in front)
+           must see the same surface */
         hearth_map_opts o;
         hearth_map_opts_default(&o);
         o.resolution = 256;
-        o.fusion = f ? HEARTH_FUSE_ROBUST : HEARTH_FUSE_MAX;
+        o.fusion = f == 1 ? HEARTH_FUSE_ROBUST : HEARTH_FUSE_MAX;
+        o.trace_rays = f == 2;
         map_eval ev;
+        static map_eval fan_max;
         CHECK_OK(map_eval_state(root, inst[i], states[s], mesh, poses, rig, &o, &ev, &err), &err);
         printf("%-16s %-8s %-6s n=%6zu median=%.3f p95=%.3f max=%.2f coverage=%.3f filled=%zu\n",
-               inst[i], states[s], f ? "robust" : "max", ev.n_eval, ev.median, ev.p95, ev.max_err,
-               ev.coverage, ev.n_filled);
+               inst[i], states[s], f == 1 ? "robust" : f ? "rays" : "max", ev.n_eval, ev.median, ev.p95,
+               ev.max_err, ev.coverage, ev.n_filled);
+        if (f == 0) fan_max = ev;
+        if (f == 2) {
+          CHECK_MSG(fabs(ev.coverage - fan_max.coverage) <= 1e-3, "coverage: rays %.4f, fan %.4f", ev.coverage,
+                    fan_max.coverage);
+          CHECK_MSG(fabs(ev.median - fan_max.median) <= 2e-3 && fabs(ev.p95 - fan_max.p95) <= 2e-3,
+                    "errors: rays %.4f/%.4f, fan %.4f/%.4f", ev.median, ev.p95, fan_max.median, fan_max.p95);
+        }
         CHECK(ev.n_eval > 1000);
         CHECK_MSG(ev.median <= 0.1, "%s/%s: median %.3f", inst[i], states[s], ev.median);
         CHECK_MSG(ev.p95 <= 0.5, "%s/%s %s: p95 %.3f > 0.5", inst[i], states[s],
-                  f ? "robust" : "max", ev.p95);
+                  f == 1 ? "robust" : "max", ev.p95);
         CHECK_MSG(ev.cross_island == 0, "%zu filled texels took a value from another island",
                   ev.cross_island);
       }
