@@ -111,17 +111,21 @@ void hearth_ray_fan_free(hearth_ray_fan *f);
  * of hearth_camera_ray_grid, with zero where the lens cannot be inverted
  * (such a pixel never hits). */
 const float *hearth_ray_fan_dirs(const hearth_ray_fan *f, size_t *w, size_t *h);
-/* Bytes of scratch one cast at a mesh of n_vertices needs (one block per
- * concurrent cast; the fan itself is only read). */
+/* Bytes of scratch one cast at a mesh of n_vertices needs: one block per
+ * concurrent cast, zero-filled before its first cast (calloc); every cast
+ * leaves it zero-filled again. The fan itself is only read. */
 size_t hearth_ray_fan_scratch_size(const hearth_ray_fan *f, size_t n_vertices);
-/* Cast the grid from the pose T_world_from_cam: hits[p] for grid pixel p,
- * t along the unit direction, front 1; prim UINT32_MAX where the ray hits
- * nothing. Equal depths go to the lower triangle index, so the result
- * depends only on the inputs. HEARTH_E_UNSUPPORTED (naming the vertex) if a
- * vertex is not in front of the camera. */
+/* Cast the grid from the pose T_world_from_cam. box = {x0, x1, y0, y1}
+ * (grid pixels, inclusive; x0 > x1 when nothing is hit) bounds the hits:
+ * hits[p] is written for every grid pixel p in the box only (t along the
+ * unit direction, front 1; prim UINT32_MAX where the ray hits nothing), and
+ * every pixel outside it hits nothing. Equal depths go to the lower
+ * triangle index, so the result depends only on the inputs.
+ * HEARTH_E_UNSUPPORTED (naming the vertex) if a vertex is not in front of
+ * the camera. */
 hearth_status hearth_ray_fan_cast(const hearth_ray_fan *f, const hearth_mesh *m,
                                   const hearth_rigid *T_world_from_cam, void *scratch,
-                                  hearth_ray_hit *hits, hearth_err *err);
+                                  hearth_ray_hit *hits, size_t box[4], hearth_err *err);
 
 /* ---- UV islands and texel rasterisation ----------------------------------- */
 /* Label connected UV islands: triangles sharing an edge in UV space (same two

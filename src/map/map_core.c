@@ -1,55 +1,37 @@
 /* Temperature / colour mapping onto a UV layout (see include/hearth/map.h).
  *
- * Determinism: views are processed in parallel, but every cross-view
- * reduction is order-independent by construction: the maximum is exact,
- * means are accumulated in 64-bit fixed point (integer addition is
- * associative), and the robust median works on per-view records reduced in
- * view order. Within a view, pixels are visited in raster order by one
- * thread. */
+ * Two parallel phases. Views: each view is cast and splatted by one worker,
+ * and reduced to its own records, one per texel it observes (the view's
+ * mean there, its weight and best viewing cosine), sorted by texel. Texels:
+ * bands of rows fold every view's records for their texels in view order
+ * (maximum, weighted mean or weighted median), touching only the band's
+ * slice of the maps. Nothing is shared between workers while it is
+ * written, and every texel is folded in the same order whatever the thread
+ * count: the result does not depend on it. Within a view, pixels are
+ * visited in raster order by one thread. */
 #include <math.h>
 #include <pthread.h>
-#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include "hearth/map.h"
 
-#define FIX_SCALE 1048576.0 /* 2^20: fixed-point resolution of mean fusion */
 #define MAX_BACKFACE_SKIPS 8
 /* One bilinear touch of a texel by a splat within one view; a view's
  * touches are sorted by texel (stably: pixel order within a texel) and
- * reduced in one pass, so the shared records are visited in address order
- * and each texel's sums add up in the same order as pixel by pixel. */
+ * reduced in one pass into the view's records, each texel's sums added up
+ * in the same order as pixel by pixel. */
 typedef struct touch {
   uint32_t q;     /* texel */
   uint32_t splat; /* index into the view's splats */
   float w;        /* bilinear weight */
 } touch;
 
-/* fused results shared by the workers: maximum and best cosine as atomic
- * maxima (exact and order-independent), the mean's fixed-point sums as
- * atomic additions (integer addition is associative) */
-static void atomic_max_f32(_Atomic uint32_t *a, float v) {
-  uint32_t old = atomic_load_explicit(a, memory_order_relaxed), nv;
-  memcpy(&nv, &v, sizeof nv);
-  for (;;) {
-    float f;
-    memcpy(&f, &old, sizeof f);
-    if (!(v > f)) return;
-    if (atomic_compare_exchange_weak_explicit(a, &old, nv, memory_order_relaxed, memory_order_relaxed)) return;
-  }
-}
-
-#define FUSED_STRIDE(C) (2 + (size_t)(C))
-#define FUSED_MAX 1 /* then C words */
-#define FUSED_COS(C) (1 + (size_t)(C))
-
-static float atomic_get_f32(_Atomic uint32_t *a) {
-  uint32_t u = atomic_load_explicit(a, memory_order_relaxed);
-  float f;
-  memcpy(&f, &u, sizeof f);
-  return f;
-}
+/* a view's record of a texel: the texel's index in rec_q, then REC_WORDS(C)
+ * floats: the weight (sum of bilinear weights), the best viewing cosine and
+ * per channel the mean (the weighted sum for mean fusion) */
+#define REC_WORDS(C) (2 + (size_t)(C))
+#define BAND_TEXELS 16384 /* texels per band of the fusion phase (whole rows) */
 
 void hearth_map_opts_default(hearth_map_opts *o) {
   memset(o, 0, sizeof *o);
@@ -68,13 +50,6 @@ void hearth_map_result_free(hearth_map_result *r) {
   free(r->view_hits);
   memset(r, 0, sizeof *r);
 }
-
-/* a per-view contribution to one texel, for the robust fusion */
-typedef struct view_record {
-  uint32_t texel;
-  float value;
-  float weight;
-} view_record;
 
 /* one hit pixel's splat: its bilinear footprint, island, cosine and value;
  * a view's splats become touches of texels (see touch) */
@@ -114,12 +89,14 @@ typedef struct map_ctx {
   int cast_threads; /* threads for ray casting when views are processed serially */
   /* per thread: a view's touches and the sort's second buffer (4 per pixel) */
   touch **touches, **touches_tmp;
-  /* shared fused state, FUSED_STRIDE(C) words per texel: the texel's island
-   * (read-only), the maximum of the view means (C floats) and the best
-   * cosine over views; one cache line for everything a first touch or a
-   * fold needs. Mean fusion's fixed-point sums beside it. */
-  _Atomic uint32_t *fused;
-  _Atomic int64_t *msum, *mw;
+  /* the views' records (see REC_WORDS), each view's sorted by texel, in
+   * per-thread arenas (room for 4 records per pixel of every view of the
+   * thread's range; only what is written is ever touched) */
+  uint32_t **rec_q;
+  float **rec_d;
+  size_t *n_rec;
+  uint32_t **arena_q; /* per thread */
+  float **arena_d;
   splat **splats; /* per thread: n_pix */
   uint8_t **sil; /* per thread: n_pix silhouette flags */
   float *hit_t; /* per thread: n_pix */
@@ -129,8 +106,6 @@ typedef struct map_ctx {
   hearth_ray_hit *hits;
   /* outputs */
   uint32_t *view_hits;
-  view_record **records; /* robust: per view */
-  size_t *n_records;
   int failed;
 } map_ctx;
 
@@ -174,11 +149,27 @@ static void cast_view(map_ctx *m, size_t v, int t, pix_box *box) {
   if (m->view_fan[v]) {
     /* the whole mesh lies in front of this view: rasterise */
     hearth_ray_hit *hits = m->hits + (size_t)t * n;
-    if (hearth_ray_fan_cast(m->fan, m->mesh, T, m->fan_scratch[t], hits, NULL)) {
+    size_t fb[4];
+    if (hearth_ray_fan_cast(m->fan, m->mesh, T, m->fan_scratch[t], hits, fb, NULL)) {
       m->failed = 2; /* cannot happen: the bounding sphere lies in front */
       return;
     }
-    for (size_t p = 0; p < n; p++) keep_hit(m, t, p, &hits[p], box);
+    if (fb[0] > fb[1]) return; /* no hit */
+    /* the hits' box, and misses in a 2-pixel ring around it (what the
+       silhouette filter reads) */
+    const size_t W = m->pix_w, H = m->pix_h;
+    float *ht = m->hit_t + (size_t)t * n;
+    uint32_t *tri = m->hit_tri + (size_t)t * n;
+    for (size_t y = fb[2] >= 2 ? fb[2] - 2 : 0; y <= fb[3] + 2 && y < H; y++)
+      for (size_t x = fb[0] >= 2 ? fb[0] - 2 : 0; x <= fb[1] + 2 && x < W; x++) {
+        size_t p = y * W + x;
+        if (x >= fb[0] && x <= fb[1] && y >= fb[2] && y <= fb[3]) {
+          keep_hit(m, t, p, &hits[p], box);
+        } else {
+          ht[p] = INFINITY;
+          tri[p] = UINT32_MAX;
+        }
+      }
     return;
   }
   float *org = m->ray_org + (size_t)t * 3 * n, *dir = m->ray_dir + (size_t)t * 3 * n;
@@ -361,26 +352,18 @@ static void process_view(map_ctx *m, size_t v, int t) {
   }
   m->view_hits[v] = hits;
   /* each texel's touches in pixel order: splat only from the texel's own
-   * island; the view's mean then folds into the shared fused state */
-  _Atomic uint32_t *fused = m->fused;
-  const size_t FS = FUSED_STRIDE(C);
+   * island; one record per texel with any */
+  const uint32_t *iot = m->island_of_texel;
+  const size_t RW = REC_WORDS(C);
   int fusion = m->opts->fusion;
-  view_record *rec = NULL;
-  if (fusion == HEARTH_FUSE_ROBUST) {
-    /* at most one record per touch */
-    rec = malloc((n_tc ? n_tc : 1) * sizeof *rec);
-    if (!rec) {
-      m->failed = 1;
-      return;
-    }
-  }
+  uint32_t *rq = m->rec_q[v];
+  float *rd = m->rec_d[v];
   for (size_t i = 0; i < n_tc;) {
     uint32_t q = tc[i].q;
     size_t j = i;
     while (j < n_tc && tc[j].q == q) j++;
-    if (j + PREFETCH_AHEAD < n_tc) __builtin_prefetch(&fused[(size_t)tc[j + PREFETCH_AHEAD].q * FS], 1);
-    _Atomic uint32_t *f = fused + (size_t)q * FS;
-    uint32_t island = atomic_load_explicit(&f[0], memory_order_relaxed);
+    if (j + PREFETCH_AHEAD < n_tc) __builtin_prefetch(&iot[tc[j + PREFETCH_AHEAD].q], 0);
+    uint32_t island = iot[q];
     float wsum = 0.0f, best_cos = 0.0f, sum[3] = {0.0f, 0.0f, 0.0f};
     int any = 0;
     for (size_t k = i; k < j; k++) {
@@ -393,60 +376,31 @@ static void process_view(map_ctx *m, size_t v, int t) {
     }
     i = j;
     if (!any) continue;
-    n_touched++;
-    atomic_max_f32(&f[FUSED_COS(C)], best_cos);
-    if (fusion == HEARTH_FUSE_MAX) {
-      for (int c = 0; c < C; c++) {
-        /* + 0.0f: a negative zero becomes +0, so equal means cannot make
-           the maximum's bits depend on which view came first */
-        float mean = sum[c] / wsum + 0.0f;
-        atomic_max_f32(&f[FUSED_MAX + (size_t)c], mean);
-      }
-    } else if (fusion == HEARTH_FUSE_MEAN) {
-      /* each view counts with its total weight at this texel */
-      atomic_fetch_add_explicit(&m->mw[q], (int64_t)llround((double)wsum * FIX_SCALE), memory_order_relaxed);
-      for (int c = 0; c < C; c++)
-        atomic_fetch_add_explicit(&m->msum[(size_t)q * (size_t)C + (size_t)c],
-                                  (int64_t)llround((double)sum[c] * FIX_SCALE), memory_order_relaxed);
-    } else {
-      rec[n_touched - 1] = (view_record){q, sum[0] / wsum, wsum};
-    }
+    float *d = rd + n_touched * RW;
+    rq[n_touched++] = q;
+    d[0] = wsum;
+    d[1] = best_cos;
+    /* + 0.0f: a negative zero becomes +0, so equal means cannot make the
+       maximum's bits depend on which view came first */
+    for (int c = 0; c < C; c++) d[2 + c] = fusion == HEARTH_FUSE_MEAN ? sum[c] : sum[c] / wsum + 0.0f;
   }
-  if (rec) {
-    m->records[v] = rec;
-    m->n_records[v] = n_touched;
-  }
-}
-
-/* the shared fused state: islands, maxima -inf, best cosines 0, mean sums
- * 0; rows in parallel */
-static void init_fused(void *ctx, size_t b, size_t e, int t) {
-  map_ctx *m = ctx;
-  size_t R = m->R, C = (size_t)m->C;
-  uint32_t minf;
-  float ninf = -INFINITY;
-  memcpy(&minf, &ninf, sizeof minf);
-  (void)t;
-  for (size_t q = b * R; q < e * R; q++) {
-    _Atomic uint32_t *f = m->fused + q * FUSED_STRIDE(C);
-    atomic_init(&f[0], m->island_of_texel[q]);
-    for (size_t c = 0; c < C; c++) atomic_init(&f[FUSED_MAX + c], minf);
-    atomic_init(&f[FUSED_COS(C)], 0u);
-    if (m->mw) {
-      atomic_init(&m->mw[q], 0);
-      for (size_t c = 0; c < C; c++) atomic_init(&m->msum[q * C + c], 0);
-    }
-  }
+  m->n_rec[v] = n_touched;
 }
 
 static void views_range(void *ctx, size_t b, size_t e, int t) {
   map_ctx *m = ctx;
-  for (size_t v = b; v < e; v++) process_view(m, v, t);
-}
-
-static int cmp_record_texel(const void *a, const void *b) {
-  uint32_t x = ((const view_record *)a)->texel, y = ((const view_record *)b)->texel;
-  return (x > y) - (x < y);
+  size_t per_view = 4 * m->n_pix;
+  m->arena_q[t] = hearth_alloc_array((e - b) * per_view, sizeof(uint32_t));
+  m->arena_d[t] = hearth_alloc_array((e - b) * per_view, REC_WORDS(m->C) * sizeof(float));
+  if (!m->arena_q[t] || !m->arena_d[t]) {
+    m->failed = 1;
+    return;
+  }
+  for (size_t v = b; v < e; v++) {
+    m->rec_q[v] = m->arena_q[t] + (v - b) * per_view;
+    m->rec_d[v] = m->arena_d[t] + (v - b) * per_view * REC_WORDS(m->C);
+    process_view(m, v, t);
+  }
 }
 
 /* weighted median of n (value, weight) pairs; sorts in place */
@@ -695,31 +649,119 @@ typedef struct texel_pass {
   hearth_map_result *out;
   const int32_t *seed;
   size_t (*counts)[4]; /* per worker: observed, filled, unobserved, surface */
+  int *nomem;          /* per worker */
 } texel_pass;
 
-/* best cosine, mask NONE / UNOBSERVED, observed NaN, and for max fusion
- * the maximum over the views */
-static void fuse_rows(void *ctx, size_t b, size_t e, int t) {
+/* the first of n sorted texels at or above q */
+static size_t lower_bound_u32(const uint32_t *a, size_t n, uint32_t q) {
+  size_t lo = 0, hi = n;
+  while (lo < hi) {
+    size_t mid = lo + (hi - lo) / 2;
+    if (a[mid] < q) lo = mid + 1;
+    else hi = mid;
+  }
+  return lo;
+}
+
+/* Fusion over bands of whole rows: every view's records of the band's
+ * texels, folded in view order into the band's slice of observed, mask and
+ * best_cos (the maximum of the view means, the weighted mean, or the
+ * weighted median). A worker sets nomem[t] if its scratch cannot be had. */
+static void fuse_bands(void *ctx, size_t b, size_t e, int t) {
   const texel_pass *tp = ctx;
   const map_ctx *m = tp->m;
   hearth_map_result *out = tp->out;
-  size_t R = m->R, C = (size_t)m->C;
-  int fmax = m->opts->fusion == HEARTH_FUSE_MAX;
-  (void)t;
-  for (size_t q = b * R; q < e * R; q++) {
-    _Atomic uint32_t *f = m->fused + q * FUSED_STRIDE(C);
-    out->best_cos[q] = atomic_get_f32(&f[FUSED_COS(C)]);
-    out->mask[q] = m->island_of_texel[q] == UINT32_MAX ? HEARTH_TEXEL_NONE : HEARTH_TEXEL_UNOBSERVED;
-    for (size_t c = 0; c < C; c++) {
-      float best = fmax ? atomic_get_f32(&f[FUSED_MAX + c]) : -INFINITY;
-      if (best > -INFINITY) {
-        out->observed[q * C + c] = best;
-        out->mask[q] = HEARTH_TEXEL_OBSERVED;
-      } else {
-        out->observed[q * C + c] = NAN;
+  const size_t R = m->R, C = (size_t)m->C, N = R * R, RW = REC_WORDS(C), nv = m->n_views;
+  const size_t rows = R < BAND_TEXELS ? BAND_TEXELS / R : 1, band = rows * R;
+  const int fusion = m->opts->fusion;
+  double *acc = NULL; /* mean: sums per channel and weight, per texel of a band */
+  uint32_t *cnt = NULL; /* robust: records per texel of a band, then offsets */
+  vw *all = NULL, *tmp = NULL;
+  size_t all_cap = 0;
+  if (fusion == HEARTH_FUSE_MEAN) acc = hearth_alloc_array(band, (C + 1) * sizeof *acc);
+  if (fusion == HEARTH_FUSE_ROBUST) {
+    cnt = hearth_alloc_array(band + 1, sizeof *cnt);
+    tmp = hearth_alloc_array(nv ? nv : 1, sizeof *tmp);
+  }
+  if ((fusion == HEARTH_FUSE_MEAN && !acc) || (fusion == HEARTH_FUSE_ROBUST && (!cnt || !tmp))) {
+    tp->nomem[t] = 1;
+    goto done;
+  }
+  for (size_t bi = b; bi < e; bi++) {
+    const size_t q0 = bi * band, q1 = q0 + band < N ? q0 + band : N, nq = q1 - q0;
+    for (size_t q = q0; q < q1; q++) {
+      out->best_cos[q] = 0.0f;
+      out->mask[q] = m->island_of_texel[q] == UINT32_MAX ? HEARTH_TEXEL_NONE : HEARTH_TEXEL_UNOBSERVED;
+      for (size_t c = 0; c < C; c++) out->observed[q * C + c] = -INFINITY;
+    }
+    if (acc) memset(acc, 0, nq * (C + 1) * sizeof *acc);
+    if (cnt) memset(cnt, 0, (nq + 1) * sizeof *cnt);
+    size_t total = 0;
+    for (size_t v = 0; v < nv; v++) {
+      const uint32_t *rq = m->rec_q[v];
+      const float *rd = m->rec_d[v];
+      size_t k = lower_bound_u32(rq, m->n_rec[v], (uint32_t)q0);
+      for (; k < m->n_rec[v] && rq[k] < q1; k++) {
+        const size_t q = rq[k];
+        const float *d = rd + k * RW;
+        if (d[1] > out->best_cos[q]) out->best_cos[q] = d[1];
+        if (fusion == HEARTH_FUSE_MAX) {
+          for (size_t c = 0; c < C; c++)
+            if (d[2 + c] > out->observed[q * C + c]) out->observed[q * C + c] = d[2 + c];
+        } else if (fusion == HEARTH_FUSE_MEAN) {
+          /* each view counts with its total weight at this texel */
+          double *a = acc + (q - q0) * (C + 1);
+          for (size_t c = 0; c < C; c++) a[c] += d[2 + c];
+          a[C] += d[0];
+        } else {
+          cnt[q - q0 + 1]++;
+          total++;
+        }
       }
     }
+    if (fusion == HEARTH_FUSE_MEAN) {
+      for (size_t q = q0; q < q1; q++) {
+        const double *a = acc + (q - q0) * (C + 1);
+        if (a[C] > 0.0)
+          for (size_t c = 0; c < C; c++) out->observed[q * C + c] = (float)(a[c] / a[C]);
+      }
+    } else if (fusion == HEARTH_FUSE_ROBUST && total) {
+      /* every view's (value, weight) per texel, in view order */
+      if (total > all_cap) {
+        free(all);
+        all_cap = total;
+        all = hearth_alloc_array(all_cap, sizeof *all);
+        if (!all) {
+          tp->nomem[t] = 1;
+          goto done;
+        }
+      }
+      for (size_t i = 0; i < nq; i++) cnt[i + 1] += cnt[i];
+      for (size_t v = 0; v < nv; v++) {
+        const uint32_t *rq = m->rec_q[v];
+        const float *rd = m->rec_d[v];
+        for (size_t k = lower_bound_u32(rq, m->n_rec[v], (uint32_t)q0); k < m->n_rec[v] && rq[k] < q1; k++)
+          all[cnt[rq[k] - q0]++] = (vw){rd[k * RW + 2], rd[k * RW]};
+      }
+      /* cnt[i] is now the end of texel i's records (the start of i + 1's) */
+      for (size_t i = 0, start = 0; i < nq; start = cnt[i], i++) {
+        size_t n = cnt[i] - start;
+        if (!n) continue;
+        memcpy(tmp, all + start, n * sizeof *tmp);
+        out->observed[q0 + i] = weighted_median(tmp, n);
+      }
+    }
+    for (size_t q = q0; q < q1; q++)
+      for (size_t c = 0; c < C; c++) {
+        if (out->observed[q * C + c] > -INFINITY) out->mask[q] = HEARTH_TEXEL_OBSERVED;
+        else out->observed[q * C + c] = NAN;
+      }
   }
+done:
+  free(acc);
+  free(cnt);
+  free(all);
+  free(tmp);
 }
 
 /* the filled map from the observed one and the fill seeds; final mask */
@@ -791,9 +833,13 @@ static void free_scratch(map_ctx *m) {
   free(m->fan_scratch);
   free(m->touches);
   free(m->touches_tmp);
-  free((void *)m->fused);
-  free((void *)m->msum);
-  free((void *)m->mw);
+  for (int t = 0; m->arena_q && t < m->n_threads; t++) free(m->arena_q[t]);
+  for (int t = 0; m->arena_d && t < m->n_threads; t++) free(m->arena_d[t]);
+  free(m->arena_q);
+  free(m->arena_d);
+  free(m->rec_q);
+  free(m->rec_d);
+  free(m->n_rec);
   free(m->splats);
   free(m->sil);
   free(m->hit_t);
@@ -803,10 +849,6 @@ static void free_scratch(map_ctx *m) {
   free(m->ray_org);
   free(m->ray_dir);
   free(m->hits);
-  if (m->records)
-    for (size_t v = 0; v < m->n_views; v++) free(m->records[v]);
-  free(m->records);
-  free(m->n_records);
 }
 
 hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_raycaster *rc_in,
@@ -959,11 +1001,11 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
   m.sil = calloc((size_t)nt, sizeof *m.sil);
   m.splats = calloc((size_t)nt, sizeof *m.splats);
   m.fan_scratch = calloc((size_t)nt, sizeof *m.fan_scratch);
-  m.fused = hearth_alloc_array(N, FUSED_STRIDE(C) * sizeof *m.fused);
-  if (opts.fusion == HEARTH_FUSE_MEAN) {
-    m.msum = hearth_alloc_array(N * (size_t)C, sizeof *m.msum);
-    m.mw = hearth_alloc_array(N, sizeof *m.mw);
-  }
+  m.rec_q = calloc(n_views ? n_views : 1, sizeof *m.rec_q);
+  m.rec_d = calloc(n_views ? n_views : 1, sizeof *m.rec_d);
+  m.n_rec = calloc(n_views ? n_views : 1, sizeof *m.n_rec);
+  m.arena_q = calloc((size_t)nt, sizeof *m.arena_q);
+  m.arena_d = calloc((size_t)nt, sizeof *m.arena_d);
   m.hit_t = hearth_alloc_array(np * (size_t)nt, sizeof(float));
   m.hit_tri = hearth_alloc_array(np * (size_t)nt, sizeof(uint32_t));
   m.hit_b1 = hearth_alloc_array(np * (size_t)nt, sizeof(float));
@@ -972,21 +1014,16 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
   m.ray_dir = hearth_alloc_array(np * (size_t)nt, 3 * sizeof(float));
   m.hits = hearth_alloc_array(np * (size_t)nt, sizeof(hearth_ray_hit));
   m.view_hits = calloc(n_views ? n_views : 1, sizeof *m.view_hits);
-  int bad = !m.touches || !m.touches_tmp || !m.sil || !m.splats || !m.fan_scratch || !m.fused ||
-            (opts.fusion == HEARTH_FUSE_MEAN && (!m.msum || !m.mw)) || !m.hit_t || !m.hit_tri || !m.hit_b1 || !m.hit_b2 || !m.ray_org ||
-            !m.ray_dir || !m.hits || !m.view_hits;
-  if (opts.fusion == HEARTH_FUSE_ROBUST) {
-    m.records = calloc(n_views ? n_views : 1, sizeof *m.records);
-    m.n_records = calloc(n_views ? n_views : 1, sizeof *m.n_records);
-    bad |= !m.records || !m.n_records;
-  }
+  int bad = !m.touches || !m.touches_tmp || !m.sil || !m.splats || !m.fan_scratch || !m.rec_q || !m.rec_d ||
+            !m.n_rec || !m.arena_q || !m.arena_d || !m.hit_t || !m.hit_tri || !m.hit_b1 || !m.hit_b2 ||
+            !m.ray_org || !m.ray_dir || !m.hits || !m.view_hits;
   for (int t = 0; !bad && t < nt; t++) {
     m.sil[t] = hearth_alloc_array(np, 1);
     m.splats[t] = hearth_alloc_array(np, sizeof(splat));
     m.touches[t] = hearth_alloc_array(np, 4 * sizeof(touch));
     m.touches_tmp[t] = hearth_alloc_array(np, 4 * sizeof(touch));
     if (gb.fan) {
-      m.fan_scratch[t] = malloc(hearth_ray_fan_scratch_size(gb.fan, mesh->n_vertices));
+      m.fan_scratch[t] = calloc(1, hearth_ray_fan_scratch_size(gb.fan, mesh->n_vertices));
       bad |= !m.fan_scratch[t];
     }
     bad |= !m.sil[t] || !m.splats[t] || !m.touches[t] || !m.touches_tmp[t];
@@ -995,7 +1032,6 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
     s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory for %d threads at R=%zu", nt, R);
     goto done;
   }
-  hearth_parallel_for(R, nt, init_fused, &m);
   hearth_parallel_for(n_views, nt, views_range, &m);
   if (m.failed == 2) {
     s = hearth_err_set(err, HEARTH_E_NUMERIC, "map: a view's camera does not have the mesh in front after all");
@@ -1014,7 +1050,7 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
   out->n_views = n_views;
   out->observed = hearth_alloc_array(N, (size_t)C * sizeof(float));
   out->filled = hearth_alloc_array(N, (size_t)C * sizeof(float));
-  /* every texel of these is written by fuse_rows */
+  /* every texel of these is written by fuse_bands */
   out->mask = hearth_alloc_array(N, 1);
   out->best_cos = hearth_alloc_array(N, sizeof(float));
   out->view_hits = m.view_hits;
@@ -1025,52 +1061,16 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
     goto done;
   }
   {
-    /* the maximum fusion is done here too, row by row */
-    texel_pass tp = {&m, out, NULL, NULL};
-    hearth_parallel_for(R, nt, fuse_rows, &tp);
-  }
-  if (opts.fusion == HEARTH_FUSE_MEAN) {
-    for (size_t q = 0; q < N; q++) {
-      int64_t w = atomic_load_explicit(&m.mw[q], memory_order_relaxed);
-      if (w <= 0) continue;
-      for (int c = 0; c < C; c++) {
-        int64_t sm = atomic_load_explicit(&m.msum[q * (size_t)C + (size_t)c], memory_order_relaxed);
-        out->observed[q * (size_t)C + (size_t)c] = (float)((double)sm / (double)w);
-      }
-      out->mask[q] = HEARTH_TEXEL_OBSERVED;
-    }
-  } else if (opts.fusion == HEARTH_FUSE_ROBUST) {
-    /* robust: gather every view's record per texel in view order */
-    size_t total = 0;
-    for (size_t v = 0; v < n_views; v++) total += m.n_records[v];
-    view_record *all = hearth_alloc_array(total ? total : 1, sizeof *all);
-    vw *tmp = hearth_alloc_array(n_views ? n_views : 1, sizeof *tmp);
-    if (!all || !tmp) {
-      free(all);
-      free(tmp);
-      s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
+    const size_t rows = R < BAND_TEXELS ? BAND_TEXELS / R : 1;
+    int *nomem = calloc((size_t)nt, sizeof *nomem), failed = !nomem;
+    texel_pass tp = {&m, out, NULL, NULL, nomem};
+    if (nomem) hearth_parallel_for((R + rows - 1) / rows, nt, fuse_bands, &tp);
+    for (int t = 0; nomem && t < nt; t++) failed |= nomem[t];
+    free(nomem);
+    if (failed) {
+      s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory while fusing");
       goto done;
     }
-    size_t k = 0;
-    for (size_t v = 0; v < n_views; v++) {
-      memcpy(all + k, m.records[v], m.n_records[v] * sizeof *all);
-      k += m.n_records[v];
-    }
-    /* group by texel; the median depends only on each group's values and
-       weights, so qsort's instability cannot change the result */
-    qsort(all, total, sizeof *all, cmp_record_texel);
-    for (size_t i = 0; i < total;) {
-      size_t j = i;
-      while (j < total && all[j].texel == all[i].texel) j++;
-      size_t cnt = 0;
-      for (size_t r = i; r < j && cnt < n_views; r++) tmp[cnt++] = (vw){all[r].value, all[r].weight};
-      uint32_t q = all[i].texel;
-      out->observed[q] = weighted_median(tmp, cnt);
-      out->mask[q] = HEARTH_TEXEL_OBSERVED;
-      i = j;
-    }
-    free(all);
-    free(tmp);
   }
   double t_fill0 = hearth_now();
   if (timing) timing->fuse = t_fill0 - t_fuse0;
@@ -1079,7 +1079,7 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
     goto done;
   }
   {
-    texel_pass tp = {&m, out, seed, NULL};
+    texel_pass tp = {&m, out, seed, NULL, NULL};
     tp.counts = calloc((size_t)nt, sizeof *tp.counts);
     if (!tp.counts) {
       s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");

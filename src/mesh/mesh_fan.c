@@ -27,6 +27,7 @@
  * gaps along shared edges. Equal depths go to the lower triangle index
  * (triangles are visited in index order; only a strictly nearer one
  * replaces the current). */
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -149,7 +150,8 @@ typedef struct fan_vertex {
   float x, y, u, v;
 } fan_vertex;
 
-/* per pixel: the nearest front face so far */
+/* per pixel: the nearest front face so far; w = 0 (all zero bits) for none,
+   which is how every cast finds and leaves the scratch */
 typedef struct fan_best {
   float w;
   uint32_t tri;
@@ -198,11 +200,10 @@ static inline void grid_range(float lo, float hi, long n, long *i0, long *i1) {
 
 hearth_status hearth_ray_fan_cast(const hearth_ray_fan *f, const hearth_mesh *m,
                                   const hearth_rigid *T_world_from_cam, void *scratch,
-                                  hearth_ray_hit *hits, hearth_err *err) {
-  if (!m->n_triangles) {
-    for (size_t i = 0; i < f->n; i++) hits[i] = (hearth_ray_hit){INFINITY, UINT32_MAX, 0.0f, 0.0f, 0};
-    return HEARTH_OK;
-  }
+                                  hearth_ray_hit *hits, size_t box[4], hearth_err *err) {
+  box[0] = box[2] = 1;
+  box[1] = box[3] = 0;
+  if (!m->n_triangles) return HEARTH_OK;
   fan_vertex *V = scratch;
   float *IZ = (float *)(void *)(V + (m->n_vertices ? m->n_vertices : 1));
   fan_best *best = (fan_best *)(void *)(IZ + (m->n_vertices ? m->n_vertices : 1));
@@ -244,7 +245,7 @@ hearth_status hearth_ray_fan_cast(const hearth_ray_fan *f, const hearth_mesh *m,
                               "ray fan: vertex %zu is not in front of the camera (z = %g): cast rays instead", i,
                               (double)z);
     }
-  for (size_t p = 0; p < f->n; p++) best[p] = (fan_best){0.0f, UINT32_MAX};
+  long bx0 = LONG_MAX, bx1 = -1, by0 = LONG_MAX, by1 = -1; /* the hits' box */
   const float slack = f->slack, inv_st = 1.0f / (float)f->stride;
   const long pw = (long)f->pw, ph = (long)f->ph;
   for (size_t tri = 0; tri < m->n_triangles; tri++) {
@@ -279,23 +280,37 @@ hearth_status hearth_ray_fan_cast(const hearth_ray_fan *f, const hearth_mesh *m,
         float la = edge_eval(&ea, x, y), lb = edge_eval(&eb, x, y), lc = edge_eval(&ec, x, y);
         if (!(la <= 0.0f && lb <= 0.0f && lc <= 0.0f)) continue;
         float w = (la * IZ[ia] + lb * IZ[ib] + lc * IZ[ic]) * inv_area;
-        if (w > best[p].w) best[p] = (fan_best){w, (uint32_t)tri};
+        if (!(w > best[p].w)) continue;
+        best[p] = (fan_best){w, (uint32_t)tri};
+        bx0 = i < bx0 ? i : bx0;
+        bx1 = i > bx1 ? i : bx1;
+        by0 = j < by0 ? j : by0;
+        by1 = j > by1 ? j : by1;
       }
   }
-  for (size_t p = 0; p < f->n; p++) {
-    if (best[p].tri == UINT32_MAX) {
-      hits[p] = (hearth_ray_hit){INFINITY, UINT32_MAX, 0.0f, 0.0f, 0};
-      continue;
+  /* the hits within their box, which leaves the scratch all zero again */
+  if (bx1 < 0) return HEARTH_OK;
+  box[0] = (size_t)bx0;
+  box[1] = (size_t)bx1;
+  box[2] = (size_t)by0;
+  box[3] = (size_t)by1;
+  for (long j = by0; j <= by1; j++)
+    for (long i = bx0; i <= bx1; i++) {
+      size_t p = (size_t)j * (size_t)pw + (size_t)i;
+      if (!(best[p].w > 0.0f)) {
+        hits[p] = (hearth_ray_hit){INFINITY, UINT32_MAX, 0.0f, 0.0f, 0};
+        continue;
+      }
+      const uint32_t *ix = m->indices + 3 * (size_t)best[p].tri;
+      float x = f->pt[2 * p], y = f->pt[2 * p + 1];
+      fan_edge ea = edge_of(V, ix[1], ix[2]), eb = edge_of(V, ix[2], ix[0]), ec = edge_of(V, ix[0], ix[1]);
+      double wa = (double)edge_eval(&ea, x, y) * IZ[ix[0]], wb = (double)edge_eval(&eb, x, y) * IZ[ix[1]],
+             wc = (double)edge_eval(&ec, x, y) * IZ[ix[2]], ws = wa + wb + wc;
+      /* depth 1/w along z; the distance along the unit direction is
+         depth / d_z */
+      hits[p] = (hearth_ray_hit){(float)(1.0 / ((double)best[p].w * (double)f->dirs[3 * p + 2])), best[p].tri,
+                                 (float)(wb / ws), (float)(wc / ws), 1};
+      best[p] = (fan_best){0.0f, 0};
     }
-    const uint32_t *ix = m->indices + 3 * (size_t)best[p].tri;
-    float x = f->pt[2 * p], y = f->pt[2 * p + 1];
-    fan_edge ea = edge_of(V, ix[1], ix[2]), eb = edge_of(V, ix[2], ix[0]), ec = edge_of(V, ix[0], ix[1]);
-    double wa = (double)edge_eval(&ea, x, y) * IZ[ix[0]], wb = (double)edge_eval(&eb, x, y) * IZ[ix[1]],
-           wc = (double)edge_eval(&ec, x, y) * IZ[ix[2]], ws = wa + wb + wc;
-    /* depth 1/w along z; the distance along the unit direction is
-       depth / d_z */
-    hits[p] = (hearth_ray_hit){(float)(1.0 / ((double)best[p].w * (double)f->dirs[3 * p + 2])), best[p].tri,
-                               (float)(wb / ws), (float)(wc / ws), 1};
-  }
   return HEARTH_OK;
 }

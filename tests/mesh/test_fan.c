@@ -116,11 +116,27 @@ static void compare(const hearth_mesh *m, const hearth_camera *cam, size_t strid
   size_t w, h;
   const float *dirs = hearth_ray_fan_dirs(fan, &w, &h);
   CHECK(w == ((size_t)cam->width + stride - 1) / stride && h == ((size_t)cam->height + stride - 1) / stride);
-  void *scratch = malloc(hearth_ray_fan_scratch_size(fan, m->n_vertices));
+  size_t ss = hearth_ray_fan_scratch_size(fan, m->n_vertices);
+  unsigned char *scratch = calloc(1, ss);
   hearth_ray_hit *hits = malloc(w * h * sizeof *hits);
-  CHECK_OK(hearth_ray_fan_cast(fan, m, T, scratch, hits, &err), &err);
+  /* a first cast from elsewhere must leave no trace in the scratch */
+  hearth_rigid other = look_at(0.2, -1.3, 0.4);
+  size_t box[4];
+  CHECK_OK(hearth_ray_fan_cast(fan, m, &other, scratch, hits, box, &err), &err);
+  for (size_t p = 0; p < w * h; p++) hits[p] = (hearth_ray_hit){-1.0f, 12345u, -1.0f, -1.0f, 7};
+  CHECK_OK(hearth_ray_fan_cast(fan, m, T, scratch, hits, box, &err), &err);
+  size_t nz = 0;
+  for (size_t k = ss - w * h * 8; k < ss; k++) nz += scratch[k] != 0;
+  CHECK_MSG(nz == 0, "%zu scratch bytes left set", nz);
   for (size_t p = 0; p < w * h; p++) {
     hearth_ray_hit r = reference(rc, T, dirs + 3 * p);
+    size_t px = p % w, py = p / w;
+    int in_box = px >= box[0] && px <= box[1] && py >= box[2] && py <= box[3];
+    /* written inside the box; outside it, untouched and a miss */
+    if (!in_box) {
+      CHECK(hits[p].prim == 12345u);
+      hits[p].prim = UINT32_MAX;
+    }
     int a = hits[p].prim != UINT32_MAX, b = r.prim != UINT32_MAX;
     st->hits += (size_t)a;
     st->ref_hits += (size_t)b;
@@ -231,9 +247,11 @@ int main(void) {
     hearth_rigid_identity(&I);
     hearth_ray_fan *fan = NULL;
     CHECK_OK(hearth_ray_fan_new(&pin, 1, &fan, &err), &err);
-    void *scratch = malloc(hearth_ray_fan_scratch_size(fan, plane.n_vertices));
+    void *scratch = calloc(1, hearth_ray_fan_scratch_size(fan, plane.n_vertices));
+    size_t box[4];
     hearth_ray_hit *hits = malloc(160 * 120 * sizeof *hits);
-    CHECK_OK(hearth_ray_fan_cast(fan, &plane, &I, scratch, hits, &err), &err);
+    CHECK_OK(hearth_ray_fan_cast(fan, &plane, &I, scratch, hits, box, &err), &err);
+    CHECK(box[0] == 0 && box[1] >= 158 && box[2] == 0 && box[3] == 119);
     size_t holes = 0, inside = 0;
     for (size_t v = 0; v < 120; v++)
       for (size_t u = 0; u < 160; u++) {
@@ -255,7 +273,7 @@ int main(void) {
     memcpy(twin.positions, plane.positions, plane.n_vertices * 3 * sizeof(float));
     memcpy(twin.indices + 3, plane.indices, plane.n_triangles * 3 * sizeof(uint32_t));
     memcpy(twin.indices, plane.indices + 3 * TT, 3 * sizeof(uint32_t)); /* triangle 0 = old TT */
-    CHECK_OK(hearth_ray_fan_cast(fan, &twin, &I, scratch, hits, &err), &err);
+    CHECK_OK(hearth_ray_fan_cast(fan, &twin, &I, scratch, hits, box, &err), &err);
     size_t won = 0, lost = 0;
     for (size_t p = 0; p < 160 * 120; p++) {
       won += hits[p].prim == 0;
@@ -267,7 +285,7 @@ int main(void) {
     /* a vertex behind the camera: refused, naming it */
     plane.positions[3 * 7 + 2] = -0.5f;
     hearth_ray_hit *h2 = hits;
-    CHECK(hearth_ray_fan_cast(fan, &plane, &I, scratch, h2, &err) == HEARTH_E_UNSUPPORTED);
+    CHECK(hearth_ray_fan_cast(fan, &plane, &I, scratch, h2, box, &err) == HEARTH_E_UNSUPPORTED);
     CHECK(strstr(err.msg, "vertex 7") != NULL);
     free(scratch);
     free(hits);
