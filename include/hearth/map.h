@@ -99,6 +99,25 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
                                      hearth_map_result *out, hearth_map_timing *timing,
                                      hearth_err *err);
 
+/* The part of a mapping that depends only on the mesh, the camera and the
+ * options' resolution and pixel stride: the UV raster and islands, the
+ * triangles' normals, the mesh's bounding sphere, and the camera's pixel
+ * grid with its ray fan. Made once, it serves any number of view sets of
+ * that mesh and camera (the states of an instance), and it can be made
+ * while the images are being read. The mesh must outlive it. */
+typedef struct hearth_map_layout hearth_map_layout;
+hearth_status hearth_map_layout_new(const hearth_mesh *mesh, const hearth_camera *cam,
+                                    const hearth_map_opts *opts, hearth_map_layout **out,
+                                    hearth_err *err);
+void hearth_map_layout_free(hearth_map_layout *l);
+/* hearth_map_views_timed on a layout (opts' resolution and pixel stride
+ * must be the layout's: HEARTH_E_INCONSISTENT otherwise). timing->raster is
+ * left as it is (the layout's time is the caller's to measure). */
+hearth_status hearth_map_views_with_layout(const hearth_map_layout *l, const hearth_raycaster *rc,
+                                          const hearth_map_view *views, size_t n_views,
+                                          const hearth_map_opts *opts, hearth_map_result *out,
+                                          hearth_map_timing *timing, hearth_err *err);
+
 /* Copy the filled map into an image for a texture: Turbo over [lo, hi] for
  * temperatures (channels == 1) or the colour (channels == 3); texels without
  * a value are padded from neighbours for `pad` texels (so bilinear texture

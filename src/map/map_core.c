@@ -851,24 +851,145 @@ static void free_scratch(map_ctx *m) {
   free(m->hits);
 }
 
-hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_raycaster *rc_in,
-                                     const hearth_camera *cam, const hearth_map_view *views,
-                                     size_t n_views, const hearth_map_opts *opts_in,
-                                     hearth_map_result *out, hearth_map_timing *timing,
-                                     hearth_err *err) {
-  double t_start = hearth_now();
-  memset(out, 0, sizeof *out);
-  if (timing) memset(timing, 0, sizeof *timing);
+struct hearth_map_layout {
+  const hearth_mesh *mesh;
+  hearth_camera cam;
+  size_t R, stride;
+  uint32_t *island_of_tri, *island_of_texel, n_islands;
+  float *tri_normal; /* 3 per triangle, unit */
+  double sphere[4];  /* bounding sphere */
+  size_t pw, ph, np; /* pixel grid */
+  float *pix_dir;
+  uint32_t *pix_index, *tile_order;
+  hearth_ray_fan *fan; /* NULL where the fan cannot hold the grid */
+};
+
+void hearth_map_layout_free(hearth_map_layout *l) {
+  if (!l) return;
+  free(l->island_of_tri);
+  free(l->island_of_texel);
+  free(l->tri_normal);
+  free(l->pix_dir);
+  free(l->pix_index);
+  free(l->tile_order);
+  hearth_ray_fan_free(l->fan);
+  free(l);
+}
+
+hearth_status hearth_map_layout_new(const hearth_mesh *mesh, const hearth_camera *cam,
+                                    const hearth_map_opts *opts_in, hearth_map_layout **out,
+                                    hearth_err *err) {
+  *out = NULL;
   hearth_map_opts opts;
   if (opts_in) opts = *opts_in;
   else hearth_map_opts_default(&opts);
-  if (!mesh || !cam || (!views && n_views))
-    return hearth_err_set(err, HEARTH_E_ARG, "map: missing mesh, camera or views");
+  if (!mesh || !cam) return hearth_err_set(err, HEARTH_E_ARG, "map: missing mesh or camera");
   if (!mesh->uvs) return hearth_err_set(err, HEARTH_E_NOT_FOUND, "map: the mesh has no UVs (TEXCOORD_0)");
   size_t R = opts.resolution;
   if (R < 2 || R > 16384) return hearth_err_set(err, HEARTH_E_RANGE, "map: resolution %zu outside 2..16384", R);
   if (opts.pixel_stride < 1) opts.pixel_stride = 1;
   if (cam->width <= 0 || cam->height <= 0) return hearth_err_set(err, HEARTH_E_ARG, "map: camera has no size");
+  hearth_status s = hearth_mesh_validate(mesh, "map mesh", err);
+  if (s) return s;
+  hearth_map_layout *l = calloc(1, sizeof *l);
+  if (!l) return hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
+  l->mesh = mesh;
+  l->cam = *cam;
+  l->R = R;
+  l->stride = (size_t)opts.pixel_stride;
+  uint32_t *tri_of_texel = NULL;
+  size_t N = R * R;
+  grid_build gb = {0};
+  pthread_t gb_tid;
+  int gb_started = 0;
+  /* pixel grid: undistorted centres of every stride-th pixel, made with its
+     ray fan beside the UV raster */
+  size_t st = l->stride;
+  l->pw = ((size_t)cam->width + st - 1) / st;
+  l->ph = ((size_t)cam->height + st - 1) / st;
+  l->np = l->pw * l->ph;
+  l->pix_dir = hearth_alloc_array(l->np, 3 * sizeof *l->pix_dir);
+  l->pix_index = hearth_alloc_array(l->np, sizeof *l->pix_index);
+  l->tile_order = hearth_alloc_array(l->np, sizeof *l->tile_order);
+  if (!l->pix_dir || !l->pix_index || !l->tile_order) {
+    s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
+    goto done;
+  }
+  gb = (grid_build){cam, st, l->pw, l->ph, l->pix_dir, l->pix_index, l->tile_order, NULL, 0};
+  gb_started = pthread_create(&gb_tid, NULL, grid_build_run, &gb) == 0;
+  if (!gb_started) grid_build_run(&gb); /* no thread: make it here */
+  tri_of_texel = hearth_alloc_array(N, sizeof *tri_of_texel);
+  l->island_of_tri = hearth_alloc_array(mesh->n_triangles, sizeof *l->island_of_tri);
+  l->tri_normal = hearth_alloc_array(mesh->n_triangles, 3 * sizeof *l->tri_normal);
+  l->island_of_texel = hearth_alloc_array(N, sizeof *l->island_of_texel);
+  if (!tri_of_texel || !l->island_of_tri || !l->tri_normal || !l->island_of_texel) {
+    s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory for R=%zu", R);
+    goto done;
+  }
+  if ((s = hearth_uv_rasterize(mesh, R, tri_of_texel, NULL, err))) goto done;
+  if ((s = hearth_uv_islands(mesh, l->island_of_tri, &l->n_islands, err))) goto done;
+  for (size_t q = 0; q < N; q++) {
+    uint32_t tq = tri_of_texel[q];
+    l->island_of_texel[q] = tq == UINT32_MAX ? UINT32_MAX : l->island_of_tri[tq];
+  }
+  for (size_t i = 0; i < mesh->n_triangles; i++) {
+    const uint32_t *ix = mesh->indices + 3 * i;
+    const float *a = mesh->positions + 3 * ix[0], *b = mesh->positions + 3 * ix[1],
+                *c = mesh->positions + 3 * ix[2];
+    double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    double nn[3];
+    hearth_cross3(e1, e2, nn);
+    double len = hearth_norm3(nn);
+    for (int k = 0; k < 3; k++) l->tri_normal[3 * i + k] = len > 0 ? (float)(nn[k] / len) : 0.0f;
+  }
+  /* bounding sphere: the box centre and the farthest vertex from it,
+   * padded so that rounding can never cull a ray that touches the mesh */
+  {
+    double lo[3], hi[3], r2 = 0;
+    hearth_mesh_bounds(mesh, lo, hi);
+    for (int k = 0; k < 3; k++) l->sphere[k] = 0.5 * (lo[k] + hi[k]);
+    for (size_t i = 0; i < mesh->n_vertices; i++) {
+      const float *pv = mesh->positions + 3 * i;
+      double dx = pv[0] - l->sphere[0], dy = pv[1] - l->sphere[1], dz = pv[2] - l->sphere[2];
+      double d2 = dx * dx + dy * dy + dz * dz;
+      if (d2 > r2) r2 = d2;
+    }
+    l->sphere[3] = sqrt(r2) * (1.0 + 1e-3) + 1e-6;
+  }
+  if (gb_started) {
+    pthread_join(gb_tid, NULL);
+    gb_started = 0;
+  }
+  l->fan = gb.fan;
+  gb.fan = NULL;
+  if (gb.nomem) s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory for the pixel grid");
+done:
+  if (gb_started) pthread_join(gb_tid, NULL);
+  hearth_ray_fan_free(gb.fan);
+  free(tri_of_texel);
+  if (s) hearth_map_layout_free(l);
+  else *out = l;
+  return s;
+}
+
+hearth_status hearth_map_views_with_layout(const hearth_map_layout *l, const hearth_raycaster *rc_in,
+                                          const hearth_map_view *views, size_t n_views,
+                                          const hearth_map_opts *opts_in, hearth_map_result *out,
+                                          hearth_map_timing *timing, hearth_err *err) {
+  double t_start = hearth_now();
+  memset(out, 0, sizeof *out);
+  hearth_map_opts opts;
+  if (opts_in) opts = *opts_in;
+  else hearth_map_opts_default(&opts);
+  if (opts.pixel_stride < 1) opts.pixel_stride = 1;
+  if (!views && n_views) return hearth_err_set(err, HEARTH_E_ARG, "map: missing views");
+  if (opts.resolution != l->R || (size_t)opts.pixel_stride != l->stride)
+    return hearth_err_set(err, HEARTH_E_INCONSISTENT,
+                          "map: the layout was made for resolution %zu, stride %zu; asked for %zu, %d", l->R,
+                          l->stride, opts.resolution, opts.pixel_stride);
+  const hearth_mesh *mesh = l->mesh;
+  const hearth_camera *cam = &l->cam;
+  const size_t R = l->R, N = R * R, np = l->np;
   int C = 0;
   for (size_t v = 0; v < n_views; v++) {
     const hearth_image *im = views[v].image;
@@ -885,92 +1006,15 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
   if (!C) C = 1;
   if (opts.fusion == HEARTH_FUSE_ROBUST && C != 1)
     return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "map: robust fusion is for temperatures only");
-  hearth_status s = hearth_mesh_validate(mesh, "map mesh", err);
-  if (s) return s;
-
+  hearth_status s = HEARTH_OK;
   map_ctx m;
   memset(&m, 0, sizeof m);
   hearth_raycaster *own_rc = NULL;
-  uint32_t *tri_of_texel = NULL, *island_of_tri = NULL, *island_of_texel = NULL, *pix_index = NULL,
-           *tile_order = NULL;
-  float *tri_normal = NULL, *pix_dir = NULL;
-  uint8_t *view_fan = NULL;
+  uint8_t *view_fan = calloc(n_views ? n_views : 1, 1);
   int32_t *seed = NULL;
-  size_t N = R * R;
-  grid_build gb = {0};
-  pthread_t gb_tid;
-  int gb_started = 0;
-  double t_raster0 = hearth_now();
-  /* pixel grid: undistorted centres of every stride-th pixel, made with its
-     ray fan beside the UV raster */
-  size_t st = (size_t)opts.pixel_stride;
-  size_t pw = ((size_t)cam->width + st - 1) / st, ph = ((size_t)cam->height + st - 1) / st;
-  size_t np = pw * ph;
-  pix_dir = hearth_alloc_array(np, 3 * sizeof *pix_dir);
-  pix_index = hearth_alloc_array(np, sizeof *pix_index);
-  tile_order = hearth_alloc_array(np, sizeof *tile_order);
-  view_fan = calloc(n_views ? n_views : 1, 1);
-  if (!pix_dir || !pix_index || !tile_order || !view_fan) {
-    s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
-    goto done;
-  }
-  gb = (grid_build){cam, st, pw, ph, pix_dir, pix_index, tile_order, NULL, 0};
-  gb_started = pthread_create(&gb_tid, NULL, grid_build_run, &gb) == 0;
-  if (!gb_started) grid_build_run(&gb); /* no thread: make it here */
-  tri_of_texel = hearth_alloc_array(N, sizeof *tri_of_texel);
-  island_of_tri = hearth_alloc_array(mesh->n_triangles, sizeof *island_of_tri);
-  tri_normal = hearth_alloc_array(mesh->n_triangles, 3 * sizeof *tri_normal);
-  if (!tri_of_texel || !island_of_tri || !tri_normal) {
-    s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory for R=%zu", R);
-    goto done;
-  }
-  if ((s = hearth_uv_rasterize(mesh, R, tri_of_texel, NULL, err))) goto done;
-  uint32_t n_islands = 0;
-  if ((s = hearth_uv_islands(mesh, island_of_tri, &n_islands, err))) goto done;
-  island_of_texel = hearth_alloc_array(N, sizeof *island_of_texel);
-  if (!island_of_texel) {
-    s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory for R=%zu", R);
-    goto done;
-  }
-  for (size_t q = 0; q < N; q++) {
-    uint32_t tq = tri_of_texel[q];
-    island_of_texel[q] = tq == UINT32_MAX ? UINT32_MAX : island_of_tri[tq];
-  }
-  for (size_t i = 0; i < mesh->n_triangles; i++) {
-    const uint32_t *ix = mesh->indices + 3 * i;
-    const float *a = mesh->positions + 3 * ix[0], *b = mesh->positions + 3 * ix[1],
-                *c = mesh->positions + 3 * ix[2];
-    double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    double nn[3];
-    hearth_cross3(e1, e2, nn);
-    double l = hearth_norm3(nn);
-    for (int k = 0; k < 3; k++) tri_normal[3 * i + k] = l > 0 ? (float)(nn[k] / l) : 0.0f;
-  }
-  /* bounding sphere: the box centre and the farthest vertex from it,
-   * padded so that rounding can never cull a ray that touches the mesh */
-  double sphere[4] = {0, 0, 0, 0};
-  {
-    double lo[3], hi[3], r2 = 0;
-    hearth_mesh_bounds(mesh, lo, hi);
-    for (int k = 0; k < 3; k++) sphere[k] = 0.5 * (lo[k] + hi[k]);
-    for (size_t i = 0; i < mesh->n_vertices; i++) {
-      const float *pv = mesh->positions + 3 * i;
-      double dx = pv[0] - sphere[0], dy = pv[1] - sphere[1], dz = pv[2] - sphere[2];
-      double d2 = dx * dx + dy * dy + dz * dz;
-      if (d2 > r2) r2 = d2;
-    }
-    sphere[3] = sqrt(r2) * (1.0 + 1e-3) + 1e-6;
-  }
-  if (gb_started) {
-    pthread_join(gb_tid, NULL);
-    gb_started = 0;
-  }
-  if (gb.nomem) {
-    s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory for the pixel grid");
-    goto done;
-  }
+  if (!view_fan) return hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
   double t_cast0 = hearth_now();
-  if (timing) timing->raster = t_cast0 - t_raster0;
+  const double *sphere = l->sphere;
   /* a view whose camera has the whole mesh (its bounding sphere, with a
      margin) in front is rasterised through the fan; any other view casts
      rays, through a ray caster built only then */
@@ -979,22 +1023,23 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
     const hearth_rigid *T = &views[v].T_world_from_cam;
     double d[3] = {sphere[0] - T->t[0], sphere[1] - T->t[1], sphere[2] - T->t[2]};
     double z = T->R[2] * d[0] + T->R[5] * d[1] + T->R[8] * d[2];
-    view_fan[v] = gb.fan && !opts.trace_rays && z > sphere[3] * (1.0 + 1e-6) + 1e-9;
+    view_fan[v] = l->fan && !opts.trace_rays && z > sphere[3] * (1.0 + 1e-6) + 1e-9;
     need_rays |= !view_fan[v];
   }
   if (need_rays && !rc_in) {
     double t0 = hearth_now();
     if ((s = hearth_raycaster_new(mesh, &own_rc, err))) goto done;
     if (timing) timing->build = hearth_now() - t0;
+    t_cast0 = hearth_now();
   }
   int nt = opts.threads > 0 ? opts.threads : hearth_default_threads();
   if ((size_t)nt > n_views) nt = n_views ? (int)n_views : 1;
   m = (map_ctx){.mesh = mesh, .rc = rc_in ? rc_in : own_rc, .cam = cam, .views = views,
-                .n_views = n_views, .opts = &opts, .R = R, .C = C, .island_of_texel = island_of_texel,
-                .island_of_tri = island_of_tri, .tri_normal = tri_normal, .n_pix = np,
-                .pix_w = pw, .pix_h = ph, .pix_dir = pix_dir, .pix_index = pix_index,
-                .tile_order = tile_order, .sphere = {sphere[0], sphere[1], sphere[2], sphere[3]},
-                .fan = gb.fan, .view_fan = view_fan, .n_threads = nt,
+                .n_views = n_views, .opts = &opts, .R = R, .C = C, .island_of_texel = l->island_of_texel,
+                .island_of_tri = l->island_of_tri, .tri_normal = l->tri_normal, .n_pix = np,
+                .pix_w = l->pw, .pix_h = l->ph, .pix_dir = l->pix_dir, .pix_index = l->pix_index,
+                .tile_order = l->tile_order, .sphere = {sphere[0], sphere[1], sphere[2], sphere[3]},
+                .fan = l->fan, .view_fan = view_fan, .n_threads = nt,
                 .cast_threads = opts.threads > 0 ? opts.threads : hearth_default_threads()};
   m.touches = calloc((size_t)nt, sizeof *m.touches);
   m.touches_tmp = calloc((size_t)nt, sizeof *m.touches_tmp);
@@ -1022,8 +1067,8 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
     m.splats[t] = hearth_alloc_array(np, sizeof(splat));
     m.touches[t] = hearth_alloc_array(np, 4 * sizeof(touch));
     m.touches_tmp[t] = hearth_alloc_array(np, 4 * sizeof(touch));
-    if (gb.fan) {
-      m.fan_scratch[t] = calloc(1, hearth_ray_fan_scratch_size(gb.fan, mesh->n_vertices));
+    if (l->fan) {
+      m.fan_scratch[t] = calloc(1, hearth_ray_fan_scratch_size(l->fan, mesh->n_vertices));
       bad |= !m.fan_scratch[t];
     }
     bad |= !m.sil[t] || !m.splats[t] || !m.touches[t] || !m.touches_tmp[t];
@@ -1074,7 +1119,7 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
   }
   double t_fill0 = hearth_now();
   if (timing) timing->fuse = t_fill0 - t_fuse0;
-  if (fill_islands(R, island_of_texel, n_islands, out->mask, seed, nt)) {
+  if (fill_islands(R, l->island_of_texel, l->n_islands, out->mask, seed, nt)) {
     s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory while filling");
     goto done;
   }
@@ -1100,21 +1145,34 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
   }
   s = HEARTH_OK;
 done:
-  if (gb_started) pthread_join(gb_tid, NULL);
-  hearth_ray_fan_free(gb.fan);
   free(view_fan);
   free_scratch(&m);
   free(m.view_hits);
   hearth_raycaster_free(own_rc);
-  free(tri_of_texel);
-  free(island_of_tri);
-  free(island_of_texel);
-  free(tri_normal);
-  free(pix_dir);
-  free(pix_index);
-  free(tile_order);
   free(seed);
   if (s) hearth_map_result_free(out);
+  return s;
+}
+
+hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_raycaster *rc,
+                                     const hearth_camera *cam, const hearth_map_view *views,
+                                     size_t n_views, const hearth_map_opts *opts,
+                                     hearth_map_result *out, hearth_map_timing *timing,
+                                     hearth_err *err) {
+  memset(out, 0, sizeof *out);
+  if (timing) memset(timing, 0, sizeof *timing);
+  if (!views && n_views) return hearth_err_set(err, HEARTH_E_ARG, "map: missing views");
+  double t0 = hearth_now();
+  hearth_map_layout *l = NULL;
+  hearth_status s = hearth_map_layout_new(mesh, cam, opts, &l, err);
+  if (s) return s;
+  double t1 = hearth_now();
+  s = hearth_map_views_with_layout(l, rc, views, n_views, opts, out, timing, err);
+  if (timing) {
+    timing->raster = t1 - t0;
+    timing->total = hearth_now() - t0;
+  }
+  hearth_map_layout_free(l);
   return s;
 }
 

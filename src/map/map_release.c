@@ -4,6 +4,7 @@
 #include <stdarg.h>
 #include <jansson.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -271,6 +272,25 @@ static void write_outputs(void *ctx, size_t b, size_t e, int t) {
   }
 }
 
+/* the mapping layout, made on a thread of its own */
+typedef struct layout_build {
+  const hearth_mesh *mesh;
+  const hearth_camera *cam;
+  const hearth_map_opts *opts;
+  hearth_map_layout *layout;
+  hearth_status s;
+  hearth_err err;
+  double seconds;
+} layout_build;
+
+static void *layout_build_run(void *arg) {
+  layout_build *b = arg;
+  double t0 = hearth_now();
+  b->s = hearth_map_layout_new(b->mesh, b->cam, b->opts, &b->layout, &b->err);
+  b->seconds = hearth_now() - t0;
+  return NULL;
+}
+
 hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats, hearth_err *err) {
   if (!job || !job->root || !job->instance || !job->state)
     return hearth_err_set(err, HEARTH_E_ARG, "map: root, instance and state are required");
@@ -297,6 +317,9 @@ hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats
   size_t *idx = NULL, n = 0;
   hearth_map_result r = {0};
   tmp_dir[0] = 0;
+  layout_build lb = {0};
+  pthread_t lb_tid;
+  int lb_started = 0;
   hearth_status s;
   if ((s = hearth_rig_read(rig_path, &rig, err))) goto done;
   if ((s = hearth_manifest_read(man_path, &man, err))) goto done;
@@ -327,6 +350,11 @@ hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats
     views[k].image = &imgs[k];
     views[k].T_world_from_cam = vp->T_world_from_cam;
   }
+  /* the layout (UV raster, islands, pixel grid and fan: mesh and camera
+     only) is made on a thread of its own while the CSVs are read */
+  lb = (layout_build){&mesh, &rig.thermal, &job->map, NULL, HEARTH_OK, {0}, 0.0};
+  lb_started = pthread_create(&lb_tid, NULL, layout_build_run, &lb) == 0;
+  if (!lb_started) layout_build_run(&lb);
   /* the CSVs in parallel; the first failing view (in order) is reported */
   {
     csv_jobs cj = {root, inst, job->state, &man, idx, imgs, {(size_t)rig.thermal.width, (size_t)rig.thermal.height}, NULL, NULL};
@@ -346,10 +374,20 @@ hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats
     if (s) goto done;
   }
   double t_read = hearth_now() - t_start;
-  if ((s = hearth_map_views_timed(&mesh, NULL, &rig.thermal, views, n, &job->map, &r, job->timing, err))) {
+  if (lb_started) pthread_join(lb_tid, NULL);
+  lb_started = 0;
+  if (lb.s) {
+    if (err) *err = lb.err;
+    s = lb.s;
     hearth_err_prefix(err, "%s/%s", inst, job->state);
     goto done;
   }
+  if (job->timing) memset(job->timing, 0, sizeof *job->timing);
+  if ((s = hearth_map_views_with_layout(lb.layout, NULL, views, n, &job->map, &r, job->timing, err))) {
+    hearth_err_prefix(err, "%s/%s", inst, job->state);
+    goto done;
+  }
+  if (job->timing) job->timing->raster = lb.seconds;
   /* write everything into a temporary sibling directory, then swap it in */
   double t_write0 = hearth_now();
   char parent[PATH_SZ];
@@ -387,6 +425,8 @@ hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats
     stats->view_hits = NULL;
   }
 done:
+  if (lb_started) pthread_join(lb_tid, NULL);
+  hearth_map_layout_free(lb.layout);
   if (tmp_dir[0]) hearth_remove_tree(tmp_dir, NULL);
   hearth_map_result_free(&r);
   if (imgs)
