@@ -104,7 +104,7 @@ def build_driver(build, tmp):
     exe = os.path.join(tmp, "driver")
     cmd = [cc, "-O2", "-std=c11", "-I", os.path.join(root, "include"), src,
            os.path.join(build, "libhearth_io.a"), os.path.join(build, "libhearth_core.a"),
-           "-lpng", "-ljpeg", "-ljansson", "-lm", "-lpthread", "-o", exe]
+           "-lpng", "-lz", "-ljpeg", "-ljansson", "-lm", "-lpthread", "-o", exe]
     subprocess.run(cmd, check=True)
     return exe
 

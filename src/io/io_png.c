@@ -228,10 +228,15 @@ static void encode_bands(void *ctx, size_t b, size_t e, int t) {
   size_t rowb = 1 + j->stride, bpp = j->bpp;
   int swap16 = img->type == HEARTH_PIX_U16 && host_is_little_endian();
   uint8_t *raw = malloc(PNG_BAND_ROWS * rowb);
+  /* one compressor per worker, reset between bands (a reset stream gives
+     the bytes of a fresh one, without its allocation) */
+  z_stream zs;
+  memset(&zs, 0, sizeof zs);
+  int zs_ok = deflateInit2(&zs, 1, Z_DEFLATED, -15, 8, Z_RLE) == Z_OK;
   (void)t;
   for (size_t band = b; band < e; band++) {
     j->failed[band] = 1;
-    if (!raw) continue;
+    if (!raw || !zs_ok || deflateReset(&zs) != Z_OK) continue;
     size_t y0 = band * PNG_BAND_ROWS, y1 = y0 + PNG_BAND_ROWS < img->height ? y0 + PNG_BAND_ROWS : img->height;
     for (size_t y = y0; y < y1; y++) {
       const uint8_t *src = (const uint8_t *)img->data + y * j->stride;
@@ -251,9 +256,6 @@ static void encode_bands(void *ctx, size_t b, size_t e, int t) {
     size_t n = (y1 - y0) * rowb;
     j->raw_len[band] = n;
     j->adler[band] = adler32(adler32(0L, Z_NULL, 0), raw, (uInt)n);
-    z_stream zs;
-    memset(&zs, 0, sizeof zs);
-    if (deflateInit2(&zs, 1, Z_DEFLATED, -15, 8, Z_RLE) != Z_OK) continue;
     size_t cap = deflateBound(&zs, (uLong)n) + 64;
     j->out[band] = malloc(cap);
     if (j->out[band]) {
@@ -268,8 +270,8 @@ static void encode_bands(void *ctx, size_t b, size_t e, int t) {
         j->failed[band] = 0;
       }
     }
-    deflateEnd(&zs);
   }
+  if (zs_ok) deflateEnd(&zs);
   free(raw);
 }
 

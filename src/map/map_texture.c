@@ -16,6 +16,44 @@ static int neighbours4(size_t q, size_t R, size_t nb[4]) {
   return k;
 }
 
+/* the colours of observed and filled texels, nan_rgb elsewhere; rows in
+   parallel (each texel from its own value) */
+typedef struct colour_job {
+  const hearth_map_result *r;
+  uint8_t *px, *have;
+  const uint8_t (*lut)[3];
+  int lut_n;
+  double lo, scale;
+  const uint8_t *nan_rgb;
+} colour_job;
+
+static void colour_rows(void *ctx, size_t b, size_t e, int t) {
+  const colour_job *j = ctx;
+  const hearth_map_result *r = j->r;
+  size_t R = r->R;
+  int C = r->channels;
+  (void)t;
+  for (size_t q = b * R; q < e * R; q++) {
+    uint8_t *p = j->px + 3 * q;
+    if (r->mask[q] == HEARTH_TEXEL_OBSERVED || r->mask[q] == HEARTH_TEXEL_FILLED) {
+      if (C == 1) {
+        double u = ((double)r->filled[q] - j->lo) * j->scale;
+        int k = !(u > 0) ? 0 : u >= j->lut_n - 1 ? j->lut_n - 1 : (int)(u + 0.5);
+        memcpy(p, j->lut[k], 3);
+      } else {
+        for (int c = 0; c < 3; c++) {
+          double v = r->filled[q * (size_t)C + (size_t)c];
+          p[c] = (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : lround(v));
+        }
+      }
+      j->have[q] = 1;
+    } else {
+      memcpy(p, j->nan_rgb, 3);
+      j->have[q] = 0;
+    }
+  }
+}
+
 hearth_status hearth_map_texture(const hearth_map_result *r, double lo, double hi, int pad,
                                  const uint8_t nan_rgb[3], hearth_image *out, hearth_err *err) {
   size_t R = r->R, N = R * R;
@@ -29,7 +67,7 @@ hearth_status hearth_map_texture(const hearth_map_result *r, double lo, double h
    * table (0.012 degC steps over 10-60 degC, finer than the 8-bit colours
    * resolve). */
   enum { LUT_N = 4096 };
-  uint8_t *have = hearth_calloc_array(N, 1), *listed = hearth_calloc_array(N, 1);
+  uint8_t *have = hearth_alloc_array(N, 1), *listed = hearth_calloc_array(N, 1);
   uint8_t(*lut)[3] = C == 1 ? malloc(sizeof(uint8_t[LUT_N][3])) : NULL;
   uint32_t *cand = hearth_alloc_array(N, sizeof *cand), *fresh = hearth_alloc_array(N, sizeof *fresh);
   uint8_t *rgb = hearth_alloc_array(N, 3);
@@ -39,25 +77,8 @@ hearth_status hearth_map_texture(const hearth_map_result *r, double lo, double h
     goto done;
   }
   for (int i = 0; C == 1 && i < LUT_N; i++) hearth_turbo((double)i / (LUT_N - 1), lut[i]);
-  double scale = (LUT_N - 1) / (hi - lo);
-  for (size_t q = 0; q < N; q++) {
-    uint8_t *p = px + 3 * q;
-    if (r->mask[q] == HEARTH_TEXEL_OBSERVED || r->mask[q] == HEARTH_TEXEL_FILLED) {
-      if (C == 1) {
-        double u = ((double)r->filled[q] - lo) * scale;
-        int k = !(u > 0) ? 0 : u >= LUT_N - 1 ? LUT_N - 1 : (int)(u + 0.5);
-        memcpy(p, lut[k], 3);
-      } else {
-        for (int c = 0; c < 3; c++) {
-          double v = r->filled[q * (size_t)C + (size_t)c];
-          p[c] = (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : lround(v));
-        }
-      }
-      have[q] = 1;
-    } else {
-      memcpy(p, nan_rgb, 3);
-    }
-  }
+  colour_job cj = {r, px, have, (const uint8_t(*)[3])lut, LUT_N, lo, (LUT_N - 1) / (hi - lo), nan_rgb};
+  hearth_parallel_for(R, 0, colour_rows, &cj);
   /* padding: each round, a texel without colour takes the mean of its
      coloured 4-neighbours (deterministic: reads the previous round only).
      Only the frontier is visited: round 0's candidates are the uncoloured
