@@ -22,9 +22,8 @@
  * reduced in one pass into the view's records, each texel's sums added up
  * in the same order as pixel by pixel. */
 typedef struct touch {
-  uint32_t q;     /* texel */
-  uint32_t splat; /* index into the view's splats */
-  float w;        /* bilinear weight */
+  uint32_t q;  /* texel */
+  uint32_t sk; /* 4 * (index into the view's splats) + corner (bit 0: +x, bit 1: +y) */
 } touch;
 
 /* a view's record of a texel: the texel's index in rec_q, then REC_WORDS(C)
@@ -60,7 +59,12 @@ typedef struct splat {
   float cosv;
   float val[3];
 } splat;
-#define PREFETCH_AHEAD 8 /* touches ahead whose shared record is prefetched */
+#define PREFETCH_AHEAD 8
+
+/* the bilinear weight of corner k (bit 0: +x, bit 1: +y) of a splat */
+static inline float corner_weight(const splat *e, int k) {
+  return (float)(((k & 1) ? e->fx : 1.0 - e->fx) * ((k >> 1) ? e->fy : 1.0 - e->fy));
+} /* touches ahead whose shared record is prefetched */
 
 typedef struct map_ctx {
   const hearth_mesh *mesh;
@@ -329,21 +333,25 @@ static void process_view(map_ctx *m, size_t v, int t) {
     for (int k = 0; k < 4; k++) {
       long tx = (long)e->x0 + (k & 1), ty = (long)e->y0 + (k >> 1);
       if (tx < 0 || ty < 0 || tx >= (long)R || ty >= (long)R) continue;
-      float w = (float)(((k & 1) ? e->fx : 1.0 - e->fx) * ((k >> 1) ? e->fy : 1.0 - e->fy));
-      if (!(w > 0.0f)) continue;
-      tc[n_tc++] = (touch){(uint32_t)((size_t)ty * R + (size_t)tx), (uint32_t)i, w};
+      if (!(corner_weight(e, k) > 0.0f)) continue;
+      tc[n_tc++] = (touch){(uint32_t)((size_t)ty * R + (size_t)tx), (uint32_t)(4 * i + (size_t)k)};
     }
   }
-  /* stable LSD radix sort by texel, 11-bit digits */
+  /* stable LSD radix sort by texel, 11-bit digits (at most 3: R <= 16384
+     gives 28 bits), every digit's histogram from one read */
   {
     touch *src = tc, *dst = m->touches_tmp[t];
     size_t bits = 1;
     while (bits < 32 && ((size_t)1 << bits) < R * R) bits++;
-    for (size_t shift = 0; shift < bits; shift += 11) {
-      size_t count[2048 + 1] = {0};
-      for (size_t i = 0; i < n_tc; i++) count[((src[i].q >> shift) & 2047) + 1]++;
-      for (size_t d = 0; d < 2048; d++) count[d + 1] += count[d];
-      for (size_t i = 0; i < n_tc; i++) dst[count[(src[i].q >> shift) & 2047]++] = src[i];
+    size_t nd = (bits + 10) / 11;
+    size_t count[3][2048 + 1];
+    memset(count, 0, sizeof count);
+    for (size_t i = 0; i < n_tc; i++)
+      for (size_t d = 0; d < nd; d++) count[d][((src[i].q >> (11 * d)) & 2047) + 1]++;
+    for (size_t d = 0; d < nd; d++) {
+      size_t *cd = count[d], shift = 11 * d;
+      for (size_t b = 0; b < 2048; b++) cd[b + 1] += cd[b];
+      for (size_t i = 0; i < n_tc; i++) dst[cd[(src[i].q >> shift) & 2047]++] = src[i];
       touch *x = src;
       src = dst;
       dst = x;
@@ -367,12 +375,13 @@ static void process_view(map_ctx *m, size_t v, int t) {
     float wsum = 0.0f, best_cos = 0.0f, sum[3] = {0.0f, 0.0f, 0.0f};
     int any = 0;
     for (size_t k = i; k < j; k++) {
-      const splat *e = &sp[tc[k].splat];
+      const splat *e = &sp[tc[k].sk >> 2];
       if (e->island != island) continue;
       if (!any || e->cosv > best_cos) best_cos = e->cosv;
       any = 1;
-      wsum += tc[k].w;
-      for (int c = 0; c < C; c++) sum[c] += tc[k].w * e->val[c];
+      float w = corner_weight(e, (int)(tc[k].sk & 3));
+      wsum += w;
+      for (int c = 0; c < C; c++) sum[c] += w * e->val[c];
     }
     i = j;
     if (!any) continue;
@@ -908,6 +917,10 @@ hearth_status hearth_map_layout_new(const hearth_mesh *mesh, const hearth_camera
   l->pw = ((size_t)cam->width + st - 1) / st;
   l->ph = ((size_t)cam->height + st - 1) / st;
   l->np = l->pw * l->ph;
+  if (l->np > UINT32_MAX / 4) {
+    s = hearth_err_set(err, HEARTH_E_LIMIT, "map: a %zu x %zu pixel grid exceeds the limit", l->pw, l->ph);
+    goto done;
+  }
   l->pix_dir = hearth_alloc_array(l->np, 3 * sizeof *l->pix_dir);
   l->pix_index = hearth_alloc_array(l->np, sizeof *l->pix_index);
   l->tile_order = hearth_alloc_array(l->np, sizeof *l->tile_order);
