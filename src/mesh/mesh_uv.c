@@ -192,6 +192,34 @@ static void tri_uv(const hearth_mesh *m, size_t t, size_t R, double x[3], double
   }
 }
 
+/* texel-centre bounding boxes of triangles [t0, t1), clipped to the map
+   (x0 > x1 when a triangle covers no texel centre) */
+static void bbox_range(void *vctx, size_t t0, size_t t1, int thread_index) {
+  const raster_ctx *c = vctx;
+  const double R = (double)c->R;
+  (void)thread_index;
+  for (size_t t = t0; t < t1; t++) {
+    double x[3], y[3];
+    tri_uv(c->m, t, c->R, x, y);
+    double xl = fmin(x[0], fmin(x[1], x[2])), xh = fmax(x[0], fmax(x[1], x[2]));
+    double yl = fmin(y[0], fmin(y[1], y[2])), yh = fmax(y[0], fmax(y[1], y[2]));
+    double c0 = fmax(ceil(xl), 0.0), c1 = fmin(floor(xh), R - 1.0);
+    double r0 = fmax(ceil(yl), 0.0), r1 = fmin(floor(yh), R - 1.0);
+    int32_t *bb = c->bbox + t * 4;
+    if (c0 > c1 || r0 > r1) {
+      bb[0] = 1;
+      bb[1] = 0;
+      bb[2] = 1;
+      bb[3] = 0;
+      continue;
+    }
+    bb[0] = (int32_t)c0;
+    bb[1] = (int32_t)c1;
+    bb[2] = (int32_t)r0;
+    bb[3] = (int32_t)r1;
+  }
+}
+
 static void raster_band(void *vctx, size_t band0, size_t band1, int thread_index) {
   const raster_ctx *c = vctx;
   const hearth_mesh *m = c->m;
@@ -201,6 +229,9 @@ static void raster_band(void *vctx, size_t band0, size_t band1, int thread_index
     int64_t r_hi = (int64_t)((band + 1) * c->rows_per_band);
     if (r_hi > (int64_t)R) r_hi = (int64_t)R;
     r_hi -= 1;
+    /* the band's texels start empty */
+    for (size_t q = (size_t)r_lo * R; q < (size_t)(r_hi + 1) * R; q++) c->tri_of_texel[q] = UINT32_MAX;
+    if (c->bary) memset(c->bary + (size_t)r_lo * R * 3, 0, (size_t)(r_hi + 1 - r_lo) * R * 3 * sizeof(float));
     /* triangles in index order; a texel keeps the first (lowest) one */
     for (size_t t = 0; t < m->n_triangles; t++) {
       const int32_t *bb = c->bbox + t * 4;
@@ -258,34 +289,12 @@ hearth_status hearth_uv_rasterize(const hearth_mesh *m, size_t R, uint32_t *tri_
     return hearth_err_set(err, HEARTH_E_NOMEM, "UV rasterisation: size overflow");
   int32_t *bbox = hearth_alloc_array(nb4 ? nb4 : 1, sizeof *bbox);
   if (!bbox) return hearth_err_set(err, HEARTH_E_NOMEM, "UV rasterisation: out of memory");
-  for (size_t i = 0; i < n_tex; i++) tri_of_texel[i] = UINT32_MAX;
-  if (bary)
-    for (size_t i = 0; i < n_tex * 3; i++) bary[i] = 0.0f;
-  /* texel-centre bounding boxes, clipped to the map */
-  for (size_t t = 0; t < m->n_triangles; t++) {
-    double x[3], y[3];
-    tri_uv(m, t, R, x, y);
-    double xl = fmin(x[0], fmin(x[1], x[2])), xh = fmax(x[0], fmax(x[1], x[2]));
-    double yl = fmin(y[0], fmin(y[1], y[2])), yh = fmax(y[0], fmax(y[1], y[2]));
-    double c0 = fmax(ceil(xl), 0.0), c1 = fmin(floor(xh), (double)R - 1.0);
-    double r0 = fmax(ceil(yl), 0.0), r1 = fmin(floor(yh), (double)R - 1.0);
-    int32_t *bb = bbox + t * 4;
-    if (c0 > c1 || r0 > r1) {
-      bb[0] = 1;
-      bb[1] = 0;
-      bb[2] = 1;
-      bb[3] = 0;
-      continue;
-    }
-    bb[0] = (int32_t)c0;
-    bb[1] = (int32_t)c1;
-    bb[2] = (int32_t)r0;
-    bb[3] = (int32_t)r1;
-  }
-  /* row bands in parallel; within a band triangles go in index order, so
-   * the result does not depend on the thread count */
+  /* texel-centre bounding boxes, clipped to the map, in parallel chunks */
   raster_ctx c = {m, R, 0, bbox, tri_of_texel, bary};
   int nth = hearth_default_threads();
+  hearth_parallel_for(m->n_triangles, nth, bbox_range, &c);
+  /* row bands in parallel; within a band triangles go in index order, so
+   * the result does not depend on the thread count */
   size_t nbands = (size_t)nth * 8;
   if (nbands > R) nbands = R;
   c.rows_per_band = (R + nbands - 1) / nbands;
