@@ -796,9 +796,9 @@ static void finish_rows(void *ctx, size_t b, size_t e, int t) {
   }
 }
 
-/* the pixel grid (undistorted centres of every stride-th pixel) and its ray
- * fan, made on a thread of their own while the UV layout is rasterised (the
- * two only read their inputs) */
+/* the pixel grid (undistorted centres of every stride-th pixel), its ray
+ * fan and the UV islands, made on a thread of their own while the UV layout
+ * is rasterised (all only read their inputs) */
 typedef struct grid_build {
   const hearth_camera *cam;
   size_t stride, pw, ph;
@@ -806,6 +806,11 @@ typedef struct grid_build {
   uint32_t *pix_index, *tile_order;
   hearth_ray_fan *fan; /* NULL where the fan cannot hold the grid */
   int nomem;
+  /* then the UV islands (the mesh only) */
+  const hearth_mesh *mesh;
+  uint32_t *island_of_tri, n_islands;
+  hearth_status islands_status;
+  hearth_err islands_err;
 } grid_build;
 
 static void *grid_build_run(void *arg) {
@@ -828,6 +833,7 @@ static void *grid_build_run(void *arg) {
     for (size_t tx = 0; tx < pw; tx += 4)
       for (size_t y = ty; y < ty + 4 && y < ph; y++)
         for (size_t x = tx; x < tx + 4 && x < pw; x++) g->tile_order[k++] = (uint32_t)(y * pw + x);
+  g->islands_status = hearth_uv_islands(g->mesh, g->island_of_tri, &g->n_islands, &g->islands_err);
   return NULL;
 }
 
@@ -872,6 +878,38 @@ struct hearth_map_layout {
   uint32_t *pix_index, *tile_order;
   hearth_ray_fan *fan; /* NULL where the fan cannot hold the grid */
 };
+
+typedef struct layout_pass {
+  hearth_map_layout *l;
+  const uint32_t *tri_of_texel;
+} layout_pass;
+
+static void texel_islands(void *ctx, size_t b, size_t e, int t) {
+  const layout_pass *lp = ctx;
+  hearth_map_layout *l = lp->l;
+  (void)t;
+  for (size_t q = b * l->R; q < e * l->R; q++) {
+    uint32_t tq = lp->tri_of_texel[q];
+    l->island_of_texel[q] = tq == UINT32_MAX ? UINT32_MAX : l->island_of_tri[tq];
+  }
+}
+
+static void tri_normals(void *ctx, size_t b, size_t e, int t) {
+  const layout_pass *lp = ctx;
+  hearth_map_layout *l = lp->l;
+  const hearth_mesh *mesh = l->mesh;
+  (void)t;
+  for (size_t i = b; i < e; i++) {
+    const uint32_t *ix = mesh->indices + 3 * i;
+    const float *a = mesh->positions + 3 * ix[0], *bb = mesh->positions + 3 * ix[1],
+                *c = mesh->positions + 3 * ix[2];
+    double e1[3] = {bb[0] - a[0], bb[1] - a[1], bb[2] - a[2]}, e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    double nn[3];
+    hearth_cross3(e1, e2, nn);
+    double len = hearth_norm3(nn);
+    for (int k = 0; k < 3; k++) l->tri_normal[3 * i + k] = len > 0 ? (float)(nn[k] / len) : 0.0f;
+  }
+}
 
 void hearth_map_layout_free(hearth_map_layout *l) {
   if (!l) return;
@@ -928,11 +966,16 @@ hearth_status hearth_map_layout_new(const hearth_mesh *mesh, const hearth_camera
     s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
     goto done;
   }
-  gb = (grid_build){cam, st, l->pw, l->ph, l->pix_dir, l->pix_index, l->tile_order, NULL, 0};
+  l->island_of_tri = hearth_alloc_array(mesh->n_triangles ? mesh->n_triangles : 1, sizeof *l->island_of_tri);
+  if (!l->island_of_tri) {
+    s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
+    goto done;
+  }
+  gb = (grid_build){cam, st, l->pw, l->ph, l->pix_dir, l->pix_index, l->tile_order, NULL, 0,
+                    mesh, l->island_of_tri, 0, HEARTH_OK, {0}};
   gb_started = pthread_create(&gb_tid, NULL, grid_build_run, &gb) == 0;
   if (!gb_started) grid_build_run(&gb); /* no thread: make it here */
   tri_of_texel = hearth_alloc_array(N, sizeof *tri_of_texel);
-  l->island_of_tri = hearth_alloc_array(mesh->n_triangles, sizeof *l->island_of_tri);
   l->tri_normal = hearth_alloc_array(mesh->n_triangles, 3 * sizeof *l->tri_normal);
   l->island_of_texel = hearth_alloc_array(N, sizeof *l->island_of_texel);
   if (!tri_of_texel || !l->island_of_tri || !l->tri_normal || !l->island_of_texel) {
@@ -940,20 +983,21 @@ hearth_status hearth_map_layout_new(const hearth_mesh *mesh, const hearth_camera
     goto done;
   }
   if ((s = hearth_uv_rasterize(mesh, R, tri_of_texel, NULL, err))) goto done;
-  if ((s = hearth_uv_islands(mesh, l->island_of_tri, &l->n_islands, err))) goto done;
-  for (size_t q = 0; q < N; q++) {
-    uint32_t tq = tri_of_texel[q];
-    l->island_of_texel[q] = tq == UINT32_MAX ? UINT32_MAX : l->island_of_tri[tq];
+  if (gb_started) {
+    pthread_join(gb_tid, NULL);
+    gb_started = 0;
   }
-  for (size_t i = 0; i < mesh->n_triangles; i++) {
-    const uint32_t *ix = mesh->indices + 3 * i;
-    const float *a = mesh->positions + 3 * ix[0], *b = mesh->positions + 3 * ix[1],
-                *c = mesh->positions + 3 * ix[2];
-    double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    double nn[3];
-    hearth_cross3(e1, e2, nn);
-    double len = hearth_norm3(nn);
-    for (int k = 0; k < 3; k++) l->tri_normal[3 * i + k] = len > 0 ? (float)(nn[k] / len) : 0.0f;
+  if (gb.islands_status) {
+    if (err) *err = gb.islands_err;
+    s = gb.islands_status;
+    goto done;
+  }
+  l->n_islands = gb.n_islands;
+  {
+    /* texels' islands and triangles' normals, in parallel chunks */
+    layout_pass lp = {l, tri_of_texel};
+    hearth_parallel_for(R, 0, texel_islands, &lp);
+    hearth_parallel_for(mesh->n_triangles, 0, tri_normals, &lp);
   }
   /* bounding sphere: the box centre and the farthest vertex from it,
    * padded so that rounding can never cull a ray that touches the mesh */
