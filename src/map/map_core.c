@@ -11,6 +11,7 @@
  * visited in raster order by one thread. */
 #include <math.h>
 #include <pthread.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -93,14 +94,15 @@ typedef struct map_ctx {
   int cast_threads; /* threads for ray casting when views are processed serially */
   /* per thread: a view's touches and the sort's second buffer (4 per pixel) */
   touch **touches, **touches_tmp;
-  /* the views' records (see REC_WORDS), each view's sorted by texel, in
-   * per-thread arenas (room for 4 records per pixel of every view of the
-   * thread's range; only what is written is ever touched) */
+  /* the views' records (see REC_WORDS), each view's sorted by texel: made
+   * in the worker's scratch (room for 4 per pixel), kept in an allocation
+   * of their own size */
   uint32_t **rec_q;
   float **rec_d;
   size_t *n_rec;
-  uint32_t **arena_q; /* per thread */
-  float **arena_d;
+  uint32_t **scratch_q; /* per thread */
+  float **scratch_d;
+  _Atomic size_t next_view; /* views are taken in turn by whichever worker is free */
   splat **splats; /* per thread: n_pix */
   uint8_t **sil; /* per thread: n_pix silhouette flags */
   float *hit_t; /* per thread: n_pix */
@@ -110,7 +112,7 @@ typedef struct map_ctx {
   hearth_ray_hit *hits;
   /* outputs */
   uint32_t *view_hits;
-  int failed;
+  _Atomic int failed; /* 1 out of memory, 2 a view not in front after all */
 } map_ctx;
 
 static float image_value(const hearth_image *img, size_t idx, int c) {
@@ -364,8 +366,8 @@ static void process_view(map_ctx *m, size_t v, int t) {
   const uint32_t *iot = m->island_of_texel;
   const size_t RW = REC_WORDS(C);
   int fusion = m->opts->fusion;
-  uint32_t *rq = m->rec_q[v];
-  float *rd = m->rec_d[v];
+  uint32_t *rq = m->scratch_q[t];
+  float *rd = m->scratch_d[t];
   for (size_t i = 0; i < n_tc;) {
     uint32_t q = tc[i].q;
     size_t j = i;
@@ -394,20 +396,26 @@ static void process_view(map_ctx *m, size_t v, int t) {
     for (int c = 0; c < C; c++) d[2 + c] = fusion == HEARTH_FUSE_MEAN ? sum[c] : sum[c] / wsum + 0.0f;
   }
   m->n_rec[v] = n_touched;
-}
-
-static void views_range(void *ctx, size_t b, size_t e, int t) {
-  map_ctx *m = ctx;
-  size_t per_view = 4 * m->n_pix;
-  m->arena_q[t] = hearth_alloc_array((e - b) * per_view, sizeof(uint32_t));
-  m->arena_d[t] = hearth_alloc_array((e - b) * per_view, REC_WORDS(m->C) * sizeof(float));
-  if (!m->arena_q[t] || !m->arena_d[t]) {
+  m->rec_q[v] = hearth_alloc_array(n_touched ? n_touched : 1, sizeof *rq);
+  m->rec_d[v] = hearth_alloc_array(n_touched ? n_touched : 1, RW * sizeof *rd);
+  if (!m->rec_q[v] || !m->rec_d[v]) {
     m->failed = 1;
     return;
   }
-  for (size_t v = b; v < e; v++) {
-    m->rec_q[v] = m->arena_q[t] + (v - b) * per_view;
-    m->rec_d[v] = m->arena_d[t] + (v - b) * per_view * REC_WORDS(m->C);
+  memcpy(m->rec_q[v], rq, n_touched * sizeof *rq);
+  memcpy(m->rec_d[v], rd, n_touched * RW * sizeof *rd);
+}
+
+/* a worker: the next view not yet taken, until none is left (views differ
+   in cost, and a shared machine slows workers unevenly; a view's result
+   does not depend on the worker) */
+static void views_worker(void *ctx, size_t b, size_t e, int t) {
+  map_ctx *m = ctx;
+  (void)b;
+  (void)e;
+  for (;;) {
+    size_t v = atomic_fetch_add_explicit(&m->next_view, 1, memory_order_relaxed);
+    if (v >= m->n_views) break;
     process_view(m, v, t);
   }
 }
@@ -848,10 +856,12 @@ static void free_scratch(map_ctx *m) {
   free(m->fan_scratch);
   free(m->touches);
   free(m->touches_tmp);
-  for (int t = 0; m->arena_q && t < m->n_threads; t++) free(m->arena_q[t]);
-  for (int t = 0; m->arena_d && t < m->n_threads; t++) free(m->arena_d[t]);
-  free(m->arena_q);
-  free(m->arena_d);
+  for (int t = 0; m->scratch_q && t < m->n_threads; t++) free(m->scratch_q[t]);
+  for (int t = 0; m->scratch_d && t < m->n_threads; t++) free(m->scratch_d[t]);
+  free(m->scratch_q);
+  free(m->scratch_d);
+  for (size_t v = 0; m->rec_q && v < m->n_views; v++) free(m->rec_q[v]);
+  for (size_t v = 0; m->rec_d && v < m->n_views; v++) free(m->rec_d[v]);
   free(m->rec_q);
   free(m->rec_d);
   free(m->n_rec);
@@ -1106,8 +1116,8 @@ hearth_status hearth_map_views_with_layout(const hearth_map_layout *l, const hea
   m.rec_q = calloc(n_views ? n_views : 1, sizeof *m.rec_q);
   m.rec_d = calloc(n_views ? n_views : 1, sizeof *m.rec_d);
   m.n_rec = calloc(n_views ? n_views : 1, sizeof *m.n_rec);
-  m.arena_q = calloc((size_t)nt, sizeof *m.arena_q);
-  m.arena_d = calloc((size_t)nt, sizeof *m.arena_d);
+  m.scratch_q = calloc((size_t)nt, sizeof *m.scratch_q);
+  m.scratch_d = calloc((size_t)nt, sizeof *m.scratch_d);
   m.hit_t = hearth_alloc_array(np * (size_t)nt, sizeof(float));
   m.hit_tri = hearth_alloc_array(np * (size_t)nt, sizeof(uint32_t));
   m.hit_b1 = hearth_alloc_array(np * (size_t)nt, sizeof(float));
@@ -1117,7 +1127,7 @@ hearth_status hearth_map_views_with_layout(const hearth_map_layout *l, const hea
   m.hits = hearth_alloc_array(np * (size_t)nt, sizeof(hearth_ray_hit));
   m.view_hits = calloc(n_views ? n_views : 1, sizeof *m.view_hits);
   int bad = !m.touches || !m.touches_tmp || !m.sil || !m.splats || !m.fan_scratch || !m.rec_q || !m.rec_d ||
-            !m.n_rec || !m.arena_q || !m.arena_d || !m.hit_t || !m.hit_tri || !m.hit_b1 || !m.hit_b2 ||
+            !m.n_rec || !m.scratch_q || !m.scratch_d || !m.hit_t || !m.hit_tri || !m.hit_b1 || !m.hit_b2 ||
             !m.ray_org || !m.ray_dir || !m.hits || !m.view_hits;
   for (int t = 0; !bad && t < nt; t++) {
     m.sil[t] = hearth_alloc_array(np, 1);
@@ -1128,13 +1138,16 @@ hearth_status hearth_map_views_with_layout(const hearth_map_layout *l, const hea
       m.fan_scratch[t] = calloc(1, hearth_ray_fan_scratch_size(l->fan, mesh->n_vertices));
       bad |= !m.fan_scratch[t];
     }
-    bad |= !m.sil[t] || !m.splats[t] || !m.touches[t] || !m.touches_tmp[t];
+    m.scratch_q[t] = hearth_alloc_array(np, 4 * sizeof(uint32_t));
+    m.scratch_d[t] = hearth_alloc_array(np, 4 * REC_WORDS(C) * sizeof(float));
+    bad |= !m.sil[t] || !m.splats[t] || !m.touches[t] || !m.touches_tmp[t] || !m.scratch_q[t] || !m.scratch_d[t];
   }
   if (bad) {
     s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory for %d threads at R=%zu", nt, R);
     goto done;
   }
-  hearth_parallel_for(n_views, nt, views_range, &m);
+  atomic_init(&m.next_view, 0);
+  hearth_parallel_for((size_t)nt, nt, views_worker, &m);
   if (m.failed == 2) {
     s = hearth_err_set(err, HEARTH_E_NUMERIC, "map: a view's camera does not have the mesh in front after all");
     goto done;
