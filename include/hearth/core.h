@@ -122,6 +122,15 @@ int hearth_default_threads(void);
  * per-thread scratch. */
 typedef void (*hearth_range_fn)(void *ctx, size_t begin, size_t end, int thread_index);
 hearth_status hearth_parallel_for(size_t n, int nthreads, hearth_range_fn fn, void *ctx);
+/* Run fn over [0, n) in chunks of `chunk` indices ([b, min(b + chunk, n))),
+ * each taken by whichever of nthreads workers is free first: uneven items
+ * and a busy machine cannot leave one worker with the tail. Which worker
+ * (thread_index) runs a chunk depends on timing, so fn must write results by
+ * index only; per-worker scratch is fine, per-worker results only if their
+ * reduction does not depend on which indices a worker saw (integer sums,
+ * minima, maxima). */
+hearth_status hearth_parallel_chunks(size_t n, size_t chunk, int nthreads, hearth_range_fn fn,
+                                     void *ctx);
 
 /* ---- locale-independent numbers ------------------------------------------ */
 /* Parse a decimal number from s[0..len): optional sign, digits, optional

@@ -1,5 +1,6 @@
 /* Deterministic parallel-for over index ranges, and progress output. */
 #include <pthread.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <time.h>
@@ -60,6 +61,63 @@ hearth_status hearth_parallel_for(size_t n, int nthreads, hearth_range_fn fn, vo
   /* threads that could not start: run their ranges here */
   for (int i = started + 1; i < nthreads; i++) par_run(&jobs[i]);
   free(jobs);
+  free(tids);
+  return HEARTH_OK;
+}
+
+/* the shared state of hearth_parallel_chunks: chunks are taken in index
+   order by whichever worker is free */
+typedef struct chunk_job {
+  hearth_range_fn fn;
+  void *ctx;
+  size_t n, chunk;
+  _Atomic size_t next;
+} chunk_job;
+
+typedef struct chunk_worker {
+  chunk_job *job;
+  int index;
+} chunk_worker;
+
+static void *chunk_run(void *arg) {
+  chunk_worker *w = arg;
+  chunk_job *j = w->job;
+  for (;;) {
+    size_t b = atomic_fetch_add_explicit(&j->next, j->chunk, memory_order_relaxed);
+    if (b >= j->n) break;
+    size_t e = j->n - b > j->chunk ? b + j->chunk : j->n;
+    j->fn(j->ctx, b, e, w->index);
+  }
+  return NULL;
+}
+
+hearth_status hearth_parallel_chunks(size_t n, size_t chunk, int nthreads, hearth_range_fn fn,
+                                     void *ctx) {
+  if (chunk < 1) chunk = 1;
+  if (nthreads <= 0) nthreads = hearth_default_threads();
+  size_t n_chunks = (n + chunk - 1) / chunk;
+  if ((size_t)nthreads > n_chunks) nthreads = n_chunks ? (int)n_chunks : 1;
+  chunk_job job = {fn, ctx, n, chunk, 0};
+  atomic_init(&job.next, 0);
+  chunk_worker *ws = calloc((size_t)nthreads, sizeof *ws);
+  pthread_t *tids = calloc((size_t)nthreads, sizeof *tids);
+  if (nthreads <= 1 || !ws || !tids) {
+    /* one worker: every chunk in order on this thread */
+    chunk_worker w = {&job, 0};
+    chunk_run(&w);
+    free(ws);
+    free(tids);
+    return HEARTH_OK;
+  }
+  int started = 0;
+  for (int i = 0; i < nthreads; i++) ws[i] = (chunk_worker){&job, i};
+  for (int i = 1; i < nthreads; i++) {
+    if (pthread_create(&tids[i], NULL, chunk_run, &ws[i]) != 0) break;
+    started = i;
+  }
+  chunk_run(&ws[0]); /* this thread takes chunks too, and whatever is left */
+  for (int i = 1; i <= started; i++) pthread_join(tids[i], NULL);
+  free(ws);
   free(tids);
   return HEARTH_OK;
 }

@@ -311,7 +311,7 @@ static hearth_status png_encode_mem(const hearth_image *img, const char *name, u
     goto done;
   }
   int nt = hearth_default_threads();
-  hearth_parallel_for(nb, nb < (size_t)nt ? (int)nb : nt, encode_bands, &j);
+  hearth_parallel_chunks(nb, 2, nt, encode_bands, &j);
   size_t total = 8 + 25 + 12 + 2 + 4;
   for (size_t k = 0; k < nb; k++) {
     if (j.failed[k]) {

@@ -102,7 +102,6 @@ typedef struct map_ctx {
   size_t *n_rec;
   uint32_t **scratch_q; /* per thread */
   float **scratch_d;
-  _Atomic size_t next_view; /* views are taken in turn by whichever worker is free */
   splat **splats; /* per thread: n_pix */
   uint8_t **sil; /* per thread: n_pix silhouette flags */
   float *hit_t; /* per thread: n_pix */
@@ -406,18 +405,12 @@ static void process_view(map_ctx *m, size_t v, int t) {
   memcpy(m->rec_d[v], rd, n_touched * RW * sizeof *rd);
 }
 
-/* a worker: the next view not yet taken, until none is left (views differ
-   in cost, and a shared machine slows workers unevenly; a view's result
-   does not depend on the worker) */
-static void views_worker(void *ctx, size_t b, size_t e, int t) {
+/* views [b, e) on worker t; views are handed out one at a time to whichever
+   worker is free (they differ in cost, and a shared machine slows workers
+   unevenly); a view's records do not depend on the worker */
+static void views_range(void *ctx, size_t b, size_t e, int t) {
   map_ctx *m = ctx;
-  (void)b;
-  (void)e;
-  for (;;) {
-    size_t v = atomic_fetch_add_explicit(&m->next_view, 1, memory_order_relaxed);
-    if (v >= m->n_views) break;
-    process_view(m, v, t);
-  }
+  for (size_t v = b; v < e; v++) process_view(m, v, t);
 }
 
 /* weighted median of n (value, weight) pairs; sorts in place */
@@ -462,7 +455,6 @@ typedef struct fill_ctx {
   const uint8_t *mask;
   const island_box *box;
   const uint32_t *order; /* islands with work, largest box first */
-  const int *bin;        /* worker of each entry of order */
   uint32_t n;
   int32_t *seed; /* out: nearest observed texel of each filled texel */
   int *failed;   /* per worker: out of memory */
@@ -557,12 +549,11 @@ static int cmp_isl_work(const void *a, const void *b) {
   return (x->island > y->island) - (x->island < y->island);
 }
 
+/* islands order[b..e), each whole on this worker */
 static void fill_range(void *ctx, size_t b, size_t e, int t) {
   const fill_ctx *c = ctx;
-  (void)t;
-  for (size_t w = b; w < e; w++)
-    for (uint32_t i = 0; i < c->n; i++)
-      if (c->bin[i] == (int)w && !fill_one_island(c, c->order[i])) c->failed[w] = 1;
+  for (size_t i = b; i < e; i++)
+    if (!fill_one_island(c, c->order[i])) c->failed[t] = 1;
 }
 
 typedef struct box_pass {
@@ -574,8 +565,8 @@ typedef struct box_pass {
   island_box *part; /* per worker: n_islands + 1 boxes */
 } box_pass;
 
-/* per worker: the islands' boxes over its rows (grown from the empty boxes
- * set before); every seed set to none */
+/* per worker: the islands' boxes over the rows it takes (grown from the
+ * empty boxes set before); every seed set to none */
 static void box_rows(void *ctx, size_t b, size_t e, int t) {
   const box_pass *bp = ctx;
   size_t R = bp->R;
@@ -590,7 +581,7 @@ static void box_rows(void *ctx, size_t b, size_t e, int t) {
       if ((int32_t)x < bx->x0) bx->x0 = (int32_t)x;
       if ((int32_t)x > bx->x1) bx->x1 = (int32_t)x;
       if ((int32_t)y < bx->y0) bx->y0 = (int32_t)y;
-      bx->y1 = (int32_t)y;
+      if ((int32_t)y > bx->y1) bx->y1 = (int32_t)y;
       if (bp->mask[q] == HEARTH_TEXEL_OBSERVED) bx->has_seed = 1;
       else bx->n_todo++;
     }
@@ -602,11 +593,9 @@ static hearth_status fill_islands(size_t R, const uint32_t *island_of_texel, uin
   island_box *box = hearth_alloc_array((size_t)n_islands + 1, sizeof *box);
   isl_work *work = hearth_alloc_array((size_t)n_islands + 1, sizeof *work);
   uint32_t *order = hearth_alloc_array((size_t)n_islands + 1, sizeof *order);
-  int *bin = hearth_alloc_array((size_t)n_islands + 1, sizeof *bin);
-  size_t *load = calloc((size_t)nw, sizeof *load);
   int *failed = calloc((size_t)nw, sizeof *failed);
   hearth_status s = HEARTH_E_NOMEM;
-  if (!box || !work || !order || !bin || !load || !failed) goto done;
+  if (!box || !work || !order || !failed) goto done;
   {
     /* the islands' boxes over row bands in parallel, merged (minima,
        maxima, sums: the same for any split) */
@@ -615,7 +604,7 @@ static hearth_status fill_islands(size_t R, const uint32_t *island_of_texel, uin
     if (!bp.part) goto done;
     for (size_t i = 0; i < (size_t)nw * ((size_t)n_islands + 1); i++)
       bp.part[i] = (island_box){INT32_MAX, INT32_MAX, -1, -1, 0, 0};
-    hearth_parallel_for(R, nw, box_rows, &bp);
+    hearth_parallel_chunks(R, 32, nw, box_rows, &bp);
     for (uint32_t i = 0; i < n_islands; i++) {
       island_box b = bp.part[i];
       for (int w = 1; w < nw; w++) {
@@ -635,17 +624,10 @@ static hearth_status fill_islands(size_t R, const uint32_t *island_of_texel, uin
   for (uint32_t i = 0; i < n_islands; i++)
     if (box[i].has_seed && box[i].n_todo) work[n++] = (isl_work){box_area(&box[i]), i};
   qsort(work, n, sizeof *work, cmp_isl_work);
-  /* dealt largest first, each to the least loaded worker */
-  for (uint32_t i = 0; i < n; i++) {
-    int best = 0;
-    for (int w = 1; w < nw; w++)
-      if (load[w] < load[best]) best = w;
-    order[i] = work[i].island;
-    bin[i] = best;
-    load[best] += work[i].work;
-  }
-  fill_ctx c = {R, island_of_texel, mask, box, order, bin, n, seed, failed};
-  hearth_parallel_for((size_t)nw, nw, fill_range, &c);
+  /* largest first, each island to whichever worker is free */
+  for (uint32_t i = 0; i < n; i++) order[i] = work[i].island;
+  fill_ctx c = {R, island_of_texel, mask, box, order, n, seed, failed};
+  hearth_parallel_chunks(n, 1, nw, fill_range, &c);
   s = HEARTH_OK;
   for (int w = 0; w < nw; w++)
     if (failed[w]) s = HEARTH_E_NOMEM;
@@ -653,8 +635,6 @@ done:
   free(box);
   free(work);
   free(order);
-  free(bin);
-  free(load);
   free(failed);
   return s;
 }
@@ -1006,8 +986,8 @@ hearth_status hearth_map_layout_new(const hearth_mesh *mesh, const hearth_camera
   {
     /* texels' islands and triangles' normals, in parallel chunks */
     layout_pass lp = {l, tri_of_texel};
-    hearth_parallel_for(R, 0, texel_islands, &lp);
-    hearth_parallel_for(mesh->n_triangles, 0, tri_normals, &lp);
+    hearth_parallel_chunks(R, 32, 0, texel_islands, &lp);
+    hearth_parallel_chunks(mesh->n_triangles, 8192, 0, tri_normals, &lp);
   }
   /* bounding sphere: the box centre and the farthest vertex from it,
    * padded so that rounding can never cull a ray that touches the mesh */
@@ -1146,8 +1126,7 @@ hearth_status hearth_map_views_with_layout(const hearth_map_layout *l, const hea
     s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory for %d threads at R=%zu", nt, R);
     goto done;
   }
-  atomic_init(&m.next_view, 0);
-  hearth_parallel_for((size_t)nt, nt, views_worker, &m);
+  hearth_parallel_chunks(n_views, 1, nt, views_range, &m);
   if (m.failed == 2) {
     s = hearth_err_set(err, HEARTH_E_NUMERIC, "map: a view's camera does not have the mesh in front after all");
     goto done;
@@ -1179,7 +1158,7 @@ hearth_status hearth_map_views_with_layout(const hearth_map_layout *l, const hea
     const size_t rows = R < BAND_TEXELS ? BAND_TEXELS / R : 1;
     int *nomem = calloc((size_t)nt, sizeof *nomem), failed = !nomem;
     texel_pass tp = {&m, out, NULL, NULL, nomem};
-    if (nomem) hearth_parallel_for((R + rows - 1) / rows, nt, fuse_bands, &tp);
+    if (nomem) hearth_parallel_chunks((R + rows - 1) / rows, 4, nt, fuse_bands, &tp);
     for (int t = 0; nomem && t < nt; t++) failed |= nomem[t];
     free(nomem);
     if (failed) {
@@ -1200,7 +1179,7 @@ hearth_status hearth_map_views_with_layout(const hearth_map_layout *l, const hea
       s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
       goto done;
     }
-    hearth_parallel_for(R, nt, finish_rows, &tp);
+    hearth_parallel_chunks(R, 32, nt, finish_rows, &tp);
     for (int t = 0; t < nt; t++) {
       out->n_observed += tp.counts[t][0];
       out->n_filled += tp.counts[t][1];

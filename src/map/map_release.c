@@ -367,7 +367,7 @@ hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats
       goto done;
     }
     int nt = job->map.threads > 0 ? job->map.threads : hearth_default_threads();
-    hearth_parallel_for(n, nt, read_csv_range, &cj);
+    hearth_parallel_chunks(n, 1, nt, read_csv_range, &cj);
     s = first_failure(cj.st, cj.errs, n, err);
     free(cj.st);
     free(cj.errs);

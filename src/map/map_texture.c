@@ -78,7 +78,7 @@ hearth_status hearth_map_texture(const hearth_map_result *r, double lo, double h
   }
   for (int i = 0; C == 1 && i < LUT_N; i++) hearth_turbo((double)i / (LUT_N - 1), lut[i]);
   colour_job cj = {r, px, have, (const uint8_t(*)[3])lut, LUT_N, lo, (LUT_N - 1) / (hi - lo), nan_rgb};
-  hearth_parallel_for(R, 0, colour_rows, &cj);
+  hearth_parallel_chunks(R, 32, 0, colour_rows, &cj);
   /* padding: each round, a texel without colour takes the mean of its
      coloured 4-neighbours (deterministic: reads the previous round only).
      Only the frontier is visited: round 0's candidates are the uncoloured

@@ -292,14 +292,14 @@ hearth_status hearth_uv_rasterize(const hearth_mesh *m, size_t R, uint32_t *tri_
   /* texel-centre bounding boxes, clipped to the map, in parallel chunks */
   raster_ctx c = {m, R, 0, bbox, tri_of_texel, bary};
   int nth = hearth_default_threads();
-  hearth_parallel_for(m->n_triangles, nth, bbox_range, &c);
+  hearth_parallel_chunks(m->n_triangles, 8192, nth, bbox_range, &c);
   /* row bands in parallel; within a band triangles go in index order, so
    * the result does not depend on the thread count */
   size_t nbands = (size_t)nth * 8;
   if (nbands > R) nbands = R;
   c.rows_per_band = (R + nbands - 1) / nbands;
   nbands = (R + c.rows_per_band - 1) / c.rows_per_band;
-  hearth_parallel_for(nbands, nth, raster_band, &c);
+  hearth_parallel_chunks(nbands, 1, nth, raster_band, &c);
   free(bbox);
   return HEARTH_OK;
 }

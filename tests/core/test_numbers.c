@@ -1,7 +1,21 @@
 /* Locale-free number parsing/formatting, RNG determinism, parallel-for. */
 #include <locale.h>
+#include <stdatomic.h>
 #include "hearth/core.h"
 #include "test_util.h"
+
+typedef struct chunk_seen {
+  _Atomic int hits[1000];
+  _Atomic int bad;
+  size_t chunk;
+  int nt;
+} chunk_seen;
+
+static void chunk_range(void *ctx, size_t b, size_t e, int t) {
+  chunk_seen *cs = ctx;
+  if (t < 0 || t >= cs->nt || b >= e || b % cs->chunk || (e - b != cs->chunk && e != 1000)) atomic_store(&cs->bad, 1);
+  for (size_t i = b; i < e && i < 1000; i++) atomic_fetch_add(&cs->hits[i], 1);
+}
 
 static void sum_range(void *ctx, size_t b, size_t e, int t) {
   double *out = ctx;
@@ -65,6 +79,27 @@ int main(void) {
     memset(out, 0, sizeof out);
     hearth_parallel_for(1000, nt, sum_range, out);
     for (int i = 0; i < 1000; i++) CHECK(out[i] == i * 0.5);
+  }
+  /* parallel_chunks: every index exactly once, in chunks of the asked size
+     (the last shorter), each chunk on a worker below the thread count */
+  for (int nt = 1; nt <= 5; nt++)
+    for (size_t chunk = 1; chunk <= 300; chunk += 37) {
+      chunk_seen cs;
+      memset(&cs, 0, sizeof cs);
+      cs.chunk = chunk;
+      cs.nt = nt;
+      hearth_parallel_chunks(1000, chunk, nt, chunk_range, &cs);
+      int ok = !atomic_load(&cs.bad);
+      for (int i = 0; i < 1000; i++) ok &= atomic_load(&cs.hits[i]) == 1;
+      CHECK_MSG(ok, "parallel_chunks: %d threads, chunk %zu", nt, chunk);
+    }
+  {
+    chunk_seen cs;
+    memset(&cs, 0, sizeof cs);
+    cs.chunk = 1;
+    cs.nt = 3;
+    hearth_parallel_chunks(0, 1, 3, chunk_range, &cs); /* nothing to do */
+    CHECK(!atomic_load(&cs.bad));
   }
   size_t m;
   CHECK(!hearth_mul_size(SIZE_MAX / 2, 3, &m));
