@@ -79,6 +79,7 @@ typedef struct map_ctx {
   /* layout */
   const uint32_t *island_of_texel; /* UINT32_MAX off the surface */
   const uint32_t *island_of_tri;
+  uint32_t n_islands;
   const float *tri_normal; /* 3 per triangle, unit */
   /* pixel grid */
   size_t n_pix, pix_w, pix_h;
@@ -450,14 +451,15 @@ typedef struct island_box {
 } island_box;
 
 typedef struct fill_ctx {
-  size_t R;
+  size_t R, C;
   const uint32_t *island_of_texel;
-  const uint8_t *mask;
+  uint8_t *mask;         /* observed texels in; filled ones marked */
+  const float *observed;
+  float *filled;         /* out: the filled texels' values */
   const island_box *box;
   const uint32_t *order; /* islands with work, largest box first */
   uint32_t n;
-  int32_t *seed; /* out: nearest observed texel of each filled texel */
-  int *failed;   /* per worker: out of memory */
+  int *failed;           /* per worker: out of memory */
 } fill_ctx;
 
 static size_t box_area(const island_box *b) {
@@ -468,7 +470,7 @@ static int fill_one_island(const fill_ctx *c, uint32_t isl) {
   const island_box *b = &c->box[isl];
   size_t R = c->R, W = (size_t)(b->x1 - b->x0 + 1), H = (size_t)(b->y1 - b->y0 + 1);
   const uint32_t *iot = c->island_of_texel;
-  const uint8_t *mask = c->mask;
+  uint8_t *mask = c->mask;
   int32_t *srow = hearth_alloc_array(W * H, sizeof *srow); /* nearest seed row in the column, -1 none */
   int32_t *cur = hearth_alloc_array(W, sizeof *cur);
   int32_t *env = hearth_alloc_array(W, sizeof *env);       /* columns on the lower envelope */
@@ -526,8 +528,9 @@ static int fill_one_island(const fill_ctx *c, uint32_t isl) {
       size_t q = q0 + x;
       if (iot[q] != isl || mask[q] == HEARTH_TEXEL_OBSERVED) continue;
       while (j < k && z[j + 1] <= (double)x) j++;
-      size_t sc = (size_t)env[j];
-      c->seed[q] = (int32_t)(((size_t)b->y0 + (size_t)row[sc]) * R + (size_t)b->x0 + sc);
+      size_t sc = (size_t)env[j], seed = ((size_t)b->y0 + (size_t)row[sc]) * R + (size_t)b->x0 + sc;
+      for (size_t ch = 0; ch < c->C; ch++) c->filled[q * c->C + ch] = c->observed[seed * c->C + ch];
+      mask[q] = HEARTH_TEXEL_FILLED; /* read again only as "not observed" */
     }
   }
 #undef IS_SEED
@@ -556,69 +559,32 @@ static void fill_range(void *ctx, size_t b, size_t e, int t) {
     if (!fill_one_island(c, c->order[i])) c->failed[t] = 1;
 }
 
-typedef struct box_pass {
-  size_t R;
-  const uint32_t *island_of_texel;
-  const uint8_t *mask;
-  int32_t *seed;
-  uint32_t n_islands;
-  island_box *part; /* per worker: n_islands + 1 boxes */
-} box_pass;
-
-/* per worker: the islands' boxes over the rows it takes (grown from the
- * empty boxes set before); every seed set to none */
-static void box_rows(void *ctx, size_t b, size_t e, int t) {
-  const box_pass *bp = ctx;
-  size_t R = bp->R;
-  island_box *box = bp->part + (size_t)t * ((size_t)bp->n_islands + 1);
-  for (size_t y = b; y < e; y++)
-    for (size_t x = 0; x < R; x++) {
-      size_t q = y * R + x;
-      bp->seed[q] = -1;
-      uint32_t isl = bp->island_of_texel[q];
-      if (isl == UINT32_MAX) continue;
-      island_box *bx = &box[isl];
-      if ((int32_t)x < bx->x0) bx->x0 = (int32_t)x;
-      if ((int32_t)x > bx->x1) bx->x1 = (int32_t)x;
-      if ((int32_t)y < bx->y0) bx->y0 = (int32_t)y;
-      if ((int32_t)y > bx->y1) bx->y1 = (int32_t)y;
-      if (bp->mask[q] == HEARTH_TEXEL_OBSERVED) bx->has_seed = 1;
-      else bx->n_todo++;
-    }
-}
-
-static hearth_status fill_islands(size_t R, const uint32_t *island_of_texel, uint32_t n_islands,
-                                  const uint8_t *mask, int32_t *seed, int nthreads) {
-  int nw = nthreads > 0 ? nthreads : hearth_default_threads();
+/* Fill every island that has observed texels and unobserved ones, from the
+ * islands' boxes (merged from the workers' parts of the fusion pass: nw
+ * sets of n_islands + 1). Writes filled and marks mask for filled texels. */
+static hearth_status fill_islands(size_t R, size_t C, const uint32_t *island_of_texel, uint32_t n_islands,
+                                  const island_box *parts, int nw, uint8_t *mask, const float *observed,
+                                  float *filled, int nthreads) {
   island_box *box = hearth_alloc_array((size_t)n_islands + 1, sizeof *box);
   isl_work *work = hearth_alloc_array((size_t)n_islands + 1, sizeof *work);
   uint32_t *order = hearth_alloc_array((size_t)n_islands + 1, sizeof *order);
-  int *failed = calloc((size_t)nw, sizeof *failed);
+  int nf = nthreads > 0 ? nthreads : hearth_default_threads();
+  int *failed = calloc((size_t)nf, sizeof *failed);
   hearth_status s = HEARTH_E_NOMEM;
   if (!box || !work || !order || !failed) goto done;
-  {
-    /* the islands' boxes over row bands in parallel, merged (minima,
-       maxima, sums: the same for any split) */
-    box_pass bp = {R, island_of_texel, mask, seed, n_islands,
-                   hearth_alloc_array((size_t)nw * ((size_t)n_islands + 1), sizeof(island_box))};
-    if (!bp.part) goto done;
-    for (size_t i = 0; i < (size_t)nw * ((size_t)n_islands + 1); i++)
-      bp.part[i] = (island_box){INT32_MAX, INT32_MAX, -1, -1, 0, 0};
-    hearth_parallel_chunks(R, 32, nw, box_rows, &bp);
-    for (uint32_t i = 0; i < n_islands; i++) {
-      island_box b = bp.part[i];
-      for (int w = 1; w < nw; w++) {
-        const island_box *o = &bp.part[(size_t)w * ((size_t)n_islands + 1) + i];
-        if (o->x0 < b.x0) b.x0 = o->x0;
-        if (o->x1 > b.x1) b.x1 = o->x1;
-        if (o->y0 < b.y0) b.y0 = o->y0;
-        if (o->y1 > b.y1) b.y1 = o->y1;
-        b.n_todo += o->n_todo;
-        b.has_seed |= o->has_seed;
-      }
-      box[i] = b;
+  /* minima, maxima, sums: the same for any split of the rows */
+  for (uint32_t i = 0; i < n_islands; i++) {
+    island_box b = parts[i];
+    for (int w = 1; w < nw; w++) {
+      const island_box *o = &parts[(size_t)w * ((size_t)n_islands + 1) + i];
+      if (o->x0 < b.x0) b.x0 = o->x0;
+      if (o->x1 > b.x1) b.x1 = o->x1;
+      if (o->y0 < b.y0) b.y0 = o->y0;
+      if (o->y1 > b.y1) b.y1 = o->y1;
+      b.n_todo += o->n_todo;
+      b.has_seed |= o->has_seed;
     }
-    free(bp.part);
+    box[i] = b;
   }
   uint32_t n = 0;
   for (uint32_t i = 0; i < n_islands; i++)
@@ -626,10 +592,10 @@ static hearth_status fill_islands(size_t R, const uint32_t *island_of_texel, uin
   qsort(work, n, sizeof *work, cmp_isl_work);
   /* largest first, each island to whichever worker is free */
   for (uint32_t i = 0; i < n; i++) order[i] = work[i].island;
-  fill_ctx c = {R, island_of_texel, mask, box, order, n, seed, failed};
-  hearth_parallel_chunks(n, 1, nw, fill_range, &c);
+  fill_ctx c = {R, C, island_of_texel, mask, observed, filled, box, order, n, failed};
+  hearth_parallel_chunks(n, 1, nf, fill_range, &c);
   s = HEARTH_OK;
-  for (int w = 0; w < nw; w++)
+  for (int w = 0; w < nf; w++)
     if (failed[w]) s = HEARTH_E_NOMEM;
 done:
   free(box);
@@ -644,7 +610,7 @@ done:
 typedef struct texel_pass {
   const map_ctx *m;
   hearth_map_result *out;
-  const int32_t *seed;
+  island_box *parts;   /* per worker: the islands' boxes (n_islands + 1) */
   size_t (*counts)[4]; /* per worker: observed, filled, unobserved, surface */
   int *nomem;          /* per worker */
 } texel_pass;
@@ -748,11 +714,24 @@ static void fuse_bands(void *ctx, size_t b, size_t e, int t) {
         out->observed[q0 + i] = weighted_median(tmp, n);
       }
     }
-    for (size_t q = q0; q < q1; q++)
+    /* the mask, and the islands' boxes for the fill */
+    island_box *box = tp->parts + (size_t)t * ((size_t)m->n_islands + 1);
+    for (size_t q = q0; q < q1; q++) {
       for (size_t c = 0; c < C; c++) {
         if (out->observed[q * C + c] > -INFINITY) out->mask[q] = HEARTH_TEXEL_OBSERVED;
         else out->observed[q * C + c] = NAN;
       }
+      uint32_t isl = m->island_of_texel[q];
+      if (isl == UINT32_MAX) continue;
+      island_box *bx = &box[isl];
+      int32_t x = (int32_t)(q % R), y = (int32_t)(q / R);
+      if (x < bx->x0) bx->x0 = x;
+      if (x > bx->x1) bx->x1 = x;
+      if (y < bx->y0) bx->y0 = y;
+      if (y > bx->y1) bx->y1 = y;
+      if (out->mask[q] == HEARTH_TEXEL_OBSERVED) bx->has_seed = 1;
+      else bx->n_todo++;
+    }
   }
 done:
   free(acc);
@@ -761,23 +740,22 @@ done:
   free(tmp);
 }
 
-/* the filled map from the observed one and the fill seeds; final mask */
+/* the filled map's other texels (the fill wrote the filled ones): the
+ * observed values, NaN elsewhere; the counts */
 static void finish_rows(void *ctx, size_t b, size_t e, int t) {
   const texel_pass *tp = ctx;
   hearth_map_result *out = tp->out;
   size_t R = tp->m->R, C = (size_t)tp->m->C, *cnt = tp->counts[t];
   for (size_t q = b * R; q < e * R; q++) {
     uint8_t mk = out->mask[q];
-    for (size_t c = 0; c < C; c++) out->filled[q * C + c] = NAN;
-    if (mk == HEARTH_TEXEL_NONE) continue;
-    if (mk == HEARTH_TEXEL_OBSERVED) {
+    if (mk == HEARTH_TEXEL_FILLED) {
+      cnt[1]++;
+    } else if (mk == HEARTH_TEXEL_OBSERVED) {
       cnt[0]++;
       for (size_t c = 0; c < C; c++) out->filled[q * C + c] = out->observed[q * C + c];
-    } else if (tp->seed[q] >= 0) {
-      out->mask[q] = HEARTH_TEXEL_FILLED;
-      cnt[1]++;
-      for (size_t c = 0; c < C; c++) out->filled[q * C + c] = out->observed[(size_t)tp->seed[q] * C + c];
     } else {
+      for (size_t c = 0; c < C; c++) out->filled[q * C + c] = NAN;
+      if (mk == HEARTH_TEXEL_NONE) continue;
       cnt[2]++;
     }
     cnt[3]++;
@@ -1058,7 +1036,7 @@ hearth_status hearth_map_views_with_layout(const hearth_map_layout *l, const hea
   memset(&m, 0, sizeof m);
   hearth_raycaster *own_rc = NULL;
   uint8_t *view_fan = calloc(n_views ? n_views : 1, 1);
-  int32_t *seed = NULL;
+  island_box *parts = NULL;
   if (!view_fan) return hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
   double t_cast0 = hearth_now();
   const double *sphere = l->sphere;
@@ -1083,7 +1061,7 @@ hearth_status hearth_map_views_with_layout(const hearth_map_layout *l, const hea
   if ((size_t)nt > n_views) nt = n_views ? (int)n_views : 1;
   m = (map_ctx){.mesh = mesh, .rc = rc_in ? rc_in : own_rc, .cam = cam, .views = views,
                 .n_views = n_views, .opts = &opts, .R = R, .C = C, .island_of_texel = l->island_of_texel,
-                .island_of_tri = l->island_of_tri, .tri_normal = l->tri_normal, .n_pix = np,
+                .island_of_tri = l->island_of_tri, .n_islands = l->n_islands, .tri_normal = l->tri_normal, .n_pix = np,
                 .pix_w = l->pw, .pix_h = l->ph, .pix_dir = l->pix_dir, .pix_index = l->pix_index,
                 .tile_order = l->tile_order, .sphere = {sphere[0], sphere[1], sphere[2], sphere[3]},
                 .fan = l->fan, .view_fan = view_fan, .n_threads = nt,
@@ -1149,15 +1127,18 @@ hearth_status hearth_map_views_with_layout(const hearth_map_layout *l, const hea
   out->best_cos = hearth_alloc_array(N, sizeof(float));
   out->view_hits = m.view_hits;
   m.view_hits = NULL;
-  seed = hearth_alloc_array(N, sizeof *seed);
-  if (!out->observed || !out->filled || !out->mask || !out->best_cos || !seed) {
+  /* per worker of the fusion: the islands' boxes, empty */
+  const size_t nparts = (size_t)nt * ((size_t)l->n_islands + 1);
+  parts = hearth_alloc_array(nparts, sizeof *parts);
+  for (size_t i = 0; parts && i < nparts; i++) parts[i] = (island_box){INT32_MAX, INT32_MAX, -1, -1, 0, 0};
+  if (!out->observed || !out->filled || !out->mask || !out->best_cos || !parts) {
     s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
     goto done;
   }
   {
     const size_t rows = R < BAND_TEXELS ? BAND_TEXELS / R : 1;
     int *nomem = calloc((size_t)nt, sizeof *nomem), failed = !nomem;
-    texel_pass tp = {&m, out, NULL, NULL, nomem};
+    texel_pass tp = {&m, out, parts, NULL, nomem};
     if (nomem) hearth_parallel_chunks((R + rows - 1) / rows, 4, nt, fuse_bands, &tp);
     for (int t = 0; nomem && t < nt; t++) failed |= nomem[t];
     free(nomem);
@@ -1168,12 +1149,13 @@ hearth_status hearth_map_views_with_layout(const hearth_map_layout *l, const hea
   }
   double t_fill0 = hearth_now();
   if (timing) timing->fuse = t_fill0 - t_fuse0;
-  if (fill_islands(R, l->island_of_texel, l->n_islands, out->mask, seed, nt)) {
+  if (fill_islands(R, (size_t)C, l->island_of_texel, l->n_islands, parts, nt, out->mask, out->observed,
+                   out->filled, nt)) {
     s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory while filling");
     goto done;
   }
   {
-    texel_pass tp = {&m, out, seed, NULL, NULL};
+    texel_pass tp = {&m, out, NULL, NULL, NULL};
     tp.counts = calloc((size_t)nt, sizeof *tp.counts);
     if (!tp.counts) {
       s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
@@ -1198,7 +1180,7 @@ done:
   free_scratch(&m);
   free(m.view_hits);
   hearth_raycaster_free(own_rc);
-  free(seed);
+  free(parts);
   if (s) hearth_map_result_free(out);
   return s;
 }
