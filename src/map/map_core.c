@@ -60,12 +60,12 @@ typedef struct splat {
   float cosv;
   float val[3];
 } splat;
-#define PREFETCH_AHEAD 8
+#define PREFETCH_AHEAD 8 /* touches ahead whose texel's island is prefetched */
 
 /* the bilinear weight of corner k (bit 0: +x, bit 1: +y) of a splat */
 static inline float corner_weight(const splat *e, int k) {
   return (float)(((k & 1) ? e->fx : 1.0 - e->fx) * ((k >> 1) ? e->fy : 1.0 - e->fy));
-} /* touches ahead whose shared record is prefetched */
+}
 
 typedef struct map_ctx {
   const hearth_mesh *mesh;
@@ -125,9 +125,6 @@ typedef struct pix_box {
   size_t x0, x1, y0, y1; /* inclusive; x0 > x1 when empty */
 } pix_box;
 
-/* cast every grid pixel of view v; fill hit_* arrays of thread t. Rays go
- * to Embree in 4x4 pixel tiles (packets of nearly parallel rays); rays that
- * miss the mesh's bounding sphere are not cast at all. */
 /* record a hit (or a miss) of grid pixel p */
 static void keep_hit(map_ctx *m, int t, size_t p, const hearth_ray_hit *h, pix_box *box) {
   size_t n = m->n_pix;
@@ -149,6 +146,11 @@ static void keep_hit(map_ctx *m, int t, size_t p, const hearth_ray_hit *h, pix_b
   }
 }
 
+/* cast every grid pixel of view v; fill hit_* arrays of thread t and grow
+ * box around the hits. Through the fan where the view has the whole mesh in
+ * front; otherwise rays go to Embree in 4x4 pixel tiles (packets of nearly
+ * parallel rays), and rays that miss the mesh's bounding sphere are not
+ * cast at all. */
 static void cast_view(map_ctx *m, size_t v, int t, pix_box *box) {
   const hearth_rigid *T = &m->views[v].T_world_from_cam;
   size_t n = m->n_pix;
@@ -980,10 +982,6 @@ hearth_status hearth_map_layout_new(const hearth_mesh *mesh, const hearth_camera
       if (d2 > r2) r2 = d2;
     }
     l->sphere[3] = sqrt(r2) * (1.0 + 1e-3) + 1e-6;
-  }
-  if (gb_started) {
-    pthread_join(gb_tid, NULL);
-    gb_started = 0;
   }
   l->fan = gb.fan;
   gb.fan = NULL;

@@ -112,7 +112,6 @@ static const char *fusion_name(hearth_fusion f) {
   return f == HEARTH_FUSE_MAX ? "max" : f == HEARTH_FUSE_ROBUST ? "robust" : "mean";
 }
 
-/* path relative to the release root when it lies inside it */
 static json_t *camera_json(const hearth_camera *c) {
   json_t *o = json_object();
   double K[9];
