@@ -215,9 +215,6 @@ hearth_status hearth_ray_fan_cast(const hearth_ray_fan *f, const hearth_mesh *m,
   const float r00 = (float)R[0], r01 = (float)R[1], r02 = (float)R[2], r10 = (float)R[3], r11 = (float)R[4],
               r12 = (float)R[5], r20 = (float)R[6], r21 = (float)R[7], r22 = (float)R[8];
   const float t0 = (float)t[0], t1 = (float)t[1], t2 = (float)t[2];
-  const float k1 = (float)cam->dist[0], k2 = (float)cam->dist[1], p1 = (float)cam->dist[2],
-              p2 = (float)cam->dist[3], k3 = (float)cam->dist[4];
-  const float fx = (float)cam->fx, fy = (float)cam->fy, cx = (float)cam->cx, cy = (float)cam->cy;
   int behind = 0;
   const float *restrict pos = m->positions;
   for (size_t i = 0; i < m->n_vertices; i++) {
@@ -229,11 +226,9 @@ hearth_status hearth_ray_fan_cast(const hearth_ray_fan *f, const hearth_mesh *m,
     float iz = 1.0f / z;
     x *= iz;
     y *= iz;
-    float x2 = x * x, y2 = y * y, xy = x * y, r2 = x2 + y2;
-    float radial = 1.0f + r2 * (k1 + r2 * (k2 + r2 * k3));
-    float xd = x * radial + 2.0f * p1 * xy + p2 * (r2 + 2.0f * x2);
-    float yd = y * radial + p1 * (r2 + 2.0f * y2) + 2.0f * p2 * xy;
-    V[i] = (fan_vertex){x, y, fx * xd + cx, fy * yd + cy};
+    double xd, yd;
+    hearth_distort_xy(cam->dist, x, y, &xd, &yd);
+    V[i] = (fan_vertex){x, y, (float)(cam->fx * xd + cam->cx), (float)(cam->fy * yd + cam->cy)};
     IZ[i] = iz;
   }
   if (behind)
