@@ -14,6 +14,7 @@
 #include "hearth/geom.h"
 #include "hearth/mesh.h"
 #include "test_util.h"
+#include "mesh/cube_mesh.h"
 
 /* camera at c looking at the origin, world up +z (x right, y down) */
 static hearth_rigid look_at(double cx, double cy, double cz) {
@@ -64,24 +65,6 @@ static void make_torus(hearth_mesh *m, double a, double b, size_t nu, size_t nv)
       ix[3] = p00; ix[4] = p11; ix[5] = p01;
       t += 2;
     }
-}
-
-/* cube [-h, h]^3, outward counter-clockwise faces */
-static void make_cube(hearth_mesh *m, float h) {
-  hearth_err err;
-  CHECK_OK(hearth_mesh_alloc(m, 8, 12, 0, &err), &err);
-  for (int i = 0; i < 8; i++) {
-    m->positions[i * 3 + 0] = (i & 1) ? h : -h;
-    m->positions[i * 3 + 1] = (i & 2) ? h : -h;
-    m->positions[i * 3 + 2] = (i & 4) ? h : -h;
-  }
-  static const uint32_t quads[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4},
-                                       {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
-  for (int f = 0; f < 6; f++) {
-    uint32_t *t = m->indices + f * 6;
-    t[0] = quads[f][0]; t[1] = quads[f][1]; t[2] = quads[f][2];
-    t[3] = quads[f][0]; t[4] = quads[f][2]; t[5] = quads[f][3];
-  }
 }
 
 /* the reference: Embree's nearest hit, continued past back faces */
@@ -200,7 +183,7 @@ int main(void) {
      near enough that it fills the image and its edges curve */
   {
     hearth_mesh cube = {0};
-    make_cube(&cube, 0.5f);
+    make_cube(&cube);
     compare_stats s = {0};
     hearth_camera strong = lens;
     strong.dist[0] = -0.45;
