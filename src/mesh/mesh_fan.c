@@ -215,8 +215,15 @@ hearth_status hearth_ray_fan_cast(const hearth_ray_fan *f, const hearth_mesh *m,
   const float r00 = (float)R[0], r01 = (float)R[1], r02 = (float)R[2], r10 = (float)R[3], r11 = (float)R[4],
               r12 = (float)R[5], r20 = (float)R[6], r21 = (float)R[7], r22 = (float)R[8];
   const float t0 = (float)t[0], t1 = (float)t[1], t2 = (float)t[2];
+  /* the pixels in float: their rounding (about 1e-7 relative, some 1e-4
+     pixel) is far inside the slack */
+  const float kd[5] = {(float)cam->dist[0], (float)cam->dist[1], (float)cam->dist[2], (float)cam->dist[3],
+                       (float)cam->dist[4]};
+  const float ffx = (float)cam->fx, ffy = (float)cam->fy, fcx = (float)cam->cx, fcy = (float)cam->cy;
   int behind = 0;
   const float *restrict pos = m->positions;
+  fan_vertex *restrict VV = V;
+  float *restrict IZZ = IZ;
   for (size_t i = 0; i < m->n_vertices; i++) {
     float dx = pos[3 * i] - t0, dy = pos[3 * i + 1] - t1, dz = pos[3 * i + 2] - t2;
     float x = r00 * dx + r10 * dy + r20 * dz;
@@ -226,10 +233,10 @@ hearth_status hearth_ray_fan_cast(const hearth_ray_fan *f, const hearth_mesh *m,
     float iz = 1.0f / z;
     x *= iz;
     y *= iz;
-    double xd, yd;
-    hearth_distort_xy(cam->dist, x, y, &xd, &yd);
-    V[i] = (fan_vertex){x, y, (float)(cam->fx * xd + cam->cx), (float)(cam->fy * yd + cam->cy)};
-    IZ[i] = iz;
+    float xd, yd;
+    hearth_distort_xyf(kd, x, y, &xd, &yd);
+    VV[i] = (fan_vertex){x, y, ffx * xd + fcx, ffy * yd + fcy};
+    IZZ[i] = iz;
   }
   if (behind)
     for (size_t i = 0; i < m->n_vertices; i++) {
