@@ -473,73 +473,85 @@ static int fill_one_island(const fill_ctx *c, uint32_t isl) {
   size_t R = c->R, W = (size_t)(b->x1 - b->x0 + 1), H = (size_t)(b->y1 - b->y0 + 1);
   const uint32_t *iot = c->island_of_texel;
   uint8_t *mask = c->mask;
-  int32_t *srow = hearth_alloc_array(W * H, sizeof *srow); /* nearest seed row in the column, -1 none */
-  int32_t *cur = hearth_alloc_array(W, sizeof *cur);
+  /* nearest seed row in the column, -1 none (rows < R <= 16384 fit) */
+  int16_t *srow = hearth_alloc_array(W * H, sizeof *srow);
+  int16_t *cur = hearth_alloc_array(W, sizeof *cur);
   int32_t *env = hearth_alloc_array(W, sizeof *env);       /* columns on the lower envelope */
-  double *z = hearth_alloc_array(W + 1, sizeof *z);        /* where each takes over */
-  if (!srow || !cur || !env || !z) {
+  /* where each takes over from the one before: x = zn / zd exactly (zd > 0;
+     the first has none) */
+  int64_t *zn = hearth_alloc_array(W + 1, sizeof *zn), *zd = hearth_alloc_array(W + 1, sizeof *zd);
+  if (!srow || !cur || !env || !zn || !zd) {
     free(srow);
     free(cur);
     free(env);
-    free(z);
+    free(zn);
+    free(zd);
     return 0;
   }
-#define IS_SEED(q) (iot[q] == isl && mask[q] == HEARTH_TEXEL_OBSERVED)
-  /* pass 1: the nearest seed row above (downward sweep), then below */
+  /* pass 1: the nearest seed row above (downward sweep), then below; a
+     texel is a seed exactly where the downward sweep put its own row */
   for (size_t x = 0; x < W; x++) cur[x] = -1;
   for (size_t r = 0; r < H; r++) {
     const size_t q0 = ((size_t)b->y0 + r) * R + (size_t)b->x0;
-    int32_t *row = srow + r * W;
+    int16_t *row = srow + r * W;
     for (size_t x = 0; x < W; x++) {
-      if (IS_SEED(q0 + x)) cur[x] = (int32_t)r;
+      int seed = iot[q0 + x] == isl && mask[q0 + x] == HEARTH_TEXEL_OBSERVED;
+      cur[x] = seed ? (int16_t)r : cur[x];
       row[x] = cur[x];
     }
   }
   for (size_t x = 0; x < W; x++) cur[x] = -1;
   for (size_t r = H; r-- > 0;) {
-    const size_t q0 = ((size_t)b->y0 + r) * R + (size_t)b->x0;
-    int32_t *row = srow + r * W;
+    int16_t *row = srow + r * W;
+    const int ir = (int)r;
     for (size_t x = 0; x < W; x++) {
-      if (IS_SEED(q0 + x)) cur[x] = (int32_t)r;
-      int32_t up = row[x], dn = cur[x];
-      if (dn >= 0 && (up < 0 || dn - (int32_t)r < (int32_t)r - up)) row[x] = dn;
+      int up = row[x];
+      cur[x] = up == ir ? (int16_t)ir : cur[x];
+      int dn = cur[x];
+      row[x] = dn >= 0 && (up < 0 || dn - ir < ir - up) ? (int16_t)dn : (int16_t)up;
     }
   }
   /* pass 2: along each row, the lower envelope of the columns' parabolas */
   for (size_t r = 0; r < H; r++) {
     const size_t q0 = ((size_t)b->y0 + r) * R + (size_t)b->x0;
-    const int32_t *row = srow + r * W;
+    const int16_t *row = srow + r * W;
+    /* parabola of column c: (x - c)^2 + dy_c^2; the one of column x takes
+       over from v's at (f_x - f_v) / (2 (x - v)) with f_c = c^2 + dy_c^2.
+       Kept as exact integer fractions: the comparisons need no division */
     long k = -1;
+    const int64_t ir = (int64_t)r;
     for (size_t x = 0; x < W; x++) {
       if (row[x] < 0) continue;
-      double dy = (double)row[x] - (double)r, fx = dy * dy + (double)x * (double)x;
-      double sx = -INFINITY;
+      const int64_t ix = (int64_t)x, dy = (int64_t)row[x] - ir, fx = dy * dy + ix * ix;
+      int64_t num = 0, den = 1;
       while (k >= 0) {
-        double v = (double)env[k], dv = (double)row[env[k]] - (double)r;
-        sx = (fx - (dv * dv + v * v)) / (2.0 * ((double)x - v));
-        if (sx > z[k]) break;
+        const int64_t v = env[k], dv = (int64_t)row[v] - ir;
+        num = fx - (dv * dv + v * v);
+        den = 2 * (ix - v);
+        /* the first parabola reigns from -infinity: never popped */
+        if (k == 0 || num * zd[k] > zn[k] * den) break;
         k--;
       }
-      if (k < 0) sx = -INFINITY;
       env[++k] = (int32_t)x;
-      z[k] = sx;
+      zn[k] = num;
+      zd[k] = den;
     }
     if (k < 0) continue; /* no seed in any column: only possible when the island has none */
     long j = 0;
     for (size_t x = 0; x < W; x++) {
       size_t q = q0 + x;
       if (iot[q] != isl || mask[q] == HEARTH_TEXEL_OBSERVED) continue;
-      while (j < k && z[j + 1] <= (double)x) j++;
+      while (j < k && zn[j + 1] <= (int64_t)x * zd[j + 1]) j++;
       size_t sc = (size_t)env[j], seed = ((size_t)b->y0 + (size_t)row[sc]) * R + (size_t)b->x0 + sc;
       for (size_t ch = 0; ch < c->C; ch++) c->filled[q * c->C + ch] = c->observed[seed * c->C + ch];
       mask[q] = HEARTH_TEXEL_FILLED; /* read again only as "not observed" */
     }
   }
-#undef IS_SEED
   free(srow);
   free(cur);
   free(env);
-  free(z);
+  free(zn);
+  free(zd);
   return 1;
 }
 
