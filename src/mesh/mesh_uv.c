@@ -155,6 +155,9 @@ typedef struct raster_ctx {
   size_t R;
   size_t rows_per_band;
   int32_t *bbox; /* per triangle: col0 col1 row0 row1 (inclusive), col0 > col1 if empty */
+  /* the triangles that reach band b: band_tris[band_start[b] .. band_start[b + 1]), in index order */
+  const size_t *band_start;
+  const uint32_t *band_tris;
   uint32_t *tri_of_texel;
   float *bary;
 } raster_ctx;
@@ -165,7 +168,7 @@ typedef struct raster_ctx {
  * on a shared edge falls through the crack. Split in two: the endpoint
  * order (and sign) fixed once per edge, then evaluated per point. */
 typedef struct edge_c {
-  double ax, ay, dx, dy, sign;
+  double ax, ay, dx, dy; /* dx, dy carry the sign */
 } edge_c;
 static void edge_setup(double ax, double ay, double bx, double by, edge_c *e) {
   int swap = (ax > bx) || (ax == bx && ay > by);
@@ -176,11 +179,12 @@ static void edge_setup(double ax, double ay, double bx, double by, edge_c *e) {
     bx = tx;
     by = ty;
   }
-  e->ax = ax, e->ay = ay, e->dx = bx - ax, e->dy = by - ay, e->sign = swap ? -1.0 : 1.0;
+  /* negating dx and dy negates the value exactly: (-a) b - (-c) d = -(a b - c d)
+     in floating point too */
+  e->ax = ax, e->ay = ay, e->dx = swap ? ax - bx : bx - ax, e->dy = swap ? ay - by : by - ay;
 }
 static inline double edge_eval(const edge_c *e, double px, double py) {
-  double v = e->dx * (py - e->ay) - e->dy * (px - e->ax);
-  return e->sign < 0 ? -v : v;
+  return e->dx * (py - e->ay) - e->dy * (px - e->ax);
 }
 
 /* texel coordinates: texel (col, row) has its centre at integer (col, row) */
@@ -192,6 +196,15 @@ static void tri_uv(const hearth_mesh *m, size_t t, size_t R, double x[3], double
   }
 }
 
+static inline double min3d(double a, double b, double c) {
+  double m = a < b ? a : b;
+  return m < c ? m : c;
+}
+static inline double max3d(double a, double b, double c) {
+  double m = a > b ? a : b;
+  return m > c ? m : c;
+}
+
 /* texel-centre bounding boxes of triangles [t0, t1), clipped to the map
    (x0 > x1 when a triangle covers no texel centre) */
 static void bbox_range(void *vctx, size_t t0, size_t t1, int thread_index) {
@@ -201,10 +214,14 @@ static void bbox_range(void *vctx, size_t t0, size_t t1, int thread_index) {
   for (size_t t = t0; t < t1; t++) {
     double x[3], y[3];
     tri_uv(c->m, t, c->R, x, y);
-    double xl = fmin(x[0], fmin(x[1], x[2])), xh = fmax(x[0], fmax(x[1], x[2]));
-    double yl = fmin(y[0], fmin(y[1], y[2])), yh = fmax(y[0], fmax(y[1], y[2]));
-    double c0 = fmax(ceil(xl), 0.0), c1 = fmin(floor(xh), R - 1.0);
-    double r0 = fmax(ceil(yl), 0.0), r1 = fmin(floor(yh), R - 1.0);
+    /* (finite: the mesh was validated) */
+    double xl = min3d(x[0], x[1], x[2]), xh = max3d(x[0], x[1], x[2]);
+    double yl = min3d(y[0], y[1], y[2]), yh = max3d(y[0], y[1], y[2]);
+    double c0 = ceil(xl), c1 = floor(xh), r0 = ceil(yl), r1 = floor(yh);
+    c0 = c0 > 0.0 ? c0 : 0.0;
+    r0 = r0 > 0.0 ? r0 : 0.0;
+    c1 = c1 < R - 1.0 ? c1 : R - 1.0;
+    r1 = r1 < R - 1.0 ? r1 : R - 1.0;
     int32_t *bb = c->bbox + t * 4;
     if (c0 > c1 || r0 > r1) {
       bb[0] = 1;
@@ -232,10 +249,11 @@ static void raster_band(void *vctx, size_t band0, size_t band1, int thread_index
     /* the band's texels start empty */
     for (size_t q = (size_t)r_lo * R; q < (size_t)(r_hi + 1) * R; q++) c->tri_of_texel[q] = UINT32_MAX;
     if (c->bary) memset(c->bary + (size_t)r_lo * R * 3, 0, (size_t)(r_hi + 1 - r_lo) * R * 3 * sizeof(float));
-    /* triangles in index order; a texel keeps the first (lowest) one */
-    for (size_t t = 0; t < m->n_triangles; t++) {
+    /* the band's triangles in index order; a texel keeps the first
+       (lowest) one */
+    for (size_t k = c->band_start[band]; k < c->band_start[band + 1]; k++) {
+      const size_t t = c->band_tris[k];
       const int32_t *bb = c->bbox + t * 4;
-      if (bb[0] > bb[1]) continue;
       int64_t row0 = bb[2] > r_lo ? bb[2] : r_lo, row1 = bb[3] < r_hi ? bb[3] : r_hi;
       if (row0 > row1) continue;
       double x[3], y[3];
@@ -248,18 +266,27 @@ static void raster_band(void *vctx, size_t band0, size_t band1, int thread_index
       edge_setup(x[0], y[0], x[1], y[1], &e[2]);
       double area = edge_eval(&e[2], x[2], y[2]);
       if (area == 0.0 || !isfinite(area)) continue;
-      double sgn = area > 0.0 ? 1.0 : -1.0, inv = 1.0 / area;
+      if (area < 0.0) {
+        /* clockwise: every edge turned round (exactly) so that inside is
+           positive; the barycentrics w_k / area are unchanged */
+        for (int j = 0; j < 3; j++) {
+          e[j].dx = -e[j].dx;
+          e[j].dy = -e[j].dy;
+        }
+        area = -area;
+      }
+      const double inv = 1.0 / area;
       for (int64_t row = row0; row <= row1; row++) {
         double py = (double)row;
         for (int64_t col = bb[0]; col <= bb[1]; col++) {
           size_t idx = (size_t)row * R + (size_t)col;
           if (c->tri_of_texel[idx] != UINT32_MAX) continue;
           double px = (double)col;
-          /* w_k: edge opposite vertex k, positive inside for either winding */
+          /* w_k: edge opposite vertex k, positive inside */
           double w0 = edge_eval(&e[0], px, py);
           double w1 = edge_eval(&e[1], px, py);
           double w2 = edge_eval(&e[2], px, py);
-          if (w0 * sgn < 0.0 || w1 * sgn < 0.0 || w2 * sgn < 0.0) continue;
+          if (w0 < 0.0 || w1 < 0.0 || w2 < 0.0) continue;
           c->tri_of_texel[idx] = (uint32_t)t;
           if (c->bary) {
             float *b = c->bary + idx * 3;
@@ -290,16 +317,50 @@ hearth_status hearth_uv_rasterize(const hearth_mesh *m, size_t R, uint32_t *tri_
   int32_t *bbox = hearth_alloc_array(nb4 ? nb4 : 1, sizeof *bbox);
   if (!bbox) return hearth_err_set(err, HEARTH_E_NOMEM, "UV rasterisation: out of memory");
   /* texel-centre bounding boxes, clipped to the map, in parallel chunks */
-  raster_ctx c = {m, R, 0, bbox, tri_of_texel, bary};
+  raster_ctx c = {m, R, 0, bbox, NULL, NULL, tri_of_texel, bary};
   int nth = hearth_default_threads();
   hearth_parallel_chunks(m->n_triangles, 8192, nth, bbox_range, &c);
   /* row bands in parallel; within a band triangles go in index order, so
    * the result does not depend on the thread count */
   size_t nbands = (size_t)nth * 8;
   if (nbands > R) nbands = R;
-  c.rows_per_band = (R + nbands - 1) / nbands;
-  nbands = (R + c.rows_per_band - 1) / c.rows_per_band;
+  size_t rpb = (R + nbands - 1) / nbands;
+  c.rows_per_band = rpb;
+  nbands = (R + rpb - 1) / rpb;
+  /* each band's triangles (a counting sort, index order kept) */
+  size_t *band_start = calloc(nbands + 1, sizeof *band_start), n_entries = 0;
+  if (!band_start) {
+    free(bbox);
+    return hearth_err_set(err, HEARTH_E_NOMEM, "UV rasterisation: out of memory");
+  }
+  for (size_t t = 0; t < m->n_triangles; t++) {
+    const int32_t *bb = bbox + t * 4;
+    if (bb[0] > bb[1]) continue;
+    for (size_t b = (size_t)bb[2] / rpb; b <= (size_t)bb[3] / rpb; b++) band_start[b + 1]++;
+  }
+  for (size_t b = 0; b < nbands; b++) band_start[b + 1] += band_start[b];
+  n_entries = band_start[nbands];
+  uint32_t *band_tris = hearth_alloc_array(n_entries ? n_entries : 1, sizeof *band_tris);
+  size_t *fill = hearth_alloc_array(nbands, sizeof *fill);
+  if (!band_tris || !fill) {
+    free(bbox);
+    free(band_start);
+    free(band_tris);
+    free(fill);
+    return hearth_err_set(err, HEARTH_E_NOMEM, "UV rasterisation: out of memory");
+  }
+  memcpy(fill, band_start, nbands * sizeof *fill);
+  for (size_t t = 0; t < m->n_triangles; t++) {
+    const int32_t *bb = bbox + t * 4;
+    if (bb[0] > bb[1]) continue;
+    for (size_t b = (size_t)bb[2] / rpb; b <= (size_t)bb[3] / rpb; b++) band_tris[fill[b]++] = (uint32_t)t;
+  }
+  free(fill);
+  c.band_start = band_start;
+  c.band_tris = band_tris;
   hearth_parallel_chunks(nbands, 1, nth, raster_band, &c);
   free(bbox);
+  free(band_start);
+  free(band_tris);
   return HEARTH_OK;
 }
