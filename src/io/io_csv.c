@@ -450,12 +450,13 @@ hearth_status hearth_thermal_parse_csv(const char *text, size_t len, const char 
     goto done;
   }
 
-  st = hearth_image_alloc(out, n_exp, nrows, 1, HEARTH_PIX_F32, err);
-  if (st) {
-    hearth_err_prefix(err, "%s: ", name);
-    goto done;
-  }
-  memcpy(out->data, B.vals + skipped_vals, n_exp * nrows * sizeof(float));
+  /* the values become the image's: no second buffer, no copy */
+  size_t n_vals = n_exp * nrows;
+  if (skipped_vals) memmove(B.vals, B.vals + skipped_vals, n_vals * sizeof(float));
+  float *data = realloc(B.vals, n_vals * sizeof(float));
+  if (data) B.vals = data; /* a failed shrink keeps the larger block */
+  *out = (hearth_image){n_exp, nrows, 1, HEARTH_PIX_F32, B.vals};
+  B.vals = NULL;
 
 done:
   free(B.vals);
