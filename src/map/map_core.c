@@ -863,15 +863,15 @@ struct hearth_map_layout {
 
 typedef struct layout_pass {
   hearth_map_layout *l;
-  const uint32_t *tri_of_texel;
 } layout_pass;
 
+/* the rasterised triangle of each texel replaced by its island, in place */
 static void texel_islands(void *ctx, size_t b, size_t e, int t) {
   const layout_pass *lp = ctx;
   hearth_map_layout *l = lp->l;
   (void)t;
   for (size_t q = b * l->R; q < e * l->R; q++) {
-    uint32_t tq = lp->tri_of_texel[q];
+    uint32_t tq = l->island_of_texel[q];
     l->island_of_texel[q] = tq == UINT32_MAX ? UINT32_MAX : l->island_of_tri[tq];
   }
 }
@@ -926,7 +926,6 @@ hearth_status hearth_map_layout_new(const hearth_mesh *mesh, const hearth_camera
   l->cam = *cam;
   l->R = R;
   l->stride = (size_t)opts.pixel_stride;
-  uint32_t *tri_of_texel = NULL;
   size_t N = R * R;
   grid_build gb = {0};
   pthread_t gb_tid;
@@ -957,14 +956,14 @@ hearth_status hearth_map_layout_new(const hearth_mesh *mesh, const hearth_camera
                     mesh, l->island_of_tri, 0, HEARTH_OK, {0}};
   gb_started = pthread_create(&gb_tid, NULL, grid_build_run, &gb) == 0;
   if (!gb_started) grid_build_run(&gb); /* no thread: make it here */
-  tri_of_texel = hearth_alloc_array(N, sizeof *tri_of_texel);
   l->tri_normal = hearth_alloc_array(mesh->n_triangles, 3 * sizeof *l->tri_normal);
   l->island_of_texel = hearth_alloc_array(N, sizeof *l->island_of_texel);
-  if (!tri_of_texel || !l->island_of_tri || !l->tri_normal || !l->island_of_texel) {
+  if (!l->island_of_tri || !l->tri_normal || !l->island_of_texel) {
     s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory for R=%zu", R);
     goto done;
   }
-  if ((s = hearth_uv_rasterize(mesh, R, tri_of_texel, NULL, err))) goto done;
+  /* each texel's triangle, made its island below */
+  if ((s = hearth_uv_rasterize(mesh, R, l->island_of_texel, NULL, err))) goto done;
   if (gb_started) {
     pthread_join(gb_tid, NULL);
     gb_started = 0;
@@ -977,7 +976,7 @@ hearth_status hearth_map_layout_new(const hearth_mesh *mesh, const hearth_camera
   l->n_islands = gb.n_islands;
   {
     /* texels' islands and triangles' normals, in parallel chunks */
-    layout_pass lp = {l, tri_of_texel};
+    layout_pass lp = {l};
     hearth_parallel_chunks(R, 32, 0, texel_islands, &lp);
     hearth_parallel_chunks(mesh->n_triangles, 8192, 0, tri_normals, &lp);
   }
@@ -1001,7 +1000,6 @@ hearth_status hearth_map_layout_new(const hearth_mesh *mesh, const hearth_camera
 done:
   if (gb_started) pthread_join(gb_tid, NULL);
   hearth_ray_fan_free(gb.fan);
-  free(tri_of_texel);
   if (s) hearth_map_layout_free(l);
   else *out = l;
   return s;
