@@ -319,8 +319,47 @@ hearth_status hearth_thermal_parse_csv(const char *text, size_t len, const char 
     if (b > a && s[b - 1] == '\r') b--;
     csv_row r = {line_no, a, b, 0, 0, 1};
     size_t p = a;
-    int first_numeric = 0;
-    for (;;) {
+    int first_numeric = 0, line_done = 0;
+    /* fastest path, for the usual file: a run of bare decimals ("-12.34")
+     * and separators on a line that a newline ends (s[b] is '\r' or '\n',
+     * so every digit scan stops there without a bound check). The first
+     * cell that is anything else, or out of range, goes to the loop below
+     * from where this one stopped; the values are the same either way. */
+    if (b < len && p < b) {
+      for (;;) {
+        const char *c = s + p;
+        int neg = 0;
+        if (*c == '-' || *c == '+') neg = *c++ == '-';
+        const char *d0 = c;
+        uint64_t mant = 0;
+        while ((unsigned)(*c - '0') < 10) mant = mant * 10 + (uint64_t)(*c++ - '0');
+        int nd = (int)(c - d0), frac = 0;
+        if (*c == '.') {
+          const char *f0 = ++c;
+          while ((unsigned)(*c - '0') < 10) mant = mant * 10 + (uint64_t)(*c++ - '0');
+          frac = (int)(c - f0);
+          nd += frac;
+        }
+        size_t q = (size_t)(c - s);
+        if (!(nd > 0 && nd <= 15 && (q == b || *c == sep))) break;
+        double v = plain_value(mant, frac, neg);
+        if (!(v >= HEARTH_THERMAL_MIN_C && v <= HEARTH_THERMAL_MAX_C)) break;
+        if (B.nvals == B.capvals && !grow((void **)&B.vals, &B.capvals, B.nvals + 1, sizeof(float))) {
+          st = hearth_err_set(err, HEARTH_E_NOMEM, "%s: out of memory", name);
+          goto done;
+        }
+        B.vals[B.nvals++] = (float)v;
+        if (r.ncells == 0) first_numeric = 1;
+        r.nnum++;
+        r.ncells++;
+        p = q;
+        if (p >= b || ++p >= b) { /* the line's end, or one trailing separator */
+          line_done = 1;
+          break;
+        }
+      }
+    }
+    for (; !line_done;) {
       double v = 0;
       int kind;
       /* fast path: a bare decimal ending at a separator or the line end */
