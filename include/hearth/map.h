@@ -51,6 +51,8 @@ typedef struct hearth_map_opts {
   int threads;            /* 0 = hearth_default_threads() */
   int trace_rays;         /* 1: trace every view's rays (Embree) even where the fan could
                              rasterise it; default 0 (the same hits up to float rounding) */
+  int skip_best_cos;      /* 1: leave the result's best_cos NULL, saving an R*R map per
+                             worker; default 0 */
 } hearth_map_opts;
 void hearth_map_opts_default(hearth_map_opts *o);
 
@@ -67,7 +69,8 @@ typedef struct hearth_map_result {
   float *observed;            /* R*R*channels; NaN where mask != OBSERVED */
   float *filled;              /* R*R*channels; NaN where mask not in {OBSERVED, FILLED} */
   uint8_t *mask;              /* R*R, HEARTH_TEXEL_* */
-  float *best_cos;            /* R*R: largest viewing cosine among observing views (0 if none) */
+  float *best_cos;            /* R*R: largest viewing cosine among observing views (0 if none);
+                                 NULL with opts.skip_best_cos */
   uint32_t *view_hits;        /* n_views: pixels of each view that landed on the surface */
   size_t n_views;
   size_t n_surface, n_observed, n_filled, n_unobserved;

@@ -33,6 +33,20 @@ typedef struct touch {
 #define REC_WORDS(C) (2 + (size_t)(C))
 #define BAND_TEXELS 16384 /* texels per band of the fusion phase (whole rows) */
 
+/* a float as an unsigned integer of the same order (-0 below +0, NaN not
+ * used), never 0 for a float: a zeroed map holds "none" below every value */
+static inline uint32_t max_code(float f) {
+  uint32_t b;
+  memcpy(&b, &f, sizeof b);
+  return b & 0x80000000u ? ~b : b | 0x80000000u;
+}
+static inline float max_decode(uint32_t c) {
+  uint32_t b = c & 0x80000000u ? c & 0x7fffffffu : ~c;
+  float f;
+  memcpy(&f, &b, sizeof f);
+  return f;
+}
+
 void hearth_map_opts_default(hearth_map_opts *o) {
   memset(o, 0, sizeof *o);
   o->resolution = 1024;
@@ -103,6 +117,14 @@ typedef struct map_ctx {
   size_t *n_rec;
   uint32_t **scratch_q; /* per thread */
   float **scratch_d;
+  /* max fusion folds each view into per-worker maps instead (the maximum
+   * does not depend on the order): the view means' maximum per texel and
+   * channel as order-preserving codes (see max_code; 0 for none) and the
+   * best viewing cosine (0 for none); worker 0's are the result's own
+   * observed and best_cos arrays */
+  int dense;
+  uint32_t **max_code;
+  float **max_cos;
   splat **splats; /* per thread: n_pix */
   uint8_t **sil; /* per thread: n_pix silhouette flags */
   float *hit_t; /* per thread: n_pix */
@@ -125,13 +147,12 @@ typedef struct pix_box {
   size_t x0, x1, y0, y1; /* inclusive; x0 > x1 when empty */
 } pix_box;
 
-/* record a hit (or a miss) of grid pixel p */
-static void keep_hit(map_ctx *m, int t, size_t p, const hearth_ray_hit *h, pix_box *box) {
+/* record a hit (or a miss) of grid pixel p = (px, py) */
+static void keep_hit(map_ctx *m, int t, size_t p, size_t px, size_t py, const hearth_ray_hit *h, pix_box *box) {
   size_t n = m->n_pix;
   float *ht = m->hit_t + (size_t)t * n, *b1 = m->hit_b1 + (size_t)t * n, *b2 = m->hit_b2 + (size_t)t * n;
   uint32_t *tri = m->hit_tri + (size_t)t * n;
   if (h->prim != UINT32_MAX && h->front) {
-    size_t px = p % m->pix_w, py = p / m->pix_w;
     if (px < box->x0) box->x0 = px;
     if (px > box->x1) box->x1 = px;
     if (py < box->y0) box->y0 = py;
@@ -172,7 +193,7 @@ static void cast_view(map_ctx *m, size_t v, int t, pix_box *box) {
       for (size_t x = fb[0] >= 2 ? fb[0] - 2 : 0; x <= fb[1] + 2 && x < W; x++) {
         size_t p = y * W + x;
         if (x >= fb[0] && x <= fb[1] && y >= fb[2] && y <= fb[3]) {
-          keep_hit(m, t, p, &hits[p], box);
+          keep_hit(m, t, p, x, y, &hits[p], box);
         } else {
           ht[p] = INFINITY;
           tri[p] = UINT32_MAX;
@@ -214,7 +235,7 @@ static void cast_view(map_ctx *m, size_t v, int t, pix_box *box) {
       double tn = (double)h.t * (1.0 + 1e-6) + 1e-7;
       if (!hearth_raycast(m->rc, o, d, tn, INFINITY, &h)) h.prim = UINT32_MAX;
     }
-    keep_hit(m, t, p, &h, box);
+    keep_hit(m, t, p, p % m->pix_w, p / m->pix_w, &h, box);
   }
 }
 
@@ -370,6 +391,8 @@ static void process_view(map_ctx *m, size_t v, int t) {
   int fusion = m->opts->fusion;
   uint32_t *rq = m->scratch_q[t];
   float *rd = m->scratch_d[t];
+  uint32_t *mc = m->dense ? m->max_code[t] : NULL;
+  float *mcos = m->dense && m->max_cos ? m->max_cos[t] : NULL;
   for (size_t i = 0; i < n_tc;) {
     uint32_t q = tc[i].q;
     size_t j = i;
@@ -389,6 +412,15 @@ static void process_view(map_ctx *m, size_t v, int t) {
     }
     i = j;
     if (!any) continue;
+    if (mc) {
+      /* + 0.0f: a negative zero becomes +0, so equal means give one code */
+      if (mcos && best_cos > mcos[q]) mcos[q] = best_cos;
+      for (int c = 0; c < C; c++) {
+        uint32_t code = max_code(sum[c] / wsum + 0.0f);
+        if (code > mc[(size_t)q * (size_t)C + (size_t)c]) mc[(size_t)q * (size_t)C + (size_t)c] = code;
+      }
+      continue;
+    }
     float *d = rd + n_touched * RW;
     rq[n_touched++] = q;
     d[0] = wsum;
@@ -397,6 +429,7 @@ static void process_view(map_ctx *m, size_t v, int t) {
        maximum's bits depend on which view came first */
     for (int c = 0; c < C; c++) d[2 + c] = fusion == HEARTH_FUSE_MEAN ? sum[c] : sum[c] / wsum + 0.0f;
   }
+  if (mc) return; /* folded into the worker's maps: no records */
   m->n_rec[v] = n_touched;
   m->rec_q[v] = hearth_alloc_array(n_touched ? n_touched : 1, sizeof *rq);
   m->rec_d[v] = hearth_alloc_array(n_touched ? n_touched : 1, RW * sizeof *rd);
@@ -406,6 +439,17 @@ static void process_view(map_ctx *m, size_t v, int t) {
   }
   memcpy(m->rec_q[v], rq, n_touched * sizeof *rq);
   memcpy(m->rec_d[v], rd, n_touched * RW * sizeof *rd);
+}
+
+/* rows [b, e) of every worker's maxima maps: zero (no maximum) */
+static void zero_maps(void *ctx, size_t b, size_t e, int t) {
+  map_ctx *m = ctx;
+  const size_t C = (size_t)m->C, q0 = b * m->R, nq = (e - b) * m->R;
+  (void)t;
+  for (int w = 0; w < m->n_threads; w++) {
+    memset(m->max_code[w] + q0 * C, 0, nq * C * sizeof(uint32_t));
+    if (m->max_cos) memset(m->max_cos[w] + q0, 0, nq * sizeof(float));
+  }
 }
 
 /* views [b, e) on worker t; views are handed out one at a time to whichever
@@ -654,7 +698,7 @@ static void fuse_bands(void *ctx, size_t b, size_t e, int t) {
   double *acc = NULL; /* mean: sums per channel and weight, per texel of a band */
   uint32_t *cnt = NULL; /* robust: records per texel of a band, then offsets */
   vw *all = NULL, *tmp = NULL;
-  size_t all_cap = 0;
+  size_t all_cap = 0, nv_band = nv; /* views with records */
   if (fusion == HEARTH_FUSE_MEAN) acc = hearth_alloc_array(band, (C + 1) * sizeof *acc);
   if (fusion == HEARTH_FUSE_ROBUST) {
     cnt = hearth_alloc_array(band + 1, sizeof *cnt);
@@ -666,22 +710,45 @@ static void fuse_bands(void *ctx, size_t b, size_t e, int t) {
   }
   for (size_t bi = b; bi < e; bi++) {
     const size_t q0 = bi * band, q1 = q0 + band < N ? q0 + band : N, nq = q1 - q0;
-    for (size_t q = q0; q < q1; q++) {
-      out->best_cos[q] = 0.0f;
-      out->mask[q] = m->island_of_texel[q] == UINT32_MAX ? HEARTH_TEXEL_NONE : HEARTH_TEXEL_UNOBSERVED;
-      for (size_t c = 0; c < C; c++) out->observed[q * C + c] = -INFINITY;
+    if (m->dense) {
+      /* the workers' maxima, decoded (worker 0's codes are read from and
+         then overwritten by the values): -inf where none */
+      const uint32_t *code = m->max_code[0];
+      for (size_t q = q0; q < q1; q++) {
+        for (int w = 1; m->max_cos && w < m->n_threads; w++) {
+          const float cw = m->max_cos[w][q];
+          if (cw > out->best_cos[q]) out->best_cos[q] = cw;
+        }
+        out->mask[q] = m->island_of_texel[q] == UINT32_MAX ? HEARTH_TEXEL_NONE : HEARTH_TEXEL_UNOBSERVED;
+        for (size_t c = 0; c < C; c++) {
+          uint32_t k = code[q * C + c];
+          for (int w = 1; w < m->n_threads; w++) {
+            const uint32_t kw = m->max_code[w][q * C + c];
+            k = kw > k ? kw : k;
+          }
+          out->observed[q * C + c] = k ? max_decode(k) : -INFINITY;
+        }
+      }
+      nv_band = 0;
+    } else {
+      for (size_t q = q0; q < q1; q++) {
+        if (out->best_cos) out->best_cos[q] = 0.0f;
+        out->mask[q] = m->island_of_texel[q] == UINT32_MAX ? HEARTH_TEXEL_NONE : HEARTH_TEXEL_UNOBSERVED;
+        for (size_t c = 0; c < C; c++) out->observed[q * C + c] = -INFINITY;
+      }
+      nv_band = nv;
     }
     if (acc) memset(acc, 0, nq * (C + 1) * sizeof *acc);
     if (cnt) memset(cnt, 0, (nq + 1) * sizeof *cnt);
     size_t total = 0;
-    for (size_t v = 0; v < nv; v++) {
+    for (size_t v = 0; v < nv_band; v++) {
       const uint32_t *rq = m->rec_q[v];
       const float *rd = m->rec_d[v];
       size_t k = lower_bound_u32(rq, m->n_rec[v], (uint32_t)q0);
       for (; k < m->n_rec[v] && rq[k] < q1; k++) {
         const size_t q = rq[k];
         const float *d = rd + k * RW;
-        if (d[1] > out->best_cos[q]) out->best_cos[q] = d[1];
+        if (out->best_cos && d[1] > out->best_cos[q]) out->best_cos[q] = d[1];
         if (fusion == HEARTH_FUSE_MAX) {
           for (size_t c = 0; c < C; c++)
             if (d[2 + c] > out->observed[q * C + c]) out->observed[q * C + c] = d[2 + c];
@@ -728,17 +795,20 @@ static void fuse_bands(void *ctx, size_t b, size_t e, int t) {
         out->observed[q0 + i] = weighted_median(tmp, n);
       }
     }
-    /* the mask, and the islands' boxes for the fill */
+    /* the mask, the filled map as far as observed (NaN elsewhere: the fill
+       writes the texels it fills), and the islands' boxes for the fill */
     island_box *box = tp->parts + (size_t)t * ((size_t)m->n_islands + 1);
-    for (size_t q = q0; q < q1; q++) {
+    /* (the band is whole rows: x and y counted, not divided out of q) */
+    for (size_t q = q0, xq = 0, yq = q0 / R; q < q1; q++, xq = xq + 1 == R ? (yq++, 0) : xq + 1) {
       for (size_t c = 0; c < C; c++) {
         if (out->observed[q * C + c] > -INFINITY) out->mask[q] = HEARTH_TEXEL_OBSERVED;
         else out->observed[q * C + c] = NAN;
+        out->filled[q * C + c] = out->observed[q * C + c];
       }
       uint32_t isl = m->island_of_texel[q];
       if (isl == UINT32_MAX) continue;
       island_box *bx = &box[isl];
-      int32_t x = (int32_t)(q % R), y = (int32_t)(q / R);
+      int32_t x = (int32_t)xq, y = (int32_t)yq;
       if (x < bx->x0) bx->x0 = x;
       if (x > bx->x1) bx->x1 = x;
       if (y < bx->y0) bx->y0 = y;
@@ -754,25 +824,17 @@ done:
   free(tmp);
 }
 
-/* the filled map's other texels (the fill wrote the filled ones): the
- * observed values, NaN elsewhere; the counts */
-static void finish_rows(void *ctx, size_t b, size_t e, int t) {
+/* the texels of each kind, counted by rows */
+static void count_rows(void *ctx, size_t b, size_t e, int t) {
   const texel_pass *tp = ctx;
-  hearth_map_result *out = tp->out;
-  size_t R = tp->m->R, C = (size_t)tp->m->C, *cnt = tp->counts[t];
+  const uint8_t *mask = tp->out->mask;
+  size_t R = tp->m->R, *cnt = tp->counts[t];
   for (size_t q = b * R; q < e * R; q++) {
-    uint8_t mk = out->mask[q];
-    if (mk == HEARTH_TEXEL_FILLED) {
-      cnt[1]++;
-    } else if (mk == HEARTH_TEXEL_OBSERVED) {
-      cnt[0]++;
-      for (size_t c = 0; c < C; c++) out->filled[q * C + c] = out->observed[q * C + c];
-    } else {
-      for (size_t c = 0; c < C; c++) out->filled[q * C + c] = NAN;
-      if (mk == HEARTH_TEXEL_NONE) continue;
-      cnt[2]++;
-    }
-    cnt[3]++;
+    uint8_t mk = mask[q];
+    cnt[0] += mk == HEARTH_TEXEL_OBSERVED;
+    cnt[1] += mk == HEARTH_TEXEL_FILLED;
+    cnt[2] += mk == HEARTH_TEXEL_UNOBSERVED;
+    cnt[3] += mk != HEARTH_TEXEL_NONE;
   }
 }
 
@@ -826,6 +888,11 @@ static void free_scratch(map_ctx *m) {
     if (m->fan_scratch) free(m->fan_scratch[t]);
   }
   free(m->fan_scratch);
+  /* worker 0's maxima are the result's arrays */
+  for (int t = 1; m->max_code && t < m->n_threads; t++) free(m->max_code[t]);
+  for (int t = 1; m->max_cos && t < m->n_threads; t++) free(m->max_cos[t]);
+  free(m->max_code);
+  free(m->max_cos);
   free(m->touches);
   free(m->touches_tmp);
   for (int t = 0; m->scratch_q && t < m->n_threads; t++) free(m->scratch_q[t]);
@@ -1092,9 +1159,26 @@ hearth_status hearth_map_views_with_layout(const hearth_map_layout *l, const hea
   m.ray_dir = hearth_alloc_array(np * (size_t)nt, 3 * sizeof(float));
   m.hits = hearth_alloc_array(np * (size_t)nt, sizeof(hearth_ray_hit));
   m.view_hits = calloc(n_views ? n_views : 1, sizeof *m.view_hits);
+  m.dense = opts.fusion == HEARTH_FUSE_MAX;
+  const int want_cos = !opts.skip_best_cos;
+  m.max_code = calloc((size_t)nt, sizeof *m.max_code);
+  if (want_cos) m.max_cos = calloc((size_t)nt, sizeof *m.max_cos);
   int bad = !m.touches || !m.touches_tmp || !m.sil || !m.splats || !m.fan_scratch || !m.rec_q || !m.rec_d ||
             !m.n_rec || !m.scratch_q || !m.scratch_d || !m.hit_t || !m.hit_tri || !m.hit_b1 || !m.hit_b2 ||
-            !m.ray_org || !m.ray_dir || !m.hits || !m.view_hits;
+            !m.ray_org || !m.ray_dir || !m.hits || !m.view_hits || !m.max_code || (want_cos && !m.max_cos);
+  if (!bad && m.dense) {
+    /* the workers' maps, zeroed below (no maximum yet); worker 0's are the
+       result's arrays */
+    out->observed = hearth_alloc_array(N, (size_t)C * sizeof(float));
+    m.max_code[0] = (uint32_t *)(void *)out->observed;
+    if (want_cos) m.max_cos[0] = out->best_cos = hearth_alloc_array(N, sizeof(float));
+    for (int t = 1; t < nt; t++) {
+      m.max_code[t] = hearth_alloc_array(N, (size_t)C * sizeof(uint32_t));
+      if (want_cos) m.max_cos[t] = hearth_alloc_array(N, sizeof(float));
+    }
+    for (int t = 0; t < nt; t++) bad |= !m.max_code[t] || (want_cos && !m.max_cos[t]);
+    if (!bad) hearth_parallel_chunks(R, 32, nt, zero_maps, &m);
+  }
   for (int t = 0; !bad && t < nt; t++) {
     m.sil[t] = hearth_alloc_array(np, 1);
     m.splats[t] = hearth_alloc_array(np, sizeof(splat));
@@ -1104,9 +1188,12 @@ hearth_status hearth_map_views_with_layout(const hearth_map_layout *l, const hea
       m.fan_scratch[t] = calloc(1, hearth_ray_fan_scratch_size(l->fan, mesh->n_vertices));
       bad |= !m.fan_scratch[t];
     }
-    m.scratch_q[t] = hearth_alloc_array(np, 4 * sizeof(uint32_t));
-    m.scratch_d[t] = hearth_alloc_array(np, 4 * REC_WORDS(C) * sizeof(float));
-    bad |= !m.sil[t] || !m.splats[t] || !m.touches[t] || !m.touches_tmp[t] || !m.scratch_q[t] || !m.scratch_d[t];
+    if (!m.dense) {
+      m.scratch_q[t] = hearth_alloc_array(np, 4 * sizeof(uint32_t));
+      m.scratch_d[t] = hearth_alloc_array(np, 4 * REC_WORDS(C) * sizeof(float));
+      bad |= !m.scratch_q[t] || !m.scratch_d[t];
+    }
+    bad |= !m.sil[t] || !m.splats[t] || !m.touches[t] || !m.touches_tmp[t];
   }
   if (bad) {
     s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory for %d threads at R=%zu", nt, R);
@@ -1128,18 +1215,18 @@ hearth_status hearth_map_views_with_layout(const hearth_map_layout *l, const hea
   out->R = R;
   out->channels = C;
   out->n_views = n_views;
-  out->observed = hearth_alloc_array(N, (size_t)C * sizeof(float));
+  if (!m.dense) out->observed = hearth_alloc_array(N, (size_t)C * sizeof(float));
   out->filled = hearth_alloc_array(N, (size_t)C * sizeof(float));
   /* every texel of these is written by fuse_bands */
   out->mask = hearth_alloc_array(N, 1);
-  out->best_cos = hearth_alloc_array(N, sizeof(float));
+  if (!m.dense && want_cos) out->best_cos = hearth_alloc_array(N, sizeof(float));
   out->view_hits = m.view_hits;
   m.view_hits = NULL;
   /* per worker of the fusion: the islands' boxes, empty */
   const size_t nparts = (size_t)nt * ((size_t)l->n_islands + 1);
   parts = hearth_alloc_array(nparts, sizeof *parts);
   for (size_t i = 0; parts && i < nparts; i++) parts[i] = (island_box){INT32_MAX, INT32_MAX, -1, -1, 0, 0};
-  if (!out->observed || !out->filled || !out->mask || !out->best_cos || !parts) {
+  if (!out->observed || !out->filled || !out->mask || (want_cos && !out->best_cos) || !parts) {
     s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
     goto done;
   }
@@ -1169,7 +1256,7 @@ hearth_status hearth_map_views_with_layout(const hearth_map_layout *l, const hea
       s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
       goto done;
     }
-    hearth_parallel_chunks(R, 32, nt, finish_rows, &tp);
+    hearth_parallel_chunks(R, 32, nt, count_rows, &tp);
     for (int t = 0; t < nt; t++) {
       out->n_observed += tp.counts[t][0];
       out->n_filled += tp.counts[t][1];

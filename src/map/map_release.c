@@ -382,7 +382,10 @@ hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats
     goto done;
   }
   if (job->timing) memset(job->timing, 0, sizeof *job->timing);
-  if ((s = hearth_map_views_with_layout(lb.layout, NULL, views, n, &job->map, &r, job->timing, err))) {
+  /* the viewing cosines are not written: not kept */
+  hearth_map_opts mo = job->map;
+  mo.skip_best_cos = 1;
+  if ((s = hearth_map_views_with_layout(lb.layout, NULL, views, n, &mo, &r, job->timing, err))) {
     hearth_err_prefix(err, "%s/%s", inst, job->state);
     goto done;
   }
@@ -504,6 +507,7 @@ hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err) {
   mo.pixel_stride = job->pixel_stride > 0 ? job->pixel_stride : 2;
   mo.min_cos = 0.2; /* grazing colour samples smear texture detail */
   mo.threads = job->threads;
+  mo.skip_best_cos = 1;
   if ((s = hearth_map_views(&mesh, NULL, &rig.rgb, views, man.n_views, &mo, &r, err))) goto done;
   hearth_image_free(&mesh.texture);
   const uint8_t grey[3] = {128, 128, 128};

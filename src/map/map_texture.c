@@ -7,7 +7,16 @@
 
 /* the 4-neighbours of texel q inside the R x R map; returns their count */
 static int neighbours4(size_t q, size_t R, size_t nb[4]) {
-  size_t x = q % R, y = q / R;
+  /* 32-bit division where the map allows (always, for R <= 16384): the
+     64-bit one costs several times more */
+  size_t x, y;
+  if (R <= UINT16_MAX) {
+    x = (uint32_t)q % (uint32_t)R;
+    y = (uint32_t)q / (uint32_t)R;
+  } else {
+    x = q % R;
+    y = q / R;
+  }
   int k = 0;
   if (x > 0) nb[k++] = q - 1;
   if (x + 1 < R) nb[k++] = q + 1;

@@ -115,12 +115,42 @@ int main(void) {
   CHECK(both > 0);
   CHECK_MSG(warmer > 0.95 * both, "max fusion: %zu of %zu texels took the warmer view", warmer, both);
 
-  /* same bytes for any thread count */
+  /* the maximum is exactly the larger of the two views' own means (each
+     view's mean does not depend on the other view), texel by texel */
+  hearth_map_result rb;
+  CHECK_OK(hearth_map_views(&m, NULL, &cam, views + 1, 1, &o, &rb, &err), &err);
+  size_t exact = 0, either = 0;
+  for (size_t q = 0; q < (size_t)RES * RES; q++) {
+    int a = r1.mask[q] == HEARTH_TEXEL_OBSERVED, b = rb.mask[q] == HEARTH_TEXEL_OBSERVED;
+    CHECK(a || b ? r2.mask[q] == HEARTH_TEXEL_OBSERVED : r2.mask[q] != HEARTH_TEXEL_OBSERVED);
+    if (!a && !b) continue;
+    either++;
+    float want = !b ? r1.observed[q] : !a ? rb.observed[q] : fmaxf(r1.observed[q], rb.observed[q]);
+    float want_cos = !b ? r1.best_cos[q] : !a ? rb.best_cos[q] : fmaxf(r1.best_cos[q], rb.best_cos[q]);
+    exact += r2.observed[q] == want && r2.best_cos[q] == want_cos;
+  }
+  CHECK(either > 0);
+  CHECK_MSG(exact == either, "max fusion: %zu of %zu texels are the larger view mean", exact, either);
+  hearth_map_result_free(&rb);
+
+  /* same bytes for any thread count, with or without the cosines */
   o.threads = 2;
   CHECK_OK(hearth_map_views(&m, NULL, &cam, views, 2, &o, &r3, &err), &err);
   CHECK(!memcmp(r2.mask, r3.mask, (size_t)RES * RES));
   CHECK(!memcmp(r2.filled, r3.filled, (size_t)RES * RES * sizeof(float)));
+  CHECK(!memcmp(r2.observed, r3.observed, (size_t)RES * RES * sizeof(float)));
+  CHECK(!memcmp(r2.best_cos, r3.best_cos, (size_t)RES * RES * sizeof(float)));
   hearth_map_result_free(&r3);
+  o.threads = 3;
+  o.skip_best_cos = 1;
+  CHECK_OK(hearth_map_views(&m, NULL, &cam, views, 2, &o, &r3, &err), &err);
+  CHECK(r3.best_cos == NULL);
+  CHECK(!memcmp(r2.mask, r3.mask, (size_t)RES * RES));
+  CHECK(!memcmp(r2.observed, r3.observed, (size_t)RES * RES * sizeof(float)));
+  CHECK(!memcmp(r2.filled, r3.filled, (size_t)RES * RES * sizeof(float)));
+  CHECK(r3.n_observed == r2.n_observed && r3.n_filled == r2.n_filled && r3.n_surface == r2.n_surface);
+  hearth_map_result_free(&r3);
+  o.skip_best_cos = 0;
   o.fusion = HEARTH_FUSE_MEAN;
   o.threads = 1;
   CHECK_OK(hearth_map_views(&m, NULL, &cam, views, 2, &o, &r3, &err), &err);
