@@ -250,45 +250,68 @@ hearth_status hearth_ray_fan_cast(const hearth_ray_fan *f, const hearth_mesh *m,
   long bx0 = LONG_MAX, bx1 = -1, by0 = LONG_MAX, by1 = -1; /* the hits' box */
   const float slack = f->slack, inv_st = 1.0f / (float)f->stride;
   const long pw = (long)f->pw, ph = (long)f->ph;
-  for (size_t tri = 0; tri < m->n_triangles; tri++) {
-    const uint32_t *ix = m->indices + 3 * tri;
-    uint32_t ia = ix[0], ib = ix[1], ic = ix[2];
-    const fan_vertex *a = V + ia, *b = V + ib, *c = V + ic;
-    /* front faces (counter-clockwise seen from outside) project clockwise
-       in this frame (x right, y down): negative signed area */
-    float area = (b->x - a->x) * (c->y - a->y) - (b->y - a->y) * (c->x - a->x);
-    if (!(area < 0.0f)) continue;
-    float minx = min3f(a->x, b->x, c->x), maxx = max3f(a->x, b->x, c->x);
-    float miny = min3f(a->y, b->y, c->y), maxy = max3f(a->y, b->y, c->y);
-    float dx = maxx - minx, dy = maxy - miny, d2 = dx * dx + dy * dy;
-    /* the margin: the lens curvature over the box (the region's bound for
-       the usual triangle inside it) times the squared diameter */
-    float hu = f->mu_reg, hv = f->mv_reg;
-    float A = maxx > -minx ? maxx : -minx, B = maxy > -miny ? maxy : -miny;
-    if (!(A <= f->ax && B <= f->ay)) lens_curvature(cam, A, B, &hu, &hv);
-    float mu = hu * d2 + slack, mv = hv * d2 + slack;
-    long i0, i1, j0, j1;
-    grid_range((min3f(a->u, b->u, c->u) - mu) * inv_st, (max3f(a->u, b->u, c->u) + mu) * inv_st, pw, &i0, &i1);
-    grid_range((min3f(a->v, b->v, c->v) - mv) * inv_st, (max3f(a->v, b->v, c->v) + mv) * inv_st, ph, &j0, &j1);
-    if (i0 > i1 || j0 > j1) continue;
-    const fan_edge ea = edge_of(V, ib, ic), eb = edge_of(V, ic, ia), ec = edge_of(V, ia, ib);
-    const float inv_area = 1.0f / area;
-    for (long j = j0; j <= j1; j++)
-      for (long i = i0; i <= i1; i++) {
-        size_t p = (size_t)j * (size_t)pw + (size_t)i;
-        float x = f->pt[2 * p], y = f->pt[2 * p + 1];
-        /* signed areas opposite a, b and c: all <= 0 inside (area < 0);
-           a pixel without a point (NaN) is never inside */
-        float la = edge_eval(&ea, x, y), lb = edge_eval(&eb, x, y), lc = edge_eval(&ec, x, y);
-        if (!(la <= 0.0f && lb <= 0.0f && lc <= 0.0f)) continue;
-        float w = (la * IZ[ia] + lb * IZ[ib] + lc * IZ[ic]) * inv_area;
-        if (!(w > best[p].w)) continue;
-        best[p] = (fan_best){w, (uint32_t)tri};
-        bx0 = i < bx0 ? i : bx0;
-        bx1 = i > bx1 ? i : bx1;
-        by0 = j < by0 ? j : by0;
-        by1 = j > by1 ? j : by1;
-      }
+  /* triangles in blocks: first every front face's candidate pixels (most
+     have none, and whether one has is a coin toss: appended without a
+     branch), then the inside tests of those with some, in index order */
+  enum { FAN_BLOCK = 256 };
+  struct {
+    uint32_t tri;
+    int32_t i0, i1, j0, j1;
+  } cand[FAN_BLOCK];
+  for (size_t blk = 0; blk < m->n_triangles; blk += FAN_BLOCK) {
+    const size_t blk_end = blk + FAN_BLOCK < m->n_triangles ? blk + FAN_BLOCK : m->n_triangles;
+    size_t nc = 0;
+    for (size_t tri = blk; tri < blk_end; tri++) {
+      const uint32_t *ix = m->indices + 3 * tri;
+      const fan_vertex *a = V + ix[0], *b = V + ix[1], *c = V + ix[2];
+      /* front faces (counter-clockwise seen from outside) project clockwise
+         in this frame (x right, y down): negative signed area */
+      float area = (b->x - a->x) * (c->y - a->y) - (b->y - a->y) * (c->x - a->x);
+      if (!(area < 0.0f)) continue;
+      float minx = min3f(a->x, b->x, c->x), maxx = max3f(a->x, b->x, c->x);
+      float miny = min3f(a->y, b->y, c->y), maxy = max3f(a->y, b->y, c->y);
+      float dx = maxx - minx, dy = maxy - miny, d2 = dx * dx + dy * dy;
+      /* the margin: the lens curvature over the box (the region's bound for
+         the usual triangle inside it) times the squared diameter */
+      float hu = f->mu_reg, hv = f->mv_reg;
+      float A = maxx > -minx ? maxx : -minx, B = maxy > -miny ? maxy : -miny;
+      if (!(A <= f->ax && B <= f->ay)) lens_curvature(cam, A, B, &hu, &hv);
+      float mu = hu * d2 + slack, mv = hv * d2 + slack;
+      long i0, i1, j0, j1;
+      grid_range((min3f(a->u, b->u, c->u) - mu) * inv_st, (max3f(a->u, b->u, c->u) + mu) * inv_st, pw, &i0, &i1);
+      grid_range((min3f(a->v, b->v, c->v) - mv) * inv_st, (max3f(a->v, b->v, c->v) + mv) * inv_st, ph, &j0, &j1);
+      cand[nc].tri = (uint32_t)tri;
+      cand[nc].i0 = (int32_t)i0;
+      cand[nc].i1 = (int32_t)i1;
+      cand[nc].j0 = (int32_t)j0;
+      cand[nc].j1 = (int32_t)j1;
+      nc += (i0 <= i1) & (j0 <= j1);
+    }
+    for (size_t k = 0; k < nc; k++) {
+      const size_t tri = cand[k].tri;
+      const uint32_t *ix = m->indices + 3 * tri;
+      const uint32_t ia = ix[0], ib = ix[1], ic = ix[2];
+      const fan_vertex *a = V + ia, *b = V + ib, *c = V + ic;
+      const float area = (b->x - a->x) * (c->y - a->y) - (b->y - a->y) * (c->x - a->x);
+      const fan_edge ea = edge_of(V, ib, ic), eb = edge_of(V, ic, ia), ec = edge_of(V, ia, ib);
+      const float inv_area = 1.0f / area;
+      for (long j = cand[k].j0; j <= cand[k].j1; j++)
+        for (long i = cand[k].i0; i <= cand[k].i1; i++) {
+          size_t p = (size_t)j * (size_t)pw + (size_t)i;
+          float x = f->pt[2 * p], y = f->pt[2 * p + 1];
+          /* signed areas opposite a, b and c: all <= 0 inside (area < 0);
+             a pixel without a point (NaN) is never inside */
+          float la = edge_eval(&ea, x, y), lb = edge_eval(&eb, x, y), lc = edge_eval(&ec, x, y);
+          if (!(la <= 0.0f && lb <= 0.0f && lc <= 0.0f)) continue;
+          float w = (la * IZ[ia] + lb * IZ[ib] + lc * IZ[ic]) * inv_area;
+          if (!(w > best[p].w)) continue;
+          best[p] = (fan_best){w, (uint32_t)tri};
+          bx0 = i < bx0 ? i : bx0;
+          bx1 = i > bx1 ? i : bx1;
+          by0 = j < by0 ? j : by0;
+          by1 = j > by1 ? j : by1;
+        }
+    }
   }
   /* the hits within their box, which leaves the scratch all zero again */
   if (bx1 < 0) return HEARTH_OK;
