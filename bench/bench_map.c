@@ -179,13 +179,13 @@ int main(int argc, char **argv) {
   printf("    fusion              %6.1f ms (%4.1f%%)\n", 1e3 * best.fuse, 100 * best.fuse / best.total);
   printf("    fill                %6.1f ms (%4.1f%%)\n", 1e3 * best.fill, 100 * best.fill / best.total);
   printf("  reading one thread: 30 CSVs %.1f ms, mesh + documents %.1f ms\n", 1e3 * t_csv, 1e3 * t_mesh);
-  /* the best end-to-end run's own phases: reading (mesh, documents, CSVs in
-     parallel) beside the layout on a thread of its own; writing (maps,
-     Turbo PNG, provenance, swap) */
+  /* the best end-to-end run's own phases: reading (documents, CSVs in
+     parallel) beside the mesh and the layout on a thread of their own;
+     writing (maps, Turbo PNG, provenance, swap) */
   /* reading and the layout run side by side: their wall time together is
      what the later phases leave of the total */
   double front = e2e.total - (e2e.cast + e2e.fuse + e2e.fill + e2e.write);
-  printf("  end to end, best run by phase: read %.1f ms beside layout (UV raster, islands, pixel grid, fan) "
+  printf("  end to end, best run by phase: read %.1f ms beside mesh + layout (UV raster, islands, pixel grid, fan) "
          "%.1f ms: %.1f ms (%.0f%%); cast+splat %.1f (%.0f%%), fusion %.1f (%.0f%%), fill %.1f (%.0f%%), "
          "write %.1f (%.0f%%)\n",
          1e3 * e2e.read, 1e3 * e2e.raster, 1e3 * front, 100 * front / e2e.total, 1e3 * e2e.cast,

@@ -271,19 +271,26 @@ static void write_outputs(void *ctx, size_t b, size_t e, int t) {
   }
 }
 
-/* the mapping layout, made on a thread of its own */
+/* the mesh, read, and the mapping layout, made on a thread of their own */
 typedef struct layout_build {
-  const hearth_mesh *mesh;
+  const char *mesh_path;
+  hearth_mesh *mesh;
   const hearth_camera *cam;
   const hearth_map_opts *opts;
   hearth_map_layout *layout;
   hearth_status s;
+  int mesh_failed; /* s is the mesh file's error */
   hearth_err err;
   double seconds;
 } layout_build;
 
 static void *layout_build_run(void *arg) {
   layout_build *b = arg;
+  hearth_glb_read_opts gopts = {.require_uvs = 1};
+  if ((b->s = hearth_glb_read(b->mesh_path, &gopts, b->mesh, &b->err))) {
+    b->mesh_failed = 1;
+    return NULL;
+  }
   double t0 = hearth_now();
   b->s = hearth_map_layout_new(b->mesh, b->cam, b->opts, &b->layout, &b->err);
   b->seconds = hearth_now() - t0;
@@ -306,7 +313,7 @@ hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats
   if (job->out_dir) snprintf(out_dir, PATH_SZ, "%s", job->out_dir);
   else joinf(out_dir, "%s/instances/%s/derived/%s", root, inst, job->state);
 
-  double t_start = hearth_now();
+  double t_start = hearth_now(), t_read = 0.0;
   hearth_rig rig;
   hearth_manifest man = {0};
   hearth_poses poses = {0};
@@ -328,8 +335,6 @@ hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats
     goto done;
   }
   if ((s = hearth_poses_read(poses_path, &poses, err))) goto done;
-  hearth_glb_read_opts gopts = {.require_uvs = 1};
-  if ((s = hearth_glb_read(mesh_path, &gopts, &mesh, err))) goto done;
   idx = calloc(man.n_views ? man.n_views : 1, sizeof *idx);
   imgs = calloc(man.n_views ? man.n_views : 1, sizeof *imgs);
   views = calloc(man.n_views ? man.n_views : 1, sizeof *views);
@@ -349,9 +354,11 @@ hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats
     views[k].image = &imgs[k];
     views[k].T_world_from_cam = vp->T_world_from_cam;
   }
-  /* the layout (UV raster, islands, pixel grid and fan: mesh and camera
-     only) is made on a thread of its own while the CSVs are read */
-  lb = (layout_build){&mesh, &rig.thermal, &job->map, NULL, HEARTH_OK, {0}, 0.0};
+  /* the mesh is read and the layout (UV raster, islands, pixel grid and
+     fan: mesh and camera only) made on a thread of their own while the CSVs
+     are read; a bad mesh is reported before a bad CSV, a failed layout
+     after */
+  lb = (layout_build){mesh_path, &mesh, &rig.thermal, &job->map, NULL, HEARTH_OK, 0, {0}, 0.0};
   lb_started = pthread_create(&lb_tid, NULL, layout_build_run, &lb) == 0;
   if (!lb_started) layout_build_run(&lb);
   /* the CSVs in parallel; the first failing view (in order) is reported */
@@ -367,19 +374,19 @@ hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats
     }
     int nt = job->map.threads > 0 ? job->map.threads : hearth_default_threads();
     hearth_parallel_chunks(n, 1, nt, read_csv_range, &cj);
-    s = first_failure(cj.st, cj.errs, n, err);
+    hearth_status cs = first_failure(cj.st, cj.errs, n, err);
     free(cj.st);
     free(cj.errs);
-    if (s) goto done;
-  }
-  double t_read = hearth_now() - t_start;
-  if (lb_started) pthread_join(lb_tid, NULL);
-  lb_started = 0;
-  if (lb.s) {
-    if (err) *err = lb.err;
-    s = lb.s;
-    hearth_err_prefix(err, "%s/%s", inst, job->state);
-    goto done;
+    t_read = hearth_now() - t_start;
+    if (lb_started) pthread_join(lb_tid, NULL);
+    lb_started = 0;
+    if (lb.s && (lb.mesh_failed || !cs)) {
+      if (err) *err = lb.err;
+      s = lb.s;
+      if (!lb.mesh_failed) hearth_err_prefix(err, "%s/%s", inst, job->state);
+      goto done;
+    }
+    if ((s = cs)) goto done;
   }
   if (job->timing) memset(job->timing, 0, sizeof *job->timing);
   /* the viewing cosines are not written: not kept */
