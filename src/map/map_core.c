@@ -801,25 +801,46 @@ static void fuse_bands(void *ctx, size_t b, size_t e, int t) {
       }
     }
     /* the mask, the filled map as far as observed (NaN elsewhere: the fill
-       writes the texels it fills), and the islands' boxes for the fill */
+       writes the texels it fills), and the islands' boxes for the fill, run
+       by run of one island along each row (the band is whole rows) */
     island_box *box = tp->parts + (size_t)t * ((size_t)m->n_islands + 1);
-    /* (the band is whole rows: x and y counted, not divided out of q) */
-    for (size_t q = q0, xq = 0, yq = q0 / R; q < q1; q++, xq = xq + 1 == R ? (yq++, 0) : xq + 1) {
-      for (size_t c = 0; c < C; c++) {
-        if (out->observed[q * C + c] > -INFINITY) out->mask[q] = HEARTH_TEXEL_OBSERVED;
-        else out->observed[q * C + c] = NAN;
-        out->filled[q * C + c] = out->observed[q * C + c];
+    for (size_t y = q0 / R; y < q1 / R; y++) {
+      const size_t row = y * R;
+      uint32_t run_isl = UINT32_MAX;
+      size_t run_x0 = 0, run_todo = 0;
+      int run_seed = 0;
+      for (size_t x = 0; x <= R; x++) {
+        uint32_t isl = UINT32_MAX;
+        int seen = 0;
+        if (x < R) {
+          const size_t q = row + x;
+          for (size_t c = 0; c < C; c++) {
+            if (out->observed[q * C + c] > -INFINITY) out->mask[q] = HEARTH_TEXEL_OBSERVED;
+            else out->observed[q * C + c] = NAN;
+            out->filled[q * C + c] = out->observed[q * C + c];
+          }
+          isl = m->island_of_texel[q];
+          seen = out->mask[q] == HEARTH_TEXEL_OBSERVED;
+        }
+        if (isl != run_isl) {
+          if (run_isl != UINT32_MAX) {
+            island_box *bx = &box[run_isl];
+            int32_t xa = (int32_t)run_x0, xb = (int32_t)x - 1, yy = (int32_t)y;
+            if (xa < bx->x0) bx->x0 = xa;
+            if (xb > bx->x1) bx->x1 = xb;
+            if (yy < bx->y0) bx->y0 = yy;
+            if (yy > bx->y1) bx->y1 = yy;
+            bx->has_seed |= (uint8_t)run_seed;
+            bx->n_todo += run_todo;
+          }
+          run_isl = isl;
+          run_x0 = x;
+          run_todo = 0;
+          run_seed = 0;
+        }
+        run_seed |= seen;
+        run_todo += !seen;
       }
-      uint32_t isl = m->island_of_texel[q];
-      if (isl == UINT32_MAX) continue;
-      island_box *bx = &box[isl];
-      int32_t x = (int32_t)xq, y = (int32_t)yq;
-      if (x < bx->x0) bx->x0 = x;
-      if (x > bx->x1) bx->x1 = x;
-      if (y < bx->y0) bx->y0 = y;
-      if (y > bx->y1) bx->y1 = y;
-      if (out->mask[q] == HEARTH_TEXEL_OBSERVED) bx->has_seed = 1;
-      else bx->n_todo++;
     }
   }
 done:
@@ -833,14 +854,19 @@ done:
 static void count_rows(void *ctx, size_t b, size_t e, int t) {
   const texel_pass *tp = ctx;
   const uint8_t *mask = tp->out->mask;
-  size_t R = tp->m->R, *cnt = tp->counts[t];
+  size_t R = tp->m->R, n_obs = 0, n_fill = 0, n_unobs = 0, n_none = 0;
   for (size_t q = b * R; q < e * R; q++) {
     uint8_t mk = mask[q];
-    cnt[0] += mk == HEARTH_TEXEL_OBSERVED;
-    cnt[1] += mk == HEARTH_TEXEL_FILLED;
-    cnt[2] += mk == HEARTH_TEXEL_UNOBSERVED;
-    cnt[3] += mk != HEARTH_TEXEL_NONE;
+    n_obs += mk == HEARTH_TEXEL_OBSERVED;
+    n_fill += mk == HEARTH_TEXEL_FILLED;
+    n_unobs += mk == HEARTH_TEXEL_UNOBSERVED;
+    n_none += mk == HEARTH_TEXEL_NONE;
   }
+  size_t *cnt = tp->counts[t];
+  cnt[0] += n_obs;
+  cnt[1] += n_fill;
+  cnt[2] += n_unobs;
+  cnt[3] += (e - b) * R - n_none;
 }
 
 /* the pixel grid (undistorted centres of every stride-th pixel), its ray
