@@ -869,8 +869,8 @@ static void count_rows(void *ctx, size_t b, size_t e, int t) {
   cnt[3] += (e - b) * R - n_none;
 }
 
-/* the pixel grid (undistorted centres of every stride-th pixel), its ray
- * fan and the UV islands, made on a thread of their own while the UV layout
+/* the pixel grid (undistorted centres of every stride-th pixel) and its ray
+ * fan, and the UV islands, made on threads of their own while the UV layout
  * is rasterised (all only read their inputs) */
 typedef struct grid_build {
   const hearth_camera *cam;
@@ -906,6 +906,12 @@ static void *grid_build_run(void *arg) {
     for (size_t tx = 0; tx < pw; tx += 4)
       for (size_t y = ty; y < ty + 4 && y < ph; y++)
         for (size_t x = tx; x < tx + 4 && x < pw; x++) g->tile_order[k++] = (uint32_t)(y * pw + x);
+  return NULL;
+}
+
+/* the UV islands, on a thread of their own */
+static void *islands_run(void *arg) {
+  grid_build *g = arg;
   g->islands_status = hearth_uv_islands(g->mesh, g->island_of_tri, &g->n_islands, &g->islands_err);
   return NULL;
 }
@@ -1027,7 +1033,8 @@ hearth_status hearth_map_layout_new(const hearth_mesh *mesh, const hearth_camera
   size_t N = R * R;
   grid_build gb = {0};
   pthread_t gb_tid;
-  int gb_started = 0;
+  pthread_t isl_tid;
+  int gb_started = 0, isl_started = 0;
   /* pixel grid: undistorted centres of every stride-th pixel, made with its
      ray fan beside the UV raster */
   size_t st = l->stride;
@@ -1054,6 +1061,8 @@ hearth_status hearth_map_layout_new(const hearth_mesh *mesh, const hearth_camera
                     mesh, l->island_of_tri, 0, HEARTH_OK, {0}};
   gb_started = pthread_create(&gb_tid, NULL, grid_build_run, &gb) == 0;
   if (!gb_started) grid_build_run(&gb); /* no thread: make it here */
+  isl_started = pthread_create(&isl_tid, NULL, islands_run, &gb) == 0;
+  if (!isl_started) islands_run(&gb);
   l->tri_normal = hearth_alloc_array(mesh->n_triangles, 3 * sizeof *l->tri_normal);
   l->island_of_texel = hearth_alloc_array(N, sizeof *l->island_of_texel);
   if (!l->island_of_tri || !l->tri_normal || !l->island_of_texel) {
@@ -1065,6 +1074,10 @@ hearth_status hearth_map_layout_new(const hearth_mesh *mesh, const hearth_camera
   if (gb_started) {
     pthread_join(gb_tid, NULL);
     gb_started = 0;
+  }
+  if (isl_started) {
+    pthread_join(isl_tid, NULL);
+    isl_started = 0;
   }
   if (gb.islands_status) {
     if (err) *err = gb.islands_err;
@@ -1097,6 +1110,7 @@ hearth_status hearth_map_layout_new(const hearth_mesh *mesh, const hearth_camera
   if (gb.nomem) s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory for the pixel grid");
 done:
   if (gb_started) pthread_join(gb_tid, NULL);
+  if (isl_started) pthread_join(isl_tid, NULL);
   hearth_ray_fan_free(gb.fan);
   if (s) hearth_map_layout_free(l);
   else *out = l;
