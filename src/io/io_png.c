@@ -1,4 +1,5 @@
-/* PNG reading through libpng, writing with our own DEFLATE encoder and zlib's checksums (see the encoder below).
+/* PNG reading through libpng, writing with our own DEFLATE encoder and
+ * zlib's checksums (see the encoder below).
  *
  * libpng reports errors by longjmp. Each setjmp lives in a small function
  * whose only locals are set before setjmp and never changed afterwards; all
