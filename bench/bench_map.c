@@ -12,6 +12,10 @@
 #include "hearth/hearth.h"
 
 static double best_of(double a, double b) { return a < b ? a : b; }
+static int cmp_double(const void *a, const void *b) {
+  double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
 
 int main(int argc, char **argv) {
   size_t tris = 100000, R = 1024;
@@ -68,7 +72,7 @@ int main(int argc, char **argv) {
   job.rig_path = rig_path;
   job.map.resolution = R;
   job.map.threads = threads;
-  double t_all = 1e30;
+  double t_all = 1e30, t_runs[64];
   hearth_map_timing e2e = {0}, run;
   job.timing = &run;
   for (int k = 0; k < reps; k++) {
@@ -78,6 +82,7 @@ int main(int argc, char **argv) {
       return 1;
     }
     double t = hearth_now() - t0;
+    if (k < 64) t_runs[k] = t;
     if (t < t_all) {
       t_all = t;
       e2e = run; /* the phases of the best run */
@@ -171,6 +176,11 @@ int main(int argc, char **argv) {
   printf("mapping benchmark: %zu triangles, %zu views, R = %zu, %d thread(s), best of %d\n",
          mesh.n_triangles, man.n_views, R, threads, reps);
   printf("  end to end (read CSVs + mesh, build, cast, splat, fuse, fill, write): %7.1f ms\n", 1e3 * t_all);
+  /* every run, not only the best: the first one starts with cold caches */
+  int n_runs = reps < 64 ? reps : 64;
+  qsort(t_runs, (size_t)n_runs, sizeof *t_runs, cmp_double);
+  printf("    all %d runs: median %.1f ms, slowest %.1f ms\n", n_runs, 1e3 * t_runs[n_runs / 2],
+         1e3 * t_runs[n_runs - 1]);
   printf("  the same with traced rays (Embree BVH + casting, --trace-rays):        %7.1f ms\n", 1e3 * t_traced);
   printf("  in memory total:                                                     %7.1f ms\n", 1e3 * best.total);
   printf("    UV raster + islands %6.1f ms (%4.1f%%)\n", 1e3 * best.raster, 100 * best.raster / best.total);
