@@ -133,7 +133,7 @@ int main(int argc, char **argv) {
   hearth_map_opts_default(&o);
   o.resolution = R;
   o.threads = threads;
-  hearth_map_timing best = {1e30, 1e30, 1e30, 1e30, 1e30}, tm;
+  hearth_map_timing best = {.raster = 1e30, .cast = 1e30, .fuse = 1e30, .fill = 1e30, .total = 1e30}, tm;
   double t_bvh = 1e30;
   for (int k = 0; k < reps; k++) {
     hearth_map_result r;
