@@ -109,9 +109,9 @@ typedef struct map_ctx {
   int cast_threads; /* threads for ray casting when views are processed serially */
   /* per thread: a view's touches and the sort's second buffer (4 per pixel) */
   touch **touches, **touches_tmp;
-  /* the views' records (see REC_WORDS), each view's sorted by texel: made
-   * in the worker's scratch (room for 4 per pixel), kept in an allocation
-   * of their own size */
+  /* mean and robust fusion: the views' records (see REC_WORDS), each
+   * view's sorted by texel: made in the worker's scratch (room for 4 per
+   * pixel), kept in an allocation of their own size */
   uint32_t **rec_q;
   float **rec_d;
   size_t *n_rec;
@@ -689,10 +689,11 @@ static size_t lower_bound_u32(const uint32_t *a, size_t n, uint32_t q) {
   return lo;
 }
 
-/* Fusion over bands of whole rows: every view's records of the band's
- * texels, folded in view order into the band's slice of observed, mask and
- * best_cos (the maximum of the view means, the weighted mean, or the
- * weighted median). A worker sets nomem[t] if its scratch cannot be had. */
+/* Fusion over bands of whole rows, into the band's slice of observed, mask,
+ * best_cos and filled: for max fusion the workers' maxima maps merged and
+ * decoded; otherwise every view's records of the band's texels folded in
+ * view order (the weighted mean, or the weighted median). A worker sets
+ * nomem[t] if its scratch cannot be had. */
 static void fuse_bands(void *ctx, size_t b, size_t e, int t) {
   const texel_pass *tp = ctx;
   const map_ctx *m = tp->m;
