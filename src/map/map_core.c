@@ -383,7 +383,6 @@ static void process_view(map_ctx *m, size_t v, int t) {
     }
     tc = src;
   }
-  double P4 = hearth_now();
   m->view_hits[v] = hits;
   /* each texel's touches in pixel order: splat only from the texel's own
    * island; one record per texel with any */
@@ -433,7 +432,6 @@ static void process_view(map_ctx *m, size_t v, int t) {
        maximum's bits depend on which view came first */
     for (int c = 0; c < C; c++) d[2 + c] = fusion == HEARTH_FUSE_MEAN ? sum[c] : sum[c] / wsum + 0.0f;
   }
-  { static double S; static int NV; S += hearth_now() - P4; if (++NV == 30 && getenv("HDBG")) fprintf(stderr, "fold %.3f ms/view\n", S / 30 * 1e3); }
   if (mc) return; /* folded into the worker's maps: no records */
   m->n_rec[v] = n_touched;
   m->rec_q[v] = hearth_alloc_array(n_touched ? n_touched : 1, sizeof *rq);
