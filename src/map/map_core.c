@@ -1,14 +1,16 @@
 /* Temperature / colour mapping onto a UV layout (see include/hearth/map.h).
  *
- * Two parallel phases. Views: each view is cast and splatted by one worker,
- * and reduced to its own records, one per texel it observes (the view's
- * mean there, its weight and best viewing cosine), sorted by texel. Texels:
- * bands of rows fold every view's records for their texels in view order
- * (maximum, weighted mean or weighted median), touching only the band's
- * slice of the maps. Nothing is shared between workers while it is
- * written, and every texel is folded in the same order whatever the thread
- * count: the result does not depend on it. Within a view, pixels are
- * visited in raster order by one thread. */
+ * Two parallel phases. Views: each view is cast and splatted by one worker
+ * and reduced to one value per texel it observes (the view's mean there,
+ * its weight and best viewing cosine). For max fusion these fold at once
+ * into the worker's own maxima maps; for mean and robust fusion they are
+ * kept as the view's records, sorted by texel. Texels: bands of rows merge
+ * the workers' maxima, or fold every view's records in view order
+ * (weighted mean or weighted median), touching only the band's slice of
+ * the maps. Nothing is shared between workers while it is written, maxima
+ * do not depend on which worker saw which view, and records are folded in
+ * the same order whatever the thread count: the result does not depend on
+ * it. Within a view, pixels are visited in raster order by one thread. */
 #include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
@@ -1064,7 +1066,7 @@ hearth_status hearth_map_layout_new(const hearth_mesh *mesh, const hearth_camera
   if (!isl_started) islands_run(&gb);
   l->tri_normal = hearth_alloc_array(mesh->n_triangles, 3 * sizeof *l->tri_normal);
   l->island_of_texel = hearth_alloc_array(N, sizeof *l->island_of_texel);
-  if (!l->island_of_tri || !l->tri_normal || !l->island_of_texel) {
+  if (!l->tri_normal || !l->island_of_texel) {
     s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory for R=%zu", R);
     goto done;
   }

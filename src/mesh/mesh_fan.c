@@ -278,6 +278,7 @@ hearth_status hearth_ray_fan_cast(const hearth_ray_fan *f, const hearth_mesh *m,
   struct {
     uint32_t tri;
     int32_t i0, i1, j0, j1;
+    float area;
   } cand[FAN_BLOCK];
   for (size_t blk = 0; blk < m->n_triangles; blk += FAN_BLOCK) {
     const size_t blk_end = blk + FAN_BLOCK < m->n_triangles ? blk + FAN_BLOCK : m->n_triangles;
@@ -306,14 +307,14 @@ hearth_status hearth_ray_fan_cast(const hearth_ray_fan *f, const hearth_mesh *m,
       cand[nc].i1 = (int32_t)i1;
       cand[nc].j0 = (int32_t)j0;
       cand[nc].j1 = (int32_t)j1;
+      cand[nc].area = area;
       nc += (i0 <= i1) & (j0 <= j1);
     }
     for (size_t k = 0; k < nc; k++) {
       const size_t tri = cand[k].tri;
       const uint32_t *ix = m->indices + 3 * tri;
       const uint32_t ia = ix[0], ib = ix[1], ic = ix[2];
-      const fan_vertex *a = V + ia, *b = V + ib, *c = V + ic;
-      const float area = (b->x - a->x) * (c->y - a->y) - (b->y - a->y) * (c->x - a->x);
+      const float area = cand[k].area;
       const fan_edge ea = edge_of(V, ib, ic), eb = edge_of(V, ic, ia), ec = edge_of(V, ia, ib);
       const float inv_area = 1.0f / area;
       for (long j = cand[k].j0; j <= cand[k].j1; j++)
