@@ -155,9 +155,6 @@ typedef struct raster_ctx {
   size_t R;
   size_t rows_per_band;
   int32_t *bbox; /* per triangle: col0 col1 row0 row1 (inclusive), col0 > col1 if empty */
-  /* the triangles that reach band b: band_tris[band_start[b] .. band_start[b + 1]), in index order */
-  const size_t *band_start;
-  const uint32_t *band_tris;
   uint32_t *tri_of_texel;
   float *bary;
 } raster_ctx;
@@ -249,11 +246,10 @@ static void raster_band(void *vctx, size_t band0, size_t band1, int thread_index
     /* the band's texels start empty */
     for (size_t q = (size_t)r_lo * R; q < (size_t)(r_hi + 1) * R; q++) c->tri_of_texel[q] = UINT32_MAX;
     if (c->bary) memset(c->bary + (size_t)r_lo * R * 3, 0, (size_t)(r_hi + 1 - r_lo) * R * 3 * sizeof(float));
-    /* the band's triangles in index order; a texel keeps the first
-       (lowest) one */
-    for (size_t k = c->band_start[band]; k < c->band_start[band + 1]; k++) {
-      const size_t t = c->band_tris[k];
+    /* triangles in index order; a texel keeps the first (lowest) one */
+    for (size_t t = 0; t < m->n_triangles; t++) {
       const int32_t *bb = c->bbox + t * 4;
+      if (bb[0] > bb[1]) continue;
       int64_t row0 = bb[2] > r_lo ? bb[2] : r_lo, row1 = bb[3] < r_hi ? bb[3] : r_hi;
       if (row0 > row1) continue;
       double x[3], y[3];
@@ -317,50 +313,16 @@ hearth_status hearth_uv_rasterize(const hearth_mesh *m, size_t R, uint32_t *tri_
   int32_t *bbox = hearth_alloc_array(nb4 ? nb4 : 1, sizeof *bbox);
   if (!bbox) return hearth_err_set(err, HEARTH_E_NOMEM, "UV rasterisation: out of memory");
   /* texel-centre bounding boxes, clipped to the map, in parallel chunks */
-  raster_ctx c = {m, R, 0, bbox, NULL, NULL, tri_of_texel, bary};
+  raster_ctx c = {m, R, 0, bbox, tri_of_texel, bary};
   int nth = hearth_default_threads();
   hearth_parallel_chunks(m->n_triangles, 8192, nth, bbox_range, &c);
   /* row bands in parallel; within a band triangles go in index order, so
    * the result does not depend on the thread count */
   size_t nbands = (size_t)nth * 8;
   if (nbands > R) nbands = R;
-  size_t rpb = (R + nbands - 1) / nbands;
-  c.rows_per_band = rpb;
-  nbands = (R + rpb - 1) / rpb;
-  /* each band's triangles (a counting sort, index order kept) */
-  size_t *band_start = calloc(nbands + 1, sizeof *band_start), n_entries = 0;
-  if (!band_start) {
-    free(bbox);
-    return hearth_err_set(err, HEARTH_E_NOMEM, "UV rasterisation: out of memory");
-  }
-  for (size_t t = 0; t < m->n_triangles; t++) {
-    const int32_t *bb = bbox + t * 4;
-    if (bb[0] > bb[1]) continue;
-    for (size_t b = (size_t)bb[2] / rpb; b <= (size_t)bb[3] / rpb; b++) band_start[b + 1]++;
-  }
-  for (size_t b = 0; b < nbands; b++) band_start[b + 1] += band_start[b];
-  n_entries = band_start[nbands];
-  uint32_t *band_tris = hearth_alloc_array(n_entries ? n_entries : 1, sizeof *band_tris);
-  size_t *fill = hearth_alloc_array(nbands, sizeof *fill);
-  if (!band_tris || !fill) {
-    free(bbox);
-    free(band_start);
-    free(band_tris);
-    free(fill);
-    return hearth_err_set(err, HEARTH_E_NOMEM, "UV rasterisation: out of memory");
-  }
-  memcpy(fill, band_start, nbands * sizeof *fill);
-  for (size_t t = 0; t < m->n_triangles; t++) {
-    const int32_t *bb = bbox + t * 4;
-    if (bb[0] > bb[1]) continue;
-    for (size_t b = (size_t)bb[2] / rpb; b <= (size_t)bb[3] / rpb; b++) band_tris[fill[b]++] = (uint32_t)t;
-  }
-  free(fill);
-  c.band_start = band_start;
-  c.band_tris = band_tris;
+  c.rows_per_band = (R + nbands - 1) / nbands;
+  nbands = (R + c.rows_per_band - 1) / c.rows_per_band;
   hearth_parallel_chunks(nbands, 1, nth, raster_band, &c);
   free(bbox);
-  free(band_start);
-  free(band_tris);
   return HEARTH_OK;
 }
