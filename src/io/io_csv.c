@@ -118,6 +118,36 @@ static inline double plain_value(uint64_t mant, int frac, int neg) {
   return neg ? -v : v;
 }
 
+/* A bare decimal cell at s[*p..]: optional sign, digits, optionally a
+ * decimal mark ('.', or ',' where the separator is not ',') and digits; at
+ * most 15 digits in all, ending at the line's end b or at the separator.
+ * On success its value goes to *v, *p moves to its end and 1 is returned;
+ * otherwise nothing changes. checked 0 skips the bound checks of the scans:
+ * only where s[b] exists and is no sign, digit or decimal mark (a line's
+ * '\r' or '\n'). */
+static inline int plain_cell(const char *s, size_t *p, size_t b, char sep, int checked, double *v) {
+  size_t q = *p;
+  int neg = 0, nd = 0, frac = 0;
+  uint64_t mant = 0;
+  if ((!checked || q < b) && (s[q] == '-' || s[q] == '+')) neg = s[q++] == '-';
+  while ((!checked || q < b) && (unsigned)(s[q] - '0') < 10) {
+    mant = mant * 10 + (uint64_t)(s[q++] - '0');
+    nd++;
+  }
+  if ((!checked || q < b) && (s[q] == '.' || (s[q] == ',' && sep != ','))) {
+    q++;
+    while ((!checked || q < b) && (unsigned)(s[q] - '0') < 10) {
+      mant = mant * 10 + (uint64_t)(s[q++] - '0');
+      nd++;
+      frac++;
+    }
+  }
+  if (!(nd > 0 && nd <= 15 && (q == b || s[q] == sep))) return 0;
+  *v = plain_value(mant, frac, neg);
+  *p = q;
+  return 1;
+}
+
 /* Classify a cell and parse its value. */
 static inline int eval_cell(const char *s, const csv_cell *c, double *v) {
   if (c->bad_quote) return CELL_QUOTE;
@@ -327,23 +357,11 @@ hearth_status hearth_thermal_parse_csv(const char *text, size_t len, const char 
      * from where this one stopped; the values are the same either way. */
     if (b < len && p < b) {
       for (;;) {
-        const char *c = s + p;
-        int neg = 0;
-        if (*c == '-' || *c == '+') neg = *c++ == '-';
-        const char *d0 = c;
-        uint64_t mant = 0;
-        while ((unsigned)(*c - '0') < 10) mant = mant * 10 + (uint64_t)(*c++ - '0');
-        int nd = (int)(c - d0), frac = 0;
-        if (*c == '.') {
-          const char *f0 = ++c;
-          while ((unsigned)(*c - '0') < 10) mant = mant * 10 + (uint64_t)(*c++ - '0');
-          frac = (int)(c - f0);
-          nd += frac;
-        }
-        size_t q = (size_t)(c - s);
-        if (!(nd > 0 && nd <= 15 && (q == b || *c == sep))) break;
-        double v = plain_value(mant, frac, neg);
-        if (!(v >= HEARTH_THERMAL_MIN_C && v <= HEARTH_THERMAL_MAX_C)) break;
+        double v;
+        size_t q = p;
+        /* out of range: left to the loop below, from the cell's start */
+        if (!plain_cell(s, &q, b, sep, 0, &v) || !(v >= HEARTH_THERMAL_MIN_C && v <= HEARTH_THERMAL_MAX_C)) break;
+        p = q;
         if (B.nvals == B.capvals && !grow((void **)&B.vals, &B.capvals, B.nvals + 1, sizeof(float))) {
           st = hearth_err_set(err, HEARTH_E_NOMEM, "%s: out of memory", name);
           goto done;
@@ -352,7 +370,6 @@ hearth_status hearth_thermal_parse_csv(const char *text, size_t len, const char 
         if (r.ncells == 0) first_numeric = 1;
         r.nnum++;
         r.ncells++;
-        p = q;
         if (p >= b || ++p >= b) { /* the line's end, or one trailing separator */
           line_done = 1;
           break;
@@ -363,26 +380,8 @@ hearth_status hearth_thermal_parse_csv(const char *text, size_t len, const char 
       double v = 0;
       int kind;
       /* fast path: a bare decimal ending at a separator or the line end */
-      size_t q = p;
-      int neg = 0, nd = 0, frac = 0;
-      uint64_t mant = 0;
-      if (q < b && (s[q] == '-' || s[q] == '+')) neg = s[q++] == '-';
-      while (q < b && (unsigned)(s[q] - '0') < 10) {
-        mant = mant * 10 + (uint64_t)(s[q++] - '0');
-        nd++;
-      }
-      if (q < b && (s[q] == '.' || (s[q] == ',' && sep != ','))) {
-        q++;
-        while (q < b && (unsigned)(s[q] - '0') < 10) {
-          mant = mant * 10 + (uint64_t)(s[q++] - '0');
-          nd++;
-          frac++;
-        }
-      }
-      if (nd > 0 && nd <= 15 && (q == b || s[q] == sep)) {
-        v = plain_value(mant, frac, neg);
+      if (plain_cell(s, &p, b, sep, 1, &v)) {
         kind = v >= HEARTH_THERMAL_MIN_C && v <= HEARTH_THERMAL_MAX_C ? CELL_OK : CELL_RANGE;
-        p = q;
       } else {
         csv_cell c;
         if (!next_cell(s, &p, b, sep, r.ncells, &c)) break;
