@@ -17,7 +17,7 @@
 #include "hearth/camera.h"
 #include "hearth/geom.h"
 #include "hearth/image.h"
-#include "hearth/release.h"
+#include "hearth/dataset.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -97,14 +97,14 @@ hearth_status hearth_calib_stereo(const hearth_camera *cam_a, const hearth_camer
  * write <root>/calibration/detections.json and, if overlays, the
  * calibration/overlays/<frame>_<camera>.png images. Frames are listed
  * thermal fNNN first, then each stereo pair pNNN (rgb, thermal). */
-typedef struct hearth_detect_run {
+typedef struct hearth_detect_job {
   hearth_detect_opts detect;
   int overlays; /* default 1 */
   int threads;  /* 0 = hearth_default_threads() */
   int quiet;
-} hearth_detect_run;
-void hearth_detect_run_default(hearth_detect_run *r);
-hearth_status hearth_calib_detect_release(const char *root, const hearth_detect_run *r,
+} hearth_detect_job;
+void hearth_detect_job_default(hearth_detect_job *r);
+hearth_status hearth_calib_detect_release(const char *root, const hearth_detect_job *r,
                                           hearth_detections *out, hearth_err *err);
 
 /* What `calibrate` did, frame by frame. */

@@ -15,6 +15,7 @@
 #include <stdint.h>
 #include "hearth/core.h"
 #include "hearth/sim.h"
+#include "hearth/ws.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -27,26 +28,6 @@ extern "C" {
  * single pick-and-place like LIBERO-Object, and the scripted expert needs
  * about 130-170 steps, so 280 for each. */
 int hearth_eval_time_limit(hearth_sim_task t);
-
-/* ---- openpi WebSocket client ----------------------------------------------
- * ws://HOST:PORT[/PATH]; every wait is bounded by the timeout (poll). */
-typedef struct hearth_ws hearth_ws;
-hearth_status hearth_ws_connect(const char *url, double timeout_s, hearth_ws **out, hearth_err *err);
-/* Send one message (HEARTH_WS_BINARY or HEARTH_WS_TEXT), masked, in
- * fragments of at most frag_size bytes (0 = one frame). */
-hearth_status hearth_ws_send(hearth_ws *c, int opcode, const void *data, size_t n, size_t frag_size,
-                             hearth_err *err);
-/* Receive one whole message (fragments joined, pings answered). A close
- * frame from the server is an error naming its code and reason. *data is
- * malloc'd (NUL-terminated for convenience). */
-hearth_status hearth_ws_recv(hearth_ws *c, uint8_t **data, size_t *n, int *opcode, double timeout_s,
-                             hearth_err *err);
-/* Send a ping with payload and wait for the matching pong. */
-hearth_status hearth_ws_ping(hearth_ws *c, const void *payload, size_t n, double timeout_s, hearth_err *err);
-/* Close handshake with `code` (bounded wait), then free. NULL is fine. */
-void hearth_ws_close(hearth_ws *c, int code);
-/* Close code and reason of the server's close frame, if one came (else 0). */
-int hearth_ws_close_code(const hearth_ws *c, const char **reason);
 
 /* ---- openpi observations ----------------------------------------------------
  * openpi's image_tools.resize_with_pad: scale to fit out_w x out_h keeping

@@ -128,6 +128,42 @@ hearth_status hearth_map_views_with_layout(const hearth_map_layout *l, const hea
 hearth_status hearth_map_texture(const hearth_map_result *r, double lo, double hi, int pad,
                                  const uint8_t nan_rgb[3], hearth_image *out, hearth_err *err);
 
+/* ---- stages over a release tree (layout: docs/dataset.md); each writes its
+ * outputs atomically: a stage that fails leaves the previous outputs (or none). */
+/* hearth map: one state of one instance. */
+typedef struct hearth_map_job {
+  const char *root;
+  const char *instance;
+  const char *state;
+  hearth_map_opts map;
+  const char *mesh_path;   /* NULL: derived/mesh.glb */
+  const char *poses_path;  /* NULL: derived/poses_thermal.json */
+  const char *rig_path;    /* NULL: calibration/rig.json */
+  const char *views;       /* NULL: all; else comma-separated view names */
+  const char *out_dir;     /* NULL: derived/<state> */
+  double turbo_lo, turbo_hi; /* 10, 60 */
+  hearth_map_timing *timing; /* optional: phase times of the run */
+} hearth_map_job;
+void hearth_map_job_default(hearth_map_job *job);
+/* stats (optional) receives the result's counters (arrays not kept). */
+hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats,
+                             hearth_err *err);
+
+/* hearth map --rgb: bake the colour texture from the colour views into
+ * derived/rgb_texture.png and embed it in derived/mesh.glb. */
+typedef struct hearth_bake_job {
+  const char *root;
+  const char *instance;
+  const char *state;       /* which state's colour views (NULL: the first state) */
+  size_t resolution;       /* default 1024 */
+  int pixel_stride;        /* default 2 */
+  const char *mesh_path, *poses_path, *rig_path;
+  int threads;
+} hearth_bake_job;
+/* Defaults: resolution 1024, pixel stride 2, all cores, the standard paths. */
+void hearth_bake_job_default(hearth_bake_job *job);
+hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err);
+
 #ifdef __cplusplus
 }
 #endif

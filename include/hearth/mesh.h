@@ -46,6 +46,8 @@ typedef struct hearth_glb_read_opts {
   int load_texture;       /* decode the base colour texture of the first material if embedded */
   size_t max_triangles;   /* 0: default limit (50 million) */
 } hearth_glb_read_opts;
+/* Defaults: UVs not required, no texture decoded, the 50-million limit. */
+void hearth_glb_read_opts_default(hearth_glb_read_opts *o);
 
 /* Read a GLB: walks the default scene's node hierarchy applying node
  * transforms (matrix or TRS), concatenates every triangle primitive

@@ -1,177 +1,207 @@
-/* hearth/release.h - the JSON documents of a release tree and its paths.
+/* hearth/release.h - whole-release tools: check a release against the
+ * layout contract (docs/dataset.md), summarise it as the paper's dataset
+ * overview, and build it incrementally (every stage, every instance).
  *
- * The on-disk contract is docs/dataset.md. Readers are strict: a missing
- * key, a wrong type, a non-finite number, a non-rotation R or an array of
- * the wrong length is an error naming the file and the JSON path
- * (e.g. "views[3].T_world_from_cam[2][1]"). Writers are atomic. */
+ * validate and stats only read; build writes through the stages' own atomic
+ * writers and records a small stamp per finished stage so that a second run
+ * does no work and an interrupted run resumes where it stopped. */
 #ifndef HEARTH_RELEASE_H
 #define HEARTH_RELEASE_H
 
 #include <stddef.h>
+#include <stdio.h>
 #include "hearth/core.h"
-#include "hearth/camera.h"
-#include "hearth/geom.h"
+#include "hearth/map.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-#define HEARTH_MAX_VIEWS 1024
-#define HEARTH_NAME_MAX 64
+/* ---- problems -------------------------------------------------------------- */
+/* One finding of validate: the file (or directory) and what is wrong. */
+typedef struct hearth_problem {
+  char path[512];
+  char what[1024];
+} hearth_problem;
 
-/* ---- rig.json ------------------------------------------------------------ */
-typedef struct hearth_rig {
-  hearth_camera rgb, thermal, depth;
-  hearth_rigid T_thermal_from_rgb;
-  hearth_rigid T_depth_from_rgb;
-  double thermal_rms_px, stereo_rms_px;
-} hearth_rig;
-hearth_status hearth_rig_read(const char *path, hearth_rig *rig, hearth_err *err);
-hearth_status hearth_rig_parse(const char *text, size_t len, const char *name, hearth_rig *rig,
-                               hearth_err *err);
-hearth_status hearth_rig_write(const char *path, const hearth_rig *rig, hearth_err *err);
+typedef struct hearth_problems {
+  size_t n, cap;
+  hearth_problem *items; /* owned */
+} hearth_problems;
+void hearth_problems_free(hearth_problems *p);
+/* Append a problem (printf-style message). Returns HEARTH_E_NOMEM on failure. */
+hearth_status hearth_problems_add(hearth_problems *p, const char *path, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
 
-/* ---- depth/vNN.json: per-frame depth intrinsics ------------------------- */
-typedef struct hearth_depth_intrinsics {
-  hearth_camera depth;
-  hearth_rigid T_depth_from_rgb;
-} hearth_depth_intrinsics;
-hearth_status hearth_depth_intrinsics_read(const char *path, hearth_depth_intrinsics *d,
-                                           hearth_err *err);
-hearth_status hearth_depth_intrinsics_write(const char *path, const hearth_depth_intrinsics *d,
-                                            hearth_err *err);
-hearth_status hearth_depth_intrinsics_parse(const char *text, size_t len, const char *name,
-                                            hearth_depth_intrinsics *d, hearth_err *err);
+/* ---- validate ---------------------------------------------------------------- */
+typedef struct hearth_validate_opts {
+  int threads;        /* 0 = hearth_default_threads() */
+  int raw_only;       /* 1: a capture not yet built: skip derived/ */
+  int decode_images;  /* 1: decode every JPEG/PNG fully (default 0: headers + trailer) */
+} hearth_validate_opts;
+void hearth_validate_opts_default(hearth_validate_opts *o);
 
-/* ---- calibration/factory.json: factory colour + depth calibration -------- */
-/* rig.json's schema without the thermal camera, T_thermal_from_rgb and the
- * rms fields (docs/dataset.md). */
-typedef struct hearth_factory_calib {
-  hearth_camera rgb, depth;
-  hearth_rigid T_depth_from_rgb;
-} hearth_factory_calib;
-hearth_status hearth_factory_read(const char *path, hearth_factory_calib *f, hearth_err *err);
-hearth_status hearth_factory_parse(const char *text, size_t len, const char *name,
-                                   hearth_factory_calib *f, hearth_err *err);
-hearth_status hearth_factory_write(const char *path, const hearth_factory_calib *f,
-                                   hearth_err *err);
-
-/* ---- manifest.json ------------------------------------------------------- */
-typedef struct hearth_view_files {
-  char view[HEARTH_NAME_MAX];   /* "v00" */
-  int elevation_index, azimuth_index;
-  char rgb[128], cutout[128], depth[128], depth_intrinsics[128], thermal[128];
-} hearth_view_files;
-
-typedef struct hearth_manifest {
-  char instance[HEARTH_NAME_MAX];
-  char state[HEARTH_NAME_MAX];
-  size_t n_views;
-  hearth_view_files *views; /* owned */
-} hearth_manifest;
-void hearth_manifest_free(hearth_manifest *m);
-hearth_status hearth_manifest_read(const char *path, hearth_manifest *m, hearth_err *err);
-hearth_status hearth_manifest_parse(const char *text, size_t len, const char *name,
-                                    hearth_manifest *m, hearth_err *err);
-hearth_status hearth_manifest_write(const char *path, const hearth_manifest *m, hearth_err *err);
-
-/* ---- poses_*.json ---------------------------------------------------------- */
-typedef struct hearth_view_pose {
-  char state[HEARTH_NAME_MAX];
-  char view[HEARTH_NAME_MAX];
-  hearth_rigid T_world_from_cam;
-} hearth_view_pose;
-
-typedef struct hearth_poses {
-  size_t n;
-  hearth_view_pose *views; /* owned */
-} hearth_poses;
-void hearth_poses_free(hearth_poses *p);
-hearth_status hearth_poses_read(const char *path, hearth_poses *p, hearth_err *err);
-hearth_status hearth_poses_parse(const char *text, size_t len, const char *name, hearth_poses *p,
-                                 hearth_err *err);
-hearth_status hearth_poses_write(const char *path, const hearth_poses *p, hearth_err *err);
-/* The pose of (state, view), or NULL. */
-const hearth_view_pose *hearth_poses_find(const hearth_poses *p, const char *state,
-                                          const char *view);
-
-/* ---- detections.json -------------------------------------------------------- */
-#define HEARTH_PLATE_ROWS 8
-#define HEARTH_PLATE_HOLES 84
-#define HEARTH_PLATE_PITCH_M 0.012
-#define HEARTH_PLATE_ROW_STEP_M 0.0103923
-/* Plate coordinates (metres, z = 0) of hole i in row-by-row order. */
-void hearth_plate_hole(int i, double xyz[3]);
-
-typedef struct hearth_detection {
-  char frame[HEARTH_NAME_MAX];  /* "f000", "p003" */
-  char camera[16];              /* "thermal" | "rgb" */
-  int found;
-  char reason[256];             /* when !found */
-  double centres[HEARTH_PLATE_HOLES][2];
-} hearth_detection;
-
-typedef struct hearth_detections {
-  size_t n;
-  hearth_detection *frames; /* owned */
-} hearth_detections;
-void hearth_detections_free(hearth_detections *d);
-hearth_status hearth_detections_read(const char *path, hearth_detections *d, hearth_err *err);
-hearth_status hearth_detections_parse(const char *text, size_t len, const char *name,
-                                      hearth_detections *d, hearth_err *err);
-hearth_status hearth_detections_write(const char *path, const hearth_detections *d,
+/* Check the release at root against docs/dataset.md: release.json and its
+ * instances, instance.json, every manifest and the files it lists (sizes and
+ * types of images, thermal CSVs 256x192 within -50..650 degC, depth
+ * intrinsics), calibration documents, and (unless raw_only) derived/: scale,
+ * mesh, pose files (rotations, names of existing views, a pose per view),
+ * per-state maps (R x R shapes and dtypes, mask values 0..3, observed finite
+ * where mask == 1, filled finite where mask in {1, 2}), the Turbo texture and
+ * provenance (instance, state, views of that state, resolution). Every
+ * problem found is appended to *out (in a deterministic order); the return
+ * status is not OK only when the check itself could not run (bad argument,
+ * out of memory). files_checked (may be NULL) receives the count of files
+ * examined. */
+hearth_status hearth_validate_release(const char *root, const hearth_validate_opts *o,
+                                      hearth_problems *out, size_t *files_checked,
                                       hearth_err *err);
 
-/* ---- scale.json --------------------------------------------------------------- */
-/* views_used and residual_median_mm are optional in the file (0 when absent). */
-typedef struct hearth_scale_doc {
-  double scale;
-  int views_used;
-  double residual_median_mm;
-} hearth_scale_doc;
-hearth_status hearth_scale_read(const char *path, hearth_scale_doc *s, hearth_err *err);
-hearth_status hearth_scale_write(const char *path, const hearth_scale_doc *s, hearth_err *err);
-hearth_status hearth_scale_parse(const char *text, size_t len, const char *name,
-                                 hearth_scale_doc *s, hearth_err *err);
-
-/* ---- release.json / instance.json ---------------------------------------- */
-#define HEARTH_MAX_STATES 8
-typedef struct hearth_instance_doc {
-  char id[HEARTH_NAME_MAX];        /* "cup_03" */
-  char category[HEARTH_NAME_MAX];  /* "cup" */
-  size_t n_states;
-  char states[HEARTH_MAX_STATES][HEARTH_NAME_MAX];
-  char notes[512];
-} hearth_instance_doc;
-hearth_status hearth_instance_read(const char *path, hearth_instance_doc *d, hearth_err *err);
-hearth_status hearth_instance_write(const char *path, const hearth_instance_doc *d,
-                                    hearth_err *err);
-hearth_status hearth_instance_parse(const char *text, size_t len, const char *name,
-                                    hearth_instance_doc *d, hearth_err *err);
-
-typedef struct hearth_release_doc {
-  char name[128];
-  char version[32];
-  char software_version[32];
+/* ---- stats ------------------------------------------------------------------- */
+#define HEARTH_N_STATE_KINDS 5 /* neutral hot warm iced used */
+typedef struct hearth_release_stats {
+  size_t n_categories;
+  size_t instances_per_category[18];      /* indexed like hearth_categories */
   size_t n_instances;
-  char (*instances)[HEARTH_NAME_MAX]; /* owned */
-} hearth_release_doc;
-void hearth_release_free(hearth_release_doc *d);
-hearth_status hearth_release_read(const char *path, hearth_release_doc *d, hearth_err *err);
-hearth_status hearth_release_write(const char *path, const hearth_release_doc *d,
-                                   hearth_err *err);
-hearth_status hearth_release_parse(const char *text, size_t len, const char *name,
-                                   hearth_release_doc *d, hearth_err *err);
+  size_t n_states;                        /* object states (instance x state) */
+  size_t states_by_kind[HEARTH_N_STATE_KINDS];
+  size_t n_instances_nonneutral;          /* instances with a state other than neutral */
+  size_t n_categories_nonneutral;
+  size_t views_min, views_max;            /* views per object state */
+  size_t n_elevations, n_azimuths;        /* distinct indices (0 if mixed per state) */
+  size_t n_pairs;                         /* views with both an RGB image and a thermal matrix */
+  size_t n_depth;                         /* views with a depth map */
+  size_t rgb_w, rgb_h, thermal_w, thermal_h, depth_w, depth_h; /* of the first view (0 unknown) */
+  /* derived assets present */
+  size_t n_meshes, n_rgb_textures, n_scales, n_poses_rgb, n_poses_thermal;
+  size_t n_maps;                          /* states with temperature_filled.npy + mask.npy */
+  size_t n_turbo;                         /* states with thermal_turbo.png */
+  size_t n_provenance;
+  size_t map_resolution;                  /* R of the first map (0 none) */
+  int has_calibration;                    /* calibration/rig.json present */
+  int has_ground_truth;
+  uint64_t raw_bytes, derived_bytes;      /* file sizes under raw/ and derived/ */
+} hearth_release_stats;
 
-/* ---- names ----------------------------------------------------------------- */
-/* The 18 categories of the paper, lower case with underscores
- * ("bottled_drink", "electric_kettle", ...). */
-extern const char *const hearth_categories[18];
-int hearth_category_valid(const char *name);
-/* neutral | hot | warm | iced | used */
-int hearth_state_valid(const char *name);
-/* "<category>_<NN>": a valid category, '_', two to four decimal digits. */
-int hearth_instance_id_valid(const char *id);
+hearth_status hearth_release_stats_compute(const char *root, hearth_release_stats *st,
+                                           hearth_err *err);
+/* The dataset-overview table as text (two columns, like the paper's table). */
+void hearth_release_stats_print(const hearth_release_stats *st, FILE *out);
+/* The same as a JSON document (malloc'ed, NUL-terminated; NULL if out of memory). */
+char *hearth_release_stats_json(const hearth_release_stats *st);
+
+/* ---- build ------------------------------------------------------------------- */
+/* A list of file paths, relative to the release root. */
+typedef struct hearth_build_files {
+  size_t n, cap;
+  char **paths; /* owned */
+} hearth_build_files;
+void hearth_build_files_free(hearth_build_files *f);
+hearth_status hearth_build_files_add(hearth_build_files *f, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+
+/* A release-level stage run once per release before the instances. Detection
+ * and calibration are built in (hearth_build_opts.calibrate); a caller may
+ * add stages of its own, run after them. */
+#define HEARTH_BUILD_MAX_STAGES 8
+typedef struct hearth_build_stage {
+  const char *name;     /* "detect" */
+  const char *params;   /* its parameters as text: a change forces a re-run */
+  /* fill the stage's inputs and outputs (relative to root) */
+  hearth_status (*files)(void *ctx, const char *root, hearth_build_files *in,
+                         hearth_build_files *out, hearth_err *err);
+  hearth_status (*run)(void *ctx, const char *root, int threads, hearth_err *err);
+  void *ctx;
+} hearth_build_stage;
+
+typedef struct hearth_build_opts {
+  int jobs;                   /* instances in parallel; 0 = min(cores, instances) */
+  int threads;                /* total worker threads; 0 = hearth_default_threads() */
+  int shard_index, shard_count; /* this machine does instances with index % count == index */
+  const char *only_instance;  /* NULL: all of release.json */
+  size_t resolution;          /* temperature-map R; default 1024 */
+  hearth_fusion fusion;       /* default HEARTH_FUSE_MAX */
+  double min_cos;             /* default 0 */
+  size_t rgb_resolution;      /* baked colour texture side; default 1024; 0 after default = skip */
+  int bake_rgb;               /* default 1 */
+  int force;                  /* re-run every stage */
+  int quiet;                  /* no progress output */
+  int dry_run;                /* list what would run, run nothing */
+  int calibrate;              /* default 1: detect + calibrate when calibration/captures/ exists */
+  int calib_overlays;         /* default 1: detection draws its overlay pictures */
+  size_t n_release_stages;    /* extra release-level stages (at most HEARTH_BUILD_MAX_STAGES) */
+  const hearth_build_stage *release_stages;
+  FILE *log;                  /* plain lines / summary; default stdout */
+} hearth_build_opts;
+void hearth_build_opts_default(hearth_build_opts *o);
+
+/* What happened to one instance. */
+typedef struct hearth_build_instance {
+  char id[64];
+  int failed;                 /* 1: a stage failed (later stages skipped) */
+  char failed_stage[32];
+  char reason[1024];
+  size_t n_states, states_mapped;
+  size_t stages_run, stages_skipped;
+} hearth_build_instance;
+
+typedef struct hearth_build_report {
+  size_t n_instances;         /* of this shard */
+  hearth_build_instance *instances; /* owned */
+  size_t stages_run, stages_up_to_date;
+  size_t temps_removed;       /* temporaries of killed runs removed before re-running stages */
+  int release_failed;         /* a release-level stage failed (no instance was built) */
+  char release_reason[1024];
+  double seconds;
+} hearth_build_report;
+void hearth_build_report_free(hearth_build_report *r);
+
+/* The per-instance stages, in order, and whether each is part of this build
+ * (scale, transfer, refine, bake, map). */
+size_t hearth_build_instance_stages(const char **names, int *available, size_t max);
+
+/* Run every stale stage: release-level stages once, then for each instance
+ * of this shard (in parallel) scale, transfer, refine, colour baking and
+ * every state's map. Returns HEARTH_OK when the build could run (even with
+ * failed instances, which are listed in rep); an error when release.json
+ * cannot be read or a release-level stage fails. */
+hearth_status hearth_build_release(const char *root, const hearth_build_opts *o,
+                                   hearth_build_report *rep, hearth_err *err);
+/* Print the end-of-build summary. */
+void hearth_build_report_print(const hearth_build_report *r, FILE *out);
+
+/* ---- report ------------------------------------------------------------------ */
+/* One state of the report: coverage and, with ground truth (virtual rig), the
+ * error of the observed texels against ground_truth/.../temperature_true.npy. */
+typedef struct hearth_report_entry {
+  char instance[64], state[64];
+  int has_truth;
+  size_t R, n_surface, n_observed, n_compared;
+  double coverage;               /* observed / surface texels */
+  double median_abs_c, p95_abs_c; /* |observed - true| over observed texels; NaN without truth */
+  double mean_signed_c;          /* mean (observed - true) */
+} hearth_report_entry;
+
+typedef struct hearth_report {
+  size_t n;
+  hearth_report_entry *entries; /* owned */
+} hearth_report;
+void hearth_report_free(hearth_report *r);
+
+/* A static HTML report (out_dir/index.html, no server needed) with relative
+ * links to PNGs copied or drawn into out_dir: per state the Turbo thermal
+ * texture beside the colour texture, the ground-truth texture and an error
+ * map (when ground truth exists), and the before/after overlay contact sheet
+ * (when derived/overlay/<state>/ exists); plus the numbers in rep.
+ * validate_text (may be NULL) is shown as the validation result. */
+hearth_status hearth_report_write(const char *root, const char *out_dir, const char *title,
+                                  const char *validate_text, hearth_report *rep, hearth_err *err);
 
 #ifdef __cplusplus
 }

@@ -22,6 +22,8 @@ extern "C" {
 typedef struct hearth_csv_opts {
   size_t width, height;
 } hearth_csv_opts;
+/* Defaults: 256 x 192 (the paper's camera), as with opts == NULL. */
+void hearth_csv_opts_default(hearth_csv_opts *o);
 
 /* Read into a 1-channel F32 image. opts may be NULL (expect 256x192). */
 hearth_status hearth_thermal_read_csv(const char *path, const hearth_csv_opts *opts,

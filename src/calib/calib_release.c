@@ -13,7 +13,7 @@
 
 #define MAX_FRAMES 4096
 
-void hearth_detect_run_default(hearth_detect_run *r) {
+void hearth_detect_job_default(hearth_detect_job *r) {
   memset(r, 0, sizeof *r);
   hearth_detect_opts_default(&r->detect);
   r->overlays = 1;
@@ -72,7 +72,7 @@ typedef struct det_job {
 
 typedef struct det_ctx {
   det_job *jobs;
-  const hearth_detect_run *run;
+  const hearth_detect_job *run;
   int want_rgb_w, want_rgb_h;
 } det_ctx;
 
@@ -167,11 +167,11 @@ static hearth_status write_overlay(const char *path, const det_job *j, hearth_er
   return st;
 }
 
-hearth_status hearth_calib_detect_release(const char *root, const hearth_detect_run *run,
+hearth_status hearth_calib_detect_release(const char *root, const hearth_detect_job *run,
                                           hearth_detections *out, hearth_err *err) {
-  hearth_detect_run def;
+  hearth_detect_job def;
   if (!run) {
-    hearth_detect_run_default(&def);
+    hearth_detect_job_default(&def);
     run = &def;
   }
   if (!root) return hearth_err_set(err, HEARTH_E_ARG, "detect: no release root");

@@ -3,7 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "cli/cli.h"
-#include "hearth/release.h"
+#include "hearth/dataset.h"
 
 hearth_status cli_instances(const char *root, const char *only, cli_names *out, hearth_err *err) {
   memset(out, 0, sizeof *out);

@@ -1,4 +1,4 @@
-/* shared by the hearth-sim commands (cmd_sim.c, cmd_sim_eval.c) */
+/* shared by the hearth-sim commands (cmd_sim.c, cmd_sim_eval.c, sim_main.c) */
 #ifndef HEARTH_CLI_SIM_H
 #define HEARTH_CLI_SIM_H
 #include <stddef.h>
@@ -13,6 +13,9 @@ int sim_cli_assets(const char *release, int gt, char *root, size_t rootsz, char 
 /* Removes what sim_cli_assets made (nothing for a given release). */
 void sim_cli_drop_assets(const char *tmpdir);
 
+/* the subcommands (argv[0] is the subcommand's name) */
+int hearth_cmd_sim_render(int argc, char **argv);
+int hearth_cmd_sim_collect(int argc, char **argv);
 int hearth_cmd_sim_eval(int argc, char **argv);
 
 #endif

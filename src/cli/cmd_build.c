@@ -3,7 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "cli/cli.h"
-#include "cli/cli_build.h"
+#include "hearth/release.h"
 
 static const char *k_help =
     "usage: hearth build ROOT [-j N] [--shard I/N] [options]\n"
@@ -45,7 +45,6 @@ int hearth_cmd_build(int argc, char **argv) {
   const char *root = NULL;
   hearth_build_opts o;
   hearth_build_opts_default(&o);
-  int calib_overlays = 1;
   for (int i = 1; i < argc; i++) {
     const char *v = NULL;
     int r;
@@ -96,7 +95,7 @@ int hearth_cmd_build(int argc, char **argv) {
     } else if (!strcmp(argv[i], "--no-bake")) {
       o.bake_rgb = 0;
     } else if (!strcmp(argv[i], "--no-overlays")) {
-      calib_overlays = 0;
+      o.calib_overlays = 0;
     } else if (!strcmp(argv[i], "--force")) {
       o.force = 1;
     } else if (!strcmp(argv[i], "--dry-run")) {
@@ -125,9 +124,6 @@ int hearth_cmd_build(int argc, char **argv) {
     fprintf(stderr, "hearth build: missing ROOT\n%s", k_help);
     return 2;
   }
-  hearth_build_stage stages[4];
-  o.n_release_stages = cli_release_stages(root, calib_overlays, stages, 4);
-  o.release_stages = stages;
   hearth_build_report rep;
   hearth_err err = {0};
   hearth_status s = hearth_build_release(root, &o, &rep, &err);

@@ -84,8 +84,8 @@ int hearth_cmd_calibrate(int argc, char **argv) {
     return 2;
   }
   if (detect) {
-    hearth_detect_run run;
-    hearth_detect_run_default(&run);
+    hearth_detect_job run;
+    hearth_detect_job_default(&run);
     run.overlays = overlays;
     run.quiet = 1;
     hearth_detections d = {0, NULL};

@@ -5,9 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include "cli/cli.h"
-#include "cli/cli_build.h"
+#include "hearth/dataset.h"
 #include "hearth/release.h"
-#include "hearth/release_tools.h"
 #include "hearth/synth.h"
 
 static const char *k_help =
@@ -111,9 +110,7 @@ int hearth_cmd_demo(int argc, char **argv) {
   fflush(stdout);
   hearth_build_opts bo;
   hearth_build_opts_default(&bo);
-  hearth_build_stage stages[4];
-  bo.n_release_stages = cli_release_stages(root, 0, stages, 4);
-  bo.release_stages = stages;
+  bo.calib_overlays = 0;
   bo.threads = threads;
   bo.resolution = R;
   bo.rgb_resolution = 512;

@@ -28,8 +28,8 @@ static const char *k_help =
 
 int hearth_cmd_detect(int argc, char **argv) {
   const char *root = NULL;
-  hearth_detect_run run;
-  hearth_detect_run_default(&run);
+  hearth_detect_job run;
+  hearth_detect_job_default(&run);
   for (int i = 1; i < argc; i++) {
     const char *v;
     int r;

@@ -132,7 +132,7 @@ static hearth_status inspect_one(const char *path, const char *kind, hearth_err 
     hearth_detections_free(&d);
   } else if (!strcmp(kind, "scale")) {
     hearth_scale_doc sc;
-    if ((s = hearth_scale_read(path, &sc, err))) return s;
+    if ((s = hearth_scale_doc_read(path, &sc, err))) return s;
     printf("%s: scale %.6f from %d views, residual median %.3f mm\n", path, sc.scale, sc.views_used,
            sc.residual_median_mm);
   } else if (!strcmp(kind, "instance")) {

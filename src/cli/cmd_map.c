@@ -3,7 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "cli/cli.h"
-#include "hearth/pipeline.h"
+#include "hearth/map.h"
 
 static const char *k_help =
     "usage: hearth map ROOT [--instance ID] [--state S] [options]\n"

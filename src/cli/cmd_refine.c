@@ -3,7 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "cli/cli.h"
-#include "hearth/refine.h"
+#include "hearth/poses.h"
 
 static const char *k_help =
     "usage: hearth refine ROOT [--instance ID] [--state S] [options]\n"

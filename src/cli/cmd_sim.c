@@ -1,4 +1,4 @@
-/* hearth sim: the temperature-aware manipulation tasks (render, collect) */
+/* hearth sim render, hearth sim collect: scene pictures and demonstrations */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -8,20 +8,6 @@
 #include "cli/cli_sim.h"
 #include "hearth/hearth.h"
 #include "hearth/sim.h"
-
-static const char *k_usage =
-    "usage: hearth sim <subcommand> [options]\n"
-    "\n"
-    "The paper's LIBERO-derived tasks on MuJoCo with hearth assets:\n"
-    "  H1 study table: hot / normal cup (distractors: hot kettle, eraser)\n"
-    "  H2 kitchen table: iced / normal can (distractors: iced orange, cup)\n"
-    "  H3 kitchen table: hot phone / hot sponge (distractors: orange, hot cup)\n"
-    "\n"
-    "subcommands:\n"
-    "  render    write PNGs of each task's scene: front RGB, front thermal, wrist RGB\n"
-    "  collect   collect scripted-expert demonstrations into a LIBERO HDF5 file\n"
-    "\n"
-    "Run `hearth sim <subcommand> --help` for its options.\n";
 
 static const char *k_usage_render =
     "usage: hearth sim render --out DIR [options]\n"
@@ -77,55 +63,7 @@ static const char *k_usage_collect =
     "  --quiet           no progress output\n"
     "  -h, --help        this text\n";
 
-/* assets: a release root given, or a tiny virtual-rig release in a temp dir */
-int sim_cli_assets(const char *release, int gt, char *root, size_t rootsz, char *tmpdir, size_t tsz,
-                   int *use_gt, int quiet) {
-  tmpdir[0] = 0;
-  if (release) {
-    snprintf(root, rootsz, "%s", release);
-    *use_gt = gt;
-    return 0;
-  }
-  const char *t = getenv("TMPDIR");
-  snprintf(tmpdir, tsz, "%s/hearth_sim_assets_XXXXXX", t && *t ? t : "/tmp");
-  if (!mkdtemp(tmpdir)) {
-    fprintf(stderr, "hearth sim: cannot create a temporary directory %s\n", tmpdir);
-    tmpdir[0] = 0;
-    return 1;
-  }
-  snprintf(root, rootsz, "%s/release", tmpdir);
-  hearth_synth_opts so;
-  hearth_synth_opts_default(&so);
-  so.out_root = root;
-  const char *cats[] = {"cup", "canned_drink", "electric_kettle", "eraser", "orange", "smartphone", "sponge"};
-  so.n_categories = 7;
-  for (int i = 0; i < 7; i++) so.categories[i] = cats[i];
-  so.n_states = 3;
-  so.states[0] = "neutral", so.states[1] = "hot", so.states[2] = "iced";
-  so.n_views = 6; /* 2 azimuths per elevation: enough for the up direction */
-  so.triangles = 4000;
-  so.texture_size = 256;
-  so.map_resolution = 256;
-  so.calibration = 0;
-  so.rgb_full_size = 0; /* draft raw colour frames: the sim reads none of them */
-  so.quiet = 1;
-  if (!quiet) fprintf(stderr, "hearth sim: making assets with the virtual rig...\n");
-  hearth_err err = {0};
-  if (hearth_synth_release(&so, &err)) {
-    /* nothing half-made is left behind */
-    hearth_remove_tree(tmpdir, NULL);
-    tmpdir[0] = 0;
-    return cli_fail("sim", &err);
-  }
-  *use_gt = 1;
-  return 0;
-}
-
-void sim_cli_drop_assets(const char *tmpdir) {
-  if (tmpdir[0]) hearth_remove_tree(tmpdir, NULL);
-}
-
-static int cmd_render(int argc, char **argv) {
+int hearth_cmd_sim_render(int argc, char **argv) {
   const char *out = NULL, *release = NULL, *v;
   hearth_sim_task only = 0;
   long size = 256;
@@ -203,7 +141,7 @@ static int cmd_render(int argc, char **argv) {
   return rc;
 }
 
-static int cmd_collect(int argc, char **argv) {
+int hearth_cmd_sim_collect(int argc, char **argv) {
   hearth_sim_collect_opts o;
   hearth_sim_collect_opts_default(&o);
   o.task = 0;
@@ -263,17 +201,4 @@ static int cmd_collect(int argc, char **argv) {
          s.rejected_layouts, s.steps, s.seconds, s.seconds > 0 ? s.steps / s.seconds : 0.0,
          o.out_path);
   return 0;
-}
-
-
-int hearth_cmd_sim(int argc, char **argv) {
-  if (argc < 2 || cli_is_help(argv[1])) {
-    fputs(k_usage, argc < 2 ? stderr : stdout);
-    return argc < 2 ? 2 : 0;
-  }
-  if (strcmp(argv[1], "render") == 0) return cmd_render(argc - 1, argv + 1);
-  if (strcmp(argv[1], "collect") == 0) return cmd_collect(argc - 1, argv + 1);
-  if (strcmp(argv[1], "eval") == 0) return hearth_cmd_sim_eval(argc - 1, argv + 1);
-  fprintf(stderr, "hearth sim: unknown subcommand '%s'\n%s", argv[1], k_usage);
-  return 2;
 }

@@ -3,7 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "cli/cli.h"
-#include "hearth/release_tools.h"
+#include "hearth/release.h"
 
 static const char *k_help =
     "usage: hearth stats ROOT [--json FILE] [--format text|json]\n"

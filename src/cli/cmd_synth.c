@@ -3,7 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "cli/cli.h"
-#include "hearth/release.h"
+#include "hearth/dataset.h"
 #include "hearth/synth.h"
 
 static void synth_usage(FILE *out) {

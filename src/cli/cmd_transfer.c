@@ -3,7 +3,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include "cli/cli.h"
-#include "hearth/pipeline.h"
+#include "hearth/map.h"
+#include "hearth/poses.h"
 
 static const char *k_help =
     "usage: hearth transfer ROOT [--instance ID] [--rig FILE] [--poses FILE] [--keep-refined]\n"

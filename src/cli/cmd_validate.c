@@ -2,7 +2,7 @@
 #include <stdio.h>
 #include <string.h>
 #include "cli/cli.h"
-#include "hearth/release_tools.h"
+#include "hearth/release.h"
 
 static const char *k_help =
     "usage: hearth validate ROOT [--raw-only] [--decode] [--threads N] [--quiet]\n"

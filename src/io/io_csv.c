@@ -564,3 +564,8 @@ hearth_status hearth_thermal_write_csv(const char *path, const hearth_image *tem
   free(buf);
   return st;
 }
+
+void hearth_csv_opts_default(hearth_csv_opts *o) {
+  o->width = 256;
+  o->height = 192;
+}

@@ -1258,3 +1258,5 @@ hearth_status hearth_glb_write(const char *path, const hearth_mesh *m, hearth_er
   free(data);
   return s;
 }
+
+void hearth_glb_read_opts_default(hearth_glb_read_opts *o) { memset(o, 0, sizeof *o); }

@@ -7,7 +7,7 @@
 
 #include "hearth/geom.h"
 #include "hearth/npy.h"
-#include "hearth/release.h"
+#include "hearth/dataset.h"
 #include "sim/sim_internal.h"
 
 /* masses are typical for the real objects; the narrow-extent caps keep

@@ -12,7 +12,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 #include "hearth/npy.h"
-#include "hearth/release.h"
+#include "hearth/dataset.h"
 #include "hearth/thermal.h"
 #include "synth/synth_rig.h"
 
@@ -501,7 +501,7 @@ static hearth_status write_instance(const render_ctx *rc, const char *root, synt
   if ((st = write_poses(p, inst, rc->rig, 1, 0, err))) return st;
   hearth_scale_doc sd = {inst->scale, (int)(inst->n_views * inst->n_states), 0.0};
   snprintf(p, sizeof p, "%s/scale.json", gt);
-  if ((st = hearth_scale_write(p, &sd, err))) return st;
+  if ((st = hearth_scale_doc_write(p, &sd, err))) return st;
 
   /* true temperature per texel */
   size_t R = o->map_resolution ? o->map_resolution : 1024, RR;

@@ -14,7 +14,7 @@
 #include "hearth/geom.h"
 #include "hearth/image.h"
 #include "hearth/mesh.h"
-#include "hearth/release.h"
+#include "hearth/dataset.h"
 #include "hearth/synth.h"
 #include "synth/synth_object.h"
 

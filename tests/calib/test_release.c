@@ -117,8 +117,8 @@ int main(void) {
   hearth_rigid Tba;
   make_release(root, 8, 4, &th, &rgb, &Tba);
   hearth_err err = {0};
-  hearth_detect_run run;
-  hearth_detect_run_default(&run);
+  hearth_detect_job run;
+  hearth_detect_job_default(&run);
   run.threads = 2;
   hearth_detections d = {0, NULL};
   CHECK_OK(hearth_calib_detect_release(root, &run, &d, &err), &err);

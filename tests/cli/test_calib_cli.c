@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "hearth/calib.h"
-#include "hearth/release.h"
+#include "hearth/dataset.h"
 #include "hearth/synth.h"
 #include "test_util.h"
 

@@ -5,7 +5,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
-#include "hearth/release.h"
+#include "hearth/dataset.h"
 #include "hearth/thermal.h"
 #include "hearth/mesh.h"
 #include "synth/synth_object.h"

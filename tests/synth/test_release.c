@@ -13,7 +13,7 @@
 #include "hearth/image.h"
 #include "hearth/mesh.h"
 #include "hearth/npy.h"
-#include "hearth/release.h"
+#include "hearth/dataset.h"
 #include "hearth/synth.h"
 #include "hearth/thermal.h"
 #include "synth/synth_rig.h"
@@ -298,7 +298,7 @@ static void check_release(const char *root, const hearth_synth_opts *o) {
   /* recon mesh x true scale == ground-truth mesh; same UVs */
   hearth_scale_doc sd;
   snprintf(p, sizeof p, "%s/ground_truth/instances/cup_01/scale.json", root);
-  CHECK_OK(hearth_scale_read(p, &sd, &err), &err);
+  CHECK_OK(hearth_scale_doc_read(p, &sd, &err), &err);
   CHECK(sd.scale >= 0.3 && sd.scale <= 3.0);
   hearth_glb_read_opts ro = {1, 1, 0};
   hearth_mesh mr = {0}, mg = {0};

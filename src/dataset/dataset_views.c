@@ -4,9 +4,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "hearth/release.h"
-#include "io/io_json.h"
-#include "io/io_release_priv.h"
+#include "hearth/dataset.h"
+#include "dataset/dataset_json.h"
+#include "dataset/dataset_internal.h"
 
 /* poses cover every state of an instance; detections every capture frame */
 #define HR_MAX_POSES ((size_t)HEARTH_MAX_VIEWS * HEARTH_MAX_STATES)
@@ -15,61 +15,6 @@
 
 #define HR_CONVENTION "T_world_from_cam, OpenCV camera axes"
 #define HR_UNITS "m"
-
-/* ---- duplicates ------------------------------------------------------------------ */
-
-typedef struct hr_keyed {
-  const char *a, *b;
-  size_t i;
-} hr_keyed;
-
-static int hr_keyed_cmp(const void *pa, const void *pb) {
-  const hr_keyed *x = pa, *y = pb;
-  int c = strcmp(x->a, y->a);
-  if (!c && x->b && y->b) c = strcmp(x->b, y->b);
-  if (!c) c = (x->i > y->i) - (x->i < y->i);
-  return c;
-}
-
-int hr_find_duplicate(size_t n, hr_key_fn key, const void *ctx, size_t *first, size_t *second) {
-  if (n < 2) return 0;
-  hr_keyed *k = hearth_alloc_array(n, sizeof *k);
-  int found = 0;
-  if (!k) {
-    /* no memory for the sort: fall back to the quadratic scan */
-    for (size_t j = 1; j < n && !found; j++)
-      for (size_t i = 0; i < j && !found; i++) {
-        const char *a1, *b1, *a2, *b2;
-        key(ctx, i, &a1, &b1);
-        key(ctx, j, &a2, &b2);
-        if (!strcmp(a1, a2) && (!b1 || !b2 || !strcmp(b1, b2))) {
-          *first = i;
-          *second = j;
-          found = 1;
-        }
-      }
-    return found;
-  }
-  for (size_t i = 0; i < n; i++) {
-    key(ctx, i, &k[i].a, &k[i].b);
-    k[i].i = i;
-  }
-  qsort(k, n, sizeof *k, hr_keyed_cmp);
-  /* equal keys sit together ordered by index; report the smallest repeat */
-  for (size_t j = 1; j < n; j++) {
-    int same = !strcmp(k[j].a, k[j - 1].a) && (!k[j].b || !strcmp(k[j].b, k[j - 1].b));
-    if (same && (!found || k[j].i < *second)) {
-      size_t g = j - 1;
-      while (g > 0 && !strcmp(k[g - 1].a, k[j].a) && (!k[j].b || !strcmp(k[g - 1].b, k[j].b)))
-        g--;
-      *first = k[g].i;
-      *second = k[j].i;
-      found = 1;
-    }
-  }
-  free(k);
-  return found;
-}
 
 /* ---- manifest.json ------------------------------------------------------------------ */
 

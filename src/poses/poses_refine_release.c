@@ -4,9 +4,9 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include "hearth/release.h"
+#include "hearth/dataset.h"
 #include "hearth/thermal.h"
-#include "map/map_refine_priv.h"
+#include "poses/poses_internal.h"
 
 void hearth_refine_job_default(hearth_refine_job *job) {
   memset(job, 0, sizeof *job);

@@ -14,8 +14,8 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include "hearth/release.h"
-#include "map/map_refine_priv.h"
+#include "hearth/dataset.h"
+#include "poses/poses_internal.h"
 
 #define RF_BISECT 5           /* silhouette to 1/32 px */
 #define RF_EVAL_WINDOW 3.0    /* px: edge search window of the criterion */

@@ -3,9 +3,9 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include "hearth/release.h"
+#include "hearth/dataset.h"
 #include "hearth/thermal.h"
-#include "map/map_refine_priv.h"
+#include "poses/poses_internal.h"
 
 static int cmp_float(const void *a, const void *b) {
   float x = *(const float *)a, y = *(const float *)b;
@@ -179,4 +179,9 @@ done:
   hearth_poses_free(&before);
   hearth_poses_free(&after);
   return s;
+}
+
+void hearth_overlay_job_default(hearth_overlay_job *job) {
+  memset(job, 0, sizeof *job);
+  job->zoom = 3;
 }

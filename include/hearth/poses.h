@@ -1,12 +1,12 @@
-/* hearth/refine.h - metric scale recovery from depth maps, automatic
+/* hearth/poses.h - metric scale recovery from depth maps, automatic
  * thermal-pose refinement and alignment overlays (the paper's "scale
  * recovery" and its manual per-view refinement, made automatic).
  *
  * Frames: recon/ is the reconstruction frame at unknown scale; a point
  * x_recon is at s * x_recon metres (docs/conventions.md). Depth PNGs hold z
  * along the depth camera's +z axis in millimetres, 0 = no measurement. */
-#ifndef HEARTH_REFINE_H
-#define HEARTH_REFINE_H
+#ifndef HEARTH_POSES_H
+#define HEARTH_POSES_H
 
 #include <stddef.h>
 #include "hearth/camera.h"
@@ -71,6 +71,8 @@ typedef struct hearth_scale_job {
   const char *state;      /* NULL: depth frames of every state */
   hearth_scale_opts opts;
 } hearth_scale_job;
+/* Defaults: every state, hearth_scale_opts_default. */
+void hearth_scale_job_default(hearth_scale_job *job);
 hearth_status hearth_scale_run(const hearth_scale_job *job, hearth_scale_result *res,
                                hearth_err *err);
 
@@ -187,7 +189,27 @@ typedef struct hearth_overlay_job {
   double lo, hi;            /* default auto */
   int threads;
 } hearth_overlay_job;
+/* Defaults: every state, zoom 3, automatic temperature range, all cores. */
+void hearth_overlay_job_default(hearth_overlay_job *job);
 hearth_status hearth_overlay_run(const hearth_overlay_job *job, size_t *n_written, hearth_err *err);
+
+/* ---- transfer: stage over a release tree (layout: docs/dataset.md) --------- */
+/* hearth transfer: T_world_from_th = T_world_from_rgb * inverse(T_th_from_rgb)
+ * for every view of every state. Reads derived/poses_rgb.json and
+ * calibration/rig.json (rig_path overrides); writes
+ * derived/poses_thermal_transferred.json and, unless a refined
+ * derived/poses_thermal.json newer than it exists or keep_refined is 0,
+ * derived/poses_thermal.json. */
+typedef struct hearth_transfer_job {
+  const char *root;
+  const char *instance;    /* required */
+  const char *rig_path;    /* NULL: <root>/calibration/rig.json */
+  const char *poses_path;  /* NULL: <root>/instances/<id>/derived/poses_rgb.json */
+  int keep_refined;        /* 1: do not overwrite a refined poses_thermal.json */
+} hearth_transfer_job;
+/* Defaults: the standard paths, keep_refined 0. */
+void hearth_transfer_job_default(hearth_transfer_job *job);
+hearth_status hearth_transfer_run(const hearth_transfer_job *job, hearth_err *err);
 
 #ifdef __cplusplus
 }

@@ -1,6 +1,6 @@
 /* Strict JSON reading with JSON paths in every message, and a deterministic
  * pretty printer, shared by the documents of a release (io_release.c). */
-#include "io/io_json.h"
+#include "dataset/dataset_json.h"
 
 #include <locale.h>
 #include <math.h>
@@ -9,7 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "hearth/release.h"
+#include "hearth/dataset.h"
 
 /* ---- context and paths ---------------------------------------------------- */
 

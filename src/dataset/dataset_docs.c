@@ -1,64 +1,14 @@
 /* The JSON documents of a release tree (docs/dataset.md): rig.json,
  * calibration/factory.json, depth/vNN.json, scale.json, instance.json,
  * release.json, plus names and the plate layout. manifest, poses and
- * detections live in io_release_views.c. */
+ * detections live in dataset_views.c. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "hearth/release.h"
-#include "io/io_json.h"
-#include "io/io_release_priv.h"
-
-/* ---- shared plumbing ---------------------------------------------------------- */
-
-hearth_status hr_parse_doc(const char *text, size_t len, const char *name, hr_from_json_fn fn,
-                           void *out, hearth_err *err) {
-  hj_ctx c;
-  hj_init(&c, name, err);
-  json_t *root;
-  hearth_status s = hj_load(&c, text, len, &root);
-  if (s) return s;
-  s = fn(&c, root, out);
-  json_decref(root);
-  return s;
-}
-
-hearth_status hr_read_doc(const char *path, hr_from_json_fn fn, void *out, hearth_err *err) {
-  char *text;
-  size_t len;
-  hearth_status s = hj_read_text(path, &text, &len, err);
-  if (s) return s;
-  s = hr_parse_doc(text, len, path, fn, out, err);
-  free(text);
-  return s;
-}
-
-/* a required string that must be non-empty */
-hearth_status hr_get_nonempty(hj_ctx *c, const json_t *obj, const char *key, char *buf,
-                              size_t bufsz) {
-  hearth_status s = hj_get_string(c, obj, key, buf, bufsz);
-  if (s) return s;
-  if (!buf[0]) {
-    size_t m = hj_push_key(c, key);
-    s = hj_fail(c, HEARTH_E_RANGE, "expected a non-empty string");
-    hj_pop(c, m);
-  }
-  return s;
-}
-
-/* a required string that passes check(), with a description of what passes */
-hearth_status hr_get_checked(hj_ctx *c, const json_t *obj, const char *key, char *buf,
-                             size_t bufsz, int (*check)(const char *), const char *expected) {
-  hearth_status s = hj_get_string(c, obj, key, buf, bufsz);
-  if (s) return s;
-  if (!check(buf)) {
-    size_t m = hj_push_key(c, key);
-    s = hj_fail(c, HEARTH_E_RANGE, "expected %s, found \"%s\"", expected, buf);
-    hj_pop(c, m);
-  }
-  return s;
-}
+#include "hearth/dataset.h"
+#include "dataset/dataset_json.h"
+#include "dataset/dataset_internal.h"
 
 /* ---- names ------------------------------------------------------------------------ */
 
@@ -279,22 +229,22 @@ static hearth_status scale_from_json(hj_ctx *c, const json_t *root, void *out) {
   return HEARTH_OK;
 }
 
-hearth_status hearth_scale_parse(const char *text, size_t len, const char *name,
+hearth_status hearth_scale_doc_parse(const char *text, size_t len, const char *name,
                                  hearth_scale_doc *s, hearth_err *err) {
   return hr_parse_doc(text, len, name, scale_from_json, s, err);
 }
 
-hearth_status hearth_scale_read(const char *path, hearth_scale_doc *s, hearth_err *err) {
+hearth_status hearth_scale_doc_read(const char *path, hearth_scale_doc *s, hearth_err *err) {
   return hr_read_doc(path, scale_from_json, s, err);
 }
 
 static hearth_status scale_validate(const char *text, size_t len, const char *name,
                                     hearth_err *err) {
   hearth_scale_doc d;
-  return hearth_scale_parse(text, len, name, &d, err);
+  return hearth_scale_doc_parse(text, len, name, &d, err);
 }
 
-hearth_status hearth_scale_write(const char *path, const hearth_scale_doc *s, hearth_err *err) {
+hearth_status hearth_scale_doc_write(const char *path, const hearth_scale_doc *s, hearth_err *err) {
   json_t *o = json_object();
   int ok = hj_set(o, "scale", hj_real(s->scale)) &&
            hj_set(o, "views_used", json_integer(s->views_used)) &&

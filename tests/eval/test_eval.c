@@ -1,6 +1,6 @@
 /* policy evaluation end to end on a tiny virtual-rig release: the oracle
  * solves every instruction, a replayed demo reproduces its success and its
- * states exactly, an openpi-protocol server (tests/sim/policy_server.py)
+ * states exactly, an openpi-protocol server (tests/eval/policy_server.py)
  * serving a demo's actions succeeds, a misbehaving server fails episodes
  * with reasons while the evaluation goes on, and the RGB-only probe: a
  * selector seeing only RGB cannot beat chance at choosing the H1/H2 target,
@@ -125,7 +125,7 @@ typedef struct server {
 static int start_server(server *s, const char *name, const char *const *extra) {
   const char *src = getenv("HEARTH_SOURCE_DIR");
   char script[1200], portf[1200];
-  snprintf(script, sizeof script, "%s/tests/sim/policy_server.py", src ? src : ".");
+  snprintf(script, sizeof script, "%s/tests/eval/policy_server.py", src ? src : ".");
   snprintf(portf, sizeof portf, "%s/%s.port", g_dir, name);
   snprintf(s->log, sizeof s->log, "%s/%s.log", g_dir, name);
   unlink(portf), unlink(s->log);

@@ -1,9 +1,9 @@
-/* io_release_priv.h - plumbing shared by io_release.c and io_release_views.c. */
-#ifndef HEARTH_IO_RELEASE_PRIV_H
-#define HEARTH_IO_RELEASE_PRIV_H
+/* Private to the dataset area: plumbing shared by its documents (dataset_common.c). */
+#ifndef HEARTH_DATASET_INTERNAL_H
+#define HEARTH_DATASET_INTERNAL_H
 
-#include "hearth/release.h"
-#include "io/io_json.h"
+#include "hearth/dataset.h"
+#include "dataset/dataset_json.h"
 
 /* fill out from a parsed document; on failure leave nothing allocated in out */
 typedef hearth_status (*hr_from_json_fn)(hj_ctx *c, const json_t *root, void *out);

@@ -12,8 +12,8 @@
 #include "hearth/image.h"
 #include "hearth/mesh.h"
 #include "hearth/npy.h"
+#include "hearth/dataset.h"
 #include "hearth/release.h"
-#include "hearth/release_tools.h"
 #include "hearth/thermal.h"
 
 #define PATH_SZ 4096
@@ -516,7 +516,7 @@ static void check_instance(const char *root, const char *id, const hearth_valida
   (*nfiles)++;
   hearth_scale_doc sd;
   if (!file_exists(path)) hearth_problems_add(p, path, "missing");
-  else if (hearth_scale_read(path, &sd, &e)) add_err(p, path, &e);
+  else if (hearth_scale_doc_read(path, &sd, &e)) add_err(p, path, &e);
   snprintf(path, sizeof path, "%s/derived/mesh.glb", dir);
   (*nfiles)++;
   if (!file_exists(path)) {
@@ -613,7 +613,7 @@ static void check_ground_truth(const char *root, const hearth_release_doc *rel, 
     hearth_scale_doc sd;
     snprintf(path, sizeof path, "%s/ground_truth/instances/%s/scale.json", root, rel->instances[i]);
     (*nfiles)++;
-    if (hearth_scale_read(path, &sd, &e)) add_err(p, path, &e);
+    if (hearth_scale_doc_read(path, &sd, &e)) add_err(p, path, &e);
   }
 }
 

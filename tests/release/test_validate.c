@@ -5,10 +5,11 @@
 #include <stdlib.h>
 #include <string.h>
 #include "hearth/npy.h"
-#include "hearth/pipeline.h"
-#include "hearth/refine.h"
+#include "hearth/map.h"
+#include "hearth/poses.h"
+#include "hearth/poses.h"
+#include "hearth/dataset.h"
 #include "hearth/release.h"
-#include "hearth/release_tools.h"
 #include "hearth/synth.h"
 #include "test_util.h"
 

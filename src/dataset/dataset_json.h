@@ -1,11 +1,11 @@
-/* io_json.h - private helpers shared by the JSON documents of a release:
+/* dataset_json.h - private helpers shared by the JSON documents of a release:
  * strict typed getters that track the JSON path of the value being read,
  * and a deterministic pretty printer with shortest round-trip numbers.
  *
  * Error messages read "<file>: <json path>: <what was expected>", e.g.
  * "poses.json: views[3].T_world_from_cam[2][1]: expected a number, found a string". */
-#ifndef HEARTH_IO_JSON_H
-#define HEARTH_IO_JSON_H
+#ifndef HEARTH_DATASET_JSON_H
+#define HEARTH_DATASET_JSON_H
 
 #include <jansson.h>
 #include <stddef.h>

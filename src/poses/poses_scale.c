@@ -11,8 +11,8 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include "hearth/release.h"
-#include "map/map_refine_priv.h"
+#include "hearth/dataset.h"
+#include "poses/poses_internal.h"
 
 #define SCALE_MAX_ROUNDS 6
 
@@ -293,7 +293,7 @@ static hearth_status write_scale_json(const char *path, const hearth_scale_resul
   size_t len = strlen(text);
   /* the document must pass the release reader before it is written */
   hearth_scale_doc chk;
-  hearth_status s = hearth_scale_parse(text, len, path, &chk, err);
+  hearth_status s = hearth_scale_doc_parse(text, len, path, &chk, err);
   if (!s) s = hearth_write_file_atomic(path, text, len, err);
   free(text);
   return s;
@@ -401,4 +401,9 @@ done:
   hearth_mesh_free(&mesh);
   hearth_poses_free(&poses);
   return s;
+}
+
+void hearth_scale_job_default(hearth_scale_job *job) {
+  memset(job, 0, sizeof *job);
+  hearth_scale_opts_default(&job->opts);
 }

@@ -1,10 +1,12 @@
-/* Detection and calibration as release-level build stages. */
+/* Detection and calibration as release-level build stages (hearth_build_release
+ * runs them before the instances when calibration/captures/ exists). */
 #include <dirent.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include "cli/cli_build.h"
 #include "hearth/calib.h"
+#include "hearth/release.h"
+#include "release/release_internal.h"
 
 /* every capture frame, sorted, so a new or changed frame re-runs detection */
 static hearth_status detect_files(void *ctx, const char *root, hearth_build_files *in,
@@ -29,8 +31,8 @@ static hearth_status detect_files(void *ctx, const char *root, hearth_build_file
 }
 
 static hearth_status detect_run(void *ctx, const char *root, int threads, hearth_err *err) {
-  hearth_detect_run r;
-  hearth_detect_run_default(&r);
+  hearth_detect_job r;
+  hearth_detect_job_default(&r);
   r.overlays = *(const int *)ctx;
   r.threads = threads;
   r.quiet = 1;
@@ -61,7 +63,7 @@ static hearth_status calib_run(void *ctx, const char *root, int threads, hearth_
   return s;
 }
 
-size_t cli_release_stages(const char *root, int overlays, hearth_build_stage *stages, size_t max) {
+size_t hb_calib_stages(const char *root, int overlays, hearth_build_stage *stages, size_t max) {
   static const int k_overlays_on = 1, k_overlays_off = 0;
   char dir[4096];
   snprintf(dir, sizeof dir, "%s/calibration/captures", root);

@@ -1,10 +1,10 @@
 /* Private helpers shared by scale recovery, pose refinement and overlays. */
-#ifndef HEARTH_MAP_REFINE_PRIV_H
-#define HEARTH_MAP_REFINE_PRIV_H
+#ifndef HEARTH_POSES_INTERNAL_H
+#define HEARTH_POSES_INTERNAL_H
 
 #include <stdarg.h>
 #include <stdio.h>
-#include "hearth/refine.h"
+#include "hearth/poses.h"
 
 #define RF_PATH 4096
 

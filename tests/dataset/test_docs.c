@@ -10,7 +10,7 @@
 #include <stdint.h>
 #include <unistd.h>
 
-#include "hearth/release.h"
+#include "hearth/dataset.h"
 #include "test_util.h"
 
 static const char *g_dir;
@@ -248,13 +248,13 @@ static void test_round_trips(void) {
   hearth_detections_free(&d2);
 
   hearth_scale_doc sc = {0.9734123456789, 28, 0.8}, sc2;
-  CHECK_OK(hearth_scale_write(tpath("scale.json"), &sc, &err), &err);
-  CHECK_OK(hearth_scale_read(tpath("scale.json"), &sc2, &err), &err);
+  CHECK_OK(hearth_scale_doc_write(tpath("scale.json"), &sc, &err), &err);
+  CHECK_OK(hearth_scale_doc_read(tpath("scale.json"), &sc2, &err), &err);
   CHECK(sc.scale == sc2.scale && sc.views_used == sc2.views_used &&
         sc.residual_median_mm == sc2.residual_median_mm);
   /* the contract only fixes "scale": the statistics may be absent */
   const char *minimal = "{\"scale\": 2.5, \"note\": \"free\"}";
-  CHECK_OK(hearth_scale_parse(minimal, strlen(minimal), "mem", &sc2, &err), &err);
+  CHECK_OK(hearth_scale_doc_parse(minimal, strlen(minimal), "mem", &sc2, &err), &err);
   CHECK(sc2.scale == 2.5 && sc2.views_used == 0);
 
   hearth_instance_doc in, in2;
@@ -460,7 +460,7 @@ static hearth_status rd_detections(const char *p, hearth_err *e) {
 }
 static hearth_status rd_scale(const char *p, hearth_err *e) {
   hearth_scale_doc s;
-  return hearth_scale_read(p, &s, e);
+  return hearth_scale_doc_read(p, &s, e);
 }
 static hearth_status rd_instance(const char *p, hearth_err *e) {
   hearth_instance_doc d;
@@ -656,7 +656,7 @@ static void test_syntax(void) {
     spit(tpath(name), cases[k].text);
     hearth_scale_doc sc;
     memset(&err, 0, sizeof err);
-    hearth_status s = hearth_scale_read(tpath(name), &sc, &err);
+    hearth_status s = hearth_scale_doc_read(tpath(name), &sc, &err);
     CHECK_MSG(s == HEARTH_E_PARSE, "syntax %zu: %s: %s", k, hearth_status_name(s), err.msg);
     CHECK_MSG(strstr(err.msg, tpath(name)) && strstr(err.msg, cases[k].what),
               "syntax %zu: message lacks '%s': %s", k, cases[k].what, err.msg);
@@ -744,9 +744,9 @@ static void test_writer_refusals(void) {
   /* a failed write over an existing file keeps the old one */
   hearth_scale_doc sc = {1.25, 3, 0.5}, bad = {-1.0, 3, 0.5}, back;
   snprintf(path, sizeof path, "%s/scale.json", sub);
-  CHECK_OK(hearth_scale_write(path, &sc, &err), &err);
-  CHECK(hearth_scale_write(path, &bad, &err) == HEARTH_E_RANGE);
-  CHECK_OK(hearth_scale_read(path, &back, &err), &err);
+  CHECK_OK(hearth_scale_doc_write(path, &sc, &err), &err);
+  CHECK(hearth_scale_doc_write(path, &bad, &err) == HEARTH_E_RANGE);
+  CHECK_OK(hearth_scale_doc_read(path, &back, &err), &err);
   CHECK(back.scale == 1.25);
   CHECK(count_entries(sub) == 1);
 }

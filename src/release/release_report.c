@@ -8,8 +8,8 @@
 #include <string.h>
 #include "hearth/image.h"
 #include "hearth/npy.h"
+#include "hearth/dataset.h"
 #include "hearth/release.h"
-#include "hearth/release_tools.h"
 
 #define PATH_SZ 4096
 

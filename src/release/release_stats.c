@@ -8,8 +8,8 @@
 #include <sys/stat.h>
 #include "hearth/image.h"
 #include "hearth/npy.h"
+#include "hearth/dataset.h"
 #include "hearth/release.h"
-#include "hearth/release_tools.h"
 #include "hearth/thermal.h"
 
 #define PATH_SZ 4096

@@ -23,10 +23,11 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
-#include "hearth/pipeline.h"
-#include "hearth/refine.h"
+#include "hearth/map.h"
+#include "hearth/poses.h"
+#include "hearth/dataset.h"
 #include "hearth/release.h"
-#include "hearth/release_tools.h"
+#include "release/release_internal.h"
 
 #define PATH_SZ 4096
 
@@ -176,6 +177,8 @@ void hearth_build_opts_default(hearth_build_opts *o) {
   o->fusion = HEARTH_FUSE_MAX;
   o->rgb_resolution = 1024;
   o->bake_rgb = 1;
+  o->calibrate = 1;
+  o->calib_overlays = 1;
 }
 
 void hearth_build_report_free(hearth_build_report *r) {
@@ -594,11 +597,20 @@ hearth_status hearth_build_release(const char *root, const hearth_build_opts *o_
   hearth_status s = hearth_release_read(path, &rel, err);
   if (s) return s;
 
-  /* release-level stages (detection, calibration) once, with every thread */
-  for (size_t i = 0; i < o.n_release_stages; i++) {
+  /* release-level stages once, with every thread: detection and calibration
+   * (when the release has calibration captures), then the caller's own */
+  hearth_build_stage stages[2 + HEARTH_BUILD_MAX_STAGES];
+  size_t n_stages = o.calibrate ? hb_calib_stages(root, o.calib_overlays, stages, 2) : 0;
+  if (o.n_release_stages > HEARTH_BUILD_MAX_STAGES) {
+    hearth_release_free(&rel);
+    return hearth_err_set(err, HEARTH_E_ARG, "build: %zu release stages (at most %d)",
+                          o.n_release_stages, HEARTH_BUILD_MAX_STAGES);
+  }
+  for (size_t i = 0; i < o.n_release_stages; i++) stages[n_stages++] = o.release_stages[i];
+  for (size_t i = 0; i < n_stages; i++) {
     int ran = 0;
     size_t swept = 0;
-    s = run_release_stage(root, &o.release_stages[i], &o, threads, log, &ran, &swept, err);
+    s = run_release_stage(root, &stages[i], &o, threads, log, &ran, &swept, err);
     rep->temps_removed += swept;
     if (s) {
       rep->release_failed = 1;

@@ -12,7 +12,6 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "hearth/eval.h"
 #include "hearth/ws.h"
 
 #define WS_MAX_MESSAGE ((uint64_t)256 << 20)

@@ -1,0 +1,179 @@
+/* hearth/dataset.h - the JSON documents of a release tree and its paths.
+ *
+ * The on-disk contract is docs/dataset.md. Readers are strict: a missing
+ * key, a wrong type, a non-finite number, a non-rotation R or an array of
+ * the wrong length is an error naming the file and the JSON path
+ * (e.g. "views[3].T_world_from_cam[2][1]"). Writers are atomic. */
+#ifndef HEARTH_DATASET_H
+#define HEARTH_DATASET_H
+
+#include <stddef.h>
+#include "hearth/core.h"
+#include "hearth/camera.h"
+#include "hearth/geom.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define HEARTH_MAX_VIEWS 1024
+#define HEARTH_NAME_MAX 64
+
+/* ---- rig.json ------------------------------------------------------------ */
+typedef struct hearth_rig {
+  hearth_camera rgb, thermal, depth;
+  hearth_rigid T_thermal_from_rgb;
+  hearth_rigid T_depth_from_rgb;
+  double thermal_rms_px, stereo_rms_px;
+} hearth_rig;
+hearth_status hearth_rig_read(const char *path, hearth_rig *rig, hearth_err *err);
+hearth_status hearth_rig_parse(const char *text, size_t len, const char *name, hearth_rig *rig,
+                               hearth_err *err);
+hearth_status hearth_rig_write(const char *path, const hearth_rig *rig, hearth_err *err);
+
+/* ---- depth/vNN.json: per-frame depth intrinsics ------------------------- */
+typedef struct hearth_depth_intrinsics {
+  hearth_camera depth;
+  hearth_rigid T_depth_from_rgb;
+} hearth_depth_intrinsics;
+hearth_status hearth_depth_intrinsics_read(const char *path, hearth_depth_intrinsics *d,
+                                           hearth_err *err);
+hearth_status hearth_depth_intrinsics_write(const char *path, const hearth_depth_intrinsics *d,
+                                            hearth_err *err);
+hearth_status hearth_depth_intrinsics_parse(const char *text, size_t len, const char *name,
+                                            hearth_depth_intrinsics *d, hearth_err *err);
+
+/* ---- calibration/factory.json: factory colour + depth calibration -------- */
+/* rig.json's schema without the thermal camera, T_thermal_from_rgb and the
+ * rms fields (docs/dataset.md). */
+typedef struct hearth_factory_calib {
+  hearth_camera rgb, depth;
+  hearth_rigid T_depth_from_rgb;
+} hearth_factory_calib;
+hearth_status hearth_factory_read(const char *path, hearth_factory_calib *f, hearth_err *err);
+hearth_status hearth_factory_parse(const char *text, size_t len, const char *name,
+                                   hearth_factory_calib *f, hearth_err *err);
+hearth_status hearth_factory_write(const char *path, const hearth_factory_calib *f,
+                                   hearth_err *err);
+
+/* ---- manifest.json ------------------------------------------------------- */
+typedef struct hearth_view_files {
+  char view[HEARTH_NAME_MAX];   /* "v00" */
+  int elevation_index, azimuth_index;
+  char rgb[128], cutout[128], depth[128], depth_intrinsics[128], thermal[128];
+} hearth_view_files;
+
+typedef struct hearth_manifest {
+  char instance[HEARTH_NAME_MAX];
+  char state[HEARTH_NAME_MAX];
+  size_t n_views;
+  hearth_view_files *views; /* owned */
+} hearth_manifest;
+void hearth_manifest_free(hearth_manifest *m);
+hearth_status hearth_manifest_read(const char *path, hearth_manifest *m, hearth_err *err);
+hearth_status hearth_manifest_parse(const char *text, size_t len, const char *name,
+                                    hearth_manifest *m, hearth_err *err);
+hearth_status hearth_manifest_write(const char *path, const hearth_manifest *m, hearth_err *err);
+
+/* ---- poses_*.json ---------------------------------------------------------- */
+typedef struct hearth_view_pose {
+  char state[HEARTH_NAME_MAX];
+  char view[HEARTH_NAME_MAX];
+  hearth_rigid T_world_from_cam;
+} hearth_view_pose;
+
+typedef struct hearth_poses {
+  size_t n;
+  hearth_view_pose *views; /* owned */
+} hearth_poses;
+void hearth_poses_free(hearth_poses *p);
+hearth_status hearth_poses_read(const char *path, hearth_poses *p, hearth_err *err);
+hearth_status hearth_poses_parse(const char *text, size_t len, const char *name, hearth_poses *p,
+                                 hearth_err *err);
+hearth_status hearth_poses_write(const char *path, const hearth_poses *p, hearth_err *err);
+/* The pose of (state, view), or NULL. */
+const hearth_view_pose *hearth_poses_find(const hearth_poses *p, const char *state,
+                                          const char *view);
+
+/* ---- detections.json -------------------------------------------------------- */
+#define HEARTH_PLATE_ROWS 8
+#define HEARTH_PLATE_HOLES 84
+#define HEARTH_PLATE_PITCH_M 0.012
+#define HEARTH_PLATE_ROW_STEP_M 0.0103923
+/* Plate coordinates (metres, z = 0) of hole i in row-by-row order. */
+void hearth_plate_hole(int i, double xyz[3]);
+
+typedef struct hearth_detection {
+  char frame[HEARTH_NAME_MAX];  /* "f000", "p003" */
+  char camera[16];              /* "thermal" | "rgb" */
+  int found;
+  char reason[256];             /* when !found */
+  double centres[HEARTH_PLATE_HOLES][2];
+} hearth_detection;
+
+typedef struct hearth_detections {
+  size_t n;
+  hearth_detection *frames; /* owned */
+} hearth_detections;
+void hearth_detections_free(hearth_detections *d);
+hearth_status hearth_detections_read(const char *path, hearth_detections *d, hearth_err *err);
+hearth_status hearth_detections_parse(const char *text, size_t len, const char *name,
+                                      hearth_detections *d, hearth_err *err);
+hearth_status hearth_detections_write(const char *path, const hearth_detections *d,
+                                      hearth_err *err);
+
+/* ---- scale.json --------------------------------------------------------------- */
+/* views_used and residual_median_mm are optional in the file (0 when absent). */
+typedef struct hearth_scale_doc {
+  double scale;
+  int views_used;
+  double residual_median_mm;
+} hearth_scale_doc;
+hearth_status hearth_scale_doc_read(const char *path, hearth_scale_doc *s, hearth_err *err);
+hearth_status hearth_scale_doc_write(const char *path, const hearth_scale_doc *s, hearth_err *err);
+hearth_status hearth_scale_doc_parse(const char *text, size_t len, const char *name,
+                                 hearth_scale_doc *s, hearth_err *err);
+
+/* ---- release.json / instance.json ---------------------------------------- */
+#define HEARTH_MAX_STATES 8
+typedef struct hearth_instance_doc {
+  char id[HEARTH_NAME_MAX];        /* "cup_03" */
+  char category[HEARTH_NAME_MAX];  /* "cup" */
+  size_t n_states;
+  char states[HEARTH_MAX_STATES][HEARTH_NAME_MAX];
+  char notes[512];
+} hearth_instance_doc;
+hearth_status hearth_instance_read(const char *path, hearth_instance_doc *d, hearth_err *err);
+hearth_status hearth_instance_write(const char *path, const hearth_instance_doc *d,
+                                    hearth_err *err);
+hearth_status hearth_instance_parse(const char *text, size_t len, const char *name,
+                                    hearth_instance_doc *d, hearth_err *err);
+
+typedef struct hearth_release_doc {
+  char name[128];
+  char version[32];
+  char software_version[32];
+  size_t n_instances;
+  char (*instances)[HEARTH_NAME_MAX]; /* owned */
+} hearth_release_doc;
+void hearth_release_free(hearth_release_doc *d);
+hearth_status hearth_release_read(const char *path, hearth_release_doc *d, hearth_err *err);
+hearth_status hearth_release_write(const char *path, const hearth_release_doc *d,
+                                   hearth_err *err);
+hearth_status hearth_release_parse(const char *text, size_t len, const char *name,
+                                   hearth_release_doc *d, hearth_err *err);
+
+/* ---- names ----------------------------------------------------------------- */
+/* The 18 categories of the paper, lower case with underscores
+ * ("bottled_drink", "electric_kettle", ...). */
+extern const char *const hearth_categories[18];
+int hearth_category_valid(const char *name);
+/* neutral | hot | warm | iced | used */
+int hearth_state_valid(const char *name);
+/* "<category>_<NN>": a valid category, '_', two to four decimal digits. */
+int hearth_instance_id_valid(const char *id);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

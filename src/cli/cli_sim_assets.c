@@ -1,0 +1,57 @@
+/* The asset release the hearth-sim commands use: a given release, or a
+ * small virtual-rig release made in a temporary directory. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <unistd.h>
+
+#include "cli/cli.h"
+#include "cli/cli_sim.h"
+#include "hearth/synth.h"
+
+/* assets: a release root given, or a tiny virtual-rig release in a temp dir */
+int sim_cli_assets(const char *release, int gt, char *root, size_t rootsz, char *tmpdir, size_t tsz,
+                   int *use_gt, int quiet) {
+  tmpdir[0] = 0;
+  if (release) {
+    snprintf(root, rootsz, "%s", release);
+    *use_gt = gt;
+    return 0;
+  }
+  const char *t = getenv("TMPDIR");
+  snprintf(tmpdir, tsz, "%s/hearth_sim_assets_XXXXXX", t && *t ? t : "/tmp");
+  if (!mkdtemp(tmpdir)) {
+    fprintf(stderr, "hearth sim: cannot create a temporary directory %s\n", tmpdir);
+    tmpdir[0] = 0;
+    return 1;
+  }
+  snprintf(root, rootsz, "%s/release", tmpdir);
+  hearth_synth_opts so;
+  hearth_synth_opts_default(&so);
+  so.out_root = root;
+  const char *cats[] = {"cup", "canned_drink", "electric_kettle", "eraser", "orange", "smartphone", "sponge"};
+  so.n_categories = 7;
+  for (int i = 0; i < 7; i++) so.categories[i] = cats[i];
+  so.n_states = 3;
+  so.states[0] = "neutral", so.states[1] = "hot", so.states[2] = "iced";
+  so.n_views = 6; /* 2 azimuths per elevation: enough for the up direction */
+  so.triangles = 4000;
+  so.texture_size = 256;
+  so.map_resolution = 256;
+  so.calibration = 0;
+  so.rgb_full_size = 0; /* draft raw colour frames: the sim reads none of them */
+  so.quiet = 1;
+  if (!quiet) fprintf(stderr, "hearth sim: making assets with the virtual rig...\n");
+  hearth_err err = {0};
+  if (hearth_synth_release(&so, &err)) {
+    /* nothing half-made is left behind */
+    hearth_remove_tree(tmpdir, NULL);
+    tmpdir[0] = 0;
+    return cli_fail("sim", &err);
+  }
+  *use_gt = 1;
+  return 0;
+}
+
+void sim_cli_drop_assets(const char *tmpdir) {
+  if (tmpdir[0]) hearth_remove_tree(tmpdir, NULL);
+}
