@@ -18,6 +18,10 @@ h="$build/hearth"
 "$h" sim collect --task H1 --layouts 3 --out "$out/h1.hdf5" --quiet >/dev/null
 cd "$out"
 # build stamps record file times, not content: left out
+# the report names the release's path: hashed with OUT_DIR replaced
 find . -type f -not -path "*/.stamps/*" | LC_ALL=C sort | while read -r f; do
-  echo "$(sha256sum < "$f" | cut -c1-16) $f"
+  case "$f" in
+    *.html) echo "$(sed "s|$out|OUT_DIR|g" "$f" | sha256sum | cut -c1-16) $f" ;;
+    *) echo "$(sha256sum < "$f" | cut -c1-16) $f" ;;
+  esac
 done
