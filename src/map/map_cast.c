@@ -1,0 +1,415 @@
+/* Casting and splatting one view (see map_internal.h).
+ *
+ * A view is done whole by one worker, in its own map_worker: its grid
+ * pixels are cast (through the ray fan, or as traced rays), pixels near a
+ * silhouette are dropped, every remaining hit splats its value bilinearly
+ * into the UV map, and the view is reduced to one value per texel it
+ * observes (the view's mean there, its weight and best viewing cosine).
+ * For max fusion that value folds at once into the worker's maxima maps;
+ * for mean and robust fusion it becomes the view's record of the texel.
+ * Within a view, pixels are visited in raster order. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "map/map_internal.h"
+
+#define MAX_BACKFACE_SKIPS 8
+#define PREFETCH_AHEAD 8 /* touches ahead whose texel's island is prefetched */
+
+int map_worker_alloc(map_worker *w, const hearth_map_layout *l, int C, int records) {
+  const size_t np = l->np;
+  w->hit_t = hearth_alloc_array(np, sizeof(float));
+  w->hit_tri = hearth_alloc_array(np, sizeof(uint32_t));
+  w->hit_b1 = hearth_alloc_array(np, sizeof(float));
+  w->hit_b2 = hearth_alloc_array(np, sizeof(float));
+  w->ray_org = hearth_alloc_array(np, 3 * sizeof(float));
+  w->ray_dir = hearth_alloc_array(np, 3 * sizeof(float));
+  w->hits = hearth_alloc_array(np, sizeof(hearth_ray_hit));
+  w->sil = hearth_alloc_array(np, 1);
+  w->splats = hearth_alloc_array(np, sizeof(splat));
+  w->touches = hearth_alloc_array(np, 4 * sizeof(touch));
+  w->touches_tmp = hearth_alloc_array(np, 4 * sizeof(touch));
+  int ok = w->hit_t && w->hit_tri && w->hit_b1 && w->hit_b2 && w->ray_org && w->ray_dir && w->hits && w->sil &&
+           w->splats && w->touches && w->touches_tmp;
+  if (l->fan) {
+    w->fan_scratch = calloc(1, hearth_ray_fan_scratch_size(l->fan, l->mesh->n_vertices));
+    ok &= w->fan_scratch != NULL;
+  }
+  if (records) {
+    w->rec_q = hearth_alloc_array(np, 4 * sizeof(uint32_t));
+    w->rec_d = hearth_alloc_array(np, 4 * REC_WORDS(C) * sizeof(float));
+    ok &= w->rec_q && w->rec_d;
+  }
+  return ok;
+}
+
+void map_worker_free(map_worker *w) {
+  free(w->hit_t);
+  free(w->hit_tri);
+  free(w->hit_b1);
+  free(w->hit_b2);
+  free(w->ray_org);
+  free(w->ray_dir);
+  free(w->hits);
+  free(w->sil);
+  free(w->splats);
+  free(w->touches);
+  free(w->touches_tmp);
+  free(w->fan_scratch);
+  free(w->rec_q);
+  free(w->rec_d);
+  memset(w, 0, sizeof *w);
+}
+
+static float image_value(const hearth_image *img, size_t idx, int c) {
+  if (img->type == HEARTH_PIX_F32) return ((const float *)img->data)[idx * (size_t)img->channels + (size_t)c];
+  return (float)((const uint8_t *)img->data)[idx * (size_t)img->channels + (size_t)c];
+}
+
+/* the bilinear weight of corner k (bit 0: +x, bit 1: +y) of a splat */
+static inline float corner_weight(const splat *e, int k) {
+  return (float)(((k & 1) ? e->fx : 1.0 - e->fx) * ((k >> 1) ? e->fy : 1.0 - e->fy));
+}
+
+/* a box of grid pixels */
+typedef struct pix_box {
+  size_t x0, x1, y0, y1; /* inclusive; x0 > x1 when empty */
+} pix_box;
+
+/* record a hit (or a miss) of grid pixel p = (px, py) */
+static void keep_hit(map_worker *w, size_t p, size_t px, size_t py, const hearth_ray_hit *h, pix_box *box) {
+  if (h->prim != UINT32_MAX && h->front) {
+    if (px < box->x0) box->x0 = px;
+    if (px > box->x1) box->x1 = px;
+    if (py < box->y0) box->y0 = py;
+    if (py > box->y1) box->y1 = py;
+    w->hit_t[p] = h->t;
+    w->hit_tri[p] = h->prim;
+    w->hit_b1[p] = h->b1;
+    w->hit_b2[p] = h->b2;
+  } else {
+    w->hit_t[p] = INFINITY;
+    w->hit_tri[p] = UINT32_MAX;
+  }
+}
+
+/* view v, whose camera has the whole mesh in front: rasterised through the
+ * fan; the hits' box, and misses in a 2-pixel ring around it (what the
+ * silhouette filter reads) */
+static void cast_fan(map_ctx *m, size_t v, map_worker *w, pix_box *box) {
+  const hearth_map_layout *l = m->l;
+  size_t fb[4];
+  if (hearth_ray_fan_cast(l->fan, l->mesh, &m->views[v].T_world_from_cam, w->fan_scratch, w->hits, fb, NULL)) {
+    m->failed = 2; /* cannot happen: the bounding sphere lies in front */
+    return;
+  }
+  if (fb[0] > fb[1]) return; /* no hit */
+  const size_t W = l->pw, H = l->ph;
+  for (size_t y = fb[2] >= 2 ? fb[2] - 2 : 0; y <= fb[3] + 2 && y < H; y++)
+    for (size_t x = fb[0] >= 2 ? fb[0] - 2 : 0; x <= fb[1] + 2 && x < W; x++) {
+      size_t p = y * W + x;
+      if (x >= fb[0] && x <= fb[1] && y >= fb[2] && y <= fb[3]) {
+        keep_hit(w, p, x, y, &w->hits[p], box);
+      } else {
+        w->hit_t[p] = INFINITY;
+        w->hit_tri[p] = UINT32_MAX;
+      }
+    }
+}
+
+/* view v by traced rays, in 4x4 pixel tiles (packets of nearly parallel
+ * rays); rays that miss the mesh's bounding sphere are not cast at all, and
+ * back faces are culled by continuing the ray behind them */
+static void cast_rays(const map_ctx *m, size_t v, map_worker *w, pix_box *box) {
+  const hearth_map_layout *l = m->l;
+  const hearth_rigid *T = &m->views[v].T_world_from_cam;
+  const size_t n = l->np;
+  float *org = w->ray_org, *dir = w->ray_dir;
+  hearth_ray_hit *hits = w->hits;
+  const double *S = l->sphere;
+  double oc[3] = {S[0] - T->t[0], S[1] - T->t[1], S[2] - T->t[2]};
+  double oc2 = oc[0] * oc[0] + oc[1] * oc[1] + oc[2] * oc[2];
+  double r2 = S[3] * S[3];
+  for (size_t i = 0; i < n; i++) {
+    size_t p = l->tile_order[i];
+    const float *d = l->pix_dir + 3 * p;
+    double wd[3];
+    for (int k = 0; k < 3; k++) wd[k] = T->R[3 * k] * d[0] + T->R[3 * k + 1] * d[1] + T->R[3 * k + 2] * d[2];
+    /* squared distance of the sphere centre from the ray (unit direction),
+     * or from the origin when the centre lies behind it */
+    double along = oc[0] * wd[0] + oc[1] * wd[1] + oc[2] * wd[2];
+    double dist2 = along > 0 ? oc2 - along * along : oc2;
+    int skip = dist2 > r2;
+    for (int k = 0; k < 3; k++) {
+      org[3 * i + k] = (float)T->t[k];
+      dir[3 * i + k] = skip ? 0.0f : (float)wd[k]; /* a zero direction is not cast */
+    }
+  }
+  /* views already run in parallel: cast on this thread only, unless there
+     is a single worker for all views */
+  hearth_raycast_batch_mt(m->rc, n, org, dir, 0.0f, INFINITY, hits, m->n_threads > 1 ? 1 : m->cast_threads);
+  for (size_t i = 0; i < n; i++) {
+    size_t p = l->tile_order[i];
+    hearth_ray_hit h = hits[i];
+    for (int k = 0; k < MAX_BACKFACE_SKIPS && h.prim != UINT32_MAX && !h.front; k++) {
+      double o[3] = {org[3 * i], org[3 * i + 1], org[3 * i + 2]};
+      double d[3] = {dir[3 * i], dir[3 * i + 1], dir[3 * i + 2]};
+      double tn = (double)h.t * (1.0 + 1e-6) + 1e-7;
+      if (!hearth_raycast(m->rc, o, d, tn, INFINITY, &h)) h.prim = UINT32_MAX;
+    }
+    keep_hit(w, p, p % l->pw, p / l->pw, &h, box);
+  }
+}
+
+/* silhouette flags: 1 if a grid pixel lies within 2 pixels of a
+ * silhouette, i.e. a pixel in its 5x5 neighbourhood (clipped to the image)
+ * misses the surface or lies at a clearly different depth (more than 3%).
+ * The lens blur and the pixel footprint mix the two sides of such an edge,
+ * so these pixels do not measure one surface. Computed with separable 5x5
+ * minimum and maximum filters of the hit distance (a miss is +inf). Only
+ * pixels inside box (the hits' bounding box) get flags; the filters read up
+ * to 2 pixels beyond it, where ht holds the misses. */
+static void silhouettes(const hearth_map_layout *l, const float *ht, const pix_box *box, float *lo, float *hi,
+                        float *tmp_lo, float *tmp_hi, uint8_t *sil) {
+  size_t W = l->pw, H = l->ph;
+  size_t ry0 = box->y0 >= 2 ? box->y0 - 2 : 0, ry1 = box->y1 + 2 < H ? box->y1 + 2 : H - 1;
+  for (size_t y = ry0; y <= ry1; y++) {
+    const float *r = ht + y * W;
+    for (size_t x = box->x0; x <= box->x1; x++) {
+      size_t a = x >= 2 ? x - 2 : 0, b = x + 2 < W ? x + 2 : W - 1;
+      float mn = r[a], mx = r[a];
+      for (size_t k = a + 1; k <= b; k++) {
+        mn = r[k] < mn ? r[k] : mn;
+        mx = r[k] > mx ? r[k] : mx;
+      }
+      tmp_lo[y * W + x] = mn;
+      tmp_hi[y * W + x] = mx;
+    }
+  }
+  for (size_t y = box->y0; y <= box->y1; y++) {
+    size_t a = y >= 2 ? y - 2 : 0, b = y + 2 < H ? y + 2 : H - 1;
+    for (size_t x = box->x0; x <= box->x1; x++) {
+      float mn = tmp_lo[a * W + x], mx = tmp_hi[a * W + x];
+      for (size_t k = a + 1; k <= b; k++) {
+        float lv = tmp_lo[k * W + x], hv = tmp_hi[k * W + x];
+        mn = lv < mn ? lv : mn;
+        mx = hv > mx ? hv : mx;
+      }
+      lo[y * W + x] = mn;
+      hi[y * W + x] = mx;
+    }
+  }
+  for (size_t y = box->y0; y <= box->y1; y++)
+    for (size_t x = box->x0; x <= box->x1; x++) {
+      size_t p = y * W + x;
+      float t0 = ht[p];
+      if (!isfinite(t0)) {
+        sil[p] = 1;
+        continue;
+      }
+      float tol = 0.03f * t0;
+      sil[p] = !isfinite(hi[p]) || hi[p] - t0 > tol || t0 - lo[p] > tol;
+    }
+}
+
+/* The splats of view v's hits within box, in raster order: hits at a
+ * silhouette (with edges) or seen more obliquely than min_cos are dropped,
+ * and so are footprints entirely off the map. *n_hits counts the hits kept
+ * before that last test (the view's pixels on the surface). */
+static size_t splat_hits(const map_ctx *m, size_t v, map_worker *w, const pix_box *box, int edges,
+                         uint32_t *n_hits) {
+  const hearth_map_layout *l = m->l;
+  const hearth_mesh *mesh = l->mesh;
+  const size_t R = l->R;
+  const int C = m->C;
+  const hearth_image *img = m->views[v].image;
+  const double *Rw = m->views[v].T_world_from_cam.R;
+  const float min_cos = (float)m->opts->min_cos;
+  const uint32_t *htri = w->hit_tri;
+  const uint8_t *sil = w->sil;
+  splat *sp = w->splats;
+  uint32_t hits = 0;
+  size_t n_sp = 0;
+  for (size_t py = box->y0; py <= box->y1 && box->x0 <= box->x1; py++) {
+    for (size_t p = py * l->pw + box->x0; p <= py * l->pw + box->x1; p++) {
+      uint32_t tri = htri[p];
+      if (tri == UINT32_MAX) continue;
+      if (edges && sil[p]) continue;
+      const float *nrm = l->tri_normal + 3 * (size_t)tri, *dc = l->pix_dir + 3 * p;
+      float d[3];
+      for (int k = 0; k < 3; k++) d[k] = (float)(Rw[3 * k] * dc[0] + Rw[3 * k + 1] * dc[1] + Rw[3 * k + 2] * dc[2]);
+      float cosv = -(nrm[0] * d[0] + nrm[1] * d[1] + nrm[2] * d[2]);
+      if (cosv < min_cos) continue;
+      hits++;
+      /* UV of the hit point */
+      const uint32_t *ix = mesh->indices + 3 * (size_t)tri;
+      float b1 = w->hit_b1[p], b2 = w->hit_b2[p], b0 = 1.0f - b1 - b2;
+      float u = b0 * mesh->uvs[2 * ix[0]] + b1 * mesh->uvs[2 * ix[1]] + b2 * mesh->uvs[2 * ix[2]];
+      float vv = b0 * mesh->uvs[2 * ix[0] + 1] + b1 * mesh->uvs[2 * ix[1] + 1] +
+                 b2 * mesh->uvs[2 * ix[2] + 1];
+      double x = (double)u * (double)R - 0.5, y = (double)vv * (double)R - 0.5;
+      double x0f = floor(x), y0f = floor(y);
+      if (!(x0f >= -1.0 && y0f >= -1.0 && x0f < (double)R && y0f < (double)R)) continue;
+      splat *e = &sp[n_sp++];
+      e->fx = x - x0f;
+      e->fy = y - y0f;
+      e->x0 = (int32_t)x0f;
+      e->y0 = (int32_t)y0f;
+      e->island = l->island_of_tri[tri];
+      e->cosv = cosv;
+      size_t src = l->pix_index[p];
+      for (int c = 0; c < C; c++) e->val[c] = image_value(img, src, c);
+    }
+  }
+  *n_hits = hits;
+  return n_sp;
+}
+
+/* The touches of n_sp splats, sorted by texel (pixel order within a
+ * texel): in w->touches or w->touches_tmp, whichever the sort ended in.
+ * *n_out is their count. */
+static const touch *sorted_touches(map_worker *w, size_t n_sp, size_t R, size_t *n_out) {
+  const splat *sp = w->splats;
+  touch *tc = w->touches;
+  size_t n_tc = 0;
+  for (size_t i = 0; i < n_sp; i++) {
+    const splat *e = &sp[i];
+    for (int k = 0; k < 4; k++) {
+      long tx = (long)e->x0 + (k & 1), ty = (long)e->y0 + (k >> 1);
+      if (tx < 0 || ty < 0 || tx >= (long)R || ty >= (long)R) continue;
+      if (!(corner_weight(e, k) > 0.0f)) continue;
+      tc[n_tc++] = (touch){(uint32_t)((size_t)ty * R + (size_t)tx), (uint32_t)(4 * i + (size_t)k)};
+    }
+  }
+  /* stable LSD radix sort by texel, 11-bit digits (at most 3: R <= 16384
+     gives 28 bits), every digit's histogram from one read */
+  touch *src = tc, *dst = w->touches_tmp;
+  size_t bits = 1;
+  while (bits < 32 && ((size_t)1 << bits) < R * R) bits++;
+  size_t nd = (bits + 10) / 11;
+  size_t count[3][2048 + 1];
+  memset(count, 0, sizeof count);
+  for (size_t i = 0; i < n_tc; i++)
+    for (size_t d = 0; d < nd; d++) count[d][((src[i].q >> (11 * d)) & 2047) + 1]++;
+  for (size_t d = 0; d < nd; d++) {
+    size_t *cd = count[d], shift = 11 * d;
+    for (size_t b = 0; b < 2048; b++) cd[b + 1] += cd[b];
+    for (size_t i = 0; i < n_tc; i++) dst[cd[(src[i].q >> shift) & 2047]++] = src[i];
+    touch *x = src;
+    src = dst;
+    dst = x;
+  }
+  *n_out = n_tc;
+  return src;
+}
+
+/* max fusion: a view's mean at texel q folded into a worker's maxima */
+static inline void fold_max(uint32_t *mc, float *mcos, uint32_t q, int C, float wsum, float best_cos,
+                            const float sum[3]) {
+  /* + 0.0f: a negative zero becomes +0, so equal means give one code */
+  if (mcos && best_cos > mcos[q]) mcos[q] = best_cos;
+  for (int c = 0; c < C; c++) {
+    uint32_t code = max_code(sum[c] / wsum + 0.0f);
+    if (code > mc[(size_t)q * (size_t)C + (size_t)c]) mc[(size_t)q * (size_t)C + (size_t)c] = code;
+  }
+}
+
+/* mean and robust fusion: a view's record of texel q, at d (see REC_WORDS) */
+static inline void put_record(float *d, int mean, int C, float wsum, float best_cos, const float sum[3]) {
+  d[0] = wsum;
+  d[1] = best_cos;
+  /* + 0.0f: a negative zero becomes +0, so equal means cannot make the
+     maximum's bits depend on which view came first */
+  for (int c = 0; c < C; c++) d[2 + c] = mean ? sum[c] : sum[c] / wsum + 0.0f;
+}
+
+/* Each texel's touches in pixel order, splatted only from the texel's own
+ * island: folded into worker t's maxima (max fusion), or made records in
+ * the worker's scratch. Returns the records' count. */
+static size_t reduce_touches(const map_ctx *m, map_worker *w, const touch *tc, size_t n_tc, int t) {
+  const uint32_t *iot = m->l->island_of_texel;
+  const int C = m->C;
+  const size_t RW = REC_WORDS(C);
+  const int mean = m->opts->fusion == HEARTH_FUSE_MEAN;
+  const splat *sp = w->splats;
+  uint32_t *mc = m->max ? m->max->code[t] : NULL;
+  float *mcos = m->max && m->max->cos ? m->max->cos[t] : NULL;
+  size_t n_rec = 0;
+  for (size_t i = 0; i < n_tc;) {
+    uint32_t q = tc[i].q;
+    size_t j = i;
+    while (j < n_tc && tc[j].q == q) j++;
+    if (j + PREFETCH_AHEAD < n_tc) {
+      __builtin_prefetch(&iot[tc[j + PREFETCH_AHEAD].q], 0);
+      if (mc) __builtin_prefetch(&mc[(size_t)tc[j + PREFETCH_AHEAD].q * (size_t)C], 1);
+    }
+    uint32_t island = iot[q];
+    float wsum = 0.0f, best_cos = 0.0f, sum[3] = {0.0f, 0.0f, 0.0f};
+    int any = 0;
+    for (size_t k = i; k < j; k++) {
+      const splat *e = &sp[tc[k].sk >> 2];
+      if (e->island != island) continue;
+      if (!any || e->cosv > best_cos) best_cos = e->cosv;
+      any = 1;
+      float wk = corner_weight(e, (int)(tc[k].sk & 3));
+      wsum += wk;
+      for (int c = 0; c < C; c++) sum[c] += wk * e->val[c];
+    }
+    i = j;
+    if (!any) continue;
+    if (mc) {
+      fold_max(mc, mcos, q, C, wsum, best_cos, sum);
+      continue;
+    }
+    w->rec_q[n_rec] = q;
+    put_record(w->rec_d + n_rec * RW, mean, C, wsum, best_cos, sum);
+    n_rec++;
+  }
+  return n_rec;
+}
+
+/* view v's n records, made in w's scratch, kept in their own allocation */
+static void keep_records(map_ctx *m, size_t v, const map_worker *w, size_t n) {
+  const size_t RW = REC_WORDS(m->C);
+  view_records *r = m->rec;
+  r->n[v] = n;
+  r->q[v] = hearth_alloc_array(n ? n : 1, sizeof *w->rec_q);
+  r->d[v] = hearth_alloc_array(n ? n : 1, RW * sizeof *w->rec_d);
+  if (!r->q[v] || !r->d[v]) {
+    m->failed = 1;
+    return;
+  }
+  memcpy(r->q[v], w->rec_q, n * sizeof *w->rec_q);
+  memcpy(r->d[v], w->rec_d, n * RW * sizeof *w->rec_d);
+}
+
+static void process_view(map_ctx *m, size_t v, int t) {
+  const hearth_map_layout *l = m->l;
+  map_worker *w = &m->workers[t];
+  pix_box box = {SIZE_MAX, 0, SIZE_MAX, 0};
+  if (m->view_fan[v]) cast_fan(m, v, w, &box);
+  else cast_rays(m, v, w, &box);
+  if (m->failed) return;
+  if (box.x0 > box.x1) box = (pix_box){1, 0, 1, 0}; /* no hit: empty */
+  const int edges = m->opts->fusion == HEARTH_FUSE_ROBUST || !m->opts->keep_edges;
+  if (edges && box.x0 <= box.x1) {
+    /* the ray arrays are free again: scratch for the filters */
+    const size_t n = l->np;
+    silhouettes(l, w->hit_t, &box, w->ray_org, w->ray_org + n, w->ray_dir, w->ray_dir + n, w->sil);
+  }
+  uint32_t hits = 0;
+  size_t n_sp = splat_hits(m, v, w, &box, edges, &hits);
+  size_t n_tc = 0;
+  const touch *tc = sorted_touches(w, n_sp, l->R, &n_tc);
+  m->view_hits[v] = hits;
+  size_t n_rec = reduce_touches(m, w, tc, n_tc, t);
+  if (m->rec) keep_records(m, v, w, n_rec);
+}
+
+/* views are handed out one at a time to whichever worker is free (they
+   differ in cost, and a shared machine slows workers unevenly); a view's
+   records do not depend on the worker */
+void map_cast_views(void *ctx, size_t b, size_t e, int t) {
+  map_ctx *m = ctx;
+  for (size_t v = b; v < e; v++) process_view(m, v, t);
+}

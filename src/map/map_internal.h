@@ -1,0 +1,186 @@
+/* Private to the map area: the state the phases of a mapping share.
+ *
+ * hearth_map_views_with_layout (map_core.c) runs them in turn:
+ *   map_layout.c  the layout: UV raster and islands, triangle normals, the
+ *                 mesh's bounding sphere, the camera's pixel grid and ray fan
+ *   map_cast.c    each view cast and splatted by one worker and reduced to
+ *                 one value per texel it observes, folded into the fusion
+ *                 rule's state (max_maps or view_records)
+ *   map_fuse.c    fusion across views over bands of whole texel rows
+ *   map_fill.c    the nearest-observed fill within each UV island
+ *
+ * Nothing is shared between workers while it is written: each worker casts
+ * into its own map_worker, folds into its own maxima maps or its view's
+ * records, and each band of the fusion writes only its slice of the maps.
+ * Maxima do not depend on which worker saw which view, and records are
+ * folded in view order: the result does not depend on the thread count. */
+#ifndef HEARTH_MAP_INTERNAL_H
+#define HEARTH_MAP_INTERNAL_H
+
+#include <stdatomic.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+#include "hearth/map.h"
+
+/* The part of a mapping fixed by the mesh, the camera, the resolution and
+ * the pixel stride; read-only once made (map_layout.c). */
+struct hearth_map_layout {
+  const hearth_mesh *mesh;
+  hearth_camera cam;
+  size_t R, stride;
+  uint32_t *island_of_tri;
+  uint32_t *island_of_texel; /* R * R; UINT32_MAX off the surface */
+  uint32_t n_islands;
+  float *tri_normal;        /* 3 per triangle, unit */
+  double sphere[4];         /* mesh bounding sphere: rays that miss it are not cast */
+  size_t pw, ph, np;        /* pixel grid: every stride-th pixel */
+  float *pix_dir;           /* 3 per grid pixel, camera frame, unit (0: never cast) */
+  uint32_t *pix_index;      /* image pixel index of each grid pixel */
+  uint32_t *tile_order;     /* grid pixels in 4x4 tiles: coherent packets of 16 */
+  hearth_ray_fan *fan;      /* the pixel grid as a ray fan; NULL where it cannot hold it */
+};
+
+/* a view's record of a texel: the texel's index (in the q arrays), then
+ * REC_WORDS(C) floats: the weight (sum of bilinear weights), the best
+ * viewing cosine and per channel the mean (the weighted sum for mean
+ * fusion) */
+#define REC_WORDS(C) (2 + (size_t)(C))
+#define BAND_TEXELS 16384 /* texels per band of the fusion phase (whole rows) */
+
+/* one hit pixel's splat: its bilinear footprint, island, cosine and value */
+typedef struct splat {
+  double fx, fy;  /* bilinear fractions */
+  int32_t x0, y0; /* lower-left texel of the 2 x 2 footprint */
+  uint32_t island;
+  float cosv;
+  float val[3];
+} splat;
+
+/* One bilinear touch of a texel by a splat within one view; a view's
+ * touches are sorted by texel (stably: pixel order within a texel) and
+ * reduced in one pass, each texel's sums added up in the same order as
+ * pixel by pixel. */
+typedef struct touch {
+  uint32_t q;  /* texel */
+  uint32_t sk; /* 4 * (index into the view's splats) + corner (bit 0: +x, bit 1: +y) */
+} touch;
+
+/* One worker's scratch for casting and splatting a view; each array holds
+ * one view (the pixel grid's np pixels, or 4 touches a pixel). The worker
+ * owns every array. */
+typedef struct map_worker {
+  float *hit_t, *hit_b1, *hit_b2; /* np: the hit distance (+inf: none) and barycentrics */
+  uint32_t *hit_tri;              /* np: the hit triangle (UINT32_MAX: none) */
+  float *ray_org, *ray_dir;       /* 3 * np: traced rays; after the cast, the silhouette filters' scratch */
+  hearth_ray_hit *hits;           /* np */
+  uint8_t *sil;                   /* np: silhouette flags */
+  splat *splats;                  /* np */
+  touch *touches, *touches_tmp;   /* 4 * np: a view's touches and the sort's second buffer */
+  void *fan_scratch;              /* the ray fan's scratch (NULL without a fan) */
+  uint32_t *rec_q;                /* 4 * np: mean and robust fusion: a view's records, made */
+  float *rec_d;                   /* here, then kept in view_records (NULL for max fusion) */
+} map_worker;
+
+/* Max fusion: each worker folds its views' means into maps of its own (the
+ * maximum does not depend on the order); the fusion merges them. */
+typedef struct max_maps {
+  int n;           /* workers */
+  uint32_t **code; /* per worker: R * R * C maxima as order-preserving codes (see max_code), 0 none */
+  float **cos;     /* per worker: R * R best viewing cosines, 0 none; NULL with skip_best_cos */
+} max_maps;
+
+/* Mean and robust fusion: each view's records (see REC_WORDS), sorted by
+ * texel, in an allocation of their own size; the fusion folds them in view
+ * order. */
+typedef struct view_records {
+  size_t n_views;
+  uint32_t **q; /* per view: n[v] texels */
+  float **d;    /* per view: n[v] * REC_WORDS(C) words */
+  size_t *n;
+} view_records;
+
+/* one mapping of a view set: what the cast and fusion phases read, and the
+ * fusion rule's state they write */
+typedef struct map_ctx {
+  const hearth_map_layout *l;
+  const hearth_raycaster *rc; /* for views that trace rays */
+  const hearth_map_view *views;
+  size_t n_views;
+  const hearth_map_opts *opts;
+  int C;               /* channels */
+  int n_threads;       /* workers over views */
+  int cast_threads;    /* threads for ray casting when one worker does every view */
+  const uint8_t *view_fan; /* per view: the mesh lies in front, the fan applies */
+  map_worker *workers; /* n_threads */
+  max_maps *max;       /* max fusion, else NULL */
+  view_records *rec;   /* mean and robust fusion, else NULL */
+  uint32_t *view_hits; /* per view: pixels on the surface */
+  _Atomic int failed;  /* 1 out of memory, 2 a view not in front after all */
+} map_ctx;
+
+/* a float as an unsigned integer of the same order (-0 below +0, NaN not
+ * used), never 0 for a float: a zeroed map holds "none" below every value */
+static inline uint32_t max_code(float f) {
+  uint32_t b;
+  memcpy(&b, &f, sizeof b);
+  return b & 0x80000000u ? ~b : b | 0x80000000u;
+}
+static inline float max_decode(uint32_t c) {
+  uint32_t b = c & 0x80000000u ? c & 0x7fffffffu : ~c;
+  float f;
+  memcpy(&f, &b, sizeof f);
+  return f;
+}
+
+/* map_cast.c */
+/* The scratch of one worker for the layout's pixel grid and C channels
+ * (records: room for a view's records, for mean and robust fusion).
+ * Returns 0 out of memory; map_worker_free frees what was made. */
+int map_worker_alloc(map_worker *w, const hearth_map_layout *l, int C, int records);
+void map_worker_free(map_worker *w);
+/* views [b, e) on worker t (a hearth_parallel_chunks function over m) */
+void map_cast_views(void *ctx, size_t b, size_t e, int t);
+
+/* map_fuse.c */
+/* n workers' maxima maps for R x R texels, zeroed; worker 0's are the
+ * result's observed and best_cos arrays (best_cos only with want_cos), so
+ * out owns them, the maps the others. Returns 0 out of memory. */
+int map_max_alloc(max_maps *mx, int n, size_t R, int C, int want_cos, hearth_map_result *out);
+void map_max_free(max_maps *mx);
+/* room for n views' records. Returns 0 out of memory. */
+int map_records_alloc(view_records *r, size_t n_views);
+void map_records_free(view_records *r);
+
+/* The islands' bounding boxes and counts, gathered by the fusion for the
+ * fill: per worker a set of n_islands + 1 (merged in map_fill_islands). */
+typedef struct island_box {
+  int32_t x0, y0, x1, y1; /* inclusive; x1 < x0 for an island without texels */
+  size_t n_todo;          /* surface texels to fill */
+  uint8_t has_seed;       /* any observed texel */
+} island_box;
+
+/* the fusion over bands of whole rows (see map_fuse.c) */
+typedef struct fuse_pass {
+  const map_ctx *m;
+  hearth_map_result *out; /* observed, filled, mask and best_cos written band by band */
+  island_box *parts;      /* per worker: the islands' boxes */
+  int *nomem;             /* per worker: out of memory */
+} fuse_pass;
+/* bands [b, e) of BAND_TEXELS texels (whole rows) on worker t */
+void map_fuse_bands(void *ctx, size_t b, size_t e, int t);
+
+/* map_fill.c */
+/* For rows [y0, y1) of fused maps: the mask of the observed texels, the
+ * filled map as far as observed (NaN elsewhere, for the fill to write),
+ * and the islands' boxes grown by the rows' texels. */
+void map_fill_prepare_rows(size_t R, size_t C, const uint32_t *island_of_texel, size_t y0, size_t y1,
+                           hearth_map_result *out, island_box *box);
+/* Fill every island that has observed texels and unobserved ones, from the
+ * islands' boxes (nw sets of n_islands + 1); writes filled and marks mask
+ * for filled texels. */
+hearth_status map_fill_islands(size_t R, size_t C, const uint32_t *island_of_texel, uint32_t n_islands,
+                               const island_box *parts, int nw, uint8_t *mask, const float *observed,
+                               float *filled, int nthreads);
+
+#endif

@@ -1,0 +1,202 @@
+/* The mapping layout (see map_internal.h): the UV raster and islands, the
+ * triangles' normals, the mesh's bounding sphere, and the camera's pixel
+ * grid with its ray fan. The pixel grid and the islands are made on
+ * threads of their own while the UV layout is rasterised; the layout owns
+ * every array it holds (not the mesh). */
+#include <math.h>
+#include <pthread.h>
+#include <stdlib.h>
+#include <string.h>
+#include "map/map_internal.h"
+
+/* the pixel grid (undistorted centres of every stride-th pixel) and its ray
+ * fan, then the UV islands, each made on a thread of its own (all only
+ * read their inputs) */
+typedef struct grid_build {
+  const hearth_camera *cam;
+  size_t stride, pw, ph;
+  float *pix_dir;
+  uint32_t *pix_index, *tile_order;
+  hearth_ray_fan *fan; /* NULL where the fan cannot hold the grid */
+  int nomem;
+  /* then the UV islands (the mesh only) */
+  const hearth_mesh *mesh;
+  uint32_t *island_of_tri, n_islands;
+  hearth_status islands_status;
+  hearth_err islands_err;
+} grid_build;
+
+static void *grid_build_run(void *arg) {
+  grid_build *g = arg;
+  size_t st = g->stride, pw = g->pw, ph = g->ph, np = pw * ph;
+  hearth_status s = hearth_ray_fan_new(g->cam, st, &g->fan, NULL);
+  if (s == HEARTH_OK) {
+    memcpy(g->pix_dir, hearth_ray_fan_dirs(g->fan, NULL, NULL), np * 3 * sizeof *g->pix_dir);
+  } else {
+    g->nomem = s == HEARTH_E_NOMEM;
+    /* a pixel the lens model cannot invert gets a zero direction: never cast */
+    if (hearth_camera_ray_grid(g->cam, st, g->pix_dir))
+      for (size_t k = 0; k < 3 * np; k++)
+        if (isnan(g->pix_dir[k])) g->pix_dir[k] = 0.0f;
+  }
+  for (size_t y = 0; y < ph; y++)
+    for (size_t x = 0; x < pw; x++) g->pix_index[y * pw + x] = (uint32_t)(y * st * (size_t)g->cam->width + x * st);
+  size_t k = 0;
+  for (size_t ty = 0; ty < ph; ty += 4)
+    for (size_t tx = 0; tx < pw; tx += 4)
+      for (size_t y = ty; y < ty + 4 && y < ph; y++)
+        for (size_t x = tx; x < tx + 4 && x < pw; x++) g->tile_order[k++] = (uint32_t)(y * pw + x);
+  return NULL;
+}
+
+static void *islands_run(void *arg) {
+  grid_build *g = arg;
+  g->islands_status = hearth_uv_islands(g->mesh, g->island_of_tri, &g->n_islands, &g->islands_err);
+  return NULL;
+}
+
+/* the rasterised triangle of each texel of rows [b, e) replaced by its
+   island, in place */
+static void texel_islands(void *ctx, size_t b, size_t e, int t) {
+  hearth_map_layout *l = ctx;
+  (void)t;
+  for (size_t q = b * l->R; q < e * l->R; q++) {
+    uint32_t tq = l->island_of_texel[q];
+    l->island_of_texel[q] = tq == UINT32_MAX ? UINT32_MAX : l->island_of_tri[tq];
+  }
+}
+
+/* unit normals of triangles [b, e) (0 for a degenerate one) */
+static void tri_normals(void *ctx, size_t b, size_t e, int t) {
+  hearth_map_layout *l = ctx;
+  const hearth_mesh *mesh = l->mesh;
+  (void)t;
+  for (size_t i = b; i < e; i++) {
+    const uint32_t *ix = mesh->indices + 3 * i;
+    const float *a = mesh->positions + 3 * ix[0], *bb = mesh->positions + 3 * ix[1],
+                *c = mesh->positions + 3 * ix[2];
+    double e1[3] = {bb[0] - a[0], bb[1] - a[1], bb[2] - a[2]}, e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    double nn[3];
+    hearth_cross3(e1, e2, nn);
+    double len = hearth_norm3(nn);
+    for (int k = 0; k < 3; k++) l->tri_normal[3 * i + k] = len > 0 ? (float)(nn[k] / len) : 0.0f;
+  }
+}
+
+/* the box centre and the farthest vertex from it, padded so that rounding
+   can never cull a ray that touches the mesh */
+static void bounding_sphere(const hearth_mesh *mesh, double sphere[4]) {
+  double lo[3], hi[3], r2 = 0;
+  hearth_mesh_bounds(mesh, lo, hi);
+  for (int k = 0; k < 3; k++) sphere[k] = 0.5 * (lo[k] + hi[k]);
+  for (size_t i = 0; i < mesh->n_vertices; i++) {
+    const float *pv = mesh->positions + 3 * i;
+    double dx = pv[0] - sphere[0], dy = pv[1] - sphere[1], dz = pv[2] - sphere[2];
+    double d2 = dx * dx + dy * dy + dz * dz;
+    if (d2 > r2) r2 = d2;
+  }
+  sphere[3] = sqrt(r2) * (1.0 + 1e-3) + 1e-6;
+}
+
+/* the pixel grid's size and arrays, and the triangles' islands */
+static hearth_status alloc_grid(hearth_map_layout *l, hearth_err *err) {
+  const size_t st = l->stride;
+  l->pw = ((size_t)l->cam.width + st - 1) / st;
+  l->ph = ((size_t)l->cam.height + st - 1) / st;
+  l->np = l->pw * l->ph;
+  if (l->np > UINT32_MAX / 4)
+    return hearth_err_set(err, HEARTH_E_LIMIT, "map: a %zu x %zu pixel grid exceeds the limit", l->pw, l->ph);
+  l->pix_dir = hearth_alloc_array(l->np, 3 * sizeof *l->pix_dir);
+  l->pix_index = hearth_alloc_array(l->np, sizeof *l->pix_index);
+  l->tile_order = hearth_alloc_array(l->np, sizeof *l->tile_order);
+  if (!l->pix_dir || !l->pix_index || !l->tile_order) return hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
+  const size_t nt = l->mesh->n_triangles;
+  l->island_of_tri = hearth_alloc_array(nt ? nt : 1, sizeof *l->island_of_tri);
+  if (!l->island_of_tri) return hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
+  return HEARTH_OK;
+}
+
+/* everything of l after its inputs: the pixel grid and the islands on
+   threads of their own beside the UV raster, then each texel's island, the
+   normals and the bounding sphere */
+static hearth_status build_layout(hearth_map_layout *l, hearth_err *err) {
+  const hearth_mesh *mesh = l->mesh;
+  const size_t R = l->R;
+  grid_build gb = {0};
+  pthread_t gb_tid, isl_tid;
+  int gb_started = 0, isl_started = 0;
+  hearth_status s = alloc_grid(l, err);
+  if (s) goto done;
+  gb = (grid_build){&l->cam, l->stride, l->pw, l->ph, l->pix_dir, l->pix_index, l->tile_order, NULL, 0,
+                    mesh, l->island_of_tri, 0, HEARTH_OK, {0}};
+  gb_started = pthread_create(&gb_tid, NULL, grid_build_run, &gb) == 0;
+  if (!gb_started) grid_build_run(&gb); /* no thread: make it here */
+  isl_started = pthread_create(&isl_tid, NULL, islands_run, &gb) == 0;
+  if (!isl_started) islands_run(&gb);
+  l->tri_normal = hearth_alloc_array(mesh->n_triangles, 3 * sizeof *l->tri_normal);
+  l->island_of_texel = hearth_alloc_array(R * R, sizeof *l->island_of_texel);
+  if (!l->tri_normal || !l->island_of_texel) {
+    s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory for R=%zu", R);
+    goto done;
+  }
+  /* each texel's triangle, made its island below */
+  if ((s = hearth_uv_rasterize(mesh, R, l->island_of_texel, NULL, err))) goto done;
+  if (gb_started) pthread_join(gb_tid, NULL);
+  if (isl_started) pthread_join(isl_tid, NULL);
+  gb_started = isl_started = 0;
+  if (gb.islands_status) {
+    if (err) *err = gb.islands_err;
+    s = gb.islands_status;
+    goto done;
+  }
+  l->n_islands = gb.n_islands;
+  hearth_parallel_chunks(R, 32, 0, texel_islands, l);
+  hearth_parallel_chunks(mesh->n_triangles, 8192, 0, tri_normals, l);
+  bounding_sphere(mesh, l->sphere);
+  l->fan = gb.fan;
+  gb.fan = NULL;
+  if (gb.nomem) s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory for the pixel grid");
+done:
+  if (gb_started) pthread_join(gb_tid, NULL);
+  if (isl_started) pthread_join(isl_tid, NULL);
+  hearth_ray_fan_free(gb.fan);
+  return s;
+}
+
+void hearth_map_layout_free(hearth_map_layout *l) {
+  if (!l) return;
+  free(l->island_of_tri);
+  free(l->island_of_texel);
+  free(l->tri_normal);
+  free(l->pix_dir);
+  free(l->pix_index);
+  free(l->tile_order);
+  hearth_ray_fan_free(l->fan);
+  free(l);
+}
+
+hearth_status hearth_map_layout_new(const hearth_mesh *mesh, const hearth_camera *cam,
+                                    const hearth_map_opts *opts_in, hearth_map_layout **out,
+                                    hearth_err *err) {
+  *out = NULL;
+  hearth_map_opts opts;
+  if (opts_in) opts = *opts_in;
+  else hearth_map_opts_default(&opts);
+  if (!mesh || !cam) return hearth_err_set(err, HEARTH_E_ARG, "map: missing mesh or camera");
+  if (!mesh->uvs) return hearth_err_set(err, HEARTH_E_NOT_FOUND, "map: the mesh has no UVs (TEXCOORD_0)");
+  size_t R = opts.resolution;
+  if (R < 2 || R > 16384) return hearth_err_set(err, HEARTH_E_RANGE, "map: resolution %zu outside 2..16384", R);
+  if (opts.pixel_stride < 1) opts.pixel_stride = 1;
+  if (cam->width <= 0 || cam->height <= 0) return hearth_err_set(err, HEARTH_E_ARG, "map: camera has no size");
+  hearth_status s = hearth_mesh_validate(mesh, "map mesh", err);
+  if (s) return s;
+  hearth_map_layout *l = calloc(1, sizeof *l);
+  if (!l) return hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
+  l->mesh = mesh;
+  l->cam = *cam;
+  l->R = R;
+  l->stride = (size_t)opts.pixel_stride;
+  if ((s = build_layout(l, err))) hearth_map_layout_free(l);
+  else *out = l;
+  return s;
+}
