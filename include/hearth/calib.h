@@ -1,7 +1,7 @@
-/* hearth/calib.h - the 84-hole plate: hole-centre detection in colour and
- * thermal images, thermal intrinsics (Zhang + Levenberg-Marquardt) and the
- * RGB-thermal stereo transform, plus the release-level `detect` and
- * `calibrate` stages.
+/* hearth/calib.h - area calib (src/calib/): the 84-hole plate: hole-centre
+ * detection in colour and thermal images, thermal intrinsics (Zhang +
+ * Levenberg-Marquardt) and the RGB-thermal stereo transform, plus the
+ * release-level `detect` and `calibrate` stages.
  *
  * Detection never alters its input: thermal enhancement (percentile clip,
  * 8-bit, upsampling) works on a private copy and the final centres are
@@ -37,7 +37,8 @@ void hearth_detect_opts_default(hearth_detect_opts *o);
 
 /* Thermal matrix (1-channel F32, degC), holes warmer than the plate. Fills
  * det->found, det->reason, det->centres (native pixels); det->frame and
- * det->camera are left to the caller. Errors only for invalid arguments. */
+ * det->camera are left to the caller. Errors only for invalid arguments.
+ * o may be NULL (the defaults); temps is only read. */
 hearth_status hearth_detect_plate_thermal(const hearth_image *temps, const hearth_detect_opts *o,
                                           hearth_detection *det, hearth_err *err);
 /* Colour or gray U8 image (1, 3 or 4 channels), holes darker than the plate. */
@@ -64,11 +65,13 @@ typedef struct hearth_calib_opts {
 void hearth_calib_opts_default(hearth_calib_opts *o);
 
 /* Intrinsics and 5-parameter distortion from n_frames views of n_pts known
- * planar points (obj z = 0). img holds n_frames * n_pts (u, v) pairs, frame
- * after frame. Zhang's closed form initialises, then LM refines intrinsics,
- * distortion and every pose. Outputs: cam (width/height set from the
- * arguments), rms_px = sqrt(mean squared point error), optionally per-frame
- * RMS (n_frames) and T_cam_from_plate (n_frames). */
+ * planar points (obj z = 0, metres). img holds n_frames * n_pts (u, v)
+ * pairs in pixels, frame after frame. Zhang's closed form initialises, then
+ * LM refines intrinsics, distortion and every pose. Outputs: cam
+ * (width/height set from the arguments), rms_px = sqrt(mean squared point
+ * error), optionally per-frame RMS (n_frames) and T_cam_from_plate
+ * (n_frames), into the caller's arrays (NULL to skip). o may be NULL (the
+ * defaults). */
 hearth_status hearth_calib_intrinsics(const double (*obj)[3], size_t n_pts, const double *img,
                                       size_t n_frames, int width, int height,
                                       const hearth_calib_opts *o, hearth_camera *cam,
@@ -96,7 +99,9 @@ hearth_status hearth_calib_stereo(const hearth_camera *cam_a, const hearth_camer
 /* Detect the plate in every capture under <root>/calibration/captures and
  * write <root>/calibration/detections.json and, if overlays, the
  * calibration/overlays/<frame>_<camera>.png images. Frames are listed
- * thermal fNNN first, then each stereo pair pNNN (rgb, thermal). */
+ * thermal fNNN first, then each stereo pair pNNN (rgb, thermal). out (may
+ * be NULL) receives the detections (the caller frees them with
+ * hearth_detections_free). */
 typedef struct hearth_detect_job {
   hearth_detect_opts detect;
   int overlays; /* default 1 */
@@ -122,11 +127,14 @@ typedef struct hearth_calib_report {
   hearth_rig rig;
   double t_calib_s;       /* seconds spent reading, solving (not writing) */
 } hearth_calib_report;
+/* Frees the frame lists and zeroes r; accepts a zeroed report. */
 void hearth_calib_report_free(hearth_calib_report *r);
 
 /* Read calibration/detections.json and calibration/factory.json, calibrate,
  * write calibration/rig.json, calibration/rig_opencv.yaml and
- * calibration/calibration_report.json (all atomically, all or nothing). */
+ * calibration/calibration_report.json (all atomically, all or nothing).
+ * rep (required) is filled; the caller frees it with
+ * hearth_calib_report_free. */
 hearth_status hearth_calib_calibrate_release(const char *root, const hearth_calib_opts *o,
                                              hearth_calib_report *rep, hearth_err *err);
 

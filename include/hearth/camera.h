@@ -1,5 +1,6 @@
-/* hearth/camera.h - the pinhole camera with 5-parameter Brown-Conrady
- * distortion, in OpenCV's conventions.
+/* hearth/camera.h - area core (src/core/core_camera.c): the pinhole camera
+ * with 5-parameter Brown-Conrady distortion, in OpenCV's conventions. A
+ * camera is a plain value; nothing here allocates.
  *
  * Camera axes: +x right, +y down, +z forward. Pixel (0,0) is the centre of
  * the top-left pixel. Distortion order [k1, k2, p1, p2, k3]:
@@ -21,7 +22,7 @@ extern "C" {
 
 typedef struct hearth_camera {
   int width, height;   /* pixels */
-  double fx, fy, cx, cy;
+  double fx, fy, cx, cy; /* pixels */
   double dist[5];      /* k1 k2 p1 p2 k3 */
 } hearth_camera;
 
@@ -75,7 +76,9 @@ double hearth_camera_undistort(const hearth_camera *cam, double u, double v, dou
  * undistortion residual as above. */
 double hearth_camera_ray(const hearth_camera *cam, double u, double v, double dir[3]);
 
-/* Unit ray directions (camera frame, 3 floats each, row-major) through the
+/* Unit ray directions (camera frame, 3 floats each, row-major, into the
+ * caller's dirs of 3 * ceil(width / stride) * ceil(height / stride) floats)
+ * through the
  * pixels (x * stride, y * stride), x < ceil(width / stride), y < ceil(height /
  * stride): hearth_camera_ray for a whole grid, faster (each solve starts
  * where its neighbours' roots point). A pixel that cannot be undistorted to

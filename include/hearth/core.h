@@ -1,4 +1,5 @@
-/* hearth/core.h - status codes, error reports, files, threads, numbers.
+/* hearth/core.h - area core (src/core/): status codes, error reports,
+ * files, threads, locale-independent numbers, random numbers, progress.
  *
  * Every fallible function in hearth returns a hearth_status and, when the
  * caller passes a hearth_err, fills it with a message a person can act on:
@@ -31,12 +32,13 @@ typedef enum hearth_status {
   HEARTH_E_LIMIT         /* input exceeds an explicit safety limit */
 } hearth_status;
 
-/* "HEARTH_E_PARSE" etc.; never NULL. */
+/* "HEARTH_E_PARSE" etc.; a static string, never NULL. */
 const char *hearth_status_name(hearth_status s);
-/* A short description of the status; never NULL. */
+/* A short description of the status; a static string, never NULL. */
 const char *hearth_strerror(hearth_status s);
 
-/* An error report. Owned by the caller; functions fill it on failure. */
+/* An error report. Owned by the caller (usually on the stack, nothing
+ * inside to free); functions fill it on failure. */
 typedef struct hearth_err {
   hearth_status status;
   char msg[1024];
@@ -49,7 +51,8 @@ hearth_status hearth_err_set(hearth_err *err, hearth_status s, const char *fmt, 
     __attribute__((format(printf, 3, 4)))
 #endif
     ;
-/* Prefix the existing message with context ("reading cup_03/hot: ..."). */
+/* Prefix the existing message with context ("reading cup_03/hot: ...");
+ * returns err->status (HEARTH_OK when err is NULL). */
 hearth_status hearth_err_prefix(hearth_err *err, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 2, 3)))
@@ -61,8 +64,8 @@ hearth_status hearth_err_prefix(hearth_err *err, const char *fmt, ...)
 int hearth_mul_size(size_t a, size_t b, size_t *out);
 /* malloc of n * size bytes with overflow check; NULL on failure. */
 void *hearth_alloc_array(size_t n, size_t size);
-/* The same, zeroed; the memory is written at once (no lazily mapped zero
- * pages, whose first write after a read costs a copy-on-write fault). */
+/* The same, zeroed by writing every byte at once (rather than relying on
+ * lazily mapped zero pages). Free both with free(). */
 void *hearth_calloc_array(size_t n, size_t size);
 
 /* ---- files ----------------------------------------------------------------- */
@@ -78,7 +81,9 @@ hearth_status hearth_write_file_atomic(const char *path, const void *data, size_
                                        hearth_err *err);
 
 /* A streamed atomic writer for code that writes through FILE*:
- * open -> fwrite/fprintf to af.fp -> commit (rename) or abort (unlink). */
+ * open -> fwrite/fprintf to af.fp -> commit (flush, close, rename over path)
+ * or abort (close, unlink). af is the caller's; after commit or abort
+ * af.fp is closed and nothing else needs freeing. */
 typedef struct hearth_atomic_file {
   FILE *fp;
   char tmp_path[4096];
@@ -97,7 +102,7 @@ int hearth_is_atomic_temp(const char *name);
  * them. Only for directories no other process is writing to. */
 hearth_status hearth_remove_stale_temps(const char *dir, size_t *n_removed, hearth_err *err);
 
-/* mkdir -p. */
+/* mkdir -p (mode 0755); directories that exist already are fine. */
 hearth_status hearth_mkdirs(const char *path, hearth_err *err);
 /* 1 if path exists (file or directory). */
 int hearth_path_exists(const char *path);
@@ -107,12 +112,13 @@ hearth_status hearth_remove_tree(const char *path, hearth_err *err);
  * does not fit. */
 hearth_status hearth_path_join(char *buf, size_t bufsz, const char *a, const char *b);
 /* path relative to root when it lies under root (textually), else path
- * itself: what documents record, so a moved release keeps its bytes. */
+ * itself: what documents record, so a moved release keeps its bytes. The
+ * result points into path (nothing allocated). */
 const char *hearth_path_under(const char *root, const char *path);
 
 /* ---- threads --------------------------------------------------------------- */
 /* Number of worker threads to use when a caller passes 0: $HEARTH_THREADS if
- * set, else the online processor count. */
+ * set to 1..1024, else the online processor count (1..256). */
 int hearth_default_threads(void);
 
 /* Run fn over [0, n) split into contiguous chunks, one per thread, in
@@ -146,17 +152,19 @@ int hearth_format_fixed(char *buf, size_t bufsz, double x, int decimals);
  * same seed, same stream on every machine. */
 typedef struct hearth_rng { uint64_t s[4]; } hearth_rng;
 void hearth_rng_seed(hearth_rng *r, uint64_t seed);
-/* Derive an independent stream for a named sub-task (e.g. view index). */
+/* Derive an independent stream for a named sub-task (e.g. view index);
+ * the parent is not advanced, so forks do not depend on call order. */
 void hearth_rng_fork(const hearth_rng *parent, uint64_t stream, hearth_rng *child);
 uint64_t hearth_rng_u64(hearth_rng *r);
 double hearth_rng_uniform(hearth_rng *r);            /* [0, 1) */
-double hearth_rng_range(hearth_rng *r, double lo, double hi);
+double hearth_rng_range(hearth_rng *r, double lo, double hi); /* [lo, hi) */
 double hearth_rng_normal(hearth_rng *r);             /* N(0, 1) */
 
 /* ---- progress -------------------------------------------------------------- */
-/* A progress reporter for long jobs: a bar on a terminal, plain lines
- * otherwise (one every ~5 %), silent if quiet. Not thread-safe: call
- * hearth_progress_step from one thread. */
+/* A progress reporter for long jobs, on stderr: a bar on a terminal, plain
+ * lines otherwise (one every ~5 %), silent if quiet. label is borrowed
+ * (must outlive the reporter); nothing is allocated. Not thread-safe: call
+ * hearth_progress_step (k more items done) from one thread. */
 typedef struct hearth_progress {
   const char *label;
   size_t total, done;
@@ -167,7 +175,7 @@ typedef struct hearth_progress {
 void hearth_progress_begin(hearth_progress *p, const char *label, size_t total, int quiet);
 void hearth_progress_step(hearth_progress *p, size_t k);
 void hearth_progress_end(hearth_progress *p);
-/* Monotonic seconds. */
+/* Monotonic seconds (CLOCK_MONOTONIC), for durations only. */
 double hearth_now(void);
 
 #ifdef __cplusplus

@@ -1,9 +1,18 @@
-/* hearth/dataset.h - the JSON documents of a release tree and its paths.
+/* hearth/dataset.h - area dataset (src/dataset/): the JSON documents of a
+ * release tree and the names used in it (categories, states, instances).
  *
  * The on-disk contract is docs/dataset.md. Readers are strict: a missing
  * key, a wrong type, a non-finite number, a non-rotation R or an array of
  * the wrong length is an error naming the file and the JSON path
- * (e.g. "views[3].T_world_from_cam[2][1]"). Writers are atomic. */
+ * (e.g. "views[3].T_world_from_cam[2][1]"). Writers are atomic and
+ * deterministic, and refuse what their reader would refuse.
+ *
+ * Every document has _read (a file), _parse (text[0..len), not necessarily
+ * NUL-terminated, `name` naming it in messages) and _write. Documents with
+ * arrays (manifest, poses, detections, release) own them after a read and
+ * are released with their _free (which accepts a zeroed struct); the others
+ * hold no heap memory. Lengths in metres, angles in radians, pixel values
+ * in pixels (docs/conventions.md). */
 #ifndef HEARTH_DATASET_H
 #define HEARTH_DATASET_H
 
@@ -20,6 +29,9 @@ extern "C" {
 #define HEARTH_NAME_MAX 64
 
 /* ---- rig.json ------------------------------------------------------------ */
+/* The calibrated rig: the three cameras, the thermal and depth cameras'
+ * transforms from the colour camera, and the calibration's RMS errors
+ * (pixels). */
 typedef struct hearth_rig {
   hearth_camera rgb, thermal, depth;
   hearth_rigid T_thermal_from_rgb;
@@ -57,6 +69,7 @@ hearth_status hearth_factory_write(const char *path, const hearth_factory_calib 
                                    hearth_err *err);
 
 /* ---- manifest.json ------------------------------------------------------- */
+/* One state's views and the files of each, relative to raw/<state>/. */
 typedef struct hearth_view_files {
   char view[HEARTH_NAME_MAX];   /* "v00" */
   int elevation_index, azimuth_index;
@@ -76,6 +89,7 @@ hearth_status hearth_manifest_parse(const char *text, size_t len, const char *na
 hearth_status hearth_manifest_write(const char *path, const hearth_manifest *m, hearth_err *err);
 
 /* ---- poses_*.json ---------------------------------------------------------- */
+/* Camera poses T_world_from_cam of the views of one or more states. */
 typedef struct hearth_view_pose {
   char state[HEARTH_NAME_MAX];
   char view[HEARTH_NAME_MAX];
@@ -91,7 +105,7 @@ hearth_status hearth_poses_read(const char *path, hearth_poses *p, hearth_err *e
 hearth_status hearth_poses_parse(const char *text, size_t len, const char *name, hearth_poses *p,
                                  hearth_err *err);
 hearth_status hearth_poses_write(const char *path, const hearth_poses *p, hearth_err *err);
-/* The pose of (state, view), or NULL. */
+/* The pose of (state, view), or NULL; points into p. */
 const hearth_view_pose *hearth_poses_find(const hearth_poses *p, const char *state,
                                           const char *view);
 
@@ -100,7 +114,10 @@ const hearth_view_pose *hearth_poses_find(const hearth_poses *p, const char *sta
 #define HEARTH_PLATE_HOLES 84
 #define HEARTH_PLATE_PITCH_M 0.012
 #define HEARTH_PLATE_ROW_STEP_M 0.0103923
-/* Plate coordinates (metres, z = 0) of hole i in row-by-row order. */
+/* The calibration plate: 84 holes in 8 rows of alternately 11 and 10,
+ * HEARTH_PLATE_PITCH_M apart in a row, rows HEARTH_PLATE_ROW_STEP_M apart,
+ * odd rows shifted by half a pitch. Plate coordinates (metres, z = 0) of
+ * hole i in row-by-row order. */
 void hearth_plate_hole(int i, double xyz[3]);
 
 typedef struct hearth_detection {
@@ -108,7 +125,7 @@ typedef struct hearth_detection {
   char camera[16];              /* "thermal" | "rgb" */
   int found;
   char reason[256];             /* when !found */
-  double centres[HEARTH_PLATE_HOLES][2];
+  double centres[HEARTH_PLATE_HOLES][2]; /* (u, v) pixels in plate order, when found */
 } hearth_detection;
 
 typedef struct hearth_detections {
@@ -125,7 +142,7 @@ hearth_status hearth_detections_write(const char *path, const hearth_detections 
 /* ---- scale.json --------------------------------------------------------------- */
 /* views_used and residual_median_mm are optional in the file (0 when absent). */
 typedef struct hearth_scale_doc {
-  double scale;
+  double scale; /* metres per reconstruction unit */
   int views_used;
   double residual_median_mm;
 } hearth_scale_doc;
@@ -165,10 +182,11 @@ hearth_status hearth_release_parse(const char *text, size_t len, const char *nam
 
 /* ---- names ----------------------------------------------------------------- */
 /* The 18 categories of the paper, lower case with underscores
- * ("bottled_drink", "electric_kettle", ...). */
+ * ("bottled_drink", "electric_kettle", ...); a constant table. */
 extern const char *const hearth_categories[18];
+/* 1 if name is one of them. */
 int hearth_category_valid(const char *name);
-/* neutral | hot | warm | iced | used */
+/* 1 if name is a state: neutral | hot | warm | iced | used */
 int hearth_state_valid(const char *name);
 /* "<category>_<NN>": a valid category, '_', two to four decimal digits. */
 int hearth_instance_id_valid(const char *id);

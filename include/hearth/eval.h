@@ -1,13 +1,15 @@
-/* hearth/eval.h - scoring policies on the sim tasks H1-H3 the way the paper
- * does (10 episodes per instruction, 20 per task, 60 per policy; success =
- * target on the mat within the time limit), for policies running anywhere:
+/* hearth/eval.h - area eval (src/eval/; built with HEARTH_SIM): scoring
+ * policies on the sim tasks H1-H3 the way the paper does (10 episodes per
+ * instruction, 20 per task, 60 per policy; success = target on the mat
+ * within the time limit), for policies running anywhere:
  * the scripted expert (an upper bound), a replay of an HDF5 demonstration
  * (a determinism check) and an openpi policy server over WebSocket.
  *
  * Held-out layouts: evaluation episode e of a task uses layout
  * HEARTH_EVAL_LAYOUT_BASE + e of the seed stream, never reached by
  * collection (which uses layouts 0, 1, 2, ... up to at most 100000 + retries);
- * both instructions of an episode index share the layout, as in the paper. */
+ * both instructions of an episode index share the layout, as in the paper.
+ * The policy protocol and results.json: docs/simulation.md. */
 #ifndef HEARTH_EVAL_H
 #define HEARTH_EVAL_H
 
@@ -25,19 +27,20 @@ extern "C" {
 /* Time limits in control steps (policy steps; the 10 no-op steps of the
  * openpi client come on top, as in openpi's LIBERO example). LIBERO uses
  * 220 (spatial), 280 (object), 300 (goal) and 520 (long); our tasks are
- * single pick-and-place like LIBERO-Object, and the scripted expert needs
- * about 130-170 steps, so 280 for each. */
+ * single pick-and-place like LIBERO-Object, so 280 for each (the scripted
+ * expert finishes well within it). */
 int hearth_eval_time_limit(hearth_sim_task t);
 
 /* ---- openpi observations ----------------------------------------------------
  * openpi's image_tools.resize_with_pad: scale to fit out_w x out_h keeping
- * the aspect ratio (bilinear), centre, pad with zeros. RGB U8. */
+ * the aspect ratio (bilinear), centre, pad with zeros. RGB U8, in[w*h*3]
+ * into the caller's out[out_w*out_h*3]. */
 void hearth_eval_resize_with_pad(const uint8_t *in, int w, int h, uint8_t *out, int out_w, int out_h);
 /* Build the openpi LIBERO request (msgpack map): observation/image,
  * observation/wrist_image (and observation/thermal_image if thermal), each
  * rotated 180 degrees from OpenGL order and resized with padding to
  * size x size; observation/state (8 x <f8: ee pos, axis-angle, gripper);
- * prompt. The caller frees the writer. */
+ * prompt. Appended to w (initialised by the caller, who frees it). */
 struct hearth_mp_writer;
 hearth_status hearth_eval_encode_obs(const hearth_sim_obs *obs, const char *prompt, int thermal, int size,
                                      struct hearth_mp_writer *w, hearth_err *err);
@@ -73,7 +76,7 @@ typedef struct hearth_eval_episode {
   int success, steps;
   int error;               /* the policy failed (server gone, bad reply ...) */
   char reason[512];        /* why it failed ("time limit", the error) */
-  double state_diff;       /* replay: max |state - stored state| at the last stored step; else -1 */
+  double state_diff;       /* replay: max |state - stored state| over the replayed steps; else -1 */
   int expected_success;    /* replay: 1 (the stored demo succeeded), else -1 */
 } hearth_eval_episode;
 
@@ -86,6 +89,10 @@ typedef struct hearth_eval_results {
   char metadata[512];      /* server metadata (JSON-ish summary), if any */
 } hearth_eval_results;
 
+/* Run every episode; r is filled on success (the caller frees it with
+ * hearth_eval_results_free, which accepts a zeroed struct). A policy's
+ * failure fails its episode and the run goes on; a simulator failure stops
+ * the run with an error. */
 hearth_status hearth_eval_run(const hearth_eval_opts *o, hearth_eval_results *r, hearth_err *err);
 void hearth_eval_results_free(hearth_eval_results *r);
 
@@ -94,7 +101,7 @@ void hearth_eval_results_free(hearth_eval_results *r);
 double hearth_eval_rates(const hearth_eval_results *r, double per_instr[4][2], double per_task[4]);
 /* The paper's table (Task, Thermal, Instr. 1, Instr. 2, Average) as text
  * (ends with a line "overall <pct> (k/n)"), Markdown and JSON (with every
- * episode). malloc'd strings. */
+ * episode). malloc'd strings (the caller frees them). */
 char *hearth_eval_format_text(const hearth_eval_results *r);
 char *hearth_eval_format_markdown(const hearth_eval_results *r);
 char *hearth_eval_format_json(const hearth_eval_results *r);

@@ -1,4 +1,5 @@
-/* hearth/geom.h - rigid transforms and small 3-D helpers.
+/* hearth/geom.h - area core (src/core/core_geom.c): rigid transforms and
+ * small 3-D helpers. Plain values, nothing allocated.
  *
  * A transform named T_a_from_b maps coordinates in frame b to frame a:
  *   x_a = R * x_b + t,  R row-major 3x3.
@@ -39,7 +40,7 @@ void hearth_matrix_to_rotvec(const double R[9], double w[3]);
 /* Derivative of the rotation matrix w.r.t. the rotation vector:
  * dR[k*9 + i] = d R[i] / d w[k]. */
 void hearth_rotvec_to_matrix_jac(const double w[3], double R[9], double dR[27]);
-/* Angle of the relative rotation between two matrices, radians. */
+/* Angle of the relative rotation between two matrices, radians (0..pi). */
 double hearth_rotation_angle_between(const double Ra[9], const double Rb[9]);
 /* Re-orthonormalise a nearly orthonormal matrix (SVD-free polar iteration). */
 void hearth_orthonormalize(double R[9]);

@@ -1,7 +1,11 @@
-/* hearth/image.h - images in memory and on disk (PNG 8/16-bit, JPEG), the
- * Turbo colour map and a few drawing helpers for overlays and contact sheets.
+/* hearth/image.h - area io (src/io/): images in memory and on disk (PNG
+ * 8/16-bit, JPEG), the Turbo colour map and a few drawing helpers for
+ * overlays and contact sheets.
  *
- * Pixels are row-major, channels interleaved, row 0 at the top. */
+ * Pixels are row-major, channels interleaved, row 0 at the top; 16-bit and
+ * float samples in native byte order. Every function that fills a
+ * hearth_image * output allocates its data (the caller frees it with
+ * hearth_image_free); on failure the output is left zeroed. */
 #ifndef HEARTH_IMAGE_H
 #define HEARTH_IMAGE_H
 
@@ -26,26 +30,29 @@ typedef struct hearth_image {
   void *data;            /* owned; width*height*channels samples */
 } hearth_image;
 
-/* Allocate a zeroed image; sizes are overflow-checked. */
+/* Allocate a zeroed image; sizes are overflow-checked. img need not be
+ * initialised (it is overwritten, not freed). */
 hearth_status hearth_image_alloc(hearth_image *img, size_t width, size_t height, int channels,
                                  hearth_pixtype type, hearth_err *err);
-void hearth_image_free(hearth_image *img); /* accepts a zeroed image */
+void hearth_image_free(hearth_image *img); /* frees data, zeroes img; accepts a zeroed image */
 size_t hearth_image_bytes(const hearth_image *img);
 
 /* Limits applied to untrusted image files. */
 #define HEARTH_IMAGE_MAX_DIM 16384
 
 /* PNG: reads 8- or 16-bit gray, gray+alpha, RGB or RGBA (palette and low
- * bit depths are expanded to 8-bit). Writes U8 or U16 images, 1-4 channels. */
+ * bit depths are expanded to 8-bit). Writes U8 or U16 images, 1-4 channels,
+ * atomically. `name` names the data in messages; read_mem copies what it
+ * needs (data may be freed after the call). */
 hearth_status hearth_png_read(const char *path, hearth_image *img, hearth_err *err);
 hearth_status hearth_png_read_mem(const void *data, size_t size, const char *name,
                                   hearth_image *img, hearth_err *err);
 hearth_status hearth_png_write(const char *path, const hearth_image *img, hearth_err *err);
-/* Encode to memory (*out malloc'ed). */
+/* Encode to memory (*out malloc'ed, the caller frees it). */
 hearth_status hearth_png_encode(const hearth_image *img, uint8_t **out, size_t *size,
                                 hearth_err *err);
 
-/* JPEG (8-bit gray or RGB). quality 1..100. */
+/* JPEG (8-bit gray or RGB; U8 images). quality 1..100. Writes atomically. */
 hearth_status hearth_jpeg_read(const char *path, hearth_image *img, hearth_err *err);
 hearth_status hearth_jpeg_read_mem(const void *data, size_t size, const char *name,
                                    hearth_image *img, hearth_err *err);
@@ -59,22 +66,28 @@ hearth_status hearth_jpeg_write(const char *path, const hearth_image *img, int q
  * table). t is clamped to [0, 1]. */
 void hearth_turbo(double t, uint8_t rgb[3]);
 /* Colour a float temperature image (1 channel) with Turbo over [lo, hi] degC
- * into an RGB U8 image. NaN pixels get nan_rgb. */
+ * (lo < hi; values outside are clamped) into a new RGB U8 image. NaN pixels
+ * get nan_rgb (NULL: black). */
 hearth_status hearth_turbo_image(const hearth_image *temps, double lo, double hi,
                                  const uint8_t nan_rgb[3], hearth_image *rgb, hearth_err *err);
 
-/* Drawing on RGB(A) U8 images, clipped to the image. */
+/* Drawing on RGB(A) U8 images in place, clipped to the image; coordinates
+ * in pixels (pixel centres at integers). */
 void hearth_draw_line(hearth_image *img, double x0, double y0, double x1, double y1,
                       const uint8_t rgb[3], int thickness);
 void hearth_draw_circle(hearth_image *img, double cx, double cy, double r,
                         const uint8_t rgb[3]);
-/* Nearest-neighbour or box resample of a U8 image to new size (for
- * thumbnails). */
+/* Resample a U8 image into a new width x height image (for thumbnails),
+ * per axis: the area average when shrinking, linear interpolation between
+ * pixel centres when enlarging. */
 hearth_status hearth_image_resize(const hearth_image *src, size_t width, size_t height,
                                   hearth_image *dst, hearth_err *err);
-/* Copy src (U8, same channel count, or gray into RGB) into dst at (x, y). */
+/* Copy src into dst with its top-left at (x, y), clipped to dst: U8 images
+ * with the same channel count, gray into RGB(A), or RGB into RGBA (alpha
+ * kept); other combinations do nothing. */
 void hearth_image_blit(hearth_image *dst, const hearth_image *src, size_t x, size_t y);
-/* Write text with a built-in 5x7 pixel font, scale >= 1. */
+/* Write text with a built-in 5x7 pixel font, each font pixel scale x scale
+ * image pixels (scale >= 1), the top-left of the first glyph at (x, y). */
 void hearth_draw_text(hearth_image *img, size_t x, size_t y, const char *text,
                       const uint8_t rgb[3], int scale);
 

@@ -1,5 +1,6 @@
-/* hearth/map.h - temperature (and colour) mapping from camera views onto a
- * mesh's UV layout: the paper's "Temperature Mapping and Thermal Textures".
+/* hearth/map.h - area map (src/map/): temperature (and colour) mapping from
+ * camera views onto a mesh's UV layout: the paper's "Temperature Mapping and
+ * Thermal Textures".
  *
  * For each view, every pixel's undistorted centre is cast into the scene
  * (by rasterising the mesh through the camera's ray fan when the whole mesh
@@ -75,11 +76,15 @@ typedef struct hearth_map_result {
   size_t n_views;
   size_t n_surface, n_observed, n_filled, n_unobserved;
 } hearth_map_result;
+/* A result owns its arrays (filled by the mapping functions); this frees
+ * them and zeroes r, and accepts a zeroed result. */
 void hearth_map_result_free(hearth_map_result *r);
 
 /* Map n views seen by one camera model onto mesh (which must have UVs).
  * rc is a ray caster built over the same mesh, or NULL to build one here
- * if a view needs rays.
+ * if a view needs rays. opts may be NULL (the defaults). out is filled (the
+ * caller frees it with hearth_map_result_free); values are in the views'
+ * units (degC, or colour 0..255).
  * Deterministic: the same bytes for any thread count. */
 hearth_status hearth_map_views(const hearth_mesh *mesh, const hearth_raycaster *rc,
                                const hearth_camera *cam, const hearth_map_view *views,
@@ -103,7 +108,8 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
                                      hearth_err *err);
 
 /* The part of a mapping that depends only on the mesh, the camera and the
- * options' resolution and pixel stride: the UV raster and islands, the
+ * options' resolution and pixel stride (released with
+ * hearth_map_layout_free, which accepts NULL): the UV raster and islands, the
  * triangles' normals, the mesh's bounding sphere, and the camera's pixel
  * grid with its ray fan. Made once, it serves any number of view sets of
  * that mesh and camera (the states of an instance), and it can be made
@@ -121,7 +127,8 @@ hearth_status hearth_map_views_with_layout(const hearth_map_layout *l, const hea
                                           const hearth_map_opts *opts, hearth_map_result *out,
                                           hearth_map_timing *timing, hearth_err *err);
 
-/* Copy the filled map into an image for a texture: Turbo over [lo, hi] for
+/* Copy the filled map into a new R x R RGB U8 image for a texture (the
+ * caller frees it with hearth_image_free): Turbo over [lo, hi] degC for
  * temperatures (channels == 1) or the colour (channels == 3); texels without
  * a value are padded from neighbours for `pad` texels (so bilinear texture
  * lookups at island borders stay clean) and set to nan_rgb beyond. */

@@ -1,5 +1,7 @@
-/* hearth/mesh.h - triangle meshes with UVs, glTF binary (GLB) files, and the
- * ray caster used by the virtual rig, scale recovery and mapping.
+/* hearth/mesh.h - area mesh (src/mesh/): triangle meshes with UVs, glTF
+ * binary (GLB) files, the ray caster (Embree) used by the virtual rig, scale
+ * recovery and mapping, a camera's pixel grid cast by rasterisation, and UV
+ * islands and texel rasterisation.
  *
  * UVs follow glTF: (0,0) is the top-left of the texture image, v grows
  * downwards, so texel [row][col] of an R x R map has its centre at
@@ -27,10 +29,16 @@ typedef struct hearth_mesh {
   uint32_t *indices;  /* 3 * n_triangles, counter-clockwise front faces */
   hearth_image texture; /* base colour (RGB/RGBA U8), data NULL if none */
 } hearth_mesh;
+/* A mesh owns its arrays and its texture's data; every function that fills
+ * a hearth_mesh * output allocates them, released with hearth_mesh_free. */
 
-void hearth_mesh_free(hearth_mesh *m); /* accepts a zeroed mesh */
+/* Frees the arrays and the texture and zeroes m; accepts a zeroed mesh. */
+void hearth_mesh_free(hearth_mesh *m);
+/* Allocate (uninitialised) positions, indices and, with with_uvs, uvs for
+ * the given counts; no texture. m need not be initialised. */
 hearth_status hearth_mesh_alloc(hearth_mesh *m, size_t n_vertices, size_t n_triangles,
                                 int with_uvs, hearth_err *err);
+/* A deep copy of src, texture included, into dst (overwritten, not freed). */
 hearth_status hearth_mesh_copy(const hearth_mesh *src, hearth_mesh *dst, hearth_err *err);
 /* Axis-aligned bounds. */
 void hearth_mesh_bounds(const hearth_mesh *m, double lo[3], double hi[3]);
@@ -53,7 +61,9 @@ void hearth_glb_read_opts_default(hearth_glb_read_opts *o);
  * transforms (matrix or TRS), concatenates every triangle primitive
  * (indexed or not) of every mesh instance into one mesh. Draco/meshopt
  * compression, sparse accessors, non-triangle modes, out-of-range indices
- * and truncated chunks are errors naming the file and the element. */
+ * and truncated chunks are errors naming the file and the element. opts may
+ * be NULL (the defaults). parse reads data[0..size) (copied; `name` names it
+ * in messages). */
 hearth_status hearth_glb_read(const char *path, const hearth_glb_read_opts *opts,
                               hearth_mesh *out, hearth_err *err);
 hearth_status hearth_glb_parse(const void *data, size_t size, const char *name,
@@ -61,7 +71,8 @@ hearth_status hearth_glb_parse(const void *data, size_t size, const char *name,
                                hearth_err *err);
 /* Write one mesh (POSITION, TEXCOORD_0 if present, NORMAL computed, uint32
  * indices) and, if m->texture is set, an embedded PNG base-colour texture.
- * The file passes the Khronos glTF validator. Atomic. */
+ * The file passes the Khronos glTF validator. Atomic. encode writes the
+ * same bytes to *out (malloc'ed, the caller frees it). */
 hearth_status hearth_glb_write(const char *path, const hearth_mesh *m, hearth_err *err);
 hearth_status hearth_glb_encode(const hearth_mesh *m, uint8_t **out, size_t *size,
                                 hearth_err *err);
@@ -76,14 +87,18 @@ typedef struct hearth_ray_hit {
   int front;        /* 1 if the ray hit the front (counter-clockwise) side */
 } hearth_ray_hit;
 
-/* Build an acceleration structure over m (m must outlive it). */
+/* Build an acceleration structure over m (m must outlive it and stay
+ * unchanged); released with hearth_raycaster_free (NULL is fine). Rays are
+ * in the mesh's frame and units; a direction need not be a unit vector, t
+ * is measured in units of its length (a distance for unit directions). */
 hearth_status hearth_raycaster_new(const hearth_mesh *m, hearth_raycaster **out,
                                    hearth_err *err);
 void hearth_raycaster_free(hearth_raycaster *rc);
 /* Nearest hit in (tnear, tfar). Returns 1 on a hit. Thread-safe. */
 int hearth_raycast(const hearth_raycaster *rc, const double org[3], const double dir[3],
                    double tnear, double tfar, hearth_ray_hit *hit);
-/* Cast n rays (org/dir 3*n floats); hits[i].prim = UINT32_MAX where none. */
+/* Cast n rays (org/dir 3*n floats) into the caller's hits[n];
+ * hits[i].prim = UINT32_MAX where none. */
 void hearth_raycast_batch(const hearth_raycaster *rc, size_t n, const float *org,
                           const float *dir, float tnear, float tfar, hearth_ray_hit *hits);
 /* The same with an explicit worker count (0 = hearth_default_threads(),
@@ -106,12 +121,14 @@ void hearth_raycast_batch_mt(const hearth_raycaster *rc, size_t n, const float *
  * otherwise cast rays. */
 typedef struct hearth_ray_fan hearth_ray_fan;
 
+/* The fan of cam's pixel grid (every stride-th pixel; stride 0 counts as
+ * 1); released with hearth_ray_fan_free. */
 hearth_status hearth_ray_fan_new(const hearth_camera *cam, size_t stride, hearth_ray_fan **out,
                                  hearth_err *err);
 void hearth_ray_fan_free(hearth_ray_fan *f);
 /* The grid's unit directions (3 floats per pixel, row-major, w x h): those
  * of hearth_camera_ray_grid, with zero where the lens cannot be inverted
- * (such a pixel never hits). */
+ * (such a pixel never hits). Owned by the fan. */
 const float *hearth_ray_fan_dirs(const hearth_ray_fan *f, size_t *w, size_t *h);
 /* Bytes of scratch one cast at a mesh of n_vertices needs: one block per
  * concurrent cast, zero-filled before its first cast (calloc); every cast
@@ -132,14 +149,15 @@ hearth_status hearth_ray_fan_cast(const hearth_ray_fan *f, const hearth_mesh *m,
 /* ---- UV islands and texel rasterisation ----------------------------------- */
 /* Label connected UV islands: triangles sharing an edge in UV space (same two
  * UV coordinates, bit-exact after welding identical UVs) belong to one
- * island. island_of_tri[n_triangles] gets 0..n_islands-1. */
+ * island. The caller's island_of_tri[n_triangles] gets 0..n_islands-1. */
 hearth_status hearth_uv_islands(const hearth_mesh *m, uint32_t *island_of_tri,
                                 uint32_t *n_islands, hearth_err *err);
 
-/* Rasterise the UV layout into R x R: tri_of_texel[row*R+col] is the
- * triangle whose UV triangle contains the texel centre (UINT32_MAX if none;
- * ties go to the lowest triangle index, so the result is deterministic),
- * bary (optional, 3 floats per texel) its barycentrics. */
+/* Rasterise the UV layout into R x R (caller's arrays of R * R entries):
+ * tri_of_texel[row*R+col] is the triangle whose UV triangle contains the
+ * texel centre (UINT32_MAX if none; ties go to the lowest triangle index, so
+ * the result is deterministic), bary (optional, 3 floats per texel) its
+ * barycentrics. */
 hearth_status hearth_uv_rasterize(const hearth_mesh *m, size_t R, uint32_t *tri_of_texel,
                                   float *bary, hearth_err *err);
 

@@ -1,6 +1,7 @@
-/* hearth/msgpack.h - a small MessagePack encoder and a strict decoder for
- * untrusted input (the openpi policy-server protocol), with numpy arrays as
- * openpi-client's msgpack_numpy sends them: maps with the BINARY keys
+/* hearth/msgpack.h - area net (src/net/net_msgpack.c): a small MessagePack
+ * encoder and a strict decoder for untrusted input (the openpi
+ * policy-server protocol), with numpy arrays as openpi-client's
+ * msgpack_numpy sends them: maps with the BINARY keys
  * __ndarray__ (true), data (raw C-order bytes), dtype (str such as "<f4")
  * and shape (array of ints). */
 #ifndef HEARTH_MSGPACK_H
@@ -52,8 +53,10 @@ typedef struct hearth_mp_doc {
 } hearth_mp_doc;
 
 /* Decode exactly one object filling buf[0..len) (trailing bytes are an
- * error). Strings and binaries point into buf, which must outlive the
- * document. Errors name the byte offset and what was expected. */
+ * error). lim may be NULL (the defaults). Strings and binaries point into
+ * buf, which must outlive the document; the values are one allocation,
+ * released with hearth_mp_doc_free (which accepts a zeroed doc). Errors name
+ * the byte offset and what was expected. */
 hearth_status hearth_mp_decode(const uint8_t *buf, size_t len, const hearth_mp_limits *lim,
                                hearth_mp_doc *doc, hearth_err *err);
 void hearth_mp_doc_free(hearth_mp_doc *doc);
@@ -87,9 +90,11 @@ hearth_status hearth_mp_ndarray_get(const hearth_mp_value *v, const char *where,
 double hearth_mp_ndarray_at(const hearth_mp_ndarray *a, size_t k);
 
 /* ---- encoder --------------------------------------------------------------
- * Appends to a growing buffer; an allocation failure sets .failed and later
+ * Appends to a growing buffer (buf[0..len), malloc'ed, released with
+ * hearth_mp_writer_free); an allocation failure sets .failed and later
  * calls do nothing. Containers are written as a header with their count
- * followed by that many values (maps: 2 per entry). */
+ * followed by that many values (maps: 2 per entry). Data passed in is
+ * copied. */
 typedef struct hearth_mp_writer {
   uint8_t *buf;
   size_t len, cap;

@@ -1,6 +1,7 @@
-/* hearth/poses.h - metric scale recovery from depth maps, automatic
- * thermal-pose refinement and alignment overlays (the paper's "scale
- * recovery" and its manual per-view refinement, made automatic).
+/* hearth/poses.h - area poses (src/poses/): metric scale recovery from depth
+ * maps, pose transfer through the rig, automatic thermal-pose refinement
+ * and alignment overlays (the paper's "scale recovery" and its manual
+ * per-view refinement, made automatic).
  *
  * Frames: recon/ is the reconstruction frame at unknown scale; a point
  * x_recon is at s * x_recon metres (docs/conventions.md). Depth PNGs hold z
@@ -102,8 +103,9 @@ typedef struct hearth_refine_view_result {
 } hearth_refine_view_result;
 
 /* Refine each view's T_world_from_cam (views[i].image: F32 temperatures)
- * against the metric mesh. Views are independent and run in parallel;
- * output i depends only on view i. */
+ * against the metric mesh; out is the caller's array of n_views results.
+ * Views are independent and run in parallel; output i depends only on view
+ * i. opts may be NULL (the defaults). */
 hearth_status hearth_refine_views(const hearth_mesh *mesh, const hearth_raycaster *rc,
                                   const hearth_camera *cam, const hearth_map_view *views,
                                   size_t n_views, const hearth_refine_opts *opts,
@@ -124,7 +126,8 @@ typedef struct hearth_pose_nudge {
 void hearth_pose_nudge_apply(const hearth_pose_nudge *n, hearth_rigid *T_world_from_cam);
 /* "STATE/VIEW:rx,ry,rz,tx,ty,tz" (degrees, millimetres). */
 hearth_status hearth_pose_nudge_parse(const char *text, hearth_pose_nudge *out, hearth_err *err);
-/* {"views": [{"state", "view", "d_rot_deg": [3], "d_t_mm": [3]}]}; *out malloc'ed. */
+/* {"views": [{"state", "view", "d_rot_deg": [3], "d_t_mm": [3]}]}; *out
+ * malloc'ed (n entries, the caller frees it with free()). */
 hearth_status hearth_pose_nudges_read(const char *path, hearth_pose_nudge **out, size_t *n,
                                       hearth_err *err);
 
@@ -172,7 +175,8 @@ hearth_status hearth_reprojection_error(const hearth_raycaster *rc, const hearth
 /* ---- overlays -------------------------------------------------------------- */
 /* Render the mesh outline (silhouette and depth edges) of a pose onto a
  * Turbo-coloured thermal image, upscaled by `zoom`; colour rgb. Temperature
- * range [lo, hi]; lo >= hi picks the 2..98 % range of the image. */
+ * range [lo, hi] degC; lo >= hi picks the 2..98 % range of the image. out
+ * is a new RGB U8 image (the caller frees it with hearth_image_free). */
 hearth_status hearth_overlay_render(const hearth_raycaster *rc, const hearth_camera *cam,
                                     const hearth_image *temps, const hearth_rigid *T_world_from_cam,
                                     int zoom, double lo, double hi, const uint8_t rgb[3],

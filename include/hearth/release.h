@@ -1,10 +1,13 @@
-/* hearth/release.h - whole-release tools: check a release against the
- * layout contract (docs/dataset.md), summarise it as the paper's dataset
- * overview, and build it incrementally (every stage, every instance).
+/* hearth/release.h - area release (src/release/): whole-release tools:
+ * check a release against the layout contract (docs/dataset.md), summarise
+ * it as the paper's dataset overview, build it incrementally (every stage,
+ * every instance) and write the static HTML report.
  *
  * validate and stats only read; build writes through the stages' own atomic
  * writers and records a small stamp per finished stage so that a second run
- * does no work and an interrupted run resumes where it stopped. */
+ * does no work and an interrupted run resumes where it stopped. Structs
+ * with "owned" arrays are released with their _free function, which
+ * accepts a zeroed struct. */
 #ifndef HEARTH_RELEASE_H
 #define HEARTH_RELEASE_H
 
@@ -90,7 +93,8 @@ hearth_status hearth_release_stats_compute(const char *root, hearth_release_stat
                                            hearth_err *err);
 /* The dataset-overview table as text (two columns, like the paper's table). */
 void hearth_release_stats_print(const hearth_release_stats *st, FILE *out);
-/* The same as a JSON document (malloc'ed, NUL-terminated; NULL if out of memory). */
+/* The same as a JSON document (malloc'ed, NUL-terminated, the caller frees
+ * it with free(); NULL if out of memory). */
 char *hearth_release_stats_json(const hearth_release_stats *st);
 
 /* ---- build ------------------------------------------------------------------- */
@@ -170,7 +174,8 @@ size_t hearth_build_instance_stages(const char **names, int *available, size_t m
  * of this shard (in parallel) scale, transfer, refine, colour baking and
  * every state's map. Returns HEARTH_OK when the build could run (even with
  * failed instances, which are listed in rep); an error when release.json
- * cannot be read or a release-level stage fails. */
+ * cannot be read or a release-level stage fails. rep is filled either way
+ * (the caller frees it with hearth_build_report_free). */
 hearth_status hearth_build_release(const char *root, const hearth_build_opts *o,
                                    hearth_build_report *rep, hearth_err *err);
 /* Print the end-of-build summary. */
@@ -198,7 +203,8 @@ void hearth_report_free(hearth_report *r);
  * links to PNGs copied or drawn into out_dir: per state the Turbo thermal
  * texture beside the colour texture, the ground-truth texture and an error
  * map (when ground truth exists), and the before/after overlay contact sheet
- * (when derived/overlay/<state>/ exists); plus the numbers in rep.
+ * (when derived/overlay/<state>/ exists); plus the numbers, which are also
+ * returned in rep (the caller frees it with hearth_report_free).
  * validate_text (may be NULL) is shown as the validation result. */
 hearth_status hearth_report_write(const char *root, const char *out_dir, const char *title,
                                   const char *validate_text, hearth_report *rep, hearth_err *err);

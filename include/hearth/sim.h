@@ -1,9 +1,11 @@
-/* hearth/sim.h - the paper's three temperature-aware pick-and-place tasks
+/* hearth/sim.h - area sim (src/sim/; built with HEARTH_SIM, links MuJoCo,
+ * OSMesa and HDF5): the paper's three temperature-aware pick-and-place tasks
  * (H1 study table: hot/normal cup; H2 kitchen: iced/normal can; H3 kitchen:
  * hot phone/hot sponge) on MuJoCo, with hearth assets, a Panda arm under an
  * operational-space pose controller, three rendered views (front RGB, front
  * thermal, wrist RGB), a scripted expert and a LIBERO-layout HDF5 writer.
- * Facts and conventions: docs/simulation.md (spec/simulation.md).
+ * Scenes, robot, controller, file layout and image conventions:
+ * docs/simulation.md.
  *
  * Frames: world z up, table top centre at (0, 0, HEARTH_SIM_TABLE_Z), the
  * robot base behind the table at x = -0.66 facing +x. Images are RGB U8 in
@@ -27,9 +29,10 @@ typedef enum hearth_sim_task { HEARTH_SIM_H1 = 1, HEARTH_SIM_H2 = 2, HEARTH_SIM_
 
 /* Parse "H1".."H3" (case-insensitive); 0 if unknown. */
 hearth_sim_task hearth_sim_task_parse(const char *s);
+/* "H1".."H3" ("?" for an invalid task); a static string. */
 const char *hearth_sim_task_name(hearth_sim_task t);
 /* The instruction (0 or 1) of a task: "pick up the hot cup and place it on
- * the mat", ...; never NULL for valid arguments. */
+ * the mat", ...; a static string, "" for invalid arguments. */
 const char *hearth_sim_instruction_text(hearth_sim_task t, int instruction);
 
 /* Where the assets come from. A release root holds the instances of the
@@ -38,7 +41,8 @@ const char *hearth_sim_instruction_text(hearth_sim_task t, int instruction);
  * With use_ground_truth (virtual-rig releases) the metric mesh is
  * ground_truth/instances/<id>/mesh.glb and temperatures come from
  * <state>/temperature_true.npy; otherwise derived/mesh.glb and
- * derived/<state>/thermal_turbo.png. */
+ * derived/<state>/thermal_turbo.png. Strings are borrowed for the call that
+ * takes the options. */
 typedef struct hearth_sim_opts {
   hearth_sim_task task;
   const char *release_root;
@@ -47,19 +51,21 @@ typedef struct hearth_sim_opts {
   int max_steps;         /* time limit in control steps; default 400 */
   int render_wrist;      /* default 1 */
   int shadows;           /* shadow-mapped light in the RGB views; default 0
-                          * (3x the CPU rendering cost; the thermal view is
-                          * unlit either way) */
+                          * (a shadow-map pass per lit view, costly on the
+                          * CPU; the thermal view is unlit either way) */
   const char *gl;        /* "osmesa" (CPU, default) or "egl" (GPU through
                           * EGL's device platform, else Mesa's surfaceless
                           * platform); NULL: $HEARTH_GL, else "osmesa" */
-  const char *work_dir;  /* scratch for the MJCF/mesh files; NULL = a fresh dir under /tmp */
+  const char *work_dir;  /* scratch for the MJCF/mesh files; NULL = a fresh dir under
+                          * $TMPDIR (else /tmp), removed with the env */
 } hearth_sim_opts;
 void hearth_sim_opts_default(hearth_sim_opts *o);
 
 typedef struct hearth_sim_env hearth_sim_env;
 
-/* Build the scene (model, renderer) for a task. Rendering uses OSMesa, or
- * EGL when HEARTH_GL=egl and the build has it. */
+/* Build the scene (assets, model, renderer) for a task, with the GL back end
+ * of o->gl. The env owns everything it made; hearth_sim_env_free releases it
+ * (NULL is fine). Use an env from one thread at a time. */
 hearth_status hearth_sim_env_new(const hearth_sim_opts *o, hearth_sim_env **out, hearth_err *err);
 void hearth_sim_env_free(hearth_sim_env *env);
 /* The GL back end and renderer in use, e.g. "osmesa: llvmpipe (...)" or
@@ -75,7 +81,8 @@ hearth_status hearth_sim_reset(hearth_sim_env *env, uint64_t seed, uint64_t layo
                                int instruction, hearth_err *err);
 
 /* One control step (25 physics steps): action [dx dy dz dax day daz grip] in
- * [-1, 1] (clipped), 1.0 = 0.05 m / 0.5 rad; grip -1 open, +1 closed. */
+ * [-1, 1] (clipped; non-finite is HEARTH_E_RANGE), 1.0 = 0.05 m / 0.5 rad
+ * (world frame, at the grip site); grip -1 open, +1 closed. */
 hearth_status hearth_sim_step(hearth_sim_env *env, const double action[7], hearth_err *err);
 
 typedef struct hearth_sim_obs {
@@ -84,13 +91,14 @@ typedef struct hearth_sim_obs {
   uint8_t *agentview_thermal;
   uint8_t *eye_in_hand_rgb;    /* NULL if the wrist view is off */
   double joint_states[7];
-  double gripper_states[2];    /* finger joint positions */
-  double ee_pos[3];
+  double gripper_states[2];    /* left finger, minus right finger position (m) */
+  double ee_pos[3];            /* grip site, world, m */
   double ee_ori[3];            /* axis-angle of the end-effector rotation */
   double ee_quat[4];           /* w x y z */
 } hearth_sim_obs;
 
-/* Render the views and read the robot state. */
+/* Render the views and read the robot state into obs (its image buffers
+ * belong to the env). */
 hearth_status hearth_sim_observe(hearth_sim_env *env, hearth_sim_obs *obs, hearth_err *err);
 
 /* 1 when the target rests on the mat, released by the gripper. */
@@ -99,11 +107,12 @@ int hearth_sim_success(const hearth_sim_env *env);
 int hearth_sim_steps(const hearth_sim_env *env);
 int hearth_sim_max_steps(const hearth_sim_env *env);
 const char *hearth_sim_instruction(const hearth_sim_env *env);
-/* Full simulator state [time, qpos, qvel]; returns its length, writes up to max. */
+/* Full simulator state [time, qpos, qvel]; returns its length and writes it
+ * into state only when max is at least that (state may be NULL). */
 size_t hearth_sim_state(const hearth_sim_env *env, double *state, size_t max);
 /* Fraction of the target candidate's and the other candidate's pixels
- * visible in the front view at the current state (privileged; collection
- * checks). */
+ * visible in the front view at the current state, from segmentation
+ * renders (privileged; tests and audits). */
 hearth_status hearth_sim_visibility(hearth_sim_env *env, double *target_frac, double *other_frac,
                                     hearth_err *err);
 /* Pixel boxes [x0 y0 x1 y1] (OpenGL rows) of the two candidates in the
@@ -127,7 +136,7 @@ typedef struct hearth_sim_collect_opts {
   int shadows;          /* as hearth_sim_opts.shadows; default 0 */
   const char *gl;       /* as hearth_sim_opts.gl */
   int quiet;
-  const char *out_path; /* .hdf5, written atomically */
+  const char *out_path; /* .hdf5, written atomically (layout: docs/simulation.md) */
 } hearth_sim_collect_opts;
 void hearth_sim_collect_opts_default(hearth_sim_collect_opts *o);
 
@@ -138,11 +147,14 @@ typedef struct hearth_sim_collect_stats {
   double seconds;
   int rejected_layouts;          /* layouts skipped because the expert failed */
 } hearth_sim_collect_stats;
+/* Collect layouts x 2 demonstrations with the scripted expert into
+ * out_path; stats may be NULL. */
 hearth_status hearth_sim_collect(const hearth_sim_collect_opts *o, hearth_sim_collect_stats *stats,
                                  hearth_err *err);
 
-/* Render the task's scene (layout 0) to <out_prefix>_rgb.png,
- * <out_prefix>_thermal.png and <out_prefix>_wrist.png, top row first. */
+/* Render the task's scene (layout 0 of seed, instruction 0) to
+ * <out_prefix>_rgb.png, <out_prefix>_thermal.png and (with the wrist view)
+ * <out_prefix>_wrist.png, top row first. */
 hearth_status hearth_sim_render_scene(const hearth_sim_opts *o, uint64_t seed,
                                       const char *out_prefix, hearth_err *err);
 

@@ -1,10 +1,12 @@
-/* hearth/synth.h - the virtual capture rig: a digital twin of the paper's
- * RGB-thermal-depth rig that writes a release tree with ground truth.
+/* hearth/synth.h - area synth (src/synth/): the virtual capture rig, a
+ * digital twin of the paper's RGB-thermal-depth rig that writes a release
+ * tree with ground truth.
  *
  * It is an independent forward model (scene -> sensor): thermal pixels
  * integrate the scene over their footprint through the distorting lens, then
  * optical blur and sensor noise are applied. It never runs a pipeline stage
- * backwards. Requirements: docs/virtual-rig.md. */
+ * backwards. Same options and seed, same bytes, for any thread count. What
+ * it models, what it writes and every option: docs/virtual-rig.md. */
 #ifndef HEARTH_SYNTH_H
 #define HEARTH_SYNTH_H
 
@@ -18,10 +20,12 @@ extern "C" {
 
 #define HEARTH_SYNTH_MAX_ITEMS 32
 
+/* Strings are borrowed: they must stay valid during hearth_synth_release. */
 typedef struct hearth_synth_opts {
   uint64_t seed;                 /* default 1 */
   const char *out_root;          /* release root to create (must not exist, or be empty) */
-  /* categories to make; NULL/0 = the default set (every procedural category) */
+  /* categories to make (hearth_synth_opts_default: one, "cup"); 0 = every
+     procedural category */
   size_t n_categories;
   const char *categories[HEARTH_SYNTH_MAX_ITEMS];
   int instances_per_category;    /* default 1 */
@@ -29,7 +33,7 @@ typedef struct hearth_synth_opts {
   size_t n_states;
   const char *states[8];
   int n_views;                   /* views per state, <= 30; default 30 (3 x 10) */
-  size_t triangles;              /* target mesh detail; default 20000, up to 200000+ */
+  size_t triangles;              /* target mesh detail; default 20000 (100..5000000) */
   size_t texture_size;           /* RGB texture side; default 1024 */
   size_t map_resolution;         /* R of ground-truth temperature maps; default 1024 */
   int calibration;               /* write calibration/ captures; default 1 */
@@ -37,7 +41,7 @@ typedef struct hearth_synth_opts {
   int n_stereo_pairs;            /* default 24 */
   int rgb_full_size;             /* 1 (default): object colour views rendered at full size;
                                     0: draft, rendered at a quarter of the size and enlarged 4x to
-                                    the full 1920x1080 frame (16x faster; for tests only) */
+                                    the full 1920x1080 frame (for tests only) */
   /* put a given UV-mapped GLB on the turntable instead of a procedural object */
   const char *mesh_path;
   double mesh_size_m;            /* largest extent after scaling; default 0.12 */
@@ -50,10 +54,11 @@ typedef struct hearth_synth_opts {
 
 void hearth_synth_opts_default(hearth_synth_opts *o);
 /* Write a complete release tree (atomically: built under a temporary name
- * beside out_root, renamed at the end). */
+ * beside out_root, renamed at the end; removed on failure). */
 hearth_status hearth_synth_release(const hearth_synth_opts *o, hearth_err *err);
 
-/* Names of the procedural categories available. */
+/* Names of the procedural categories available (static strings) into
+ * names[0..max); returns how many there are (18), which may exceed max. */
 size_t hearth_synth_categories(const char **names, size_t max);
 
 #ifdef __cplusplus

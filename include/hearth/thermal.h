@@ -1,4 +1,5 @@
-/* hearth/thermal.h - apparent-temperature matrices (thermal CSV).
+/* hearth/thermal.h - area io (src/io/io_csv.c): apparent-temperature
+ * matrices (thermal CSV).
  *
  * The canonical file is 192 lines of 256 comma-separated decimal numbers in
  * degrees Celsius, no header, native sensor row order. Readers also accept
@@ -25,13 +26,17 @@ typedef struct hearth_csv_opts {
 /* Defaults: 256 x 192 (the paper's camera), as with opts == NULL. */
 void hearth_csv_opts_default(hearth_csv_opts *o);
 
-/* Read into a 1-channel F32 image. opts may be NULL (expect 256x192). */
+/* Read into a new 1-channel F32 image of degC (the caller frees it with
+ * hearth_image_free); row r of the image is line r of the matrix. opts may
+ * be NULL (expect 256x192). parse reads text[0..len), which need not be
+ * NUL-terminated; `name` names it in messages. */
 hearth_status hearth_thermal_read_csv(const char *path, const hearth_csv_opts *opts,
                                       hearth_image *out, hearth_err *err);
 hearth_status hearth_thermal_parse_csv(const char *text, size_t len, const char *name,
                                        const hearth_csv_opts *opts, hearth_image *out,
                                        hearth_err *err);
-/* Write the canonical form with `decimals` fixed decimals (atomic). */
+/* Write the canonical form of a 1-channel F32 image with `decimals` (0..9)
+ * fixed decimals, '.' as the decimal point whatever the locale (atomic). */
 hearth_status hearth_thermal_write_csv(const char *path, const hearth_image *temps,
                                        int decimals, hearth_err *err);
 
