@@ -1,33 +1,27 @@
 /* Private to the command-line tool: each subcommand lives in cmd_<name>.c
  * and exports `int hearth_cmd_<name>(int argc, char **argv)` where argv[0]
- * is the subcommand's name. A command handles `--help` itself, prints errors
- * to stderr and returns the process exit status (0 ok, 1 failure, 2 usage). */
+ * is the subcommand's name. A command declares its options in a cli_opt
+ * table and reads argv with cli_parse (cli_opts.h), prints errors to stderr
+ * and returns the process exit status (0 ok, 1 failure, 2 usage). */
 #ifndef HEARTH_CLI_H
 #define HEARTH_CLI_H
 
 #include <stddef.h>
 #include <stdint.h>
+#include "cli/cli_opts.h"
+#include "hearth/calib.h"
 #include "hearth/core.h"
 
-/* Small option helpers shared by the commands. */
-int cli_is_help(const char *arg);
-/* Parse "--name=value" or "--name value"; returns 1 and sets *val if argv[*i]
- * is option `name` (advancing *i past a separate value), -1 if the value is
- * missing, 0 otherwise. */
-int cli_opt(int argc, char **argv, int *i, const char *name, const char **val);
-/* The option whose value cli_opt just returned in val, for messages: the
- * word before a separate value, or the part of "--name=value" before '='
- * (copied into buf). */
-const char *cli_opt_name(char **argv, int i, const char *val, char *buf, size_t bufsz);
-int cli_parse_int(const char *s, long lo, long hi, long *out);
-int cli_parse_u64(const char *s, uint64_t *out);
-int cli_parse_num(const char *s, double *out);
-/* A non-option argument of a pipeline command: the first is ROOT, a second
- * is an error; an unknown option is an error too. Returns 0 when taken,
- * 2 (the usage exit status) after printing the problem. */
-int cli_root_arg(const char *cmd, const char *arg, const char **root, const char *help);
-/* Print "hearth <cmd>: missing ROOT" and the help; returns 2. */
-int cli_missing_root(const char *cmd, const char *help);
+/* --fusion of map and build: the names and their hearth_fusion values. */
+extern const char *const cli_fusion_names[];
+extern const int cli_fusion_values[];
+
+/* detect's options bound to `run`: the one definition that `hearth detect`
+ * and `hearth calibrate --detect` both include (as a CLI_GROUP). Fills
+ * out[0..CLI_DETECT_OPTS), the last entry being CLI_END. */
+#define CLI_DETECT_OPTS 5
+void cli_detect_opts(hearth_detect_job *run, cli_opt out[CLI_DETECT_OPTS]);
+
 /* Print "hearth <cmd>: <message>" for a failed status; returns 1. */
 int cli_fail(const char *cmd, const hearth_err *err);
 

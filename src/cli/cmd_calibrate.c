@@ -2,91 +2,56 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
-#include <string.h>
 #include "cli/cli.h"
 #include "hearth/calib.h"
 
-static const char *k_help =
-    "usage: hearth calibrate ROOT [--detect [--no-overlays]] [--max-iterations N]\n"
-    "                             [--outlier-factor F] [--outlier-min PX]\n"
-    "                             [--no-perspective-correction] [--quiet]\n"
-    "\n"
+static const char *k_about =
     "From ROOT/calibration/detections.json (run `hearth detect` first, or pass\n"
-    "--detect to run it in the same process with its default options) and the\n"
-    "factory colour/depth calibration ROOT/calibration/factory.json:\n"
+    "--detect to run it in the same process) and the factory colour/depth\n"
+    "calibration ROOT/calibration/factory.json:\n"
     "  1. thermal intrinsics + 5-parameter distortion from the thermal-only frames\n"
     "     (Zhang's closed form, then Levenberg-Marquardt over all poses);\n"
     "  2. T_thermal_from_rgb from the stereo pairs with both intrinsics fixed.\n"
     "Frames whose residual exceeds F x the median (and PX pixels) are rejected and\n"
     "the solve repeated. Writes calibration/rig.json, calibration/rig_opencv.yaml\n"
-    "(cv2.FileStorage) and calibration/calibration_report.json (per-frame RMS).\n"
-    "\n"
-    "  --detect             detect the plate first (as `hearth detect ROOT`)\n"
-    "  --no-overlays        with --detect: skip the overlay images\n"
-    "  --max-iterations N   Levenberg-Marquardt iterations (default 100)\n"
-    "  --outlier-factor F   default 2.5\n"
-    "  --outlier-min PX     default 0.01\n"
-    "  --no-perspective-correction\n"
-    "                       use the detected centroids as they are (by default each\n"
-    "                       centroid is moved to the projected hole centre using the\n"
-    "                       estimated pose, removing the perspective bias of circles)\n"
-    "  --quiet              summary line only\n";
+    "(cv2.FileStorage) and calibration/calibration_report.json (per-frame RMS).\n";
 
 int hearth_cmd_calibrate(int argc, char **argv) {
-  const char *root = NULL;
-  int quiet = 0, detect = 0, overlays = 1;
+  int quiet = 0, detect = 0;
   hearth_calib_opts o;
   hearth_calib_opts_default(&o);
-  for (int i = 1; i < argc; i++) {
-    const char *v;
-    int r;
-    long n;
-    double f;
-    if (cli_is_help(argv[i])) {
-      fputs(k_help, stdout);
-      return 0;
-    } else if (!strcmp(argv[i], "--quiet")) {
-      quiet = 1;
-    } else if (!strcmp(argv[i], "--detect")) {
-      detect = 1;
-    } else if (!strcmp(argv[i], "--no-overlays")) {
-      overlays = 0;
-    } else if (!strcmp(argv[i], "--no-perspective-correction")) {
-      o.perspective_correction = 0;
-    } else if ((r = cli_opt(argc, argv, &i, "--max-iterations", &v))) {
-      if (r < 0) goto missing;
-      if (!cli_parse_int(v, 1, 100000, &n)) goto bad;
-      o.max_iterations = (int)n;
-    } else if ((r = cli_opt(argc, argv, &i, "--outlier-factor", &v))) {
-      if (r < 0) goto missing;
-      if (!cli_parse_num(v, &f) || !(f > 1)) goto bad;
-      o.outlier_factor = f;
-    } else if ((r = cli_opt(argc, argv, &i, "--outlier-min", &v))) {
-      if (r < 0) goto missing;
-      if (!cli_parse_num(v, &f) || !(f > 0)) goto bad;
-      o.outlier_min_px = f;
-    } else if (cli_root_arg("calibrate", argv[i], &root, k_help)) {
-      return 2;
-    }
-    continue;
-  missing:
-    fprintf(stderr, "hearth calibrate: option '%s' needs a value\n", argv[i]);
-    return 2;
-  bad:;
-    char optbuf[64];
-    fprintf(stderr, "hearth calibrate: bad value '%s' for %s\n", v, cli_opt_name(argv, i, v, optbuf, sizeof optbuf));
-    return 2;
-  }
-  if (!root) return cli_missing_root("calibrate", k_help);
+  hearth_detect_job run;
+  hearth_detect_job_default(&run);
+  cli_opt detect_opts[CLI_DETECT_OPTS];
+  cli_detect_opts(&run, detect_opts);
+  const char *detect_opt = NULL;
+  const cli_opt opts[] = {
+      CLI_FLAG("--detect", &detect, 1, "detect the plate first (as `hearth detect ROOT`)"),
+      CLI_INT("--max-iterations", "N", &o.max_iterations, 1, 100000,
+              "Levenberg-Marquardt iterations"),
+      CLI_NUM("--outlier-factor", "F", &o.outlier_factor, 1, CLI_INF,
+              "reject frames whose residual exceeds F x the median (and --outlier-min)",
+              .flags = CLI_LO_OPEN),
+      CLI_NUM("--outlier-min", "PX", &o.outlier_min_px, 0, CLI_INF,
+              "residuals below PX pixels are never rejected", .flags = CLI_LO_OPEN),
+      CLI_FLAG("--no-perspective-correction", &o.perspective_correction, 0,
+               "use the detected centroids as they are (by default each centroid is moved to "
+               "the projected hole centre using the estimated pose, removing the perspective "
+               "bias of circles)"),
+      CLI_FLAG("--quiet", &quiet, 1, "summary line only"),
+      CLI_GROUP("with --detect, the options of `hearth detect`", detect_opts, &detect_opt),
+      CLI_END,
+  };
+  const cli_command cmd = {.name = "hearth calibrate", .args = "ROOT", .min_args = 1,
+                           .max_args = 1, .about = k_about, .opts = opts};
+  cli_args args;
+  int rc = cli_parse(&cmd, argc, argv, &args);
+  if (rc != CLI_RUN) return rc;
+  const char *root = args.v[0];
+  if (detect_opt && !detect)
+    return cli_usage_error(&cmd, "option %s only applies with --detect", detect_opt);
   hearth_err err = {0};
-  if (!overlays && !detect) {
-    fprintf(stderr, "hearth calibrate: --no-overlays only applies with --detect\n");
-    return 2;
-  }
   if (detect) {
-    hearth_detect_job run;
-    hearth_detect_job_default(&run);
-    run.overlays = overlays;
     run.quiet = 1;
     hearth_detections d = {0, NULL};
     if (hearth_calib_detect_release(root, &run, &d, &err)) return cli_fail("calibrate", &err);

@@ -3,15 +3,12 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
-#include <string.h>
 #include "cli/cli.h"
 #include "hearth/dataset.h"
 #include "hearth/release.h"
 #include "hearth/synth.h"
 
-static const char *k_help =
-    "usage: hearth demo [DIR] [--threads N] [--views N] [--resolution R] [--quiet]\n"
-    "\n"
+static const char *k_about =
     "The main job end to end on the virtual capture rig, in DIR (default out/demo):\n"
     "  1. DIR/release: a small release (cup hot, canned_drink iced, smartphone warm,\n"
     "     each also neutral) with calibration captures and ground truth;\n"
@@ -21,55 +18,25 @@ static const char *k_help =
     "  4. DIR/report/index.html: a static page (open it in any browser) with, per\n"
     "     state, the Turbo thermal texture beside the colour texture, the ground truth,\n"
     "     the error map, the before/after overlays and the error statistics.\n"
-    "Re-running reuses DIR/release and rebuilds only what is stale.\n"
-    "\n"
-    "  --threads N     worker threads (default: HEARTH_THREADS or all cores)\n"
-    "  --views N       views per state (default 10 of the 3 x 10 turntable grid)\n"
-    "  --resolution R  temperature-map size (default 256)\n"
-    "  --quiet         only the final summary\n";
+    "Re-running reuses DIR/release and rebuilds only what is stale.\n";
 
 int hearth_cmd_demo(int argc, char **argv) {
-  const char *dir = NULL;
   int threads = 0, quiet = 0, views = 10;
   size_t R = 256;
-  for (int i = 1; i < argc; i++) {
-    const char *v;
-    int r;
-    long n;
-    if (cli_is_help(argv[i])) {
-      fputs(k_help, stdout);
-      return 0;
-    } else if ((r = cli_opt(argc, argv, &i, "--threads", &v))) {
-      if (r < 0 || !cli_parse_int(v, 1, 1024, &n)) {
-        fprintf(stderr, "hearth demo: option --threads needs an integer 1..1024\n");
-        return 2;
-      }
-      threads = (int)n;
-    } else if ((r = cli_opt(argc, argv, &i, "--views", &v))) {
-      if (r < 0 || !cli_parse_int(v, 1, 30, &n)) {
-        fprintf(stderr, "hearth demo: option --views needs an integer 1..30\n");
-        return 2;
-      }
-      views = (int)n;
-    } else if ((r = cli_opt(argc, argv, &i, "--resolution", &v))) {
-      if (r < 0 || !cli_parse_int(v, 16, 4096, &n)) {
-        fprintf(stderr, "hearth demo: option --resolution needs an integer 16..4096\n");
-        return 2;
-      }
-      R = (size_t)n;
-    } else if (!strcmp(argv[i], "--quiet")) {
-      quiet = 1;
-    } else if (argv[i][0] == '-') {
-      fprintf(stderr, "hearth demo: unknown option '%s'\n%s", argv[i], k_help);
-      return 2;
-    } else if (!dir) {
-      dir = argv[i];
-    } else {
-      fprintf(stderr, "hearth demo: unexpected argument '%s'\n", argv[i]);
-      return 2;
-    }
-  }
-  if (!dir) dir = "out/demo";
+  const cli_opt opts[] = {
+      CLI_INT("--threads", "N", &threads, 1, 1024, "worker threads",
+              .def = "HEARTH_THREADS or all cores"),
+      CLI_INT("--views", "N", &views, 1, 30, "views per state, of the 3 x 10 turntable grid"),
+      CLI_SIZE("--resolution", "R", &R, 16, 4096, "temperature-map size"),
+      CLI_FLAG("--quiet", &quiet, 1, "only the final summary"),
+      CLI_END,
+  };
+  const cli_command cmd = {.name = "hearth demo", .args = "DIR", .min_args = 0, .max_args = 1,
+                           .about = k_about, .opts = opts};
+  cli_args args;
+  int rc = cli_parse(&cmd, argc, argv, &args);
+  if (rc != CLI_RUN) return rc;
+  const char *dir = args.n ? args.v[0] : "out/demo";
   double t0 = hearth_now();
   char root[4096], report_dir[4096], path[4096];
   snprintf(root, sizeof root, "%s/release", dir);

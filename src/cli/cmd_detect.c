@@ -5,10 +5,7 @@
 #include "cli/cli.h"
 #include "hearth/calib.h"
 
-static const char *k_help =
-    "usage: hearth detect ROOT [--no-overlays] [--threads N] [--upsample N]\n"
-    "                          [--max-blur F] [--quiet]\n"
-    "\n"
+static const char *k_about =
     "Finds the 84 hole centres of the calibration plate in every capture under\n"
     "ROOT/calibration/captures (thermal/fNNN.csv, stereo/pNNN_rgb.jpg +\n"
     "pNNN_thermal.csv). Colour: dark blobs. Thermal: per-frame percentile clip,\n"
@@ -18,55 +15,38 @@ static const char *k_help =
     "partial, blurred or missing plates are reported and marked found=false.\n"
     "\n"
     "Writes ROOT/calibration/detections.json and overlay images\n"
-    "ROOT/calibration/overlays/<frame>_<camera>.png (centres joined row by row).\n"
-    "\n"
-    "  --no-overlays   skip the overlay images\n"
-    "  --threads N     worker threads (default: HEARTH_THREADS or all cores)\n"
-    "  --upsample N    thermal upsampling for blob detection (1..8, default 4)\n"
-    "  --max-blur F    reject frames whose edge spread exceeds F hole radii (default 0.4)\n"
-    "  --quiet         no per-frame lines\n";
+    "ROOT/calibration/overlays/<frame>_<camera>.png (centres joined row by row).\n";
+
+void cli_detect_opts(hearth_detect_job *run, cli_opt out[CLI_DETECT_OPTS]) {
+  const cli_opt t[CLI_DETECT_OPTS] = {
+      CLI_FLAG("--no-overlays", &run->overlays, 0, "skip the overlay images"),
+      CLI_INT("--threads", "N", &run->threads, 1, 1024, "worker threads",
+              .def = "HEARTH_THREADS or all cores"),
+      CLI_INT("--upsample", "N", &run->detect.upsample, 1, 8,
+              "thermal upsampling for blob detection (1..8)"),
+      CLI_NUM("--max-blur", "F", &run->detect.max_blur_frac, 0, CLI_INF,
+              "reject frames whose edge spread exceeds F hole radii", .flags = CLI_LO_OPEN),
+      CLI_END,
+  };
+  memcpy(out, t, sizeof t);
+}
 
 int hearth_cmd_detect(int argc, char **argv) {
-  const char *root = NULL;
   hearth_detect_job run;
   hearth_detect_job_default(&run);
-  for (int i = 1; i < argc; i++) {
-    const char *v;
-    int r;
-    long n;
-    double f;
-    if (cli_is_help(argv[i])) {
-      fputs(k_help, stdout);
-      return 0;
-    } else if (!strcmp(argv[i], "--no-overlays")) {
-      run.overlays = 0;
-    } else if (!strcmp(argv[i], "--quiet")) {
-      run.quiet = 1;
-    } else if ((r = cli_opt(argc, argv, &i, "--threads", &v))) {
-      if (r < 0) goto missing;
-      if (!cli_parse_int(v, 1, 1024, &n)) goto bad;
-      run.threads = (int)n;
-    } else if ((r = cli_opt(argc, argv, &i, "--upsample", &v))) {
-      if (r < 0) goto missing;
-      if (!cli_parse_int(v, 1, 8, &n)) goto bad;
-      run.detect.upsample = (int)n;
-    } else if ((r = cli_opt(argc, argv, &i, "--max-blur", &v))) {
-      if (r < 0) goto missing;
-      if (!cli_parse_num(v, &f) || !(f > 0)) goto bad;
-      run.detect.max_blur_frac = f;
-    } else if (cli_root_arg("detect", argv[i], &root, k_help)) {
-      return 2;
-    }
-    continue;
-  missing:
-    fprintf(stderr, "hearth detect: option '%s' needs a value\n", argv[i]);
-    return 2;
-  bad:;
-    char optbuf[64];
-    fprintf(stderr, "hearth detect: bad value '%s' for %s\n", v, cli_opt_name(argv, i, v, optbuf, sizeof optbuf));
-    return 2;
-  }
-  if (!root) return cli_missing_root("detect", k_help);
+  cli_opt detect_opts[CLI_DETECT_OPTS];
+  cli_detect_opts(&run, detect_opts);
+  const cli_opt opts[] = {
+      CLI_GROUP(NULL, detect_opts, NULL),
+      CLI_FLAG("--quiet", &run.quiet, 1, "no per-frame lines"),
+      CLI_END,
+  };
+  const cli_command cmd = {.name = "hearth detect", .args = "ROOT", .min_args = 1, .max_args = 1,
+                           .about = k_about, .opts = opts};
+  cli_args args;
+  int rc = cli_parse(&cmd, argc, argv, &args);
+  if (rc != CLI_RUN) return rc;
+  const char *root = args.v[0];
   hearth_err err = {0};
   hearth_detections d = {0, NULL};
   double t0 = hearth_now();

@@ -7,13 +7,10 @@
 #include "cli/cli.h"
 #include "hearth/hearth.h"
 
-static const char *k_help =
-    "usage: hearth inspect FILE [FILE...] [--as KIND]\n"
-    "\n"
+static const char *k_about =
     "Reads each file with hearth's strict readers and prints a summary, or the exact\n"
     "problem (file, line/column or JSON path) and exits 1. The kind follows from the\n"
-    "name; --as forces one of: csv png jpeg npy glb rig manifest poses detections\n"
-    "scale instance release depth-intrinsics.\n";
+    "name, or --as.\n";
 
 static int ends_with(const char *s, const char *suf) {
   size_t a = strlen(s), b = strlen(suf);
@@ -157,45 +154,34 @@ static hearth_status inspect_one(const char *path, const char *kind, hearth_err 
   return HEARTH_OK;
 }
 
+/* the kinds of --as */
+static const char *const k_kinds[] = {"csv",   "png",        "jpeg",  "npy",      "glb",
+                                      "rig",   "manifest",   "poses", "detections", "scale",
+                                      "instance", "release", "depth-intrinsics", NULL};
+
 int hearth_cmd_inspect(int argc, char **argv) {
-  const char *force = NULL;
-  int n_files = 0, rc = 0;
-  for (int i = 1; i < argc; i++) {
-    const char *v;
-    int r;
-    if (cli_is_help(argv[i])) {
-      fputs(k_help, stdout);
-      return 0;
-    }
-    if ((r = cli_opt(argc, argv, &i, "--as", &v))) {
-      if (r < 0) {
-        fprintf(stderr, "hearth inspect: option '--as' needs a value\n");
-        return 2;
-      }
-      force = v;
-    } else if (argv[i][0] == '-') {
-      fprintf(stderr, "hearth inspect: unknown option '%s'\n%s", argv[i], k_help);
-      return 2;
-    }
-  }
-  for (int i = 1; i < argc; i++) {
-    if (!strncmp(argv[i], "--as", 4)) {
-      if (!strcmp(argv[i], "--as")) i++;
-      continue;
-    }
-    n_files++;
-    const char *kind = force ? force : guess_kind(argv[i]);
+  int as = -1;
+  const cli_opt opts[] = {
+      CLI_CHOICE("--as", &as, k_kinds, NULL, "read every file as KIND", .metavar = "KIND",
+                 .def = "from the name"),
+      CLI_END,
+  };
+  const cli_command cmd = {.name = "hearth inspect", .args = "FILE", .min_args = 1,
+                           .max_args = -1, .about = k_about, .opts = opts};
+  cli_args args;
+  int rc = cli_parse(&cmd, argc, argv, &args);
+  if (rc != CLI_RUN) return rc;
+  rc = 0;
+  for (int i = 0; i < args.n; i++) {
+    const char *kind = as >= 0 ? k_kinds[as] : guess_kind(args.v[i]);
     hearth_err err = {0};
     if (!kind) {
-      fprintf(stderr, "hearth inspect: %s: cannot tell the kind from the name; use --as\n", argv[i]);
+      fprintf(stderr, "hearth inspect: %s: cannot tell the kind from the name; use --as\n",
+              args.v[i]);
       rc = 1;
       continue;
     }
-    if (inspect_one(argv[i], kind, &err)) rc = cli_fail("inspect", &err);
-  }
-  if (!n_files) {
-    fprintf(stderr, "hearth inspect: no file given\n%s", k_help);
-    return 2;
+    if (inspect_one(args.v[i], kind, &err)) rc = cli_fail("inspect", &err);
   }
   return rc;
 }

@@ -1,27 +1,15 @@
 /* hearth overlay ROOT: mesh outline over the thermal images, before/after refinement. */
 #include <stdio.h>
 #include <stdlib.h>
-#include <string.h>
 #include "cli/cli.h"
 #include "hearth/poses.h"
 
-static const char *k_help =
-    "usage: hearth overlay ROOT [--instance ID] [--state S] [options]\n"
-    "\n"
+static const char *k_about =
     "Draws the projected outline of the metric mesh (silhouette and depth edges) on\n"
     "each Turbo-coloured thermal image so alignment can be checked at a glance:\n"
     "derived/overlay/<state>/vNN.png (zoomed; white = derived/poses_thermal.json,\n"
     "magenta = the transferred start poses) and derived/overlay/<state>/contact_sheet.png\n"
-    "(every view, before on the left, after on the right).\n"
-    "\n"
-    "  --instance ID      only this instance (default: all in release.json)\n"
-    "  --state S          only this state (default: all states)\n"
-    "  --before FILE      poses drawn as 'before' (default derived/poses_thermal_transferred.json)\n"
-    "  --after FILE       poses drawn as 'after' (default derived/poses_thermal.json)\n"
-    "  --mesh FILE        metric mesh (default derived/mesh.glb)\n"
-    "  --rig FILE         rig (default calibration/rig.json)\n"
-    "  --zoom K           per-view image magnification (default 3)\n"
-    "  --range LO,HI      Turbo range in degC (default: 2..98 % of each image)\n";
+    "(every view, before on the left, after on the right).\n";
 
 static hearth_status overlay_one(void *ctx, const char *instance, const char *state,
                                  hearth_err *err) {
@@ -35,57 +23,29 @@ static hearth_status overlay_one(void *ctx, const char *instance, const char *st
 }
 
 int hearth_cmd_overlay(int argc, char **argv) {
-  const char *root = NULL, *instance = NULL, *state = NULL;
+  const char *instance = NULL, *state = NULL;
   hearth_overlay_job job = {0};
   job.zoom = 3;
-  for (int i = 1; i < argc; i++) {
-    const char *v = NULL;
-    int r;
-    long lv;
-    if (cli_is_help(argv[i])) {
-      fputs(k_help, stdout);
-      return 0;
-    } else if ((r = cli_opt(argc, argv, &i, "--instance", &v))) {
-      if (r < 0) goto missing;
-      instance = v;
-    } else if ((r = cli_opt(argc, argv, &i, "--state", &v))) {
-      if (r < 0) goto missing;
-      state = v;
-    } else if ((r = cli_opt(argc, argv, &i, "--before", &v))) {
-      if (r < 0) goto missing;
-      job.before_path = v;
-    } else if ((r = cli_opt(argc, argv, &i, "--after", &v))) {
-      if (r < 0) goto missing;
-      job.after_path = v;
-    } else if ((r = cli_opt(argc, argv, &i, "--mesh", &v))) {
-      if (r < 0) goto missing;
-      job.mesh_path = v;
-    } else if ((r = cli_opt(argc, argv, &i, "--rig", &v))) {
-      if (r < 0) goto missing;
-      job.rig_path = v;
-    } else if ((r = cli_opt(argc, argv, &i, "--zoom", &v))) {
-      if (r < 0) goto missing;
-      if (!cli_parse_int(v, 1, 16, &lv)) goto bad;
-      job.zoom = (int)lv;
-    } else if ((r = cli_opt(argc, argv, &i, "--range", &v))) {
-      if (r < 0) goto missing;
-      const char *comma = strchr(v, ',');
-      if (!comma || hearth_parse_double(v, (size_t)(comma - v), 0, &job.lo) ||
-          !cli_parse_num(comma + 1, &job.hi) || !(job.lo < job.hi))
-        goto bad;
-    } else if (cli_root_arg("overlay", argv[i], &root, k_help)) {
-      return 2;
-    }
-    continue;
-  missing:
-    fprintf(stderr, "hearth overlay: option '%s' needs a value\n", argv[i]);
-    return 2;
-  bad:;
-    char optbuf[64];
-    fprintf(stderr, "hearth overlay: bad value '%s' for option '%s'\n", v, cli_opt_name(argv, i, v, optbuf, sizeof optbuf));
-    return 2;
-  }
-  if (!root) return cli_missing_root("overlay", k_help);
+  const cli_opt opts[] = {
+      CLI_STR("--instance", "ID", &instance, "only this instance", .def = "all in release.json"),
+      CLI_STR("--state", "S", &state, "only this state", .def = "all states"),
+      CLI_STR("--before", "FILE", &job.before_path, "poses drawn as 'before'",
+              .def = "derived/poses_thermal_transferred.json"),
+      CLI_STR("--after", "FILE", &job.after_path, "poses drawn as 'after'",
+              .def = "derived/poses_thermal.json"),
+      CLI_STR("--mesh", "FILE", &job.mesh_path, "metric mesh", .def = "derived/mesh.glb"),
+      CLI_STR("--rig", "FILE", &job.rig_path, "rig", .def = "calibration/rig.json"),
+      CLI_INT("--zoom", "K", &job.zoom, 1, 16, "per-view image magnification"),
+      CLI_PAIR("--range", "LO,HI", &job.lo, &job.hi, -CLI_INF, CLI_INF, "Turbo range in degC",
+               .flags = CLI_ASCENDING, .def = "2..98 % of each image"),
+      CLI_END,
+  };
+  const cli_command cmd = {.name = "hearth overlay", .args = "ROOT", .min_args = 1,
+                           .max_args = 1, .about = k_about, .opts = opts};
+  cli_args args;
+  int rc = cli_parse(&cmd, argc, argv, &args);
+  if (rc != CLI_RUN) return rc;
+  const char *root = args.v[0];
   job.root = root;
   return cli_each_state("overlay", root, instance, state, overlay_one, &job);
 }

@@ -1,25 +1,16 @@
 /* hearth scale ROOT: metric scale from rendered vs recorded depth. */
 #include <stdio.h>
 #include <stdlib.h>
-#include <string.h>
 #include "cli/cli.h"
 #include "hearth/poses.h"
 
-static const char *k_help =
-    "usage: hearth scale ROOT [--instance ID] [--state S] [options]\n"
-    "\n"
+static const char *k_about =
     "Recovers the metric scale of the reconstruction: casts the recon mesh into every\n"
     "depth camera (colour pose from recon/poses_rgb.json, per-frame depth intrinsics and\n"
     "T_depth_from_rgb from raw/<state>/depth/vNN.json) and fits z_measured = s z_rendered\n"
     "robustly (depth holes, object edges, background and outliers excluded).\n"
     "Writes derived/scale.json (scale, residual statistics, views used), the metric\n"
-    "derived/mesh.glb (RGB texture embedded) and derived/poses_rgb.json.\n"
-    "\n"
-    "  --instance ID      only this instance (default: all in release.json)\n"
-    "  --state S          use only this state's depth frames (default: all states)\n"
-    "  --stride K         cast every K-th depth pixel (default 2)\n"
-    "  --edge-rel E       relative depth jump that marks an edge (default 0.02)\n"
-    "  --threads N        worker threads (default: all cores)\n";
+    "derived/mesh.glb (RGB texture embedded) and derived/poses_rgb.json.\n";
 
 static hearth_status scale_one(void *ctx, const char *instance, hearth_err *err) {
   hearth_scale_job *job = ctx;
@@ -36,46 +27,24 @@ static hearth_status scale_one(void *ctx, const char *instance, hearth_err *err)
 }
 
 int hearth_cmd_scale(int argc, char **argv) {
-  const char *root = NULL, *instance = NULL, *state = NULL;
+  const char *instance = NULL, *state = NULL;
   hearth_scale_job job = {0};
   hearth_scale_opts_default(&job.opts);
-  for (int i = 1; i < argc; i++) {
-    const char *v = NULL;
-    int r;
-    long lv;
-    if (cli_is_help(argv[i])) {
-      fputs(k_help, stdout);
-      return 0;
-    } else if ((r = cli_opt(argc, argv, &i, "--instance", &v))) {
-      if (r < 0) goto missing;
-      instance = v;
-    } else if ((r = cli_opt(argc, argv, &i, "--state", &v))) {
-      if (r < 0) goto missing;
-      state = v;
-    } else if ((r = cli_opt(argc, argv, &i, "--stride", &v))) {
-      if (r < 0) goto missing;
-      if (!cli_parse_int(v, 1, 64, &lv)) goto bad;
-      job.opts.pixel_stride = (int)lv;
-    } else if ((r = cli_opt(argc, argv, &i, "--edge-rel", &v))) {
-      if (r < 0) goto missing;
-      if (!cli_parse_num(v, &job.opts.edge_rel) || !(job.opts.edge_rel > 0)) goto bad;
-    } else if ((r = cli_opt(argc, argv, &i, "--threads", &v))) {
-      if (r < 0) goto missing;
-      if (!cli_parse_int(v, 1, 1024, &lv)) goto bad;
-      job.opts.threads = (int)lv;
-    } else if (cli_root_arg("scale", argv[i], &root, k_help)) {
-      return 2;
-    }
-    continue;
-  missing:
-    fprintf(stderr, "hearth scale: option '%s' needs a value\n", argv[i]);
-    return 2;
-  bad:;
-    char optbuf[64];
-    fprintf(stderr, "hearth scale: bad value '%s' for option '%s'\n", v, cli_opt_name(argv, i, v, optbuf, sizeof optbuf));
-    return 2;
-  }
-  if (!root) return cli_missing_root("scale", k_help);
+  const cli_opt opts[] = {
+      CLI_STR("--instance", "ID", &instance, "only this instance", .def = "all in release.json"),
+      CLI_STR("--state", "S", &state, "use only this state's depth frames", .def = "all states"),
+      CLI_INT("--stride", "K", &job.opts.pixel_stride, 1, 64, "cast every K-th depth pixel"),
+      CLI_NUM("--edge-rel", "E", &job.opts.edge_rel, 0, CLI_INF,
+              "relative depth jump that marks an edge", .flags = CLI_LO_OPEN),
+      CLI_INT("--threads", "N", &job.opts.threads, 1, 1024, "worker threads", .def = "all cores"),
+      CLI_END,
+  };
+  const cli_command cmd = {.name = "hearth scale", .args = "ROOT", .min_args = 1, .max_args = 1,
+                           .about = k_about, .opts = opts};
+  cli_args args;
+  int rc = cli_parse(&cmd, argc, argv, &args);
+  if (rc != CLI_RUN) return rc;
+  const char *root = args.v[0];
   job.root = root;
   job.state = state;
   return cli_each_instance("scale", root, instance, scale_one, &job);

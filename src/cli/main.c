@@ -55,53 +55,80 @@ typedef struct command {
   const char *summary;
 } command;
 
-static int usage(FILE *out, const command *cmds, size_t n) {
-  fprintf(out,
-          "hearth %s - temperature-textured 3D assets from RGB-thermal-depth captures\n\n"
-          "usage: hearth <command> [ROOT] [options]     hearth <command> --help\n\n"
-          "Pipeline commands take the release root as their first argument.\n\n"
-          "commands:\n",
-          HEARTH_VERSION);
-  for (size_t i = 0; i < n; i++)
-    if (cmds[i].fn) fprintf(out, "  %-10s %s\n", cmds[i].name, cmds[i].summary);
+static const command k_cmds[] = {
+    {"synth", hearth_cmd_synth, "make a release with the virtual capture rig (ground truth included)"},
+    {"inspect", hearth_cmd_inspect, "read and summarise one file (CSV, PNG, JPEG, NPY, GLB, JSON)"},
+    {"detect", hearth_cmd_detect, "find plate hole centres in the calibration captures"},
+    {"calibrate", hearth_cmd_calibrate, "thermal intrinsics and RGB-thermal stereo from detections"},
+    {"scale", hearth_cmd_scale, "recover metric scale from recorded depth"},
+    {"transfer", hearth_cmd_transfer, "thermal poses from colour poses through the rig transform"},
+    {"refine", hearth_cmd_refine, "refine thermal poses automatically"},
+    {"map", hearth_cmd_map, "map temperatures onto the mesh's UV layout"},
+    {"overlay", hearth_cmd_overlay, "draw projected mesh outlines on thermal views"},
+    {"build", hearth_cmd_build, "run the whole pipeline over a release"},
+    {"validate", hearth_cmd_validate, "check a release against the layout contract"},
+    {"stats", hearth_cmd_stats, "dataset overview table of a release"},
+    {"demo", hearth_cmd_demo, "make, build and report a small virtual release"},
+    {"sim", run_sim, "temperature-aware manipulation tasks (render, collect, eval)"},
+};
+#define N_CMDS (sizeof k_cmds / sizeof k_cmds[0])
+
+/* the commands of this build and the environment, after the options */
+static void list_commands(FILE *out) {
+  fprintf(out, "\ncommands:\n");
+  for (size_t i = 0; i < N_CMDS; i++)
+    if (k_cmds[i].fn) fprintf(out, "  %-10s %s\n", k_cmds[i].name, k_cmds[i].summary);
   fprintf(out, "\nEnvironment: HEARTH_THREADS sets the default worker count.\n"
                "Conventions and file layout: docs/conventions.md, docs/dataset.md.\n");
-  return out == stdout ? 0 : 2;
 }
 
 int main(int argc, char **argv) {
-  const command cmds[] = {
-      {"synth", hearth_cmd_synth, "make a release with the virtual capture rig (ground truth included)"},
-      {"inspect", hearth_cmd_inspect, "read and summarise one file (CSV, PNG, JPEG, NPY, GLB, JSON)"},
-      {"detect", hearth_cmd_detect, "find plate hole centres in the calibration captures"},
-      {"calibrate", hearth_cmd_calibrate, "thermal intrinsics and RGB-thermal stereo from detections"},
-      {"scale", hearth_cmd_scale, "recover metric scale from recorded depth"},
-      {"transfer", hearth_cmd_transfer, "thermal poses from colour poses through the rig transform"},
-      {"refine", hearth_cmd_refine, "refine thermal poses automatically"},
-      {"map", hearth_cmd_map, "map temperatures onto the mesh's UV layout"},
-      {"overlay", hearth_cmd_overlay, "draw projected mesh outlines on thermal views"},
-      {"build", hearth_cmd_build, "run the whole pipeline over a release"},
-      {"validate", hearth_cmd_validate, "check a release against the layout contract"},
-      {"stats", hearth_cmd_stats, "dataset overview table of a release"},
-      {"demo", hearth_cmd_demo, "make, build and report a small virtual release"},
-      {"sim", run_sim, "temperature-aware manipulation tasks (render, collect, eval)"},
+  int version = 0;
+  const cli_opt opts[] = {
+      CLI_FLAG("--version", &version, 1, "print the version"),
+      CLI_END,
   };
-  size_t n = sizeof cmds / sizeof cmds[0];
-  if (argc < 2) return usage(stderr, cmds, n);
-  if (cli_is_help(argv[1]) || !strcmp(argv[1], "help")) return usage(stdout, cmds, n);
-  if (!strcmp(argv[1], "--version")) {
+  const cli_command cmd = {
+      .name = "hearth",
+      .args = "COMMAND",
+      .min_args = 0,
+      .max_args = -1,
+      .about = "hearth " HEARTH_VERSION
+               " - temperature-textured 3D assets from RGB-thermal-depth captures\n\n"
+               "Pipeline commands take the release root as their first argument.\n",
+      .opts = opts,
+      .more = list_commands,
+      .usage = "hearth <command> [ROOT] [options]     hearth <command> --help",
+      .stop_at_arg = 1,
+  };
+  if (argc < 2) {
+    cli_help(&cmd, stderr);
+    return 2;
+  }
+  if (!strcmp(argv[1], "help")) {
+    cli_help(&cmd, stdout);
+    return 0;
+  }
+  cli_args sub;
+  int rc = cli_parse(&cmd, argc, argv, &sub);
+  if (rc != CLI_RUN) return rc;
+  if (version) {
     printf("hearth %s\n", HEARTH_VERSION);
     return 0;
   }
-  for (size_t i = 0; i < n; i++) {
-    if (!strcmp(argv[1], cmds[i].name)) {
-      if (!cmds[i].fn) {
-        fprintf(stderr, "hearth: '%s' is not part of this build\n", argv[1]);
+  if (!sub.n) {
+    cli_help(&cmd, stderr);
+    return 2;
+  }
+  for (size_t i = 0; i < N_CMDS; i++) {
+    if (!strcmp(sub.v[0], k_cmds[i].name)) {
+      if (!k_cmds[i].fn) {
+        fprintf(stderr, "hearth: '%s' is not part of this build\n", sub.v[0]);
         return 2;
       }
-      return cmds[i].fn(argc - 1, argv + 1);
+      return k_cmds[i].fn(sub.n, sub.v);
     }
   }
-  fprintf(stderr, "hearth: unknown command '%s' (see 'hearth --help')\n", argv[1]);
+  fprintf(stderr, "hearth: unknown command '%s' (see 'hearth --help')\n", sub.v[0]);
   return 2;
 }

@@ -8,9 +8,7 @@
 #include "cli/cli.h"
 #include "cli/cli_sim.h"
 
-static const char *k_usage =
-    "usage: hearth sim <subcommand> [options]\n"
-    "\n"
+static const char k_about[] =
     "The paper's LIBERO-derived tasks on MuJoCo with hearth assets:\n"
     "  H1 study table: hot / normal cup (distractors: hot kettle, eraser)\n"
     "  H2 kitchen table: iced / normal can (distractors: iced orange, cup)\n"
@@ -19,20 +17,27 @@ static const char *k_usage =
     "subcommands:\n"
     "  render    write PNGs of each task's scene: front RGB, front thermal, wrist RGB\n"
     "  collect   collect scripted-expert demonstrations into a LIBERO HDF5 file\n"
-    "\n"
-    "Run `hearth sim <subcommand> --help` for its options.\n";
+    "  eval      score a policy on the tasks the way the paper does\n";
 
+static const char k_tail[] = "Run `hearth sim <subcommand> --help` for its options.\n";
 
-static int cmd_sim(int argc, char **argv) {
-  if (argc < 2 || cli_is_help(argv[1])) {
-    fputs(k_usage, argc < 2 ? stderr : stdout);
-    return argc < 2 ? 2 : 0;
+static const cli_opt k_opts[] = {CLI_END};
+
+static const cli_command k_cmd = {.name = "hearth sim", .args = "SUBCOMMAND", .min_args = 1,
+                                  .max_args = -1, .about = k_about, .opts = k_opts,
+                                  .tail = k_tail, .usage = "hearth sim <subcommand> [options]",
+                                  .stop_at_arg = 1};
+
+int main(int argc, char **argv) {
+  if (argc < 2) {
+    cli_help(&k_cmd, stderr);
+    return 2;
   }
-  if (strcmp(argv[1], "render") == 0) return hearth_cmd_sim_render(argc - 1, argv + 1);
-  if (strcmp(argv[1], "collect") == 0) return hearth_cmd_sim_collect(argc - 1, argv + 1);
-  if (strcmp(argv[1], "eval") == 0) return hearth_cmd_sim_eval(argc - 1, argv + 1);
-  fprintf(stderr, "hearth sim: unknown subcommand '%s'\n%s", argv[1], k_usage);
-  return 2;
+  cli_args sub;
+  int rc = cli_parse(&k_cmd, argc, argv, &sub);
+  if (rc != CLI_RUN) return rc;
+  if (strcmp(sub.v[0], "render") == 0) return hearth_cmd_sim_render(sub.n, sub.v);
+  if (strcmp(sub.v[0], "collect") == 0) return hearth_cmd_sim_collect(sub.n, sub.v);
+  if (strcmp(sub.v[0], "eval") == 0) return hearth_cmd_sim_eval(sub.n, sub.v);
+  return cli_usage_error(&k_cmd, "unknown subcommand '%s' (see 'hearth sim --help')", sub.v[0]);
 }
-
-int main(int argc, char **argv) { return cmd_sim(argc, argv); }
