@@ -8,9 +8,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "hearth/eval.h"
+#include "hearth/image.h"
 #include "hearth/msgpack.h"
 #include "hearth/ws.h"
 
@@ -113,7 +113,7 @@ hearth_status hearth_eval_encode_obs(const hearth_sim_obs *obs, const char *prom
   return HEARTH_OK;
 }
 
-/* ---- animated PNG (APNG) with stored deflate blocks --------------------------- */
+/* ---- videos: the three views side by side, one frame per kept step ------------- */
 typedef struct video {
   int w, h, n, cap;
   uint8_t *frames;
@@ -139,117 +139,11 @@ static void video_add(video *v, const hearth_sim_obs *ob) {
   v->n++;
 }
 
-static uint32_t crc_update(uint32_t c, const uint8_t *p, size_t n) {
-  for (size_t i = 0; i < n; i++) {
-    c ^= p[i];
-    for (int k = 0; k < 8; k++) c = c & 1 ? 0xedb88320u ^ (c >> 1) : c >> 1;
-  }
-  return c;
-}
-
-static void be32(uint8_t *p, uint32_t v) {
-  p[0] = (uint8_t)(v >> 24), p[1] = (uint8_t)(v >> 16), p[2] = (uint8_t)(v >> 8), p[3] = (uint8_t)v;
-}
-
-static void chunk(hearth_mp_writer *b, const char *type, const uint8_t *pre, size_t npre, const uint8_t *data,
-                  size_t n) {
-  uint8_t hdr[8];
-  be32(hdr, (uint32_t)(npre + n));
-  memcpy(hdr + 4, type, 4);
-  uint32_t c = crc_update(0xffffffffu, hdr + 4, 4);
-  c = crc_update(c, pre, npre);
-  c = crc_update(c, data, n);
-  uint8_t tail[4];
-  be32(tail, c ^ 0xffffffffu);
-  /* the writer is reused as a plain byte buffer */
-  hearth_mp_writer *w = b;
-  size_t need = 8 + npre + n + 4;
-  if (w->failed) return;
-  if (w->cap - w->len < need) {
-    size_t cap = w->cap ? w->cap : 4096;
-    while (cap - w->len < need) cap *= 2;
-    uint8_t *nb = realloc(w->buf, cap);
-    if (!nb) {
-      w->failed = 1;
-      return;
-    }
-    w->buf = nb, w->cap = cap;
-  }
-  memcpy(w->buf + w->len, hdr, 8), w->len += 8;
-  if (npre) memcpy(w->buf + w->len, pre, npre), w->len += npre;
-  if (n) memcpy(w->buf + w->len, data, n), w->len += n;
-  memcpy(w->buf + w->len, tail, 4), w->len += 4;
-}
-
-/* zlib stream of the filtered rows using stored (uncompressed) blocks */
-static uint8_t *zlib_stored(const uint8_t *img, int w, int h, size_t *out_n) {
-  size_t raw = (size_t)h * (1 + (size_t)w * 3);
-  size_t nblk = raw / 65535 + 1;
-  uint8_t *z = malloc(2 + raw + nblk * 5 + 4);
-  if (!z) return NULL;
-  size_t o = 0;
-  z[o++] = 0x78, z[o++] = 0x01;
-  uint32_t a = 1, b = 0;
-  size_t done = 0, row = 0, col = 0; /* position in the virtual filtered stream */
-  while (done < raw || raw == 0) {
-    size_t k = raw - done < 65535 ? raw - done : 65535;
-    z[o++] = done + k == raw ? 1 : 0;
-    z[o++] = (uint8_t)k, z[o++] = (uint8_t)(k >> 8), z[o++] = (uint8_t)~k, z[o++] = (uint8_t)(~k >> 8);
-    for (size_t i = 0; i < k; i++) {
-      uint8_t v = col == 0 ? 0 : img[row * (size_t)w * 3 + col - 1];
-      if (++col == 1 + (size_t)w * 3) col = 0, row++;
-      z[o++] = v;
-      a = (a + v) % 65521u, b = (b + a) % 65521u;
-    }
-    done += k;
-    if (raw == 0) break;
-  }
-  be32(z + o, b << 16 | a), o += 4;
-  *out_n = o;
-  return z;
-}
-
+/* the episode's frames as an animated PNG, 1/10 s each; nothing when
+ * there are none */
 static hearth_status video_write(const video *v, const char *path, hearth_err *err) {
   if (v->n == 0) return HEARTH_OK;
-  hearth_mp_writer b;
-  hearth_mp_writer_init(&b);
-  static const uint8_t sig[8] = {0x89, 'P', 'N', 'G', 0x0d, 0x0a, 0x1a, 0x0a};
-  chunk(&b, "\0\0\0\0", NULL, 0, NULL, 0); /* placeholder, replaced below */
-  b.len = 0;
-  memcpy(b.buf, sig, 8), b.len = 8;
-  uint8_t ihdr[13] = {0};
-  be32(ihdr, (uint32_t)v->w), be32(ihdr + 4, (uint32_t)v->h);
-  ihdr[8] = 8, ihdr[9] = 2;
-  chunk(&b, "IHDR", NULL, 0, ihdr, 13);
-  uint8_t actl[8];
-  be32(actl, (uint32_t)v->n), be32(actl + 4, 0);
-  chunk(&b, "acTL", NULL, 0, actl, 8);
-  uint32_t seq = 0;
-  size_t fs = (size_t)v->w * v->h * 3;
-  for (int f = 0; f < v->n && !b.failed; f++) {
-    uint8_t fctl[26] = {0};
-    be32(fctl, seq++), be32(fctl + 4, (uint32_t)v->w), be32(fctl + 8, (uint32_t)v->h);
-    fctl[20] = 0, fctl[21] = 1, fctl[22] = 0, fctl[23] = 10; /* 1/10 s per frame */
-    chunk(&b, "fcTL", NULL, 0, fctl, 26);
-    size_t zn;
-    uint8_t *z = zlib_stored(v->frames + fs * f, v->w, v->h, &zn);
-    if (!z) {
-      b.failed = 1;
-      break;
-    }
-    if (f == 0) chunk(&b, "IDAT", NULL, 0, z, zn);
-    else {
-      uint8_t s[4];
-      be32(s, seq++);
-      chunk(&b, "fdAT", s, 4, z, zn);
-    }
-    free(z);
-  }
-  chunk(&b, "IEND", NULL, 0, NULL, 0);
-  hearth_status st = b.failed ? hearth_err_set(err, HEARTH_E_NOMEM, "%s: video too large", path)
-                              : hearth_write_file_atomic(path, b.buf, b.len, err);
-  hearth_mp_writer_free(&b);
-  return st;
+  return hearth_apng_write(path, v->frames, (size_t)v->w, (size_t)v->h, (size_t)v->n, 1, 10, err);
 }
 
 /* ---- replay: actions of LIBERO HDF5 demos -------------------------------------- */
@@ -608,12 +502,6 @@ static hearth_status run_episode(ep_ctx *x, hearth_eval_episode *ep, int limit, 
   return HEARTH_OK;
 }
 
-static double mono(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
-}
-
 static hearth_status push_ep(hearth_eval_results *r, const hearth_eval_episode *ep, hearth_err *err) {
   hearth_eval_episode *n = realloc(r->eps, (r->n + 1) * sizeof *n);
   if (!n) return hearth_err_set(err, HEARTH_E_NOMEM, "eval: results");
@@ -657,7 +545,7 @@ hearth_status hearth_eval_run(const hearth_eval_opts *o, hearth_eval_results *r,
     hearth_status st = hearth_mkdirs(o->video_dir, err);
     if (st) return st;
   }
-  double t0 = mono();
+  double t0 = hearth_now();
   replay_file rf = {0};
   hearth_status st = HEARTH_OK;
   if (is_replay && (st = replay_load(o->policy + 7, &rf, err))) return st;
@@ -713,7 +601,7 @@ hearth_status hearth_eval_run(const hearth_eval_opts *o, hearth_eval_results *r,
   snprintf(r->metadata, sizeof r->metadata, "%s", wsp.metadata);
   if (wsp.c) ws_drop(&wsp, 1000);
   replay_free(&rf);
-  r->seconds = mono() - t0;
+  r->seconds = hearth_now() - t0;
   if (st) hearth_eval_results_free(r);
   return st;
 }
@@ -741,33 +629,6 @@ double hearth_eval_rates(const hearth_eval_results *r, double per_instr[4][2], d
   return tot ? (double)ok / tot : NAN;
 }
 
-/* growing text buffer */
-typedef struct sbuf {
-  char *s;
-  size_t n, cap;
-} sbuf;
-
-static void sb_add(sbuf *b, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-#include <stdarg.h>
-static void sb_add(sbuf *b, const char *fmt, ...) {
-  va_list ap;
-  va_start(ap, fmt);
-  char tmp[2048];
-  int k = vsnprintf(tmp, sizeof tmp, fmt, ap);
-  va_end(ap);
-  if (k < 0) return;
-  size_t kk = (size_t)k < sizeof tmp ? (size_t)k : sizeof tmp - 1;
-  if (b->n + kk + 1 > b->cap) {
-    size_t cap = (b->cap ? b->cap : 1024);
-    while (cap < b->n + kk + 1) cap *= 2;
-    char *ns = realloc(b->s, cap);
-    if (!ns) return;
-    b->s = ns, b->cap = cap;
-  }
-  memcpy(b->s + b->n, tmp, kk + 1);
-  b->n += kk;
-}
-
 static const char *pct(double f, char *buf) {
   if (isnan(f)) return "-";
   hearth_format_fixed(buf, 32, 100.0 * f, 1);
@@ -786,43 +647,44 @@ static void counts(const hearth_eval_results *r, int *ok, int *tot) {
 char *hearth_eval_format_text(const hearth_eval_results *r) {
   double pi[4][2], pt[4];
   double all = hearth_eval_rates(r, pi, pt);
-  sbuf b = {0};
+  hearth_strbuf b = {0};
   for (size_t i = 0; i < r->n; i++)
     if (!r->eps[i].success)
-      sb_add(&b, "failed: %s instr %d episode %d (layout %llu): %s\n", hearth_sim_task_name(r->eps[i].task),
-             r->eps[i].instruction + 1, r->eps[i].episode, (unsigned long long)r->eps[i].layout, r->eps[i].reason);
-  sb_add(&b, "policy %s\n", r->policy);
-  sb_add(&b, "%-6s %-8s %9s %9s %9s\n", "Task", "Thermal", "Instr. 1", "Instr. 2", "Average");
+      hearth_strbuf_printf(&b, "failed: %s instr %d episode %d (layout %llu): %s\n",
+                           hearth_sim_task_name(r->eps[i].task), r->eps[i].instruction + 1, r->eps[i].episode,
+                           (unsigned long long)r->eps[i].layout, r->eps[i].reason);
+  hearth_strbuf_printf(&b, "policy %s\n", r->policy);
+  hearth_strbuf_printf(&b, "%-6s %-8s %9s %9s %9s\n", "Task", "Thermal", "Instr. 1", "Instr. 2", "Average");
   for (int t = 1; t <= 3; t++) {
     if (isnan(pt[t])) continue;
     char a[32], c[32], d[32];
-    sb_add(&b, "%-6s %-8s %9s %9s %9s\n", hearth_sim_task_name((hearth_sim_task)t), thermal_label(r),
-           pct(pi[t][0], a), pct(pi[t][1], c), pct(pt[t], d));
+    hearth_strbuf_printf(&b, "%-6s %-8s %9s %9s %9s\n", hearth_sim_task_name((hearth_sim_task)t), thermal_label(r),
+                         pct(pi[t][0], a), pct(pi[t][1], c), pct(pt[t], d));
   }
   int ok, tot;
   counts(r, &ok, &tot);
   char a[32];
-  sb_add(&b, "overall %s (%d/%d)\n", pct(all, a), ok, tot);
-  return b.s;
+  hearth_strbuf_printf(&b, "overall %s (%d/%d)\n", pct(all, a), ok, tot);
+  return hearth_strbuf_take(&b);
 }
 
 char *hearth_eval_format_markdown(const hearth_eval_results *r) {
   double pi[4][2], pt[4];
   double all = hearth_eval_rates(r, pi, pt);
-  sbuf b = {0};
-  sb_add(&b, "Task success rates (%%), policy `%s`\n\n", r->policy);
-  sb_add(&b, "| Task | Thermal | Instr. 1 | Instr. 2 | Average |\n|---|---|---:|---:|---:|\n");
+  hearth_strbuf b = {0};
+  hearth_strbuf_printf(&b, "Task success rates (%%), policy `%s`\n\n", r->policy);
+  hearth_strbuf_printf(&b, "| Task | Thermal | Instr. 1 | Instr. 2 | Average |\n|---|---|---:|---:|---:|\n");
   for (int t = 1; t <= 3; t++) {
     if (isnan(pt[t])) continue;
     char a[32], c[32], d[32];
-    sb_add(&b, "| %s | %s | %s | %s | %s |\n", hearth_sim_task_name((hearth_sim_task)t), thermal_label(r),
-           pct(pi[t][0], a), pct(pi[t][1], c), pct(pt[t], d));
+    hearth_strbuf_printf(&b, "| %s | %s | %s | %s | %s |\n", hearth_sim_task_name((hearth_sim_task)t), thermal_label(r),
+                         pct(pi[t][0], a), pct(pi[t][1], c), pct(pt[t], d));
   }
   int ok, tot;
   counts(r, &ok, &tot);
   char a[32];
-  sb_add(&b, "| **Overall** | %s | | | **%s** (%d/%d) |\n", thermal_label(r), pct(all, a), ok, tot);
-  return b.s;
+  hearth_strbuf_printf(&b, "| **Overall** | %s | | | **%s** (%d/%d) |\n", thermal_label(r), pct(all, a), ok, tot);
+  return hearth_strbuf_take(&b);
 }
 
 static json_t *jnum(double v) {
