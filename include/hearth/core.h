@@ -1,5 +1,6 @@
 /* hearth/core.h - area core (src/core/): status codes, error reports,
- * files, threads, locale-independent numbers, random numbers, progress.
+ * files, threads, locale-independent numbers, random numbers, progress,
+ * growing text buffers.
  *
  * Every fallible function in hearth returns a hearth_status and, when the
  * caller passes a hearth_err, fills it with a message a person can act on:
@@ -146,6 +147,28 @@ int hearth_parse_double(const char *s, size_t len, int decimal_comma, double *ou
 /* Write x with `decimals` fixed decimals using '.', independent of locale.
  * Returns the length written (excluding NUL) or -1 if it did not fit. */
 int hearth_format_fixed(char *buf, size_t bufsz, double x, int decimals);
+
+/* ---- growing text ------------------------------------------------------------ */
+/* A NUL-terminated text that grows as printf-style pieces are appended.
+ * Start from a zeroed buffer (hearth_strbuf b = {0}); data stays NULL until
+ * the first append and is owned by the buffer until hearth_strbuf_take or
+ * hearth_strbuf_free. An allocation or formatting failure sets `failed`;
+ * later appends then do nothing, so callers check once at the end. */
+typedef struct hearth_strbuf {
+  char *data;   /* len bytes plus a NUL, or NULL while empty */
+  size_t len, cap;
+  int failed;
+} hearth_strbuf;
+void hearth_strbuf_printf(hearth_strbuf *b, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+/* The text, malloc'ed (the caller frees it; "" when nothing was appended),
+ * or NULL after a failure; the buffer is left empty either way. */
+char *hearth_strbuf_take(hearth_strbuf *b);
+/* Free the text and zero the buffer; accepts a zeroed buffer. */
+void hearth_strbuf_free(hearth_strbuf *b);
 
 /* ---- deterministic random numbers ------------------------------------------ */
 /* A small counter-based generator (SplitMix64 seeding, xoshiro256**):

@@ -1,6 +1,6 @@
 /* hearth/image.h - area io (src/io/): images in memory and on disk (PNG
- * 8/16-bit, JPEG), the Turbo colour map and a few drawing helpers for
- * overlays and contact sheets.
+ * 8/16-bit, animated PNG, JPEG), the Turbo colour map and a few drawing
+ * helpers for overlays and contact sheets.
  *
  * Pixels are row-major, channels interleaved, row 0 at the top; 16-bit and
  * float samples in native byte order. Every function that fills a
@@ -51,6 +51,19 @@ hearth_status hearth_png_write(const char *path, const hearth_image *img, hearth
 /* Encode to memory (*out malloc'ed, the caller frees it). */
 hearth_status hearth_png_encode(const hearth_image *img, uint8_t **out, size_t *size,
                                 hearth_err *err);
+
+/* Animated PNG (APNG): n_frames RGB U8 frames of width x height, stored
+ * back to back in `frames` (top row first), each shown for
+ * delay_num / delay_den seconds, looping forever. The first frame is also
+ * the default image, so a plain PNG reader shows it. Rows are unfiltered
+ * and stored uncompressed (quick to write, frame-sized chunks). */
+hearth_status hearth_apng_write(const char *path, const uint8_t *frames, size_t width, size_t height,
+                                size_t n_frames, unsigned delay_num, unsigned delay_den,
+                                hearth_err *err);
+/* The same file in memory (*out malloc'ed, the caller frees). */
+hearth_status hearth_apng_encode(const uint8_t *frames, size_t width, size_t height, size_t n_frames,
+                                 unsigned delay_num, unsigned delay_den, uint8_t **out,
+                                 size_t *size, hearth_err *err);
 
 /* JPEG (8-bit gray or RGB; U8 images). quality 1..100. Writes atomically. */
 hearth_status hearth_jpeg_read(const char *path, hearth_image *img, hearth_err *err);

@@ -309,3 +309,7 @@ int hearth_deflate_rle(const uint8_t *in, size_t n, int final, uint8_t *out, siz
   else *out_len = (size_t)(w.p - out);
   return 1;
 }
+
+size_t hearth_deflate_stored(const uint8_t *in, size_t n, int final, uint8_t *out) {
+  return write_stored(in, n, final, out);
+}

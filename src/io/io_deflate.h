@@ -19,4 +19,10 @@ size_t hearth_deflate_bound(size_t n);
  * 1 otherwise. */
 int hearth_deflate_rle(const uint8_t *in, size_t n, int final, uint8_t *out, size_t *out_len);
 
+/* in[0..n) as stored (uncompressed) blocks of up to 65535 bytes, the last
+ * marked final when final is set (else followed by a sync flush), into out
+ * (hearth_deflate_bound(n) bytes); returns the bytes written. n == 0 gives
+ * one empty block. */
+size_t hearth_deflate_stored(const uint8_t *in, size_t n, int final, uint8_t *out);
+
 #endif

@@ -13,6 +13,7 @@
 #include <zlib.h>
 #include "hearth/image.h"
 #include "io_deflate.h"
+#include "io_png.h"
 
 /* files larger than this are refused before decoding */
 #define PNG_MAX_FILE_BYTES ((size_t)1 << 30)
@@ -263,24 +264,23 @@ static void encode_bands(void *ctx, size_t b, size_t e, int t) {
   free(raw);
 }
 
-static void put32(uint8_t *p, uint32_t v) {
+void hearth_png_put32(uint8_t *p, uint32_t v) {
   p[0] = (uint8_t)(v >> 24);
   p[1] = (uint8_t)(v >> 16);
   p[2] = (uint8_t)(v >> 8);
   p[3] = (uint8_t)v;
 }
 
-/* a chunk from up to three pieces of data (length, type, data, CRC) */
-static uint8_t *put_chunk(uint8_t *o, const char type[4], const uint8_t *a, size_t na,
-                          const uint8_t *b, size_t nb, const uint8_t *c, size_t nc) {
-  put32(o, (uint32_t)(na + nb + nc));
+uint8_t *hearth_png_put_chunk(uint8_t *o, const char type[4], const uint8_t *a, size_t na,
+                              const uint8_t *b, size_t nb, const uint8_t *c, size_t nc) {
+  hearth_png_put32(o, (uint32_t)(na + nb + nc));
   memcpy(o + 4, type, 4);
   uLong crc = crc32(crc32(0L, Z_NULL, 0), o + 4, 4);
   uint8_t *d = o + 8;
   if (na) memcpy(d, a, na), crc = crc32(crc, a, (uInt)na), d += na;
   if (nb) memcpy(d, b, nb), crc = crc32(crc, b, (uInt)nb), d += nb;
   if (nc) memcpy(d, c, nc), crc = crc32(crc, c, (uInt)nc), d += nc;
-  put32(d, (uint32_t)crc);
+  hearth_png_put32(d, (uint32_t)crc);
   return d + 4;
 }
 
@@ -319,23 +319,23 @@ static hearth_status png_encode_mem(const hearth_image *img, const char *name, u
   memcpy(o, sig, 8);
   o += 8;
   uint8_t ihdr[13];
-  put32(ihdr, (uint32_t)img->width);
-  put32(ihdr + 4, (uint32_t)img->height);
+  hearth_png_put32(ihdr, (uint32_t)img->width);
+  hearth_png_put32(ihdr + 4, (uint32_t)img->height);
   ihdr[8] = img->type == HEARTH_PIX_U16 ? 16 : 8;
   ihdr[9] = ctype[img->channels];
   ihdr[10] = ihdr[11] = ihdr[12] = 0; /* deflate, adaptive filtering, no interlace */
-  o = put_chunk(o, "IHDR", ihdr, 13, NULL, 0, NULL, 0);
+  o = hearth_png_put_chunk(o, "IHDR", ihdr, 13, NULL, 0, NULL, 0);
   /* the zlib header (deflate, 32 KiB window, fastest) before the first band,
    * the Adler-32 of the filtered bytes after the last */
   static const uint8_t zhdr[2] = {0x78, 0x01};
   uLong adler = j.adler[0];
   for (size_t k = 1; k < nb; k++) adler = adler32_combine(adler, j.adler[k], (z_off_t)j.raw_len[k]);
   uint8_t ztail[4];
-  put32(ztail, (uint32_t)adler);
+  hearth_png_put32(ztail, (uint32_t)adler);
   for (size_t k = 0; k < nb; k++)
-    o = put_chunk(o, "IDAT", k == 0 ? zhdr : NULL, k == 0 ? 2 : 0, j.out[k], j.out_len[k],
-                  k + 1 == nb ? ztail : NULL, k + 1 == nb ? 4 : 0);
-  o = put_chunk(o, "IEND", NULL, 0, NULL, 0, NULL, 0);
+    o = hearth_png_put_chunk(o, "IDAT", k == 0 ? zhdr : NULL, k == 0 ? 2 : 0, j.out[k], j.out_len[k],
+                             k + 1 == nb ? ztail : NULL, k + 1 == nb ? 4 : 0);
+  o = hearth_png_put_chunk(o, "IEND", NULL, 0, NULL, 0, NULL, 0);
   *out = buf;
   *size = (size_t)(o - buf);
 done:

@@ -1,10 +1,11 @@
-/* private: the env struct shared by the sim sources */
+/* private: the env struct shared by the sim sources, and the privileged
+ * helpers of sim_env.c */
 #ifndef HEARTH_SIM_ENV_H
 #define HEARTH_SIM_ENV_H
 
 #include "sim/sim_internal.h"
+#include "sim/sim_tasks.h"
 
-#define SIM_NOBJ 4
 #define SIM_MAXNV 64
 
 typedef struct sim_render sim_render;
@@ -30,17 +31,16 @@ struct hearth_sim_env {
   sim_render *rnd;
 };
 
-void sim_osc(hearth_sim_env *e);
 /* visibility rule of a layout: both candidates at least this visible */
 #define SIM_MIN_VISIBLE 0.7
 #define SIM_MAX_ATTEMPTS 20
-void sim_layout(uint64_t seed, uint64_t layout, int attempt, double pos[SIM_NOBJ][2], int *swap);
 /* privileged helpers for tests and audits: object k's position (its
  * bottom centre) and teleporting it upright at rest to xyz */
 void sim_object_pos(const hearth_sim_env *e, int k, double xyz[3]);
 void sim_place_object(hearth_sim_env *e, int k, const double xyz[3]);
 /* fraction of object k's surface samples seen by the front camera */
 double sim_visible_frac(const hearth_sim_env *e, int k);
+/* sim_render.c: the GL context and scene of an env, and their release */
 hearth_status sim_render_init(hearth_sim_env *e, hearth_err *err);
 void sim_render_free(hearth_sim_env *e);
 

@@ -1,0 +1,61 @@
+/* The three tasks as data: objects, instructions, where things stand on the
+ * table, and the layout draw that jitters them. */
+#include "sim/sim_tasks.h"
+#include "hearth/core.h"
+
+/* paper, Table III */
+static const sim_task_def k_tasks[3] = {
+    {"H1", "study",
+     {{"cup", "hot", "hot cup"}, {"cup", "neutral", "normal cup"}},
+     {{"electric_kettle", "hot", "kettle"}, {"eraser", "neutral", "eraser"}}},
+    {"H2", "kitchen",
+     {{"canned_drink", "iced", "iced can"}, {"canned_drink", "neutral", "normal can"}},
+     {{"orange", "iced", "orange"}, {"cup", "neutral", "cup"}}},
+    {"H3", "kitchen",
+     {{"smartphone", "hot", "hot phone"}, {"sponge", "hot", "hot sponge"}},
+     {{"orange", "neutral", "orange"}, {"cup", "hot", "cup"}}},
+};
+static const char *const k_instr[3][2] = {
+    {"pick up the hot cup and place it on the mat", "pick up the normal cup and place it on the mat"},
+    {"pick up the iced can and place it on the mat", "pick up the normal can and place it on the mat"},
+    {"pick up the hot phone and place it on the mat",
+     "pick up the hot sponge and place it on the mat"},
+};
+
+/* distractor 1 stands behind slot B, where even the kettle stays in view
+ * and clear of the hand; distractor 2 in front. The slots are 19 cm apart
+ * so the 18 cm wide hand fits beside the other candidate at any jitter */
+const double sim_spots[SIM_NOBJ][2] = {{0.05, 0.00}, {0.05, 0.19}, {-0.17, 0.29}, {0.20, -0.07}};
+const double sim_mat_centre[2] = {-0.05, -0.22};
+
+const sim_task_def *sim_task_get(hearth_sim_task t) { return &k_tasks[t - 1]; }
+
+hearth_sim_task hearth_sim_task_parse(const char *s) {
+  if (!s) return 0;
+  if ((s[0] == 'H' || s[0] == 'h') && s[1] >= '1' && s[1] <= '3' && s[2] == 0)
+    return (hearth_sim_task)(s[1] - '0');
+  return 0;
+}
+const char *hearth_sim_task_name(hearth_sim_task t) {
+  return t >= 1 && t <= 3 ? k_tasks[t - 1].name : "?";
+}
+const char *hearth_sim_instruction_text(hearth_sim_task t, int i) {
+  if (t < 1 || t > 3 || i < 0 || i > 1) return "";
+  return k_instr[t - 1][i];
+}
+
+void sim_layout(uint64_t seed, uint64_t layout, int attempt, double pos[SIM_NOBJ][2], int *swap) {
+  hearth_rng base, r;
+  hearth_rng_seed(&base, seed);
+  hearth_rng_fork(&base, layout, &r);
+  /* attempt k continues the layout's own stream, so attempt 0 is the
+   * plain draw and later attempts never depend on the image size */
+  for (int a = 0; a <= attempt; a++)
+    for (int k = 0; k < SIM_NOBJ; k++) {
+      pos[k][0] = sim_spots[k][0] + hearth_rng_range(&r, -0.025, 0.025);
+      pos[k][1] = sim_spots[k][1] + hearth_rng_range(&r, -0.025, 0.025);
+    }
+  /* candidate identities alternate between the slots: even layouts put
+   * candidate 0 in slot A, odd ones in slot B (balanced for any even N) */
+  *swap = (int)(layout & 1);
+}

@@ -1,0 +1,35 @@
+/* private: the task table (paper, Table III), the table-top spots and the
+ * layout draw (sim_tasks.c) */
+#ifndef HEARTH_SIM_TASKS_H
+#define HEARTH_SIM_TASKS_H
+
+#include <stdint.h>
+#include "hearth/sim.h"
+
+/* objects per scene: 0, 1 the candidates (instruction i targets i), 2, 3
+ * the distractors */
+#define SIM_NOBJ 4
+
+typedef struct sim_task_obj {
+  const char *category, *state, *noun;
+} sim_task_obj;
+typedef struct sim_task_def {
+  const char *name, *scene; /* "H1", "study" or "kitchen" */
+  sim_task_obj cand[2];     /* instruction i targets cand[i] */
+  sim_task_obj dist[2];
+} sim_task_def;
+/* The row of a valid task (1..3). */
+const sim_task_def *sim_task_get(hearth_sim_task t);
+
+/* Nominal spots on the table top (world x, y; x towards the front camera,
+ * y to the image's right): slot A, slot B, distractor 1, distractor 2; and
+ * the mat (centre, half side), where the target must end. */
+extern const double sim_spots[SIM_NOBJ][2];
+extern const double sim_mat_centre[2];
+#define SIM_MAT_HALF 0.08
+
+/* Draw `attempt` of layout `layout` of the stream `seed`: the jittered
+ * positions of the four spots and whether the candidates swap slots. */
+void sim_layout(uint64_t seed, uint64_t layout, int attempt, double pos[SIM_NOBJ][2], int *swap);
+
+#endif
