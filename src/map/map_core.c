@@ -179,6 +179,9 @@ hearth_status hearth_map_views_with_layout(const hearth_map_layout *l, const hea
   int C = 0;
   hearth_status s = view_channels(&l->cam, views, n_views, &C, err);
   if (s) return s;
+  if (opts.fusion != HEARTH_FUSE_MAX && opts.fusion != HEARTH_FUSE_ROBUST &&
+      opts.fusion != HEARTH_FUSE_MEAN)
+    return hearth_err_set(err, HEARTH_E_ARG, "map: unknown fusion rule %d", (int)opts.fusion);
   if (opts.fusion == HEARTH_FUSE_ROBUST && C != 1)
     return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "map: robust fusion is for temperatures only");
   map_ctx m;

@@ -169,6 +169,11 @@ int main(void) {
   small.width = 255;
   CHECK(hearth_map_views(&m, NULL, &small, views, 1, &o, &r4, &err) == HEARTH_E_SIZE);
   CHECK(strstr(err.msg, "256x192") != NULL);
+  /* an unknown fusion rule is refused, not run */
+  hearth_map_opts bad = o;
+  bad.fusion = (hearth_fusion)7;
+  CHECK(hearth_map_views(&m, NULL, &cam, views, 1, &bad, &r4, &err) == HEARTH_E_ARG);
+  CHECK(strstr(err.msg, "fusion") != NULL);
 
   hearth_map_result_free(&r1);
   hearth_map_result_free(&r2);
