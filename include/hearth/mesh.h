@@ -136,6 +136,38 @@ hearth_status hearth_ray_fan_cast(const hearth_ray_fan *f, const hearth_mesh *m,
 hearth_status hearth_uv_islands(const hearth_mesh *m, uint32_t *island_of_tri,
                                 uint32_t *n_islands, hearth_err *err);
 
+/* Fold UV islands into [0,1]^2 by whole tiles. With a REPEAT sampler the
+ * texture at u + k (k an integer) is the texture at u, so an island lying
+ * in one tile [i, i+1] x [j, j+1] (overhanging it by at most
+ * HEARTH_UV_TILE_SLACK; [0,1]^2 itself is preferred) is translated by
+ * (-i, -j); along a MIRRORED_REPEAT axis an odd tile is reflected instead,
+ * u' = i + 1 - u; along a CLAMP_TO_EDGE axis an island outside [0,1] is
+ * not moved. Islands here join triangles that share a UV point (bit
+ * exact), so a vertex always moves with every triangle using it. wrap:
+ * NULL for REPEAT everywhere, or two hearth_uv_wrap codes per triangle (u
+ * axis, v axis); an island takes the most restrictive of its triangles'
+ * (CLAMP_TO_EDGE over MIRRORED_REPEAT over REPEAT). Islands that cannot be
+ * folded (spanning tiles, or clamped) are left as they are and counted.
+ * When every UV already lies in [-slack, 1 + slack] nothing is done (all
+ * counts 0). */
+#define HEARTH_UV_TILE_SLACK 1e-3 /* overhang of an island past its tile, in tiles */
+typedef enum hearth_uv_wrap {
+  HEARTH_UV_REPEAT = 0,
+  HEARTH_UV_MIRRORED_REPEAT = 1,
+  HEARTH_UV_CLAMP_TO_EDGE = 2
+} hearth_uv_wrap;
+typedef struct hearth_uv_tiles {
+  uint32_t moved;              /* islands brought into [0,1]^2 */
+  uint32_t mirrored;           /* of those, reflected on an axis */
+  uint32_t straddling;         /* islands spanning more than one tile: left */
+  uint32_t clamped;            /* islands outside [0,1]^2 under CLAMP_TO_EDGE: left */
+  size_t triangles_straddling; /* triangles crossing a tile border */
+  size_t triangles_left;       /* triangles of the islands left */
+  size_t first_left;           /* lowest triangle of an island left; SIZE_MAX if none */
+} hearth_uv_tiles;
+hearth_status hearth_uv_fold_tiles(hearth_mesh *m, const uint8_t *wrap, hearth_uv_tiles *out,
+                                   hearth_err *err);
+
 /* Rasterise the UV layout into R x R: tri_of_texel[row*R+col] is the
  * triangle whose UV triangle contains the texel centre (UINT32_MAX if none;
  * ties go to the lowest triangle index, so the result is deterministic),
