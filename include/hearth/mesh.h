@@ -49,21 +49,78 @@ void hearth_mesh_transform(hearth_mesh *m, double s, const double R[9], const do
 hearth_status hearth_mesh_validate(const hearth_mesh *m, const char *name, hearth_err *err);
 
 /* ---- glTF binary ---------------------------------------------------------- */
+/* What hearth_glb_read did to the file's UVs, filled on success when
+ * hearth_glb_read_opts.report is set. */
+typedef struct hearth_glb_report {
+  uint32_t uv_islands_moved;      /* islands brought into [0,1]^2 by whole tiles */
+  uint32_t uv_islands_mirrored;   /* of those, reflected on an axis (MIRRORED_REPEAT) */
+  uint32_t uv_islands_left;       /* left outside [0,1]^2 (only when UVs are not required) */
+  size_t uv_triangles_straddling; /* triangles crossing a tile border */
+  size_t quantized_primitives;    /* primitives with integer POSITION or UVs */
+  size_t transformed_primitives;  /* primitives whose UVs KHR_texture_transform changed */
+} hearth_glb_report;
+
 typedef struct hearth_glb_read_opts {
-  int require_uvs;        /* fail with HEARTH_E_NOT_FOUND naming the primitive if no TEXCOORD_0 */
+  int require_uvs;        /* fail with HEARTH_E_NOT_FOUND naming the primitive if no UVs */
   int load_texture;       /* decode the base colour texture of the first material if embedded */
   size_t max_triangles;   /* 0: default limit (50 million) */
+  int keep_uv_tiles;      /* 1: UVs as stored; 0 (default): islands folded into [0,1]^2 */
+  hearth_glb_report *report; /* optional, written on success; NULL: not wanted */
 } hearth_glb_read_opts;
-/* Defaults: UVs not required, no texture decoded, the 50-million limit. */
+/* Defaults (all zero): UVs not required, no texture decoded, the
+ * 50-million limit, UV islands folded into [0,1]^2, no report. */
 void hearth_glb_read_opts_default(hearth_glb_read_opts *o);
 
 /* Read a GLB: walks the default scene's node hierarchy applying node
  * transforms (matrix or TRS), concatenates every triangle primitive
  * (indexed or not) of every mesh instance into one mesh. Draco/meshopt
  * compression, sparse accessors, non-triangle modes, out-of-range indices
- * and truncated chunks are errors naming the file and the element. opts may
- * be NULL (the defaults). parse reads data[0..size) (copied; `name` names it
- * in messages). */
+ * and truncated chunks are errors naming the file and the element; so is
+ * any extension in extensionsRequired but the two below. Skins and morph
+ * targets are not applied (the bind shape is read). opts may be NULL (the
+ * defaults). parse reads data[0..size) (copied; `name` names it in messages).
+ *
+ * UVs. A primitive's UVs are those its material's base colour texture
+ * samples: TEXCOORD_n for the textureInfo's texCoord n (0 without a
+ * texture), with KHR_texture_transform applied when the textureInfo has
+ * it (its texCoord overrides the textureInfo's). The transform is
+ * uv' = T(offset) R(rotation) S(scale) uv, scale first:
+ *   u' = ox + sx cos(r) u + sy sin(r) v,   v' = oy - sx sin(r) u + sy cos(r) v.
+ * That sign is the one of the extension's worked examples, the Khronos
+ * sample viewer and Blender (a positive rotation turns the UVs
+ * counter-clockwise as seen on the image, v pointing down); the
+ * extension's GLSL listing read as column-major has the opposite sign
+ * (KhronosGroup/glTF issue 1563).
+ *
+ * KHR_mesh_quantization (in extensionsUsed or extensionsRequired) allows
+ * POSITION and TEXCOORD_n of BYTE, UNSIGNED_BYTE, SHORT or UNSIGNED_SHORT,
+ * normalised or not: normalised values map to [0,1] (c / 255, c / 65535)
+ * or [-1,1] (max(c / 127, -1), max(c / 32767, -1)), plain ones to their
+ * integer value; the node transform (positions) and the texture transform
+ * (UVs) dequantise them, as the extension specifies. Without the
+ * extension POSITION is FLOAT and UVs FLOAT or normalised unsigned.
+ *
+ * UV tiles. UVs outside [0,1] are valid glTF: the default sampler wraps
+ * with REPEAT, so the texture at u + k (k an integer) is the texture at u,
+ * and exporters write such files (Blender stores v' = 1 - v, so an island
+ * anywhere outside Blender's unit square, e.g. a UDIM-style tile, lies
+ * outside [0,1] in the file). Maps cover [0,1]^2 only, so unless
+ * keep_uv_tiles is set every UV island (triangles joined by shared UV
+ * points) that lies in one tile [i, i+1] x [j, j+1] (overhanging it by at
+ * most HEARTH_UV_TILE_SLACK) is brought into [0,1]^2, per axis as the
+ * wrap mode of its base colour texture's sampler allows:
+ *   REPEAT (also: no sampler, no texture): translated by -i;
+ *   MIRRORED_REPEAT (period 2, odd tiles mirror tile 0): an even i is
+ *     translated by -i, an odd one reflected, u' = i + 1 - u: the same
+ *     texel either way;
+ *   CLAMP_TO_EDGE: outside [0,1] the lookup repeats the edge texels, so
+ *     such an island owns no texels; it is not moved (that would change
+ *     what it shows).
+ * An island spanning tiles, or clamped outside [0,1]^2, cannot be mapped:
+ * with require_uvs that is HEARTH_E_UNSUPPORTED naming the file, the
+ * island and triangle counts and a first triangle (mesh, primitive,
+ * index); without, such islands stay as stored. Overlaps between islands
+ * folded from different tiles are not checked. */
 hearth_status hearth_glb_read(const char *path, const hearth_glb_read_opts *opts,
                               hearth_mesh *out, hearth_err *err);
 hearth_status hearth_glb_parse(const void *data, size_t size, const char *name,
@@ -152,6 +209,38 @@ hearth_status hearth_ray_fan_cast(const hearth_ray_fan *f, const hearth_mesh *m,
  * island. The caller's island_of_tri[n_triangles] gets 0..n_islands-1. */
 hearth_status hearth_uv_islands(const hearth_mesh *m, uint32_t *island_of_tri,
                                 uint32_t *n_islands, hearth_err *err);
+
+/* Fold UV islands into [0,1]^2 by whole tiles. With a REPEAT sampler the
+ * texture at u + k (k an integer) is the texture at u, so an island lying
+ * in one tile [i, i+1] x [j, j+1] (overhanging it by at most
+ * HEARTH_UV_TILE_SLACK; [0,1]^2 itself is preferred) is translated by
+ * (-i, -j); along a MIRRORED_REPEAT axis an odd tile is reflected instead,
+ * u' = i + 1 - u; along a CLAMP_TO_EDGE axis an island outside [0,1] is
+ * not moved. Islands here join triangles that share a UV point (bit
+ * exact), so a vertex always moves with every triangle using it. wrap:
+ * NULL for REPEAT everywhere, or two hearth_uv_wrap codes per triangle (u
+ * axis, v axis); an island takes the most restrictive of its triangles'
+ * (CLAMP_TO_EDGE over MIRRORED_REPEAT over REPEAT). Islands that cannot be
+ * folded (spanning tiles, or clamped) are left as they are and counted.
+ * When every UV already lies in [-slack, 1 + slack] nothing is done (all
+ * counts 0). */
+#define HEARTH_UV_TILE_SLACK 1e-3 /* overhang of an island past its tile, in tiles */
+typedef enum hearth_uv_wrap {
+  HEARTH_UV_REPEAT = 0,
+  HEARTH_UV_MIRRORED_REPEAT = 1,
+  HEARTH_UV_CLAMP_TO_EDGE = 2
+} hearth_uv_wrap;
+typedef struct hearth_uv_tiles {
+  uint32_t moved;              /* islands brought into [0,1]^2 */
+  uint32_t mirrored;           /* of those, reflected on an axis */
+  uint32_t straddling;         /* islands spanning more than one tile: left */
+  uint32_t clamped;            /* islands outside [0,1]^2 under CLAMP_TO_EDGE: left */
+  size_t triangles_straddling; /* triangles crossing a tile border */
+  size_t triangles_left;       /* triangles of the islands left */
+  size_t first_left;           /* lowest triangle of an island left; SIZE_MAX if none */
+} hearth_uv_tiles;
+hearth_status hearth_uv_fold_tiles(hearth_mesh *m, const uint8_t *wrap, hearth_uv_tiles *out,
+                                   hearth_err *err);
 
 /* Rasterise the UV layout into R x R (caller's arrays of R * R entries):
  * tri_of_texel[row*R+col] is the triangle whose UV triangle contains the

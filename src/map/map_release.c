@@ -365,6 +365,15 @@ hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats
     hearth_err_prefix(err, "%s/%s", inst, job->state);
     goto done;
   }
+  /* a map without surface is nothing mapped: the UVs cover no texel */
+  if (!r.n_surface) {
+    s = hearth_err_set(err, HEARTH_E_RANGE,
+                       "%s/%s: %s: the mesh's UV layout covers no texel of the %zux%zu map "
+                       "(surface 0 texels): its UVs lie outside [0,1] or its UV triangles "
+                       "are too small to hold a texel centre",
+                       inst, job->state, mesh_path, r.R, r.R);
+    goto done;
+  }
   if (job->timing) job->timing->raster = lb.seconds;
   /* write everything into a temporary sibling directory, then swap it in */
   double t_write0 = hearth_now();
@@ -485,6 +494,14 @@ hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err) {
   mo.threads = job->threads;
   mo.skip_best_cos = 1;
   if ((s = hearth_map_views(&mesh, NULL, &rig.rgb, views, man.n_views, &mo, &r, err))) goto done;
+  if (!r.n_surface) {
+    s = hearth_err_set(err, HEARTH_E_RANGE,
+                       "%s/%s: %s: the mesh's UV layout covers no texel of the %zux%zu colour "
+                       "map (surface 0 texels): its UVs lie outside [0,1] or its UV triangles "
+                       "are too small to hold a texel centre",
+                       inst, state, mesh_path, r.R, r.R);
+    goto done;
+  }
   hearth_image_free(&mesh.texture);
   const uint8_t grey[3] = {128, 128, 128};
   if ((s = hearth_map_texture(&r, 0, 255, 8, grey, &mesh.texture, err))) goto done;

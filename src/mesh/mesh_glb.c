@@ -70,6 +70,7 @@ typedef struct glb_ctx {
   size_t bin_size;
   hearth_err *err;
   json_t *accessors, *views, *buffers, *meshes, *nodes;
+  int quantization; /* KHR_mesh_quantization declared: integer POSITION/UVs allowed */
 } glb_ctx;
 
 /* A resolved accessor: where element i, component c lives. base == NULL means
@@ -493,11 +494,106 @@ static hearth_status collect_instances(glb_ctx *c, glb_inst_list *list) {
 }
 
 /* ---- primitives ------------------------------------------------------------ */
+/* Where a primitive's UVs come from: the UV set its base colour texture
+ * samples, the texture transform and the sampler's wrap modes. */
+typedef struct glb_uvsrc {
+  size_t set;       /* TEXCOORD_<set> */
+  int has_xform;    /* KHR_texture_transform present */
+  double xf[6];     /* u' = xf[0] u + xf[1] v + xf[2], v' = xf[3] u + xf[4] v + xf[5] */
+  uint8_t wrap[2];  /* hearth_uv_wrap of wrapS, wrapT */
+} glb_uvsrc;
+
 typedef struct glb_prim {
   glb_acc pos, uv, idx;
   int has_uv, has_idx;
   size_t n_tris;
+  glb_uvsrc src;
+  size_t mesh, prim, tbase; /* where it is in the file and in the output */
 } glb_prim;
+
+static hearth_status wrap_mode(glb_ctx *c, json_t *smp, const char *key, const char *at,
+                               uint8_t *out) {
+  size_t w = 10497;
+  hearth_status s = get_uint(c, smp, key, at, 0, &w, NULL);
+  if (s) return s;
+  switch (w) {
+  case 10497: *out = HEARTH_UV_REPEAT; return HEARTH_OK;
+  case 33648: *out = HEARTH_UV_MIRRORED_REPEAT; return HEARTH_OK;
+  case 33071: *out = HEARTH_UV_CLAMP_TO_EDGE; return HEARTH_OK;
+  default:
+    return hearth_err_set(c->err, HEARTH_E_PARSE,
+                          "%s: %s.%s: %zu is not a wrap mode; expected 10497 (REPEAT), 33648 "
+                          "(MIRRORED_REPEAT) or 33071 (CLAMP_TO_EDGE)",
+                          c->name, at, key, w);
+  }
+}
+
+/* The UV source of a primitive: TEXCOORD_0, REPEAT and no transform unless
+ * its material has a base colour texture saying otherwise. */
+static hearth_status resolve_uv_source(glb_ctx *c, json_t *prim, const char *pat,
+                                       glb_uvsrc *out) {
+  hearth_status s;
+  memset(out, 0, sizeof *out);
+  out->xf[0] = out->xf[4] = 1.0;
+  size_t mat_idx = 0, tex_idx = 0, smp_idx = 0;
+  int has;
+  if ((s = get_uint(c, prim, "material", pat, 0, &mat_idx, &has)) || !has) return s;
+  json_t *mat, *tex, *smp;
+  if ((s = get_elem(c, json_object_get(c->root, "materials"), "materials", mat_idx, pat, &mat)))
+    return s;
+  json_t *pbr = json_object_get(mat, "pbrMetallicRoughness");
+  json_t *bct = json_is_object(pbr) ? json_object_get(pbr, "baseColorTexture") : NULL;
+  if (!json_is_object(bct)) return HEARTH_OK;
+  char at[160], xat[224];
+  snprintf(at, sizeof at, "materials[%zu].pbrMetallicRoughness.baseColorTexture", mat_idx);
+  if ((s = get_uint(c, bct, "index", at, 1, &tex_idx, NULL))) return s;
+  if ((s = get_uint(c, bct, "texCoord", at, 0, &out->set, NULL))) return s;
+  if ((s = get_elem(c, json_object_get(c->root, "textures"), "textures", tex_idx, at, &tex)))
+    return s;
+  char tat[48];
+  snprintf(tat, sizeof tat, "textures[%zu]", tex_idx);
+  if ((s = get_uint(c, tex, "sampler", tat, 0, &smp_idx, &has))) return s;
+  if (has) {
+    char sat[48];
+    snprintf(sat, sizeof sat, "samplers[%zu]", smp_idx);
+    if ((s = get_elem(c, json_object_get(c->root, "samplers"), "samplers", smp_idx, tat, &smp)) ||
+        (s = wrap_mode(c, smp, "wrapS", sat, &out->wrap[0])) ||
+        (s = wrap_mode(c, smp, "wrapT", sat, &out->wrap[1])))
+      return s;
+  }
+  json_t *ext = json_object_get(bct, "extensions");
+  json_t *tt = json_is_object(ext) ? json_object_get(ext, "KHR_texture_transform") : NULL;
+  if (!tt) return HEARTH_OK;
+  snprintf(xat, sizeof xat, "%s.extensions.KHR_texture_transform", at);
+  if (!json_is_object(tt))
+    return hearth_err_set(c->err, HEARTH_E_PARSE, "%s: %s: expected an object", c->name, xat);
+  double off[2] = {0, 0}, sc[2] = {1, 1}, rot = 0;
+  int has_off, has_sc;
+  if ((s = get_numbers(c, tt, "offset", xat, 2, off, &has_off)) ||
+      (s = get_numbers(c, tt, "scale", xat, 2, sc, &has_sc)) ||
+      (s = get_uint(c, tt, "texCoord", xat, 0, &out->set, NULL)))
+    return s;
+  json_t *r = json_object_get(tt, "rotation");
+  if (r && !json_is_number(r))
+    return hearth_err_set(c->err, HEARTH_E_PARSE, "%s: %s.rotation: expected a number", c->name,
+                          xat);
+  if (r) rot = json_number_value(r);
+  /* T(offset) R(rotation) S(scale), the sign as in mesh.h */
+  double cr = cos(rot), sr = sin(rot);
+  out->xf[0] = cr * sc[0];
+  out->xf[1] = sr * sc[1];
+  out->xf[2] = off[0];
+  out->xf[3] = -sr * sc[0];
+  out->xf[4] = cr * sc[1];
+  out->xf[5] = off[1];
+  out->has_xform = out->xf[0] != 1.0 || out->xf[1] != 0.0 || out->xf[2] != 0.0 ||
+                   out->xf[3] != 0.0 || out->xf[4] != 1.0 || out->xf[5] != 0.0;
+  return HEARTH_OK;
+}
+
+static int is_int8_16(int t) {
+  return t == GL_BYTE || t == GL_UNSIGNED_BYTE || t == GL_SHORT || t == GL_UNSIGNED_SHORT;
+}
 
 static hearth_status resolve_primitive(glb_ctx *c, size_t mesh, size_t p, json_t *prim,
                                        const hearth_glb_read_opts *o, glb_prim *out) {
@@ -527,32 +623,41 @@ static hearth_status resolve_primitive(glb_ctx *c, size_t mesh, size_t p, json_t
                           at);
   snprintf(where, sizeof where, "%s.attributes.POSITION", at);
   if ((s = resolve_accessor(c, ai, where, &out->pos))) return s;
-  if (out->pos.comp_type != GL_FLOAT || out->pos.ncomp != 3)
+  int pt = out->pos.comp_type;
+  if (out->pos.ncomp != 3 || (pt != GL_FLOAT && !(c->quantization && is_int8_16(pt))))
     return hearth_err_set(c->err, HEARTH_E_UNSUPPORTED,
-                          "%s: %s (accessors[%zu]): expected FLOAT VEC3 positions", c->name, where,
-                          ai);
+                          "%s: %s (accessors[%zu]): expected FLOAT VEC3 positions (BYTE, "
+                          "UNSIGNED_BYTE, SHORT or UNSIGNED_SHORT with KHR_mesh_quantization)",
+                          c->name, where, ai);
 
+  /* the UV set the base colour texture samples */
+  if ((s = resolve_uv_source(c, prim, at, &out->src))) return s;
+  char set[40];
+  snprintf(set, sizeof set, "TEXCOORD_%zu", out->src.set);
   snprintf(where, sizeof where, "%s.attributes", at);
-  if ((s = get_uint(c, attrs, "TEXCOORD_0", where, 0, &ai, &out->has_uv))) return s;
+  if ((s = get_uint(c, attrs, set, where, 0, &ai, &out->has_uv))) return s;
   if (!out->has_uv && o->require_uvs)
     return hearth_err_set(c->err, HEARTH_E_NOT_FOUND,
-                          "%s: %s: no TEXCOORD_0 attribute (UVs are required)", c->name, at);
+                          "%s: %s: no %s attribute (UVs are required%s)", c->name, at, set,
+                          out->src.set ? "; the base colour texture's texCoord names it" : "");
   if (out->has_uv) {
-    snprintf(where, sizeof where, "%s.attributes.TEXCOORD_0", at);
+    snprintf(where, sizeof where, "%s.attributes.%s", at, set);
     if ((s = resolve_accessor(c, ai, where, &out->uv))) return s;
     int t = out->uv.comp_type;
     int ok = out->uv.ncomp == 2 &&
-             (t == GL_FLOAT || ((t == GL_UNSIGNED_BYTE || t == GL_UNSIGNED_SHORT) &&
-                                out->uv.normalized));
+             (t == GL_FLOAT ||
+              ((t == GL_UNSIGNED_BYTE || t == GL_UNSIGNED_SHORT) && out->uv.normalized) ||
+              (c->quantization && is_int8_16(t)));
     if (!ok)
       return hearth_err_set(c->err, HEARTH_E_UNSUPPORTED,
                             "%s: %s (accessors[%zu]): expected VEC2 of FLOAT or normalized "
-                            "UNSIGNED_BYTE/UNSIGNED_SHORT",
+                            "UNSIGNED_BYTE/UNSIGNED_SHORT (any BYTE/SHORT type with "
+                            "KHR_mesh_quantization)",
                             c->name, where, ai);
     if (out->uv.count != out->pos.count)
       return hearth_err_set(c->err, HEARTH_E_INCONSISTENT,
-                            "%s: %s: TEXCOORD_0 has %zu elements but POSITION has %zu", c->name,
-                            at, out->uv.count, out->pos.count);
+                            "%s: %s: %s has %zu elements but POSITION has %zu", c->name, at, set,
+                            out->uv.count, out->pos.count);
   }
 
   if ((s = get_uint(c, prim, "indices", at, 0, &ai, &out->has_idx))) return s;
@@ -682,6 +787,58 @@ static void to_rgb8(hearth_image *img) {
   img->type = HEARTH_PIX_U8;
 }
 
+/* Fold the UV islands of the assembled mesh into [0,1]^2 (mesh.h, "UV
+ * tiles"), with each triangle's wrap modes from its primitive's sampler;
+ * islands that cannot be folded fail a read that requires UVs. */
+static hearth_status fold_tiles(glb_ctx *c, const glb_prim *prims, size_t n_prims,
+                                const hearth_glb_read_opts *o, hearth_mesh *m,
+                                hearth_glb_report *rep) {
+  uint8_t *wrap = NULL;
+  for (size_t q = 0; q < n_prims && !wrap; q++)
+    if (prims[q].src.wrap[0] || prims[q].src.wrap[1]) {
+      wrap = hearth_alloc_array(m->n_triangles, 2);
+      if (!wrap) return hearth_err_set(c->err, HEARTH_E_NOMEM, "%s: out of memory", c->name);
+      for (size_t r = 0; r < n_prims; r++)
+        for (size_t t = 0; t < prims[r].n_tris; t++) {
+          wrap[2 * (prims[r].tbase + t)] = prims[r].src.wrap[0];
+          wrap[2 * (prims[r].tbase + t) + 1] = prims[r].src.wrap[1];
+        }
+    }
+  hearth_uv_tiles ut;
+  hearth_status s = hearth_uv_fold_tiles(m, wrap, &ut, c->err);
+  free(wrap);
+  if (s) return hearth_err_prefix(c->err, "%s", c->name);
+  rep->uv_islands_moved = ut.moved;
+  rep->uv_islands_mirrored = ut.mirrored;
+  rep->uv_islands_left = ut.straddling + ut.clamped;
+  rep->uv_triangles_straddling = ut.triangles_straddling;
+  if (!o->require_uvs || ut.first_left == SIZE_MAX) return HEARTH_OK;
+  /* name the first triangle left where the file has it */
+  size_t t = ut.first_left, q = 0;
+  while (q + 1 < n_prims && t >= prims[q].tbase + prims[q].n_tris) q++;
+  const glb_prim *gp = &prims[q];
+  const float *uv = m->uvs + 2 * (size_t)m->indices[3 * t];
+  char first[200];
+  snprintf(first, sizeof first, "first: meshes[%zu].primitives[%zu] triangle %zu, UV (%g, %g)",
+           gp->mesh, gp->prim, t - gp->tbase, (double)uv[0], (double)uv[1]);
+  if (ut.straddling)
+    return hearth_err_set(c->err, HEARTH_E_UNSUPPORTED,
+                          "%s: %u UV island%s span%s more than one texture tile (%zu triangles "
+                          "in them, %zu crossing a tile border; %s): maps cover [0,1] and an "
+                          "island moves only by whole tiles; split the islands at the tile "
+                          "borders or pack them into [0,1]",
+                          c->name, ut.straddling, ut.straddling == 1 ? "" : "s",
+                          ut.straddling == 1 ? "s" : "", ut.triangles_left,
+                          ut.triangles_straddling, first);
+  return hearth_err_set(c->err, HEARTH_E_UNSUPPORTED,
+                        "%s: %u UV island%s (%zu triangles; %s) lie%s outside [0,1] under a "
+                        "CLAMP_TO_EDGE sampler, which shows the texture's edge texels there, so "
+                        "they have no texels to map and moving them would change what they "
+                        "show; use REPEAT or pack them into [0,1]",
+                        c->name, ut.clamped, ut.clamped == 1 ? "" : "s", ut.triangles_left, first,
+                        ut.clamped == 1 ? "s" : "");
+}
+
 /* Split the container into its JSON and BIN chunks. */
 static hearth_status split_chunks(const uint8_t *d, size_t size, const char *name,
                                   const uint8_t **json, size_t *json_len, const uint8_t **bin,
@@ -765,10 +922,12 @@ hearth_status hearth_glb_parse(const void *data, size_t size, const char *name,
     return hearth_err_set(err, HEARTH_E_PARSE, "%s: JSON chunk: line %d, column %d: %s", name,
                           jerr.line, jerr.column, jerr.text);
 
-  glb_ctx c = {name, root, bin, bin_len, err, NULL, NULL, NULL, NULL, NULL};
+  glb_ctx c = {name, root, bin, bin_len, err, NULL, NULL, NULL, NULL, NULL, 0};
   glb_inst_list list = {0};
   glb_prim *prims = NULL;
   size_t n_prims = 0;
+  hearth_glb_report rep;
+  memset(&rep, 0, sizeof rep);
   if (!json_is_object(root)) {
     s = hearth_err_set(err, HEARTH_E_PARSE, "%s: JSON chunk: expected an object", name);
     goto done;
@@ -791,9 +950,25 @@ hearth_status hearth_glb_parse(const void *data, size_t size, const char *name,
     s = hearth_err_set(err, HEARTH_E_PARSE, "%s: extensionsRequired: expected an array", name);
     goto done;
   }
+  json_t *used = json_object_get(root, "extensionsUsed");
+  if (used && !json_is_array(used)) {
+    s = hearth_err_set(err, HEARTH_E_PARSE, "%s: extensionsUsed: expected an array", name);
+    goto done;
+  }
+  for (size_t i = 0; i < json_array_size(used); i++) {
+    json_t *e = json_array_get(used, i);
+    if (json_is_string(e) && strcmp(json_string_value(e), "KHR_mesh_quantization") == 0)
+      c.quantization = 1;
+  }
   for (size_t i = 0; i < json_array_size(req); i++) {
     json_t *e = json_array_get(req, i);
     const char *en = json_is_string(e) ? json_string_value(e) : "?";
+    /* the two extensions the reader applies (see mesh.h) */
+    if (strcmp(en, "KHR_mesh_quantization") == 0) {
+      c.quantization = 1;
+      continue;
+    }
+    if (strcmp(en, "KHR_texture_transform") == 0) continue;
     const char *why = strcmp(en, "KHR_draco_mesh_compression") == 0 ? " (Draco compression)"
                       : strcmp(en, "EXT_meshopt_compression") == 0 ? " (meshopt compression)"
                                                                     : "";
@@ -808,8 +983,8 @@ hearth_status hearth_glb_parse(const void *data, size_t size, const char *name,
   c.buffers = json_object_get(root, "buffers");
   c.meshes = json_object_get(root, "meshes");
   c.nodes = json_object_get(root, "nodes");
-  const char *arrays[] = {"accessors", "bufferViews", "buffers", "meshes", "nodes",
-                          "scenes",    "materials",   "textures", "images"};
+  const char *arrays[] = {"accessors", "bufferViews", "buffers",  "meshes", "nodes",
+                          "scenes",    "materials",   "textures", "images", "samplers"};
   for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++) {
     json_t *a = json_object_get(root, arrays[i]);
     if (a && !json_is_array(a)) {
@@ -850,6 +1025,9 @@ hearth_status hearth_glb_parse(const void *data, size_t size, const char *name,
     for (size_t p = 0; p < json_array_size(pr); p++) {
       glb_prim *gp = &prims[n_prims++];
       if ((s = resolve_primitive(&c, mi, p, json_array_get(pr, p), &o, gp))) goto done;
+      gp->mesh = mi;
+      gp->prim = p;
+      gp->tbase = nt;
       all_uv &= gp->has_uv;
       if (!add_size(nt, gp->n_tris, &nt) || nt > o.max_triangles) {
         s = hearth_err_set(err, HEARTH_E_LIMIT,
@@ -905,12 +1083,22 @@ hearth_status hearth_glb_parse(const void *data, size_t size, const char *name,
           goto done;
         }
         if (out->uvs) {
-          float u = (float)acc_get(&gp->uv, v, 0), w = (float)acc_get(&gp->uv, v, 1);
+          float u, w;
+          if (gp->src.has_xform) {
+            const double *xf = gp->src.xf;
+            double a = acc_get(&gp->uv, v, 0), b = acc_get(&gp->uv, v, 1);
+            u = (float)(xf[0] * a + xf[1] * b + xf[2]);
+            w = (float)(xf[3] * a + xf[4] * b + xf[5]);
+          } else {
+            u = (float)acc_get(&gp->uv, v, 0);
+            w = (float)acc_get(&gp->uv, v, 1);
+          }
           if (!isfinite(u) || !isfinite(w)) {
             s = hearth_err_set(err, HEARTH_E_RANGE,
-                               "%s: meshes[%zu].primitives[%zu].attributes.TEXCOORD_0: vertex "
-                               "%zu is not finite",
-                               name, in->mesh, p, v);
+                               "%s: meshes[%zu].primitives[%zu].attributes.TEXCOORD_%zu: vertex "
+                               "%zu is not finite%s",
+                               name, in->mesh, p, gp->src.set, v,
+                               gp->src.has_xform ? " after KHR_texture_transform" : "");
             goto done;
           }
           out->uvs[2 * (vbase + v)] = u;
@@ -941,6 +1129,14 @@ hearth_status hearth_glb_parse(const void *data, size_t size, const char *name,
     }
   }
 
+  if (out->uvs && !o.keep_uv_tiles && (s = fold_tiles(&c, prims, n_prims, &o, out, &rep)))
+    goto done;
+  for (size_t q = 0; q < n_prims; q++) {
+    rep.quantized_primitives += prims[q].pos.comp_type != GL_FLOAT ||
+                                (prims[q].has_uv && prims[q].uv.comp_type != GL_FLOAT);
+    rep.transformed_primitives += prims[q].has_uv && prims[q].src.has_xform;
+  }
+
   /* base colour texture of the first primitive (in scene order) that has one */
   if (o.load_texture) {
     int got = 0;
@@ -951,6 +1147,7 @@ hearth_status hearth_glb_parse(const void *data, size_t size, const char *name,
     }
   }
   s = HEARTH_OK;
+  if (o.report) *o.report = rep;
 
 done:
   free(prims);

@@ -42,6 +42,37 @@ static void uf_union(uint32_t *parent, uint32_t a, uint32_t b) {
   else if (b < a) parent[a] = b;
 }
 
+/* Weld: vertices with bit-identical UVs share one id (an open-addressing
+ * table of the UV bits; ids 0..n_uv-1 in order of first appearance).
+ * Returns 0 when out of memory. */
+static int uv_weld(const hearth_mesh *m, uint32_t *uv_id, uint32_t *n_uv) {
+  size_t nv = m->n_vertices, cap = 16;
+  while (cap < 2 * nv) cap *= 2;
+  uint64_t *hkey = hearth_alloc_array(cap, sizeof *hkey);
+  uint32_t *hid = hearth_alloc_array(cap, sizeof *hid);
+  if (!hkey || !hid) {
+    free(hkey);
+    free(hid);
+    return 0;
+  }
+  for (size_t i = 0; i < cap; i++) hid[i] = UINT32_MAX;
+  uint32_t n = 0;
+  for (size_t i = 0; i < nv; i++) {
+    uint64_t key = ((uint64_t)float_bits(m->uvs[2 * i]) << 32) | float_bits(m->uvs[2 * i + 1]);
+    size_t h = (size_t)mix64(key) & (cap - 1);
+    while (hid[h] != UINT32_MAX && hkey[h] != key) h = (h + 1) & (cap - 1);
+    if (hid[h] == UINT32_MAX) {
+      hkey[h] = key;
+      hid[h] = n++;
+    }
+    uv_id[i] = hid[h];
+  }
+  free(hkey);
+  free(hid);
+  *n_uv = n;
+  return 1;
+}
+
 hearth_status hearth_uv_islands(const hearth_mesh *m, uint32_t *island_of_tri,
                                 uint32_t *n_islands, hearth_err *err) {
   *n_islands = 0;
@@ -54,32 +85,11 @@ hearth_status hearth_uv_islands(const hearth_mesh *m, uint32_t *island_of_tri,
   size_t nv = m->n_vertices, nt = m->n_triangles, ne;
   if (!hearth_mul_size(nt, 3, &ne))
     return hearth_err_set(err, HEARTH_E_NOMEM, "UV islands: size overflow");
-  /* weld: vertices with bit-identical UVs share one id (an open-addressing
-   * table of the UV bits; ids in order of first appearance) */
-  size_t cap = 16;
-  while (cap < 2 * nv) cap *= 2;
-  uint64_t *hkey = hearth_alloc_array(cap, sizeof *hkey);
-  uint32_t *hid = hearth_alloc_array(cap, sizeof *hid);
   uint32_t *uv_id = hearth_alloc_array(nv ? nv : 1, sizeof *uv_id);
   uint32_t *parent = hearth_alloc_array(nt ? nt : 1, sizeof *parent);
   uint32_t *start = NULL, *other = NULL, *tri = NULL;
-  if (!hkey || !hid || !uv_id || !parent) goto oom;
-  for (size_t i = 0; i < cap; i++) hid[i] = UINT32_MAX;
   uint32_t n_uv = 0;
-  for (size_t i = 0; i < nv; i++) {
-    uint64_t key = ((uint64_t)float_bits(m->uvs[2 * i]) << 32) | float_bits(m->uvs[2 * i + 1]);
-    size_t h = (size_t)mix64(key) & (cap - 1);
-    while (hid[h] != UINT32_MAX && hkey[h] != key) h = (h + 1) & (cap - 1);
-    if (hid[h] == UINT32_MAX) {
-      hkey[h] = key;
-      hid[h] = n_uv++;
-    }
-    uv_id[i] = hid[h];
-  }
-  free(hkey);
-  free(hid);
-  hkey = NULL;
-  hid = NULL;
+  if (!uv_id || !parent || !uv_weld(m, uv_id, &n_uv)) goto oom;
   /* edges in UV space, grouped by their lower end (a counting sort); two
    * triangles with the same edge join. A degenerate edge (both ends welded)
    * joins nothing. Island labels do not depend on the order of the unions. */
@@ -138,14 +148,149 @@ hearth_status hearth_uv_islands(const hearth_mesh *m, uint32_t *island_of_tri,
   free(parent);
   return HEARTH_OK;
 oom:
-  free(hkey);
-  free(hid);
   free(uv_id);
   free(parent);
   free(start);
   free(other);
   free(tri);
   return hearth_err_set(err, HEARTH_E_NOMEM, "UV islands: out of memory for %zu triangles", nt);
+}
+
+/* ---- UV tiles ----------------------------------------------------------------- */
+
+/* One island's extent and what folding does to it. */
+typedef struct tile_island {
+  double lo[2], hi[2]; /* UV bounds over its triangles' corners */
+  size_t n_tris, first_tri;
+  uint8_t wrap[2];     /* most restrictive hearth_uv_wrap of its triangles */
+  int8_t action;       /* 0 nothing, 1 move, 2 straddles, 3 clamped */
+  uint8_t mirror[2];   /* axis reflected (MIRRORED_REPEAT, odd tile) */
+  double tile[2];      /* the tile it lies in */
+} tile_island;
+
+/* the tile an extent [lo, hi] lies in (with the slack), or 0 if it spans
+   more; tile 0 first, so an island at a border of [0,1] stays */
+static int tile_of(double lo, double hi, double *k) {
+  *k = 0.0;
+  if (lo >= -HEARTH_UV_TILE_SLACK && hi <= 1.0 + HEARTH_UV_TILE_SLACK) return 1;
+  *k = floor(0.5 * (lo + hi));
+  return lo >= *k - HEARTH_UV_TILE_SLACK && hi <= *k + 1.0 + HEARTH_UV_TILE_SLACK;
+}
+
+/* whether [lo, hi] runs past an integer by more than the slack on both sides */
+static int crosses_border(double lo, double hi) {
+  double n = floor(lo + HEARTH_UV_TILE_SLACK) + 1.0;
+  return n < hi - HEARTH_UV_TILE_SLACK;
+}
+
+hearth_status hearth_uv_fold_tiles(hearth_mesh *m, const uint8_t *wrap, hearth_uv_tiles *out,
+                                   hearth_err *err) {
+  memset(out, 0, sizeof *out);
+  out->first_left = SIZE_MAX;
+  if (!m->uvs) return HEARTH_OK;
+  hearth_status s = hearth_mesh_validate(m, "UV tiles", err);
+  if (s != HEARTH_OK) return s;
+  size_t nv = m->n_vertices, nt = m->n_triangles;
+  /* nothing to do when every UV lies in the unit square (with the slack) */
+  int outside = 0;
+  for (size_t i = 0; i < 2 * nv && !outside; i++)
+    outside = m->uvs[i] < -HEARTH_UV_TILE_SLACK || m->uvs[i] > 1.0 + HEARTH_UV_TILE_SLACK;
+  if (!outside) return HEARTH_OK;
+
+  /* islands: union-find over welded UV points, joined by every triangle */
+  uint32_t *uv_id = hearth_alloc_array(nv ? nv : 1, sizeof *uv_id);
+  uint32_t *parent = NULL, n_uv = 0;
+  tile_island *isl = NULL;
+  if (!uv_id || !uv_weld(m, uv_id, &n_uv)) goto oom;
+  parent = hearth_alloc_array(n_uv ? n_uv : 1, sizeof *parent);
+  isl = hearth_calloc_array(n_uv ? n_uv : 1, sizeof *isl);
+  if (!parent || !isl) goto oom;
+  for (uint32_t i = 0; i < n_uv; i++) {
+    parent[i] = i;
+    isl[i].lo[0] = isl[i].lo[1] = INFINITY;
+    isl[i].hi[0] = isl[i].hi[1] = -INFINITY;
+  }
+  const uint32_t *ix = m->indices;
+  for (size_t t = 0; t < nt; t++) {
+    uf_union(parent, uv_id[ix[3 * t]], uv_id[ix[3 * t + 1]]);
+    uf_union(parent, uv_id[ix[3 * t]], uv_id[ix[3 * t + 2]]);
+  }
+  /* each island's extent, triangle count and wrap modes, kept at its root */
+  for (size_t t = 0; t < nt; t++) {
+    tile_island *is = &isl[uf_find(parent, uv_id[ix[3 * t]])];
+    if (!is->n_tris++) is->first_tri = t;
+    for (int k = 0; k < 3; k++) {
+      const float *uv = m->uvs + 2 * (size_t)ix[3 * t + k];
+      for (int a = 0; a < 2; a++) {
+        if (uv[a] < is->lo[a]) is->lo[a] = uv[a];
+        if (uv[a] > is->hi[a]) is->hi[a] = uv[a];
+      }
+    }
+    for (int a = 0; wrap && a < 2; a++)
+      if (wrap[2 * t + a] > is->wrap[a]) is->wrap[a] = wrap[2 * t + a];
+  }
+  /* what each island needs: its tile per axis, then a move, or nothing */
+  for (uint32_t r = 0; r < n_uv; r++) {
+    tile_island *is = &isl[r];
+    if (!is->n_tris) continue;
+    int fits = tile_of(is->lo[0], is->hi[0], &is->tile[0]) &
+               tile_of(is->lo[1], is->hi[1], &is->tile[1]);
+    int clamped = 0;
+    for (int a = 0; a < 2; a++)
+      if (is->tile[a] != 0.0 && is->wrap[a] == HEARTH_UV_CLAMP_TO_EDGE) clamped = 1;
+    if (!fits) is->action = 2;
+    else if (is->tile[0] == 0.0 && is->tile[1] == 0.0) is->action = 0;
+    else if (clamped) is->action = 3;
+    else is->action = 1;
+    if (is->action == 1) {
+      int mir = 0;
+      for (int a = 0; a < 2; a++) {
+        is->mirror[a] = is->wrap[a] == HEARTH_UV_MIRRORED_REPEAT && fmod(is->tile[a], 2.0) != 0.0;
+        mir |= is->mirror[a];
+      }
+      out->moved++;
+      out->mirrored += mir != 0;
+    } else if (is->action >= 2) {
+      if (is->action == 2) out->straddling++;
+      else out->clamped++;
+      out->triangles_left += is->n_tris;
+      if (is->first_tri < out->first_left) out->first_left = is->first_tri;
+    }
+  }
+  /* triangles crossing a tile border, among the islands that span tiles */
+  for (size_t t = 0; t < nt && out->straddling; t++) {
+    if (isl[uf_find(parent, uv_id[ix[3 * t]])].action != 2) continue;
+    int cross = 0;
+    for (int a = 0; a < 2; a++) {
+      double lo = INFINITY, hi = -INFINITY;
+      for (int k = 0; k < 3; k++) {
+        double v = m->uvs[2 * (size_t)ix[3 * t + k] + a];
+        lo = v < lo ? v : lo;
+        hi = v > hi ? v : hi;
+      }
+      cross |= crosses_border(lo, hi);
+    }
+    out->triangles_straddling += (size_t)cross;
+  }
+  /* move: every vertex goes with its island (u - i, or i + 1 - u reflected;
+     both exact in double, rounded once to float) */
+  for (size_t v = 0; v < nv && out->moved; v++) {
+    const tile_island *is = &isl[uf_find(parent, uv_id[v])];
+    if (is->action != 1) continue;
+    for (int a = 0; a < 2; a++) {
+      double x = m->uvs[2 * v + a], k = is->tile[a];
+      m->uvs[2 * v + a] = (float)(is->mirror[a] ? k + 1.0 - x : x - k);
+    }
+  }
+  free(uv_id);
+  free(parent);
+  free(isl);
+  return HEARTH_OK;
+oom:
+  free(uv_id);
+  free(parent);
+  free(isl);
+  return hearth_err_set(err, HEARTH_E_NOMEM, "UV tiles: out of memory for %zu vertices", nv);
 }
 
 /* ---- rasterisation ------------------------------------------------------------ */

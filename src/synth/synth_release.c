@@ -511,6 +511,16 @@ static hearth_status write_instance(const render_ctx *rc, const char *root, synt
   float *map = hearth_alloc_array(RR, sizeof(float));
   if (!tri || !bary || !map) st = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
   if (!st) st = hearth_uv_rasterize(&inst->obj.mesh, R, tri, bary, err);
+  /* ground truth without surface would be all NaN: the UVs cover no texel */
+  size_t covered = 0;
+  for (size_t q = 0; !st && q < RR && !covered; q++) covered = tri[q] != UINT32_MAX;
+  if (!st && !covered)
+    st = hearth_err_set(err, HEARTH_E_RANGE,
+                        "%s/%s: %s: the mesh's UV layout covers no texel of the %zux%zu "
+                        "temperature_true map (surface 0 texels): its UVs lie outside [0,1] or "
+                        "its UV triangles are too small to hold a texel centre",
+                        inst->id, inst->states[0], o->mesh_path ? o->mesh_path : "generated mesh",
+                        R, R);
   for (size_t s = 0; s < inst->n_states && !st; s++) {
     tmap_ctx c = {&inst->obj, &inst->fields[s], tri, bary, R, map};
     hearth_parallel_for(R, rc->threads, tmap_rows, &c);

@@ -3,12 +3,16 @@
  * scripts/setup.sh). Writes a textured, an untextured and a UV-less mesh,
  * runs tests/mesh/validate_glb.js on each and asserts zero errors; a
  * deliberately broken file must be flagged so the check cannot pass
- * vacuously. Missing node or package is a failure, not a skip. */
+ * vacuously. The reader's own fixtures (glb_build.h: the cube quantised in
+ * every KHR_mesh_quantization type, with KHR_texture_transform, and with
+ * UVs in other tiles) and the fuzz corpus's valid_*.glb must be valid
+ * files too. Missing node or package is a failure, not a skip. */
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/wait.h>
+#include "glb_build.h"
 #include "hearth/mesh.h"
 #include "test_util.h"
 
@@ -111,6 +115,52 @@ int main(void) {
     int rc = run_validator(src, path);
     CHECK_MSG(rc == 0, "%s: validator exit status %d", path, rc);
     hearth_mesh_free(&m);
+  }
+
+  /* the reader's fixtures, validated in one run of node */
+  {
+    tb_cube_init();
+    char list[8192] = "";
+    size_t used = 0;
+    const double lo[3] = {-0.05, 0.01, -0.2}, hi[3] = {0.07, 0.09, 0.3};
+    for (size_t q = 0; q <= TB_N_QTYPES; q++) {
+      tb_qcube qc;
+      tb_glb g;
+      double uv[CUBE_NV * 2];
+      if (q < TB_N_QTYPES) {
+        tb_quantized_cube(&tb_qtypes[q], lo, hi, &qc);
+        g = qc.g;
+        snprintf(path, sizeof path, "%s/quantized_%zu.glb", dir, q);
+      } else {
+        /* UVs in tiles (1, 0) .. (-2, -2), a rotating texture transform,
+           MIRRORED_REPEAT along u */
+        memset(&g, 0, sizeof g);
+        for (int v = 0; v < CUBE_NV; v++) {
+          uv[2 * v] = g_uv[2 * v] + (v / 4) - 2;
+          uv[2 * v + 1] = g_uv[2 * v + 1] + (v / 8);
+        }
+        g.nv = CUBE_NV, g.nt = CUBE_NT, g.pos = g_pos, g.uv[0] = uv, g.idx = g_idx;
+        g.texture = 1, g.tex_coord = 0, g.wrap_s = 33648, g.wrap_t = 10497;
+        g.transform = "{\"offset\":[0.25,1],\"rotation\":0.5,\"scale\":[2,0.5]}";
+        g.transform_required = 1;
+        snprintf(path, sizeof path, "%s/texture_transform.glb", dir);
+      }
+      size_t n = 0;
+      uint8_t *f = tb_encode(&g, &n);
+      CHECK(f != NULL);
+      if (f) CHECK_OK(hearth_write_file_atomic(path, f, n, &e), &e);
+      free(f);
+      used += (size_t)snprintf(list + used, sizeof list - used, " '%s'", path);
+    }
+    const char *corpus[] = {"valid_quantized.glb", "valid_texture_transform.glb"};
+    for (size_t i = 0; i < 2; i++)
+      used += (size_t)snprintf(list + used, sizeof list - used, " '%s/fuzz/corpus/glb/%s'", src,
+                               corpus[i]);
+    char cmd[9000];
+    snprintf(cmd, sizeof cmd, "node '%s/tests/mesh/validate_glb.js'%s", src, list);
+    int rc = system(cmd);
+    CHECK_MSG(rc != -1 && WIFEXITED(rc) && WEXITSTATUS(rc) == 0,
+              "the reader's fixtures: validator exit status %d", rc);
   }
 
   /* negative control: retarget the index view as a vertex buffer */
