@@ -10,6 +10,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "synth/synth_noise.h"
 #include "synth/synth_object.h"
 
 /* params layout */
@@ -54,42 +55,11 @@ static int fcat(const char *c) {
   return F_OTHER;
 }
 
-/* ---- smooth noise -------------------------------------------------------- */
-
-static uint64_t mix64(uint64_t x) {
-  x ^= x >> 30;
-  x *= 0xbf58476d1ce4e5b9ULL;
-  x ^= x >> 27;
-  x *= 0x94d049bb133111ebULL;
-  x ^= x >> 31;
-  return x;
-}
-
-static double lat(uint64_t seed, int64_t a, int64_t b, int64_t c) {
-  uint64_t h = mix64(seed ^ mix64((uint64_t)a * 0x9E3779B97F4A7C15ULL ^
-                                  mix64((uint64_t)b + 0x632BE59BD9B4E019ULL) ^
-                                  mix64((uint64_t)c * 0xD6E8FEB86659FD93ULL + 3)));
-  return (double)(h >> 11) * (2.0 / 9007199254740992.0) - 1.0;
-}
+/* ---- shaping ------------------------------------------------------------ */
 
 static double sstep(double t) {
   t = t < 0 ? 0 : t > 1 ? 1 : t;
   return t * t * (3 - 2 * t);
-}
-
-/* value noise in [-1, 1] with quintic interpolation (C2 smooth) */
-static double noise3(uint64_t seed, double x, double y, double z) {
-  double fx = floor(x), fy = floor(y), fz = floor(z);
-  int64_t ix = (int64_t)fx, iy = (int64_t)fy, iz = (int64_t)fz;
-  double u[3] = {x - fx, y - fy, z - fz};
-  for (int k = 0; k < 3; k++) u[k] = u[k] * u[k] * u[k] * (u[k] * (u[k] * 6 - 15) + 10);
-  double v = 0;
-  for (int c = 0; c < 8; c++) {
-    double w = ((c & 1) ? u[0] : 1 - u[0]) * ((c & 2) ? u[1] : 1 - u[1]) *
-               ((c & 4) ? u[2] : 1 - u[2]);
-    v += w * lat(seed, ix + (c & 1), iy + ((c >> 1) & 1), iz + ((c >> 2) & 1));
-  }
-  return v;
 }
 
 static double clamp01(double t) { return t < 0 ? 0 : t > 1 ? 1 : t; }
@@ -276,7 +246,7 @@ double synth_field_eval(const synth_field *f, const synth_object *obj, uint32_t 
   int cat = (int)P[P_CAT], st = (int)P[P_STATE];
   double amb = f->ambient_c, H = P[P_H], zf = P[P_ZF], rb = P[P_RB], rmax = P[P_RMAX];
   double x = p[0], y = p[1], z = p[2], r = hypot(x, y);
-  double nz = noise3(f->seed, x / 0.05, y / 0.05, z / 0.05);
+  double nz = synth_smooth_noise3(f->seed, x / 0.05, y / 0.05, z / 0.05);
   double small = P[P_NAMP] * nz;
   double zr = clamp01(z / H);
 
@@ -321,7 +291,8 @@ double synth_field_eval(const synth_field *f, const synth_object *obj, uint32_t 
       }
     }
     case F_SPONGE: {
-      double moist = sstep((noise3(f->seed + 17, x / 0.03, y / 0.03, z / 0.03) - 0.05) / 0.5);
+      double wet = synth_smooth_noise3(f->seed + 17, x / 0.03, y / 0.03, z / 0.03);
+      double moist = sstep((wet - 0.05) / 0.5);
       double t = T[0] - T[1] * moist;
       if (role == R_PAD) t -= T[2];
       return t + 0.2 * small;
@@ -366,7 +337,7 @@ double synth_field_eval(const synth_field *f, const synth_object *obj, uint32_t 
   }
 
   /* used: mild warmth, more where hands, palms or heads were */
-  double blob = sstep(0.5 + 0.8 * noise3(f->seed + 29, x / 0.04, y / 0.04, z / 0.04));
+  double blob = sstep(0.5 + 0.8 * synth_smooth_noise3(f->seed + 29, x / 0.04, y / 0.04, z / 0.04));
   if (cat == F_HEADSET && role == R_CUSHION) return amb + T[1] + 0.3 * small;
   if (cat == F_MOUSE && (role == R_SHELL || role == R_TOP))
     return amb + T[0] + (T[1] - T[0]) * sstep(-y / 0.05 + 0.2) + 0.3 * small;

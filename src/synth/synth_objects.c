@@ -17,6 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "synth/synth_noise.h"
 #include "synth/synth_object.h"
 
 #ifndef M_PI
@@ -67,63 +68,6 @@ size_t synth_category_states(const char *category, const char **states, size_t m
     n = 2;
   }
   return n;
-}
-
-/* ---- stateless noise ----------------------------------------------------- */
-
-static uint64_t mix64(uint64_t x) {
-  x ^= x >> 30;
-  x *= 0xbf58476d1ce4e5b9ULL;
-  x ^= x >> 27;
-  x *= 0x94d049bb133111ebULL;
-  x ^= x >> 31;
-  return x;
-}
-
-static double hash3(uint64_t seed, int64_t a, int64_t b, int64_t c) {
-  uint64_t h = mix64(seed ^ mix64((uint64_t)a * 0x9E3779B97F4A7C15ULL ^
-                                  mix64((uint64_t)b + 0x632BE59BD9B4E019ULL) ^
-                                  mix64((uint64_t)c * 0xD6E8FEB86659FD93ULL + 7)));
-  return (double)(h >> 11) * (1.0 / 9007199254740992.0); /* [0,1) */
-}
-
-static double sstep(double t) { return t * t * (3.0 - 2.0 * t); }
-
-/* value noise in [-1, 1] */
-static double vnoise2(uint64_t seed, double x, double y) {
-  double fx = floor(x), fy = floor(y);
-  int64_t ix = (int64_t)fx, iy = (int64_t)fy;
-  double tx = sstep(x - fx), ty = sstep(y - fy);
-  double a = hash3(seed, ix, iy, 0), b = hash3(seed, ix + 1, iy, 0);
-  double c = hash3(seed, ix, iy + 1, 0), d = hash3(seed, ix + 1, iy + 1, 0);
-  double v = (a + (b - a) * tx) + ((c + (d - c) * tx) - (a + (b - a) * tx)) * ty;
-  return 2.0 * v - 1.0;
-}
-
-static double vnoise3(uint64_t seed, double x, double y, double z) {
-  double fx = floor(x), fy = floor(y), fz = floor(z);
-  int64_t ix = (int64_t)fx, iy = (int64_t)fy, iz = (int64_t)fz;
-  double tx = sstep(x - fx), ty = sstep(y - fy), tz = sstep(z - fz);
-  double v[2];
-  for (int k = 0; k < 2; k++) {
-    double a = hash3(seed, ix, iy, iz + k), b = hash3(seed, ix + 1, iy, iz + k);
-    double c = hash3(seed, ix, iy + 1, iz + k), d = hash3(seed, ix + 1, iy + 1, iz + k);
-    double ab = a + (b - a) * tx, cd = c + (d - c) * tx;
-    v[k] = ab + (cd - ab) * ty;
-  }
-  return 2.0 * (v[0] + (v[1] - v[0]) * tz) - 1.0;
-}
-
-static double fbm2(uint64_t seed, double x, double y, int oct) {
-  double s = 0, amp = 0.5, norm = 0;
-  for (int o = 0; o < oct; o++) {
-    s += amp * vnoise2(seed + (uint64_t)o * 101, x, y);
-    norm += amp;
-    x *= 2.03;
-    y *= 2.03;
-    amp *= 0.5;
-  }
-  return s / norm;
 }
 
 /* ---- mesh builder -------------------------------------------------------- */
@@ -839,8 +783,8 @@ static void orange_displace(const void *ctx, double p[3]) {
   double q[3] = {p[0], p[1], p[2] - od->zc};
   double r = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
   if (r < 1e-9) return;
-  double n = vnoise3(od->seed, q[0] / 0.006, q[1] / 0.006, q[2] / 0.006) * 0.6 +
-             vnoise3(od->seed + 1, q[0] / 0.0025, q[1] / 0.0025, q[2] / 0.0025) * 0.4;
+  double n = synth_noise3(od->seed, q[0] / 0.006, q[1] / 0.006, q[2] / 0.006) * 0.6 +
+             synth_noise3(od->seed + 1, q[0] / 0.0025, q[1] / 0.0025, q[2] / 0.0025) * 0.4;
   double k = 1 + od->amp * n / r;
   p[0] = q[0] * k;
   p[1] = q[1] * k;
@@ -1311,8 +1255,9 @@ static void setc(double out[3], double r, double g, double b) {
 static double textish(uint64_t seed, double x, double y, double lh) {
   double row = floor(y / lh), fy = y / lh - row;
   if (fy < 0.25 || fy > 0.8) return 0;
-  double word = floor(x / (lh * 0.9) + hash3(seed, (int64_t)row, 3, 0) * 7);
-  if (hash3(seed, (int64_t)row, (int64_t)word, 1) < 0.25) return 0;
+  double word =
+      floor(x / (lh * 0.9) + synth_lattice(seed, SYNTH_NOISE_SALT, (int64_t)row, 3, 0) * 7);
+  if (synth_lattice(seed, SYNTH_NOISE_SALT, (int64_t)row, (int64_t)word, 1) < 0.25) return 0;
   double fx = x / (lh * 0.9) - floor(x / (lh * 0.9));
   return (fx > 0.1 && fx < 0.92) ? 1 : 0;
 }
@@ -1320,7 +1265,7 @@ static double textish(uint64_t seed, double x, double y, double lh) {
 /* colour of native point (x, y) of an island; texture detail from s->tseed */
 static void shade(const shape *s, const patch *p, double x, double y, double out[3]) {
   uint64_t ts = s->tseed + (uint64_t)p->style * 977;
-  double n1 = fbm2(ts, x / 0.01, y / 0.01, 3);
+  double n1 = synth_fbm2(ts, x / 0.01, y / 0.01, 3);
   double lx = x - p->ox, ly = y - p->oy;
   switch (p->style) {
   case S_GLAZE:
@@ -1354,7 +1299,7 @@ static void shade(const shape *s, const patch *p, double x, double y, double out
   case S_ALU:
   case S_ALU_TOP: {
     double r = hypot(x, y);
-    double v = 0.74 + 0.05 * vnoise2(ts, r / 0.0006, 0.5) + 0.02 * n1;
+    double v = 0.74 + 0.05 * synth_noise2(ts, r / 0.0006, 0.5) + 0.02 * n1;
     setc(out, v, v + 0.005, v + 0.015);
     if (p->style == S_ALU_TOP && p->kind == K_DISK && x > 0.004 && x < 0.02 && fabs(y) < 0.006)
       setc(out, 0.55, 0.56, 0.58); /* tab */
@@ -1383,7 +1328,7 @@ static void shade(const shape *s, const patch *p, double x, double y, double out
   case S_PEEL:
   case S_PEEL_TOP: {
     setc(out, 0.96, 0.55, 0.10);
-    double pores = vnoise2(ts, x / 0.0009, y / 0.0009);
+    double pores = synth_noise2(ts, x / 0.0009, y / 0.0009);
     double k = 0.06 * n1 - (pores > 0.55 ? 0.12 * (pores - 0.55) / 0.45 : 0);
     for (int m = 0; m < 3; m++) out[m] += k * out[m] * 2;
     if (p->style == S_PEEL_TOP) {
@@ -1422,20 +1367,21 @@ static void shade(const shape *s, const patch *p, double x, double y, double out
   }
   case S_FOAM: {
     setc(out, 0.97, 0.82, 0.22);
-    double pores = vnoise2(ts, x / 0.0007, y / 0.0007);
+    double pores = synth_noise2(ts, x / 0.0007, y / 0.0007);
     if (pores > 0.5) mixc(out, out, (const double[3]){0.75, 0.58, 0.10}, (pores - 0.5) * 1.6);
     break;
   }
   case S_PAD: {
     setc(out, 0.12, 0.45, 0.18);
-    double f = vnoise2(ts, x / 0.0004, y / 0.003) * 0.5 + vnoise2(ts + 9, x / 0.003, y / 0.0004) * 0.5;
+    double f = synth_noise2(ts, x / 0.0004, y / 0.003) * 0.5 +
+               synth_noise2(ts + 9, x / 0.003, y / 0.0004) * 0.5;
     for (int k = 0; k < 3; k++) out[k] *= 0.8 + 0.35 * f;
     break;
   }
   case S_STEEL:
   case S_STEEL_DARK: {
-    double v = (p->style == S_STEEL ? 0.72 : 0.55) + 0.06 * vnoise2(ts, lx / 0.03, ly / 0.0004) +
-               0.03 * n1;
+    double v = (p->style == S_STEEL ? 0.72 : 0.55) +
+               0.06 * synth_noise2(ts, lx / 0.03, ly / 0.0004) + 0.03 * n1;
     if (p->kind == K_STRIP) v += 0.08 * sin(2 * M_PI * lx / p->w * 2);
     setc(out, v, v + 0.005, v + 0.012);
     break;
@@ -1472,7 +1418,7 @@ static void shade(const shape *s, const patch *p, double x, double y, double out
     break;
   case S_LEATHER: {
     mixc(out, s->col[0], (const double[3]){0.40, 0.22, 0.10}, 0.5);
-    for (int k = 0; k < 3; k++) out[k] += 0.05 * fbm2(ts, x / 0.002, y / 0.002, 2);
+    for (int k = 0; k < 3; k++) out[k] += 0.05 * synth_fbm2(ts, x / 0.002, y / 0.002, 2);
     if (p->kind == K_DISK) {
       double dx = 0.5 * s->W - s->e - fabs(x), dy = 0.5 * s->L - s->e - fabs(y);
       double d = fmin(dx, dy);
@@ -1483,7 +1429,7 @@ static void shade(const shape *s, const patch *p, double x, double y, double out
   }
   case S_TISSUE_BOX: {
     mixc(out, s->col[0], s->col[0], 0);
-    double fl = vnoise2(ts, lx / 0.02, ly / 0.02);
+    double fl = synth_noise2(ts, lx / 0.02, ly / 0.02);
     if (fl > 0.45) mixc(out, out, s->col[1], 0.7);
     break;
   }
@@ -1516,7 +1462,7 @@ static void shade(const shape *s, const patch *p, double x, double y, double out
     break;
   case S_CUSHION_PAD:
     setc(out, 0.16, 0.16, 0.17);
-    for (int k = 0; k < 3; k++) out[k] += 0.04 * fbm2(ts, x / 0.002, y / 0.002, 2);
+    for (int k = 0; k < 3; k++) out[k] += 0.04 * synth_fbm2(ts, x / 0.002, y / 0.002, 2);
     break;
   default: /* S_PLAIN */
     setc(out, 0.94, 0.94, 0.93);
