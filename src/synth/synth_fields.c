@@ -10,6 +10,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "synth/synth_category.h"
 #include "synth/synth_noise.h"
 #include "synth/synth_object.h"
 
@@ -46,13 +47,10 @@ enum {
   F_HEADSET, F_OTHER
 };
 
+/* the field behaviour of a category: its stream number (the codes above) */
 static int fcat(const char *c) {
-  static const char *const n[] = {"cup",    "canned_drink", "bottled_drink",   "orange",
-                                  "smartphone", "sponge",   "electric_kettle", "pot",
-                                  "mouse",  "laptop",       "headset"};
-  for (int i = 0; i < F_OTHER; i++)
-    if (strcmp(c, n[i]) == 0) return i;
-  return F_OTHER;
+  const synth_category *sc = synth_category_find(c);
+  return sc ? sc->field_stream : SYNTH_FIELD_STREAM_OTHER;
 }
 
 /* ---- shaping ------------------------------------------------------------ */

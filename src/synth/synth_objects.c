@@ -17,6 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "synth/synth_category.h"
 #include "synth/synth_noise.h"
 #include "synth/synth_object.h"
 
@@ -26,49 +27,11 @@
 
 /* ---- categories ---------------------------------------------------------- */
 
+/* entries of synth_categories, in its order */
 enum {
   C_CUP, C_CAN, C_BOTTLE, C_ORANGE, C_PHONE, C_SPONGE, C_KETTLE, C_POT, C_MOUSE, C_ERASER,
   C_LAPTOP, C_WALLET, C_TISSUE, C_GLASSES, C_PILLOW, C_CUSHION, C_BAG, C_HEADSET, C_COUNT
 };
-
-static const char *const k_cat_names[C_COUNT] = {
-    "cup",    "canned_drink", "bottled_drink", "orange",       "smartphone", "sponge",
-    "electric_kettle", "pot", "mouse",         "eraser",       "laptop",     "wallet",
-    "tissue", "glasses_case", "pillow",        "cushion",      "storage_bag", "headset"};
-
-/* second captured state per category (NULL: room temperature only); 11
- * categories have one, as in the paper */
-static const char *const k_cat_state2[C_COUNT] = {
-    "hot", "iced", "iced", "iced", "warm", "hot", "hot", "hot", "used", NULL,
-    "warm", NULL, NULL, NULL, NULL, NULL, NULL, "used"};
-
-size_t synth_object_categories(const char **names, size_t max) {
-  size_t n = 0;
-  for (int c = 0; c < C_COUNT; c++) {
-    if (names && n < max) names[n] = k_cat_names[c];
-    n++;
-  }
-  return n;
-}
-
-static int cat_code(const char *name) {
-  if (!name) return -1;
-  for (int c = 0; c < C_COUNT; c++)
-    if (strcmp(name, k_cat_names[c]) == 0) return c;
-  return -1;
-}
-
-size_t synth_category_states(const char *category, const char **states, size_t max) {
-  int c = cat_code(category);
-  size_t n = 0;
-  if (states && max > 0) states[0] = "neutral";
-  n = 1;
-  if (c >= 0 && k_cat_state2[c]) {
-    if (states && max > 1) states[1] = k_cat_state2[c];
-    n = 2;
-  }
-  return n;
-}
 
 /* ---- mesh builder -------------------------------------------------------- */
 
@@ -1538,14 +1501,18 @@ hearth_status synth_object_make(const char *category, uint64_t seed, size_t targ
                                 size_t texture_size, synth_object *obj, hearth_err *err) {
   if (!obj) return hearth_err_set(err, HEARTH_E_ARG, "synth_object_make: obj is NULL");
   memset(obj, 0, sizeof *obj);
-  int cat = cat_code(category);
-  if (cat < 0)
+  int cat = synth_category_index(category);
+  if (cat < 0) {
+    char known[512];
+    size_t n = 0;
+    for (int c = 0; c < SYNTH_N_CATEGORIES && n < sizeof known; c++)
+      n += (size_t)snprintf(known + n, sizeof known - n, "%s%s", c ? ", " : "",
+                            synth_categories[c].name);
     return hearth_err_set(err, HEARTH_E_ARG,
-                          "synth_object_make: unknown category '%s': expected one of cup, "
-                          "canned_drink, bottled_drink, orange, smartphone, sponge, "
-                          "electric_kettle, pot, mouse, eraser, laptop, wallet, tissue, "
-                          "glasses_case, pillow, cushion, storage_bag, headset",
-                          category ? category : "(null)");
+                          "synth_object_make: unknown category '%s': expected one of %s",
+                          category ? category : "(null)", known);
+  }
+  const synth_category *sc = &synth_categories[cat];
   if (target_triangles < 200 || target_triangles > 5000000)
     return hearth_err_set(err, HEARTH_E_RANGE,
                           "synth_object_make(%s): target_triangles %zu: expected 200..5000000",
@@ -1619,14 +1586,15 @@ hearth_status synth_object_make(const char *category, uint64_t seed, size_t targ
       for (size_t v = 0; v < cb.nv; v++) obj->mesh.positions[3 * v + 2] -= zmin;
   }
 
-  snprintf(obj->category, sizeof obj->category, "%s", k_cat_names[cat]);
+  snprintf(obj->category, sizeof obj->category, "%s", sc->name);
   obj->n_parts = b->n_parts;
   for (int k = 0; k < b->n_parts; k++) obj->part_names[k] = b->part_names[k];
   obj_extent(obj);
-  obj->fill_level = s.fillz;
-  if (cat == C_CUP) obj->fill_level = s.fillz;
-  if (cat == C_KETTLE) obj->fill_level = (s.t + s.H2 * s.fillz) / obj->height;
-  if (cat == C_POT) obj->fill_level = s.H2 * s.fillz / obj->height;
+  switch (sc->fill) {
+  case FILL_DRAWN: obj->fill_level = s.fillz; break;
+  case FILL_DEPTH: obj->fill_level = s.H2 * s.fillz / obj->height; break;
+  case FILL_ABOVE_BASE: obj->fill_level = (s.t + s.H2 * s.fillz) / obj->height; break;
+  }
 
   st = hearth_image_alloc(&obj->albedo, texture_size, texture_size, 3, HEARTH_PIX_U8, err);
   if (st) {
@@ -1706,8 +1674,8 @@ hearth_status synth_object_from_mesh(const hearth_mesh *m, double size_m, const 
   obj->part_names[0] = "body";
   snprintf(obj->category, sizeof obj->category, "%s", category ? category : "object");
   obj_extent(obj);
-  int cat = cat_code(category);
-  obj->fill_level = cat == C_CUP ? 0.8 : (cat == C_KETTLE || cat == C_POT) ? 0.6 : 0;
+  const synth_category *kind = synth_category_find(category);
+  obj->fill_level = kind ? kind->wrapped_fill : 0;
   st = hearth_image_alloc(&obj->albedo, texture_size, texture_size, 3, HEARTH_PIX_U8, err);
   if (st) {
     synth_object_free(obj);
