@@ -4,28 +4,107 @@
 #include "synth/synth_category.h"
 #include "synth/synth_object.h"
 
+/* ---- palettes ---------------------------------------------------------------- */
+
+static const double k_vivid[8][3] = {
+    {0.80, 0.10, 0.12}, {0.10, 0.30, 0.75}, {0.95, 0.75, 0.10}, {0.10, 0.55, 0.25},
+    {0.55, 0.15, 0.55}, {0.95, 0.45, 0.10}, {0.85, 0.85, 0.88}, {0.10, 0.10, 0.12}};
+static const double k_dark[6][3] = {{0.08, 0.08, 0.09}, {0.20, 0.22, 0.25}, {0.12, 0.16, 0.30},
+                                    {0.35, 0.18, 0.10}, {0.85, 0.85, 0.86}, {0.75, 0.60, 0.55}};
+static const double k_pastel[6][3] = {{0.92, 0.90, 0.85}, {0.80, 0.86, 0.93},
+                                      {0.93, 0.82, 0.84}, {0.82, 0.90, 0.80},
+                                      {0.95, 0.93, 0.78}, {0.70, 0.72, 0.75}};
+
+const synth_palette synth_palettes[PAL_COUNT] = {
+    [PAL_VIVID] = {k_vivid, 8}, [PAL_DARK] = {k_dark, 6}, [PAL_PASTEL] = {k_pastel, 6}};
+
+/* ---- the table ------------------------------------------------------------------- */
+
+#define RANGE(d, lo, hi) {DRAW_RANGE, d, 0, 0, lo, hi}
+#define SCALED(d, k, s, lo, hi) {DRAW_SCALED, d, s, k, lo, hi}
+#define OFFSET(d, s, lo, hi) {DRAW_OFFSET, d, s, 0, lo, hi}
+#define CONST(d, k) {DRAW_CONST, d, 0, k, 0, 0}
+#define TIMES(d, s, k) {DRAW_TIMES, d, s, k, 0, 0}
+#define MINUS(d, s, k) {DRAW_MINUS, d, s, k, 0, 0}
+#define FLAG(d, p) {DRAW_FLAG, d, 0, p, 0, 0}
+#define COLOUR(slot, pal, n) {DRAW_COLOUR, slot, pal, n, 0, 0}
+
 const synth_category synth_categories[SYNTH_N_CATEGORIES] = {
-    {.name = "cup", .second_state = "hot", .fill = FILL_DRAWN, .wrapped_fill = 0.8,
+    {.name = "cup", .second_state = "hot",
+     .draw = {RANGE(D_R, 0.038, 0.043), SCALED(D_R2, 1, D_R, 0.80, 0.92), RANGE(D_H, 0.090, 0.100),
+              RANGE(D_T, 0.0035, 0.0045), RANGE(D_T2, 0.006, 0.008), RANGE(D_A, 0.0055, 0.0070),
+              RANGE(D_C, 0.0032, 0.0040), RANGE(D_REACH, 0.033, 0.040), RANGE(D_FILL, 0.78, 0.88),
+              FLAG(D_VARIANT, 0.5)},
+     .fill = FILL_DRAWN, .wrapped_fill = 0.8,
      .field_stream = 0},
-    {.name = "canned_drink", .second_state = "iced", .fill = FILL_DRAWN, .field_stream = 1},
-    {.name = "bottled_drink", .second_state = "iced", .fill = FILL_DRAWN, .field_stream = 2},
-    {.name = "orange", .second_state = "iced", .fill = FILL_DRAWN, .field_stream = 3},
-    {.name = "smartphone", .second_state = "warm", .fill = FILL_DRAWN, .field_stream = 4},
-    {.name = "sponge", .second_state = "hot", .fill = FILL_DRAWN, .field_stream = 5},
-    {.name = "electric_kettle", .second_state = "hot", .fill = FILL_ABOVE_BASE,
+    {.name = "canned_drink", .second_state = "iced",
+     .draw = {RANGE(D_R, 0.0325, 0.0335), RANGE(D_H, 0.119, 0.123), CONST(D_FILL, 0.92)},
+     .fill = FILL_DRAWN, .field_stream = 1},
+    {.name = "bottled_drink", .second_state = "iced",
+     .draw = {RANGE(D_R, 0.030, 0.034), RANGE(D_H, 0.20, 0.23), RANGE(D_R2, 0.0125, 0.0135),
+              CONST(D_FILL, 0.85), COLOUR(1, PAL_VIVID, 6)},
+     .fill = FILL_DRAWN, .field_stream = 2},
+    {.name = "orange", .second_state = "iced",
+     .draw = {RANGE(D_R, 0.036, 0.042), SCALED(D_H, 2, D_R, 0.90, 0.96)},
+     .fill = FILL_DRAWN, .field_stream = 3},
+    {.name = "smartphone", .second_state = "warm",
+     .draw = {RANGE(D_W, 0.070, 0.076), RANGE(D_L, 0.145, 0.160), RANGE(D_H, 0.0075, 0.0090),
+              RANGE(D_RC, 0.008, 0.011), RANGE(D_E, 0.0022, 0.0030), COLOUR(0, PAL_DARK, 6)},
+     .fill = FILL_DRAWN, .field_stream = 4},
+    {.name = "sponge", .second_state = "hot",
+     .draw = {RANGE(D_W, 0.070, 0.095), RANGE(D_L, 0.100, 0.150), RANGE(D_H2, 0.020, 0.030),
+              OFFSET(D_H, D_H2, 0.005, 0.008), CONST(D_RC, 0.006), CONST(D_E, 0.0025)},
+     .fill = FILL_DRAWN, .field_stream = 5},
+    {.name = "electric_kettle", .second_state = "hot",
+     .draw = {RANGE(D_R, 0.070, 0.085), RANGE(D_H2, 0.17, 0.21), RANGE(D_T, 0.018, 0.024),
+              RANGE(D_REACH, 0.055, 0.065), RANGE(D_FILL, 0.5, 0.7), FLAG(D_VARIANT, 0.6)},
+     .fill = FILL_ABOVE_BASE,
      .wrapped_fill = 0.6, .field_stream = 6},
-    {.name = "pot", .second_state = "hot", .fill = FILL_DEPTH, .wrapped_fill = 0.6,
+    {.name = "pot", .second_state = "hot",
+     .draw = {RANGE(D_R, 0.090, 0.115), RANGE(D_H2, 0.095, 0.14), CONST(D_T, 0.003),
+              RANGE(D_FILL, 0.5, 0.7), FLAG(D_VARIANT, 0.5)},
+     .fill = FILL_DEPTH, .wrapped_fill = 0.6,
      .field_stream = 7},
-    {.name = "mouse", .second_state = "used", .fill = FILL_DRAWN, .field_stream = 8},
-    {.name = "eraser", .fill = FILL_DRAWN, .field_stream = SYNTH_FIELD_STREAM_OTHER},
-    {.name = "laptop", .second_state = "warm", .fill = FILL_DRAWN, .field_stream = 9},
-    {.name = "wallet", .fill = FILL_DRAWN, .field_stream = SYNTH_FIELD_STREAM_OTHER},
-    {.name = "tissue", .fill = FILL_DRAWN, .field_stream = SYNTH_FIELD_STREAM_OTHER},
-    {.name = "glasses_case", .fill = FILL_DRAWN, .field_stream = SYNTH_FIELD_STREAM_OTHER},
-    {.name = "pillow", .fill = FILL_DRAWN, .field_stream = SYNTH_FIELD_STREAM_OTHER},
-    {.name = "cushion", .fill = FILL_DRAWN, .field_stream = SYNTH_FIELD_STREAM_OTHER},
-    {.name = "storage_bag", .fill = FILL_DRAWN, .field_stream = SYNTH_FIELD_STREAM_OTHER},
-    {.name = "headset", .second_state = "used", .fill = FILL_DRAWN, .field_stream = 10},
+    {.name = "mouse", .second_state = "used",
+     .draw = {RANGE(D_W, 0.058, 0.066), RANGE(D_L, 0.100, 0.120), RANGE(D_H, 0.033, 0.040),
+              TIMES(D_RC, D_W, 0.45), CONST(D_E, 0.003), COLOUR(0, PAL_DARK, 4)},
+     .fill = FILL_DRAWN, .field_stream = 8},
+    {.name = "eraser",
+     .draw = {RANGE(D_W, 0.020, 0.025), RANGE(D_L, 0.045, 0.065), RANGE(D_H, 0.010, 0.013),
+              CONST(D_RC, 0.002), CONST(D_E, 0.0012)},
+     .fill = FILL_DRAWN, .field_stream = SYNTH_FIELD_STREAM_OTHER},
+    {.name = "laptop", .second_state = "warm",
+     .draw = {RANGE(D_W, 0.30, 0.34), RANGE(D_L, 0.21, 0.235), RANGE(D_H, 0.015, 0.019),
+              TIMES(D_H2, D_H, 0.55), CONST(D_RC, 0.010), CONST(D_E, 0.004)},
+     .fill = FILL_DRAWN, .field_stream = 9},
+    {.name = "wallet",
+     .draw = {RANGE(D_W, 0.105, 0.120), RANGE(D_L, 0.085, 0.095), RANGE(D_H, 0.012, 0.020),
+              CONST(D_RC, 0.008), TIMES(D_E, D_H, 0.35), COLOUR(0, PAL_DARK, 6)},
+     .fill = FILL_DRAWN, .field_stream = SYNTH_FIELD_STREAM_OTHER},
+    {.name = "tissue",
+     .draw = {RANGE(D_W, 0.22, 0.24), RANGE(D_L, 0.11, 0.125), RANGE(D_H, 0.075, 0.095),
+              CONST(D_RC, 0.004), CONST(D_E, 0.002), COLOUR(0, PAL_PASTEL, 6)},
+     .fill = FILL_DRAWN, .field_stream = SYNTH_FIELD_STREAM_OTHER},
+    {.name = "glasses_case",
+     .draw = {RANGE(D_W, 0.155, 0.170), RANGE(D_L, 0.055, 0.065), RANGE(D_H, 0.035, 0.045),
+              TIMES(D_RC, D_L, 0.45), TIMES(D_E, D_H, 0.45), COLOUR(0, PAL_DARK, 6)},
+     .fill = FILL_DRAWN, .field_stream = SYNTH_FIELD_STREAM_OTHER},
+    {.name = "pillow",
+     .draw = {RANGE(D_W, 0.45, 0.55), RANGE(D_L, 0.30, 0.36), RANGE(D_H, 0.10, 0.14),
+              CONST(D_RC, 0.05), CONST(D_E, 0.035), COLOUR(0, PAL_PASTEL, 6)},
+     .fill = FILL_DRAWN, .field_stream = SYNTH_FIELD_STREAM_OTHER},
+    {.name = "cushion",
+     .draw = {RANGE(D_W, 0.38, 0.45), TIMES(D_L, D_W, 1), RANGE(D_H, 0.09, 0.13), CONST(D_RC, 0.04),
+              CONST(D_E, 0.03)},
+     .fill = FILL_DRAWN, .field_stream = SYNTH_FIELD_STREAM_OTHER},
+    {.name = "storage_bag",
+     .draw = {RANGE(D_W, 0.17, 0.27), RANGE(D_L, 0.15, 0.24), RANGE(D_H, 0.012, 0.025),
+              CONST(D_RC, 0.012), TIMES(D_E, D_H, 0.45)},
+     .fill = FILL_DRAWN, .field_stream = SYNTH_FIELD_STREAM_OTHER},
+    {.name = "headset", .second_state = "used",
+     .draw = {RANGE(D_R, 0.038, 0.048), RANGE(D_T, 0.028, 0.036), RANGE(D_W, 0.14, 0.17),
+              RANGE(D_A, 0.014, 0.019), RANGE(D_C, 0.004, 0.006), COLOUR(0, PAL_DARK, 4)},
+     .fill = FILL_DRAWN, .field_stream = 10},
 };
 
 int synth_category_index(const char *name) {

@@ -573,169 +573,40 @@ enum {
 
 typedef struct shape {
   int cat;
-  double R, R2, H, H2, t, t2, e, rc, W, L, a, c, reach, fillz;
-  int flag;
-  double col[4][3];
-  uint64_t tseed;
+  double d[D_COUNT]; /* dimensions (synth_dim) */
+  double col[4][3];  /* colour slots */
+  uint64_t tseed;    /* texture detail */
 } shape;
 
-static void pick_col(hearth_rng *r, double out[3], const double *choices, int n) {
+static void pick_col(hearth_rng *r, double out[3], const double (*choices)[3], int n) {
   int k = (int)(hearth_rng_uniform(r) * n);
   if (k >= n) k = n - 1;
-  for (int m = 0; m < 3; m++) out[m] = choices[3 * k + m];
+  for (int m = 0; m < 3; m++) out[m] = choices[k][m];
 }
 
+/* an instance's texture seed, colours and dimensions (synth_draw) */
 static void shape_draw(shape *s, int cat, hearth_rng *r) {
   memset(s, 0, sizeof *s);
   s->cat = cat;
   s->tseed = hearth_rng_u64(r);
-  static const double vivid[] = {0.80, 0.10, 0.12, 0.10, 0.30, 0.75, 0.95, 0.75, 0.10,
-                                 0.10, 0.55, 0.25, 0.55, 0.15, 0.55, 0.95, 0.45, 0.10,
-                                 0.85, 0.85, 0.88, 0.10, 0.10, 0.12};
-  static const double dark[] = {0.08, 0.08, 0.09, 0.20, 0.22, 0.25, 0.12, 0.16, 0.30,
-                                0.35, 0.18, 0.10, 0.85, 0.85, 0.86, 0.75, 0.60, 0.55};
-  static const double pastel[] = {0.92, 0.90, 0.85, 0.80, 0.86, 0.93, 0.93, 0.82, 0.84,
-                                  0.82, 0.90, 0.80, 0.95, 0.93, 0.78, 0.70, 0.72, 0.75};
-  for (int k = 0; k < 4; k++) pick_col(r, s->col[k], vivid, 8);
-  switch (cat) {
-  case C_CUP:
-    s->R = hearth_rng_range(r, 0.038, 0.043);       /* top outer radius */
-    s->R2 = s->R * hearth_rng_range(r, 0.80, 0.92); /* bottom outer radius */
-    s->H = hearth_rng_range(r, 0.090, 0.100);
-    s->t = hearth_rng_range(r, 0.0035, 0.0045);     /* wall */
-    s->t2 = hearth_rng_range(r, 0.006, 0.008);      /* bottom */
-    s->a = hearth_rng_range(r, 0.0055, 0.0070);     /* handle half-width */
-    s->c = hearth_rng_range(r, 0.0032, 0.0040);     /* handle half-thickness */
-    s->reach = hearth_rng_range(r, 0.033, 0.040);
-    s->fillz = hearth_rng_range(r, 0.78, 0.88);
-    s->flag = hearth_rng_uniform(r) < 0.5;          /* a coloured band */
-    break;
-  case C_CAN:
-    s->R = hearth_rng_range(r, 0.0325, 0.0335);
-    s->H = hearth_rng_range(r, 0.119, 0.123);
-    s->fillz = 0.92;
-    break;
-  case C_BOTTLE:
-    s->R = hearth_rng_range(r, 0.030, 0.034);
-    s->H = hearth_rng_range(r, 0.20, 0.23);
-    s->R2 = hearth_rng_range(r, 0.0125, 0.0135); /* neck */
-    s->fillz = 0.85;
-    pick_col(r, s->col[1], vivid, 6);
-    break;
-  case C_ORANGE:
-    s->R = hearth_rng_range(r, 0.036, 0.042);
-    s->H = 2 * s->R * hearth_rng_range(r, 0.90, 0.96);
-    break;
-  case C_PHONE:
-    s->W = hearth_rng_range(r, 0.070, 0.076);
-    s->L = hearth_rng_range(r, 0.145, 0.160);
-    s->H = hearth_rng_range(r, 0.0075, 0.0090);
-    s->rc = hearth_rng_range(r, 0.008, 0.011);
-    s->e = hearth_rng_range(r, 0.0022, 0.0030);
-    pick_col(r, s->col[0], dark, 6);
-    break;
-  case C_SPONGE:
-    s->W = hearth_rng_range(r, 0.070, 0.095);
-    s->L = hearth_rng_range(r, 0.100, 0.150);
-    s->H2 = hearth_rng_range(r, 0.020, 0.030);  /* foam */
-    s->H = s->H2 + hearth_rng_range(r, 0.005, 0.008);
-    s->rc = 0.006;
-    s->e = 0.0025;
-    break;
-  case C_KETTLE:
-    s->R = hearth_rng_range(r, 0.070, 0.085);
-    s->H2 = hearth_rng_range(r, 0.17, 0.21);    /* body height above the base */
-    s->t = hearth_rng_range(r, 0.018, 0.024);   /* base height */
-    s->reach = hearth_rng_range(r, 0.055, 0.065);
-    s->fillz = hearth_rng_range(r, 0.5, 0.7);
-    s->flag = hearth_rng_uniform(r) < 0.6;      /* steel (else white plastic) */
-    break;
-  case C_POT:
-    s->R = hearth_rng_range(r, 0.090, 0.115);
-    s->H2 = hearth_rng_range(r, 0.095, 0.14);
-    s->t = 0.003;
-    s->fillz = hearth_rng_range(r, 0.5, 0.7);
-    s->flag = hearth_rng_uniform(r) < 0.5;      /* has a lid */
-    break;
-  case C_MOUSE:
-    s->W = hearth_rng_range(r, 0.058, 0.066);
-    s->L = hearth_rng_range(r, 0.100, 0.120);
-    s->H = hearth_rng_range(r, 0.033, 0.040);
-    s->rc = s->W * 0.45;
-    s->e = 0.003;
-    pick_col(r, s->col[0], dark, 4);
-    break;
-  case C_ERASER:
-    s->W = hearth_rng_range(r, 0.020, 0.025);
-    s->L = hearth_rng_range(r, 0.045, 0.065);
-    s->H = hearth_rng_range(r, 0.010, 0.013);
-    s->rc = 0.002;
-    s->e = 0.0012;
-    break;
-  case C_LAPTOP:
-    s->W = hearth_rng_range(r, 0.30, 0.34);
-    s->L = hearth_rng_range(r, 0.21, 0.235);
-    s->H = hearth_rng_range(r, 0.015, 0.019);
-    s->H2 = s->H * 0.55;
-    s->rc = 0.010;
-    s->e = 0.004;
-    break;
-  case C_WALLET:
-    s->W = hearth_rng_range(r, 0.105, 0.120);
-    s->L = hearth_rng_range(r, 0.085, 0.095);
-    s->H = hearth_rng_range(r, 0.012, 0.020);
-    s->rc = 0.008;
-    s->e = s->H * 0.35;
-    pick_col(r, s->col[0], dark, 6);
-    break;
-  case C_TISSUE:
-    s->W = hearth_rng_range(r, 0.22, 0.24);
-    s->L = hearth_rng_range(r, 0.11, 0.125);
-    s->H = hearth_rng_range(r, 0.075, 0.095);
-    s->rc = 0.004;
-    s->e = 0.002;
-    pick_col(r, s->col[0], pastel, 6);
-    break;
-  case C_GLASSES:
-    s->W = hearth_rng_range(r, 0.155, 0.170);
-    s->L = hearth_rng_range(r, 0.055, 0.065);
-    s->H = hearth_rng_range(r, 0.035, 0.045);
-    s->rc = s->L * 0.45;
-    s->e = s->H * 0.45;
-    pick_col(r, s->col[0], dark, 6);
-    break;
-  case C_PILLOW:
-    s->W = hearth_rng_range(r, 0.45, 0.55);
-    s->L = hearth_rng_range(r, 0.30, 0.36);
-    s->H = hearth_rng_range(r, 0.10, 0.14);
-    s->rc = 0.05;
-    s->e = 0.035;
-    pick_col(r, s->col[0], pastel, 6);
-    break;
-  case C_CUSHION:
-    s->W = hearth_rng_range(r, 0.38, 0.45);
-    s->L = s->W;
-    s->H = hearth_rng_range(r, 0.09, 0.13);
-    s->rc = 0.04;
-    s->e = 0.03;
-    break;
-  case C_BAG:
-    s->W = hearth_rng_range(r, 0.17, 0.27);
-    s->L = hearth_rng_range(r, 0.15, 0.24);
-    s->H = hearth_rng_range(r, 0.012, 0.025);
-    s->rc = 0.012;
-    s->e = s->H * 0.45;
-    break;
-  case C_HEADSET:
-    s->R = hearth_rng_range(r, 0.038, 0.048);  /* ear cup radius */
-    s->t = hearth_rng_range(r, 0.028, 0.036);  /* cup thickness */
-    s->W = hearth_rng_range(r, 0.14, 0.17);    /* distance between cup centres */
-    s->a = hearth_rng_range(r, 0.014, 0.019);
-    s->c = hearth_rng_range(r, 0.004, 0.006);
-    pick_col(r, s->col[0], dark, 4);
-    break;
-  default:
-    break;
+  const synth_palette *vivid = &synth_palettes[PAL_VIVID];
+  for (int k = 0; k < 4; k++) pick_col(r, s->col[k], vivid->rgb, vivid->n);
+  double *d = s->d;
+  for (const synth_draw *st = synth_categories[cat].draw;
+       st < synth_categories[cat].draw + SYNTH_MAX_DRAWS && st->op != DRAW_END; st++) {
+    switch (st->op) {
+    case DRAW_RANGE: d[st->dst] = hearth_rng_range(r, st->lo, st->hi); break;
+    case DRAW_SCALED: d[st->dst] = st->k * d[st->src] * hearth_rng_range(r, st->lo, st->hi); break;
+    case DRAW_OFFSET: d[st->dst] = d[st->src] + hearth_rng_range(r, st->lo, st->hi); break;
+    case DRAW_CONST: d[st->dst] = st->k; break;
+    case DRAW_TIMES: d[st->dst] = d[st->src] * st->k; break;
+    case DRAW_MINUS: d[st->dst] = d[st->src] - st->k; break;
+    case DRAW_FLAG: d[st->dst] = hearth_rng_uniform(r) < st->k; break;
+    case DRAW_COLOUR:
+      pick_col(r, s->col[st->dst], synth_palettes[st->src].rgb, (int)st->k);
+      break;
+    case DRAW_END: break;
+    }
   }
 }
 
@@ -794,7 +665,7 @@ static int shape_build(builder *b, const shape *s, double h) {
   case C_CUP: {
     int pb = b_part(b, "body"), pbot = b_part(b, "bottom"), prim = b_part(b, "rim");
     int pin = b_part(b, "inner"), ph = b_part(b, "handle");
-    double R = s->R, Rb = s->R2, H = s->H, tw = s->t, tb = s->t2, f = 0.003;
+    double R = s->d[D_R], Rb = s->d[D_R2], H = s->d[D_H], tw = s->d[D_T], tb = s->d[D_T2], f = 0.003;
     if (outline_circle(&ol, R, h)) return -1;
     prof_init(&pf, 0, h);
     prof_push(&pf, 1, 0, 0);
@@ -818,13 +689,13 @@ static int shape_build(builder *b, const shape *s, double h) {
     double z0 = H * 0.78, z1 = H * 0.28;
     double r0 = Rb + (R - Rb) * z0 / H - 0.5 * tw, r1 = Rb + (R - Rb) * z1 / H - 0.5 * tw;
     tube_def td;
-    tube_handle(&td, 0, r0, z0, r1, z1, s->reach * 1.33, s->a, s->c);
+    tube_handle(&td, 0, r0, z0, r1, z1, s->d[D_REACH] * 1.33, s->d[D_A], s->d[D_C]);
     rc = tube_build(b, &td, ph, S_GLAZE, S_GLAZE, h);
     break;
   }
   case C_CAN: {
     int pb = b_part(b, "body"), pt = b_part(b, "top"), pbot = b_part(b, "bottom");
-    double R = s->R, H = s->H;
+    double R = s->d[D_R], H = s->d[D_H];
     if (outline_circle(&ol, R, h)) return -1;
     prof_init(&pf, 0, h);
     prof_push(&pf, 1, 0, 0.004);
@@ -849,7 +720,7 @@ static int shape_build(builder *b, const shape *s, double h) {
   case C_BOTTLE: {
     int pb = b_part(b, "body"), pl = b_part(b, "label"), pn = b_part(b, "neck");
     int pc = b_part(b, "cap"), pbot = b_part(b, "bottom");
-    double R = s->R, H = s->H, rn = s->R2, rcap = rn + 0.0015, hc = 0.02;
+    double R = s->d[D_R], H = s->d[D_H], rn = s->d[D_R2], rcap = rn + 0.0015, hc = 0.02;
     double zs = H * 0.62, zn = H * 0.84, zl0 = H * 0.25, zl1 = H * 0.50;
     if (outline_circle(&ol, R, h)) return -1;
     prof_init(&pf, 0, h);
@@ -884,7 +755,7 @@ static int shape_build(builder *b, const shape *s, double h) {
   }
   case C_ORANGE: {
     int pp = b_part(b, "peel"), pt = b_part(b, "stem_end");
-    double R = s->R, Hz = 0.5 * s->H, cap = 0.35;
+    double R = s->d[D_R], Hz = 0.5 * s->d[D_H], cap = 0.35;
     if (outline_circle(&ol, R, h)) return -1;
     prof_init(&pf, 0, h);
     size_t n1 = nseg(cap * R, h, 2), n2 = nseg((M_PI - 2 * cap) * R, h, 6);
@@ -911,8 +782,8 @@ static int shape_build(builder *b, const shape *s, double h) {
   }
   case C_PHONE: case C_SPONGE: case C_ERASER: case C_LAPTOP: case C_WALLET: case C_TISSUE:
   case C_GLASSES: case C_PILLOW: case C_CUSHION: case C_BAG: case C_MOUSE: {
-    double A = 0.5 * s->W, B = 0.5 * s->L;
-    if (outline_rrect(&ol, A, B, s->rc, h)) return -1;
+    double A = 0.5 * s->d[D_W], B = 0.5 * s->d[D_L];
+    if (outline_rrect(&ol, A, B, s->d[D_RC], h)) return -1;
     prof_init(&pf, 0.5 * (A + B), h);
     int p1, p2, p3, p4, s1, s2, s3, s4;
     double zsplit = 0, bulge = 0;
@@ -923,7 +794,7 @@ static int shape_build(builder *b, const shape *s, double h) {
       break;
     case C_SPONGE:
       p3 = p1 = b_part(b, "foam"); p2 = p4 = b_part(b, "pad");
-      s3 = s1 = S_FOAM; s2 = s4 = S_PAD; zsplit = s->H2;
+      s3 = s1 = S_FOAM; s2 = s4 = S_PAD; zsplit = s->d[D_H2];
       break;
     case C_ERASER:
       p3 = p1 = p4 = b_part(b, "body"); p2 = b_part(b, "sleeve");
@@ -931,41 +802,41 @@ static int shape_build(builder *b, const shape *s, double h) {
       break;
     case C_LAPTOP:
       p3 = p1 = b_part(b, "base"); p2 = p4 = b_part(b, "lid");
-      s3 = s1 = S_LAPTOP_BASE; s2 = S_STEEL; s4 = S_LAPTOP_LID; zsplit = s->H2;
+      s3 = s1 = S_LAPTOP_BASE; s2 = S_STEEL; s4 = S_LAPTOP_LID; zsplit = s->d[D_H2];
       break;
     case C_TISSUE:
       p3 = p1 = b_part(b, "box"); p4 = p2 = b_part(b, "top");
-      s3 = s1 = S_TISSUE_BOX; s4 = S_TISSUE_TOP; s2 = S_TISSUE_BOX; zsplit = s->H * 0.85;
+      s3 = s1 = S_TISSUE_BOX; s4 = S_TISSUE_TOP; s2 = S_TISSUE_BOX; zsplit = s->d[D_H] * 0.85;
       break;
     case C_MOUSE:
       p3 = b_part(b, "bottom"); p1 = p2 = b_part(b, "side"); p4 = b_part(b, "shell");
       s3 = S_BLACK; s1 = s2 = S_MOUSE_TOP; s4 = S_MOUSE_TOP;
-      bulge = s->H - 0.012;
+      bulge = s->d[D_H] - 0.012;
       break;
     case C_GLASSES:
       p3 = p1 = b_part(b, "shell"); p4 = p2 = b_part(b, "lid");
-      s3 = s1 = s4 = s2 = S_CASE; zsplit = s->H * 0.5;
+      s3 = s1 = s4 = s2 = S_CASE; zsplit = s->d[D_H] * 0.5;
       break;
     case C_PILLOW: case C_CUSHION:
       p3 = p1 = p4 = p2 = b_part(b, "fabric");
       s3 = s1 = s4 = s2 = s->cat == C_PILLOW ? S_FABRIC : S_FABRIC_CHECK;
-      bulge = s->H * 0.25;
+      bulge = s->d[D_H] * 0.25;
       break;
     case C_BAG:
       p3 = p1 = p4 = b_part(b, "bag"); p2 = b_part(b, "zip");
-      s3 = s1 = s4 = S_BAG; s2 = S_BAG_ZIP; zsplit = s->H * 0.5;
+      s3 = s1 = s4 = S_BAG; s2 = S_BAG_ZIP; zsplit = s->d[D_H] * 0.5;
       break;
     default: /* wallet */
       p3 = p1 = p4 = p2 = b_part(b, "leather");
       s3 = s1 = s4 = s2 = S_LEATHER;
       break;
     }
-    double H = s->H - bulge;
+    double H = s->d[D_H] - bulge;
     if (s->cat == C_ERASER) {
       /* the sleeve covers the middle of the side band */
-      prof_slab(&pf, H, s->e, 0, H * 0.5, p1, s1, p3, s3, p2, s2, p4, s4);
+      prof_slab(&pf, H, s->d[D_E], 0, H * 0.5, p1, s1, p3, s3, p2, s2, p4, s4);
     } else {
-      prof_slab(&pf, H, s->e, bulge, zsplit, p1, s1, p3, s3, p2, s2, p4, s4);
+      prof_slab(&pf, H, s->d[D_E], bulge, zsplit, p1, s1, p3, s3, p2, s2, p4, s4);
     }
     rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
     prof_free(&pf);
@@ -974,8 +845,8 @@ static int shape_build(builder *b, const shape *s, double h) {
   case C_KETTLE: {
     int pbase = b_part(b, "base"), pb = b_part(b, "body"), pl = b_part(b, "lid");
     int ph = b_part(b, "handle"), psp = b_part(b, "spout");
-    int sb = s->flag ? S_STEEL : S_PLAIN;
-    double R = s->R, zb = s->t, Hb = s->H2, Rt = R * 0.82;
+    int sb = s->d[D_VARIANT] ? S_STEEL : S_PLAIN;
+    double R = s->d[D_R], zb = s->d[D_T], Hb = s->d[D_H2], Rt = R * 0.82;
     /* base plate */
     if (outline_circle(&ol, R + 0.01, h)) return -1;
     prof_init(&pf, 0, h);
@@ -1030,7 +901,7 @@ static int shape_build(builder *b, const shape *s, double h) {
     double z0 = zb + Hb * 0.85, z1 = zb + Hb * 0.25;
     double rz0 = R - (R - Rt) * 0.85 - 0.015, rz1 = R - (R - Rt) * 0.25 - 0.015;
     tube_def td;
-    tube_handle(&td, M_PI, rz0, z0, rz1, z1, s->reach * 1.33, 0.012, 0.010);
+    tube_handle(&td, M_PI, rz0, z0, rz1, z1, s->d[D_REACH] * 1.33, 0.012, 0.010);
     rc = tube_build(b, &td, ph, S_BLACK, S_BLACK, h);
     if (rc) break;
     /* spout at the front: up and out, tapering */
@@ -1044,7 +915,7 @@ static int shape_build(builder *b, const shape *s, double h) {
   case C_POT: {
     int pb = b_part(b, "body"), pbot = b_part(b, "bottom"), prim = b_part(b, "rim");
     int pin = b_part(b, "inner"), ph = b_part(b, "handle");
-    double R = s->R, H = s->H2, tw = s->t, tb = 0.005;
+    double R = s->d[D_R], H = s->d[D_H2], tw = s->d[D_T], tb = 0.005;
     if (outline_circle(&ol, R + 0.004, h)) return -1;
     prof_init(&pf, 0, h);
     prof_push(&pf, 1, 0, 0);
@@ -1071,7 +942,7 @@ static int shape_build(builder *b, const shape *s, double h) {
       rc = tube_build(b, &td, ph, S_BLACK, S_BLACK, h);
       if (rc) break;
     }
-    if (rc || !s->flag) break;
+    if (rc || !s->d[D_VARIANT]) break;
     /* lid resting on the rim */
     int pl = b_part(b, "lid");
     double Rl = R + 0.002, zl = H + 0.0002;
@@ -1099,7 +970,7 @@ static int shape_build(builder *b, const shape *s, double h) {
   }
   case C_HEADSET: {
     int pcup = b_part(b, "cup"), pcu = b_part(b, "cushion"), pband = b_part(b, "band");
-    double R = s->R, T = s->t, e = 0.006;
+    double R = s->d[D_R], T = s->d[D_T], e = 0.006;
     if (outline_circle(&ol, R, h)) return -1;
     prof_init(&pf, 0, h);
     prof_push(&pf, 1, 0, 0);
@@ -1113,7 +984,7 @@ static int shape_build(builder *b, const shape *s, double h) {
     prof_seg(&pf, pcu, S_CUSHION_PAD);
     for (int k = 0; k < 2; k++) {
       /* cups stand on edge with their axes along x, cushions facing in */
-      double sx = k ? -1.0 : 1.0, x0 = k ? 0.5 * s->W + 0.5 * T : -0.5 * s->W - 0.5 * T;
+      double sx = k ? -1.0 : 1.0, x0 = k ? 0.5 * s->d[D_W] + 0.5 * T : -0.5 * s->d[D_W] - 0.5 * T;
       double M[12] = {0, 0, sx, x0, 0, 1, 0, 0, -sx, 0, 0, R};
       rc = sweep_build(b, &ol, &pf, M, NULL, NULL);
       if (rc) break;
@@ -1121,10 +992,10 @@ static int shape_build(builder *b, const shape *s, double h) {
     prof_free(&pf);
     if (rc) break;
     /* band over the top, its ends inside the cups */
-    double hw = 0.5 * s->W, zc = R, k4 = 0.5523 * 2;
+    double hw = 0.5 * s->d[D_W], zc = R, k4 = 0.5523 * 2;
     tube_def td = {{{-hw, 0, zc}, {-hw, 0, zc + hw * k4 * 1.3}, {hw, 0, zc + hw * k4 * 1.3},
                     {hw, 0, zc}},
-                   {0, 1, 0}, s->a, s->a, s->c, s->c};
+                   {0, 1, 0}, s->d[D_A], s->d[D_A], s->d[D_C], s->d[D_C]};
     rc = tube_build(b, &td, pband, S_BLACK, S_BLACK, h);
     break;
   }
@@ -1233,7 +1104,7 @@ static void shade(const shape *s, const patch *p, double x, double y, double out
   switch (p->style) {
   case S_GLAZE:
     setc(out, 0.93, 0.93, 0.91);
-    if (s->flag && p->kind == K_STRIP && s->cat == C_CUP && p->part == 0) {
+    if (s->d[D_VARIANT] && p->kind == K_STRIP && s->cat == C_CUP && p->part == 0) {
       /* a coloured band round the body */
       double t = ly / p->h;
       if (t > 0.55 && t < 0.70) mixc(out, out, s->col[0], 0.85);
@@ -1301,14 +1172,14 @@ static void shade(const shape *s, const patch *p, double x, double y, double out
     break;
   }
   case S_SCREEN: {
-    double A = 0.5 * s->W - s->e - 0.0025, B = 0.5 * s->L - s->e - 0.004;
+    double A = 0.5 * s->d[D_W] - s->d[D_E] - 0.0025, B = 0.5 * s->d[D_L] - s->d[D_E] - 0.004;
     if (fabs(x) < A && fabs(y) < B) {
       double g = 0.04 + 0.03 * (x / A + y / B + 2) / 4;
       setc(out, g, g, g + 0.01);
     } else {
       setc(out, 0.02, 0.02, 0.02);
     }
-    if (hypot(x, y - (0.5 * s->L - 0.009)) < 0.0018) setc(out, 0.10, 0.10, 0.14);
+    if (hypot(x, y - (0.5 * s->d[D_L] - 0.009)) < 0.0018) setc(out, 0.10, 0.10, 0.14);
     break;
   }
   case S_FRAME: {
@@ -1319,7 +1190,7 @@ static void shade(const shape *s, const patch *p, double x, double y, double out
   case S_PHONE_BACK: {
     mixc(out, s->col[0], s->col[0], 0);
     for (int k = 0; k < 3; k++) out[k] += 0.01 * n1;
-    double cx = -(0.5 * s->W - 0.02), cy = 0.5 * s->L - 0.02;
+    double cx = -(0.5 * s->d[D_W] - 0.02), cy = 0.5 * s->d[D_L] - 0.02;
     if (fabs(x - cx) < 0.015 && fabs(y - cy) < 0.015) {
       mixc(out, out, (const double[3]){0.15, 0.15, 0.16}, 0.7);
       for (int l = 0; l < 2; l++)
@@ -1355,8 +1226,8 @@ static void shade(const shape *s, const patch *p, double x, double y, double out
     break;
   case S_MOUSE_TOP: {
     mixc(out, s->col[0], s->col[0], 0);
-    if (p->kind == K_DISK && fabs(x) < 0.0006 && y > s->L * 0.1) setc(out, 0.02, 0.02, 0.02);
-    if (p->kind == K_DISK && hypot(x, y - s->L * 0.3) < 0.004) setc(out, 0.2, 0.2, 0.22);
+    if (p->kind == K_DISK && fabs(x) < 0.0006 && y > s->d[D_L] * 0.1) setc(out, 0.02, 0.02, 0.02);
+    if (p->kind == K_DISK && hypot(x, y - s->d[D_L] * 0.3) < 0.004) setc(out, 0.2, 0.2, 0.22);
     break;
   }
   case S_RUBBER:
@@ -1375,15 +1246,15 @@ static void shade(const shape *s, const patch *p, double x, double y, double out
     break;
   case S_LAPTOP_BASE:
     setc(out, 0.60, 0.61, 0.63);
-    if (p->kind == K_DISK && fabs(fabs(x) - 0.5 * s->W + 0.03) < 0.008 &&
-        fabs(fabs(y) - 0.5 * s->L + 0.03) < 0.008)
+    if (p->kind == K_DISK && fabs(fabs(x) - 0.5 * s->d[D_W] + 0.03) < 0.008 &&
+        fabs(fabs(y) - 0.5 * s->d[D_L] + 0.03) < 0.008)
       setc(out, 0.1, 0.1, 0.1);
     break;
   case S_LEATHER: {
     mixc(out, s->col[0], (const double[3]){0.40, 0.22, 0.10}, 0.5);
     for (int k = 0; k < 3; k++) out[k] += 0.05 * synth_fbm2(ts, x / 0.002, y / 0.002, 2);
     if (p->kind == K_DISK) {
-      double dx = 0.5 * s->W - s->e - fabs(x), dy = 0.5 * s->L - s->e - fabs(y);
+      double dx = 0.5 * s->d[D_W] - s->d[D_E] - fabs(x), dy = 0.5 * s->d[D_L] - s->d[D_E] - fabs(y);
       double d = fmin(dx, dy);
       if (d > 0.003 && d < 0.0038 && fmod(fabs(x + y) / 0.003, 1.0) < 0.6)
         setc(out, 0.85, 0.78, 0.60);
@@ -1398,7 +1269,7 @@ static void shade(const shape *s, const patch *p, double x, double y, double out
   }
   case S_TISSUE_TOP: {
     mixc(out, s->col[0], s->col[0], 0);
-    double ex = x / (0.5 * s->W * 0.6), ey = y / (0.5 * s->L * 0.35);
+    double ex = x / (0.5 * s->d[D_W] * 0.6), ey = y / (0.5 * s->d[D_L] * 0.35);
     if (ex * ex + ey * ey < 1) setc(out, 0.97, 0.97, 0.97);
     break;
   }
@@ -1591,9 +1462,9 @@ hearth_status synth_object_make(const char *category, uint64_t seed, size_t targ
   for (int k = 0; k < b->n_parts; k++) obj->part_names[k] = b->part_names[k];
   obj_extent(obj);
   switch (sc->fill) {
-  case FILL_DRAWN: obj->fill_level = s.fillz; break;
-  case FILL_DEPTH: obj->fill_level = s.H2 * s.fillz / obj->height; break;
-  case FILL_ABOVE_BASE: obj->fill_level = (s.t + s.H2 * s.fillz) / obj->height; break;
+  case FILL_DRAWN: obj->fill_level = s.d[D_FILL]; break;
+  case FILL_DEPTH: obj->fill_level = s.d[D_H2] * s.d[D_FILL] / obj->height; break;
+  case FILL_ABOVE_BASE: obj->fill_level = (s.d[D_T] + s.d[D_H2] * s.d[D_FILL]) / obj->height; break;
   }
 
   st = hearth_image_alloc(&obj->albedo, texture_size, texture_size, 3, HEARTH_PIX_U8, err);
