@@ -17,11 +17,10 @@
 /* An instance's dimensions (metres unless noted), drawn by its steps. */
 typedef enum synth_dim {
   D_R,       /* radius: top outer radius, body radius, ear-cup radius */
-  D_R2,      /* second radius: cup bottom, bottle neck */
-  D_H,       /* height; slab: thickness */
-  D_H2,      /* second height: kettle and pot body, sponge foam, laptop base */
+  D_R2,      /* second radius: vessel bottom, bottle neck */
+  D_H,       /* height of the body; slab: thickness */
   D_T,       /* wall thickness; kettle: base height; headset: cup thickness */
-  D_T2,      /* bottom thickness */
+  D_T2,      /* vessel: bottom thickness */
   D_E,       /* slab: edge round radius */
   D_RC,      /* slab: corner radius in plan */
   D_W,       /* slab: width (x); headset: distance between the cups */
@@ -30,7 +29,9 @@ typedef enum synth_dim {
   D_C,       /* handle or band: half-thickness */
   D_REACH,   /* handle: how far it stands out */
   D_FILL,    /* liquid line, a fraction (see synth_fill) */
-  D_VARIANT, /* 1: the instance's alternative look (cup band, kettle steel, pot lid) */
+  D_ZSPLIT,  /* slab: height of the seam between the lower and upper side (0: none) */
+  D_BULGE,   /* slab: how far the top face domes up (part of D_H) */
+  D_VARIANT, /* 1: the instance's alternative look (synth_slot.style[1]; vessel lid) */
   D_COUNT
 } synth_dim;
 
@@ -73,12 +74,73 @@ typedef enum synth_fill {
   FILL_ABOVE_BASE, /* the same, standing on a base of its own height */
 } synth_fill;
 
+/* ---- shapes ------------------------------------------------------------------ */
+
+/* Albedo styles (the materials of synth_objects.c's shader). */
+enum {
+  S_PLAIN, S_GLAZE, S_UNGLAZED, S_CAN_LABEL, S_ALU, S_ALU_TOP, S_CLEAR, S_BOTTLE_LABEL, S_CAP,
+  S_PEEL, S_PEEL_TOP, S_SCREEN, S_FRAME, S_PHONE_BACK, S_FOAM, S_PAD, S_STEEL, S_STEEL_DARK,
+  S_BLACK, S_MOUSE_TOP, S_RUBBER, S_SLEEVE, S_LAPTOP_LID, S_LAPTOP_BASE, S_LEATHER, S_TISSUE_BOX,
+  S_TISSUE_TOP, S_CASE, S_FABRIC, S_FABRIC_CHECK, S_BAG, S_BAG_ZIP, S_CUSHION_PAD, S_COUNT
+};
+
+/* The shape builders (synth_objects.c); each names the slots it fills. */
+typedef enum synth_shape {
+  SHAPE_VESSEL,   /* open revolved vessel: wall, rim, inner wall, handle(s), lid */
+  SHAPE_CAN,      /* drinks can: label, rolled rim, lid, domed bottom */
+  SHAPE_BOTTLE,   /* bottle: body, label band, shoulder, neck, cap */
+  SHAPE_SPHEROID, /* fruit: a bumpy spheroid with a stem end */
+  SHAPE_KETTLE,   /* kettle on its base: body, domed lid and knob, handle, spout */
+  SHAPE_SLAB,     /* rounded box, optionally split along the side and domed on top */
+  SHAPE_HEADSET,  /* two ear cups with cushions and a head band */
+  SHAPE_COUNT
+} synth_shape;
+
+/* A part of the surface and its material: style[0], or style[1] for an
+ * instance drawn with D_VARIANT. Parts are numbered in slot order (a slot
+ * naming an earlier slot's part joins it). */
+typedef struct synth_slot {
+  const char *part;
+  int style[2];
+} synth_slot;
+#define SYNTH_MAX_SLOTS 8
+
+/* the slots of each shape */
+enum { VESSEL_BODY, VESSEL_BOTTOM, VESSEL_RIM, VESSEL_INNER, VESSEL_HANDLE, VESSEL_LID,
+       VESSEL_KNOB, VESSEL_SLOTS };
+enum { CAN_BODY, CAN_RIM, CAN_LID, CAN_DOME, CAN_FOOT, CAN_SLOTS };
+enum { BOTTLE_BODY, BOTTLE_LABEL, BOTTLE_NECK, BOTTLE_CAP, BOTTLE_BOTTOM, BOTTLE_SLOTS };
+enum { SPHEROID_PEEL, SPHEROID_STEM, SPHEROID_SLOTS };
+enum { KETTLE_BASE, KETTLE_BODY, KETTLE_LID, KETTLE_KNOB, KETTLE_HANDLE, KETTLE_SPOUT,
+       KETTLE_SLOTS };
+enum { SLAB_BOTTOM, SLAB_SIDE, SLAB_UPPER, SLAB_TOP, SLAB_SLOTS }; /* upper: side above D_ZSPLIT */
+enum { HEADSET_CUP, HEADSET_CUSHION, HEADSET_BAND, HEADSET_SLOTS };
+
+/* SHAPE_VESSEL: wall from radius D_R2 at the bottom to D_R at height D_H,
+ * wall D_T, bottom D_T2 */
+typedef struct synth_vessel {
+  double margin;      /* the outline is sampled for radius D_R + margin */
+  double foot;        /* radius of the round at the outer bottom edge */
+  int foot_steps;     /* its fewest segments */
+  double inner_round; /* radius of the round at the inner bottom edge */
+  /* handles: 0: one mug handle at azimuth 0, ends at heights mug[0] * D_H and
+   * mug[1] * D_H, standing out mug[2] * D_REACH; 1: two lugs at azimuths 0
+   * and pi, centred lug[0] below the rim, lug[1] high each way, standing
+   * out D_REACH */
+  int lugs;
+  double mug[3], lug[2];
+  int lid;            /* a domed lid with a knob when D_VARIANT is drawn */
+} synth_vessel;
+
 /* ---- categories ------------------------------------------------------------ */
 
 typedef struct synth_category {
   const char *name;
   const char *second_state; /* captured besides "neutral" by default; NULL: none */
   synth_draw draw[SYNTH_MAX_DRAWS];
+  synth_shape shape;
+  synth_slot slots[SYNTH_MAX_SLOTS]; /* indexed by the shape's slot enum */
+  synth_vessel vessel;               /* SHAPE_VESSEL only */
   synth_fill fill;
   double wrapped_fill;      /* fill level of a given mesh put under this category */
   /* the random stream of the temperature draws (with the state); categories

@@ -25,17 +25,12 @@
 #define M_PI 3.14159265358979323846
 #endif
 
-/* ---- categories ---------------------------------------------------------- */
-
-/* entries of synth_categories, in its order */
-enum {
-  C_CUP, C_CAN, C_BOTTLE, C_ORANGE, C_PHONE, C_SPONGE, C_KETTLE, C_POT, C_MOUSE, C_ERASER,
-  C_LAPTOP, C_WALLET, C_TISSUE, C_GLASSES, C_PILLOW, C_CUSHION, C_BAG, C_HEADSET, C_COUNT
-};
-
 /* ---- mesh builder -------------------------------------------------------- */
 
 enum { K_STRIP, K_DISK };
+
+/* a part id and an albedo style (synth_slot once numbered) */
+typedef struct slot_use { int part, style; } slot_use;
 
 typedef struct patch {
   int part, style, kind;
@@ -282,12 +277,13 @@ static void prof_arc(profile *pf, double cd, double cz, double rad, double a0, d
   }
 }
 
-static void prof_seg(profile *pf, int part, int style) {
+/* the rows since the last segment end become a segment of part/style u */
+static void prof_seg(profile *pf, slot_use u) {
   if (pf->nseg >= MAX_SEGS || pf->n == 0) {
     pf->oom = 1;
     return;
   }
-  pf->seg[pf->nseg++] = (pseg){pf->mark, pf->n - 1, part, style};
+  pf->seg[pf->nseg++] = (pseg){pf->mark, pf->n - 1, u.part, u.style};
   pf->mark = pf->n - 1;
 }
 
@@ -450,8 +446,8 @@ static void bez(const tube_def *td, double t, double out[3]) {
     out[k] = w0 * td->p[0][k] + w1 * td->p[1][k] + w2 * td->p[2][k] + w3 * td->p[3][k];
 }
 
-static int tube_build(builder *b, const tube_def *td, int part, int style_side,
-                      int style_cap, double h) {
+static int tube_build(builder *b, const tube_def *td, slot_use u, double h) {
+  int part = u.part;
   double len = 0, prev[3], cur[3];
   bez(td, 0, prev);
   for (int k = 1; k <= 64; k++) {
@@ -502,7 +498,7 @@ static int tube_build(builder *b, const tube_def *td, int part, int style_side,
   }
   double zero[3] = {0, 0, 0};
   /* side strip */
-  patch *pp = b_patch(b, part, style_side, K_STRIP);
+  patch *pp = b_patch(b, part, u.style, K_STRIP);
   uint32_t base = (uint32_t)b->nv;
   for (size_t i = 0; i <= M; i++)
     for (size_t k = 0; k <= K; k++)
@@ -518,7 +514,7 @@ static int tube_build(builder *b, const tube_def *td, int part, int style_side,
   patch_close(b, pp);
   /* end caps: fans round the path's end points */
   for (int e = 0; e < 2; e++) {
-    patch *cp = b_patch(b, part, style_cap, K_DISK);
+    patch *cp = b_patch(b, part, u.style, K_DISK);
     double pc[3];
     bez(td, (double)e, pc);
     uint32_t c = b_vert(b, pc, 0, 0);
@@ -563,16 +559,8 @@ static void tube_handle(tube_def *td, double phi, double r0, double z0, double r
 
 /* ---- shapes ------------------------------------------------------------- */
 
-/* styles of albedo */
-enum {
-  S_PLAIN, S_GLAZE, S_UNGLAZED, S_CAN_LABEL, S_ALU, S_ALU_TOP, S_CLEAR, S_BOTTLE_LABEL, S_CAP,
-  S_PEEL, S_PEEL_TOP, S_SCREEN, S_FRAME, S_PHONE_BACK, S_FOAM, S_PAD, S_STEEL, S_STEEL_DARK,
-  S_BLACK, S_MOUSE_TOP, S_RUBBER, S_SLEEVE, S_LAPTOP_LID, S_LAPTOP_BASE, S_LEATHER, S_TISSUE_BOX,
-  S_TISSUE_TOP, S_CASE, S_FABRIC, S_FABRIC_CHECK, S_BAG, S_BAG_ZIP, S_CUSHION_PAD
-};
-
 typedef struct shape {
-  int cat;
+  const synth_category *cat;
   double d[D_COUNT]; /* dimensions (synth_dim) */
   double col[4][3];  /* colour slots */
   uint64_t tseed;    /* texture detail */
@@ -585,15 +573,14 @@ static void pick_col(hearth_rng *r, double out[3], const double (*choices)[3], i
 }
 
 /* an instance's texture seed, colours and dimensions (synth_draw) */
-static void shape_draw(shape *s, int cat, hearth_rng *r) {
+static void shape_draw(shape *s, const synth_category *cat, hearth_rng *r) {
   memset(s, 0, sizeof *s);
   s->cat = cat;
   s->tseed = hearth_rng_u64(r);
   const synth_palette *vivid = &synth_palettes[PAL_VIVID];
   for (int k = 0; k < 4; k++) pick_col(r, s->col[k], vivid->rgb, vivid->n);
   double *d = s->d;
-  for (const synth_draw *st = synth_categories[cat].draw;
-       st < synth_categories[cat].draw + SYNTH_MAX_DRAWS && st->op != DRAW_END; st++) {
+  for (const synth_draw *st = cat->draw; st < cat->draw + SYNTH_MAX_DRAWS && st->op; st++) {
     switch (st->op) {
     case DRAW_RANGE: d[st->dst] = hearth_rng_range(r, st->lo, st->hi); break;
     case DRAW_SCALED: d[st->dst] = st->k * d[st->src] * hearth_rng_range(r, st->lo, st->hi); break;
@@ -602,18 +589,174 @@ static void shape_draw(shape *s, int cat, hearth_rng *r) {
     case DRAW_TIMES: d[st->dst] = d[st->src] * st->k; break;
     case DRAW_MINUS: d[st->dst] = d[st->src] - st->k; break;
     case DRAW_FLAG: d[st->dst] = hearth_rng_uniform(r) < st->k; break;
-    case DRAW_COLOUR:
-      pick_col(r, s->col[st->dst], synth_palettes[st->src].rgb, (int)st->k);
-      break;
+    case DRAW_COLOUR: pick_col(r, s->col[st->dst], synth_palettes[st->src].rgb, (int)st->k); break;
     case DRAW_END: break;
     }
   }
 }
 
-/* orange peel bumps: a small radial displacement from smooth 3D noise */
-typedef struct orange_disp { double zc, amp; uint64_t seed; } orange_disp;
-static void orange_displace(const void *ctx, double p[3]) {
-  const orange_disp *od = ctx;
+/* the part and style of slot k of the instance's category (the part is
+ * numbered on first use) */
+static slot_use b_slot(builder *b, const shape *s, int k) {
+  const synth_slot *sl = &s->cat->slots[k];
+  return (slot_use){b_part(b, sl->part), sl->style[s->d[D_VARIANT] != 0]};
+}
+
+/* slots first..last-1, numbered in that order */
+static void b_slots(builder *b, const shape *s, int first, int last, slot_use *out) {
+  for (int k = first; k < last; k++) out[k] = b_slot(b, s, k);
+}
+
+/* a domed lid from radius r0 at height z0 in to a knob of radius rk: the
+ * dome rises by hd, the knob hk above it */
+static void prof_dome(profile *pf, double r0, double z0, double rk, double hd, double hk,
+                      slot_use dome, slot_use knob) {
+  size_t n = nseg(r0, pf->h, 4);
+  for (size_t k = 1; k <= n; k++) {
+    double t = (double)k / (double)n, r = r0 + (rk - r0) * t;
+    prof_push(pf, 1, r, z0 + hd * sin(0.5 * M_PI * t));
+  }
+  prof_seg(pf, dome);
+  prof_line(pf, 1, rk, z0 + hd + hk);
+  prof_seg(pf, knob);
+  prof_line(pf, 1, 0, z0 + hd + hk);
+  prof_seg(pf, knob);
+}
+
+/* SHAPE_VESSEL (synth_vessel) */
+static int build_vessel(builder *b, const shape *s, double h) {
+  const synth_vessel *v = &s->cat->vessel;
+  slot_use sl[VESSEL_SLOTS];
+  b_slots(b, s, VESSEL_BODY, VESSEL_LID, sl);
+  const double *d = s->d;
+  double R = d[D_R], Rb = d[D_R2], H = d[D_H], tw = d[D_T], tb = d[D_T2], f = v->foot;
+  double fi = v->inner_round;
+  outline ol = {0};
+  profile pf;
+  if (outline_circle(&ol, R + v->margin, h)) return -1;
+  prof_init(&pf, 0, h);
+  prof_push(&pf, 1, 0, 0);
+  prof_line(&pf, 1, Rb - f, 0);
+  prof_seg(&pf, sl[VESSEL_BOTTOM]);
+  prof_arc(&pf, Rb - f, f, f, -0.5 * M_PI, 0, (size_t)v->foot_steps);
+  prof_line(&pf, 1, R, H - 0.5 * tw);
+  prof_seg(&pf, sl[VESSEL_BODY]);
+  prof_arc(&pf, R - 0.5 * tw, H - 0.5 * tw, 0.5 * tw, 0, M_PI, 3);
+  prof_seg(&pf, sl[VESSEL_RIM]);
+  /* the inner wall parallel to the outer one */
+  double rib = Rb - tw + (R - Rb) * tb / H;
+  prof_line(&pf, 1, rib, tb + fi);
+  prof_arc(&pf, rib - fi, tb + fi, fi, 0, -0.5 * M_PI, 2);
+  prof_seg(&pf, sl[VESSEL_INNER]);
+  prof_line(&pf, 1, 0, tb);
+  prof_seg(&pf, sl[VESSEL_INNER]);
+  int rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
+  prof_free(&pf);
+  tube_def td;
+  if (!rc && !v->lugs) {
+    /* ends buried half-way into the wall */
+    double z0 = H * v->mug[0], z1 = H * v->mug[1];
+    double r0 = Rb + (R - Rb) * z0 / H - 0.5 * tw, r1 = Rb + (R - Rb) * z1 / H - 0.5 * tw;
+    tube_handle(&td, 0, r0, z0, r1, z1, d[D_REACH] * v->mug[2], d[D_A], d[D_C]);
+    rc = tube_build(b, &td, sl[VESSEL_HANDLE], h);
+  }
+  for (int k = 0; !rc && v->lugs && k < 2; k++) {
+    double zh = H - v->lug[0];
+    tube_handle(&td, k * M_PI, R - 0.5 * tw, zh + v->lug[1], R - 0.5 * tw, zh - v->lug[1],
+                d[D_REACH], d[D_A], d[D_C]);
+    rc = tube_build(b, &td, sl[VESSEL_HANDLE], h);
+  }
+  if (!rc && v->lid && d[D_VARIANT]) {
+    /* resting on the rim */
+    b_slots(b, s, VESSEL_LID, VESSEL_SLOTS, sl);
+    double Rl = R + 0.002, zl = H + 0.0002;
+    prof_init(&pf, 0, h);
+    prof_push(&pf, 1, 0, zl);
+    prof_line(&pf, 1, Rl, zl);
+    prof_seg(&pf, sl[VESSEL_LID]);
+    prof_line(&pf, 1, Rl, zl + 0.004);
+    prof_dome(&pf, Rl, zl + 0.004, 0.016, 0.015, 0.02, sl[VESSEL_LID], sl[VESSEL_KNOB]);
+    rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
+    prof_free(&pf);
+  }
+  outline_free(&ol);
+  return rc;
+}
+
+/* SHAPE_CAN */
+static int build_can(builder *b, const shape *s, double h) {
+  slot_use sl[CAN_SLOTS];
+  b_slots(b, s, 0, CAN_SLOTS, sl);
+  double R = s->d[D_R], H = s->d[D_H];
+  outline ol = {0};
+  profile pf;
+  if (outline_circle(&ol, R, h)) return -1;
+  prof_init(&pf, 0, h);
+  prof_push(&pf, 1, 0, 0.004);
+  prof_line(&pf, 1, R - 0.008, 0.0);
+  prof_seg(&pf, sl[CAN_DOME]);
+  prof_line(&pf, 1, R - 0.0065, 0.0);
+  prof_line(&pf, 1, R, 0.010);
+  prof_seg(&pf, sl[CAN_FOOT]);
+  prof_line(&pf, 1, R, H - 0.013);
+  prof_seg(&pf, sl[CAN_BODY]);
+  prof_line(&pf, 1, R - 0.0045, H - 0.002);
+  prof_line(&pf, 1, R - 0.0045, H);
+  prof_line(&pf, 1, R - 0.0065, H);
+  prof_line(&pf, 1, R - 0.0065, H - 0.003);
+  prof_seg(&pf, sl[CAN_RIM]);
+  prof_line(&pf, 1, 0, H - 0.003);
+  prof_seg(&pf, sl[CAN_LID]);
+  int rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
+  prof_free(&pf);
+  outline_free(&ol);
+  return rc;
+}
+
+/* SHAPE_BOTTLE: body D_R x D_H, neck radius D_R2 */
+static int build_bottle(builder *b, const shape *s, double h) {
+  slot_use sl[BOTTLE_SLOTS];
+  b_slots(b, s, 0, BOTTLE_SLOTS, sl);
+  double R = s->d[D_R], H = s->d[D_H], rn = s->d[D_R2], rcap = rn + 0.0015, hc = 0.02;
+  double zs = H * 0.62, zn = H * 0.84, zl0 = H * 0.25, zl1 = H * 0.50;
+  outline ol = {0};
+  profile pf;
+  if (outline_circle(&ol, R, h)) return -1;
+  prof_init(&pf, 0, h);
+  prof_push(&pf, 1, 0, 0.003);
+  prof_line(&pf, 1, R - 0.006, 0);
+  prof_seg(&pf, sl[BOTTLE_BOTTOM]);
+  prof_arc(&pf, R - 0.006, 0.006, 0.006, -0.5 * M_PI, 0, 3);
+  prof_line(&pf, 1, R, zl0);
+  prof_seg(&pf, sl[BOTTLE_BODY]);
+  prof_line(&pf, 1, R, zl1);
+  prof_seg(&pf, sl[BOTTLE_LABEL]);
+  prof_line(&pf, 1, R, zs);
+  /* the shoulder: a half cosine from the body in to the neck */
+  size_t n = nseg(hypot(R - rn, zn - zs) * 1.2, h, 6);
+  for (size_t k = 1; k <= n; k++) {
+    double t = (double)k / (double)n;
+    prof_push(&pf, 1, rn + (R - rn) * 0.5 * (1 + cos(M_PI * t)), zs + (zn - zs) * t);
+  }
+  prof_seg(&pf, sl[BOTTLE_BODY]);
+  prof_line(&pf, 1, rn, H - hc);
+  prof_seg(&pf, sl[BOTTLE_NECK]);
+  prof_line(&pf, 1, rcap, H - hc);
+  prof_line(&pf, 1, rcap, H - 0.0015);
+  prof_arc(&pf, rcap - 0.0015, H - 0.0015, 0.0015, 0, 0.5 * M_PI, 2);
+  prof_seg(&pf, sl[BOTTLE_CAP]);
+  prof_line(&pf, 1, 0, H);
+  prof_seg(&pf, sl[BOTTLE_CAP]);
+  int rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
+  prof_free(&pf);
+  outline_free(&ol);
+  return rc;
+}
+
+/* peel bumps: a small radial displacement from smooth 3D noise */
+typedef struct peel_disp { double zc, amp; uint64_t seed; } peel_disp;
+static void peel_displace(const void *ctx, double p[3]) {
+  const peel_disp *od = ctx;
   double q[3] = {p[0], p[1], p[2] - od->zc};
   double r = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
   if (r < 1e-9) return;
@@ -625,385 +768,188 @@ static void orange_displace(const void *ctx, double p[3]) {
   p[2] = q[2] * k + od->zc;
 }
 
-/* a rounded slab profile: bottom face, edge round, side, edge round, top
- * face; split at z = zsplit (0: no split) into a lower and an upper part */
-static void prof_slab(profile *pf, double H, double e, double bulge, double zsplit, int p_lo,
-                      int s_lo, int p_bot, int s_bot, int p_hi, int s_hi, int p_top, int s_top) {
-  size_t nf = nseg(pf->rref, pf->h, 2);
-  /* bottom face from the centre out (bulging downward for soft items) */
-  for (size_t k = 0; k <= nf; k++) {
-    double s = (double)k / (double)nf;
-    prof_push(pf, s, -e, 0.0);
+/* SHAPE_SPHEROID: radius D_R, height D_H; the stem end is a cap at the top */
+static int build_spheroid(builder *b, const shape *s, double h) {
+  slot_use sl[SPHEROID_SLOTS];
+  b_slots(b, s, 0, SPHEROID_SLOTS, sl);
+  double R = s->d[D_R], Hz = 0.5 * s->d[D_H], cap = 0.35;
+  outline ol = {0};
+  profile pf;
+  if (outline_circle(&ol, R, h)) return -1;
+  prof_init(&pf, 0, h);
+  size_t n1 = nseg(cap * R, h, 2), n2 = nseg((M_PI - 2 * cap) * R, h, 6);
+  prof_push(&pf, 1, 0, 0);
+  for (size_t k = 1; k <= n1; k++) {
+    double a = -0.5 * M_PI + cap * (double)k / (double)n1;
+    prof_push(&pf, 1, R * cos(a), Hz * (1 + sin(a)));
   }
-  prof_seg(pf, p_bot, s_bot);
-  prof_arc(pf, -e, e, e, -0.5 * M_PI, 0, 2);
-  if (zsplit > e && zsplit < H - e) {
-    prof_line(pf, 1, 0, zsplit);
-    prof_seg(pf, p_lo, s_lo);
-    prof_line(pf, 1, 0, H - e);
-    prof_arc(pf, -e, H - e, e, 0, 0.5 * M_PI, 2);
-    prof_seg(pf, p_hi, s_hi);
-  } else {
-    prof_line(pf, 1, 0, H - e);
-    prof_arc(pf, -e, H - e, e, 0, 0.5 * M_PI, 2);
-    prof_seg(pf, p_lo, s_lo);
+  prof_seg(&pf, sl[SPHEROID_PEEL]);
+  for (size_t k = 1; k <= n2; k++) {
+    double a = -0.5 * M_PI + cap + (M_PI - 2 * cap) * (double)k / (double)n2;
+    prof_push(&pf, 1, R * cos(a), Hz * (1 + sin(a)));
   }
-  /* top face from the rim in to the centre, optionally domed */
-  for (size_t k = 1; k <= nf; k++) {
-    double s = 1 - (double)k / (double)nf;
-    prof_push(pf, s, -e, H + bulge * (1 - s * s));
+  prof_seg(&pf, sl[SPHEROID_PEEL]);
+  for (size_t k = 1; k <= n1; k++) {
+    double a = 0.5 * M_PI - cap + cap * (double)k / (double)n1;
+    prof_push(&pf, 1, k == n1 ? 0 : R * cos(a), Hz * (1 + sin(a)));
   }
-  prof_seg(pf, p_top, s_top);
+  prof_seg(&pf, sl[SPHEROID_STEM]);
+  peel_disp od = {Hz, 0.0004, s->tseed};
+  int rc = sweep_build(b, &ol, &pf, NULL, peel_displace, &od);
+  prof_free(&pf);
+  outline_free(&ol);
+  return rc;
 }
+
+/* SHAPE_KETTLE: body radius D_R and height D_H on a base D_T high */
+static int build_kettle(builder *b, const shape *s, double h) {
+  slot_use sl[KETTLE_SLOTS];
+  b_slots(b, s, 0, KETTLE_SLOTS, sl);
+  double R = s->d[D_R], zb = s->d[D_T], Hb = s->d[D_H], Rt = R * 0.82;
+  outline ol = {0};
+  profile pf;
+  /* base plate */
+  if (outline_circle(&ol, R + 0.01, h)) return -1;
+  prof_init(&pf, 0, h);
+  prof_push(&pf, 1, 0, 0);
+  prof_line(&pf, 1, R + 0.004, 0);
+  prof_seg(&pf, sl[KETTLE_BASE]);
+  prof_arc(&pf, R + 0.004, 0.004, 0.004, -0.5 * M_PI, 0, 2);
+  prof_line(&pf, 1, R + 0.008, zb - 0.004);
+  prof_arc(&pf, R + 0.004, zb - 0.004, 0.004, 0, 0.5 * M_PI, 2);
+  prof_seg(&pf, sl[KETTLE_BASE]);
+  prof_line(&pf, 1, 0, zb);
+  prof_seg(&pf, sl[KETTLE_BASE]);
+  int rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
+  prof_free(&pf);
+  outline_free(&ol);
+  if (rc) return rc;
+  /* body with a domed lid and knob; it floats 0.3 mm above the base so the
+   * two never share a vertex */
+  prof_init(&pf, 0, h);
+  zb += 0.0003;
+  prof_push(&pf, 1, 0, zb);
+  prof_line(&pf, 1, R - 0.01, zb);
+  prof_seg(&pf, sl[KETTLE_BODY]);
+  prof_arc(&pf, R - 0.01, zb + 0.01, 0.01, -0.5 * M_PI, 0, 3);
+  prof_line(&pf, 1, Rt + 0.012, zb + Hb - 0.012);
+  prof_arc(&pf, Rt, zb + Hb - 0.012, 0.012, 0, 0.5 * M_PI, 3);
+  prof_seg(&pf, sl[KETTLE_BODY]);
+  prof_dome(&pf, Rt, zb + Hb, 0.014, 0.012, 0.012, sl[KETTLE_LID], sl[KETTLE_KNOB]);
+  if (outline_circle(&ol, R, h)) {
+    prof_free(&pf);
+    return -1;
+  }
+  rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
+  prof_free(&pf);
+  outline_free(&ol);
+  if (rc) return rc;
+  /* handle at the back, ends inside the body */
+  double z0 = zb + Hb * 0.85, z1 = zb + Hb * 0.25;
+  double rz0 = R - (R - Rt) * 0.85 - 0.015, rz1 = R - (R - Rt) * 0.25 - 0.015;
+  tube_def td;
+  tube_handle(&td, M_PI, rz0, z0, rz1, z1, s->d[D_REACH] * 1.33, 0.012, 0.010);
+  rc = tube_build(b, &td, sl[KETTLE_HANDLE], h);
+  if (rc) return rc;
+  /* spout at the front: up and out, tapering */
+  double zs = zb + Hb * 0.78, rs = R - (R - Rt) * 0.78 - 0.012;
+  tube_def sp = {{{rs, 0, zs}, {rs + 0.03, 0, zs + 0.004}, {rs + 0.04, 0, zs + 0.025},
+                  {rs + 0.045, 0, zs + 0.04}},
+                 {0, 1, 0}, 0.014, 0.008, 0.012, 0.006};
+  return tube_build(b, &sp, sl[KETTLE_SPOUT], h);
+}
+
+/* SHAPE_SLAB: a rounded rectangle D_W x D_L (corner radius D_RC) swept by a
+ * profile D_H high with edge rounds D_E: bottom face, side, top face. The
+ * side is split at D_ZSPLIT (0: none) into SLAB_SIDE and SLAB_UPPER; the top
+ * face domes up by D_BULGE. */
+static int build_slab(builder *b, const shape *s, double h) {
+  slot_use sl[SLAB_SLOTS];
+  b_slots(b, s, 0, SLAB_SLOTS, sl);
+  const double *d = s->d;
+  double A = 0.5 * d[D_W], B = 0.5 * d[D_L], e = d[D_E], bulge = d[D_BULGE];
+  double H = d[D_H] - bulge, zsplit = d[D_ZSPLIT];
+  outline ol = {0};
+  profile pf;
+  if (outline_rrect(&ol, A, B, d[D_RC], h)) return -1;
+  prof_init(&pf, 0.5 * (A + B), h);
+  size_t nf = nseg(pf.rref, pf.h, 2);
+  /* bottom face from the centre out */
+  for (size_t k = 0; k <= nf; k++) {
+    double t = (double)k / (double)nf;
+    prof_push(&pf, t, -e, 0.0);
+  }
+  prof_seg(&pf, sl[SLAB_BOTTOM]);
+  prof_arc(&pf, -e, e, e, -0.5 * M_PI, 0, 2);
+  if (zsplit > e && zsplit < H - e) {
+    prof_line(&pf, 1, 0, zsplit);
+    prof_seg(&pf, sl[SLAB_SIDE]);
+    prof_line(&pf, 1, 0, H - e);
+    prof_arc(&pf, -e, H - e, e, 0, 0.5 * M_PI, 2);
+    prof_seg(&pf, sl[SLAB_UPPER]);
+  } else {
+    prof_line(&pf, 1, 0, H - e);
+    prof_arc(&pf, -e, H - e, e, 0, 0.5 * M_PI, 2);
+    prof_seg(&pf, sl[SLAB_SIDE]);
+  }
+  /* top face from the rim in to the centre */
+  for (size_t k = 1; k <= nf; k++) {
+    double t = 1 - (double)k / (double)nf;
+    prof_push(&pf, t, -e, H + bulge * (1 - t * t));
+  }
+  prof_seg(&pf, sl[SLAB_TOP]);
+  int rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
+  prof_free(&pf);
+  outline_free(&ol);
+  return rc;
+}
+
+/* SHAPE_HEADSET: ear cups of radius D_R, D_T thick, D_W apart, on a band of
+ * half-axes D_A x D_C */
+static int build_headset(builder *b, const shape *s, double h) {
+  slot_use sl[HEADSET_SLOTS];
+  b_slots(b, s, 0, HEADSET_SLOTS, sl);
+  double R = s->d[D_R], T = s->d[D_T], W = s->d[D_W], e = 0.006;
+  outline ol = {0};
+  profile pf;
+  if (outline_circle(&ol, R, h)) return -1;
+  prof_init(&pf, 0, h);
+  prof_push(&pf, 1, 0, 0);
+  prof_line(&pf, 1, R - e, 0);
+  prof_seg(&pf, sl[HEADSET_CUP]);
+  prof_arc(&pf, R - e, e, e, -0.5 * M_PI, 0, 2);
+  prof_line(&pf, 1, R, T - e);
+  prof_seg(&pf, sl[HEADSET_CUP]);
+  prof_arc(&pf, R - e, T - e, e, 0, 0.5 * M_PI, 2);
+  prof_line(&pf, 1, 0, T);
+  prof_seg(&pf, sl[HEADSET_CUSHION]);
+  int rc = 0;
+  for (int k = 0; k < 2 && !rc; k++) {
+    /* cups stand on edge with their axes along x, cushions facing in */
+    double sx = k ? -1.0 : 1.0, x0 = k ? 0.5 * W + 0.5 * T : -0.5 * W - 0.5 * T;
+    double M[12] = {0, 0, sx, x0, 0, 1, 0, 0, -sx, 0, 0, R};
+    rc = sweep_build(b, &ol, &pf, M, NULL, NULL);
+  }
+  prof_free(&pf);
+  outline_free(&ol);
+  if (rc) return rc;
+  /* band over the top, its ends inside the cups */
+  double hw = 0.5 * W, zc = R, k4 = 0.5523 * 2;
+  tube_def td = {{{-hw, 0, zc}, {-hw, 0, zc + hw * k4 * 1.3}, {hw, 0, zc + hw * k4 * 1.3},
+                  {hw, 0, zc}},
+                 {0, 1, 0}, s->d[D_A], s->d[D_A], s->d[D_C], s->d[D_C]};
+  return tube_build(b, &td, sl[HEADSET_BAND], h);
+}
+
+typedef int (*shape_fn)(builder *b, const shape *s, double h);
+static const shape_fn k_shapes[SHAPE_COUNT] = {
+    [SHAPE_VESSEL] = build_vessel, [SHAPE_CAN] = build_can,         [SHAPE_BOTTLE] = build_bottle,
+    [SHAPE_SPHEROID] = build_spheroid, [SHAPE_KETTLE] = build_kettle, [SHAPE_SLAB] = build_slab,
+    [SHAPE_HEADSET] = build_headset};
 
 /* build a shape at edge length h; returns -1 on allocation failure */
 static int shape_build(builder *b, const shape *s, double h) {
-  outline ol = {0};
-  profile pf;
-  int rc = 0;
-  switch (s->cat) {
-  case C_CUP: {
-    int pb = b_part(b, "body"), pbot = b_part(b, "bottom"), prim = b_part(b, "rim");
-    int pin = b_part(b, "inner"), ph = b_part(b, "handle");
-    double R = s->d[D_R], Rb = s->d[D_R2], H = s->d[D_H], tw = s->d[D_T], tb = s->d[D_T2], f = 0.003;
-    if (outline_circle(&ol, R, h)) return -1;
-    prof_init(&pf, 0, h);
-    prof_push(&pf, 1, 0, 0);
-    prof_line(&pf, 1, Rb - f, 0);
-    prof_seg(&pf, pbot, S_UNGLAZED);
-    prof_arc(&pf, Rb - f, f, f, -0.5 * M_PI, 0, 2);
-    prof_line(&pf, 1, R, H - 0.5 * tw);
-    prof_seg(&pf, pb, S_GLAZE);
-    prof_arc(&pf, R - 0.5 * tw, H - 0.5 * tw, 0.5 * tw, 0, M_PI, 3);
-    prof_seg(&pf, prim, S_GLAZE);
-    double rib = Rb - tw + (R - Rb) * tb / H;
-    prof_line(&pf, 1, rib, tb + 0.004);
-    prof_arc(&pf, rib - 0.004, tb + 0.004, 0.004, 0, -0.5 * M_PI, 2);
-    prof_seg(&pf, pin, S_GLAZE);
-    prof_line(&pf, 1, 0, tb);
-    prof_seg(&pf, pin, S_GLAZE);
-    rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
-    prof_free(&pf);
-    if (rc) break;
-    /* handle: ends buried half-way into the wall */
-    double z0 = H * 0.78, z1 = H * 0.28;
-    double r0 = Rb + (R - Rb) * z0 / H - 0.5 * tw, r1 = Rb + (R - Rb) * z1 / H - 0.5 * tw;
-    tube_def td;
-    tube_handle(&td, 0, r0, z0, r1, z1, s->d[D_REACH] * 1.33, s->d[D_A], s->d[D_C]);
-    rc = tube_build(b, &td, ph, S_GLAZE, S_GLAZE, h);
-    break;
-  }
-  case C_CAN: {
-    int pb = b_part(b, "body"), pt = b_part(b, "top"), pbot = b_part(b, "bottom");
-    double R = s->d[D_R], H = s->d[D_H];
-    if (outline_circle(&ol, R, h)) return -1;
-    prof_init(&pf, 0, h);
-    prof_push(&pf, 1, 0, 0.004);
-    prof_line(&pf, 1, R - 0.008, 0.0);
-    prof_seg(&pf, pbot, S_ALU_TOP);
-    prof_line(&pf, 1, R - 0.0065, 0.0);
-    prof_line(&pf, 1, R, 0.010);
-    prof_seg(&pf, pbot, S_ALU);
-    prof_line(&pf, 1, R, H - 0.013);
-    prof_seg(&pf, pb, S_CAN_LABEL);
-    prof_line(&pf, 1, R - 0.0045, H - 0.002);
-    prof_line(&pf, 1, R - 0.0045, H);
-    prof_line(&pf, 1, R - 0.0065, H);
-    prof_line(&pf, 1, R - 0.0065, H - 0.003);
-    prof_seg(&pf, pt, S_ALU);
-    prof_line(&pf, 1, 0, H - 0.003);
-    prof_seg(&pf, pt, S_ALU_TOP);
-    rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
-    prof_free(&pf);
-    break;
-  }
-  case C_BOTTLE: {
-    int pb = b_part(b, "body"), pl = b_part(b, "label"), pn = b_part(b, "neck");
-    int pc = b_part(b, "cap"), pbot = b_part(b, "bottom");
-    double R = s->d[D_R], H = s->d[D_H], rn = s->d[D_R2], rcap = rn + 0.0015, hc = 0.02;
-    double zs = H * 0.62, zn = H * 0.84, zl0 = H * 0.25, zl1 = H * 0.50;
-    if (outline_circle(&ol, R, h)) return -1;
-    prof_init(&pf, 0, h);
-    prof_push(&pf, 1, 0, 0.003);
-    prof_line(&pf, 1, R - 0.006, 0);
-    prof_seg(&pf, pbot, S_CLEAR);
-    prof_arc(&pf, R - 0.006, 0.006, 0.006, -0.5 * M_PI, 0, 3);
-    prof_line(&pf, 1, R, zl0);
-    prof_seg(&pf, pb, S_CLEAR);
-    prof_line(&pf, 1, R, zl1);
-    prof_seg(&pf, pl, S_BOTTLE_LABEL);
-    prof_line(&pf, 1, R, zs);
-    {
-      size_t n = nseg(hypot(R - rn, zn - zs) * 1.2, h, 6);
-      for (size_t k = 1; k <= n; k++) {
-        double t = (double)k / (double)n;
-        prof_push(&pf, 1, rn + (R - rn) * 0.5 * (1 + cos(M_PI * t)), zs + (zn - zs) * t);
-      }
-    }
-    prof_seg(&pf, pb, S_CLEAR);
-    prof_line(&pf, 1, rn, H - hc);
-    prof_seg(&pf, pn, S_CLEAR);
-    prof_line(&pf, 1, rcap, H - hc);
-    prof_line(&pf, 1, rcap, H - 0.0015);
-    prof_arc(&pf, rcap - 0.0015, H - 0.0015, 0.0015, 0, 0.5 * M_PI, 2);
-    prof_seg(&pf, pc, S_CAP);
-    prof_line(&pf, 1, 0, H);
-    prof_seg(&pf, pc, S_CAP);
-    rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
-    prof_free(&pf);
-    break;
-  }
-  case C_ORANGE: {
-    int pp = b_part(b, "peel"), pt = b_part(b, "stem_end");
-    double R = s->d[D_R], Hz = 0.5 * s->d[D_H], cap = 0.35;
-    if (outline_circle(&ol, R, h)) return -1;
-    prof_init(&pf, 0, h);
-    size_t n1 = nseg(cap * R, h, 2), n2 = nseg((M_PI - 2 * cap) * R, h, 6);
-    prof_push(&pf, 1, 0, 0);
-    for (size_t k = 1; k <= n1; k++) {
-      double a = -0.5 * M_PI + cap * (double)k / (double)n1;
-      prof_push(&pf, 1, R * cos(a), Hz * (1 + sin(a)));
-    }
-    prof_seg(&pf, pp, S_PEEL);
-    for (size_t k = 1; k <= n2; k++) {
-      double a = -0.5 * M_PI + cap + (M_PI - 2 * cap) * (double)k / (double)n2;
-      prof_push(&pf, 1, R * cos(a), Hz * (1 + sin(a)));
-    }
-    prof_seg(&pf, pp, S_PEEL);
-    for (size_t k = 1; k <= n1; k++) {
-      double a = 0.5 * M_PI - cap + cap * (double)k / (double)n1;
-      prof_push(&pf, 1, k == n1 ? 0 : R * cos(a), Hz * (1 + sin(a)));
-    }
-    prof_seg(&pf, pt, S_PEEL_TOP);
-    orange_disp od = {Hz, 0.0004, s->tseed};
-    rc = sweep_build(b, &ol, &pf, NULL, orange_displace, &od);
-    prof_free(&pf);
-    break;
-  }
-  case C_PHONE: case C_SPONGE: case C_ERASER: case C_LAPTOP: case C_WALLET: case C_TISSUE:
-  case C_GLASSES: case C_PILLOW: case C_CUSHION: case C_BAG: case C_MOUSE: {
-    double A = 0.5 * s->d[D_W], B = 0.5 * s->d[D_L];
-    if (outline_rrect(&ol, A, B, s->d[D_RC], h)) return -1;
-    prof_init(&pf, 0.5 * (A + B), h);
-    int p1, p2, p3, p4, s1, s2, s3, s4;
-    double zsplit = 0, bulge = 0;
-    switch (s->cat) {
-    case C_PHONE:
-      p3 = b_part(b, "back"); p1 = p2 = b_part(b, "frame"); p4 = b_part(b, "screen");
-      s3 = S_PHONE_BACK; s1 = s2 = S_FRAME; s4 = S_SCREEN;
-      break;
-    case C_SPONGE:
-      p3 = p1 = b_part(b, "foam"); p2 = p4 = b_part(b, "pad");
-      s3 = s1 = S_FOAM; s2 = s4 = S_PAD; zsplit = s->d[D_H2];
-      break;
-    case C_ERASER:
-      p3 = p1 = p4 = b_part(b, "body"); p2 = b_part(b, "sleeve");
-      s3 = s1 = s4 = S_RUBBER; s2 = S_SLEEVE; zsplit = 0;
-      break;
-    case C_LAPTOP:
-      p3 = p1 = b_part(b, "base"); p2 = p4 = b_part(b, "lid");
-      s3 = s1 = S_LAPTOP_BASE; s2 = S_STEEL; s4 = S_LAPTOP_LID; zsplit = s->d[D_H2];
-      break;
-    case C_TISSUE:
-      p3 = p1 = b_part(b, "box"); p4 = p2 = b_part(b, "top");
-      s3 = s1 = S_TISSUE_BOX; s4 = S_TISSUE_TOP; s2 = S_TISSUE_BOX; zsplit = s->d[D_H] * 0.85;
-      break;
-    case C_MOUSE:
-      p3 = b_part(b, "bottom"); p1 = p2 = b_part(b, "side"); p4 = b_part(b, "shell");
-      s3 = S_BLACK; s1 = s2 = S_MOUSE_TOP; s4 = S_MOUSE_TOP;
-      bulge = s->d[D_H] - 0.012;
-      break;
-    case C_GLASSES:
-      p3 = p1 = b_part(b, "shell"); p4 = p2 = b_part(b, "lid");
-      s3 = s1 = s4 = s2 = S_CASE; zsplit = s->d[D_H] * 0.5;
-      break;
-    case C_PILLOW: case C_CUSHION:
-      p3 = p1 = p4 = p2 = b_part(b, "fabric");
-      s3 = s1 = s4 = s2 = s->cat == C_PILLOW ? S_FABRIC : S_FABRIC_CHECK;
-      bulge = s->d[D_H] * 0.25;
-      break;
-    case C_BAG:
-      p3 = p1 = p4 = b_part(b, "bag"); p2 = b_part(b, "zip");
-      s3 = s1 = s4 = S_BAG; s2 = S_BAG_ZIP; zsplit = s->d[D_H] * 0.5;
-      break;
-    default: /* wallet */
-      p3 = p1 = p4 = p2 = b_part(b, "leather");
-      s3 = s1 = s4 = s2 = S_LEATHER;
-      break;
-    }
-    double H = s->d[D_H] - bulge;
-    if (s->cat == C_ERASER) {
-      /* the sleeve covers the middle of the side band */
-      prof_slab(&pf, H, s->d[D_E], 0, H * 0.5, p1, s1, p3, s3, p2, s2, p4, s4);
-    } else {
-      prof_slab(&pf, H, s->d[D_E], bulge, zsplit, p1, s1, p3, s3, p2, s2, p4, s4);
-    }
-    rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
-    prof_free(&pf);
-    break;
-  }
-  case C_KETTLE: {
-    int pbase = b_part(b, "base"), pb = b_part(b, "body"), pl = b_part(b, "lid");
-    int ph = b_part(b, "handle"), psp = b_part(b, "spout");
-    int sb = s->d[D_VARIANT] ? S_STEEL : S_PLAIN;
-    double R = s->d[D_R], zb = s->d[D_T], Hb = s->d[D_H2], Rt = R * 0.82;
-    /* base plate */
-    if (outline_circle(&ol, R + 0.01, h)) return -1;
-    prof_init(&pf, 0, h);
-    prof_push(&pf, 1, 0, 0);
-    prof_line(&pf, 1, R + 0.004, 0);
-    prof_seg(&pf, pbase, S_BLACK);
-    prof_arc(&pf, R + 0.004, 0.004, 0.004, -0.5 * M_PI, 0, 2);
-    prof_line(&pf, 1, R + 0.008, zb - 0.004);
-    prof_arc(&pf, R + 0.004, zb - 0.004, 0.004, 0, 0.5 * M_PI, 2);
-    prof_seg(&pf, pbase, S_BLACK);
-    prof_line(&pf, 1, 0, zb);
-    prof_seg(&pf, pbase, S_BLACK);
-    rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
-    prof_free(&pf);
-    if (rc) break;
-    /* body with a domed lid and knob */
-    prof_init(&pf, 0, h);
-    /* the body floats 0.3 mm above the base so the two never share a vertex */
-    zb += 0.0003;
-    prof_push(&pf, 1, 0, zb);
-    prof_line(&pf, 1, R - 0.01, zb);
-    prof_seg(&pf, pb, sb);
-    prof_arc(&pf, R - 0.01, zb + 0.01, 0.01, -0.5 * M_PI, 0, 3);
-    prof_line(&pf, 1, Rt + 0.012, zb + Hb - 0.012);
-    prof_arc(&pf, Rt, zb + Hb - 0.012, 0.012, 0, 0.5 * M_PI, 3);
-    prof_seg(&pf, pb, sb);
-    {
-      size_t n = nseg(Rt, h, 4);
-      double rk = 0.014, hd = 0.012;
-      for (size_t k = 1; k <= n; k++) {
-        double t = (double)k / (double)n, r = Rt + (rk - Rt) * t;
-        prof_push(&pf, 1, r, zb + Hb + hd * sin(0.5 * M_PI * t));
-      }
-      prof_seg(&pf, pl, sb);
-      prof_line(&pf, 1, rk, zb + Hb + hd + 0.012);
-      prof_seg(&pf, pl, S_BLACK);
-      prof_line(&pf, 1, 0, zb + Hb + hd + 0.012);
-      prof_seg(&pf, pl, S_BLACK);
-    }
-    double Rr = R, Rmid = R;
-    ol.n = 0;
-    outline_free(&ol);
-    if (outline_circle(&ol, Rr, h)) {
-      prof_free(&pf);
-      return -1;
-    }
-    rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
-    prof_free(&pf);
-    if (rc) break;
-    (void)Rmid;
-    /* handle at the back, ends inside the body */
-    double z0 = zb + Hb * 0.85, z1 = zb + Hb * 0.25;
-    double rz0 = R - (R - Rt) * 0.85 - 0.015, rz1 = R - (R - Rt) * 0.25 - 0.015;
-    tube_def td;
-    tube_handle(&td, M_PI, rz0, z0, rz1, z1, s->d[D_REACH] * 1.33, 0.012, 0.010);
-    rc = tube_build(b, &td, ph, S_BLACK, S_BLACK, h);
-    if (rc) break;
-    /* spout at the front: up and out, tapering */
-    double zs = zb + Hb * 0.78, rs = R - (R - Rt) * 0.78 - 0.012;
-    tube_def sp = {{{rs, 0, zs}, {rs + 0.03, 0, zs + 0.004}, {rs + 0.04, 0, zs + 0.025},
-                    {rs + 0.045, 0, zs + 0.04}},
-                   {0, 1, 0}, 0.014, 0.008, 0.012, 0.006};
-    rc = tube_build(b, &sp, psp, sb, sb, h);
-    break;
-  }
-  case C_POT: {
-    int pb = b_part(b, "body"), pbot = b_part(b, "bottom"), prim = b_part(b, "rim");
-    int pin = b_part(b, "inner"), ph = b_part(b, "handle");
-    double R = s->d[D_R], H = s->d[D_H2], tw = s->d[D_T], tb = 0.005;
-    if (outline_circle(&ol, R + 0.004, h)) return -1;
-    prof_init(&pf, 0, h);
-    prof_push(&pf, 1, 0, 0);
-    prof_line(&pf, 1, R - 0.008, 0);
-    prof_seg(&pf, pbot, S_STEEL_DARK);
-    prof_arc(&pf, R - 0.008, 0.008, 0.008, -0.5 * M_PI, 0, 3);
-    prof_line(&pf, 1, R, H - 0.5 * tw);
-    prof_seg(&pf, pb, S_STEEL);
-    prof_arc(&pf, R - 0.5 * tw, H - 0.5 * tw, 0.5 * tw, 0, M_PI, 3);
-    prof_seg(&pf, prim, S_STEEL);
-    prof_line(&pf, 1, R - tw, tb + 0.006);
-    prof_arc(&pf, R - tw - 0.006, tb + 0.006, 0.006, 0, -0.5 * M_PI, 2);
-    prof_seg(&pf, pin, S_STEEL_DARK);
-    prof_line(&pf, 1, 0, tb);
-    prof_seg(&pf, pin, S_STEEL_DARK);
-    rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
-    prof_free(&pf);
-    if (rc) break;
-    for (int k = 0; k < 2; k++) {
-      double zh = H - 0.025;
-      tube_def td;
-      tube_handle(&td, k * M_PI, R - 0.5 * tw, zh + 0.011, R - 0.5 * tw, zh - 0.011, 0.035,
-                  0.009, 0.0045);
-      rc = tube_build(b, &td, ph, S_BLACK, S_BLACK, h);
-      if (rc) break;
-    }
-    if (rc || !s->d[D_VARIANT]) break;
-    /* lid resting on the rim */
-    int pl = b_part(b, "lid");
-    double Rl = R + 0.002, zl = H + 0.0002;
-    prof_init(&pf, 0, h);
-    prof_push(&pf, 1, 0, zl);
-    prof_line(&pf, 1, Rl, zl);
-    prof_seg(&pf, pl, S_STEEL);
-    prof_line(&pf, 1, Rl, zl + 0.004);
-    {
-      size_t n = nseg(Rl, h, 4);
-      double rk = 0.016, hd = 0.015;
-      for (size_t k = 1; k <= n; k++) {
-        double t = (double)k / (double)n;
-        prof_push(&pf, 1, Rl + (rk - Rl) * t, zl + 0.004 + hd * sin(0.5 * M_PI * t));
-      }
-      prof_seg(&pf, pl, S_STEEL);
-      prof_line(&pf, 1, rk, zl + 0.004 + hd + 0.02);
-      prof_seg(&pf, pl, S_BLACK);
-      prof_line(&pf, 1, 0, zl + 0.004 + hd + 0.02);
-      prof_seg(&pf, pl, S_BLACK);
-    }
-    rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
-    prof_free(&pf);
-    break;
-  }
-  case C_HEADSET: {
-    int pcup = b_part(b, "cup"), pcu = b_part(b, "cushion"), pband = b_part(b, "band");
-    double R = s->d[D_R], T = s->d[D_T], e = 0.006;
-    if (outline_circle(&ol, R, h)) return -1;
-    prof_init(&pf, 0, h);
-    prof_push(&pf, 1, 0, 0);
-    prof_line(&pf, 1, R - e, 0);
-    prof_seg(&pf, pcup, S_BLACK);
-    prof_arc(&pf, R - e, e, e, -0.5 * M_PI, 0, 2);
-    prof_line(&pf, 1, R, T - e);
-    prof_seg(&pf, pcup, S_BLACK);
-    prof_arc(&pf, R - e, T - e, e, 0, 0.5 * M_PI, 2);
-    prof_line(&pf, 1, 0, T);
-    prof_seg(&pf, pcu, S_CUSHION_PAD);
-    for (int k = 0; k < 2; k++) {
-      /* cups stand on edge with their axes along x, cushions facing in */
-      double sx = k ? -1.0 : 1.0, x0 = k ? 0.5 * s->d[D_W] + 0.5 * T : -0.5 * s->d[D_W] - 0.5 * T;
-      double M[12] = {0, 0, sx, x0, 0, 1, 0, 0, -sx, 0, 0, R};
-      rc = sweep_build(b, &ol, &pf, M, NULL, NULL);
-      if (rc) break;
-    }
-    prof_free(&pf);
-    if (rc) break;
-    /* band over the top, its ends inside the cups */
-    double hw = 0.5 * s->d[D_W], zc = R, k4 = 0.5523 * 2;
-    tube_def td = {{{-hw, 0, zc}, {-hw, 0, zc + hw * k4 * 1.3}, {hw, 0, zc + hw * k4 * 1.3},
-                    {hw, 0, zc}},
-                   {0, 1, 0}, s->d[D_A], s->d[D_A], s->d[D_C], s->d[D_C]};
-    rc = tube_build(b, &td, pband, S_BLACK, S_BLACK, h);
-    break;
-  }
-  default:
-    rc = -1;
-  }
-  outline_free(&ol);
-  return rc;
+  return k_shapes[s->cat->shape](b, s, h);
 }
 
 /* ---- UV packing ---------------------------------------------------------- */
@@ -1104,7 +1050,7 @@ static void shade(const shape *s, const patch *p, double x, double y, double out
   switch (p->style) {
   case S_GLAZE:
     setc(out, 0.93, 0.93, 0.91);
-    if (s->d[D_VARIANT] && p->kind == K_STRIP && s->cat == C_CUP && p->part == 0) {
+    if (s->d[D_VARIANT] && p->kind == K_STRIP && p->part == 0) {
       /* a coloured band round the body */
       double t = ly / p->h;
       if (t > 0.55 && t < 0.70) mixc(out, out, s->col[0], 0.85);
@@ -1396,7 +1342,7 @@ hearth_status synth_object_make(const char *category, uint64_t seed, size_t targ
   hearth_rng_seed(&root, seed);
   hearth_rng_fork(&root, 0x6f626a00u + (uint64_t)cat, &r);
   shape s;
-  shape_draw(&s, cat, &r);
+  shape_draw(&s, sc, &r);
 
   /* edge length by bisection on log(h) against the counted triangles */
   int fail = 0;
@@ -1463,8 +1409,8 @@ hearth_status synth_object_make(const char *category, uint64_t seed, size_t targ
   obj_extent(obj);
   switch (sc->fill) {
   case FILL_DRAWN: obj->fill_level = s.d[D_FILL]; break;
-  case FILL_DEPTH: obj->fill_level = s.d[D_H2] * s.d[D_FILL] / obj->height; break;
-  case FILL_ABOVE_BASE: obj->fill_level = (s.d[D_T] + s.d[D_H2] * s.d[D_FILL]) / obj->height; break;
+  case FILL_DEPTH: obj->fill_level = s.d[D_H] * s.d[D_FILL] / obj->height; break;
+  case FILL_ABOVE_BASE: obj->fill_level = (s.d[D_T] + s.d[D_H] * s.d[D_FILL]) / obj->height; break;
   }
 
   st = hearth_image_alloc(&obj->albedo, texture_size, texture_size, 3, HEARTH_PIX_U8, err);
