@@ -18,6 +18,52 @@ static const double k_pastel[6][3] = {{0.92, 0.90, 0.85}, {0.80, 0.86, 0.93},
 const synth_palette synth_palettes[PAL_COUNT] = {
     [PAL_VIVID] = {k_vivid, 8}, [PAL_DARK] = {k_dark, 6}, [PAL_PASTEL] = {k_pastel, 6}};
 
+/* ---- materials ------------------------------------------------------------------ */
+
+#define RGB(r, g, b) .base = BASE_RGB, .rgb = {r, g, b}
+#define COL(k) .base = BASE_SLOT, .slot = k
+#define GRAIN(amp) .grain = amp, .grain_size = 0.01, .grain_octaves = 3
+#define FINE_GRAIN(amp) .grain = amp, .grain_size = 0.002, .grain_octaves = 2
+
+/* stream: each material's original number, which its noise is seeded by */
+const synth_material synth_materials[S_COUNT] = {
+    [S_PLAIN] = {0, RGB(0.94, 0.94, 0.93), GRAIN(0.02)},
+    [S_GLAZE] = {1, RGB(0.93, 0.93, 0.91), GRAIN(0.015)},
+    [S_GLAZE_BAND] = {1, RGB(0.93, 0.93, 0.91), .band = {0.55, 0.70, 0.85}, GRAIN(0.015)},
+    [S_UNGLAZED] = {2, RGB(0.82, 0.76, 0.66), GRAIN(0.04)},
+    [S_CAN_LABEL] = {3, COL(0), .pattern = PAT_CAN_LABEL},
+    [S_ALU] = {4, .pattern = PAT_ALU, .param = 0.74},
+    [S_ALU_TOP] = {5, .pattern = PAT_ALU, .param = 0.74, .alt = 1},
+    [S_CLEAR] = {6, RGB(0.78, 0.86, 0.88), GRAIN(0.03)},
+    [S_BOTTLE_LABEL] = {7, COL(0), .pattern = PAT_BOTTLE_LABEL},
+    [S_CAP] = {8, COL(1), .pattern = PAT_RIBS},
+    [S_PEEL] = {9, RGB(0.96, 0.55, 0.10), .pattern = PAT_PEEL},
+    [S_PEEL_TOP] = {10, RGB(0.96, 0.55, 0.10), .pattern = PAT_PEEL, .alt = 1},
+    [S_SCREEN] = {11, .pattern = PAT_SCREEN},
+    [S_FRAME] = {12, .pattern = PAT_FRAME},
+    [S_PHONE_BACK] = {13, COL(0), GRAIN(0.01), .pattern = PAT_CAMERA},
+    [S_FOAM] = {14, RGB(0.97, 0.82, 0.22), .pattern = PAT_PORES},
+    [S_PAD] = {15, RGB(0.12, 0.45, 0.18), .pattern = PAT_FIBRES},
+    [S_STEEL] = {16, .pattern = PAT_BRUSHED, .param = 0.72},
+    [S_STEEL_DARK] = {17, .pattern = PAT_BRUSHED, .param = 0.55},
+    [S_BLACK] = {18, RGB(0.07, 0.07, 0.075), GRAIN(0.015)},
+    [S_MOUSE_TOP] = {19, COL(0), .pattern = PAT_MOUSE},
+    [S_RUBBER] = {20, RGB(0.95, 0.95, 0.93), GRAIN(0.02)},
+    [S_SLEEVE] = {21, COL(0), .pattern = PAT_PRINT, .param = 0.003},
+    [S_LAPTOP_LID] = {22, RGB(0.70, 0.71, 0.73), .pattern = PAT_LOGO},
+    [S_LAPTOP_BASE] = {23, RGB(0.60, 0.61, 0.63), .pattern = PAT_FEET},
+    [S_LEATHER] = {24, .base = BASE_MIX, .slot = 0, .rgb = {0.40, 0.22, 0.10}, .mix = 0.5,
+                   FINE_GRAIN(0.05), .pattern = PAT_STITCHES},
+    [S_TISSUE_BOX] = {25, COL(0), .pattern = PAT_FLOWERS},
+    [S_TISSUE_TOP] = {26, COL(0), .pattern = PAT_OPENING},
+    [S_CASE] = {27, COL(0), GRAIN(0.03)},
+    [S_FABRIC] = {28, COL(0), .pattern = PAT_WEAVE},
+    [S_FABRIC_CHECK] = {29, COL(1), .pattern = PAT_WEAVE, .alt = 1},
+    [S_BAG] = {30, RGB(0.86, 0.89, 0.92), GRAIN(0.03)},
+    [S_BAG_ZIP] = {31, RGB(0.86, 0.89, 0.92), .pattern = PAT_ZIP},
+    [S_CUSHION_PAD] = {32, RGB(0.16, 0.16, 0.17), FINE_GRAIN(0.04)},
+};
+
 /* ---- the table ------------------------------------------------------------------- */
 
 #define RANGE(d, lo, hi) {DRAW_RANGE, d, 0, 0, lo, hi}
@@ -39,7 +85,8 @@ const synth_category synth_categories[SYNTH_N_CATEGORIES] = {
               RANGE(D_C, 0.0032, 0.0040), RANGE(D_REACH, 0.033, 0.040), RANGE(D_FILL, 0.78, 0.88),
               FLAG(D_VARIANT, 0.5)},
      .shape = SHAPE_VESSEL,
-     .slots = {[VESSEL_BODY] = SLOT("body", S_GLAZE), [VESSEL_BOTTOM] = SLOT("bottom", S_UNGLAZED),
+     .slots = {[VESSEL_BODY] = SLOT2("body", S_GLAZE, S_GLAZE_BAND),
+               [VESSEL_BOTTOM] = SLOT("bottom", S_UNGLAZED),
                [VESSEL_RIM] = SLOT("rim", S_GLAZE), [VESSEL_INNER] = SLOT("inner", S_GLAZE),
                [VESSEL_HANDLE] = SLOT("handle", S_GLAZE)},
      .vessel = {.foot = 0.003, .foot_steps = 2, .inner_round = 0.004, .mug = {0.78, 0.28, 1.33}},

@@ -76,13 +76,70 @@ typedef enum synth_fill {
 
 /* ---- shapes ------------------------------------------------------------------ */
 
-/* Albedo styles (the materials of synth_objects.c's shader). */
+/* ---- materials ------------------------------------------------------------- */
+
+/* Albedo styles: indices of synth_materials. */
 enum {
   S_PLAIN, S_GLAZE, S_UNGLAZED, S_CAN_LABEL, S_ALU, S_ALU_TOP, S_CLEAR, S_BOTTLE_LABEL, S_CAP,
   S_PEEL, S_PEEL_TOP, S_SCREEN, S_FRAME, S_PHONE_BACK, S_FOAM, S_PAD, S_STEEL, S_STEEL_DARK,
   S_BLACK, S_MOUSE_TOP, S_RUBBER, S_SLEEVE, S_LAPTOP_LID, S_LAPTOP_BASE, S_LEATHER, S_TISSUE_BOX,
-  S_TISSUE_TOP, S_CASE, S_FABRIC, S_FABRIC_CHECK, S_BAG, S_BAG_ZIP, S_CUSHION_PAD, S_COUNT
+  S_TISSUE_TOP, S_CASE, S_FABRIC, S_FABRIC_CHECK, S_BAG, S_BAG_ZIP, S_CUSHION_PAD, S_GLAZE_BAND,
+  S_COUNT
 };
+
+/* where a material's colour starts */
+typedef enum synth_base {
+  BASE_NONE, /* the pattern paints it all */
+  BASE_RGB,  /* rgb */
+  BASE_SLOT, /* the instance's colour slot `slot` */
+  BASE_MIX,  /* colour slot `slot` blended towards rgb by `mix` */
+} synth_base;
+
+/* what is drawn over the base and grain (the shader's code); x, y are the
+ * island's native coordinates in metres */
+typedef enum synth_pattern {
+  PAT_NONE,
+  PAT_CAN_LABEL,    /* rims, a band of slot 1, a logo block with white lettering, small print */
+  PAT_ALU,          /* radially brushed metal of brightness `param`; `alt`: the opening tab */
+  PAT_BOTTLE_LABEL, /* white edges, white print across the middle */
+  PAT_RIBS,         /* grip ribs round a strip */
+  PAT_PEEL,         /* peel pores; `alt`: the stem spot */
+  PAT_SCREEN,       /* black glass, the lit display inside the bezel, the camera */
+  PAT_FRAME,        /* metal tinted by slot 0 */
+  PAT_CAMERA,       /* a phone's camera island */
+  PAT_PORES,        /* foam pores */
+  PAT_FIBRES,       /* scouring-pad fibres */
+  PAT_BRUSHED,      /* linearly brushed metal of brightness `param` */
+  PAT_MOUSE,        /* the buttons' split and the wheel */
+  PAT_PRINT,        /* white print of line height `param` */
+  PAT_LOGO,         /* a round logo in the middle */
+  PAT_FEET,         /* four feet near the corners */
+  PAT_STITCHES,     /* a stitched seam round the faces */
+  PAT_FLOWERS,      /* blotches of slot 1 */
+  PAT_OPENING,      /* white tissue in an oval opening */
+  PAT_WEAVE,        /* fabric weave; `alt`: a check */
+  PAT_ZIP,          /* a zip of slot 0 along the middle of a strip */
+} synth_pattern;
+
+/* The colour of a surface point: base, then a band round strips, then the
+ * grain (fbm noise of cell grain_size metres) added, then the pattern. */
+typedef struct synth_material {
+  int stream;         /* seeds the material's noise: texture seed + 977 * stream */
+  synth_base base;
+  double rgb[3];
+  int slot;
+  double mix;
+  double band[3];     /* a band of slot 0 between heights band[0] and band[1] (fractions of a
+                         strip), blended in by band[2]; band[2] = 0: none */
+  double grain;       /* amplitude; 0: none */
+  double grain_size;
+  int grain_octaves;
+  synth_pattern pattern;
+  double param;
+  int alt;
+} synth_material;
+
+extern const synth_material synth_materials[S_COUNT];
 
 /* The shape builders (synth_objects.c); each names the slots it fills. */
 typedef enum synth_shape {

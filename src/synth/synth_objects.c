@@ -1030,6 +1030,9 @@ static void setc(double out[3], double r, double g, double b) {
   out[1] = g;
   out[2] = b;
 }
+static void copyc(double out[3], const double a[3]) { memcpy(out, a, 3 * sizeof(double)); }
+
+static const double k_white[3] = {1, 1, 1};
 
 /* a text-like block pattern: rows of short dark bars */
 static double textish(uint64_t seed, double x, double y, double lh) {
@@ -1042,101 +1045,80 @@ static double textish(uint64_t seed, double x, double y, double lh) {
   return (fx > 0.1 && fx < 0.92) ? 1 : 0;
 }
 
-/* colour of native point (x, y) of an island; texture detail from s->tseed */
-static void shade(const shape *s, const patch *p, double x, double y, double out[3]) {
-  uint64_t ts = s->tseed + (uint64_t)p->style * 977;
-  double n1 = synth_fbm2(ts, x / 0.01, y / 0.01, 3);
+/* the grain most metal and peel patterns mix in */
+static double coarse_grain(uint64_t ts, double x, double y) {
+  return synth_fbm2(ts, x / 0.01, y / 0.01, 3);
+}
+
+/* pattern m->pattern at native point (x, y), (lx, ly) from the island's
+ * corner, over the base colour in out */
+static void draw_pattern(const shape *s, const patch *p, const synth_material *m, uint64_t ts,
+                         double x, double y, double out[3]) {
+  const double *d = s->d;
   double lx = x - p->ox, ly = y - p->oy;
-  switch (p->style) {
-  case S_GLAZE:
-    setc(out, 0.93, 0.93, 0.91);
-    if (s->d[D_VARIANT] && p->kind == K_STRIP && p->part == 0) {
-      /* a coloured band round the body */
-      double t = ly / p->h;
-      if (t > 0.55 && t < 0.70) mixc(out, out, s->col[0], 0.85);
-    }
-    for (int k = 0; k < 3; k++) out[k] += 0.015 * n1;
-    break;
-  case S_UNGLAZED:
-    setc(out, 0.82, 0.76, 0.66);
-    for (int k = 0; k < 3; k++) out[k] += 0.04 * n1;
-    break;
-  case S_CAN_LABEL: {
+  switch (m->pattern) {
+  case PAT_NONE: break;
+  case PAT_CAN_LABEL: {
     double t = ly / p->h, u = lx / p->w;
-    mixc(out, s->col[0], s->col[0], 0);
     if (t < 0.08 || t > 0.92) setc(out, 0.75, 0.76, 0.78);
-    else if (fabs(t - 0.3) < 0.04) mixc(out, s->col[1], s->col[1], 0);
+    else if (fabs(t - 0.3) < 0.04) copyc(out, s->col[1]);
     else if (t > 0.42 && t < 0.75 && u > 0.1 && u < 0.45) {
       /* a logo block with white lettering */
       double q = textish(ts, lx, ly, 0.012);
-      mixc(out, s->col[0], (const double[3]){1, 1, 1}, q);
+      mixc(out, s->col[0], k_white, q);
     } else if (t > 0.45 && t < 0.65 && u > 0.6 && u < 0.9) {
       double q = textish(ts + 5, lx, ly, 0.004);
       mixc(out, out, (const double[3]){0.05, 0.05, 0.05}, q * 0.8);
     }
     break;
   }
-  case S_ALU:
-  case S_ALU_TOP: {
+  case PAT_ALU: {
     double r = hypot(x, y);
-    double v = 0.74 + 0.05 * synth_noise2(ts, r / 0.0006, 0.5) + 0.02 * n1;
+    double v = m->param + 0.05 * synth_noise2(ts, r / 0.0006, 0.5) + 0.02 * coarse_grain(ts, x, y);
     setc(out, v, v + 0.005, v + 0.015);
-    if (p->style == S_ALU_TOP && p->kind == K_DISK && x > 0.004 && x < 0.02 && fabs(y) < 0.006)
-      setc(out, 0.55, 0.56, 0.58); /* tab */
+    if (m->alt && p->kind == K_DISK && x > 0.004 && x < 0.02 && fabs(y) < 0.006)
+      setc(out, 0.55, 0.56, 0.58);
     break;
   }
-  case S_CLEAR:
-    setc(out, 0.78, 0.86, 0.88);
-    for (int k = 0; k < 3; k++) out[k] += 0.03 * n1;
-    break;
-  case S_BOTTLE_LABEL: {
+  case PAT_BOTTLE_LABEL: {
     double t = ly / p->h;
-    mixc(out, s->col[0], s->col[0], 0);
     if (t < 0.12 || t > 0.88) setc(out, 0.95, 0.95, 0.95);
     double q = textish(ts, lx, ly, 0.008);
-    if (t > 0.3 && t < 0.7) mixc(out, out, (const double[3]){1, 1, 1}, q);
+    if (t > 0.3 && t < 0.7) mixc(out, out, k_white, q);
     break;
   }
-  case S_CAP: {
-    mixc(out, s->col[1], s->col[1], 0);
+  case PAT_RIBS:
     if (p->kind == K_STRIP) {
       double rib = 0.5 + 0.5 * sin(lx / 0.0008 * 2 * M_PI);
       for (int k = 0; k < 3; k++) out[k] *= 0.85 + 0.15 * rib;
     }
     break;
-  }
-  case S_PEEL:
-  case S_PEEL_TOP: {
-    setc(out, 0.96, 0.55, 0.10);
+  case PAT_PEEL: {
     double pores = synth_noise2(ts, x / 0.0009, y / 0.0009);
-    double k = 0.06 * n1 - (pores > 0.55 ? 0.12 * (pores - 0.55) / 0.45 : 0);
-    for (int m = 0; m < 3; m++) out[m] += k * out[m] * 2;
-    if (p->style == S_PEEL_TOP) {
-      double r = hypot(x, y);
-      if (r < 0.004) mixc(out, out, (const double[3]){0.35, 0.40, 0.12}, 1 - r / 0.004);
-    }
+    double k = 0.06 * coarse_grain(ts, x, y) - (pores > 0.55 ? 0.12 * (pores - 0.55) / 0.45 : 0);
+    for (int c = 0; c < 3; c++) out[c] += k * out[c] * 2;
+    double r = hypot(x, y);
+    if (m->alt && r < 0.004) mixc(out, out, (const double[3]){0.35, 0.40, 0.12}, 1 - r / 0.004);
     break;
   }
-  case S_SCREEN: {
-    double A = 0.5 * s->d[D_W] - s->d[D_E] - 0.0025, B = 0.5 * s->d[D_L] - s->d[D_E] - 0.004;
+  case PAT_SCREEN: {
+    double A = 0.5 * d[D_W] - d[D_E] - 0.0025, B = 0.5 * d[D_L] - d[D_E] - 0.004;
     if (fabs(x) < A && fabs(y) < B) {
       double g = 0.04 + 0.03 * (x / A + y / B + 2) / 4;
       setc(out, g, g, g + 0.01);
     } else {
       setc(out, 0.02, 0.02, 0.02);
     }
-    if (hypot(x, y - (0.5 * s->d[D_L] - 0.009)) < 0.0018) setc(out, 0.10, 0.10, 0.14);
+    if (hypot(x, y - (0.5 * d[D_L] - 0.009)) < 0.0018) setc(out, 0.10, 0.10, 0.14);
     break;
   }
-  case S_FRAME: {
-    double v = 0.55 + 0.04 * n1;
+  case PAT_FRAME: {
+    double v = 0.55 + 0.04 * coarse_grain(ts, x, y);
     mixc(out, s->col[0], (const double[3]){v, v, v}, 0.6);
     break;
   }
-  case S_PHONE_BACK: {
-    mixc(out, s->col[0], s->col[0], 0);
-    for (int k = 0; k < 3; k++) out[k] += 0.01 * n1;
-    double cx = -(0.5 * s->d[D_W] - 0.02), cy = 0.5 * s->d[D_L] - 0.02;
+  case PAT_CAMERA: {
+    double cx = -(0.5 * d[D_W] - 0.02), cy = 0.5 * d[D_L] - 0.02;
     if (fabs(x - cx) < 0.015 && fabs(y - cy) < 0.015) {
       mixc(out, out, (const double[3]){0.15, 0.15, 0.16}, 0.7);
       for (int l = 0; l < 2; l++)
@@ -1145,110 +1127,86 @@ static void shade(const shape *s, const patch *p, double x, double y, double out
     }
     break;
   }
-  case S_FOAM: {
-    setc(out, 0.97, 0.82, 0.22);
+  case PAT_PORES: {
     double pores = synth_noise2(ts, x / 0.0007, y / 0.0007);
     if (pores > 0.5) mixc(out, out, (const double[3]){0.75, 0.58, 0.10}, (pores - 0.5) * 1.6);
     break;
   }
-  case S_PAD: {
-    setc(out, 0.12, 0.45, 0.18);
+  case PAT_FIBRES: {
     double f = synth_noise2(ts, x / 0.0004, y / 0.003) * 0.5 +
                synth_noise2(ts + 9, x / 0.003, y / 0.0004) * 0.5;
     for (int k = 0; k < 3; k++) out[k] *= 0.8 + 0.35 * f;
     break;
   }
-  case S_STEEL:
-  case S_STEEL_DARK: {
-    double v = (p->style == S_STEEL ? 0.72 : 0.55) +
-               0.06 * synth_noise2(ts, lx / 0.03, ly / 0.0004) + 0.03 * n1;
+  case PAT_BRUSHED: {
+    double v = m->param + 0.06 * synth_noise2(ts, lx / 0.03, ly / 0.0004) +
+               0.03 * coarse_grain(ts, x, y);
     if (p->kind == K_STRIP) v += 0.08 * sin(2 * M_PI * lx / p->w * 2);
     setc(out, v, v + 0.005, v + 0.012);
     break;
   }
-  case S_BLACK:
-    setc(out, 0.07, 0.07, 0.075);
-    for (int k = 0; k < 3; k++) out[k] += 0.015 * n1;
+  case PAT_MOUSE:
+    if (p->kind == K_DISK && fabs(x) < 0.0006 && y > d[D_L] * 0.1) setc(out, 0.02, 0.02, 0.02);
+    if (p->kind == K_DISK && hypot(x, y - d[D_L] * 0.3) < 0.004) setc(out, 0.2, 0.2, 0.22);
     break;
-  case S_MOUSE_TOP: {
-    mixc(out, s->col[0], s->col[0], 0);
-    if (p->kind == K_DISK && fabs(x) < 0.0006 && y > s->d[D_L] * 0.1) setc(out, 0.02, 0.02, 0.02);
-    if (p->kind == K_DISK && hypot(x, y - s->d[D_L] * 0.3) < 0.004) setc(out, 0.2, 0.2, 0.22);
-    break;
-  }
-  case S_RUBBER:
-    setc(out, 0.95, 0.95, 0.93);
-    for (int k = 0; k < 3; k++) out[k] += 0.02 * n1;
-    break;
-  case S_SLEEVE: {
-    mixc(out, s->col[0], s->col[0], 0);
-    double q = textish(ts, lx, ly, 0.003);
-    mixc(out, out, (const double[3]){1, 1, 1}, q);
-    break;
-  }
-  case S_LAPTOP_LID:
-    setc(out, 0.70, 0.71, 0.73);
+  case PAT_PRINT: mixc(out, out, k_white, textish(ts, lx, ly, m->param)); break;
+  case PAT_LOGO:
     if (hypot(x, y) < 0.012) setc(out, 0.82, 0.83, 0.85);
     break;
-  case S_LAPTOP_BASE:
-    setc(out, 0.60, 0.61, 0.63);
-    if (p->kind == K_DISK && fabs(fabs(x) - 0.5 * s->d[D_W] + 0.03) < 0.008 &&
-        fabs(fabs(y) - 0.5 * s->d[D_L] + 0.03) < 0.008)
+  case PAT_FEET:
+    if (p->kind == K_DISK && fabs(fabs(x) - 0.5 * d[D_W] + 0.03) < 0.008 &&
+        fabs(fabs(y) - 0.5 * d[D_L] + 0.03) < 0.008)
       setc(out, 0.1, 0.1, 0.1);
     break;
-  case S_LEATHER: {
-    mixc(out, s->col[0], (const double[3]){0.40, 0.22, 0.10}, 0.5);
-    for (int k = 0; k < 3; k++) out[k] += 0.05 * synth_fbm2(ts, x / 0.002, y / 0.002, 2);
+  case PAT_STITCHES:
     if (p->kind == K_DISK) {
-      double dx = 0.5 * s->d[D_W] - s->d[D_E] - fabs(x), dy = 0.5 * s->d[D_L] - s->d[D_E] - fabs(y);
-      double d = fmin(dx, dy);
-      if (d > 0.003 && d < 0.0038 && fmod(fabs(x + y) / 0.003, 1.0) < 0.6)
+      double dx = 0.5 * d[D_W] - d[D_E] - fabs(x), dy = 0.5 * d[D_L] - d[D_E] - fabs(y);
+      double dm = fmin(dx, dy);
+      if (dm > 0.003 && dm < 0.0038 && fmod(fabs(x + y) / 0.003, 1.0) < 0.6)
         setc(out, 0.85, 0.78, 0.60);
     }
     break;
-  }
-  case S_TISSUE_BOX: {
-    mixc(out, s->col[0], s->col[0], 0);
-    double fl = synth_noise2(ts, lx / 0.02, ly / 0.02);
-    if (fl > 0.45) mixc(out, out, s->col[1], 0.7);
+  case PAT_FLOWERS:
+    if (synth_noise2(ts, lx / 0.02, ly / 0.02) > 0.45) mixc(out, out, s->col[1], 0.7);
     break;
-  }
-  case S_TISSUE_TOP: {
-    mixc(out, s->col[0], s->col[0], 0);
-    double ex = x / (0.5 * s->d[D_W] * 0.6), ey = y / (0.5 * s->d[D_L] * 0.35);
+  case PAT_OPENING: {
+    double ex = x / (0.5 * d[D_W] * 0.6), ey = y / (0.5 * d[D_L] * 0.35);
     if (ex * ex + ey * ey < 1) setc(out, 0.97, 0.97, 0.97);
     break;
   }
-  case S_CASE:
-    mixc(out, s->col[0], s->col[0], 0);
-    for (int k = 0; k < 3; k++) out[k] += 0.03 * n1;
-    break;
-  case S_FABRIC:
-  case S_FABRIC_CHECK: {
-    mixc(out, s->col[p->style == S_FABRIC ? 0 : 1], s->col[0], 0);
+  case PAT_WEAVE: {
     double weave = 0.5 + 0.5 * sin(lx / 0.0012 * M_PI) * sin(ly / 0.0012 * M_PI);
     for (int k = 0; k < 3; k++) out[k] *= 0.92 + 0.08 * weave;
-    if (p->style == S_FABRIC_CHECK && ((int)floor(lx / 0.04) + (int)floor(ly / 0.04)) % 2)
+    if (m->alt && ((int)floor(lx / 0.04) + (int)floor(ly / 0.04)) % 2)
       for (int k = 0; k < 3; k++) out[k] *= 0.75;
     break;
   }
-  case S_BAG:
-    setc(out, 0.86, 0.89, 0.92);
-    for (int k = 0; k < 3; k++) out[k] += 0.03 * n1;
-    break;
-  case S_BAG_ZIP:
-    setc(out, 0.86, 0.89, 0.92);
-    if (fabs(ly - 0.5 * p->h) < 0.002) mixc(out, s->col[0], s->col[0], 0);
-    break;
-  case S_CUSHION_PAD:
-    setc(out, 0.16, 0.16, 0.17);
-    for (int k = 0; k < 3; k++) out[k] += 0.04 * synth_fbm2(ts, x / 0.002, y / 0.002, 2);
-    break;
-  default: /* S_PLAIN */
-    setc(out, 0.94, 0.94, 0.93);
-    for (int k = 0; k < 3; k++) out[k] += 0.02 * n1;
+  case PAT_ZIP:
+    if (fabs(ly - 0.5 * p->h) < 0.002) copyc(out, s->col[0]);
     break;
   }
+}
+
+/* colour of native point (x, y) of an island: its material (synth_material)
+ * with texture detail from s->tseed */
+static void shade(const shape *s, const patch *p, double x, double y, double out[3]) {
+  const synth_material *m = &synth_materials[p->style];
+  uint64_t ts = s->tseed + (uint64_t)m->stream * 977;
+  switch (m->base) {
+  case BASE_NONE: break;
+  case BASE_RGB: copyc(out, m->rgb); break;
+  case BASE_SLOT: copyc(out, s->col[m->slot]); break;
+  case BASE_MIX: mixc(out, s->col[m->slot], m->rgb, m->mix); break;
+  }
+  if (m->band[2] > 0 && p->kind == K_STRIP) {
+    double t = (y - p->oy) / p->h;
+    if (t > m->band[0] && t < m->band[1]) mixc(out, out, s->col[0], m->band[2]);
+  }
+  if (m->grain != 0) {
+    double g = synth_fbm2(ts, x / m->grain_size, y / m->grain_size, m->grain_octaves);
+    for (int k = 0; k < 3; k++) out[k] += m->grain * g;
+  }
+  draw_pattern(s, p, m, ts, x, y, out);
 }
 
 typedef struct tex_job {
