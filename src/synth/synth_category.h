@@ -189,6 +189,48 @@ typedef struct synth_vessel {
   int lid;            /* a domed lid with a knob when D_VARIANT is drawn */
 } synth_vessel;
 
+/* ---- temperature fields ------------------------------------------------------- */
+
+/* How a state's temperatures spread over the object (synth_fields.c). T0..
+ * are the state's drawn temperatures (degC, or degC above ambient where
+ * marked +amb), in the order below. */
+typedef enum synth_field_model {
+  FIELD_TOP_COOLER,    /* hot: T0 at the bottom, T1 cooler at the top */
+  FIELD_CUP,           /* hot drink: T0 below the liquid line, T1 rim, handle T2 at the body to
+                          T3 at its far end, T4 line width (m), T5 bottom cooler by */
+  FIELD_KETTLE,        /* T0 below the line, T1 above, T2 lid, T3 handle, T4 base, T5 spout,
+                          T6 line width (m) */
+  FIELD_POT,           /* T0 below the line, T1 rim, handle T2 to T3, T4 lid, T5 line width (m) */
+  FIELD_SPONGE,        /* T0, moist patches T1 cooler, the pad T2 cooler */
+  FIELD_PHONE,         /* T0 edges, T1 battery on the back, T2 SoC, T3 screen */
+  FIELD_CHILLED,       /* iced: T0 at the bottom rising to T1 at the top */
+  FIELD_CHILLED_FRUIT, /* iced: T0 at the bottom, T1 more at the top */
+  FIELD_WARM,          /* warm: +amb T0, a little more low down */
+  FIELD_LAPTOP,        /* warm: +amb T0 more under the CPU, T1 the base, T2 the lid */
+  FIELD_USED,          /* used: +amb T0 to (T0 + T1) / 2 in blobs where it was handled */
+  FIELD_USED_CUSHION,  /* FIELD_USED, with cushions at +amb T1 */
+  FIELD_USED_GRIP,     /* FIELD_USED, with the shell +amb T0 at the front to T1 under the palm */
+  FIELD_MODELS
+} synth_field_model;
+
+#define SYNTH_MAX_TEMPS 7
+
+/* one state: its model and the ranges its temperatures are drawn from */
+typedef struct synth_temps {
+  synth_field_model model;
+  int n;
+  double range[SYNTH_MAX_TEMPS][2];
+} synth_temps;
+
+/* the states other than neutral (ambient with small smooth variations) */
+typedef struct synth_field_spec {
+  int stream; /* random stream of the draws (with the state): fixed, part of the output */
+  synth_temps hot, warm, iced, used;
+} synth_field_spec;
+
+/* the field of names outside the table (a given mesh's category) */
+extern const synth_field_spec synth_field_other;
+
 /* ---- categories ------------------------------------------------------------ */
 
 typedef struct synth_category {
@@ -200,9 +242,7 @@ typedef struct synth_category {
   synth_vessel vessel;               /* SHAPE_VESSEL only */
   synth_fill fill;
   double wrapped_fill;      /* fill level of a given mesh put under this category */
-  /* the random stream of the temperature draws (with the state); categories
-   * without a field of their own share stream 11 */
-  int field_stream;
+  synth_field_spec field;
 } synth_category;
 
 extern const synth_category synth_categories[SYNTH_N_CATEGORIES];
@@ -211,8 +251,5 @@ extern const synth_category synth_categories[SYNTH_N_CATEGORIES];
 int synth_category_index(const char *name);
 /* the entry, or NULL */
 const synth_category *synth_category_find(const char *name);
-/* the stream for categories without a field of their own (also for names
- * outside the table) */
-#define SYNTH_FIELD_STREAM_OTHER 11
 
 #endif
