@@ -90,6 +90,10 @@ const synth_field_spec synth_field_other = FIELD_GENERIC(11);
 
 #define SLOT(part, style) {part, {style, style}}
 #define SLOT2(part, style, variant) {part, {style, variant}}
+/* a slab of one part and one style all round */
+#define SLAB_ALL(part, style) \
+  {[SLAB_BOTTOM] = SLOT(part, style), [SLAB_SIDE] = SLOT(part, style), \
+   [SLAB_UPPER] = SLOT(part, style), [SLAB_TOP] = SLOT(part, style)}
 
 const synth_category synth_categories[SYNTH_N_CATEGORIES] = {
     {.name = "cup", .second_state = "hot",
@@ -226,8 +230,7 @@ const synth_category synth_categories[SYNTH_N_CATEGORIES] = {
      .draw = {RANGE(D_W, 0.105, 0.120), RANGE(D_L, 0.085, 0.095), RANGE(D_H, 0.012, 0.020),
               CONST(D_RC, 0.008), TIMES(D_E, D_H, 0.35), COLOUR(0, PAL_DARK, 6)},
      .shape = SHAPE_SLAB,
-     .slots = {[SLAB_BOTTOM] = SLOT("leather", S_LEATHER), [SLAB_SIDE] = SLOT("leather", S_LEATHER),
-               [SLAB_UPPER] = SLOT("leather", S_LEATHER), [SLAB_TOP] = SLOT("leather", S_LEATHER)},
+     .slots = SLAB_ALL("leather", S_LEATHER),
      .fill = FILL_DRAWN, .field = FIELD_GENERIC(11)},
 
     {.name = "tissue",
@@ -253,18 +256,14 @@ const synth_category synth_categories[SYNTH_N_CATEGORIES] = {
               CONST(D_RC, 0.05), CONST(D_E, 0.035), COLOUR(0, PAL_PASTEL, 6),
               TIMES(D_BULGE, D_H, 0.25)},
      .shape = SHAPE_SLAB,
-     .slots = {[SLAB_BOTTOM] = SLOT("fabric", S_FABRIC), [SLAB_SIDE] = SLOT("fabric", S_FABRIC),
-               [SLAB_UPPER] = SLOT("fabric", S_FABRIC), [SLAB_TOP] = SLOT("fabric", S_FABRIC)},
+     .slots = SLAB_ALL("fabric", S_FABRIC),
      .fill = FILL_DRAWN, .field = FIELD_GENERIC(11)},
 
     {.name = "cushion",
      .draw = {RANGE(D_W, 0.38, 0.45), TIMES(D_L, D_W, 1), RANGE(D_H, 0.09, 0.13), CONST(D_RC, 0.04),
               CONST(D_E, 0.03), TIMES(D_BULGE, D_H, 0.25)},
      .shape = SHAPE_SLAB,
-     .slots = {[SLAB_BOTTOM] = SLOT("fabric", S_FABRIC_CHECK),
-               [SLAB_SIDE] = SLOT("fabric", S_FABRIC_CHECK),
-               [SLAB_UPPER] = SLOT("fabric", S_FABRIC_CHECK),
-               [SLAB_TOP] = SLOT("fabric", S_FABRIC_CHECK)},
+     .slots = SLAB_ALL("fabric", S_FABRIC_CHECK),
      .fill = FILL_DRAWN, .field = FIELD_GENERIC(11)},
 
     {.name = "storage_bag",

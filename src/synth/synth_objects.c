@@ -623,6 +623,23 @@ static void prof_dome(profile *pf, double r0, double z0, double rk, double hd, d
   prof_seg(pf, knob);
 }
 
+/* a profile of edge length h starting on the axis at height z */
+static void prof_start(profile *pf, double h, double z) {
+  prof_init(pf, 0, h);
+  prof_push(pf, 1, 0, z);
+}
+
+/* sweep profile pf round a circle sampled for radius rmax, placed by M
+ * (3x4, optional) and displaced by disp (optional); frees pf */
+static int revolve(builder *b, profile *pf, double rmax, const double *M, disp_fn disp,
+                   const void *dctx) {
+  outline ol = {0};
+  int rc = outline_circle(&ol, rmax, pf->h) ? -1 : sweep_build(b, &ol, pf, M, disp, dctx);
+  outline_free(&ol);
+  prof_free(pf);
+  return rc;
+}
+
 /* SHAPE_VESSEL (synth_vessel) */
 static int build_vessel(builder *b, const shape *s, double h) {
   const synth_vessel *v = &s->cat->vessel;
@@ -631,11 +648,8 @@ static int build_vessel(builder *b, const shape *s, double h) {
   const double *d = s->d;
   double R = d[D_R], Rb = d[D_R2], H = d[D_H], tw = d[D_T], tb = d[D_T2], f = v->foot;
   double fi = v->inner_round;
-  outline ol = {0};
   profile pf;
-  if (outline_circle(&ol, R + v->margin, h)) return -1;
-  prof_init(&pf, 0, h);
-  prof_push(&pf, 1, 0, 0);
+  prof_start(&pf, h, 0);
   prof_line(&pf, 1, Rb - f, 0);
   prof_seg(&pf, sl[VESSEL_BOTTOM]);
   prof_arc(&pf, Rb - f, f, f, -0.5 * M_PI, 0, (size_t)v->foot_steps);
@@ -650,8 +664,7 @@ static int build_vessel(builder *b, const shape *s, double h) {
   prof_seg(&pf, sl[VESSEL_INNER]);
   prof_line(&pf, 1, 0, tb);
   prof_seg(&pf, sl[VESSEL_INNER]);
-  int rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
-  prof_free(&pf);
+  int rc = revolve(b, &pf, R + v->margin, NULL, NULL, NULL);
   tube_def td;
   if (!rc && !v->lugs) {
     /* ends buried half-way into the wall */
@@ -670,16 +683,13 @@ static int build_vessel(builder *b, const shape *s, double h) {
     /* resting on the rim */
     b_slots(b, s, VESSEL_LID, VESSEL_SLOTS, sl);
     double Rl = R + 0.002, zl = H + 0.0002;
-    prof_init(&pf, 0, h);
-    prof_push(&pf, 1, 0, zl);
+    prof_start(&pf, h, zl);
     prof_line(&pf, 1, Rl, zl);
     prof_seg(&pf, sl[VESSEL_LID]);
     prof_line(&pf, 1, Rl, zl + 0.004);
     prof_dome(&pf, Rl, zl + 0.004, 0.016, 0.015, 0.02, sl[VESSEL_LID], sl[VESSEL_KNOB]);
-    rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
-    prof_free(&pf);
+    rc = revolve(b, &pf, R + v->margin, NULL, NULL, NULL);
   }
-  outline_free(&ol);
   return rc;
 }
 
@@ -688,11 +698,8 @@ static int build_can(builder *b, const shape *s, double h) {
   slot_use sl[CAN_SLOTS];
   b_slots(b, s, 0, CAN_SLOTS, sl);
   double R = s->d[D_R], H = s->d[D_H];
-  outline ol = {0};
   profile pf;
-  if (outline_circle(&ol, R, h)) return -1;
-  prof_init(&pf, 0, h);
-  prof_push(&pf, 1, 0, 0.004);
+  prof_start(&pf, h, 0.004);
   prof_line(&pf, 1, R - 0.008, 0.0);
   prof_seg(&pf, sl[CAN_DOME]);
   prof_line(&pf, 1, R - 0.0065, 0.0);
@@ -707,10 +714,7 @@ static int build_can(builder *b, const shape *s, double h) {
   prof_seg(&pf, sl[CAN_RIM]);
   prof_line(&pf, 1, 0, H - 0.003);
   prof_seg(&pf, sl[CAN_LID]);
-  int rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
-  prof_free(&pf);
-  outline_free(&ol);
-  return rc;
+  return revolve(b, &pf, R, NULL, NULL, NULL);
 }
 
 /* SHAPE_BOTTLE: body D_R x D_H, neck radius D_R2 */
@@ -719,11 +723,8 @@ static int build_bottle(builder *b, const shape *s, double h) {
   b_slots(b, s, 0, BOTTLE_SLOTS, sl);
   double R = s->d[D_R], H = s->d[D_H], rn = s->d[D_R2], rcap = rn + 0.0015, hc = 0.02;
   double zs = H * 0.62, zn = H * 0.84, zl0 = H * 0.25, zl1 = H * 0.50;
-  outline ol = {0};
   profile pf;
-  if (outline_circle(&ol, R, h)) return -1;
-  prof_init(&pf, 0, h);
-  prof_push(&pf, 1, 0, 0.003);
+  prof_start(&pf, h, 0.003);
   prof_line(&pf, 1, R - 0.006, 0);
   prof_seg(&pf, sl[BOTTLE_BOTTOM]);
   prof_arc(&pf, R - 0.006, 0.006, 0.006, -0.5 * M_PI, 0, 3);
@@ -747,10 +748,7 @@ static int build_bottle(builder *b, const shape *s, double h) {
   prof_seg(&pf, sl[BOTTLE_CAP]);
   prof_line(&pf, 1, 0, H);
   prof_seg(&pf, sl[BOTTLE_CAP]);
-  int rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
-  prof_free(&pf);
-  outline_free(&ol);
-  return rc;
+  return revolve(b, &pf, R, NULL, NULL, NULL);
 }
 
 /* peel bumps: a small radial displacement from smooth 3D noise */
@@ -773,12 +771,9 @@ static int build_spheroid(builder *b, const shape *s, double h) {
   slot_use sl[SPHEROID_SLOTS];
   b_slots(b, s, 0, SPHEROID_SLOTS, sl);
   double R = s->d[D_R], Hz = 0.5 * s->d[D_H], cap = 0.35;
-  outline ol = {0};
-  profile pf;
-  if (outline_circle(&ol, R, h)) return -1;
-  prof_init(&pf, 0, h);
   size_t n1 = nseg(cap * R, h, 2), n2 = nseg((M_PI - 2 * cap) * R, h, 6);
-  prof_push(&pf, 1, 0, 0);
+  profile pf;
+  prof_start(&pf, h, 0);
   for (size_t k = 1; k <= n1; k++) {
     double a = -0.5 * M_PI + cap * (double)k / (double)n1;
     prof_push(&pf, 1, R * cos(a), Hz * (1 + sin(a)));
@@ -795,10 +790,7 @@ static int build_spheroid(builder *b, const shape *s, double h) {
   }
   prof_seg(&pf, sl[SPHEROID_STEM]);
   peel_disp od = {Hz, 0.0004, s->tseed};
-  int rc = sweep_build(b, &ol, &pf, NULL, peel_displace, &od);
-  prof_free(&pf);
-  outline_free(&ol);
-  return rc;
+  return revolve(b, &pf, R, NULL, peel_displace, &od);
 }
 
 /* SHAPE_KETTLE: body radius D_R and height D_H on a base D_T high */
@@ -806,12 +798,9 @@ static int build_kettle(builder *b, const shape *s, double h) {
   slot_use sl[KETTLE_SLOTS];
   b_slots(b, s, 0, KETTLE_SLOTS, sl);
   double R = s->d[D_R], zb = s->d[D_T], Hb = s->d[D_H], Rt = R * 0.82;
-  outline ol = {0};
-  profile pf;
   /* base plate */
-  if (outline_circle(&ol, R + 0.01, h)) return -1;
-  prof_init(&pf, 0, h);
-  prof_push(&pf, 1, 0, 0);
+  profile pf;
+  prof_start(&pf, h, 0);
   prof_line(&pf, 1, R + 0.004, 0);
   prof_seg(&pf, sl[KETTLE_BASE]);
   prof_arc(&pf, R + 0.004, 0.004, 0.004, -0.5 * M_PI, 0, 2);
@@ -820,15 +809,12 @@ static int build_kettle(builder *b, const shape *s, double h) {
   prof_seg(&pf, sl[KETTLE_BASE]);
   prof_line(&pf, 1, 0, zb);
   prof_seg(&pf, sl[KETTLE_BASE]);
-  int rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
-  prof_free(&pf);
-  outline_free(&ol);
+  int rc = revolve(b, &pf, R + 0.01, NULL, NULL, NULL);
   if (rc) return rc;
   /* body with a domed lid and knob; it floats 0.3 mm above the base so the
    * two never share a vertex */
-  prof_init(&pf, 0, h);
   zb += 0.0003;
-  prof_push(&pf, 1, 0, zb);
+  prof_start(&pf, h, zb);
   prof_line(&pf, 1, R - 0.01, zb);
   prof_seg(&pf, sl[KETTLE_BODY]);
   prof_arc(&pf, R - 0.01, zb + 0.01, 0.01, -0.5 * M_PI, 0, 3);
@@ -836,13 +822,7 @@ static int build_kettle(builder *b, const shape *s, double h) {
   prof_arc(&pf, Rt, zb + Hb - 0.012, 0.012, 0, 0.5 * M_PI, 3);
   prof_seg(&pf, sl[KETTLE_BODY]);
   prof_dome(&pf, Rt, zb + Hb, 0.014, 0.012, 0.012, sl[KETTLE_LID], sl[KETTLE_KNOB]);
-  if (outline_circle(&ol, R, h)) {
-    prof_free(&pf);
-    return -1;
-  }
-  rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
-  prof_free(&pf);
-  outline_free(&ol);
+  rc = revolve(b, &pf, R, NULL, NULL, NULL);
   if (rc) return rc;
   /* handle at the back, ends inside the body */
   double z0 = zb + Hb * 0.85, z1 = zb + Hb * 0.25;
@@ -910,11 +890,8 @@ static int build_headset(builder *b, const shape *s, double h) {
   slot_use sl[HEADSET_SLOTS];
   b_slots(b, s, 0, HEADSET_SLOTS, sl);
   double R = s->d[D_R], T = s->d[D_T], W = s->d[D_W], e = 0.006;
-  outline ol = {0};
   profile pf;
-  if (outline_circle(&ol, R, h)) return -1;
-  prof_init(&pf, 0, h);
-  prof_push(&pf, 1, 0, 0);
+  prof_start(&pf, h, 0);
   prof_line(&pf, 1, R - e, 0);
   prof_seg(&pf, sl[HEADSET_CUP]);
   prof_arc(&pf, R - e, e, e, -0.5 * M_PI, 0, 2);
@@ -923,7 +900,8 @@ static int build_headset(builder *b, const shape *s, double h) {
   prof_arc(&pf, R - e, T - e, e, 0, 0.5 * M_PI, 2);
   prof_line(&pf, 1, 0, T);
   prof_seg(&pf, sl[HEADSET_CUSHION]);
-  int rc = 0;
+  outline ol = {0};
+  int rc = outline_circle(&ol, R, h);
   for (int k = 0; k < 2 && !rc; k++) {
     /* cups stand on edge with their axes along x, cushions facing in */
     double sx = k ? -1.0 : 1.0, x0 = k ? 0.5 * W + 0.5 * T : -0.5 * W - 0.5 * T;
