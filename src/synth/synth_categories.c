@@ -4,7 +4,7 @@
 #include "synth/synth_category.h"
 #include "synth/synth_object.h"
 
-/* ---- palettes ---------------------------------------------------------------- */
+/* ---- palettes ------------------------------------------------------------ */
 
 static const double k_vivid[8][3] = {
     {0.80, 0.10, 0.12}, {0.10, 0.30, 0.75}, {0.95, 0.75, 0.10}, {0.10, 0.55, 0.25},
@@ -18,14 +18,15 @@ static const double k_pastel[6][3] = {{0.92, 0.90, 0.85}, {0.80, 0.86, 0.93},
 const synth_palette synth_palettes[PAL_COUNT] = {
     [PAL_VIVID] = {k_vivid, 8}, [PAL_DARK] = {k_dark, 6}, [PAL_PASTEL] = {k_pastel, 6}};
 
-/* ---- materials ------------------------------------------------------------------ */
+/* ---- materials ----------------------------------------------------------- */
 
 #define RGB(r, g, b) .base = BASE_RGB, .rgb = {r, g, b}
 #define COL(k) .base = BASE_SLOT, .slot = k
 #define GRAIN(amp) .grain = amp, .grain_size = 0.01, .grain_octaves = 3
 #define FINE_GRAIN(amp) .grain = amp, .grain_size = 0.002, .grain_octaves = 2
 
-/* stream: each material's original number, which its noise is seeded by */
+/* The first number is the material's stream: fixed, it seeds the material's
+ * noise (the banded glaze shares the glaze's). */
 const synth_material synth_materials[S_COUNT] = {
     [S_PLAIN] = {0, RGB(0.94, 0.94, 0.93), GRAIN(0.02)},
     [S_GLAZE] = {1, RGB(0.93, 0.93, 0.91), GRAIN(0.015)},
@@ -64,7 +65,7 @@ const synth_material synth_materials[S_COUNT] = {
     [S_CUSHION_PAD] = {32, RGB(0.16, 0.16, 0.17), FINE_GRAIN(0.04)},
 };
 
-/* ---- temperature fields ------------------------------------------------------------ */
+/* ---- temperature fields -------------------------------------------------- */
 
 /* the states a category has no model of its own for */
 #define HOT_TOP_COOLER {FIELD_TOP_COOLER, 2, {{45, 60}, {3, 8}}}
@@ -77,8 +78,9 @@ const synth_material synth_materials[S_COUNT] = {
 /* categories without a field of their own share stream 11 */
 const synth_field_spec synth_field_other = FIELD_GENERIC(11);
 
-/* ---- the table ------------------------------------------------------------------- */
+/* ---- the table ----------------------------------------------------------- */
 
+/* draw steps (synth_draw_op): d = dimension, s = the dimension it reads */
 #define RANGE(d, lo, hi) {DRAW_RANGE, d, 0, 0, lo, hi}
 #define SCALED(d, k, s, lo, hi) {DRAW_SCALED, d, s, k, lo, hi}
 #define OFFSET(d, s, lo, hi) {DRAW_OFFSET, d, s, 0, lo, hi}
@@ -95,6 +97,10 @@ const synth_field_spec synth_field_other = FIELD_GENERIC(11);
   {[SLAB_BOTTOM] = SLOT(part, style), [SLAB_SIDE] = SLOT(part, style), \
    [SLAB_UPPER] = SLOT(part, style), [SLAB_TOP] = SLOT(part, style)}
 
+/* Each entry: its draws (in their random order), the shape and the part and
+ * style of each of the shape's slots (SLOT2: a second style for instances
+ * drawn with D_VARIANT), the liquid line, and the field of each state. The
+ * entries' order seeds their draws. */
 const synth_category synth_categories[SYNTH_N_CATEGORIES] = {
     {.name = "cup", .second_state = "hot",
      .draw = {RANGE(D_R, 0.038, 0.043), SCALED(D_R2, 1, D_R, 0.80, 0.92), RANGE(D_H, 0.090, 0.100),

@@ -12,7 +12,7 @@
 
 #define SYNTH_N_CATEGORIES 18
 
-/* ---- shape parameters ------------------------------------------------------ */
+/* ---- shape parameters ---------------------------------------------------- */
 
 /* An instance's dimensions (metres unless noted), drawn by its steps. */
 typedef enum synth_dim {
@@ -74,9 +74,7 @@ typedef enum synth_fill {
   FILL_ABOVE_BASE, /* the same, standing on a base of its own height */
 } synth_fill;
 
-/* ---- shapes ------------------------------------------------------------------ */
-
-/* ---- materials ------------------------------------------------------------- */
+/* ---- materials ----------------------------------------------------------- */
 
 /* Albedo styles: indices of synth_materials. */
 enum {
@@ -141,6 +139,8 @@ typedef struct synth_material {
 
 extern const synth_material synth_materials[S_COUNT];
 
+/* ---- shapes -------------------------------------------------------------- */
+
 /* The shape builders (synth_objects.c); each names the slots it fills. */
 typedef enum synth_shape {
   SHAPE_VESSEL,   /* open revolved vessel: wall, rim, inner wall, handle(s), lid */
@@ -189,7 +189,7 @@ typedef struct synth_vessel {
   int lid;            /* a domed lid with a knob when D_VARIANT is drawn */
 } synth_vessel;
 
-/* ---- temperature fields ------------------------------------------------------- */
+/* ---- temperature fields -------------------------------------------------- */
 
 /* How a state's temperatures spread over the object (synth_fields.c). T0..
  * are the state's drawn temperatures (degC, or degC above ambient where
@@ -205,9 +205,10 @@ typedef enum synth_field_model {
   FIELD_PHONE,         /* T0 edges, T1 battery on the back, T2 SoC, T3 screen */
   FIELD_CHILLED,       /* iced: T0 at the bottom rising to T1 at the top */
   FIELD_CHILLED_FRUIT, /* iced: T0 at the bottom, T1 more at the top */
-  FIELD_WARM,          /* warm: +amb T0, a little more low down */
+  FIELD_WARM,          /* warm: +amb T0 at the bottom, 0.8 T0 at the top */
   FIELD_LAPTOP,        /* warm: +amb T0 more under the CPU, T1 the base, T2 the lid */
-  FIELD_USED,          /* used: +amb T0 to (T0 + T1) / 2 in blobs where it was handled */
+  FIELD_USED,          /* used: +amb 0.4 T0, up to T0 in blobs where it was handled (T1 is
+                          drawn for the variants below) */
   FIELD_USED_CUSHION,  /* FIELD_USED, with cushions at +amb T1 */
   FIELD_USED_GRIP,     /* FIELD_USED, with the shell +amb T0 at the front to T1 under the palm */
   FIELD_MODELS
@@ -231,7 +232,7 @@ typedef struct synth_field_spec {
 /* the field of names outside the table (a given mesh's category) */
 extern const synth_field_spec synth_field_other;
 
-/* ---- categories ------------------------------------------------------------ */
+/* ---- categories ---------------------------------------------------------- */
 
 typedef struct synth_category {
   const char *name;

@@ -12,7 +12,12 @@
  *    spouts, head bands), one strip island and two end-cap disks.
  * Islands are packed into [0,1]^2 by a shelf packer with gutters. The
  * tessellation edge length is found by bisection on a count-only pass so the
- * triangle count follows target_triangles. */
+ * triangle count follows target_triangles.
+ *
+ * What an instance is comes from its category's entry (synth_category.h):
+ * the draws of its dimensions and colours, which of the shape builders below
+ * makes it, the part and material of each of the builder's slots, and the
+ * materials the shader paints them with. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
