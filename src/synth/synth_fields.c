@@ -10,11 +10,13 @@
 #include <math.h>
 #include <string.h>
 
+#include "synth/synth_category.h"
+#include "synth/synth_noise.h"
 #include "synth/synth_object.h"
 
 /* params layout */
 enum {
-  P_CAT, P_STATE, P_H, P_ZF, P_RB, P_RMAX, P_NAMP, P_GRAD, P_T0 = 8, /* P_T0..P_T0+7: temps */
+  P_MODEL, P_STATE, P_H, P_ZF, P_RB, P_RMAX, P_NAMP, P_GRAD, P_T0 = 8, /* P_T0..P_T0+7: temps */
   P_ROLE = 16 /* role of part k at P_ROLE + k */
 };
 
@@ -40,56 +42,11 @@ static int role_of(const char *name) {
   return R_BODY;
 }
 
-enum {
-  F_CUP, F_CAN, F_BOTTLE, F_ORANGE, F_PHONE, F_SPONGE, F_KETTLE, F_POT, F_MOUSE, F_LAPTOP,
-  F_HEADSET, F_OTHER
-};
-
-static int fcat(const char *c) {
-  static const char *const n[] = {"cup",    "canned_drink", "bottled_drink",   "orange",
-                                  "smartphone", "sponge",   "electric_kettle", "pot",
-                                  "mouse",  "laptop",       "headset"};
-  for (int i = 0; i < F_OTHER; i++)
-    if (strcmp(c, n[i]) == 0) return i;
-  return F_OTHER;
-}
-
-/* ---- smooth noise -------------------------------------------------------- */
-
-static uint64_t mix64(uint64_t x) {
-  x ^= x >> 30;
-  x *= 0xbf58476d1ce4e5b9ULL;
-  x ^= x >> 27;
-  x *= 0x94d049bb133111ebULL;
-  x ^= x >> 31;
-  return x;
-}
-
-static double lat(uint64_t seed, int64_t a, int64_t b, int64_t c) {
-  uint64_t h = mix64(seed ^ mix64((uint64_t)a * 0x9E3779B97F4A7C15ULL ^
-                                  mix64((uint64_t)b + 0x632BE59BD9B4E019ULL) ^
-                                  mix64((uint64_t)c * 0xD6E8FEB86659FD93ULL + 3)));
-  return (double)(h >> 11) * (2.0 / 9007199254740992.0) - 1.0;
-}
+/* ---- shaping ------------------------------------------------------------ */
 
 static double sstep(double t) {
   t = t < 0 ? 0 : t > 1 ? 1 : t;
   return t * t * (3 - 2 * t);
-}
-
-/* value noise in [-1, 1] with quintic interpolation (C2 smooth) */
-static double noise3(uint64_t seed, double x, double y, double z) {
-  double fx = floor(x), fy = floor(y), fz = floor(z);
-  int64_t ix = (int64_t)fx, iy = (int64_t)fy, iz = (int64_t)fz;
-  double u[3] = {x - fx, y - fy, z - fz};
-  for (int k = 0; k < 3; k++) u[k] = u[k] * u[k] * u[k] * (u[k] * (u[k] * 6 - 15) + 10);
-  double v = 0;
-  for (int c = 0; c < 8; c++) {
-    double w = ((c & 1) ? u[0] : 1 - u[0]) * ((c & 2) ? u[1] : 1 - u[1]) *
-               ((c & 4) ? u[2] : 1 - u[2]);
-    v += w * lat(seed, ix + (c & 1), iy + ((c >> 1) & 1), iz + ((c >> 2) & 1));
-  }
-  return v;
 }
 
 static double clamp01(double t) { return t < 0 ? 0 : t > 1 ? 1 : t; }
@@ -131,8 +88,14 @@ hearth_status synth_field_make(const synth_object *obj, const char *state, uint6
   f->ambient_c = ambient_c;
   f->seed = seed;
   double *P = f->params;
-  int cat = fcat(obj->category);
-  P[P_CAT] = cat;
+  const synth_category *cat = synth_category_find(obj->category);
+  const synth_field_spec *spec = cat ? &cat->field : &synth_field_other;
+  const synth_temps *temps = st == ST_HOT    ? &spec->hot
+                             : st == ST_WARM ? &spec->warm
+                             : st == ST_ICED ? &spec->iced
+                             : st == ST_USED ? &spec->used
+                                             : NULL;
+  P[P_MODEL] = temps ? temps->model : FIELD_MODELS; /* neutral: none */
   P[P_STATE] = st;
   for (int k = 0; k < obj->n_parts; k++) P[P_ROLE + k] = role_of(obj->part_names[k]);
 
@@ -164,95 +127,15 @@ hearth_status synth_field_make(const synth_object *obj, const char *state, uint6
 
   hearth_rng root, r;
   hearth_rng_seed(&root, seed);
-  hearth_rng_fork(&root, 0x6669656c64ULL + (uint64_t)st * 131 + (uint64_t)cat, &r);
+  hearth_rng_fork(&root, 0x6669656c64ULL + (uint64_t)st * 131 + (uint64_t)spec->stream, &r);
   P[P_NAMP] = hearth_rng_range(&r, 0.15, 0.3);
   P[P_GRAD] = hearth_rng_range(&r, -0.15, 0.15);
   double *T = P + P_T0;
-  switch (st) {
-  case ST_HOT:
-    switch (cat) {
-    case F_CUP:
-      T[0] = hearth_rng_range(&r, 55, 62);      /* body below the liquid line */
-      T[1] = hearth_rng_range(&r, 35, 40);      /* near the rim */
-      T[2] = hearth_rng_range(&r, 34, 38);      /* handle at the body */
-      T[3] = hearth_rng_range(&r, 29.5, 32);    /* handle far end */
-      T[4] = hearth_rng_range(&r, 0.003, 0.005); /* liquid-line transition width, m */
-      T[5] = hearth_rng_range(&r, 3, 6);        /* bottom cooler by */
-      break;
-    case F_KETTLE:
-      T[0] = hearth_rng_range(&r, 80, 90);
-      T[1] = hearth_rng_range(&r, 68, 76);
-      T[2] = hearth_rng_range(&r, 60, 70);      /* lid */
-      T[3] = hearth_rng_range(&r, 30, 35);      /* handle */
-      T[4] = hearth_rng_range(&r, 30, 38);      /* base */
-      T[5] = hearth_rng_range(&r, 60, 72);      /* spout */
-      T[6] = hearth_rng_range(&r, 0.005, 0.008);
-      break;
-    case F_POT:
-      T[0] = hearth_rng_range(&r, 65, 80);
-      T[1] = hearth_rng_range(&r, 52, 62);
-      T[2] = hearth_rng_range(&r, 40, 48);      /* handle at the body */
-      T[3] = hearth_rng_range(&r, 32, 37);      /* handle far end */
-      T[4] = hearth_rng_range(&r, 55, 66);      /* lid */
-      T[5] = hearth_rng_range(&r, 0.004, 0.007);
-      break;
-    case F_SPONGE:
-      T[0] = hearth_rng_range(&r, 45, 50);
-      T[1] = hearth_rng_range(&r, 3, 6);        /* moist patches cooler by */
-      T[2] = hearth_rng_range(&r, 1, 2.5);      /* pad cooler by */
-      break;
-    case F_PHONE:
-      T[0] = hearth_rng_range(&r, 30, 33);
-      T[1] = hearth_rng_range(&r, 42, 46);
-      T[2] = hearth_rng_range(&r, 43, 47);
-      T[3] = hearth_rng_range(&r, 36, 39);
-      T[4] = ax;
-      T[5] = by;
-      break;
-    default:
-      T[0] = hearth_rng_range(&r, 45, 60);
-      T[1] = hearth_rng_range(&r, 3, 8);        /* top cooler by */
-      break;
-    }
-    break;
-  case ST_ICED:
-    switch (cat) {
-    case F_ORANGE:
-      T[0] = hearth_rng_range(&r, 5, 8);
-      T[1] = hearth_rng_range(&r, 1, 2.5);
-      break;
-    default: /* cans, bottles and anything else chilled */
-      T[0] = hearth_rng_range(&r, 2, 6);        /* bottom */
-      T[1] = hearth_rng_range(&r, 8, 12);       /* top */
-      break;
-    }
-    break;
-  case ST_WARM:
-    switch (cat) {
-    case F_PHONE:
-      T[0] = hearth_rng_range(&r, 27, 29);      /* edges */
-      T[1] = hearth_rng_range(&r, 36, 40);      /* battery on the back */
-      T[2] = hearth_rng_range(&r, 37, 41);      /* SoC spot */
-      T[3] = hearth_rng_range(&r, 31, 33);      /* screen */
-      T[4] = ax;
-      T[5] = by;
-      break;
-    case F_LAPTOP:
-      T[0] = hearth_rng_range(&r, 12, 16);      /* under the CPU, above ambient */
-      T[1] = hearth_rng_range(&r, 3, 5);        /* rest of the base */
-      T[2] = hearth_rng_range(&r, 2, 4);        /* lid */
-      break;
-    default:
-      T[0] = hearth_rng_range(&r, 8, 14);
-      break;
-    }
-    break;
-  case ST_USED:
-    T[0] = hearth_rng_range(&r, 3, 7);          /* mild warmth */
-    T[1] = hearth_rng_range(&r, 7, 11);         /* where a hand or head was */
-    break;
-  default:
-    break;
+  for (int k = 0; temps && k < temps->n && k < SYNTH_MAX_TEMPS; k++)
+    T[k] = hearth_rng_range(&r, temps->range[k][0], temps->range[k][1]);
+  if (temps && temps->model == FIELD_PHONE) {
+    T[4] = ax;
+    T[5] = by;
   }
   return HEARTH_OK;
 }
@@ -267,83 +150,63 @@ static double liquid_line(double z, double zf, double H, double hot, double top,
   return s * hot + (1 - s) * above;
 }
 
+/* a handle from T2 where it leaves the body to T3 at its far end */
+static double handle_temp(const double *T, double r, double rb, double rmax) {
+  return T[2] + (T[3] - T[2]) * sstep(clamp01((r - rb) / (rmax - rb)));
+}
+
 double synth_field_eval(const synth_field *f, const synth_object *obj, uint32_t tri,
                         const double p[3]) {
   const double *P = f->params, *T = P + P_T0;
   int part = (obj && obj->part_of_tri && tri < obj->mesh.n_triangles) ? obj->part_of_tri[tri] : 0;
   if (part >= SYNTH_MAX_PARTS) part = 0;
   int role = (int)P[P_ROLE + part];
-  int cat = (int)P[P_CAT], st = (int)P[P_STATE];
+  int st = (int)P[P_STATE];
   double amb = f->ambient_c, H = P[P_H], zf = P[P_ZF], rb = P[P_RB], rmax = P[P_RMAX];
   double x = p[0], y = p[1], z = p[2], r = hypot(x, y);
-  double nz = noise3(f->seed, x / 0.05, y / 0.05, z / 0.05);
+  double nz = synth_smooth_noise3(f->seed, x / 0.05, y / 0.05, z / 0.05);
   double small = P[P_NAMP] * nz;
   double zr = clamp01(z / H);
 
   if (st == ST_NEUTRAL) return amb + small + P[P_GRAD] * (zr - 0.5);
 
-  if (st == ST_HOT) {
-    switch (cat) {
-    case F_CUP: {
-      double hot = T[0], rim = T[1], w = T[4];
-      switch (role) {
-      case R_HANDLE: {
-        double t = clamp01((r - rb) / (rmax - rb));
-        return T[2] + (T[3] - T[2]) * sstep(t) + 0.3 * small;
-      }
-      case R_RIM: return rim + 0.3 * small;
-      case R_INNER:
-        return liquid_line(z, zf, H, hot + 1.5, rim + 3, w) + 0.3 * small;
-      case R_BOTTOM: return hot - T[5] * (1 - sstep(r / rb)) + 0.3 * small;
-      default: return liquid_line(z, zf, H, hot, rim, w) + 0.3 * small;
-      }
-    }
-    case F_KETTLE: {
-      switch (role) {
-      case R_HANDLE: return T[3] + 0.5 * small;
-      case R_BASE: return T[4] + 2 * clamp01(z / 0.02) + 0.3 * small;
-      case R_LID: /* the plastic knob is cooler than the lid */
-        return T[2] + (amb + 12 - T[2]) * sstep((0.02 - r) / 0.008) + 0.5 * small;
-      case R_SPOUT: return T[5] + 0.5 * small;
-      default: return liquid_line(z, zf, H, T[0], T[1], T[6]) + 0.4 * small;
-      }
-    }
-    case F_POT: {
-      switch (role) {
-      case R_HANDLE: {
-        double t = clamp01((r - rb) / (rmax - rb));
-        return T[2] + (T[3] - T[2]) * sstep(t) + 0.3 * small;
-      }
-      case R_LID: return T[4] + (amb + 15 - T[4]) * sstep((0.021 - r) / 0.008) + 0.5 * small;
-      case R_RIM: return T[1] + 0.3 * small;
-      case R_INNER: return liquid_line(z, zf, H, T[0] + 2, T[1] + 3, T[5]) + 0.3 * small;
-      default: return liquid_line(z, zf, H, T[0], T[1], T[5]) + 0.4 * small;
-      }
-    }
-    case F_SPONGE: {
-      double moist = sstep((noise3(f->seed + 17, x / 0.03, y / 0.03, z / 0.03) - 0.05) / 0.5);
-      double t = T[0] - T[1] * moist;
-      if (role == R_PAD) t -= T[2];
-      return t + 0.2 * small;
-    }
-    case F_PHONE:
-      break; /* same pattern as warm, hotter */
-    default:
-      return T[0] - T[1] * zr + 0.5 * small;
+  switch ((synth_field_model)P[P_MODEL]) {
+  case FIELD_TOP_COOLER: return T[0] - T[1] * zr + 0.5 * small;
+  case FIELD_CUP: {
+    double hot = T[0], rim = T[1], w = T[4];
+    switch (role) {
+    case R_HANDLE: return handle_temp(T, r, rb, rmax) + 0.3 * small;
+    case R_RIM: return rim + 0.3 * small;
+    case R_INNER: return liquid_line(z, zf, H, hot + 1.5, rim + 3, w) + 0.3 * small;
+    case R_BOTTOM: return hot - T[5] * (1 - sstep(r / rb)) + 0.3 * small;
+    default: return liquid_line(z, zf, H, hot, rim, w) + 0.3 * small;
     }
   }
-
-  if (st == ST_ICED) {
-    if (cat == F_ORANGE) return T[0] + T[1] * zr + 0.4 * small;
-    double t = T[0] + (T[1] - T[0]) * pow(zr, 0.8);
-    if (role == R_TOP) t += 0.5;
-    if (role == R_CAP) t += 2.0;
-    if (role == R_NECK) t += 1.0;
+  case FIELD_KETTLE:
+    switch (role) {
+    case R_HANDLE: return T[3] + 0.5 * small;
+    case R_BASE: return T[4] + 2 * clamp01(z / 0.02) + 0.3 * small;
+    case R_LID: /* the plastic knob is cooler than the lid */
+      return T[2] + (amb + 12 - T[2]) * sstep((0.02 - r) / 0.008) + 0.5 * small;
+    case R_SPOUT: return T[5] + 0.5 * small;
+    default: return liquid_line(z, zf, H, T[0], T[1], T[6]) + 0.4 * small;
+    }
+  case FIELD_POT:
+    switch (role) {
+    case R_HANDLE: return handle_temp(T, r, rb, rmax) + 0.3 * small;
+    case R_LID: return T[4] + (amb + 15 - T[4]) * sstep((0.021 - r) / 0.008) + 0.5 * small;
+    case R_RIM: return T[1] + 0.3 * small;
+    case R_INNER: return liquid_line(z, zf, H, T[0] + 2, T[1] + 3, T[5]) + 0.3 * small;
+    default: return liquid_line(z, zf, H, T[0], T[1], T[5]) + 0.4 * small;
+    }
+  case FIELD_SPONGE: {
+    double wet = synth_smooth_noise3(f->seed + 17, x / 0.03, y / 0.03, z / 0.03);
+    double t = T[0] - T[1] * sstep((wet - 0.05) / 0.5);
+    if (role == R_PAD) t -= T[2];
     return t + 0.2 * small;
   }
-
-  if ((st == ST_WARM || st == ST_HOT) && cat == F_PHONE) {
-    /* phone: long axis along y, screen on top (+z) */
+  case FIELD_PHONE: {
+    /* long axis along y, screen on top (+z) */
     double edge = T[0], bat = T[1], soc = T[2], scr = T[3];
     double ax = T[4], by = T[5];
     double g_bat = soft_rect(x, y, 0, -0.1 * by, 0.7 * ax, 0.45 * by, 0.006);
@@ -356,19 +219,29 @@ double synth_field_eval(const synth_field *f, const synth_object *obj, uint32_t 
     default: return edge + 1.5 * g_soc + 0.2 * small;
     }
   }
-
-  if (st == ST_WARM) {
-    if (cat == F_LAPTOP) {
-      if (role == R_LID) return amb + T[2] + 0.3 * small;
-      return amb + T[1] + T[0] * gauss2(x, y, 0.04, 0.03, 0.05) + 0.3 * small;
-    }
-    return amb + T[0] * (0.8 + 0.2 * (1 - zr)) + 0.4 * small;
+  case FIELD_CHILLED: {
+    double t = T[0] + (T[1] - T[0]) * pow(zr, 0.8);
+    if (role == R_TOP) t += 0.5;
+    if (role == R_CAP) t += 2.0;
+    if (role == R_NECK) t += 1.0;
+    return t + 0.2 * small;
   }
-
+  case FIELD_CHILLED_FRUIT: return T[0] + T[1] * zr + 0.4 * small;
+  case FIELD_WARM: return amb + T[0] * (0.8 + 0.2 * (1 - zr)) + 0.4 * small;
+  case FIELD_LAPTOP:
+    if (role == R_LID) return amb + T[2] + 0.3 * small;
+    return amb + T[1] + T[0] * gauss2(x, y, 0.04, 0.03, 0.05) + 0.3 * small;
+  case FIELD_USED_CUSHION:
+    if (role == R_CUSHION) return amb + T[1] + 0.3 * small;
+    break;
+  case FIELD_USED_GRIP:
+    if (role == R_SHELL || role == R_TOP)
+      return amb + T[0] + (T[1] - T[0]) * sstep(-y / 0.05 + 0.2) + 0.3 * small;
+    break;
+  case FIELD_USED:
+  case FIELD_MODELS: break;
+  }
   /* used: mild warmth, more where hands, palms or heads were */
-  double blob = sstep(0.5 + 0.8 * noise3(f->seed + 29, x / 0.04, y / 0.04, z / 0.04));
-  if (cat == F_HEADSET && role == R_CUSHION) return amb + T[1] + 0.3 * small;
-  if (cat == F_MOUSE && (role == R_SHELL || role == R_TOP))
-    return amb + T[0] + (T[1] - T[0]) * sstep(-y / 0.05 + 0.2) + 0.3 * small;
+  double blob = sstep(0.5 + 0.8 * synth_smooth_noise3(f->seed + 29, x / 0.04, y / 0.04, z / 0.04));
   return amb + T[0] * (0.4 + 0.6 * blob) + 0.3 * small;
 }

@@ -1,6 +1,7 @@
 /* Private to the virtual rig: procedural objects and their temperature
- * fields (synth_objects.c, synth_fields.c), used by the renderer and the
- * release writer (synth_render.c, synth_release.c, ...).
+ * fields (synth_objects.c, synth_fields.c, described by the category table
+ * of synth_categories.c), used by the renderer and the release writer
+ * (synth_render.c, synth_release.c, ...).
  *
  * Object frame: metres, +z up along the turntable axis, the object resting
  * on z = 0 and centred on the axis. UVs in [0,1] (glTF: v down), grouped in
@@ -30,11 +31,12 @@ typedef struct synth_object {
   double fill_level;
 } synth_object;
 
-/* Procedural categories this file can make (at least cup, canned_drink,
- * bottled_drink, orange, smartphone, sponge, electric_kettle, pot). */
+/* The procedural categories, in the order of their table (synth_category.h):
+ * fills names[0..max-1], returns how many there are. */
 size_t synth_object_categories(const char **names, size_t max);
 /* The states a category is captured in by default: "neutral" first, then its
- * second state (cup: hot, canned_drink: iced, smartphone: warm, ...). */
+ * second state (cup: hot, canned_drink: iced, smartphone: warm, ...); 1 for
+ * names outside the table. */
 size_t synth_category_states(const char *category, const char **states, size_t max);
 
 /* Make an instance: shape parameters (sizes in real-world ranges), colours

@@ -12,123 +12,30 @@
  *    spouts, head bands), one strip island and two end-cap disks.
  * Islands are packed into [0,1]^2 by a shelf packer with gutters. The
  * tessellation edge length is found by bisection on a count-only pass so the
- * triangle count follows target_triangles. */
+ * triangle count follows target_triangles.
+ *
+ * What an instance is comes from its category's entry (synth_category.h):
+ * the draws of its dimensions and colours, which of the shape builders below
+ * makes it, the part and material of each of the builder's slots, and the
+ * materials the shader paints them with. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "synth/synth_category.h"
+#include "synth/synth_noise.h"
 #include "synth/synth_object.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
 #endif
 
-/* ---- categories ---------------------------------------------------------- */
-
-enum {
-  C_CUP, C_CAN, C_BOTTLE, C_ORANGE, C_PHONE, C_SPONGE, C_KETTLE, C_POT, C_MOUSE, C_ERASER,
-  C_LAPTOP, C_WALLET, C_TISSUE, C_GLASSES, C_PILLOW, C_CUSHION, C_BAG, C_HEADSET, C_COUNT
-};
-
-static const char *const k_cat_names[C_COUNT] = {
-    "cup",    "canned_drink", "bottled_drink", "orange",       "smartphone", "sponge",
-    "electric_kettle", "pot", "mouse",         "eraser",       "laptop",     "wallet",
-    "tissue", "glasses_case", "pillow",        "cushion",      "storage_bag", "headset"};
-
-/* second captured state per category (NULL: room temperature only); 11
- * categories have one, as in the paper */
-static const char *const k_cat_state2[C_COUNT] = {
-    "hot", "iced", "iced", "iced", "warm", "hot", "hot", "hot", "used", NULL,
-    "warm", NULL, NULL, NULL, NULL, NULL, NULL, "used"};
-
-size_t synth_object_categories(const char **names, size_t max) {
-  size_t n = 0;
-  for (int c = 0; c < C_COUNT; c++) {
-    if (names && n < max) names[n] = k_cat_names[c];
-    n++;
-  }
-  return n;
-}
-
-static int cat_code(const char *name) {
-  if (!name) return -1;
-  for (int c = 0; c < C_COUNT; c++)
-    if (strcmp(name, k_cat_names[c]) == 0) return c;
-  return -1;
-}
-
-size_t synth_category_states(const char *category, const char **states, size_t max) {
-  int c = cat_code(category);
-  size_t n = 0;
-  if (states && max > 0) states[0] = "neutral";
-  n = 1;
-  if (c >= 0 && k_cat_state2[c]) {
-    if (states && max > 1) states[1] = k_cat_state2[c];
-    n = 2;
-  }
-  return n;
-}
-
-/* ---- stateless noise ----------------------------------------------------- */
-
-static uint64_t mix64(uint64_t x) {
-  x ^= x >> 30;
-  x *= 0xbf58476d1ce4e5b9ULL;
-  x ^= x >> 27;
-  x *= 0x94d049bb133111ebULL;
-  x ^= x >> 31;
-  return x;
-}
-
-static double hash3(uint64_t seed, int64_t a, int64_t b, int64_t c) {
-  uint64_t h = mix64(seed ^ mix64((uint64_t)a * 0x9E3779B97F4A7C15ULL ^
-                                  mix64((uint64_t)b + 0x632BE59BD9B4E019ULL) ^
-                                  mix64((uint64_t)c * 0xD6E8FEB86659FD93ULL + 7)));
-  return (double)(h >> 11) * (1.0 / 9007199254740992.0); /* [0,1) */
-}
-
-static double sstep(double t) { return t * t * (3.0 - 2.0 * t); }
-
-/* value noise in [-1, 1] */
-static double vnoise2(uint64_t seed, double x, double y) {
-  double fx = floor(x), fy = floor(y);
-  int64_t ix = (int64_t)fx, iy = (int64_t)fy;
-  double tx = sstep(x - fx), ty = sstep(y - fy);
-  double a = hash3(seed, ix, iy, 0), b = hash3(seed, ix + 1, iy, 0);
-  double c = hash3(seed, ix, iy + 1, 0), d = hash3(seed, ix + 1, iy + 1, 0);
-  double v = (a + (b - a) * tx) + ((c + (d - c) * tx) - (a + (b - a) * tx)) * ty;
-  return 2.0 * v - 1.0;
-}
-
-static double vnoise3(uint64_t seed, double x, double y, double z) {
-  double fx = floor(x), fy = floor(y), fz = floor(z);
-  int64_t ix = (int64_t)fx, iy = (int64_t)fy, iz = (int64_t)fz;
-  double tx = sstep(x - fx), ty = sstep(y - fy), tz = sstep(z - fz);
-  double v[2];
-  for (int k = 0; k < 2; k++) {
-    double a = hash3(seed, ix, iy, iz + k), b = hash3(seed, ix + 1, iy, iz + k);
-    double c = hash3(seed, ix, iy + 1, iz + k), d = hash3(seed, ix + 1, iy + 1, iz + k);
-    double ab = a + (b - a) * tx, cd = c + (d - c) * tx;
-    v[k] = ab + (cd - ab) * ty;
-  }
-  return 2.0 * (v[0] + (v[1] - v[0]) * tz) - 1.0;
-}
-
-static double fbm2(uint64_t seed, double x, double y, int oct) {
-  double s = 0, amp = 0.5, norm = 0;
-  for (int o = 0; o < oct; o++) {
-    s += amp * vnoise2(seed + (uint64_t)o * 101, x, y);
-    norm += amp;
-    x *= 2.03;
-    y *= 2.03;
-    amp *= 0.5;
-  }
-  return s / norm;
-}
-
 /* ---- mesh builder -------------------------------------------------------- */
 
 enum { K_STRIP, K_DISK };
+
+/* a part id and an albedo style (synth_slot once numbered) */
+typedef struct slot_use { int part, style; } slot_use;
 
 typedef struct patch {
   int part, style, kind;
@@ -375,12 +282,13 @@ static void prof_arc(profile *pf, double cd, double cz, double rad, double a0, d
   }
 }
 
-static void prof_seg(profile *pf, int part, int style) {
+/* the rows since the last segment end become a segment of part/style u */
+static void prof_seg(profile *pf, slot_use u) {
   if (pf->nseg >= MAX_SEGS || pf->n == 0) {
     pf->oom = 1;
     return;
   }
-  pf->seg[pf->nseg++] = (pseg){pf->mark, pf->n - 1, part, style};
+  pf->seg[pf->nseg++] = (pseg){pf->mark, pf->n - 1, u.part, u.style};
   pf->mark = pf->n - 1;
 }
 
@@ -543,8 +451,8 @@ static void bez(const tube_def *td, double t, double out[3]) {
     out[k] = w0 * td->p[0][k] + w1 * td->p[1][k] + w2 * td->p[2][k] + w3 * td->p[3][k];
 }
 
-static int tube_build(builder *b, const tube_def *td, int part, int style_side,
-                      int style_cap, double h) {
+static int tube_build(builder *b, const tube_def *td, slot_use u, double h) {
+  int part = u.part;
   double len = 0, prev[3], cur[3];
   bez(td, 0, prev);
   for (int k = 1; k <= 64; k++) {
@@ -595,7 +503,7 @@ static int tube_build(builder *b, const tube_def *td, int part, int style_side,
   }
   double zero[3] = {0, 0, 0};
   /* side strip */
-  patch *pp = b_patch(b, part, style_side, K_STRIP);
+  patch *pp = b_patch(b, part, u.style, K_STRIP);
   uint32_t base = (uint32_t)b->nv;
   for (size_t i = 0; i <= M; i++)
     for (size_t k = 0; k <= K; k++)
@@ -611,7 +519,7 @@ static int tube_build(builder *b, const tube_def *td, int part, int style_side,
   patch_close(b, pp);
   /* end caps: fans round the path's end points */
   for (int e = 0; e < 2; e++) {
-    patch *cp = b_patch(b, part, style_cap, K_DISK);
+    patch *cp = b_patch(b, part, u.style, K_DISK);
     double pc[3];
     bez(td, (double)e, pc);
     uint32_t c = b_vert(b, pc, 0, 0);
@@ -656,576 +564,375 @@ static void tube_handle(tube_def *td, double phi, double r0, double z0, double r
 
 /* ---- shapes ------------------------------------------------------------- */
 
-/* styles of albedo */
-enum {
-  S_PLAIN, S_GLAZE, S_UNGLAZED, S_CAN_LABEL, S_ALU, S_ALU_TOP, S_CLEAR, S_BOTTLE_LABEL, S_CAP,
-  S_PEEL, S_PEEL_TOP, S_SCREEN, S_FRAME, S_PHONE_BACK, S_FOAM, S_PAD, S_STEEL, S_STEEL_DARK,
-  S_BLACK, S_MOUSE_TOP, S_RUBBER, S_SLEEVE, S_LAPTOP_LID, S_LAPTOP_BASE, S_LEATHER, S_TISSUE_BOX,
-  S_TISSUE_TOP, S_CASE, S_FABRIC, S_FABRIC_CHECK, S_BAG, S_BAG_ZIP, S_CUSHION_PAD
-};
-
 typedef struct shape {
-  int cat;
-  double R, R2, H, H2, t, t2, e, rc, W, L, a, c, reach, fillz;
-  int flag;
-  double col[4][3];
-  uint64_t tseed;
+  const synth_category *cat;
+  double d[D_COUNT]; /* dimensions (synth_dim) */
+  double col[4][3];  /* colour slots */
+  uint64_t tseed;    /* texture detail */
 } shape;
 
-static void pick_col(hearth_rng *r, double out[3], const double *choices, int n) {
+static void pick_col(hearth_rng *r, double out[3], const double (*choices)[3], int n) {
   int k = (int)(hearth_rng_uniform(r) * n);
   if (k >= n) k = n - 1;
-  for (int m = 0; m < 3; m++) out[m] = choices[3 * k + m];
+  for (int m = 0; m < 3; m++) out[m] = choices[k][m];
 }
 
-static void shape_draw(shape *s, int cat, hearth_rng *r) {
+/* an instance's texture seed, colours and dimensions (synth_draw) */
+static void shape_draw(shape *s, const synth_category *cat, hearth_rng *r) {
   memset(s, 0, sizeof *s);
   s->cat = cat;
   s->tseed = hearth_rng_u64(r);
-  static const double vivid[] = {0.80, 0.10, 0.12, 0.10, 0.30, 0.75, 0.95, 0.75, 0.10,
-                                 0.10, 0.55, 0.25, 0.55, 0.15, 0.55, 0.95, 0.45, 0.10,
-                                 0.85, 0.85, 0.88, 0.10, 0.10, 0.12};
-  static const double dark[] = {0.08, 0.08, 0.09, 0.20, 0.22, 0.25, 0.12, 0.16, 0.30,
-                                0.35, 0.18, 0.10, 0.85, 0.85, 0.86, 0.75, 0.60, 0.55};
-  static const double pastel[] = {0.92, 0.90, 0.85, 0.80, 0.86, 0.93, 0.93, 0.82, 0.84,
-                                  0.82, 0.90, 0.80, 0.95, 0.93, 0.78, 0.70, 0.72, 0.75};
-  for (int k = 0; k < 4; k++) pick_col(r, s->col[k], vivid, 8);
-  switch (cat) {
-  case C_CUP:
-    s->R = hearth_rng_range(r, 0.038, 0.043);       /* top outer radius */
-    s->R2 = s->R * hearth_rng_range(r, 0.80, 0.92); /* bottom outer radius */
-    s->H = hearth_rng_range(r, 0.090, 0.100);
-    s->t = hearth_rng_range(r, 0.0035, 0.0045);     /* wall */
-    s->t2 = hearth_rng_range(r, 0.006, 0.008);      /* bottom */
-    s->a = hearth_rng_range(r, 0.0055, 0.0070);     /* handle half-width */
-    s->c = hearth_rng_range(r, 0.0032, 0.0040);     /* handle half-thickness */
-    s->reach = hearth_rng_range(r, 0.033, 0.040);
-    s->fillz = hearth_rng_range(r, 0.78, 0.88);
-    s->flag = hearth_rng_uniform(r) < 0.5;          /* a coloured band */
-    break;
-  case C_CAN:
-    s->R = hearth_rng_range(r, 0.0325, 0.0335);
-    s->H = hearth_rng_range(r, 0.119, 0.123);
-    s->fillz = 0.92;
-    break;
-  case C_BOTTLE:
-    s->R = hearth_rng_range(r, 0.030, 0.034);
-    s->H = hearth_rng_range(r, 0.20, 0.23);
-    s->R2 = hearth_rng_range(r, 0.0125, 0.0135); /* neck */
-    s->fillz = 0.85;
-    pick_col(r, s->col[1], vivid, 6);
-    break;
-  case C_ORANGE:
-    s->R = hearth_rng_range(r, 0.036, 0.042);
-    s->H = 2 * s->R * hearth_rng_range(r, 0.90, 0.96);
-    break;
-  case C_PHONE:
-    s->W = hearth_rng_range(r, 0.070, 0.076);
-    s->L = hearth_rng_range(r, 0.145, 0.160);
-    s->H = hearth_rng_range(r, 0.0075, 0.0090);
-    s->rc = hearth_rng_range(r, 0.008, 0.011);
-    s->e = hearth_rng_range(r, 0.0022, 0.0030);
-    pick_col(r, s->col[0], dark, 6);
-    break;
-  case C_SPONGE:
-    s->W = hearth_rng_range(r, 0.070, 0.095);
-    s->L = hearth_rng_range(r, 0.100, 0.150);
-    s->H2 = hearth_rng_range(r, 0.020, 0.030);  /* foam */
-    s->H = s->H2 + hearth_rng_range(r, 0.005, 0.008);
-    s->rc = 0.006;
-    s->e = 0.0025;
-    break;
-  case C_KETTLE:
-    s->R = hearth_rng_range(r, 0.070, 0.085);
-    s->H2 = hearth_rng_range(r, 0.17, 0.21);    /* body height above the base */
-    s->t = hearth_rng_range(r, 0.018, 0.024);   /* base height */
-    s->reach = hearth_rng_range(r, 0.055, 0.065);
-    s->fillz = hearth_rng_range(r, 0.5, 0.7);
-    s->flag = hearth_rng_uniform(r) < 0.6;      /* steel (else white plastic) */
-    break;
-  case C_POT:
-    s->R = hearth_rng_range(r, 0.090, 0.115);
-    s->H2 = hearth_rng_range(r, 0.095, 0.14);
-    s->t = 0.003;
-    s->fillz = hearth_rng_range(r, 0.5, 0.7);
-    s->flag = hearth_rng_uniform(r) < 0.5;      /* has a lid */
-    break;
-  case C_MOUSE:
-    s->W = hearth_rng_range(r, 0.058, 0.066);
-    s->L = hearth_rng_range(r, 0.100, 0.120);
-    s->H = hearth_rng_range(r, 0.033, 0.040);
-    s->rc = s->W * 0.45;
-    s->e = 0.003;
-    pick_col(r, s->col[0], dark, 4);
-    break;
-  case C_ERASER:
-    s->W = hearth_rng_range(r, 0.020, 0.025);
-    s->L = hearth_rng_range(r, 0.045, 0.065);
-    s->H = hearth_rng_range(r, 0.010, 0.013);
-    s->rc = 0.002;
-    s->e = 0.0012;
-    break;
-  case C_LAPTOP:
-    s->W = hearth_rng_range(r, 0.30, 0.34);
-    s->L = hearth_rng_range(r, 0.21, 0.235);
-    s->H = hearth_rng_range(r, 0.015, 0.019);
-    s->H2 = s->H * 0.55;
-    s->rc = 0.010;
-    s->e = 0.004;
-    break;
-  case C_WALLET:
-    s->W = hearth_rng_range(r, 0.105, 0.120);
-    s->L = hearth_rng_range(r, 0.085, 0.095);
-    s->H = hearth_rng_range(r, 0.012, 0.020);
-    s->rc = 0.008;
-    s->e = s->H * 0.35;
-    pick_col(r, s->col[0], dark, 6);
-    break;
-  case C_TISSUE:
-    s->W = hearth_rng_range(r, 0.22, 0.24);
-    s->L = hearth_rng_range(r, 0.11, 0.125);
-    s->H = hearth_rng_range(r, 0.075, 0.095);
-    s->rc = 0.004;
-    s->e = 0.002;
-    pick_col(r, s->col[0], pastel, 6);
-    break;
-  case C_GLASSES:
-    s->W = hearth_rng_range(r, 0.155, 0.170);
-    s->L = hearth_rng_range(r, 0.055, 0.065);
-    s->H = hearth_rng_range(r, 0.035, 0.045);
-    s->rc = s->L * 0.45;
-    s->e = s->H * 0.45;
-    pick_col(r, s->col[0], dark, 6);
-    break;
-  case C_PILLOW:
-    s->W = hearth_rng_range(r, 0.45, 0.55);
-    s->L = hearth_rng_range(r, 0.30, 0.36);
-    s->H = hearth_rng_range(r, 0.10, 0.14);
-    s->rc = 0.05;
-    s->e = 0.035;
-    pick_col(r, s->col[0], pastel, 6);
-    break;
-  case C_CUSHION:
-    s->W = hearth_rng_range(r, 0.38, 0.45);
-    s->L = s->W;
-    s->H = hearth_rng_range(r, 0.09, 0.13);
-    s->rc = 0.04;
-    s->e = 0.03;
-    break;
-  case C_BAG:
-    s->W = hearth_rng_range(r, 0.17, 0.27);
-    s->L = hearth_rng_range(r, 0.15, 0.24);
-    s->H = hearth_rng_range(r, 0.012, 0.025);
-    s->rc = 0.012;
-    s->e = s->H * 0.45;
-    break;
-  case C_HEADSET:
-    s->R = hearth_rng_range(r, 0.038, 0.048);  /* ear cup radius */
-    s->t = hearth_rng_range(r, 0.028, 0.036);  /* cup thickness */
-    s->W = hearth_rng_range(r, 0.14, 0.17);    /* distance between cup centres */
-    s->a = hearth_rng_range(r, 0.014, 0.019);
-    s->c = hearth_rng_range(r, 0.004, 0.006);
-    pick_col(r, s->col[0], dark, 4);
-    break;
-  default:
-    break;
+  const synth_palette *vivid = &synth_palettes[PAL_VIVID];
+  for (int k = 0; k < 4; k++) pick_col(r, s->col[k], vivid->rgb, vivid->n);
+  double *d = s->d;
+  for (const synth_draw *st = cat->draw; st < cat->draw + SYNTH_MAX_DRAWS && st->op; st++) {
+    switch (st->op) {
+    case DRAW_RANGE: d[st->dst] = hearth_rng_range(r, st->lo, st->hi); break;
+    case DRAW_SCALED: d[st->dst] = st->k * d[st->src] * hearth_rng_range(r, st->lo, st->hi); break;
+    case DRAW_OFFSET: d[st->dst] = d[st->src] + hearth_rng_range(r, st->lo, st->hi); break;
+    case DRAW_CONST: d[st->dst] = st->k; break;
+    case DRAW_TIMES: d[st->dst] = d[st->src] * st->k; break;
+    case DRAW_MINUS: d[st->dst] = d[st->src] - st->k; break;
+    case DRAW_FLAG: d[st->dst] = hearth_rng_uniform(r) < st->k; break;
+    case DRAW_COLOUR: pick_col(r, s->col[st->dst], synth_palettes[st->src].rgb, (int)st->k); break;
+    case DRAW_END: break;
+    }
   }
 }
 
-/* orange peel bumps: a small radial displacement from smooth 3D noise */
-typedef struct orange_disp { double zc, amp; uint64_t seed; } orange_disp;
-static void orange_displace(const void *ctx, double p[3]) {
-  const orange_disp *od = ctx;
+/* the part and style of slot k of the instance's category (the part is
+ * numbered on first use) */
+static slot_use b_slot(builder *b, const shape *s, int k) {
+  const synth_slot *sl = &s->cat->slots[k];
+  return (slot_use){b_part(b, sl->part), sl->style[s->d[D_VARIANT] != 0]};
+}
+
+/* slots first..last-1, numbered in that order */
+static void b_slots(builder *b, const shape *s, int first, int last, slot_use *out) {
+  for (int k = first; k < last; k++) out[k] = b_slot(b, s, k);
+}
+
+/* a domed lid from radius r0 at height z0 in to a knob of radius rk: the
+ * dome rises by hd, the knob hk above it */
+static void prof_dome(profile *pf, double r0, double z0, double rk, double hd, double hk,
+                      slot_use dome, slot_use knob) {
+  size_t n = nseg(r0, pf->h, 4);
+  for (size_t k = 1; k <= n; k++) {
+    double t = (double)k / (double)n, r = r0 + (rk - r0) * t;
+    prof_push(pf, 1, r, z0 + hd * sin(0.5 * M_PI * t));
+  }
+  prof_seg(pf, dome);
+  prof_line(pf, 1, rk, z0 + hd + hk);
+  prof_seg(pf, knob);
+  prof_line(pf, 1, 0, z0 + hd + hk);
+  prof_seg(pf, knob);
+}
+
+/* a profile of edge length h starting on the axis at height z */
+static void prof_start(profile *pf, double h, double z) {
+  prof_init(pf, 0, h);
+  prof_push(pf, 1, 0, z);
+}
+
+/* sweep profile pf round a circle sampled for radius rmax, placed by M
+ * (3x4, optional) and displaced by disp (optional); frees pf */
+static int revolve(builder *b, profile *pf, double rmax, const double *M, disp_fn disp,
+                   const void *dctx) {
+  outline ol = {0};
+  int rc = outline_circle(&ol, rmax, pf->h) ? -1 : sweep_build(b, &ol, pf, M, disp, dctx);
+  outline_free(&ol);
+  prof_free(pf);
+  return rc;
+}
+
+/* SHAPE_VESSEL (synth_vessel) */
+static int build_vessel(builder *b, const shape *s, double h) {
+  const synth_vessel *v = &s->cat->vessel;
+  slot_use sl[VESSEL_SLOTS];
+  b_slots(b, s, VESSEL_BODY, VESSEL_LID, sl);
+  const double *d = s->d;
+  double R = d[D_R], Rb = d[D_R2], H = d[D_H], tw = d[D_T], tb = d[D_T2], f = v->foot;
+  double fi = v->inner_round;
+  profile pf;
+  prof_start(&pf, h, 0);
+  prof_line(&pf, 1, Rb - f, 0);
+  prof_seg(&pf, sl[VESSEL_BOTTOM]);
+  prof_arc(&pf, Rb - f, f, f, -0.5 * M_PI, 0, (size_t)v->foot_steps);
+  prof_line(&pf, 1, R, H - 0.5 * tw);
+  prof_seg(&pf, sl[VESSEL_BODY]);
+  prof_arc(&pf, R - 0.5 * tw, H - 0.5 * tw, 0.5 * tw, 0, M_PI, 3);
+  prof_seg(&pf, sl[VESSEL_RIM]);
+  /* the inner wall parallel to the outer one */
+  double rib = Rb - tw + (R - Rb) * tb / H;
+  prof_line(&pf, 1, rib, tb + fi);
+  prof_arc(&pf, rib - fi, tb + fi, fi, 0, -0.5 * M_PI, 2);
+  prof_seg(&pf, sl[VESSEL_INNER]);
+  prof_line(&pf, 1, 0, tb);
+  prof_seg(&pf, sl[VESSEL_INNER]);
+  int rc = revolve(b, &pf, R + v->margin, NULL, NULL, NULL);
+  tube_def td;
+  if (!rc && !v->lugs) {
+    /* ends buried half-way into the wall */
+    double z0 = H * v->mug[0], z1 = H * v->mug[1];
+    double r0 = Rb + (R - Rb) * z0 / H - 0.5 * tw, r1 = Rb + (R - Rb) * z1 / H - 0.5 * tw;
+    tube_handle(&td, 0, r0, z0, r1, z1, d[D_REACH] * v->mug[2], d[D_A], d[D_C]);
+    rc = tube_build(b, &td, sl[VESSEL_HANDLE], h);
+  }
+  for (int k = 0; !rc && v->lugs && k < 2; k++) {
+    double zh = H - v->lug[0];
+    tube_handle(&td, k * M_PI, R - 0.5 * tw, zh + v->lug[1], R - 0.5 * tw, zh - v->lug[1],
+                d[D_REACH], d[D_A], d[D_C]);
+    rc = tube_build(b, &td, sl[VESSEL_HANDLE], h);
+  }
+  if (!rc && v->lid && d[D_VARIANT]) {
+    /* resting on the rim */
+    b_slots(b, s, VESSEL_LID, VESSEL_SLOTS, sl);
+    double Rl = R + 0.002, zl = H + 0.0002;
+    prof_start(&pf, h, zl);
+    prof_line(&pf, 1, Rl, zl);
+    prof_seg(&pf, sl[VESSEL_LID]);
+    prof_line(&pf, 1, Rl, zl + 0.004);
+    prof_dome(&pf, Rl, zl + 0.004, 0.016, 0.015, 0.02, sl[VESSEL_LID], sl[VESSEL_KNOB]);
+    rc = revolve(b, &pf, R + v->margin, NULL, NULL, NULL);
+  }
+  return rc;
+}
+
+/* SHAPE_CAN */
+static int build_can(builder *b, const shape *s, double h) {
+  slot_use sl[CAN_SLOTS];
+  b_slots(b, s, 0, CAN_SLOTS, sl);
+  double R = s->d[D_R], H = s->d[D_H];
+  profile pf;
+  prof_start(&pf, h, 0.004);
+  prof_line(&pf, 1, R - 0.008, 0.0);
+  prof_seg(&pf, sl[CAN_DOME]);
+  prof_line(&pf, 1, R - 0.0065, 0.0);
+  prof_line(&pf, 1, R, 0.010);
+  prof_seg(&pf, sl[CAN_FOOT]);
+  prof_line(&pf, 1, R, H - 0.013);
+  prof_seg(&pf, sl[CAN_BODY]);
+  prof_line(&pf, 1, R - 0.0045, H - 0.002);
+  prof_line(&pf, 1, R - 0.0045, H);
+  prof_line(&pf, 1, R - 0.0065, H);
+  prof_line(&pf, 1, R - 0.0065, H - 0.003);
+  prof_seg(&pf, sl[CAN_RIM]);
+  prof_line(&pf, 1, 0, H - 0.003);
+  prof_seg(&pf, sl[CAN_LID]);
+  return revolve(b, &pf, R, NULL, NULL, NULL);
+}
+
+/* SHAPE_BOTTLE: body D_R x D_H, neck radius D_R2 */
+static int build_bottle(builder *b, const shape *s, double h) {
+  slot_use sl[BOTTLE_SLOTS];
+  b_slots(b, s, 0, BOTTLE_SLOTS, sl);
+  double R = s->d[D_R], H = s->d[D_H], rn = s->d[D_R2], rcap = rn + 0.0015, hc = 0.02;
+  double zs = H * 0.62, zn = H * 0.84, zl0 = H * 0.25, zl1 = H * 0.50;
+  profile pf;
+  prof_start(&pf, h, 0.003);
+  prof_line(&pf, 1, R - 0.006, 0);
+  prof_seg(&pf, sl[BOTTLE_BOTTOM]);
+  prof_arc(&pf, R - 0.006, 0.006, 0.006, -0.5 * M_PI, 0, 3);
+  prof_line(&pf, 1, R, zl0);
+  prof_seg(&pf, sl[BOTTLE_BODY]);
+  prof_line(&pf, 1, R, zl1);
+  prof_seg(&pf, sl[BOTTLE_LABEL]);
+  prof_line(&pf, 1, R, zs);
+  /* the shoulder: a half cosine from the body in to the neck */
+  size_t n = nseg(hypot(R - rn, zn - zs) * 1.2, h, 6);
+  for (size_t k = 1; k <= n; k++) {
+    double t = (double)k / (double)n;
+    prof_push(&pf, 1, rn + (R - rn) * 0.5 * (1 + cos(M_PI * t)), zs + (zn - zs) * t);
+  }
+  prof_seg(&pf, sl[BOTTLE_BODY]);
+  prof_line(&pf, 1, rn, H - hc);
+  prof_seg(&pf, sl[BOTTLE_NECK]);
+  prof_line(&pf, 1, rcap, H - hc);
+  prof_line(&pf, 1, rcap, H - 0.0015);
+  prof_arc(&pf, rcap - 0.0015, H - 0.0015, 0.0015, 0, 0.5 * M_PI, 2);
+  prof_seg(&pf, sl[BOTTLE_CAP]);
+  prof_line(&pf, 1, 0, H);
+  prof_seg(&pf, sl[BOTTLE_CAP]);
+  return revolve(b, &pf, R, NULL, NULL, NULL);
+}
+
+/* peel bumps: a small radial displacement from smooth 3D noise */
+typedef struct peel_disp { double zc, amp; uint64_t seed; } peel_disp;
+static void peel_displace(const void *ctx, double p[3]) {
+  const peel_disp *od = ctx;
   double q[3] = {p[0], p[1], p[2] - od->zc};
   double r = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
   if (r < 1e-9) return;
-  double n = vnoise3(od->seed, q[0] / 0.006, q[1] / 0.006, q[2] / 0.006) * 0.6 +
-             vnoise3(od->seed + 1, q[0] / 0.0025, q[1] / 0.0025, q[2] / 0.0025) * 0.4;
+  double n = synth_noise3(od->seed, q[0] / 0.006, q[1] / 0.006, q[2] / 0.006) * 0.6 +
+             synth_noise3(od->seed + 1, q[0] / 0.0025, q[1] / 0.0025, q[2] / 0.0025) * 0.4;
   double k = 1 + od->amp * n / r;
   p[0] = q[0] * k;
   p[1] = q[1] * k;
   p[2] = q[2] * k + od->zc;
 }
 
-/* a rounded slab profile: bottom face, edge round, side, edge round, top
- * face; split at z = zsplit (0: no split) into a lower and an upper part */
-static void prof_slab(profile *pf, double H, double e, double bulge, double zsplit, int p_lo,
-                      int s_lo, int p_bot, int s_bot, int p_hi, int s_hi, int p_top, int s_top) {
-  size_t nf = nseg(pf->rref, pf->h, 2);
-  /* bottom face from the centre out (bulging downward for soft items) */
-  for (size_t k = 0; k <= nf; k++) {
-    double s = (double)k / (double)nf;
-    prof_push(pf, s, -e, 0.0);
+/* SHAPE_SPHEROID: radius D_R, height D_H; the stem end is a cap at the top */
+static int build_spheroid(builder *b, const shape *s, double h) {
+  slot_use sl[SPHEROID_SLOTS];
+  b_slots(b, s, 0, SPHEROID_SLOTS, sl);
+  double R = s->d[D_R], Hz = 0.5 * s->d[D_H], cap = 0.35;
+  size_t n1 = nseg(cap * R, h, 2), n2 = nseg((M_PI - 2 * cap) * R, h, 6);
+  profile pf;
+  prof_start(&pf, h, 0);
+  for (size_t k = 1; k <= n1; k++) {
+    double a = -0.5 * M_PI + cap * (double)k / (double)n1;
+    prof_push(&pf, 1, R * cos(a), Hz * (1 + sin(a)));
   }
-  prof_seg(pf, p_bot, s_bot);
-  prof_arc(pf, -e, e, e, -0.5 * M_PI, 0, 2);
-  if (zsplit > e && zsplit < H - e) {
-    prof_line(pf, 1, 0, zsplit);
-    prof_seg(pf, p_lo, s_lo);
-    prof_line(pf, 1, 0, H - e);
-    prof_arc(pf, -e, H - e, e, 0, 0.5 * M_PI, 2);
-    prof_seg(pf, p_hi, s_hi);
-  } else {
-    prof_line(pf, 1, 0, H - e);
-    prof_arc(pf, -e, H - e, e, 0, 0.5 * M_PI, 2);
-    prof_seg(pf, p_lo, s_lo);
+  prof_seg(&pf, sl[SPHEROID_PEEL]);
+  for (size_t k = 1; k <= n2; k++) {
+    double a = -0.5 * M_PI + cap + (M_PI - 2 * cap) * (double)k / (double)n2;
+    prof_push(&pf, 1, R * cos(a), Hz * (1 + sin(a)));
   }
-  /* top face from the rim in to the centre, optionally domed */
-  for (size_t k = 1; k <= nf; k++) {
-    double s = 1 - (double)k / (double)nf;
-    prof_push(pf, s, -e, H + bulge * (1 - s * s));
+  prof_seg(&pf, sl[SPHEROID_PEEL]);
+  for (size_t k = 1; k <= n1; k++) {
+    double a = 0.5 * M_PI - cap + cap * (double)k / (double)n1;
+    prof_push(&pf, 1, k == n1 ? 0 : R * cos(a), Hz * (1 + sin(a)));
   }
-  prof_seg(pf, p_top, s_top);
+  prof_seg(&pf, sl[SPHEROID_STEM]);
+  peel_disp od = {Hz, 0.0004, s->tseed};
+  return revolve(b, &pf, R, NULL, peel_displace, &od);
 }
+
+/* SHAPE_KETTLE: body radius D_R and height D_H on a base D_T high */
+static int build_kettle(builder *b, const shape *s, double h) {
+  slot_use sl[KETTLE_SLOTS];
+  b_slots(b, s, 0, KETTLE_SLOTS, sl);
+  double R = s->d[D_R], zb = s->d[D_T], Hb = s->d[D_H], Rt = R * 0.82;
+  /* base plate */
+  profile pf;
+  prof_start(&pf, h, 0);
+  prof_line(&pf, 1, R + 0.004, 0);
+  prof_seg(&pf, sl[KETTLE_BASE]);
+  prof_arc(&pf, R + 0.004, 0.004, 0.004, -0.5 * M_PI, 0, 2);
+  prof_line(&pf, 1, R + 0.008, zb - 0.004);
+  prof_arc(&pf, R + 0.004, zb - 0.004, 0.004, 0, 0.5 * M_PI, 2);
+  prof_seg(&pf, sl[KETTLE_BASE]);
+  prof_line(&pf, 1, 0, zb);
+  prof_seg(&pf, sl[KETTLE_BASE]);
+  int rc = revolve(b, &pf, R + 0.01, NULL, NULL, NULL);
+  if (rc) return rc;
+  /* body with a domed lid and knob; it floats 0.3 mm above the base so the
+   * two never share a vertex */
+  zb += 0.0003;
+  prof_start(&pf, h, zb);
+  prof_line(&pf, 1, R - 0.01, zb);
+  prof_seg(&pf, sl[KETTLE_BODY]);
+  prof_arc(&pf, R - 0.01, zb + 0.01, 0.01, -0.5 * M_PI, 0, 3);
+  prof_line(&pf, 1, Rt + 0.012, zb + Hb - 0.012);
+  prof_arc(&pf, Rt, zb + Hb - 0.012, 0.012, 0, 0.5 * M_PI, 3);
+  prof_seg(&pf, sl[KETTLE_BODY]);
+  prof_dome(&pf, Rt, zb + Hb, 0.014, 0.012, 0.012, sl[KETTLE_LID], sl[KETTLE_KNOB]);
+  rc = revolve(b, &pf, R, NULL, NULL, NULL);
+  if (rc) return rc;
+  /* handle at the back, ends inside the body */
+  double z0 = zb + Hb * 0.85, z1 = zb + Hb * 0.25;
+  double rz0 = R - (R - Rt) * 0.85 - 0.015, rz1 = R - (R - Rt) * 0.25 - 0.015;
+  tube_def td;
+  tube_handle(&td, M_PI, rz0, z0, rz1, z1, s->d[D_REACH] * 1.33, 0.012, 0.010);
+  rc = tube_build(b, &td, sl[KETTLE_HANDLE], h);
+  if (rc) return rc;
+  /* spout at the front: up and out, tapering */
+  double zs = zb + Hb * 0.78, rs = R - (R - Rt) * 0.78 - 0.012;
+  tube_def sp = {{{rs, 0, zs}, {rs + 0.03, 0, zs + 0.004}, {rs + 0.04, 0, zs + 0.025},
+                  {rs + 0.045, 0, zs + 0.04}},
+                 {0, 1, 0}, 0.014, 0.008, 0.012, 0.006};
+  return tube_build(b, &sp, sl[KETTLE_SPOUT], h);
+}
+
+/* SHAPE_SLAB: a rounded rectangle D_W x D_L (corner radius D_RC) swept by a
+ * profile D_H high with edge rounds D_E: bottom face, side, top face. The
+ * side is split at D_ZSPLIT (0: none) into SLAB_SIDE and SLAB_UPPER; the top
+ * face domes up by D_BULGE. */
+static int build_slab(builder *b, const shape *s, double h) {
+  slot_use sl[SLAB_SLOTS];
+  b_slots(b, s, 0, SLAB_SLOTS, sl);
+  const double *d = s->d;
+  double A = 0.5 * d[D_W], B = 0.5 * d[D_L], e = d[D_E], bulge = d[D_BULGE];
+  double H = d[D_H] - bulge, zsplit = d[D_ZSPLIT];
+  outline ol = {0};
+  profile pf;
+  if (outline_rrect(&ol, A, B, d[D_RC], h)) return -1;
+  prof_init(&pf, 0.5 * (A + B), h);
+  size_t nf = nseg(pf.rref, pf.h, 2);
+  /* bottom face from the centre out */
+  for (size_t k = 0; k <= nf; k++) {
+    double t = (double)k / (double)nf;
+    prof_push(&pf, t, -e, 0.0);
+  }
+  prof_seg(&pf, sl[SLAB_BOTTOM]);
+  prof_arc(&pf, -e, e, e, -0.5 * M_PI, 0, 2);
+  if (zsplit > e && zsplit < H - e) {
+    prof_line(&pf, 1, 0, zsplit);
+    prof_seg(&pf, sl[SLAB_SIDE]);
+    prof_line(&pf, 1, 0, H - e);
+    prof_arc(&pf, -e, H - e, e, 0, 0.5 * M_PI, 2);
+    prof_seg(&pf, sl[SLAB_UPPER]);
+  } else {
+    prof_line(&pf, 1, 0, H - e);
+    prof_arc(&pf, -e, H - e, e, 0, 0.5 * M_PI, 2);
+    prof_seg(&pf, sl[SLAB_SIDE]);
+  }
+  /* top face from the rim in to the centre */
+  for (size_t k = 1; k <= nf; k++) {
+    double t = 1 - (double)k / (double)nf;
+    prof_push(&pf, t, -e, H + bulge * (1 - t * t));
+  }
+  prof_seg(&pf, sl[SLAB_TOP]);
+  int rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
+  prof_free(&pf);
+  outline_free(&ol);
+  return rc;
+}
+
+/* SHAPE_HEADSET: ear cups of radius D_R, D_T thick, D_W apart, on a band of
+ * half-axes D_A x D_C */
+static int build_headset(builder *b, const shape *s, double h) {
+  slot_use sl[HEADSET_SLOTS];
+  b_slots(b, s, 0, HEADSET_SLOTS, sl);
+  double R = s->d[D_R], T = s->d[D_T], W = s->d[D_W], e = 0.006;
+  profile pf;
+  prof_start(&pf, h, 0);
+  prof_line(&pf, 1, R - e, 0);
+  prof_seg(&pf, sl[HEADSET_CUP]);
+  prof_arc(&pf, R - e, e, e, -0.5 * M_PI, 0, 2);
+  prof_line(&pf, 1, R, T - e);
+  prof_seg(&pf, sl[HEADSET_CUP]);
+  prof_arc(&pf, R - e, T - e, e, 0, 0.5 * M_PI, 2);
+  prof_line(&pf, 1, 0, T);
+  prof_seg(&pf, sl[HEADSET_CUSHION]);
+  outline ol = {0};
+  int rc = outline_circle(&ol, R, h);
+  for (int k = 0; k < 2 && !rc; k++) {
+    /* cups stand on edge with their axes along x, cushions facing in */
+    double sx = k ? -1.0 : 1.0, x0 = k ? 0.5 * W + 0.5 * T : -0.5 * W - 0.5 * T;
+    double M[12] = {0, 0, sx, x0, 0, 1, 0, 0, -sx, 0, 0, R};
+    rc = sweep_build(b, &ol, &pf, M, NULL, NULL);
+  }
+  prof_free(&pf);
+  outline_free(&ol);
+  if (rc) return rc;
+  /* band over the top, its ends inside the cups */
+  double hw = 0.5 * W, zc = R, k4 = 0.5523 * 2;
+  tube_def td = {{{-hw, 0, zc}, {-hw, 0, zc + hw * k4 * 1.3}, {hw, 0, zc + hw * k4 * 1.3},
+                  {hw, 0, zc}},
+                 {0, 1, 0}, s->d[D_A], s->d[D_A], s->d[D_C], s->d[D_C]};
+  return tube_build(b, &td, sl[HEADSET_BAND], h);
+}
+
+typedef int (*shape_fn)(builder *b, const shape *s, double h);
+static const shape_fn k_shapes[SHAPE_COUNT] = {
+    [SHAPE_VESSEL] = build_vessel, [SHAPE_CAN] = build_can,         [SHAPE_BOTTLE] = build_bottle,
+    [SHAPE_SPHEROID] = build_spheroid, [SHAPE_KETTLE] = build_kettle, [SHAPE_SLAB] = build_slab,
+    [SHAPE_HEADSET] = build_headset};
 
 /* build a shape at edge length h; returns -1 on allocation failure */
 static int shape_build(builder *b, const shape *s, double h) {
-  outline ol = {0};
-  profile pf;
-  int rc = 0;
-  switch (s->cat) {
-  case C_CUP: {
-    int pb = b_part(b, "body"), pbot = b_part(b, "bottom"), prim = b_part(b, "rim");
-    int pin = b_part(b, "inner"), ph = b_part(b, "handle");
-    double R = s->R, Rb = s->R2, H = s->H, tw = s->t, tb = s->t2, f = 0.003;
-    if (outline_circle(&ol, R, h)) return -1;
-    prof_init(&pf, 0, h);
-    prof_push(&pf, 1, 0, 0);
-    prof_line(&pf, 1, Rb - f, 0);
-    prof_seg(&pf, pbot, S_UNGLAZED);
-    prof_arc(&pf, Rb - f, f, f, -0.5 * M_PI, 0, 2);
-    prof_line(&pf, 1, R, H - 0.5 * tw);
-    prof_seg(&pf, pb, S_GLAZE);
-    prof_arc(&pf, R - 0.5 * tw, H - 0.5 * tw, 0.5 * tw, 0, M_PI, 3);
-    prof_seg(&pf, prim, S_GLAZE);
-    double rib = Rb - tw + (R - Rb) * tb / H;
-    prof_line(&pf, 1, rib, tb + 0.004);
-    prof_arc(&pf, rib - 0.004, tb + 0.004, 0.004, 0, -0.5 * M_PI, 2);
-    prof_seg(&pf, pin, S_GLAZE);
-    prof_line(&pf, 1, 0, tb);
-    prof_seg(&pf, pin, S_GLAZE);
-    rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
-    prof_free(&pf);
-    if (rc) break;
-    /* handle: ends buried half-way into the wall */
-    double z0 = H * 0.78, z1 = H * 0.28;
-    double r0 = Rb + (R - Rb) * z0 / H - 0.5 * tw, r1 = Rb + (R - Rb) * z1 / H - 0.5 * tw;
-    tube_def td;
-    tube_handle(&td, 0, r0, z0, r1, z1, s->reach * 1.33, s->a, s->c);
-    rc = tube_build(b, &td, ph, S_GLAZE, S_GLAZE, h);
-    break;
-  }
-  case C_CAN: {
-    int pb = b_part(b, "body"), pt = b_part(b, "top"), pbot = b_part(b, "bottom");
-    double R = s->R, H = s->H;
-    if (outline_circle(&ol, R, h)) return -1;
-    prof_init(&pf, 0, h);
-    prof_push(&pf, 1, 0, 0.004);
-    prof_line(&pf, 1, R - 0.008, 0.0);
-    prof_seg(&pf, pbot, S_ALU_TOP);
-    prof_line(&pf, 1, R - 0.0065, 0.0);
-    prof_line(&pf, 1, R, 0.010);
-    prof_seg(&pf, pbot, S_ALU);
-    prof_line(&pf, 1, R, H - 0.013);
-    prof_seg(&pf, pb, S_CAN_LABEL);
-    prof_line(&pf, 1, R - 0.0045, H - 0.002);
-    prof_line(&pf, 1, R - 0.0045, H);
-    prof_line(&pf, 1, R - 0.0065, H);
-    prof_line(&pf, 1, R - 0.0065, H - 0.003);
-    prof_seg(&pf, pt, S_ALU);
-    prof_line(&pf, 1, 0, H - 0.003);
-    prof_seg(&pf, pt, S_ALU_TOP);
-    rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
-    prof_free(&pf);
-    break;
-  }
-  case C_BOTTLE: {
-    int pb = b_part(b, "body"), pl = b_part(b, "label"), pn = b_part(b, "neck");
-    int pc = b_part(b, "cap"), pbot = b_part(b, "bottom");
-    double R = s->R, H = s->H, rn = s->R2, rcap = rn + 0.0015, hc = 0.02;
-    double zs = H * 0.62, zn = H * 0.84, zl0 = H * 0.25, zl1 = H * 0.50;
-    if (outline_circle(&ol, R, h)) return -1;
-    prof_init(&pf, 0, h);
-    prof_push(&pf, 1, 0, 0.003);
-    prof_line(&pf, 1, R - 0.006, 0);
-    prof_seg(&pf, pbot, S_CLEAR);
-    prof_arc(&pf, R - 0.006, 0.006, 0.006, -0.5 * M_PI, 0, 3);
-    prof_line(&pf, 1, R, zl0);
-    prof_seg(&pf, pb, S_CLEAR);
-    prof_line(&pf, 1, R, zl1);
-    prof_seg(&pf, pl, S_BOTTLE_LABEL);
-    prof_line(&pf, 1, R, zs);
-    {
-      size_t n = nseg(hypot(R - rn, zn - zs) * 1.2, h, 6);
-      for (size_t k = 1; k <= n; k++) {
-        double t = (double)k / (double)n;
-        prof_push(&pf, 1, rn + (R - rn) * 0.5 * (1 + cos(M_PI * t)), zs + (zn - zs) * t);
-      }
-    }
-    prof_seg(&pf, pb, S_CLEAR);
-    prof_line(&pf, 1, rn, H - hc);
-    prof_seg(&pf, pn, S_CLEAR);
-    prof_line(&pf, 1, rcap, H - hc);
-    prof_line(&pf, 1, rcap, H - 0.0015);
-    prof_arc(&pf, rcap - 0.0015, H - 0.0015, 0.0015, 0, 0.5 * M_PI, 2);
-    prof_seg(&pf, pc, S_CAP);
-    prof_line(&pf, 1, 0, H);
-    prof_seg(&pf, pc, S_CAP);
-    rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
-    prof_free(&pf);
-    break;
-  }
-  case C_ORANGE: {
-    int pp = b_part(b, "peel"), pt = b_part(b, "stem_end");
-    double R = s->R, Hz = 0.5 * s->H, cap = 0.35;
-    if (outline_circle(&ol, R, h)) return -1;
-    prof_init(&pf, 0, h);
-    size_t n1 = nseg(cap * R, h, 2), n2 = nseg((M_PI - 2 * cap) * R, h, 6);
-    prof_push(&pf, 1, 0, 0);
-    for (size_t k = 1; k <= n1; k++) {
-      double a = -0.5 * M_PI + cap * (double)k / (double)n1;
-      prof_push(&pf, 1, R * cos(a), Hz * (1 + sin(a)));
-    }
-    prof_seg(&pf, pp, S_PEEL);
-    for (size_t k = 1; k <= n2; k++) {
-      double a = -0.5 * M_PI + cap + (M_PI - 2 * cap) * (double)k / (double)n2;
-      prof_push(&pf, 1, R * cos(a), Hz * (1 + sin(a)));
-    }
-    prof_seg(&pf, pp, S_PEEL);
-    for (size_t k = 1; k <= n1; k++) {
-      double a = 0.5 * M_PI - cap + cap * (double)k / (double)n1;
-      prof_push(&pf, 1, k == n1 ? 0 : R * cos(a), Hz * (1 + sin(a)));
-    }
-    prof_seg(&pf, pt, S_PEEL_TOP);
-    orange_disp od = {Hz, 0.0004, s->tseed};
-    rc = sweep_build(b, &ol, &pf, NULL, orange_displace, &od);
-    prof_free(&pf);
-    break;
-  }
-  case C_PHONE: case C_SPONGE: case C_ERASER: case C_LAPTOP: case C_WALLET: case C_TISSUE:
-  case C_GLASSES: case C_PILLOW: case C_CUSHION: case C_BAG: case C_MOUSE: {
-    double A = 0.5 * s->W, B = 0.5 * s->L;
-    if (outline_rrect(&ol, A, B, s->rc, h)) return -1;
-    prof_init(&pf, 0.5 * (A + B), h);
-    int p1, p2, p3, p4, s1, s2, s3, s4;
-    double zsplit = 0, bulge = 0;
-    switch (s->cat) {
-    case C_PHONE:
-      p3 = b_part(b, "back"); p1 = p2 = b_part(b, "frame"); p4 = b_part(b, "screen");
-      s3 = S_PHONE_BACK; s1 = s2 = S_FRAME; s4 = S_SCREEN;
-      break;
-    case C_SPONGE:
-      p3 = p1 = b_part(b, "foam"); p2 = p4 = b_part(b, "pad");
-      s3 = s1 = S_FOAM; s2 = s4 = S_PAD; zsplit = s->H2;
-      break;
-    case C_ERASER:
-      p3 = p1 = p4 = b_part(b, "body"); p2 = b_part(b, "sleeve");
-      s3 = s1 = s4 = S_RUBBER; s2 = S_SLEEVE; zsplit = 0;
-      break;
-    case C_LAPTOP:
-      p3 = p1 = b_part(b, "base"); p2 = p4 = b_part(b, "lid");
-      s3 = s1 = S_LAPTOP_BASE; s2 = S_STEEL; s4 = S_LAPTOP_LID; zsplit = s->H2;
-      break;
-    case C_TISSUE:
-      p3 = p1 = b_part(b, "box"); p4 = p2 = b_part(b, "top");
-      s3 = s1 = S_TISSUE_BOX; s4 = S_TISSUE_TOP; s2 = S_TISSUE_BOX; zsplit = s->H * 0.85;
-      break;
-    case C_MOUSE:
-      p3 = b_part(b, "bottom"); p1 = p2 = b_part(b, "side"); p4 = b_part(b, "shell");
-      s3 = S_BLACK; s1 = s2 = S_MOUSE_TOP; s4 = S_MOUSE_TOP;
-      bulge = s->H - 0.012;
-      break;
-    case C_GLASSES:
-      p3 = p1 = b_part(b, "shell"); p4 = p2 = b_part(b, "lid");
-      s3 = s1 = s4 = s2 = S_CASE; zsplit = s->H * 0.5;
-      break;
-    case C_PILLOW: case C_CUSHION:
-      p3 = p1 = p4 = p2 = b_part(b, "fabric");
-      s3 = s1 = s4 = s2 = s->cat == C_PILLOW ? S_FABRIC : S_FABRIC_CHECK;
-      bulge = s->H * 0.25;
-      break;
-    case C_BAG:
-      p3 = p1 = p4 = b_part(b, "bag"); p2 = b_part(b, "zip");
-      s3 = s1 = s4 = S_BAG; s2 = S_BAG_ZIP; zsplit = s->H * 0.5;
-      break;
-    default: /* wallet */
-      p3 = p1 = p4 = p2 = b_part(b, "leather");
-      s3 = s1 = s4 = s2 = S_LEATHER;
-      break;
-    }
-    double H = s->H - bulge;
-    if (s->cat == C_ERASER) {
-      /* the sleeve covers the middle of the side band */
-      prof_slab(&pf, H, s->e, 0, H * 0.5, p1, s1, p3, s3, p2, s2, p4, s4);
-    } else {
-      prof_slab(&pf, H, s->e, bulge, zsplit, p1, s1, p3, s3, p2, s2, p4, s4);
-    }
-    rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
-    prof_free(&pf);
-    break;
-  }
-  case C_KETTLE: {
-    int pbase = b_part(b, "base"), pb = b_part(b, "body"), pl = b_part(b, "lid");
-    int ph = b_part(b, "handle"), psp = b_part(b, "spout");
-    int sb = s->flag ? S_STEEL : S_PLAIN;
-    double R = s->R, zb = s->t, Hb = s->H2, Rt = R * 0.82;
-    /* base plate */
-    if (outline_circle(&ol, R + 0.01, h)) return -1;
-    prof_init(&pf, 0, h);
-    prof_push(&pf, 1, 0, 0);
-    prof_line(&pf, 1, R + 0.004, 0);
-    prof_seg(&pf, pbase, S_BLACK);
-    prof_arc(&pf, R + 0.004, 0.004, 0.004, -0.5 * M_PI, 0, 2);
-    prof_line(&pf, 1, R + 0.008, zb - 0.004);
-    prof_arc(&pf, R + 0.004, zb - 0.004, 0.004, 0, 0.5 * M_PI, 2);
-    prof_seg(&pf, pbase, S_BLACK);
-    prof_line(&pf, 1, 0, zb);
-    prof_seg(&pf, pbase, S_BLACK);
-    rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
-    prof_free(&pf);
-    if (rc) break;
-    /* body with a domed lid and knob */
-    prof_init(&pf, 0, h);
-    /* the body floats 0.3 mm above the base so the two never share a vertex */
-    zb += 0.0003;
-    prof_push(&pf, 1, 0, zb);
-    prof_line(&pf, 1, R - 0.01, zb);
-    prof_seg(&pf, pb, sb);
-    prof_arc(&pf, R - 0.01, zb + 0.01, 0.01, -0.5 * M_PI, 0, 3);
-    prof_line(&pf, 1, Rt + 0.012, zb + Hb - 0.012);
-    prof_arc(&pf, Rt, zb + Hb - 0.012, 0.012, 0, 0.5 * M_PI, 3);
-    prof_seg(&pf, pb, sb);
-    {
-      size_t n = nseg(Rt, h, 4);
-      double rk = 0.014, hd = 0.012;
-      for (size_t k = 1; k <= n; k++) {
-        double t = (double)k / (double)n, r = Rt + (rk - Rt) * t;
-        prof_push(&pf, 1, r, zb + Hb + hd * sin(0.5 * M_PI * t));
-      }
-      prof_seg(&pf, pl, sb);
-      prof_line(&pf, 1, rk, zb + Hb + hd + 0.012);
-      prof_seg(&pf, pl, S_BLACK);
-      prof_line(&pf, 1, 0, zb + Hb + hd + 0.012);
-      prof_seg(&pf, pl, S_BLACK);
-    }
-    double Rr = R, Rmid = R;
-    ol.n = 0;
-    outline_free(&ol);
-    if (outline_circle(&ol, Rr, h)) {
-      prof_free(&pf);
-      return -1;
-    }
-    rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
-    prof_free(&pf);
-    if (rc) break;
-    (void)Rmid;
-    /* handle at the back, ends inside the body */
-    double z0 = zb + Hb * 0.85, z1 = zb + Hb * 0.25;
-    double rz0 = R - (R - Rt) * 0.85 - 0.015, rz1 = R - (R - Rt) * 0.25 - 0.015;
-    tube_def td;
-    tube_handle(&td, M_PI, rz0, z0, rz1, z1, s->reach * 1.33, 0.012, 0.010);
-    rc = tube_build(b, &td, ph, S_BLACK, S_BLACK, h);
-    if (rc) break;
-    /* spout at the front: up and out, tapering */
-    double zs = zb + Hb * 0.78, rs = R - (R - Rt) * 0.78 - 0.012;
-    tube_def sp = {{{rs, 0, zs}, {rs + 0.03, 0, zs + 0.004}, {rs + 0.04, 0, zs + 0.025},
-                    {rs + 0.045, 0, zs + 0.04}},
-                   {0, 1, 0}, 0.014, 0.008, 0.012, 0.006};
-    rc = tube_build(b, &sp, psp, sb, sb, h);
-    break;
-  }
-  case C_POT: {
-    int pb = b_part(b, "body"), pbot = b_part(b, "bottom"), prim = b_part(b, "rim");
-    int pin = b_part(b, "inner"), ph = b_part(b, "handle");
-    double R = s->R, H = s->H2, tw = s->t, tb = 0.005;
-    if (outline_circle(&ol, R + 0.004, h)) return -1;
-    prof_init(&pf, 0, h);
-    prof_push(&pf, 1, 0, 0);
-    prof_line(&pf, 1, R - 0.008, 0);
-    prof_seg(&pf, pbot, S_STEEL_DARK);
-    prof_arc(&pf, R - 0.008, 0.008, 0.008, -0.5 * M_PI, 0, 3);
-    prof_line(&pf, 1, R, H - 0.5 * tw);
-    prof_seg(&pf, pb, S_STEEL);
-    prof_arc(&pf, R - 0.5 * tw, H - 0.5 * tw, 0.5 * tw, 0, M_PI, 3);
-    prof_seg(&pf, prim, S_STEEL);
-    prof_line(&pf, 1, R - tw, tb + 0.006);
-    prof_arc(&pf, R - tw - 0.006, tb + 0.006, 0.006, 0, -0.5 * M_PI, 2);
-    prof_seg(&pf, pin, S_STEEL_DARK);
-    prof_line(&pf, 1, 0, tb);
-    prof_seg(&pf, pin, S_STEEL_DARK);
-    rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
-    prof_free(&pf);
-    if (rc) break;
-    for (int k = 0; k < 2; k++) {
-      double zh = H - 0.025;
-      tube_def td;
-      tube_handle(&td, k * M_PI, R - 0.5 * tw, zh + 0.011, R - 0.5 * tw, zh - 0.011, 0.035,
-                  0.009, 0.0045);
-      rc = tube_build(b, &td, ph, S_BLACK, S_BLACK, h);
-      if (rc) break;
-    }
-    if (rc || !s->flag) break;
-    /* lid resting on the rim */
-    int pl = b_part(b, "lid");
-    double Rl = R + 0.002, zl = H + 0.0002;
-    prof_init(&pf, 0, h);
-    prof_push(&pf, 1, 0, zl);
-    prof_line(&pf, 1, Rl, zl);
-    prof_seg(&pf, pl, S_STEEL);
-    prof_line(&pf, 1, Rl, zl + 0.004);
-    {
-      size_t n = nseg(Rl, h, 4);
-      double rk = 0.016, hd = 0.015;
-      for (size_t k = 1; k <= n; k++) {
-        double t = (double)k / (double)n;
-        prof_push(&pf, 1, Rl + (rk - Rl) * t, zl + 0.004 + hd * sin(0.5 * M_PI * t));
-      }
-      prof_seg(&pf, pl, S_STEEL);
-      prof_line(&pf, 1, rk, zl + 0.004 + hd + 0.02);
-      prof_seg(&pf, pl, S_BLACK);
-      prof_line(&pf, 1, 0, zl + 0.004 + hd + 0.02);
-      prof_seg(&pf, pl, S_BLACK);
-    }
-    rc = sweep_build(b, &ol, &pf, NULL, NULL, NULL);
-    prof_free(&pf);
-    break;
-  }
-  case C_HEADSET: {
-    int pcup = b_part(b, "cup"), pcu = b_part(b, "cushion"), pband = b_part(b, "band");
-    double R = s->R, T = s->t, e = 0.006;
-    if (outline_circle(&ol, R, h)) return -1;
-    prof_init(&pf, 0, h);
-    prof_push(&pf, 1, 0, 0);
-    prof_line(&pf, 1, R - e, 0);
-    prof_seg(&pf, pcup, S_BLACK);
-    prof_arc(&pf, R - e, e, e, -0.5 * M_PI, 0, 2);
-    prof_line(&pf, 1, R, T - e);
-    prof_seg(&pf, pcup, S_BLACK);
-    prof_arc(&pf, R - e, T - e, e, 0, 0.5 * M_PI, 2);
-    prof_line(&pf, 1, 0, T);
-    prof_seg(&pf, pcu, S_CUSHION_PAD);
-    for (int k = 0; k < 2; k++) {
-      /* cups stand on edge with their axes along x, cushions facing in */
-      double sx = k ? -1.0 : 1.0, x0 = k ? 0.5 * s->W + 0.5 * T : -0.5 * s->W - 0.5 * T;
-      double M[12] = {0, 0, sx, x0, 0, 1, 0, 0, -sx, 0, 0, R};
-      rc = sweep_build(b, &ol, &pf, M, NULL, NULL);
-      if (rc) break;
-    }
-    prof_free(&pf);
-    if (rc) break;
-    /* band over the top, its ends inside the cups */
-    double hw = 0.5 * s->W, zc = R, k4 = 0.5523 * 2;
-    tube_def td = {{{-hw, 0, zc}, {-hw, 0, zc + hw * k4 * 1.3}, {hw, 0, zc + hw * k4 * 1.3},
-                    {hw, 0, zc}},
-                   {0, 1, 0}, s->a, s->a, s->c, s->c};
-    rc = tube_build(b, &td, pband, S_BLACK, S_BLACK, h);
-    break;
-  }
-  default:
-    rc = -1;
-  }
-  outline_free(&ol);
-  return rc;
+  return k_shapes[s->cat->shape](b, s, h);
 }
 
 /* ---- UV packing ---------------------------------------------------------- */
@@ -1306,112 +1013,95 @@ static void setc(double out[3], double r, double g, double b) {
   out[1] = g;
   out[2] = b;
 }
+static void copyc(double out[3], const double a[3]) { memcpy(out, a, 3 * sizeof(double)); }
+
+static const double k_white[3] = {1, 1, 1};
 
 /* a text-like block pattern: rows of short dark bars */
 static double textish(uint64_t seed, double x, double y, double lh) {
   double row = floor(y / lh), fy = y / lh - row;
   if (fy < 0.25 || fy > 0.8) return 0;
-  double word = floor(x / (lh * 0.9) + hash3(seed, (int64_t)row, 3, 0) * 7);
-  if (hash3(seed, (int64_t)row, (int64_t)word, 1) < 0.25) return 0;
+  double word =
+      floor(x / (lh * 0.9) + synth_lattice(seed, SYNTH_NOISE_SALT, (int64_t)row, 3, 0) * 7);
+  if (synth_lattice(seed, SYNTH_NOISE_SALT, (int64_t)row, (int64_t)word, 1) < 0.25) return 0;
   double fx = x / (lh * 0.9) - floor(x / (lh * 0.9));
   return (fx > 0.1 && fx < 0.92) ? 1 : 0;
 }
 
-/* colour of native point (x, y) of an island; texture detail from s->tseed */
-static void shade(const shape *s, const patch *p, double x, double y, double out[3]) {
-  uint64_t ts = s->tseed + (uint64_t)p->style * 977;
-  double n1 = fbm2(ts, x / 0.01, y / 0.01, 3);
+/* the grain most metal and peel patterns mix in */
+static double coarse_grain(uint64_t ts, double x, double y) {
+  return synth_fbm2(ts, x / 0.01, y / 0.01, 3);
+}
+
+/* pattern m->pattern at native point (x, y), (lx, ly) from the island's
+ * corner, over the base colour in out */
+static void draw_pattern(const shape *s, const patch *p, const synth_material *m, uint64_t ts,
+                         double x, double y, double out[3]) {
+  const double *d = s->d;
   double lx = x - p->ox, ly = y - p->oy;
-  switch (p->style) {
-  case S_GLAZE:
-    setc(out, 0.93, 0.93, 0.91);
-    if (s->flag && p->kind == K_STRIP && s->cat == C_CUP && p->part == 0) {
-      /* a coloured band round the body */
-      double t = ly / p->h;
-      if (t > 0.55 && t < 0.70) mixc(out, out, s->col[0], 0.85);
-    }
-    for (int k = 0; k < 3; k++) out[k] += 0.015 * n1;
-    break;
-  case S_UNGLAZED:
-    setc(out, 0.82, 0.76, 0.66);
-    for (int k = 0; k < 3; k++) out[k] += 0.04 * n1;
-    break;
-  case S_CAN_LABEL: {
+  switch (m->pattern) {
+  case PAT_NONE: break;
+  case PAT_CAN_LABEL: {
     double t = ly / p->h, u = lx / p->w;
-    mixc(out, s->col[0], s->col[0], 0);
     if (t < 0.08 || t > 0.92) setc(out, 0.75, 0.76, 0.78);
-    else if (fabs(t - 0.3) < 0.04) mixc(out, s->col[1], s->col[1], 0);
+    else if (fabs(t - 0.3) < 0.04) copyc(out, s->col[1]);
     else if (t > 0.42 && t < 0.75 && u > 0.1 && u < 0.45) {
       /* a logo block with white lettering */
       double q = textish(ts, lx, ly, 0.012);
-      mixc(out, s->col[0], (const double[3]){1, 1, 1}, q);
+      mixc(out, s->col[0], k_white, q);
     } else if (t > 0.45 && t < 0.65 && u > 0.6 && u < 0.9) {
       double q = textish(ts + 5, lx, ly, 0.004);
       mixc(out, out, (const double[3]){0.05, 0.05, 0.05}, q * 0.8);
     }
     break;
   }
-  case S_ALU:
-  case S_ALU_TOP: {
+  case PAT_ALU: {
     double r = hypot(x, y);
-    double v = 0.74 + 0.05 * vnoise2(ts, r / 0.0006, 0.5) + 0.02 * n1;
+    double v = m->param + 0.05 * synth_noise2(ts, r / 0.0006, 0.5) + 0.02 * coarse_grain(ts, x, y);
     setc(out, v, v + 0.005, v + 0.015);
-    if (p->style == S_ALU_TOP && p->kind == K_DISK && x > 0.004 && x < 0.02 && fabs(y) < 0.006)
-      setc(out, 0.55, 0.56, 0.58); /* tab */
+    if (m->alt && p->kind == K_DISK && x > 0.004 && x < 0.02 && fabs(y) < 0.006)
+      setc(out, 0.55, 0.56, 0.58);
     break;
   }
-  case S_CLEAR:
-    setc(out, 0.78, 0.86, 0.88);
-    for (int k = 0; k < 3; k++) out[k] += 0.03 * n1;
-    break;
-  case S_BOTTLE_LABEL: {
+  case PAT_BOTTLE_LABEL: {
     double t = ly / p->h;
-    mixc(out, s->col[0], s->col[0], 0);
     if (t < 0.12 || t > 0.88) setc(out, 0.95, 0.95, 0.95);
     double q = textish(ts, lx, ly, 0.008);
-    if (t > 0.3 && t < 0.7) mixc(out, out, (const double[3]){1, 1, 1}, q);
+    if (t > 0.3 && t < 0.7) mixc(out, out, k_white, q);
     break;
   }
-  case S_CAP: {
-    mixc(out, s->col[1], s->col[1], 0);
+  case PAT_RIBS:
     if (p->kind == K_STRIP) {
       double rib = 0.5 + 0.5 * sin(lx / 0.0008 * 2 * M_PI);
       for (int k = 0; k < 3; k++) out[k] *= 0.85 + 0.15 * rib;
     }
     break;
-  }
-  case S_PEEL:
-  case S_PEEL_TOP: {
-    setc(out, 0.96, 0.55, 0.10);
-    double pores = vnoise2(ts, x / 0.0009, y / 0.0009);
-    double k = 0.06 * n1 - (pores > 0.55 ? 0.12 * (pores - 0.55) / 0.45 : 0);
-    for (int m = 0; m < 3; m++) out[m] += k * out[m] * 2;
-    if (p->style == S_PEEL_TOP) {
-      double r = hypot(x, y);
-      if (r < 0.004) mixc(out, out, (const double[3]){0.35, 0.40, 0.12}, 1 - r / 0.004);
-    }
+  case PAT_PEEL: {
+    double pores = synth_noise2(ts, x / 0.0009, y / 0.0009);
+    double k = 0.06 * coarse_grain(ts, x, y) - (pores > 0.55 ? 0.12 * (pores - 0.55) / 0.45 : 0);
+    for (int c = 0; c < 3; c++) out[c] += k * out[c] * 2;
+    double r = hypot(x, y);
+    if (m->alt && r < 0.004) mixc(out, out, (const double[3]){0.35, 0.40, 0.12}, 1 - r / 0.004);
     break;
   }
-  case S_SCREEN: {
-    double A = 0.5 * s->W - s->e - 0.0025, B = 0.5 * s->L - s->e - 0.004;
+  case PAT_SCREEN: {
+    double A = 0.5 * d[D_W] - d[D_E] - 0.0025, B = 0.5 * d[D_L] - d[D_E] - 0.004;
     if (fabs(x) < A && fabs(y) < B) {
       double g = 0.04 + 0.03 * (x / A + y / B + 2) / 4;
       setc(out, g, g, g + 0.01);
     } else {
       setc(out, 0.02, 0.02, 0.02);
     }
-    if (hypot(x, y - (0.5 * s->L - 0.009)) < 0.0018) setc(out, 0.10, 0.10, 0.14);
+    if (hypot(x, y - (0.5 * d[D_L] - 0.009)) < 0.0018) setc(out, 0.10, 0.10, 0.14);
     break;
   }
-  case S_FRAME: {
-    double v = 0.55 + 0.04 * n1;
+  case PAT_FRAME: {
+    double v = 0.55 + 0.04 * coarse_grain(ts, x, y);
     mixc(out, s->col[0], (const double[3]){v, v, v}, 0.6);
     break;
   }
-  case S_PHONE_BACK: {
-    mixc(out, s->col[0], s->col[0], 0);
-    for (int k = 0; k < 3; k++) out[k] += 0.01 * n1;
-    double cx = -(0.5 * s->W - 0.02), cy = 0.5 * s->L - 0.02;
+  case PAT_CAMERA: {
+    double cx = -(0.5 * d[D_W] - 0.02), cy = 0.5 * d[D_L] - 0.02;
     if (fabs(x - cx) < 0.015 && fabs(y - cy) < 0.015) {
       mixc(out, out, (const double[3]){0.15, 0.15, 0.16}, 0.7);
       for (int l = 0; l < 2; l++)
@@ -1420,109 +1110,86 @@ static void shade(const shape *s, const patch *p, double x, double y, double out
     }
     break;
   }
-  case S_FOAM: {
-    setc(out, 0.97, 0.82, 0.22);
-    double pores = vnoise2(ts, x / 0.0007, y / 0.0007);
+  case PAT_PORES: {
+    double pores = synth_noise2(ts, x / 0.0007, y / 0.0007);
     if (pores > 0.5) mixc(out, out, (const double[3]){0.75, 0.58, 0.10}, (pores - 0.5) * 1.6);
     break;
   }
-  case S_PAD: {
-    setc(out, 0.12, 0.45, 0.18);
-    double f = vnoise2(ts, x / 0.0004, y / 0.003) * 0.5 + vnoise2(ts + 9, x / 0.003, y / 0.0004) * 0.5;
+  case PAT_FIBRES: {
+    double f = synth_noise2(ts, x / 0.0004, y / 0.003) * 0.5 +
+               synth_noise2(ts + 9, x / 0.003, y / 0.0004) * 0.5;
     for (int k = 0; k < 3; k++) out[k] *= 0.8 + 0.35 * f;
     break;
   }
-  case S_STEEL:
-  case S_STEEL_DARK: {
-    double v = (p->style == S_STEEL ? 0.72 : 0.55) + 0.06 * vnoise2(ts, lx / 0.03, ly / 0.0004) +
-               0.03 * n1;
+  case PAT_BRUSHED: {
+    double v = m->param + 0.06 * synth_noise2(ts, lx / 0.03, ly / 0.0004) +
+               0.03 * coarse_grain(ts, x, y);
     if (p->kind == K_STRIP) v += 0.08 * sin(2 * M_PI * lx / p->w * 2);
     setc(out, v, v + 0.005, v + 0.012);
     break;
   }
-  case S_BLACK:
-    setc(out, 0.07, 0.07, 0.075);
-    for (int k = 0; k < 3; k++) out[k] += 0.015 * n1;
+  case PAT_MOUSE:
+    if (p->kind == K_DISK && fabs(x) < 0.0006 && y > d[D_L] * 0.1) setc(out, 0.02, 0.02, 0.02);
+    if (p->kind == K_DISK && hypot(x, y - d[D_L] * 0.3) < 0.004) setc(out, 0.2, 0.2, 0.22);
     break;
-  case S_MOUSE_TOP: {
-    mixc(out, s->col[0], s->col[0], 0);
-    if (p->kind == K_DISK && fabs(x) < 0.0006 && y > s->L * 0.1) setc(out, 0.02, 0.02, 0.02);
-    if (p->kind == K_DISK && hypot(x, y - s->L * 0.3) < 0.004) setc(out, 0.2, 0.2, 0.22);
-    break;
-  }
-  case S_RUBBER:
-    setc(out, 0.95, 0.95, 0.93);
-    for (int k = 0; k < 3; k++) out[k] += 0.02 * n1;
-    break;
-  case S_SLEEVE: {
-    mixc(out, s->col[0], s->col[0], 0);
-    double q = textish(ts, lx, ly, 0.003);
-    mixc(out, out, (const double[3]){1, 1, 1}, q);
-    break;
-  }
-  case S_LAPTOP_LID:
-    setc(out, 0.70, 0.71, 0.73);
+  case PAT_PRINT: mixc(out, out, k_white, textish(ts, lx, ly, m->param)); break;
+  case PAT_LOGO:
     if (hypot(x, y) < 0.012) setc(out, 0.82, 0.83, 0.85);
     break;
-  case S_LAPTOP_BASE:
-    setc(out, 0.60, 0.61, 0.63);
-    if (p->kind == K_DISK && fabs(fabs(x) - 0.5 * s->W + 0.03) < 0.008 &&
-        fabs(fabs(y) - 0.5 * s->L + 0.03) < 0.008)
+  case PAT_FEET:
+    if (p->kind == K_DISK && fabs(fabs(x) - 0.5 * d[D_W] + 0.03) < 0.008 &&
+        fabs(fabs(y) - 0.5 * d[D_L] + 0.03) < 0.008)
       setc(out, 0.1, 0.1, 0.1);
     break;
-  case S_LEATHER: {
-    mixc(out, s->col[0], (const double[3]){0.40, 0.22, 0.10}, 0.5);
-    for (int k = 0; k < 3; k++) out[k] += 0.05 * fbm2(ts, x / 0.002, y / 0.002, 2);
+  case PAT_STITCHES:
     if (p->kind == K_DISK) {
-      double dx = 0.5 * s->W - s->e - fabs(x), dy = 0.5 * s->L - s->e - fabs(y);
-      double d = fmin(dx, dy);
-      if (d > 0.003 && d < 0.0038 && fmod(fabs(x + y) / 0.003, 1.0) < 0.6)
+      double dx = 0.5 * d[D_W] - d[D_E] - fabs(x), dy = 0.5 * d[D_L] - d[D_E] - fabs(y);
+      double dm = fmin(dx, dy);
+      if (dm > 0.003 && dm < 0.0038 && fmod(fabs(x + y) / 0.003, 1.0) < 0.6)
         setc(out, 0.85, 0.78, 0.60);
     }
     break;
-  }
-  case S_TISSUE_BOX: {
-    mixc(out, s->col[0], s->col[0], 0);
-    double fl = vnoise2(ts, lx / 0.02, ly / 0.02);
-    if (fl > 0.45) mixc(out, out, s->col[1], 0.7);
+  case PAT_FLOWERS:
+    if (synth_noise2(ts, lx / 0.02, ly / 0.02) > 0.45) mixc(out, out, s->col[1], 0.7);
     break;
-  }
-  case S_TISSUE_TOP: {
-    mixc(out, s->col[0], s->col[0], 0);
-    double ex = x / (0.5 * s->W * 0.6), ey = y / (0.5 * s->L * 0.35);
+  case PAT_OPENING: {
+    double ex = x / (0.5 * d[D_W] * 0.6), ey = y / (0.5 * d[D_L] * 0.35);
     if (ex * ex + ey * ey < 1) setc(out, 0.97, 0.97, 0.97);
     break;
   }
-  case S_CASE:
-    mixc(out, s->col[0], s->col[0], 0);
-    for (int k = 0; k < 3; k++) out[k] += 0.03 * n1;
-    break;
-  case S_FABRIC:
-  case S_FABRIC_CHECK: {
-    mixc(out, s->col[p->style == S_FABRIC ? 0 : 1], s->col[0], 0);
+  case PAT_WEAVE: {
     double weave = 0.5 + 0.5 * sin(lx / 0.0012 * M_PI) * sin(ly / 0.0012 * M_PI);
     for (int k = 0; k < 3; k++) out[k] *= 0.92 + 0.08 * weave;
-    if (p->style == S_FABRIC_CHECK && ((int)floor(lx / 0.04) + (int)floor(ly / 0.04)) % 2)
+    if (m->alt && ((int)floor(lx / 0.04) + (int)floor(ly / 0.04)) % 2)
       for (int k = 0; k < 3; k++) out[k] *= 0.75;
     break;
   }
-  case S_BAG:
-    setc(out, 0.86, 0.89, 0.92);
-    for (int k = 0; k < 3; k++) out[k] += 0.03 * n1;
-    break;
-  case S_BAG_ZIP:
-    setc(out, 0.86, 0.89, 0.92);
-    if (fabs(ly - 0.5 * p->h) < 0.002) mixc(out, s->col[0], s->col[0], 0);
-    break;
-  case S_CUSHION_PAD:
-    setc(out, 0.16, 0.16, 0.17);
-    for (int k = 0; k < 3; k++) out[k] += 0.04 * fbm2(ts, x / 0.002, y / 0.002, 2);
-    break;
-  default: /* S_PLAIN */
-    setc(out, 0.94, 0.94, 0.93);
-    for (int k = 0; k < 3; k++) out[k] += 0.02 * n1;
+  case PAT_ZIP:
+    if (fabs(ly - 0.5 * p->h) < 0.002) copyc(out, s->col[0]);
     break;
   }
+}
+
+/* colour of native point (x, y) of an island: its material (synth_material)
+ * with texture detail from s->tseed */
+static void shade(const shape *s, const patch *p, double x, double y, double out[3]) {
+  const synth_material *m = &synth_materials[p->style];
+  uint64_t ts = s->tseed + (uint64_t)m->stream * 977;
+  switch (m->base) {
+  case BASE_NONE: break;
+  case BASE_RGB: copyc(out, m->rgb); break;
+  case BASE_SLOT: copyc(out, s->col[m->slot]); break;
+  case BASE_MIX: mixc(out, s->col[m->slot], m->rgb, m->mix); break;
+  }
+  if (m->band[2] > 0 && p->kind == K_STRIP) {
+    double t = (y - p->oy) / p->h;
+    if (t > m->band[0] && t < m->band[1]) mixc(out, out, s->col[0], m->band[2]);
+  }
+  if (m->grain != 0) {
+    double g = synth_fbm2(ts, x / m->grain_size, y / m->grain_size, m->grain_octaves);
+    for (int k = 0; k < 3; k++) out[k] += m->grain * g;
+  }
+  draw_pattern(s, p, m, ts, x, y, out);
 }
 
 typedef struct tex_job {
@@ -1592,14 +1259,18 @@ hearth_status synth_object_make(const char *category, uint64_t seed, size_t targ
                                 size_t texture_size, synth_object *obj, hearth_err *err) {
   if (!obj) return hearth_err_set(err, HEARTH_E_ARG, "synth_object_make: obj is NULL");
   memset(obj, 0, sizeof *obj);
-  int cat = cat_code(category);
-  if (cat < 0)
+  int cat = synth_category_index(category);
+  if (cat < 0) {
+    char known[512];
+    size_t n = 0;
+    for (int c = 0; c < SYNTH_N_CATEGORIES && n < sizeof known; c++)
+      n += (size_t)snprintf(known + n, sizeof known - n, "%s%s", c ? ", " : "",
+                            synth_categories[c].name);
     return hearth_err_set(err, HEARTH_E_ARG,
-                          "synth_object_make: unknown category '%s': expected one of cup, "
-                          "canned_drink, bottled_drink, orange, smartphone, sponge, "
-                          "electric_kettle, pot, mouse, eraser, laptop, wallet, tissue, "
-                          "glasses_case, pillow, cushion, storage_bag, headset",
-                          category ? category : "(null)");
+                          "synth_object_make: unknown category '%s': expected one of %s",
+                          category ? category : "(null)", known);
+  }
+  const synth_category *sc = &synth_categories[cat];
   if (target_triangles < 200 || target_triangles > 5000000)
     return hearth_err_set(err, HEARTH_E_RANGE,
                           "synth_object_make(%s): target_triangles %zu: expected 200..5000000",
@@ -1612,7 +1283,7 @@ hearth_status synth_object_make(const char *category, uint64_t seed, size_t targ
   hearth_rng_seed(&root, seed);
   hearth_rng_fork(&root, 0x6f626a00u + (uint64_t)cat, &r);
   shape s;
-  shape_draw(&s, cat, &r);
+  shape_draw(&s, sc, &r);
 
   /* edge length by bisection on log(h) against the counted triangles */
   int fail = 0;
@@ -1673,14 +1344,15 @@ hearth_status synth_object_make(const char *category, uint64_t seed, size_t targ
       for (size_t v = 0; v < cb.nv; v++) obj->mesh.positions[3 * v + 2] -= zmin;
   }
 
-  snprintf(obj->category, sizeof obj->category, "%s", k_cat_names[cat]);
+  snprintf(obj->category, sizeof obj->category, "%s", sc->name);
   obj->n_parts = b->n_parts;
   for (int k = 0; k < b->n_parts; k++) obj->part_names[k] = b->part_names[k];
   obj_extent(obj);
-  obj->fill_level = s.fillz;
-  if (cat == C_CUP) obj->fill_level = s.fillz;
-  if (cat == C_KETTLE) obj->fill_level = (s.t + s.H2 * s.fillz) / obj->height;
-  if (cat == C_POT) obj->fill_level = s.H2 * s.fillz / obj->height;
+  switch (sc->fill) {
+  case FILL_DRAWN: obj->fill_level = s.d[D_FILL]; break;
+  case FILL_DEPTH: obj->fill_level = s.d[D_H] * s.d[D_FILL] / obj->height; break;
+  case FILL_ABOVE_BASE: obj->fill_level = (s.d[D_T] + s.d[D_H] * s.d[D_FILL]) / obj->height; break;
+  }
 
   st = hearth_image_alloc(&obj->albedo, texture_size, texture_size, 3, HEARTH_PIX_U8, err);
   if (st) {
@@ -1760,8 +1432,8 @@ hearth_status synth_object_from_mesh(const hearth_mesh *m, double size_m, const 
   obj->part_names[0] = "body";
   snprintf(obj->category, sizeof obj->category, "%s", category ? category : "object");
   obj_extent(obj);
-  int cat = cat_code(category);
-  obj->fill_level = cat == C_CUP ? 0.8 : (cat == C_KETTLE || cat == C_POT) ? 0.6 : 0;
+  const synth_category *kind = synth_category_find(category);
+  obj->fill_level = kind ? kind->wrapped_fill : 0;
   st = hearth_image_alloc(&obj->albedo, texture_size, texture_size, 3, HEARTH_PIX_U8, err);
   if (st) {
     synth_object_free(obj);
