@@ -382,6 +382,33 @@ static void test_variants(void) {
        {"plain", "utf-8", "CRLF", ',', 5, "0,95", NULL, 1}},
   };
   for (size_t i = 0; i < sizeof v / sizeof v[0]; i++) check_variant(&v[i], 100 + i);
+
+  /* from a file: the HIKMICRO-like export through hearth_thermal_read_csv_ex */
+  const variant *h = v;
+  while (strcmp(h->name, "axis-hikmicro-quoted")) h++;
+  fx f = h->f;
+  char *meta = fx_meta(h->meta_tpl, f.sep, f.dm), path[1200];
+  f.meta = meta;
+  int *k = fx_values(f.w, f.h, 7);
+  sbuf t = fx_text(&f, k);
+  snprintf(path, sizeof path, "%s/hikmicro.csv", test_tmpdir("io_test_csv_variants"));
+  hearth_err err = {0};
+  CHECK_OK(hearth_write_file_atomic(path, t.s, t.n, &err), &err);
+  hearth_image img, ref = fx_reference(f.w, f.h, k);
+  hearth_thermal_info info;
+  CHECK_OK(hearth_thermal_read_csv_ex(path, NULL, &img, &info, &err), &err);
+  CHECK(img.data && ref.data && !memcmp(img.data, ref.data, sizeof(float) * 256 * 192));
+  CHECK(info.layout == HEARTH_CSV_AXIS && info.n_meta == 5 && info.meta &&
+        !strcmp(info.meta[0].key, "File") && !strcmp(info.meta[0].value, "C:\\HM0001.jpg") &&
+        info.meta[0].line == 1 && info.first_line == 7);
+  CHECK(!strcmp(hearth_thermal_info_get(&info, "temperature unit"), "\xC2\xB0" "C"));
+  hearth_thermal_info_free(&info);
+  hearth_thermal_info_free(&info); /* freeing twice (zeroed) is fine */
+  hearth_image_free(&img);
+  hearth_image_free(&ref);
+  free(t.s);
+  free(k);
+  free(meta);
 }
 
 /* ---- mangled forms ------------------------------------------------------------ */
@@ -445,38 +472,41 @@ static void test_mangled(void) {
   const fx frame = {256, 192, ';', ',', 0, 1, "\n", 0, FX_FRAME, "Frame 1", NULL, ENC_RAW, 0};
   sbuf t;
 
-  /* a wrong index row: 99 replaced by 100 */
-  t = fx_make(&axis, 1);
-  fx_set_cell(&t, 1, 100, ',', "100");
-  expect_fail("index-row", &t, &cam, HEARTH_E_PARSE, 1, fx_column(t.s, t.n, 1, 100, ','),
-              "column index '100', expected 99");
-  free(t.s);
-  /* the same after a metadata block of 9 lines */
-  {
-    fx f = axis;
-    char *m = fx_meta(k_meta_en, ',', '.');
-    f.meta = m;
-    t = fx_make(&f, 1);
-    fx_set_cell(&t, 10, 7, ',', "x");
-    expect_fail("index-row-after-metadata", &t, &cam, HEARTH_E_PARSE, 10,
-                fx_column(t.s, t.n, 10, 7, ','), "column index 'x'");
+  /* one cell replaced: the error at cell err_cell of the same line */
+  fx axis_meta = axis;
+  char *meta = fx_meta(k_meta_en, ',', '.');
+  axis_meta.meta = meta; /* 9 lines before the matrix */
+  const struct {
+    const char *label;
+    const fx *f;
+    size_t line, cell;
+    const char *rep;
+    hearth_status st;
+    size_t err_cell;
+    const char *needle;
+  } one[] = {
+      /* a wrong index row, an index column skipping a number or not an integer */
+      {"index-row", &axis, 1, 100, "100", HEARTH_E_PARSE, 100, "column index '100', expected 99"},
+      {"index-row-after-metadata", &axis_meta, 10, 7, "x", HEARTH_E_PARSE, 7, "column index 'x'"},
+      {"index-column", &axis, 52, 0, "51", HEARTH_E_PARSE, 0, "row index '51', expected 50"},
+      {"index-column-small", &axis_small, 3, 0, "2", HEARTH_E_PARSE, 0, "row index '2', expected 1"},
+      {"index-column-decimal", &axis, 40, 0, "38.0", HEARTH_E_PARSE, 0, "row index '38.0'"},
+      /* a ragged row, garbage, a second frame label */
+      {"ragged-long-axis", &axis, 12, 256, "20.00,21.00", HEARTH_E_SIZE, 257,
+       "row has more than 256 values, expected 256 (as the index row of line 1)"},
+      {"garbage-axis", &axis, 9, 6, "2O.5", HEARTH_E_PARSE, 6, "'2O.5' is not a number"},
+      {"nan-frame", &frame, 70, 3, "nan", HEARTH_E_PARSE, 3, "not a finite number"},
+      {"second-frame", &frame, 101, 0, "Frame 2", HEARTH_E_PARSE, 0, "one frame per file"},
+  };
+  for (size_t i = 0; i < sizeof one / sizeof one[0]; i++) {
+    t = fx_make(one[i].f, 1 + i);
+    fx_set_cell(&t, one[i].line, one[i].cell, one[i].f->sep, one[i].rep);
+    size_t col = fx_column(t.s, t.n, one[i].line, one[i].err_cell, one[i].f->sep);
+    expect_fail(one[i].label, &t, one[i].f == &axis_small ? &any : &cam, one[i].st, one[i].line,
+                col, one[i].needle);
     free(t.s);
-    free(m);
   }
-  /* an index column skipping a number: row 50 numbered 51 (line 52) */
-  t = fx_make(&axis, 2);
-  fx_set_cell(&t, 52, 0, ',', "51");
-  expect_fail("index-column", &t, &cam, HEARTH_E_PARSE, 52, 1, "row index '51', expected 50");
-  free(t.s);
-  t = fx_make(&axis_small, 2);
-  fx_set_cell(&t, 3, 0, ';', "2");
-  expect_fail("index-column-small", &t, &any, HEARTH_E_PARSE, 3, 1, "row index '2', expected 1");
-  free(t.s);
-  /* a row index that is no integer */
-  t = fx_make(&axis, 2);
-  fx_set_cell(&t, 40, 0, ',', "38.0");
-  expect_fail("index-column-decimal", &t, &cam, HEARTH_E_PARSE, 40, 1, "row index '38.0'");
-  free(t.s);
+  free(meta);
 
   /* blank lines inside the matrix */
   {
@@ -517,84 +547,46 @@ static void test_mangled(void) {
                 "row has 159 values, expected 160");
   }
   free(t.s);
-  t = fx_make(&axis, 4);
-  fx_set_cell(&t, 12, 256, ',', "20.00,21.00");
-  expect_fail("ragged-long-axis", &t, &cam, HEARTH_E_SIZE, 12, fx_column(t.s, t.n, 12, 257, ','),
-              "row has more than 256 values, expected 256 (as the index row of line 1)");
-  free(t.s);
 
-  /* garbage cells */
-  t = fx_make(&axis, 5);
-  fx_set_cell(&t, 9, 6, ',', "2O.5");
-  expect_fail("garbage-axis", &t, &cam, HEARTH_E_PARSE, 9, fx_column(t.s, t.n, 9, 6, ','),
-              "'2O.5' is not a number");
-  free(t.s);
-  t = fx_make(&frame, 5);
-  fx_set_cell(&t, 70, 3, ';', "nan");
-  expect_fail("nan-frame", &t, &cam, HEARTH_E_PARSE, 70, fx_column(t.s, t.n, 70, 3, ';'),
-              "not a finite number");
-  free(t.s);
-  /* a second frame label: one frame per file */
-  t = fx_make(&frame, 5);
-  fx_set_cell(&t, 101, 0, ';', "Frame 2");
-  expect_fail("second-frame", &t, &cam, HEARTH_E_PARSE, 101, 1, "one frame per file");
-  free(t.s);
-
-  /* metadata after the data */
-  t = fx_make(&plain, 6);
-  sb_add(&t, "Emissivity,0.95\n");
-  expect_fail("metadata-after", &t, &cam, HEARTH_E_PARSE, 193, 1, "'Emissivity' is not a number");
-  free(t.s);
-  t = fx_make(&axis, 6);
-  sb_add(&t, "\n\nMax,45.2\n");
-  expect_fail("metadata-after-axis", &t, &cam, HEARTH_E_PARSE, 196, 1, "'Max'");
-  free(t.s);
-  /* numbers before the metadata */
-  t = fx_make(&plain, 6);
-  fx_splice(&t, 0, 0, "0.95\nDate,2024-05-01\n");
-  expect_fail("numbers-before-metadata", &t, &cam, HEARTH_E_PARSE, 1, 1, "before the metadata");
-  free(t.s);
-
-  /* a first row or column that reads as indices without the axis labels */
-  t = fx_make(&plain, 7);
-  for (int x = 255; x >= 0; x--) {
-    char d[8];
-    snprintf(d, sizeof d, "%d", x);
-    fx_set_cell(&t, 1, (size_t)x, ',', d);
+  /* text added before or after the matrix */
+  const struct {
+    const char *label;
+    const fx *f;
+    const char *before, *after;
+    hearth_status st;
+    size_t line, col;
+    const char *needle;
+  } added[] = {
+      /* metadata after the data; numbers before the metadata; a size line */
+      {"metadata-after", &plain, "", "Emissivity,0.95\n", HEARTH_E_PARSE, 193, 1,
+       "'Emissivity' is not a number"},
+      {"metadata-after-axis", &axis, "", "\n\nMax,45.2\n", HEARTH_E_PARSE, 196, 1, "'Max'"},
+      {"numbers-before-metadata", &plain, "0.95\nDate,2024-05-01\n", "", HEARTH_E_PARSE, 1, 1,
+       "before the metadata"},
+      {"size-line-disagrees", &plain, "256,191\n", "", HEARTH_E_SIZE, 1, 1,
+       "size line says 256x191, expected the 256x192"},
+      /* units other than degC are refused, at the unit's column */
+      {"unit-degF", &plain, "Emissivity,0.95\nUnit,\xC2\xB0" "F\n", "", HEARTH_E_UNSUPPORTED, 2, 6,
+       "temperature unit '\\xc2\\xb0F'"},
+      {"unit-kelvin", &plain, "Temperature unit: K\n", "", HEARTH_E_UNSUPPORTED, 1, 19,
+       "temperature unit 'K'"},
+      {"unit-hint-degF", &plain, "Min: 65.1 \xC2\xB0" "F\n", "", HEARTH_E_UNSUPPORTED, 1, 11,
+       "expected degC"},
+      /* Windows-1252 text: columns count bytes */
+      {"unit-hint-1252", &plain_semi, "\xC4nderung;x\nMax;98,6\xB0" "F\n", "", HEARTH_E_UNSUPPORTED,
+       2, 9, "expected degC"},
+      {"unit-unknown", &plain, "Unit,counts\n", "", HEARTH_E_UNSUPPORTED, 1, 6, "'counts'"},
+  };
+  for (size_t i = 0; i < sizeof added / sizeof added[0]; i++) {
+    t = fx_make(added[i].f, 20 + i);
+    fx_splice(&t, 0, 0, added[i].before);
+    sb_add(&t, "%s", added[i].after);
+    expect_fail(added[i].label, &t, added[i].f == &plain_semi ? &any : &cam, added[i].st,
+                added[i].line, added[i].col, added[i].needle);
+    free(t.s);
   }
-  expect_fail("index-row-no-corner", &t, &cam, HEARTH_E_PARSE, 1, 1,
-              "column indices or temperatures?");
-  free(t.s);
-  t = fx_make(&plain, 7);
-  for (int x = 255; x >= 1; x--) {
-    char d[8];
-    snprintf(d, sizeof d, "%d", x - 1);
-    fx_set_cell(&t, 1, (size_t)x, ',', d);
-  }
-  expect_fail("index-row-numeric-corner", &t, &cam, HEARTH_E_PARSE, 1,
-              fx_column(t.s, t.n, 1, 1, ','), "column indices or temperatures?");
-  free(t.s);
-  t = fx_make(&plain, 7);
-  for (int y = 1; y <= 192; y++) {
-    char d[8];
-    snprintf(d, sizeof d, "%d", y - 1);
-    fx_set_cell(&t, (size_t)y, 0, ',', d);
-  }
-  expect_fail("index-column-no-index-row", &t, &cam, HEARTH_E_PARSE, 1, 1,
-              "row indices or temperatures?");
-  free(t.s);
-  /* an index row that starts at 1 is no index row: then the index column is ambiguous */
-  t = fx_make(&axis_small, 7);
-  fx_splice(&t, 0, fx_line_start(&t, 2), "X/Y;1;2;3;4\n");
-  expect_fail("index-row-from-1", &t, &any, HEARTH_E_PARSE, 2, 1, "row indices or temperatures?");
-  free(t.s);
 
   /* sizes */
-  t = fx_make(&plain, 8);
-  fx_splice(&t, 0, 0, "256,191\n");
-  expect_fail("size-line-disagrees", &t, &cam, HEARTH_E_SIZE, 1, 1,
-              "size line says 256x191, expected the 256x192");
-  free(t.s);
   t = fx_make(&plain_semi, 8);
   expect_fail("160x120-expected-256x192", &t, NULL, HEARTH_E_SIZE, 1, fx_line_start(&t, 2),
               "row has 160 values, expected 256 (a 256x192 matrix)");
@@ -614,28 +606,6 @@ static void test_mangled(void) {
                 "matrix ends after 191 rows of 256 values, expected 256x192");
     free(t.s);
   }
-
-  /* units other than degC are refused */
-  t = fx_make(&plain, 9);
-  fx_splice(&t, 0, 0, "Emissivity,0.95\nUnit,\xC2\xB0" "F\n");
-  expect_fail("unit-degF", &t, &cam, HEARTH_E_UNSUPPORTED, 2, 6, "temperature unit '\\xc2\\xb0F'");
-  free(t.s);
-  t = fx_make(&plain, 9);
-  fx_splice(&t, 0, 0, "Temperature unit: K\n");
-  expect_fail("unit-kelvin", &t, &cam, HEARTH_E_UNSUPPORTED, 1, 19, "temperature unit 'K'");
-  free(t.s);
-  t = fx_make(&plain, 9);
-  fx_splice(&t, 0, 0, "Min: 65.1 \xC2\xB0" "F\n");
-  expect_fail("unit-hint-degF", &t, &cam, HEARTH_E_UNSUPPORTED, 1, 11, "expected degC");
-  free(t.s);
-  t = fx_make(&plain_semi, 9);
-  fx_splice(&t, 0, 0, "\xC4nderung;x\nMax;98,6\xB0" "F\n"); /* Windows-1252: columns in bytes */
-  expect_fail("unit-hint-1252", &t, &any, HEARTH_E_UNSUPPORTED, 2, 9, "expected degC");
-  free(t.s);
-  t = fx_make(&plain, 9);
-  fx_splice(&t, 0, 0, "Unit,counts\n");
-  expect_fail("unit-unknown", &t, &cam, HEARTH_E_UNSUPPORTED, 1, 6, "'counts'");
-  free(t.s);
 
   /* UTF-16 problems */
   {
