@@ -42,23 +42,47 @@ static void print_cam(const char *name, const hearth_camera *c) {
          c->dist[3], c->dist[4]);
 }
 
+/* a thermal CSV: its statistics, the layout the reader recognised, its metadata */
+static hearth_status inspect_csv(const char *path, hearth_err *err) {
+  hearth_csv_opts o = {0, 0};
+  hearth_image im = {0};
+  hearth_thermal_info in;
+  hearth_status s = hearth_thermal_read_csv_ex(path, &o, &im, &in, err);
+  if (s) return s;
+  const float *p = im.data;
+  double lo = INFINITY, hi = -INFINITY, sum = 0;
+  size_t n = im.width * im.height;
+  for (size_t i = 0; i < n; i++) {
+    lo = p[i] < lo ? p[i] : lo;
+    hi = p[i] > hi ? p[i] : hi;
+    sum += p[i];
+  }
+  printf("%s: thermal CSV %zux%zu, min %.2f, mean %.2f, max %.2f degC\n", path, im.width,
+         im.height, lo, n ? sum / (double)n : 0.0, hi);
+  char sep[8], dec[8];
+  snprintf(sep, sizeof sep, in.separator == '\t' ? "tab" : "'%c'", in.separator);
+  snprintf(dec, sizeof dec, in.decimal_mark ? "'%c'" : "none", in.decimal_mark);
+  printf("  layout %s", hearth_csv_layout_name(in.layout));
+  if (in.label) printf(" (label '%s')", in.label);
+  if (in.size_line) printf(" (size line %zu)", in.size_line);
+  printf(", separator %s, decimal mark %s, encoding %s, line ends %s\n", sep, dec, in.encoding,
+         in.line_ends);
+  printf("  matrix lines %zu..%zu after %zu header line(s), unit %s\n", in.first_line,
+         in.last_line, in.header_lines, in.unit ? "degC (stated)" : "degC (not stated)");
+  for (size_t i = 0; i < in.n_meta; i++)
+    printf("  metadata line %zu: %s%s%s\n", in.meta[i].line, in.meta[i].key,
+           in.meta[i].value[0] ? " = " : "", in.meta[i].value);
+  if (in.n_meta_lines > in.n_meta)
+    printf("  (%zu more metadata lines)\n", in.n_meta_lines - in.n_meta);
+  hearth_thermal_info_free(&in);
+  hearth_image_free(&im);
+  return HEARTH_OK;
+}
+
 static hearth_status inspect_one(const char *path, const char *kind, hearth_err *err) {
   hearth_status s = HEARTH_OK;
   if (!strcmp(kind, "csv")) {
-    hearth_csv_opts o = {0, 0};
-    hearth_image im = {0};
-    if ((s = hearth_thermal_read_csv(path, &o, &im, err))) return s;
-    const float *p = im.data;
-    double lo = INFINITY, hi = -INFINITY, sum = 0;
-    size_t n = im.width * im.height;
-    for (size_t i = 0; i < n; i++) {
-      lo = p[i] < lo ? p[i] : lo;
-      hi = p[i] > hi ? p[i] : hi;
-      sum += p[i];
-    }
-    printf("%s: thermal CSV %zux%zu, min %.2f, mean %.2f, max %.2f degC\n", path, im.width,
-           im.height, lo, n ? sum / (double)n : 0.0, hi);
-    hearth_image_free(&im);
+    return inspect_csv(path, err);
   } else if (!strcmp(kind, "png") || !strcmp(kind, "jpeg")) {
     hearth_image im = {0};
     s = !strcmp(kind, "png") ? hearth_png_read(path, &im, err) : hearth_jpeg_read(path, &im, err);

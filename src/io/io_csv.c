@@ -1,93 +1,43 @@
-/* Thermal CSV: apparent-temperature matrices in degC.
+/* Thermal CSV reader: apparent-temperature matrices in degC.
  *
- * The reader makes one forward pass: it splits lines, tokenizes cells and
- * parses every number once, keeping a "block" of data-like rows. A line that
- * does not look like data (free text, key,value) ends the header: the block
- * restarts after it, so the matrix is the run of data-like lines that ends
- * the file. Only when something is wrong does it go back over the offending
- * line to say which cell, where, and what was expected. Lines are 1-based
- * counting header lines; columns are 1-based UTF-8 characters from the line
- * start (a BOM is not counted), at the cell's first non-blank character. */
+ * Three phases. Text (io_csv_text.c): byte order marks, UTF-16 and CR line
+ * ends become UTF-8 or 8-bit text with '\n' line ends. Scan: one forward
+ * pass splits lines, tokenizes cells and parses every number once, keeping
+ * one record per non-blank line (its cells, how many are numbers, where its
+ * values start, whether it looks like data or text). Layout: from those
+ * records alone, find the matrix (the data lines that end the file) and
+ * what leads it (metadata lines, a size line, an index row, a frame label),
+ * then check every matrix line. Only when something is wrong does it go
+ * back over the offending line to say which cell, where, and what was
+ * expected. Lines are 1-based counting header lines; columns are 1-based
+ * characters (bytes for 8-bit text) from the line start (a BOM is not
+ * counted), at the cell's first non-blank character. */
 #include <stdlib.h>
 #include <string.h>
-#include "hearth/thermal.h"
+#include "io/io_csv.h"
 
-/* input larger than this is refused: a 256x192 matrix is ~0.4 MB */
-#define CSV_MAX_BYTES ((size_t)64 << 20)
+#define NONE ((size_t)-1)
 
-enum { CELL_OK = 0, CELL_RANGE, CELL_NANINF, CELL_EMPTY, CELL_GARBAGE, CELL_QUOTE };
-
-/* one cell as found by the tokenizer */
-typedef struct csv_cell {
-  size_t at;       /* offset of the cell's first non-blank byte (the quote if quoted) */
-  size_t cs, ce;   /* content span, without quotes and surrounding blanks */
-  int quoted, comma, bad_quote;
-} csv_cell;
-
-/* a data-like line of the current block */
+/* a non-blank line */
 typedef struct csv_row {
   size_t line_no, start, end; /* end excludes "\r\n" */
   size_t ncells, nnum;        /* cells, and cells that are numbers (any value) */
-  int ok;                     /* every cell a finite number in range */
+  size_t nbad, nempty;        /* cells that are not temperatures; empty cells */
+  size_t voff;                /* index of its first value in the value buffer */
+  size_t blank_before;        /* first blank line between it and the row before, or 0 */
+  unsigned char first_kind;   /* CELL_* of its first cell */
+  unsigned char data;         /* looks like data (else text) */
+  unsigned char qcomma;       /* a quoted value with a decimal comma */
 } csv_row;
 
+/* the forward pass's output: one value per cell of every kept line */
 typedef struct csv_buf {
   float *vals;
   size_t nvals, capvals;
   csv_row *rows;
   size_t nrows, caprows;
+  size_t lines, n_lf, n_crlf; /* lines in all; line ends seen */
 } csv_buf;
-
-static int is_blank(char c, char sep) { return c == ' ' || (c == '\t' && sep != '\t'); }
-
-/* Take the cell at *p (line ends at b). On return *p is at the separator that
- * ended the cell, or at b. Returns 0 when the line has no more cells (only
- * blanks after a separator, i.e. a trailing separator, or an empty line). */
-static inline int next_cell(const char *s, size_t *pp, size_t b, char sep, size_t ncells,
-                            csv_cell *c) {
-  size_t p = *pp;
-  while (p < b && is_blank(s[p], sep)) p++;
-  if (p >= b && ncells > 0 && *pp > 0 && s[*pp - 1] == sep) {
-    /* "1,2,3," : one trailing separator ends the line */
-    *pp = p;
-    return 0;
-  }
-  c->at = p;
-  c->quoted = c->comma = c->bad_quote = 0;
-  if (p < b && s[p] == '"') {
-    c->quoted = 1;
-    c->cs = ++p;
-    while (p < b && s[p] != '"') {
-      if (s[p] == ',') c->comma = 1;
-      p++;
-    }
-    c->ce = p;
-    if (p >= b) {
-      c->bad_quote = 1; /* unterminated */
-    } else {
-      p++;
-      while (p < b && is_blank(s[p], sep)) p++;
-      if (p < b && s[p] != sep) {
-        c->bad_quote = 2; /* text after the closing quote */
-        while (p < b && s[p] != sep) p++;
-      }
-    }
-    /* blanks inside the quotes are tolerated */
-    while (c->cs < c->ce && (s[c->cs] == ' ' || s[c->cs] == '\t')) c->cs++;
-    while (c->ce > c->cs && (s[c->ce - 1] == ' ' || s[c->ce - 1] == '\t')) c->ce--;
-  } else {
-    c->cs = p;
-    while (p < b && s[p] != sep) {
-      if (s[p] == ',') c->comma = 1;
-      p++;
-    }
-    size_t e = p;
-    while (e > c->cs && is_blank(s[e - 1], sep)) e--;
-    c->ce = e;
-  }
-  *pp = p;
-  return 1;
-}
 
 /* NaN / infinity spellings, including the ones spreadsheets and MSVC print
  * ("-1.#IND", "1.#INF", "#N/A"). */
@@ -159,12 +109,11 @@ static inline int eval_cell(const char *s, const csv_cell *c, double *v) {
   return is_naninf(s + c->cs, c->ce - c->cs) ? CELL_NANINF : CELL_GARBAGE;
 }
 
-/* 1-based character column of byte offset `at` in a line starting at
- * `start` (UTF-8 continuation bytes do not start a character). */
-static size_t column_of(const char *s, size_t start, size_t at) {
-  size_t col = 1;
+size_t csv_column(const csv_ctx *c, size_t start, size_t at) {
+  if (!c->utf8) return at - start + 1;
+  size_t col = 1; /* UTF-8 continuation bytes do not start a character */
   for (size_t i = start; i < at; i++)
-    if (((unsigned char)s[i] & 0xC0) != 0x80) col++;
+    if (((unsigned char)c->s[i] & 0xC0) != 0x80) col++;
   return col;
 }
 
@@ -193,15 +142,17 @@ static void excerpt(const char *s, size_t a, size_t b, char *out, size_t outsz) 
   out[k] = 0;
 }
 
-static hearth_status cell_error(const char *name, const char *s, const csv_row *r,
-                                const csv_cell *c, int kind, double v, hearth_err *err) {
+static hearth_status cell_error(const csv_ctx *c, const csv_row *r, const csv_cell *cell,
+                                int kind, double v, hearth_err *err) {
+  const char *s = c->s, *name = c->name;
   char ex[48];
-  size_t col = column_of(s, r->start, c->at);
-  excerpt(s, c->quoted ? c->cs : c->at, c->ce, ex, sizeof ex);
+  size_t col = csv_column(c, r->start, cell->at);
+  excerpt(s, cell->quoted ? cell->cs : cell->at, cell->ce, ex, sizeof ex);
   switch (kind) {
     case CELL_RANGE: {
       char num[64];
-      if (hearth_format_fixed(num, sizeof num, v, 3) < 0) excerpt(s, c->cs, c->ce, num, sizeof num);
+      if (hearth_format_fixed(num, sizeof num, v, 3) < 0)
+        excerpt(s, cell->cs, cell->ce, num, sizeof num);
       return hearth_err_set(err, HEARTH_E_RANGE,
                             "%s: line %zu, column %zu: temperature %s degC is out of range, "
                             "expected %g..%g degC",
@@ -221,7 +172,7 @@ static hearth_status cell_error(const char *name, const char *s, const csv_row *
                             "%s: line %zu, column %zu: %s, expected \"number\" followed by a "
                             "separator or the end of the line",
                             name, r->line_no, col,
-                            c->bad_quote == 1 ? "unterminated quote" : "text after closing quote");
+                            cell->bad_quote == 1 ? "unterminated quote" : "text after closing quote");
     default:
       return hearth_err_set(err, HEARTH_E_PARSE,
                             "%s: line %zu, column %zu: '%s' is not a number, expected a "
@@ -230,29 +181,33 @@ static hearth_status cell_error(const char *name, const char *s, const csv_row *
   }
 }
 
-/* Go back over a row known to be wrong and report its first problem. */
-static hearth_status row_error(const char *name, const char *s, char sep, const csv_row *r,
-                               size_t n_exp, const char *shape, hearth_err *err) {
-  size_t p = r->start, n = 0;
-  csv_cell c;
-  while (next_cell(s, &p, r->end, sep, n, &c)) {
-    if (n == n_exp)
-      return hearth_err_set(err, HEARTH_E_SIZE,
-                            "%s: line %zu, column %zu: row has more than %zu values, expected "
-                            "%zu%s",
-                            name, r->line_no, column_of(s, r->start, c.at), n_exp, n_exp, shape);
-    double v = 0;
-    int kind = eval_cell(s, &c, &v);
-    if (kind != CELL_OK) return cell_error(name, s, r, &c, kind, v, err);
-    n++;
+/* Go back over a row known to be wrong and report its first problem: the
+ * `lead` label cells are skipped, then n_exp values are expected. */
+static hearth_status row_error(const csv_ctx *c, const csv_row *r, size_t lead, size_t n_exp,
+                               const char *shape, hearth_err *err) {
+  size_t p = r->start, n = 0, k = 0;
+  csv_cell cell;
+  while (csv_next_cell(c->s, &p, r->end, c->sep, k, &cell)) {
+    if (k++ >= lead) {
+      if (n == n_exp)
+        return hearth_err_set(err, HEARTH_E_SIZE,
+                              "%s: line %zu, column %zu: row has more than %zu values, expected "
+                              "%zu%s",
+                              c->name, r->line_no, csv_column(c, r->start, cell.at), n_exp, n_exp,
+                              shape);
+      double v = 0;
+      int kind = eval_cell(c->s, &cell, &v);
+      if (kind != CELL_OK) return cell_error(c, r, &cell, kind, v, err);
+      n++;
+    }
     if (p >= r->end) break;
     p++;
   }
   if (n < n_exp)
     return hearth_err_set(err, HEARTH_E_SIZE,
-                          "%s: line %zu, column %zu: row has %zu values, expected %zu%s", name,
-                          r->line_no, column_of(s, r->start, r->end) , n, n_exp, shape);
-  return hearth_err_set(err, HEARTH_E_PARSE, "%s: line %zu: malformed row", name, r->line_no);
+                          "%s: line %zu, column %zu: row has %zu values, expected %zu%s", c->name,
+                          r->line_no, csv_column(c, r->start, r->end), n, n_exp, shape);
+  return hearth_err_set(err, HEARTH_E_PARSE, "%s: line %zu: malformed row", c->name, r->line_no);
 }
 
 static int grow(void **p, size_t *cap, size_t need, size_t elsz) {
@@ -291,13 +246,132 @@ static char detect_sep(const char *s, size_t a, size_t len) {
   return ',';
 }
 
-/* Boyer-Moore majority vote over the cell counts of full numeric rows. */
-static size_t majority_cells(const csv_row *rows, size_t n) {
+/* The fastest path, for the usual file: a run of bare decimals ("-12.34")
+ * in range and separators from s[*pp] on a line that a newline ends (s[b]
+ * is '\r' or '\n', so every digit scan stops there without a bound check).
+ * Their values go to vals (room for (b - *pp) / 2 + 1); *pp stops at the
+ * first cell that is anything else, or out of range, for the general loop
+ * to take from there (the values are the same either way). *done is set
+ * when the line ended. Returns the cells taken. */
+static size_t fast_cells(const char *s, size_t *pp, size_t b, char sep, float *vals, int *done) {
+  size_t p = *pp, n = 0;
+  for (;;) {
+    double v;
+    size_t q = p;
+    if (!plain_cell(s, &q, b, sep, 0, &v) || !(v >= HEARTH_THERMAL_MIN_C && v <= HEARTH_THERMAL_MAX_C)) break;
+    p = q;
+    vals[n++] = (float)v;
+    if (p >= b || ++p >= b) { /* the line's end, or one trailing separator */
+      *done = 1;
+      break;
+    }
+  }
+  *pp = p;
+  return n;
+}
+
+/* ---- scan: the forward pass ------------------------------------------------ */
+static hearth_status scan(const csv_ctx *c, size_t pos, csv_buf *B, hearth_err *err) {
+  const char *s = c->s, *name = c->name;
+  size_t len = c->len, line_no = 0, pending_blank = 0;
+  char sep = c->sep;
+  /* a first guess at the number of values avoids most regrowth */
+  if (!grow((void **)&B->vals, &B->capvals, len / 6 + 16, sizeof(float)) ||
+      !grow((void **)&B->rows, &B->caprows, 256, sizeof(csv_row)))
+    return hearth_err_set(err, HEARTH_E_NOMEM, "%s: out of memory", name);
+  /* the value buffer in locals, which the compiler keeps in registers
+   * (B->vals and B->capvals stay current; B->nvals is set at the end) */
+  float *vals = B->vals;
+  size_t nvals = 0, capvals = B->capvals;
+
+  while (pos < len) {
+    const char *nl = memchr(s + pos, '\n', len - pos);
+    size_t a = pos, b = nl ? (size_t)(nl - s) : len;
+    pos = nl ? b + 1 : len;
+    line_no++;
+    if (b > a && s[b - 1] == '\r') {
+      b--;
+      B->n_crlf += nl != NULL;
+    } else {
+      B->n_lf += nl != NULL;
+    }
+    csv_row r = {line_no, a, b, 0, 0, 0, 0, nvals, 0, CELL_OK, 0, 0};
+    size_t p = a;
+    int first_numeric = 0, line_done = 0;
+    /* the usual line first (fast_cells), then the rest of it cell by cell */
+    if (b < len && p < b) {
+      /* room for every cell fast_cells can take: a byte and a separator each */
+      if (capvals - nvals < (b - a) / 2 + 2) {
+        if (!grow((void **)&B->vals, &B->capvals, nvals + (b - a) / 2 + 2, sizeof(float)))
+          return hearth_err_set(err, HEARTH_E_NOMEM, "%s: out of memory", name);
+        vals = B->vals;
+        capvals = B->capvals;
+      }
+      size_t taken = fast_cells(s, &p, b, sep, vals + nvals, &line_done);
+      nvals += taken;
+      r.nnum = r.ncells = taken;
+      first_numeric = r.ncells > 0; /* every cell this path took is a number */
+    }
+    for (; !line_done;) {
+      double v = 0;
+      int kind;
+      /* fast path: a bare decimal ending at a separator or the line end */
+      if (plain_cell(s, &p, b, sep, 1, &v)) {
+        kind = v >= HEARTH_THERMAL_MIN_C && v <= HEARTH_THERMAL_MAX_C ? CELL_OK : CELL_RANGE;
+      } else {
+        csv_cell cell;
+        if (!csv_next_cell(s, &p, b, sep, r.ncells, &cell)) break;
+        if (r.ncells == 0 && cell.ce == cell.cs && !cell.quoted && p >= b) break; /* blank line */
+        kind = eval_cell(s, &cell, &v);
+        if (kind == CELL_OK && cell.quoted && cell.comma) r.qcomma = 1;
+      }
+      if (kind != CELL_OK) r.nbad++;
+      if (kind == CELL_EMPTY) r.nempty++;
+      if (r.ncells == 0) r.first_kind = (unsigned char)kind;
+      if (kind == CELL_OK || kind == CELL_RANGE || kind == CELL_NANINF) {
+        r.nnum++;
+        if (r.ncells == 0) first_numeric = 1;
+      }
+      if (nvals == capvals) {
+        if (!grow((void **)&B->vals, &B->capvals, nvals + 1, sizeof(float)))
+          return hearth_err_set(err, HEARTH_E_NOMEM, "%s: out of memory", name);
+        vals = B->vals;
+        capvals = B->capvals;
+      }
+      vals[nvals++] = kind == CELL_OK ? (float)v : 0.0f;
+      r.ncells++;
+      if (p >= b) break;
+      p++; /* over the separator */
+      if (p >= b) break; /* one trailing separator */
+    }
+    if (r.ncells == r.nempty) { /* an empty line, or separators only */
+      nvals = r.voff;
+      if (B->nrows && !pending_blank) pending_blank = line_no;
+      continue;
+    }
+    r.data = r.nnum == r.ncells || (r.nnum >= 1 && first_numeric) ||
+             (r.nnum >= 8 && 2 * r.nnum > r.ncells) ||
+             (r.first_kind == CELL_EMPTY && r.ncells >= 2 && r.nnum + 1 == r.ncells);
+    r.blank_before = pending_blank;
+    pending_blank = 0;
+    if (!grow((void **)&B->rows, &B->caprows, B->nrows + 1, sizeof(csv_row)))
+      return hearth_err_set(err, HEARTH_E_NOMEM, "%s: out of memory", name);
+    B->rows[B->nrows++] = r;
+  }
+  B->nvals = nvals;
+  B->lines = line_no;
+  return HEARTH_OK;
+}
+
+/* ---- layout ------------------------------------------------------------------ */
+/* Boyer-Moore majority vote over the cell counts of rows[a..b], full numeric
+ * rows only when there are any. */
+static size_t majority_cells(const csv_row *rows, size_t a, size_t b) {
   size_t cand = 0, cnt = 0;
   int any_full = 0;
-  for (size_t i = 0; i < n; i++)
+  for (size_t i = a; i <= b; i++)
     if (rows[i].nnum == rows[i].ncells) any_full = 1;
-  for (size_t i = 0; i < n; i++) {
+  for (size_t i = a; i <= b; i++) {
     if (any_full && rows[i].nnum != rows[i].ncells) continue;
     if (cnt == 0) {
       cand = rows[i].ncells;
@@ -311,9 +385,409 @@ static size_t majority_cells(const csv_row *rows, size_t n) {
   return cand;
 }
 
-hearth_status hearth_thermal_parse_csv(const char *text, size_t len, const char *name,
-                                       const hearth_csv_opts *opts, hearth_image *out,
-                                       hearth_err *err) {
+/* Cell k (0-based) of row r into *cell; 0 if the row has fewer cells. */
+static int row_cell(const csv_ctx *c, const csv_row *r, size_t k, csv_cell *cell) {
+  size_t p = r->start, n = 0;
+  while (csv_next_cell(c->s, &p, r->end, c->sep, n, cell)) {
+    if (n++ == k) return 1;
+    if (p >= r->end) break;
+    p++;
+  }
+  return 0;
+}
+
+/* The cell's text as a plain non-negative integer (digits only, at most 9). */
+static int cell_uint(const char *s, const csv_cell *cell, size_t *v) {
+  size_t n = cell->ce - cell->cs, x = 0;
+  if (cell->bad_quote || n == 0 || n > 9) return 0;
+  for (size_t i = cell->cs; i < cell->ce; i++) {
+    if ((unsigned)(s[i] - '0') >= 10) return 0;
+    x = x * 10 + (size_t)(s[i] - '0');
+  }
+  *v = x;
+  return 1;
+}
+
+static int row_uint(const csv_ctx *c, const csv_row *r, size_t k, size_t *v) {
+  csv_cell cell;
+  return row_cell(c, r, k, &cell) && cell_uint(c->s, &cell, v);
+}
+
+/* a "W,H" size line candidate: two plain integers */
+static int size_pair(const csv_ctx *c, const csv_row *r, size_t *w, size_t *h) {
+  return r->ncells == 2 && r->nnum == 2 && row_uint(c, r, 0, w) && row_uint(c, r, 1, h);
+}
+
+/* a first cell that is no number (a label, or empty) before numbers */
+static int lead_label(const csv_row *r) {
+  return (r->first_kind == CELL_GARBAGE || r->first_kind == CELL_EMPTY) && r->ncells >= 2 &&
+         r->nnum + 1 == r->ncells;
+}
+
+/* row r reads as the column indices "label,0,1,..." of an axis-labelled
+ * matrix whose first row d is numbered 0 (r's later cells are checked
+ * later, so that a wrong index is reported as one) */
+static int index_like(const csv_ctx *c, const csv_row *r, const csv_row *d) {
+  size_t v0, v1, d0;
+  return (r->first_kind == CELL_GARBAGE || r->first_kind == CELL_EMPTY) && r->ncells >= 2 &&
+         row_uint(c, r, 1, &v0) && v0 == 0 && row_uint(c, d, 0, &d0) && d0 == 0 &&
+         (r->ncells == d->ncells || (row_uint(c, r, 2, &v1) && v1 == 1));
+}
+
+/* what was found: rows are indices into the row records */
+typedef struct csv_layout {
+  hearth_csv_layout kind;
+  size_t top;         /* first matrix row (index row or label row included) */
+  size_t first, last; /* rows holding values */
+  size_t lead;        /* label cells before the values of each row (0 or 1) */
+  size_t index;       /* the index row (axis-labelled), or NONE */
+  size_t size;        /* the size line, or NONE */
+  size_t size_w, size_h;
+  size_t meta_end;    /* rows before this are metadata */
+} csv_layout;
+
+static hearth_status blank_inside(const csv_ctx *c, size_t blank, size_t above, size_t below,
+                                  hearth_err *err) {
+  return hearth_err_set(err, HEARTH_E_PARSE,
+                        "%s: line %zu, column 1: blank line inside the matrix (between its lines "
+                        "%zu and %zu), expected its rows without blank lines between them",
+                        c->name, blank, above, below);
+}
+
+/* Find the matrix and what leads it. */
+static hearth_status find_layout(const csv_ctx *c, const csv_buf *B, const char *shape,
+                                 csv_layout *L, hearth_err *err) {
+  const csv_row *R = B->rows;
+  size_t n = B->nrows, last = NONE;
+  for (size_t i = n; i-- > 0;)
+    if (R[i].data) {
+      last = i;
+      break;
+    }
+  if (last == NONE)
+    return hearth_err_set(err, HEARTH_E_PARSE,
+                          "%s: line %zu, column 1: no numeric rows found, expected a matrix of "
+                          "temperatures%s",
+                          c->name, B->lines + 1, shape);
+  /* text after the matrix */
+  if (last + 1 < n) return row_error(c, &R[last + 1], 0, NONE, shape, err);
+
+  /* the body: the data rows that end the file, without blank or text lines */
+  size_t f = last;
+  while (f > 0 && R[f - 1].data && !R[f].blank_before) f--;
+  size_t above = f > 0 && !R[f - 1].data ? f - 1 : NONE;
+  *L = (csv_layout){HEARTH_CSV_PLAIN, f, f, last, 0, NONE, NONE, 0, 0, 0};
+
+  /* a size line at the top of the body */
+  size_t sw, sh;
+  if (f < last && size_pair(c, &R[f], &sw, &sh)) {
+    size_t rest = majority_cells(R, f + 1, last);
+    if (rest != 2) {
+      L->size = f;
+      L->size_w = sw;
+      L->size_h = sh;
+      f++;
+      above = NONE;
+    } else if (sw == 2 && sh == last - f) {
+      return hearth_err_set(err, HEARTH_E_PARSE,
+                            "%s: line %zu, column 1: '%zu%c%zu' may be a W,H size line or the "
+                            "first row of the matrix, expected a matrix that tells them apart",
+                            c->name, R[f].line_no, sw, c->sep, sh);
+    }
+  }
+
+  /* an index row, or a frame label, at the top */
+  if (f < last && index_like(c, &R[f], &R[f + 1])) {
+    L->kind = HEARTH_CSV_AXIS;
+    L->index = L->top = f;
+    L->first = f + 1;
+  } else if (above != NONE && index_like(c, &R[above], &R[f])) {
+    L->kind = HEARTH_CSV_AXIS;
+    L->index = L->top = above;
+    L->first = f;
+  } else if (f < last && R[f].first_kind == CELL_GARBAGE && lead_label(&R[f]) &&
+             R[f + 1].first_kind == CELL_EMPTY) {
+    L->kind = HEARTH_CSV_FRAME;
+    L->top = L->first = f;
+  } else if (above != NONE && R[above].first_kind == CELL_GARBAGE && lead_label(&R[above]) &&
+             R[f].first_kind == CELL_EMPTY) {
+    L->kind = HEARTH_CSV_FRAME;
+    L->top = L->first = above;
+  } else {
+    L->top = L->first = f;
+  }
+  L->lead = L->kind == HEARTH_CSV_PLAIN ? 0 : 1;
+  if (L->top == above && R[f].blank_before)
+    return blank_inside(c, R[f].blank_before, R[above].line_no, R[f].line_no, err);
+
+  /* a data row above the matrix: a size line after blank lines, or rows of
+   * the matrix that a blank line cut off, or numbers that are neither */
+  size_t lim = L->size != NONE ? L->size : L->top;
+  if (L->size == NONE && lim > 0 && R[lim - 1].data) {
+    size_t p = lim - 1, q = p;
+    while (q > 0 && R[q - 1].data && !R[q].blank_before) q--;
+    if (R[lim].blank_before && R[p].ncells == R[L->first].ncells) {
+      return blank_inside(c, R[lim].blank_before, R[p].line_no, R[lim].line_no, err);
+    } else if (q == p && size_pair(c, &R[p], &sw, &sh)) {
+      L->size = p;
+      L->size_w = sw;
+      L->size_h = sh;
+      lim = p;
+    } else {
+      return hearth_err_set(err, HEARTH_E_PARSE,
+                            "%s: line %zu, column 1: a row of %zu value(s) before the matrix of "
+                            "line %zu, expected metadata lines or a W,H size line before the "
+                            "matrix",
+                            c->name, R[q].line_no, R[q].ncells, R[L->top].line_no);
+    }
+  }
+  /* before that, metadata lines only */
+  for (size_t i = 0; i < lim; i++) {
+    if (!R[i].data) continue;
+    size_t t = i;
+    while (t < lim && R[t].data) t++;
+    if (t < lim && R[t].ncells == R[L->first].ncells && R[t - 1].ncells == R[t].ncells)
+      return row_error(c, &R[t], 0, NONE, shape, err); /* a text row inside the matrix */
+    return hearth_err_set(err, HEARTH_E_PARSE,
+                          "%s: line %zu, column 1: a row of %zu value(s) before the %s of line "
+                          "%zu, expected metadata lines first, then the matrix",
+                          c->name, R[i].line_no, R[i].ncells, t < lim ? "metadata" : "size line",
+                          R[t].line_no);
+  }
+  L->meta_end = lim;
+  return HEARTH_OK;
+}
+
+/* The axis-labelled matrix's index row: 0..w-1 after the corner. */
+static hearth_status check_index_row(const csv_ctx *c, const csv_row *r, hearth_err *err) {
+  size_t p = r->start, k = 0;
+  csv_cell cell;
+  while (csv_next_cell(c->s, &p, r->end, c->sep, k, &cell)) {
+    size_t v;
+    if (k > 0 && !(cell_uint(c->s, &cell, &v) && v == k - 1)) {
+      char ex[48];
+      excerpt(c->s, cell.cs, cell.ce, ex, sizeof ex);
+      return hearth_err_set(err, HEARTH_E_PARSE,
+                            "%s: line %zu, column %zu: column index '%s', expected %zu (an "
+                            "axis-labelled matrix numbers its columns 0..%zu after the corner "
+                            "cell)",
+                            c->name, r->line_no, csv_column(c, r->start, cell.at), ex, k - 1,
+                            r->ncells - 2);
+    }
+    k++;
+    if (p >= r->end) break;
+    p++;
+  }
+  return HEARTH_OK;
+}
+
+/* The lead cell of matrix row r (the k-th, 0-based) of an axis-labelled or
+ * frame-labelled matrix. */
+static hearth_status check_lead(const csv_ctx *c, const csv_layout *L, const csv_row *R, size_t i,
+                                size_t h, hearth_err *err) {
+  const csv_row *r = &R[i];
+  size_t k = i - L->first, v;
+  csv_cell cell;
+  int has = row_cell(c, r, 0, &cell);
+  if (L->kind == HEARTH_CSV_AXIS) {
+    if (has && cell_uint(c->s, &cell, &v) && v == k) return HEARTH_OK;
+    char ex[48] = "";
+    if (has) excerpt(c->s, cell.cs, cell.ce, ex, sizeof ex);
+    return hearth_err_set(err, HEARTH_E_PARSE,
+                          "%s: line %zu, column %zu: row index '%s', expected %zu (an "
+                          "axis-labelled matrix numbers its rows 0..%zu)",
+                          c->name, r->line_no, csv_column(c, r->start, has ? cell.at : r->start),
+                          ex, k, h - 1);
+  }
+  if (k == 0 || r->first_kind == CELL_EMPTY) return HEARTH_OK;
+  char ex[48];
+  excerpt(c->s, cell.quoted ? cell.cs : cell.at, cell.ce, ex, sizeof ex);
+  return hearth_err_set(err, HEARTH_E_PARSE,
+                        "%s: line %zu, column %zu: '%s' in the label column, expected it empty "
+                        "below the frame label of line %zu (one frame per file)",
+                        c->name, r->line_no, csv_column(c, r->start, cell.at), ex,
+                        R[L->first].line_no);
+}
+
+/* A plain matrix whose first row or column counts 0, 1, 2, ...: indices
+ * without the rest of an axis-labelled layout, or data? */
+static hearth_status check_not_indices(const csv_ctx *c, const csv_buf *B, const csv_layout *L,
+                                       size_t w, hearth_err *err) {
+  const csv_row *R = B->rows, *r = &R[L->first];
+  const float *v = B->vals + r->voff;
+  size_t h = L->last - L->first + 1, i = 0;
+  while (i < w && v[i] == (float)i) i++;
+  int whole = w >= 2 && i == w;
+  for (i = 1; i < w && v[i] == (float)(i - 1); i++) {
+  }
+  int after_first = !whole && w >= 3 && i == w;
+  if (whole || after_first) {
+    csv_cell cell;
+    size_t col = after_first && row_cell(c, r, 1, &cell) ? csv_column(c, r->start, cell.at) : 1;
+    return hearth_err_set(err, HEARTH_E_PARSE,
+                          "%s: line %zu, column %zu: the first row reads 0, 1, ..., %zu: column "
+                          "indices or temperatures? expected an axis-labelled matrix (a corner "
+                          "cell such as 'X/Y' before the indices 0..W-1) or a first row of "
+                          "temperatures",
+                          c->name, r->line_no, col, whole ? w - 1 : w - 2);
+  }
+  for (i = 0; h >= 2 && i < h && B->vals[R[L->first + i].voff] == (float)i; i++) {
+  }
+  if (h >= 2 && i == h)
+    return hearth_err_set(err, HEARTH_E_PARSE,
+                          "%s: line %zu, column 1: the first column reads 0, 1, ..., %zu down to "
+                          "line %zu: row indices or temperatures? expected an axis-labelled "
+                          "matrix (a corner cell and the column indices 0..W-1 above) or a "
+                          "first column of temperatures",
+                          c->name, r->line_no, h - 1, R[L->last].line_no);
+  return HEARTH_OK;
+}
+
+/* Unit, index, values and size of the matrix found. */
+static hearth_status check_matrix(const csv_ctx *c, const csv_buf *B, const csv_layout *L,
+                                  size_t want_w, size_t want_h, size_t *w_out, int *celsius,
+                                  hearth_err *err) {
+  const csv_row *R = B->rows;
+  const char *name = c->name;
+  hearth_status st;
+  /* the unit the metadata names */
+  csv_unit u;
+  memset(&u, 0, sizeof u);
+  for (size_t i = 0; i < L->meta_end && !u.other; i++)
+    csv_unit_scan(c, R[i].line_no, R[i].start, R[i].end, &u);
+  if (u.other)
+    return hearth_err_set(err, HEARTH_E_UNSUPPORTED,
+                          "%s: line %zu, column %zu: temperature unit '%s', expected degC "
+                          "(hearth reads Celsius matrices and never converts them: export the "
+                          "matrix in Celsius)",
+                          name, u.line, csv_column(c, u.start, u.at), u.what);
+  *celsius = u.celsius;
+
+  /* values per row */
+  char shape[96] = "";
+  size_t w;
+  if (L->kind == HEARTH_CSV_AXIS) {
+    if ((st = check_index_row(c, &R[L->index], err))) return st;
+    w = R[L->index].ncells - 1;
+    if (want_w && w != want_w)
+      return hearth_err_set(err, HEARTH_E_SIZE,
+                            "%s: line %zu, column 1: the index row numbers %zu columns, expected "
+                            "%zu (a %zu-wide matrix)",
+                            name, R[L->index].line_no, w, want_w, want_w);
+    snprintf(shape, sizeof shape, " (as the index row of line %zu)", R[L->index].line_no);
+  } else {
+    w = want_w ? want_w : majority_cells(R, L->first, L->last) - L->lead;
+    if (want_w && want_h) snprintf(shape, sizeof shape, " (a %zux%zu matrix)", want_w, want_h);
+    else if (want_w) snprintf(shape, sizeof shape, " (a width of %zu)", want_w);
+    else snprintf(shape, sizeof shape, " (as in the other rows)");
+  }
+
+  /* every row, in file order */
+  size_t h = L->last - L->first + 1;
+  for (size_t i = L->first; i <= L->last; i++) {
+    const csv_row *r = &R[i];
+    if (L->lead && (st = check_lead(c, L, R, i, h, err))) return st;
+    size_t bad = r->nbad - (L->lead && r->first_kind != CELL_OK ? 1 : 0);
+    if (bad == 0 && r->ncells == w + L->lead) continue;
+    return row_error(c, r, L->lead, w, shape, err);
+  }
+
+  if (want_h && h != want_h) {
+    char want[64];
+    if (want_w) snprintf(want, sizeof want, "%zux%zu", want_w, want_h);
+    else snprintf(want, sizeof want, "%zu rows", want_h);
+    if (h < want_h)
+      return hearth_err_set(err, HEARTH_E_SIZE,
+                            "%s: line %zu, column 1: matrix ends after %zu rows of %zu values, "
+                            "expected %s",
+                            name, R[L->last].line_no + 1, h, w, want);
+    return hearth_err_set(err, HEARTH_E_SIZE,
+                          "%s: line %zu, column 1: more than %zu rows, expected %s", name,
+                          R[L->first + want_h].line_no, want_h, want);
+  }
+  if (L->size != NONE && (L->size_w != w || L->size_h != h))
+    return hearth_err_set(err, HEARTH_E_SIZE,
+                          "%s: line %zu, column 1: size line says %zux%zu, expected the %zux%zu "
+                          "of the matrix below (lines %zu..%zu)",
+                          name, R[L->size].line_no, L->size_w, L->size_h, w, h,
+                          R[L->top].line_no, R[L->last].line_no);
+  if (L->kind == HEARTH_CSV_PLAIN && (st = check_not_indices(c, B, L, w, err))) return st;
+  *w_out = w;
+  return HEARTH_OK;
+}
+
+/* The encoding, from the lines with text (for columns and copies). */
+static const char *find_encoding(csv_ctx *c, const csv_text *t, const csv_buf *B) {
+  if (t->bom && !strncmp(t->bom, "utf-16", 6)) return t->bom; /* now UTF-8 */
+  int high = 0, valid = 1;
+  for (size_t i = 0; i < B->nrows && valid; i++) {
+    const csv_row *r = &B->rows[i];
+    if (r->data && r->first_kind != CELL_GARBAGE) continue; /* text, or a label cell */
+    for (size_t k = r->start; k < r->end && !high; k++) high = (unsigned char)c->s[k] >= 0x80;
+    if (high) valid = csv_utf8_valid(c->s, r->start, r->end);
+  }
+  if (!valid) {
+    c->utf8 = 0;
+    return "8-bit";
+  }
+  return t->bom ? t->bom : high ? "utf-8" : "ascii";
+}
+
+static hearth_status fill_info(const csv_ctx *c, const csv_text *t, const csv_buf *B,
+                               const csv_layout *L, const char *encoding, size_t w, int celsius,
+                               hearth_thermal_info *info, hearth_err *err) {
+  const csv_row *R = B->rows;
+  info->layout = L->kind == HEARTH_CSV_PLAIN && L->size != NONE ? HEARTH_CSV_SIZE_LINE : L->kind;
+  info->width = w;
+  info->height = L->last - L->first + 1;
+  info->separator = c->sep;
+  /* the decimal mark of the matrix's values */
+  const char *m = c->s + R[L->first].start;
+  size_t mn = R[L->last].end - R[L->first].start;
+  int comma = c->sep != ',' && memchr(m, ',', mn) != NULL;
+  for (size_t i = L->first; i <= L->last && !comma; i++) comma = R[i].qcomma;
+  info->decimal_mark = comma ? ',' : memchr(m, '.', mn) ? '.' : 0;
+  info->encoding = encoding;
+  info->line_ends = t->cr_only ? "CR" : B->n_lf && B->n_crlf ? "mixed" : B->n_crlf ? "CRLF"
+                                 : B->n_lf ? "LF" : "none";
+  info->first_line = R[L->top].line_no;
+  info->last_line = R[L->last].line_no;
+  info->header_lines = info->first_line - 1;
+  info->size_line = L->size != NONE ? R[L->size].line_no : 0;
+  if (L->lead) {
+    csv_cell cell;
+    const csv_row *r = &R[L->kind == HEARTH_CSV_AXIS ? L->index : L->first];
+    if (row_cell(c, r, 0, &cell) && !(info->label = csv_text_copy(c, cell.cs, cell.ce)))
+      return hearth_err_set(err, HEARTH_E_NOMEM, "%s: out of memory", c->name);
+  }
+  for (size_t i = 0; i < L->meta_end; i++)
+    if (!csv_meta_add(c, R[i].line_no, R[i].start, R[i].end, info))
+      return hearth_err_set(err, HEARTH_E_NOMEM, "%s: out of memory", c->name);
+  info->unit = celsius ? "degC" : NULL;
+  return HEARTH_OK;
+}
+
+/* The values of the matrix rows, without lead cells, as the image. */
+static void take_values(csv_buf *B, const csv_layout *L, size_t w, hearth_image *out) {
+  const csv_row *R = B->rows;
+  size_t h = L->last - L->first + 1, n = w * h;
+  if (L->lead) {
+    for (size_t i = 0; i < h; i++) /* forward: the destination never passes the source */
+      memmove(B->vals + i * w, B->vals + R[L->first + i].voff + L->lead, w * sizeof(float));
+  } else if (R[L->first].voff) {
+    memmove(B->vals, B->vals + R[L->first].voff, n * sizeof(float));
+  }
+  /* the values become the image's: no second buffer, no copy */
+  float *data = realloc(B->vals, n * sizeof(float));
+  if (data) B->vals = data; /* a failed shrink keeps the larger block */
+  *out = (hearth_image){w, h, 1, HEARTH_PIX_F32, B->vals};
+  B->vals = NULL;
+}
+
+hearth_status hearth_thermal_parse_csv_ex(const char *text, size_t len, const char *name,
+                                          const hearth_csv_opts *opts, hearth_image *out,
+                                          hearth_thermal_info *info, hearth_err *err) {
+  if (info) memset(info, 0, sizeof *info);
   if (!out) return hearth_err_set(err, HEARTH_E_ARG, "thermal csv: out is NULL");
   memset(out, 0, sizeof *out);
   if (!name) name = "(thermal csv)";
@@ -322,250 +796,67 @@ hearth_status hearth_thermal_parse_csv(const char *text, size_t len, const char 
     return hearth_err_set(err, HEARTH_E_LIMIT, "%s: %zu bytes exceeds the limit of %zu bytes",
                           name, len, CSV_MAX_BYTES);
   size_t want_w = opts ? opts->width : 256, want_h = opts ? opts->height : 192;
-  const char *s = text;
-  size_t pos = 0;
-  if (len >= 3 && (unsigned char)s[0] == 0xEF && (unsigned char)s[1] == 0xBB &&
-      (unsigned char)s[2] == 0xBF)
-    pos = 3; /* UTF-8 byte order mark */
-  char sep = detect_sep(s, pos, len);
-
-  csv_buf B = {0};
-  hearth_status st = HEARTH_OK;
-  size_t line_no = 0, last_reset_line = 0, last_reset_start = 0, last_reset_end = 0;
-  size_t rows_before_reset = 0, reset_cells = 0;
-  /* a first guess at the number of values avoids most regrowth */
-  if (!grow((void **)&B.vals, &B.capvals, len / 6 + 16, sizeof(float)) ||
-      !grow((void **)&B.rows, &B.caprows, 256, sizeof(csv_row))) {
-    st = hearth_err_set(err, HEARTH_E_NOMEM, "%s: out of memory", name);
-    goto done;
-  }
-
-  /* forward pass: one line at a time */
-  while (pos < len) {
-    const char *nl = memchr(s + pos, '\n', len - pos);
-    size_t a = pos, b = nl ? (size_t)(nl - s) : len;
-    pos = nl ? b + 1 : len;
-    line_no++;
-    if (b > a && s[b - 1] == '\r') b--;
-    csv_row r = {line_no, a, b, 0, 0, 1};
-    size_t p = a;
-    int first_numeric = 0, line_done = 0;
-    /* fastest path, for the usual file: a run of bare decimals ("-12.34")
-     * and separators on a line that a newline ends (s[b] is '\r' or '\n',
-     * so every digit scan stops there without a bound check). The first
-     * cell that is anything else, or out of range, goes to the loop below
-     * from where this one stopped; the values are the same either way. */
-    if (b < len && p < b) {
-      for (;;) {
-        double v;
-        size_t q = p;
-        /* out of range: left to the loop below, from the cell's start */
-        if (!plain_cell(s, &q, b, sep, 0, &v) || !(v >= HEARTH_THERMAL_MIN_C && v <= HEARTH_THERMAL_MAX_C)) break;
-        p = q;
-        if (B.nvals == B.capvals && !grow((void **)&B.vals, &B.capvals, B.nvals + 1, sizeof(float))) {
-          st = hearth_err_set(err, HEARTH_E_NOMEM, "%s: out of memory", name);
-          goto done;
-        }
-        B.vals[B.nvals++] = (float)v;
-        if (r.ncells == 0) first_numeric = 1;
-        r.nnum++;
-        r.ncells++;
-        if (p >= b || ++p >= b) { /* the line's end, or one trailing separator */
-          line_done = 1;
-          break;
-        }
-      }
-    }
-    for (; !line_done;) {
-      double v = 0;
-      int kind;
-      /* fast path: a bare decimal ending at a separator or the line end */
-      if (plain_cell(s, &p, b, sep, 1, &v)) {
-        kind = v >= HEARTH_THERMAL_MIN_C && v <= HEARTH_THERMAL_MAX_C ? CELL_OK : CELL_RANGE;
-      } else {
-        csv_cell c;
-        if (!next_cell(s, &p, b, sep, r.ncells, &c)) break;
-        if (r.ncells == 0 && c.ce == c.cs && !c.quoted && p >= b) break; /* blank line */
-        kind = eval_cell(s, &c, &v);
-      }
-      if (kind != CELL_OK) r.ok = 0;
-      if (kind == CELL_OK || kind == CELL_RANGE || kind == CELL_NANINF) {
-        r.nnum++;
-        if (r.ncells == 0) first_numeric = 1;
-      }
-      if (B.nvals == B.capvals &&
-          !grow((void **)&B.vals, &B.capvals, B.nvals + 1, sizeof(float))) {
-        st = hearth_err_set(err, HEARTH_E_NOMEM, "%s: out of memory", name);
-        goto done;
-      }
-      B.vals[B.nvals++] = kind == CELL_OK ? (float)v : 0.0f;
-      r.ncells++;
-      if (p >= b) break;
-      p++; /* over the separator */
-      if (p >= b) break; /* one trailing separator */
-    }
-    if (r.ncells == 0) continue; /* empty line */
-    int data_like = r.nnum == r.ncells || (r.nnum >= 1 && first_numeric) ||
-                    (r.nnum >= 8 && 2 * r.nnum > r.ncells);
-    if (!data_like) {
-      /* header (or footer) text: the matrix starts after it */
-      rows_before_reset = B.nrows;
-      last_reset_line = line_no;
-      last_reset_start = a;
-      last_reset_end = b;
-      reset_cells = r.ncells;
-      B.nrows = 0;
-      B.nvals = 0;
-      continue;
-    }
-    if (!grow((void **)&B.rows, &B.caprows, B.nrows + 1, sizeof(csv_row))) {
-      st = hearth_err_set(err, HEARTH_E_NOMEM, "%s: out of memory", name);
-      goto done;
-    }
-    B.rows[B.nrows++] = r;
-  }
-
+  csv_text t;
+  hearth_status st = csv_text_open(&t, text ? text : "", len, name, err);
+  if (st) return st;
+  csv_ctx c = {name, t.s, t.len, detect_sep(t.s, t.start, t.len), 1};
+  csv_buf B;
+  memset(&B, 0, sizeof B);
+  csv_layout L = {HEARTH_CSV_PLAIN, 0, 0, 0, 0, NONE, NONE, 0, 0, 0};
+  size_t w = 0;
+  int celsius = 0;
   char shape[64] = "";
   if (want_w && want_h) snprintf(shape, sizeof shape, " (a %zux%zu matrix)", want_w, want_h);
-
-  if (B.nrows == 0) {
-    if (last_reset_line && rows_before_reset) {
-      /* numeric rows were followed by text: report the text */
-      csv_row r = {last_reset_line, last_reset_start, last_reset_end, 0, 0, 0};
-      st = row_error(name, s, sep, &r, (size_t)-1, shape, err);
-      goto done;
-    }
-    st = hearth_err_set(err, HEARTH_E_PARSE,
-                        "%s: line %zu, column 1: no numeric rows found, expected a matrix of "
-                        "temperatures%s",
-                        name, line_no + 1, shape);
-    goto done;
-  }
-
-  /* full numeric rows of another width just before the matrix are header
-   * values (e.g. "256,192") */
-  size_t n_ref = majority_cells(B.rows, B.nrows);
-  size_t first = 0, skipped_vals = 0;
-  while (first < B.nrows && B.rows[first].nnum == B.rows[first].ncells &&
-         B.rows[first].ncells != n_ref) {
-    skipped_vals += B.rows[first].ncells;
-    first++;
-  }
-  size_t n_exp = want_w ? want_w : n_ref;
-  if (!want_w || !want_h) snprintf(shape, sizeof shape, " (as in the other rows)");
-  if (want_w && !want_h) snprintf(shape, sizeof shape, " (a width of %zu)", want_w);
-
-  /* the first wrong row, in file order */
-  for (size_t i = first; i < B.nrows; i++) {
-    const csv_row *r = &B.rows[i];
-    if (r->ok && r->ncells == n_exp) continue;
-    st = row_error(name, s, sep, r, n_exp, shape, err);
-    goto done;
-  }
-
-  size_t nrows = B.nrows - first;
-  if ((!want_h || nrows < want_h) && last_reset_line && rows_before_reset &&
-      reset_cells == n_ref) {
-    /* a text line as wide as the matrix, with numeric rows before it, cut
-     * the matrix short: that line is the problem, not a header */
-    csv_row r = {last_reset_line, last_reset_start, last_reset_end, 0, 0, 0};
-    st = row_error(name, s, sep, &r, n_exp, shape, err);
-    goto done;
-  }
-  if (want_h && nrows != want_h) {
-    char want[64];
-    if (want_w) snprintf(want, sizeof want, "%zux%zu", want_w, want_h);
-    else snprintf(want, sizeof want, "%zu rows", want_h);
-    if (nrows < want_h)
-      st = hearth_err_set(err, HEARTH_E_SIZE,
-                          "%s: line %zu, column 1: matrix ends after %zu rows of %zu values, "
-                          "expected %s",
-                          name, B.rows[B.nrows - 1].line_no + 1, nrows, n_exp, want);
-    else
-      st = hearth_err_set(err, HEARTH_E_SIZE,
-                          "%s: line %zu, column 1: more than %zu rows, expected %s", name,
-                          B.rows[first + want_h].line_no, want_h, want);
-    goto done;
-  }
-
-  /* the values become the image's: no second buffer, no copy */
-  size_t n_vals = n_exp * nrows;
-  if (skipped_vals) memmove(B.vals, B.vals + skipped_vals, n_vals * sizeof(float));
-  float *data = realloc(B.vals, n_vals * sizeof(float));
-  if (data) B.vals = data; /* a failed shrink keeps the larger block */
-  *out = (hearth_image){n_exp, nrows, 1, HEARTH_PIX_F32, B.vals};
-  B.vals = NULL;
+  if ((st = scan(&c, t.start, &B, err))) goto done;
+  const char *encoding = find_encoding(&c, &t, &B);
+  if ((st = find_layout(&c, &B, shape, &L, err))) goto done;
+  if ((st = check_matrix(&c, &B, &L, want_w, want_h, &w, &celsius, err))) goto done;
+  if (info && (st = fill_info(&c, &t, &B, &L, encoding, w, celsius, info, err))) goto done;
+  take_values(&B, &L, w, out);
 
 done:
   free(B.vals);
   free(B.rows);
-  if (st && out->data) hearth_image_free(out);
+  csv_text_free(&t);
+  if (st) {
+    if (out->data) hearth_image_free(out);
+    hearth_thermal_info_free(info);
+  }
   return st;
 }
 
-hearth_status hearth_thermal_read_csv(const char *path, const hearth_csv_opts *opts,
-                                      hearth_image *out, hearth_err *err) {
+hearth_status hearth_thermal_parse_csv(const char *text, size_t len, const char *name,
+                                       const hearth_csv_opts *opts, hearth_image *out,
+                                       hearth_err *err) {
+  return hearth_thermal_parse_csv_ex(text, len, name, opts, out, NULL, err);
+}
+
+hearth_status hearth_thermal_read_csv_ex(const char *path, const hearth_csv_opts *opts,
+                                         hearth_image *out, hearth_thermal_info *info,
+                                         hearth_err *err) {
+  if (info) memset(info, 0, sizeof *info);
   if (out) memset(out, 0, sizeof *out);
   if (!path || !out) return hearth_err_set(err, HEARTH_E_ARG, "thermal csv: NULL argument");
   uint8_t *data = NULL;
   size_t size = 0;
   hearth_status st = hearth_read_file(path, CSV_MAX_BYTES, &data, &size, err);
   if (st) return st;
-  st = hearth_thermal_parse_csv((const char *)data, size, path, opts, out, err);
+  st = hearth_thermal_parse_csv_ex((const char *)data, size, path, opts, out, info, err);
   free(data);
   return st;
 }
 
-hearth_status hearth_thermal_write_csv(const char *path, const hearth_image *temps,
-                                       int decimals, hearth_err *err) {
-  if (!path || !temps || !temps->data)
-    return hearth_err_set(err, HEARTH_E_ARG, "thermal csv: NULL argument");
-  if (temps->channels != 1 || temps->type != HEARTH_PIX_F32)
-    return hearth_err_set(err, HEARTH_E_ARG,
-                          "%s: image has %d channel(s) of %d-byte samples, expected 1-channel "
-                          "float32",
-                          path, temps->channels, (int)temps->type);
-  if (decimals < 0 || decimals > 9)
-    return hearth_err_set(err, HEARTH_E_ARG, "%s: %d decimals, expected 0..9", path, decimals);
-  size_t w = temps->width, h = temps->height, n;
-  if (!w || !h || !hearth_mul_size(w, h, &n))
-    return hearth_err_set(err, HEARTH_E_SIZE, "%s: image is %zux%zu, expected a non-empty matrix",
-                          path, w, h);
-  /* "-50.xxxxxx," at most 4 + 1 + decimals + 1 bytes per value */
-  size_t per = (size_t)decimals + 6, cap;
-  if (!hearth_mul_size(n, per, &cap))
-    return hearth_err_set(err, HEARTH_E_NOMEM, "%s: image too large", path);
-  char *buf = malloc(cap + 1);
-  if (!buf) return hearth_err_set(err, HEARTH_E_NOMEM, "%s: out of memory", path);
-  const float *t = temps->data;
-  size_t k = 0;
-  for (size_t y = 0; y < h; y++) {
-    for (size_t x = 0; x < w; x++) {
-      double v = t[y * w + x];
-      /* refuse what a reader would refuse rather than write it */
-      if (!(v >= HEARTH_THERMAL_MIN_C && v <= HEARTH_THERMAL_MAX_C)) {
-        free(buf);
-        return hearth_err_set(err, HEARTH_E_RANGE,
-                              "%s: pixel (%zu, %zu) = %g degC, expected a finite value in "
-                              "%g..%g degC",
-                              path, x, y, v, HEARTH_THERMAL_MIN_C, HEARTH_THERMAL_MAX_C);
-      }
-      int m = hearth_format_fixed(buf + k, cap + 1 - k, v, decimals);
-      if (m < 0) {
-        free(buf);
-        return hearth_err_set(err, HEARTH_E_RANGE, "%s: pixel (%zu, %zu) cannot be formatted",
-                              path, x, y);
-      }
-      k += (size_t)m;
-      buf[k++] = x + 1 < w ? ',' : '\n';
-    }
-  }
-  hearth_status st = hearth_write_file_atomic(path, buf, k, err);
-  free(buf);
-  return st;
+hearth_status hearth_thermal_read_csv(const char *path, const hearth_csv_opts *opts,
+                                      hearth_image *out, hearth_err *err) {
+  return hearth_thermal_read_csv_ex(path, opts, out, NULL, err);
 }
 
-void hearth_csv_opts_default(hearth_csv_opts *o) {
-  o->width = 256;
-  o->height = 192;
+const char *hearth_csv_layout_name(hearth_csv_layout layout) {
+  switch (layout) {
+    case HEARTH_CSV_PLAIN: return "plain";
+    case HEARTH_CSV_SIZE_LINE: return "size-line";
+    case HEARTH_CSV_AXIS: return "axis-labelled";
+    case HEARTH_CSV_FRAME: return "frame-labelled";
+  }
+  return "unknown";
 }
