@@ -38,6 +38,14 @@ if [ ! -e .tools/node_modules/gltf-validator/package.json ]; then
   npm install --silent --no-audit --no-fund --prefix .tools gltf-validator@2.0.0-dev.3.10 >/dev/null 2>&1 ||
     echo "setup: warning: gltf-validator could not be installed; the GLB validator test will fail"
 fi
+# DuckDB (npm; its native library ships inside @duckdb/node-bindings-linux-x64)
+# reads back every Parquet file hearth writes (io/test_parquet, export/test_lerobot).
+if [ ! -e .tools/node_modules/@duckdb/node-api/package.json ]; then
+  echo "setup: installing @duckdb/node-api (npm) into .tools/"
+  mkdir -p .tools
+  npm install --silent --no-audit --no-fund --prefix .tools @duckdb/node-api@1.5.6-r.1 >/dev/null 2>&1 ||
+    echo "setup: warning: @duckdb/node-api could not be installed; the Parquet read-back tests will fail"
+fi
 
 type=RelWithDebInfo
 extra=""

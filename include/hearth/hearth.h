@@ -1,10 +1,10 @@
 /* hearth/hearth.h - every area's public header in one include, in pipeline
- * order: core (core.h, geom.h, camera.h), io (image.h, thermal.h, npy.h),
- * dataset, net (msgpack.h, ws.h), mesh, synth, calib, poses, map, release,
- * then the simulation areas sim and eval.
+ * order: core (core.h, geom.h, camera.h), io (image.h, thermal.h, npy.h,
+ * parquet.h), dataset, net (msgpack.h, ws.h), mesh, synth, calib, poses, map,
+ * release, then the simulation areas sim, export and eval.
  *
- * Link the pipeline areas with `pkg-config --cflags --libs hearth`; sim.h
- * and eval.h need a build with HEARTH_SIM and `pkg-config --libs
+ * Link the pipeline areas with `pkg-config --cflags --libs hearth`; sim.h,
+ * export.h and eval.h need a build with HEARTH_SIM and `pkg-config --libs
  * hearth-sim` (MuJoCo, OSMesa, HDF5). */
 #ifndef HEARTH_HEARTH_H
 #define HEARTH_HEARTH_H
@@ -14,6 +14,7 @@
 #include "hearth/image.h"
 #include "hearth/thermal.h"
 #include "hearth/npy.h"
+#include "hearth/parquet.h"
 #include "hearth/dataset.h"
 #include "hearth/msgpack.h"
 #include "hearth/ws.h"
@@ -24,5 +25,6 @@
 #include "hearth/map.h"
 #include "hearth/release.h"
 #include "hearth/sim.h"
+#include "hearth/export.h"
 #include "hearth/eval.h"
 #endif

@@ -1,4 +1,4 @@
-/* shared by the hearth-sim commands (cmd_sim.c, cmd_sim_eval.c, sim_main.c) */
+/* shared by the hearth-sim commands (cmd_sim.c, cmd_sim_eval.c, cmd_sim_export.c, sim_main.c) */
 #ifndef HEARTH_CLI_SIM_H
 #define HEARTH_CLI_SIM_H
 #include <stddef.h>
@@ -17,5 +17,6 @@ void sim_cli_drop_assets(const char *tmpdir);
 int hearth_cmd_sim_render(int argc, char **argv);
 int hearth_cmd_sim_collect(int argc, char **argv);
 int hearth_cmd_sim_eval(int argc, char **argv);
+int hearth_cmd_sim_export(int argc, char **argv);
 
 #endif

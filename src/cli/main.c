@@ -69,7 +69,7 @@ static const command k_cmds[] = {
     {"validate", hearth_cmd_validate, "check a release against the layout contract"},
     {"stats", hearth_cmd_stats, "dataset overview table of a release"},
     {"demo", hearth_cmd_demo, "make, build and report a small virtual release"},
-    {"sim", run_sim, "temperature-aware manipulation tasks (render, collect, eval)"},
+    {"sim", run_sim, "temperature-aware manipulation tasks (render, collect, eval, export)"},
 };
 #define N_CMDS (sizeof k_cmds / sizeof k_cmds[0])
 
