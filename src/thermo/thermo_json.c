@@ -180,7 +180,10 @@ hearth_status hearth_thermo_model_write(const char *path, const hearth_thermo_mo
                                         hearth_err *err) {
   const hearth_thermo_net *net = &m->net;
   hearth_status s = hearth_thermo_net_check(net, err);
-  if (s != HEARTH_OK) return hearth_err_prefix(err, "%s: ", path);
+  if (s != HEARTH_OK) {
+    hearth_err_prefix(err, "%s", path);
+    return s;
+  }
   json_t *root = json_object();
   int ok = root != NULL;
   ok = ok && hj_set(root, "format", json_string(THERMO_FORMAT));

@@ -199,7 +199,10 @@ hearth_status hearth_thermo_step_coupled(hearth_thermo_net *const *nets, size_t 
   size_t n = 0;
   for (size_t a = 0; a < n_nets; a++) {
     hearth_status s = hearth_thermo_net_check(nets[a], err);
-    if (s != HEARTH_OK) return hearth_err_prefix(err, "network %zu: ", a);
+    if (s != HEARTH_OK) {
+      hearth_err_prefix(err, "network %zu", a);
+      return s;
+    }
     ws.base[a] = n;
     n += nets[a]->n;
   }

@@ -8,13 +8,12 @@
 
 static const hearth_thermo_material k_materials[] = {
     /* name               c (J/kg K)  k (W/m K)  emissivity  source */
-    {"porcelain",          1085.0,     1.5,      0.92,       "EBT-c, EBT-k, EBT-eps"},
-    {"ceramic",             850.0,     1.3,      0.90,       "INC-A3, EBT-eps"},
-    {"water",              4186.0,     0.60,     0.95,       "INC-A6, EBT-eps"},
-    {"aluminium",           900.0,   237.0,      0.07,       "INC-A1, EBT-eps"},
-    {"aluminium_painted",   900.0,   237.0,      0.90,       "INC-A1, EBT-eps"},
-    {"glass",               840.0,     1.4,      0.92,       "INC-A3, EBT-eps"},
-    {"stainless_steel",     480.0,    15.0,      0.15,       "INC-A1, EBT-eps"},
+    {"ceramic",             920.0,     1.3,      0.90,       "ETB-c, OMEGA-eps"},
+    {"water",              4179.0,     0.613,    0.96,       "INC-A6, IDEAL-eps"},
+    {"aluminium",           903.0,   237.0,      0.09,       "INC-A1, FLIR-eps"},
+    {"aluminium_painted",   903.0,   237.0,      0.94,       "INC-A1, IDEAL-eps"},
+    {"glass",               840.0,     1.4,      0.94,       "ETB-c, INC-A3, IDEAL-eps"},
+    {"stainless_steel",     477.0,    14.9,      0.16,       "INC-A1, IDEAL-eps"},
 };
 
 const hearth_thermo_material *hearth_thermo_material_find(const char *name) {
