@@ -304,11 +304,6 @@ static void smooth3(const float *in, int w, int h, float *out) {
     }
 }
 
-static int cmp_dbl(const void *a, const void *b) {
-  double x = *(const double *)a, y = *(const double *)b;
-  return (x > y) - (x < y);
-}
-
 /* median temperature of the pixels the mesh covers minus that of the
  * uncovered pixels of the box around it (robust to a start several pixels off) */
 static double contour_contrast(const rf_ctx *c, const rf_scratch *sc, size_t ns, const hearth_rigid *T) {
@@ -326,11 +321,7 @@ static double contour_contrast(const rf_ctx *c, const rf_scratch *sc, size_t ns,
         if (sc->hit[p]) in[ni++] = sc->smooth[p];
         else out[no++] = sc->smooth[p];
       }
-    if (ni && no) {
-      qsort(in, ni, sizeof *in, cmp_dbl);
-      qsort(out, no, sizeof *out, cmp_dbl);
-      med = in[ni / 2] - out[no / 2];
-    }
+    if (ni && no) med = rf_select(in, ni, ni / 2) - rf_select(out, no, no / 2);
   }
   free(in);
   free(out);
