@@ -179,8 +179,10 @@ static void ov_auto_range(const hearth_image *temps, double *vals, double *lo, d
   size_t n = temps->width * temps->height;
   const float *t = temps->data;
   for (size_t i = 0; i < n; i++) vals[i] = t[i];
-  *lo = rf_select(vals, n, n / 50);
-  *hi = rf_select(vals, n, n - 1 - n / 50);
+  size_t k = n / 50;
+  *lo = rf_select(vals, n, k);
+  /* what lies above position k is the rest of the order */
+  *hi = k + 1 < n ? rf_select(vals + k + 1, n - k - 1, n - 2 - 2 * k) : vals[k];
   if (!(*hi > *lo)) *hi = *lo + 1.0;
 }
 
@@ -197,8 +199,11 @@ static hearth_status ov_background(const uint8_t *turbo, size_t tw, size_t th, s
   hearth_status s = hearth_image_alloc(out, w, h, 3, HEARTH_PIX_U8, err);
   if (s) return s;
   uint8_t *o = out->data;
-  for (size_t y = 0; y < h; y++)
-    for (size_t x = 0; x < w; x++) memcpy(o + 3 * (y * w + x), turbo + 3 * ((y / zoom) * tw + x / zoom), 3);
+  for (size_t ty = 0; ty < th; ty++) {
+    uint8_t *row = o + 3 * (ty * zoom) * w;
+    for (size_t x = 0; x < w; x++) memcpy(row + 3 * x, turbo + 3 * (ty * tw + x / zoom), 3);
+    for (size_t r = 1; r < zoom; r++) memcpy(row + 3 * r * w, row, 3 * w);
+  }
   return HEARTH_OK;
 }
 
