@@ -124,21 +124,30 @@ typedef struct hearth_build_stage {
   void *ctx;
 } hearth_build_stage;
 
+/* The parameters that shape the outputs (resolution, fusion, min_cos,
+ * rgb_resolution, bake_rgb, calibrate, calib_overlays) start "unset" in
+ * hearth_build_opts_default: an unset parameter takes the value the
+ * release's build.json recorded (the last build's), else its default. The
+ * build records the parameters it runs with in build.json (docs/dataset.md),
+ * so a later build without options changes nothing. */
+#define HEARTH_BUILD_FUSION_UNSET ((hearth_fusion)-1)
 typedef struct hearth_build_opts {
   int jobs;                   /* instances in parallel; 0 = min(cores, instances) */
   int threads;                /* total worker threads; 0 = hearth_default_threads() */
   int shard_index, shard_count; /* this machine does instances with index % count == index */
   const char *only_instance;  /* NULL: all of release.json */
-  size_t resolution;          /* temperature-map R; default 1024 */
-  hearth_fusion fusion;       /* default HEARTH_FUSE_MAX */
-  double min_cos;             /* default 0 */
-  size_t rgb_resolution;      /* baked colour texture side; default 1024; 0 after default = skip */
-  int bake_rgb;               /* default 1 */
+  size_t resolution;          /* temperature-map R; 0 unset (default 1024) */
+  hearth_fusion fusion;       /* HEARTH_BUILD_FUSION_UNSET (default HEARTH_FUSE_MAX) */
+  double min_cos;             /* negative: unset (default 0) */
+  size_t rgb_resolution;      /* baked colour texture side; 0 unset (default 1024) */
+  int bake_rgb;               /* 1 bake, 0 keep the recon's texture; -1 unset (default 1) */
   int force;                  /* re-run every stage */
   int quiet;                  /* no progress output */
-  int dry_run;                /* list what would run, run nothing */
-  int calibrate;              /* default 1: detect + calibrate when calibration/captures/ exists */
-  int calib_overlays;         /* default 1: detection draws its overlay pictures */
+  int dry_run;                /* list what would run, run nothing (build.json untouched) */
+  int calibrate;              /* 1: detect + calibrate when calibration/captures/ exists;
+                                 -1 unset (default 1) */
+  int calib_overlays;         /* 1: detection draws its overlay pictures; -1 unset (default 1) */
+  int ignore_recorded;        /* 1: unset parameters take their defaults, not build.json's */
   size_t n_release_stages;    /* extra release-level stages (at most HEARTH_BUILD_MAX_STAGES) */
   const hearth_build_stage *release_stages;
   FILE *log;                  /* plain lines / summary; default stdout */

@@ -61,11 +61,14 @@ static hearth_status list_frames(const char *dir, char prefix, const char *suffi
 }
 
 /* ---- detect ------------------------------------------------------------------- */
+/* One frame: detected on a worker, which also draws and encodes its
+ * overlay; the files are written after every frame has been read. */
 typedef struct det_job {
   char path[4096];
   int thermal;
   hearth_detection det;
-  hearth_image img; /* kept for the overlay */
+  uint8_t *png; /* the encoded overlay (with overlays) */
+  size_t png_size;
   hearth_status st;
   hearth_err err;
 } det_job;
@@ -76,68 +79,116 @@ typedef struct det_ctx {
   int want_rgb_w, want_rgb_h;
 } det_ctx;
 
-static void det_range(void *vctx, size_t b, size_t e, int ti) {
-  det_ctx *c = vctx;
-  (void)ti;
-  for (size_t i = b; i < e; i++) {
-    det_job *j = &c->jobs[i];
-    if (j->thermal) {
-      j->st = hearth_thermal_read_csv(j->path, NULL, &j->img, &j->err);
-      if (!j->st) j->st = hearth_detect_plate_thermal(&j->img, &c->run->detect, &j->det, &j->err);
-    } else {
-      /* detection reads the luma plane only (no chroma work); the overlay,
-       * if wanted, decodes the colour image too */
-      j->st = hearth_jpeg_read_gray(j->path, &j->img, &j->err);
-      if (!j->st && c->want_rgb_w > 0 &&
-          (j->img.width != (size_t)c->want_rgb_w || j->img.height != (size_t)c->want_rgb_h))
-        j->st = hearth_err_set(&j->err, HEARTH_E_SIZE,
-                               "%s: image is %zux%zu, the colour camera (factory.json) is %dx%d",
-                               j->path, j->img.width, j->img.height, c->want_rgb_w, c->want_rgb_h);
-      if (!j->st) j->st = hearth_detect_plate_color(&j->img, &c->run->detect, &j->det, &j->err);
-      if (!j->st && c->run->overlays) {
-        hearth_image_free(&j->img);
-        j->st = hearth_jpeg_read(j->path, &j->img, &j->err);
+/* The two enlargements of the overlays, equal to hearth_image_resize at
+ * those ratios: there every weight is a multiple of 1/8, so its double
+ * sums are exact and integer sums in eighths give the same bytes. */
+
+/* colour halved: the mean of each 2 x 2 block, rounded half up; a grey
+ * source is repeated in the three channels */
+static void half_box(const hearth_image *src, hearth_image *dst) {
+  const uint8_t *p = src->data;
+  uint8_t *q = dst->data;
+  size_t sc = (size_t)src->channels, sw = src->width;
+  for (size_t y = 0; y < dst->height; y++)
+    for (size_t x = 0; x < dst->width; x++) {
+      const uint8_t *a = p + ((2 * y) * sw + 2 * x) * sc, *b = a + sw * sc;
+      for (size_t k = 0; k < 3; k++) {
+        size_t c = sc >= 3 ? k : 0;
+        unsigned sum = (unsigned)a[c] + a[sc + c] + b[c] + b[sc + c];
+        q[3 * (y * dst->width + x) + k] = (uint8_t)((sum + 2) / 4);
       }
     }
-    /* every error names its file */
-    if (j->st && !strstr(j->err.msg, j->path)) hearth_err_prefix(&j->err, "%s", j->path);
-    if (!c->run->overlays) hearth_image_free(&j->img);
-  }
 }
 
-/* overlay: the image (thermal in Turbo, upsampled 4x; colour halved) with
- * the centres joined row by row, one colour per row */
-static hearth_status write_overlay(const char *path, const det_job *j, hearth_err *err) {
-  hearth_image rgb = {0}, big = {0};
+/* the linear taps of output sample o when n samples are enlarged 4 times:
+ * source i0 with weight 8 - f8 and i0 + 1 with f8 (eighths), the centre
+ * (o + 0.5) / 4 - 0.5 clamped to the samples */
+static void taps4(size_t o, size_t n, size_t *i0, unsigned *f8) {
+  long x8 = 2 * (long)o - 3, top = 8 * ((long)n - 1);
+  if (x8 < 0) x8 = 0;
+  if (x8 > top) x8 = top;
+  *i0 = (size_t)(x8 / 8);
+  *f8 = (unsigned)(x8 % 8);
+  if (*i0 + 1 >= n) *f8 = 0;
+}
+
+/* an RGB image enlarged 4 times, bilinear between pixel centres: every
+ * source row enlarged along x first (eighths), then the rows blended */
+static hearth_status up4(const hearth_image *src, hearth_image *dst, hearth_err *err) {
+  const uint8_t *p = src->data;
+  size_t sw = src->width, sh = src->height, dw = dst->width, rowv = 3 * dw;
+  uint16_t *rows = hearth_alloc_array(sh, rowv * sizeof *rows);
+  if (!rows) return hearth_err_set(err, HEARTH_E_NOMEM, "overlay: out of memory");
+  for (size_t x = 0; x < dw; x++) {
+    size_t x0;
+    unsigned fx;
+    taps4(x, sw, &x0, &fx);
+    size_t x1 = fx ? x0 + 1 : x0;
+    for (size_t y = 0; y < sh; y++)
+      for (size_t k = 0; k < 3; k++)
+        rows[y * rowv + 3 * x + k] =
+            (uint16_t)((8 - fx) * p[3 * (y * sw + x0) + k] + fx * p[3 * (y * sw + x1) + k]);
+  }
+  uint8_t *q = dst->data;
+  for (size_t y = 0; y < dst->height; y++) {
+    size_t y0;
+    unsigned fy;
+    taps4(y, sh, &y0, &fy);
+    const uint16_t *h0 = rows + y0 * rowv, *h1 = rows + (fy ? y0 + 1 : y0) * rowv;
+    uint8_t *o = q + y * rowv;
+    for (size_t i = 0; i < rowv; i++) o[i] = (uint8_t)(((8 - fy) * h0[i] + fy * h1[i] + 32) / 64);
+  }
+  free(rows);
+  return HEARTH_OK;
+}
+
+/* the image enlarged s times (4: thermal, 0.5: colour), through
+ * hearth_image_resize where the shortcuts above do not apply */
+static hearth_status overlay_scale(const hearth_image *img, int thermal, double s, hearth_image *big,
+                                   hearth_err *err) {
+  size_t w = (size_t)lround((double)img->width * s), h = (size_t)lround((double)img->height * s);
+  hearth_image rgb = {0};
   hearth_status st;
-  double s;
-  if (j->thermal) {
-    const float *T = j->img.data;
-    size_t n = j->img.width * j->img.height;
+  if (thermal) {
+    const float *T = img->data;
+    size_t n = img->width * img->height;
     double lo = T[0], hi = T[0];
     for (size_t i = 0; i < n; i++) {
       lo = fmin(lo, T[i]);
       hi = fmax(hi, T[i]);
     }
     const uint8_t nan_rgb[3] = {0, 0, 0};
-    st = hearth_turbo_image(&j->img, lo, hi > lo ? hi : lo + 1, nan_rgb, &rgb, err);
-    s = 4;
-  } else {
-    st = hearth_image_alloc(&rgb, j->img.width, j->img.height, 3, HEARTH_PIX_U8, err);
-    if (!st) {
-      const uint8_t *p = j->img.data;
-      uint8_t *q = rgb.data;
-      for (size_t i = 0; i < j->img.width * j->img.height; i++)
-        for (int k = 0; k < 3; k++)
-          q[3 * i + (size_t)k] =
-              p[i * (size_t)j->img.channels + (j->img.channels >= 3 ? (size_t)k : 0)];
+    if ((st = hearth_turbo_image(img, lo, hi > lo ? hi : lo + 1, nan_rgb, &rgb, err))) return st;
+    if (w == 4 * rgb.width && h == 4 * rgb.height) {
+      if (!(st = hearth_image_alloc(big, w, h, 3, HEARTH_PIX_U8, err)) && (st = up4(&rgb, big, err)))
+        hearth_image_free(big);
+    } else {
+      st = hearth_image_resize(&rgb, w, h, big, err);
     }
-    s = 0.5;
+    hearth_image_free(&rgb);
+    return st;
   }
-  if (st) return st;
-  st = hearth_image_resize(&rgb, (size_t)lround((double)rgb.width * s),
-                           (size_t)lround((double)rgb.height * s), &big, err);
+  if (2 * w == img->width && 2 * h == img->height) {
+    if (!(st = hearth_image_alloc(big, w, h, 3, HEARTH_PIX_U8, err))) half_box(img, big);
+    return st;
+  }
+  if ((st = hearth_image_alloc(&rgb, img->width, img->height, 3, HEARTH_PIX_U8, err))) return st;
+  const uint8_t *p = img->data;
+  uint8_t *q = rgb.data;
+  for (size_t i = 0; i < img->width * img->height; i++)
+    for (int k = 0; k < 3; k++)
+      q[3 * i + (size_t)k] = p[i * (size_t)img->channels + (img->channels >= 3 ? (size_t)k : 0)];
+  st = hearth_image_resize(&rgb, w, h, big, err);
   hearth_image_free(&rgb);
+  return st;
+}
+
+/* overlay: the image (thermal in Turbo, enlarged 4x; colour halved) with
+ * the centres joined row by row, one colour per row; encoded into j->png */
+static hearth_status draw_overlay(det_job *j, const hearth_image *img, hearth_err *err) {
+  hearth_image big = {0};
+  double s = j->thermal ? 4 : 0.5;
+  hearth_status st = overlay_scale(img, j->thermal, s, &big, err);
   if (st) return st;
   if (j->det.found) {
     static const uint8_t row_rgb[8][3] = {{255, 0, 0},   {255, 128, 0}, {255, 255, 0},
@@ -162,9 +213,40 @@ static hearth_status write_overlay(const char *path, const det_job *j, hearth_er
     snprintf(msg, sizeof msg, "%s: %s", j->det.frame, j->det.reason);
     hearth_draw_text(&big, 8, 8, msg, red, 2);
   }
-  st = hearth_png_write(path, &big, err);
+  st = hearth_png_encode(&big, &j->png, &j->png_size, err);
   hearth_image_free(&big);
   return st;
+}
+
+static void det_range(void *vctx, size_t b, size_t e, int ti) {
+  det_ctx *c = vctx;
+  (void)ti;
+  for (size_t i = b; i < e; i++) {
+    det_job *j = &c->jobs[i];
+    hearth_image img = {0};
+    if (j->thermal) {
+      j->st = hearth_thermal_read_csv(j->path, NULL, &img, &j->err);
+      if (!j->st) j->st = hearth_detect_plate_thermal(&img, &c->run->detect, &j->det, &j->err);
+    } else {
+      /* detection reads the luma plane only (no chroma work); the overlay,
+       * if wanted, decodes the colour image too */
+      j->st = hearth_jpeg_read_gray(j->path, &img, &j->err);
+      if (!j->st && c->want_rgb_w > 0 &&
+          (img.width != (size_t)c->want_rgb_w || img.height != (size_t)c->want_rgb_h))
+        j->st = hearth_err_set(&j->err, HEARTH_E_SIZE,
+                               "%s: image is %zux%zu, the colour camera (factory.json) is %dx%d",
+                               j->path, img.width, img.height, c->want_rgb_w, c->want_rgb_h);
+      if (!j->st) j->st = hearth_detect_plate_color(&img, &c->run->detect, &j->det, &j->err);
+      if (!j->st && c->run->overlays) {
+        hearth_image_free(&img);
+        j->st = hearth_jpeg_read(j->path, &img, &j->err);
+      }
+    }
+    if (!j->st && c->run->overlays) j->st = draw_overlay(j, &img, &j->err);
+    hearth_image_free(&img);
+    /* every error names its file */
+    if (j->st && !strstr(j->err.msg, j->path)) hearth_err_prefix(&j->err, "%s", j->path);
+  }
 }
 
 hearth_status hearth_calib_detect_release(const char *root, const hearth_detect_job *run,
@@ -264,7 +346,7 @@ hearth_status hearth_calib_detect_release(const char *root, const hearth_detect_
     for (size_t i = 0; i < nj; i++) {
       snprintf(path, sizeof path, "%s/calibration/overlays/%s_%s.png", root, jobs[i].det.frame,
                jobs[i].det.camera);
-      if ((st = write_overlay(path, &jobs[i], err))) goto done;
+      if ((st = hearth_write_file_atomic(path, jobs[i].png, jobs[i].png_size, err))) goto done;
     }
   }
   hearth_detections dets;
@@ -283,7 +365,7 @@ hearth_status hearth_calib_detect_release(const char *root, const hearth_detect_
     hearth_detections_free(&dets);
 done:
   if (jobs)
-    for (size_t i = 0; i < nj; i++) hearth_image_free(&jobs[i].img);
+    for (size_t i = 0; i < nj; i++) free(jobs[i].png);
   free(jobs);
   free(fnames);
   free(pnames);

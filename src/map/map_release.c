@@ -427,6 +427,72 @@ done:
   return s;
 }
 
+/* The colour bake's memory. The mapping reads a view's colour only at the
+ * stride-grid pixels whose rays meet the mesh; with every vertex in front of
+ * the camera those rays point into the box that bounds the vertices'
+ * normalised coordinates (x/z, y/z): a hit is a convex combination of its
+ * triangle's vertices in those coordinates. So a decoded frame is copied
+ * only at the grid pixels whose ray points into that box (with a margin far
+ * above rounding) into a fresh zeroed image whose other pages are never
+ * written (and so never backed), and the full frame is freed: the bytes the
+ * mapping reads, and so its result, are those of the full frames. */
+#define BAKE_BOX_MARGIN 2e-3 /* normalised units: about 3 px of a 1400 px focal length */
+
+typedef struct bake_grid {
+  size_t stride, gw, gh;
+  float *dir; /* hearth_camera_ray_grid of the colour camera */
+} bake_grid;
+
+/* the box of the mesh's normalised coordinates seen from T (lo x, lo y, hi
+ * x, hi y); 0 if a vertex is not in front of the camera */
+static int bake_box(const hearth_mesh *mesh, const hearth_rigid *T_world_from_cam, double box[4]) {
+  hearth_rigid Tcw;
+  hearth_rigid_inverse(T_world_from_cam, &Tcw);
+  box[0] = box[1] = INFINITY;
+  box[2] = box[3] = -INFINITY;
+  for (size_t i = 0; i < mesh->n_vertices; i++) {
+    const float *pv = mesh->positions + 3 * i;
+    double X[3] = {pv[0], pv[1], pv[2]}, Xc[3];
+    hearth_rigid_apply(&Tcw, X, Xc);
+    if (!(Xc[2] > 0.0)) return 0;
+    double x = Xc[0] / Xc[2], y = Xc[1] / Xc[2];
+    if (x < box[0]) box[0] = x;
+    if (y < box[1]) box[1] = y;
+    if (x > box[2]) box[2] = x;
+    if (y > box[3]) box[3] = y;
+  }
+  box[0] -= BAKE_BOX_MARGIN;
+  box[1] -= BAKE_BOX_MARGIN;
+  box[2] += BAKE_BOX_MARGIN;
+  box[3] += BAKE_BOX_MARGIN;
+  return mesh->n_vertices > 0;
+}
+
+/* replace *img (a decoded frame of the camera's size) by a copy holding
+ * only the pixels the mapping can read from pose T */
+static hearth_status bake_sparse(const bake_grid *g, const hearth_mesh *mesh, const hearth_rigid *T,
+                                 hearth_image *img, hearth_err *err) {
+  double box[4];
+  if (!bake_box(mesh, T, box)) return HEARTH_OK; /* the whole frame stays */
+  hearth_image sp;
+  hearth_status s = hearth_image_alloc(&sp, img->width, img->height, 3, HEARTH_PIX_U8, err);
+  if (s) return s;
+  const uint8_t *in = img->data;
+  uint8_t *out = sp.data;
+  for (size_t gy = 0; gy < g->gh; gy++)
+    for (size_t gx = 0; gx < g->gw; gx++) {
+      const float *d = g->dir + 3 * (gy * g->gw + gx);
+      if (!(d[2] > 0.0f)) continue; /* NaN: the lens cannot be inverted, never cast */
+      double x = (double)d[0] / d[2], y = (double)d[1] / d[2];
+      if (x < box[0] || x > box[2] || y < box[1] || y > box[3]) continue;
+      size_t q = 3 * (gy * g->stride * img->width + gx * g->stride);
+      memcpy(out + q, in + q, 3);
+    }
+  hearth_image_free(img);
+  *img = sp;
+  return HEARTH_OK;
+}
+
 hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err) {
   if (!job || !job->root || !job->instance)
     return hearth_err_set(err, HEARTH_E_ARG, "bake: root and instance are required");
@@ -457,6 +523,7 @@ hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err) {
   hearth_image *imgs = NULL;
   hearth_map_view *views = NULL;
   hearth_map_result r = {0};
+  bake_grid grid = {0};
   if ((s = hearth_rig_read(rig_path, &rig, err))) goto done;
   if ((s = hearth_manifest_read(man_path, &man, err))) goto done;
   if ((s = hearth_poses_read(poses_path, &poses, err))) goto done;
@@ -467,6 +534,14 @@ hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err) {
   if (!imgs || !views) {
     s = hearth_err_set(err, HEARTH_E_NOMEM, "bake: out of memory");
     goto done;
+  }
+  /* the rays of the pixels the mapping casts (none: the frames stay whole) */
+  grid.stride = (size_t)(job->pixel_stride > 0 ? job->pixel_stride : 2);
+  if (rig.rgb.width > 0 && rig.rgb.height > 0) {
+    grid.gw = ((size_t)rig.rgb.width + grid.stride - 1) / grid.stride;
+    grid.gh = ((size_t)rig.rgb.height + grid.stride - 1) / grid.stride;
+    if ((grid.dir = hearth_alloc_array(grid.gw * grid.gh, 3 * sizeof *grid.dir)))
+      hearth_camera_ray_grid(&rig.rgb, grid.stride, grid.dir);
   }
   for (size_t k = 0; k < man.n_views; k++) {
     const hearth_view_files *vf = &man.views[k];
@@ -482,6 +557,10 @@ hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err) {
       s = hearth_err_set(err, HEARTH_E_UNSUPPORTED, "%s: expected an RGB image", path);
       goto done;
     }
+    /* a frame of another size stays whole: the mapping refuses it */
+    if (grid.dir && imgs[k].width == (size_t)rig.rgb.width && imgs[k].height == (size_t)rig.rgb.height &&
+        (s = bake_sparse(&grid, &mesh, &vp->T_world_from_cam, &imgs[k], err)))
+      goto done;
     views[k].image = &imgs[k];
     views[k].T_world_from_cam = vp->T_world_from_cam;
   }
@@ -515,6 +594,7 @@ done:
     for (size_t k = 0; k < man.n_views; k++) hearth_image_free(&imgs[k]);
   free(imgs);
   free(views);
+  free(grid.dir);
   hearth_mesh_free(&mesh);
   hearth_poses_free(&poses);
   hearth_manifest_free(&man);

@@ -23,12 +23,14 @@ static inline hearth_status rf_pathf(char *buf, const char *fmt, ...) {
  * pixel in raster order; NULL on allocation failure */
 float *rf_pixel_rays(const hearth_camera *cam);
 
-/* cast the mesh from a pose over the pixel box [x0,x1) x [y0,y1) (zoom
- * sub-pixels per pixel): depth[] along the ray (INFINITY where no surface),
- * tri[] the triangle (UINT32_MAX none). Arrays are (x1-x0)*zoom x (y1-y0)*zoom. */
-hearth_status rf_cast_box(const hearth_raycaster *rc, const hearth_camera *cam,
-                          const hearth_rigid *T_world_from_cam, int x0, int y0, int x1, int y1,
-                          int zoom, float *depth, uint32_t *tri);
+/* the k-th smallest of v[0..n) (0-based, n > 0; v is reordered so that
+ * v[0..k) <= v[k] <= v(k..n)): quickselect, linear on average */
+double rf_select(double *v, size_t n, size_t k);
+
+/* the q-quantile of v[0..n) with linear interpolation between the order
+ * statistics around q (n - 1) (0 for n == 0); v is reordered. Equal to
+ * interpolating in the sorted array. */
+double rf_quantile(double *v, size_t n, double q);
 
 /* pixel box around the projection of the mesh (clamped to the image, with
  * margin); returns 0 if nothing projects */

@@ -1,5 +1,12 @@
 /* Alignment overlays: the projected mesh outline on the Turbo-coloured
- * thermal image, per view and as a contact sheet (include/hearth/refine.h). */
+ * thermal image, per view and as a contact sheet (include/hearth/poses.h).
+ *
+ * The thermal camera is the same in every view, so the rays through its
+ * sub-pixel centres are undistorted once per zoom (ov_grid) and only rotated
+ * per pose. They are cast in packets, and only inside the box the mesh's
+ * vertices project to (the whole grid when a hit touches the box's border).
+ * Views are drawn in parallel, each worker with scratch of its own; the
+ * contact sheet is assembled in view order afterwards. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -7,21 +14,147 @@
 #include "hearth/thermal.h"
 #include "poses/poses_internal.h"
 
-static int cmp_float(const void *a, const void *b) {
-  float x = *(const float *)a, y = *(const float *)b;
-  return (x > y) - (x < y);
+#define OV_MARGIN 4   /* px around the mesh's projected vertices */
+#define OV_BATCH 4096 /* rays per cast */
+
+/* the rays of hearth_camera_ray through the centres of a zoom x zoom grid
+ * inside every pixel, row-major over the zoomed image */
+typedef struct ov_grid {
+  int zoom;
+  size_t w, h;
+  double *dir; /* 3 per sub-pixel, camera frame; NaN where the lens cannot be inverted */
+} ov_grid;
+
+/* per worker */
+typedef struct ov_scratch {
+  float *depth;  /* w x h of the largest grid: distance along the ray, INFINITY: no surface */
+  uint8_t *edge; /* w x h: outline sub-pixels */
+  float org[3 * OV_BATCH], dir[3 * OV_BATCH];
+  hearth_ray_hit hits[OV_BATCH];
+  size_t pix[OV_BATCH]; /* grid index of each ray of the batch */
+  double *vals;         /* thermal pixels, for the range */
+  uint8_t *turbo;       /* 3 per thermal pixel */
+  hearth_image temps;
+} ov_scratch;
+
+static hearth_status ov_grid_make(const hearth_camera *cam, int zoom, ov_grid *g, hearth_err *err) {
+  g->zoom = zoom;
+  g->w = (size_t)cam->width * (size_t)zoom;
+  g->h = (size_t)cam->height * (size_t)zoom;
+  size_t n = g->w * g->h;
+  g->dir = hearth_alloc_array(n ? n : 1, 3 * sizeof *g->dir);
+  if (!g->dir) return hearth_err_set(err, HEARTH_E_NOMEM, "overlay: out of memory");
+  for (size_t y = 0; y < g->h; y++)
+    for (size_t x = 0; x < g->w; x++) {
+      double u = -0.5 + ((double)x + 0.5) / zoom, v = -0.5 + ((double)y + 0.5) / zoom;
+      double *d = g->dir + 3 * (y * g->w + x);
+      if (hearth_camera_ray(cam, u, v, d) < 0) d[0] = d[1] = d[2] = NAN;
+    }
+  return HEARTH_OK;
 }
 
-/* mark outline sub-pixels (silhouette and depth jumps) of the mesh seen from T */
-static hearth_status outline_mask(const hearth_raycaster *rc, const hearth_camera *cam,
-                                  const hearth_rigid *T, int zoom, uint8_t *edge, hearth_err *err) {
-  size_t w = (size_t)cam->width * (size_t)zoom, h = (size_t)cam->height * (size_t)zoom;
-  float *depth = hearth_alloc_array(w * h, sizeof *depth);
-  if (!depth) return hearth_err_set(err, HEARTH_E_NOMEM, "overlay: out of memory");
-  rf_cast_box(rc, cam, T, 0, 0, cam->width, cam->height, zoom, depth, NULL);
+static void ov_scratch_free(ov_scratch *s) {
+  if (!s) return;
+  free(s->depth);
+  free(s->edge);
+  free(s->vals);
+  free(s->turbo);
+  hearth_image_free(&s->temps);
+}
+
+/* scratch for grids of up to n_sub sub-pixels and images of n_px pixels;
+ * NULL when out of memory */
+static ov_scratch *ov_scratch_new(size_t n_sub, size_t n_px) {
+  ov_scratch *s = calloc(1, sizeof *s);
+  if (!s) return NULL;
+  s->depth = hearth_alloc_array(n_sub ? n_sub : 1, sizeof *s->depth);
+  s->edge = hearth_alloc_array(n_sub ? n_sub : 1, 1);
+  s->vals = hearth_alloc_array(n_px ? n_px : 1, sizeof *s->vals);
+  s->turbo = hearth_alloc_array(n_px ? n_px : 1, 3);
+  if (!s->depth || !s->edge || !s->vals || !s->turbo) {
+    ov_scratch_free(s);
+    free(s);
+    return NULL;
+  }
+  return s;
+}
+
+/* cast the batch's n rays and keep the distances of the hits */
+static void ov_flush(const hearth_raycaster *rc, ov_scratch *s, size_t n) {
+  hearth_raycast_batch_mt(rc, n, s->org, s->dir, 0.0f, INFINITY, s->hits, 1);
+  for (size_t i = 0; i < n; i++)
+    if (s->hits[i].prim != UINT32_MAX) s->depth[s->pix[i]] = s->hits[i].t;
+}
+
+/* cast the grid's sub-pixels [x0, x1) x [y0, y1) from T into s->depth, in
+ * 4 x 4 tiles so that each packet of 16 rays is a tight bundle */
+static void ov_cast(const hearth_raycaster *rc, const ov_grid *g, const hearth_rigid *T, size_t x0,
+                    size_t x1, size_t y0, size_t y1, ov_scratch *s) {
+  const float o[3] = {(float)T->t[0], (float)T->t[1], (float)T->t[2]};
+  size_t n = 0;
+  for (size_t ty = y0; ty < y1; ty += 4)
+    for (size_t tx = x0; tx < x1; tx += 4)
+      for (size_t y = ty; y < ty + 4 && y < y1; y++)
+        for (size_t x = tx; x < tx + 4 && x < x1; x++) {
+          size_t p = y * g->w + x;
+          const double *dc = g->dir + 3 * p;
+          if (isnan(dc[0])) continue;
+          double dw[3];
+          hearth_rigid_rotate(T, dc, dw);
+          for (int k = 0; k < 3; k++) {
+            s->org[3 * n + (size_t)k] = o[k];
+            s->dir[3 * n + (size_t)k] = (float)dw[k];
+          }
+          s->pix[n++] = p;
+          if (n == OV_BATCH) {
+            ov_flush(rc, s, n);
+            n = 0;
+          }
+        }
+  if (n) ov_flush(rc, s, n);
+}
+
+/* 1 if a sub-pixel on a side of the box [x0, x1) x [y0, y1) that is not the
+ * grid's own border has a surface */
+static int ov_hit_on_border(const ov_grid *g, const float *depth, const size_t b[4]) {
+  const size_t x0 = b[0], x1 = b[1], y0 = b[2], y1 = b[3];
+  for (size_t x = x0; x < x1; x++) {
+    if (y0 > 0 && isfinite(depth[y0 * g->w + x])) return 1;
+    if (y1 < g->h && isfinite(depth[(y1 - 1) * g->w + x])) return 1;
+  }
+  for (size_t y = y0; y < y1; y++) {
+    if (x0 > 0 && isfinite(depth[y * g->w + x0])) return 1;
+    if (x1 < g->w && isfinite(depth[y * g->w + x1 - 1])) return 1;
+  }
+  return 0;
+}
+
+/* mark outline sub-pixels (silhouette and depth jumps) of the mesh seen
+ * from T in s->edge; mesh (may be NULL: cast everything) bounds the cast */
+static void ov_outline(const hearth_raycaster *rc, const hearth_mesh *mesh, const hearth_camera *cam,
+                       const ov_grid *g, const hearth_rigid *T, ov_scratch *s) {
+  const size_t w = g->w, h = g->h, zoom = (size_t)g->zoom;
+  float *depth = s->depth;
+  uint8_t *edge = s->edge;
+  for (size_t i = 0; i < w * h; i++) depth[i] = INFINITY;
+  size_t b[4] = {0, w, 0, h}; /* x0, x1, y0, y1 */
+  int pb[4];
+  if (mesh && rf_mesh_box(mesh, cam, T, OV_MARGIN, pb)) {
+    b[0] = (size_t)pb[0] * zoom;
+    b[1] = (size_t)pb[2] * zoom;
+    b[2] = (size_t)pb[1] * zoom;
+    b[3] = (size_t)pb[3] * zoom;
+  }
+  ov_cast(rc, g, T, b[0], b[1], b[2], b[3], s);
+  if (ov_hit_on_border(g, depth, b)) {
+    /* the surface may go on beyond the box: cast the whole grid */
+    ov_cast(rc, g, T, 0, w, 0, h, s);
+    b[0] = 0, b[1] = w, b[2] = 0, b[3] = h;
+  }
   memset(edge, 0, w * h);
-  for (size_t y = 0; y < h; y++)
-    for (size_t x = 0; x < w; x++) {
+  /* every surface sub-pixel lies in the box */
+  for (size_t y = b[2]; y < b[3]; y++)
+    for (size_t x = b[0]; x < b[1]; x++) {
       float d = depth[y * w + x];
       if (!isfinite(d)) continue;
       const long dx[4] = {-1, 1, 0, 0}, dy[4] = {0, 0, -1, 1};
@@ -33,7 +166,44 @@ static hearth_status outline_mask(const hearth_raycaster *rc, const hearth_camer
         if (!isfinite(dn) || dn > d * 1.05f) edge[y * w + x] = edge[(size_t)ny * w + (size_t)nx] = 1;
       }
     }
-  free(depth);
+}
+
+static void ov_paint(hearth_image *out, const uint8_t *edge, const uint8_t rgb[3]) {
+  uint8_t *o = out->data;
+  for (size_t i = 0; i < out->width * out->height; i++)
+    if (edge[i]) memcpy(o + 3 * i, rgb, 3);
+}
+
+/* the 2..98 % range of the image, so low-contrast states stay readable */
+static void ov_auto_range(const hearth_image *temps, double *vals, double *lo, double *hi) {
+  size_t n = temps->width * temps->height;
+  const float *t = temps->data;
+  for (size_t i = 0; i < n; i++) vals[i] = t[i];
+  size_t k = n / 50;
+  *lo = rf_select(vals, n, k);
+  /* what lies above position k is the rest of the order */
+  *hi = k + 1 < n ? rf_select(vals + k + 1, n - k - 1, n - 2 - 2 * k) : vals[k];
+  if (!(*hi > *lo)) *hi = *lo + 1.0;
+}
+
+/* Turbo colour of every thermal pixel over [lo, hi] */
+static void ov_colours(const hearth_image *temps, double lo, double hi, uint8_t *turbo) {
+  const float *t = temps->data;
+  for (size_t i = 0; i < temps->width * temps->height; i++) hearth_turbo((t[i] - lo) / (hi - lo), turbo + 3 * i);
+}
+
+/* a new image of the colours enlarged zoom times (nearest) */
+static hearth_status ov_background(const uint8_t *turbo, size_t tw, size_t th, size_t zoom,
+                                   hearth_image *out, hearth_err *err) {
+  size_t w = tw * zoom, h = th * zoom;
+  hearth_status s = hearth_image_alloc(out, w, h, 3, HEARTH_PIX_U8, err);
+  if (s) return s;
+  uint8_t *o = out->data;
+  for (size_t ty = 0; ty < th; ty++) {
+    uint8_t *row = o + 3 * (ty * zoom) * w;
+    for (size_t x = 0; x < w; x++) memcpy(row + 3 * x, turbo + 3 * (ty * tw + x / zoom), 3);
+    for (size_t r = 1; r < zoom; r++) memcpy(row + 3 * r * w, row, 3 * w);
+  }
   return HEARTH_OK;
 }
 
@@ -46,40 +216,97 @@ hearth_status hearth_overlay_render(const hearth_raycaster *rc, const hearth_cam
     return hearth_err_set(err, HEARTH_E_SIZE, "overlay: expected a %dx%d temperature image",
                           cam->width, cam->height);
   if (zoom < 1 || zoom > 16) return hearth_err_set(err, HEARTH_E_ARG, "overlay: zoom %d outside 1..16", zoom);
-  size_t n = temps->width * temps->height;
-  const float *t = temps->data;
-  if (!(lo < hi)) {
-    /* 2..98 % of the image so low-contrast states stay readable */
-    float *tmp = hearth_alloc_array(n, sizeof *tmp);
-    if (!tmp) return hearth_err_set(err, HEARTH_E_NOMEM, "overlay: out of memory");
-    memcpy(tmp, t, n * sizeof *tmp);
-    qsort(tmp, n, sizeof *tmp, cmp_float);
-    lo = tmp[n / 50];
-    hi = tmp[n - 1 - n / 50];
-    free(tmp);
-    if (!(hi > lo)) hi = lo + 1.0;
-  }
-  size_t w = temps->width * (size_t)zoom, h = temps->height * (size_t)zoom;
-  hearth_status s = HEARTH_OK;
+  size_t n = temps->width * temps->height, w = temps->width * (size_t)zoom, h = temps->height * (size_t)zoom;
+  ov_scratch *s = ov_scratch_new(w * h, n);
+  ov_grid g = {0};
+  hearth_status st = HEARTH_OK;
+  if (!s) return hearth_err_set(err, HEARTH_E_NOMEM, "overlay: out of memory");
+  if (!(lo < hi)) ov_auto_range(temps, s->vals, &lo, &hi);
   if (!out->data) {
-    if ((s = hearth_image_alloc(out, w, h, 3, HEARTH_PIX_U8, err))) return s;
-    uint8_t *o = out->data;
-    for (size_t y = 0; y < h; y++)
-      for (size_t x = 0; x < w; x++)
-        hearth_turbo((t[(y / (size_t)zoom) * temps->width + x / (size_t)zoom] - lo) / (hi - lo),
-                     o + 3 * (y * w + x));
+    ov_colours(temps, lo, hi, s->turbo);
+    if ((st = ov_background(s->turbo, temps->width, temps->height, (size_t)zoom, out, err))) goto done;
   } else if (out->width != w || out->height != h || out->channels != 3) {
-    return hearth_err_set(err, HEARTH_E_SIZE, "overlay: target image has the wrong size");
+    st = hearth_err_set(err, HEARTH_E_SIZE, "overlay: target image has the wrong size");
+    goto done;
   }
-  uint8_t *edge = hearth_alloc_array(w * h, 1);
-  if (!edge) return hearth_err_set(err, HEARTH_E_NOMEM, "overlay: out of memory");
-  if (!(s = outline_mask(rc, cam, T_world_from_cam, zoom, edge, err))) {
-    uint8_t *o = out->data;
-    for (size_t i = 0; i < w * h; i++)
-      if (edge[i]) memcpy(o + 3 * i, rgb, 3);
+  if ((st = ov_grid_make(cam, zoom, &g, err))) goto done;
+  ov_outline(rc, NULL, cam, &g, T_world_from_cam, s);
+  ov_paint(out, s->edge, rgb);
+done:
+  free(g.dir);
+  ov_scratch_free(s);
+  free(s);
+  return st;
+}
+
+/* ---- the release stage ------------------------------------------------------ */
+
+typedef struct ov_ctx {
+  const hearth_overlay_job *job;
+  const hearth_mesh *mesh;
+  const hearth_raycaster *rc;
+  const hearth_camera *cam;
+  const hearth_manifest *man;
+  const hearth_poses *before, *after; /* before: NULL when there is none */
+  const char *after_path, *dir;
+  const ov_grid *big, *small;         /* at the job's zoom and at 1 */
+  ov_scratch **scratch;               /* per worker */
+  hearth_image (*thumbs)[2];          /* per view: the sheet's before and after cells */
+  hearth_status *st;                  /* per view */
+  hearth_err *errs;                   /* per view */
+} ov_ctx;
+
+/* view k: its own file, and its two contact-sheet cells in thumbs */
+static hearth_status ov_view(const ov_ctx *c, ov_scratch *s, size_t k, hearth_image thumbs[2],
+                             hearth_err *err) {
+  const hearth_overlay_job *job = c->job;
+  const hearth_view_files *vf = &c->man->views[k];
+  const char *state = job->state;
+  const hearth_view_pose *pa = hearth_poses_find(c->after, state, vf->view);
+  const hearth_view_pose *pb = c->before ? hearth_poses_find(c->before, state, vf->view) : NULL;
+  if (!pa)
+    return hearth_err_set(err, HEARTH_E_NOT_FOUND, "%s: no pose for state '%s' view '%s'", c->after_path,
+                          state, vf->view);
+  char path[RF_PATH];
+  size_t cw = (size_t)c->cam->width, ch = (size_t)c->cam->height;
+  hearth_csv_opts copts = {cw, ch};
+  rf_pathf(path, "%s/instances/%s/raw/%s/%s", job->root, job->instance, state, vf->thermal);
+  hearth_image_free(&s->temps);
+  hearth_status st = hearth_thermal_read_csv(path, &copts, &s->temps, err);
+  if (st) return st;
+  double lo = job->lo, hi = job->hi;
+  if (!(lo < hi)) ov_auto_range(&s->temps, s->vals, &lo, &hi);
+  ov_colours(&s->temps, lo, hi, s->turbo);
+  /* the per-view file: before in magenta under after in white */
+  const uint8_t white[3] = {255, 255, 255}, magenta[3] = {255, 0, 255};
+  hearth_image ov = {0};
+  if ((st = ov_background(s->turbo, cw, ch, (size_t)c->big->zoom, &ov, err))) return st;
+  if (pb) {
+    ov_outline(c->rc, c->mesh, c->cam, c->big, &pb->T_world_from_cam, s);
+    ov_paint(&ov, s->edge, magenta);
   }
-  free(edge);
-  return s;
+  ov_outline(c->rc, c->mesh, c->cam, c->big, &pa->T_world_from_cam, s);
+  ov_paint(&ov, s->edge, white);
+  hearth_draw_text(&ov, 4, 4, vf->view, white, 2);
+  rf_pathf(path, "%s/%s.png", c->dir, vf->view);
+  st = hearth_png_write(path, &ov, err);
+  hearth_image_free(&ov);
+  for (int side = 0; side < 2 && !st; side++) {
+    const hearth_view_pose *p = side ? pa : pb;
+    if (!p) continue;
+    if ((st = ov_background(s->turbo, cw, ch, 1, &thumbs[side], err))) break;
+    ov_outline(c->rc, c->mesh, c->cam, c->small, &p->T_world_from_cam, s);
+    ov_paint(&thumbs[side], s->edge, white);
+  }
+  return st;
+}
+
+/* views [b, e) on worker t; a chunk stops at its first failure, so the
+ * lowest failing view is always reached whatever the thread count */
+static void ov_range(void *ctx, size_t b, size_t e, int t) {
+  const ov_ctx *c = ctx;
+  for (size_t k = b; k < e; k++)
+    if ((c->st[k] = ov_view(c, c->scratch[t], k, c->thumbs[k], &c->errs[k]))) break;
 }
 
 hearth_status hearth_overlay_run(const hearth_overlay_job *job, size_t *n_written, hearth_err *err) {
@@ -102,7 +329,10 @@ hearth_status hearth_overlay_run(const hearth_overlay_job *job, size_t *n_writte
   hearth_mesh mesh = {0};
   hearth_raycaster *rc = NULL;
   hearth_manifest man = {0};
-  hearth_image sheet = {0}, temps = {0}, ov = {0}, thumb = {0};
+  hearth_image sheet = {0};
+  ov_grid big = {0}, small = {0};
+  ov_ctx c = {0};
+  int nt = 0;
   size_t written = 0;
   hearth_status s;
   if ((s = hearth_rig_read(rig_path, &rig, err))) goto done;
@@ -123,56 +353,73 @@ hearth_status hearth_overlay_run(const hearth_overlay_job *job, size_t *n_writte
                               HEARTH_PIX_U8, err)))
     goto done;
   memset(sheet.data, 40, hearth_image_bytes(&sheet));
-  const uint8_t white[3] = {255, 255, 255}, magenta[3] = {255, 0, 255}, grey[3] = {190, 190, 190};
+  const uint8_t white[3] = {255, 255, 255}, grey[3] = {190, 190, 190};
   char title[160];
   snprintf(title, sizeof title, "%s %s  left: before  right: after (white outline)", inst, state);
   hearth_draw_text(&sheet, 4, 4, title, white, 1);
-  hearth_csv_opts copts = {cw, ch};
-  for (size_t k = 0; k < man.n_views; k++) {
-    const hearth_view_files *vf = &man.views[k];
-    const hearth_view_pose *pa = hearth_poses_find(&after, state, vf->view);
-    const hearth_view_pose *pb = have_before ? hearth_poses_find(&before, state, vf->view) : NULL;
-    if (!pa) {
-      s = hearth_err_set(err, HEARTH_E_NOT_FOUND, "%s: no pose for state '%s' view '%s'", after_path,
-                         state, vf->view);
-      goto done;
-    }
-    rf_pathf(path, "%s/instances/%s/raw/%s/%s", root, inst, state, vf->thermal);
-    if ((s = hearth_thermal_read_csv(path, &copts, &temps, err))) goto done;
-    /* the per-view file: before in magenta under after in white */
-    if (pb && (s = hearth_overlay_render(rc, &rig.thermal, &temps, &pb->T_world_from_cam, zoom,
-                                         job->lo, job->hi, magenta, &ov, err)))
-      goto done;
-    if ((s = hearth_overlay_render(rc, &rig.thermal, &temps, &pa->T_world_from_cam, zoom, job->lo,
-                                   job->hi, white, &ov, err)))
-      goto done;
-    hearth_draw_text(&ov, 4, 4, vf->view, white, 2);
-    rf_pathf(path, "%s/%s.png", dir, vf->view);
-    if ((s = hearth_png_write(path, &ov, err))) goto done;
-    written++;
-    hearth_image_free(&ov);
-    size_t cx = (k % cols) * (2 * cw + 8) + 4, cy = (k / cols) * (ch + label + 8) + 16;
-    hearth_draw_text(&sheet, cx, cy, vf->view, grey, 1);
-    for (int side = 0; side < 2; side++) {
-      const hearth_view_pose *p = side ? pa : pb;
-      if (!p) continue;
-      if ((s = hearth_overlay_render(rc, &rig.thermal, &temps, &p->T_world_from_cam, 1, job->lo,
-                                     job->hi, white, &thumb, err)))
-        goto done;
-      hearth_image_blit(&sheet, &thumb, cx + (size_t)side * cw, cy + label);
-      hearth_image_free(&thumb);
-    }
-    hearth_image_free(&temps);
+  if (!man.n_views) goto sheet;
+  /* the rays of the thermal camera, once for every view */
+  if ((s = ov_grid_make(&rig.thermal, zoom, &big, err))) goto done;
+  if (zoom != 1 && (s = ov_grid_make(&rig.thermal, 1, &small, err))) goto done;
+  nt = job->threads > 0 ? job->threads : hearth_default_threads();
+  if ((size_t)nt > man.n_views) nt = (int)man.n_views;
+  if (nt < 1) nt = 1;
+  c = (ov_ctx){job, &mesh, rc, &rig.thermal, &man, have_before ? &before : NULL, &after, after_path, dir,
+               &big, zoom != 1 ? &small : &big, NULL, NULL, NULL, NULL};
+  c.scratch = calloc((size_t)nt, sizeof *c.scratch);
+  c.thumbs = calloc(man.n_views, sizeof *c.thumbs);
+  c.st = calloc(man.n_views, sizeof *c.st);
+  c.errs = calloc(man.n_views, sizeof *c.errs);
+  int nomem = !c.scratch || !c.thumbs || !c.st || !c.errs;
+  for (int t = 0; t < nt && !nomem; t++) nomem = !(c.scratch[t] = ov_scratch_new(big.w * big.h, cw * ch));
+  if (nomem) {
+    s = hearth_err_set(err, HEARTH_E_NOMEM, "overlay: out of memory");
+    goto done;
   }
+  /* a view that was not reached (its chunk failed earlier) stays marked */
+  for (size_t k = 0; k < man.n_views; k++) c.st[k] = HEARTH_E_ARG;
+  if ((s = hearth_parallel_for(man.n_views, nt, ov_range, &c))) {
+    hearth_err_set(err, s, "overlay: cannot start worker threads");
+    goto done;
+  }
+  for (size_t k = 0; k < man.n_views; k++) {
+    if (c.st[k]) {
+      s = c.st[k];
+      if (err) *err = c.errs[k];
+      goto done;
+    }
+    written++;
+  }
+  /* the sheet in view order: label, then the before and after cells */
+  for (size_t k = 0; k < man.n_views; k++) {
+    size_t cx = (k % cols) * (2 * cw + 8) + 4, cy = (k / cols) * (ch + label + 8) + 16;
+    hearth_draw_text(&sheet, cx, cy, man.views[k].view, grey, 1);
+    for (int side = 0; side < 2; side++)
+      if (c.thumbs[k][side].data) hearth_image_blit(&sheet, &c.thumbs[k][side], cx + (size_t)side * cw, cy + label);
+  }
+sheet:
   rf_pathf(path, "%s/contact_sheet.png", dir);
   if ((s = hearth_png_write(path, &sheet, err))) goto done;
   written++;
   if (n_written) *n_written = written;
 done:
+  if (c.scratch)
+    for (int t = 0; t < nt; t++) {
+      ov_scratch_free(c.scratch[t]);
+      free(c.scratch[t]);
+    }
+  if (c.thumbs)
+    for (size_t k = 0; k < man.n_views; k++) {
+      hearth_image_free(&c.thumbs[k][0]);
+      hearth_image_free(&c.thumbs[k][1]);
+    }
+  free(c.scratch);
+  free(c.thumbs);
+  free(c.st);
+  free(c.errs);
+  free(big.dir);
+  free(small.dir);
   hearth_image_free(&sheet);
-  hearth_image_free(&temps);
-  hearth_image_free(&ov);
-  hearth_image_free(&thumb);
   hearth_manifest_free(&man);
   hearth_raycaster_free(rc);
   hearth_mesh_free(&mesh);

@@ -77,28 +77,6 @@ int rf_mesh_box(const hearth_mesh *mesh, const hearth_camera *cam,
   return box[2] > box[0] && box[3] > box[1];
 }
 
-hearth_status rf_cast_box(const hearth_raycaster *rc, const hearth_camera *cam,
-                          const hearth_rigid *T_world_from_cam, int x0, int y0, int x1, int y1,
-                          int zoom, float *depth, uint32_t *tri) {
-  size_t w = (size_t)(x1 - x0) * (size_t)zoom, h = (size_t)(y1 - y0) * (size_t)zoom;
-  for (size_t y = 0; y < h; y++)
-    for (size_t x = 0; x < w; x++) {
-      /* sub-pixel centres of a zoom x zoom grid inside each pixel */
-      double u = x0 - 0.5 + ((double)x + 0.5) / zoom, v = y0 - 0.5 + ((double)y + 0.5) / zoom;
-      double dc[3], dw[3];
-      depth[y * w + x] = INFINITY;
-      if (tri) tri[y * w + x] = UINT32_MAX;
-      if (hearth_camera_ray(cam, u, v, dc) < 0) continue;
-      hearth_rigid_rotate(T_world_from_cam, dc, dw);
-      hearth_ray_hit hit;
-      if (hearth_raycast(rc, T_world_from_cam->t, dw, 0.0, INFINITY, &hit)) {
-        depth[y * w + x] = hit.t;
-        if (tri) tri[y * w + x] = hit.prim;
-      }
-    }
-  return HEARTH_OK;
-}
-
 /* ---- per-view machinery ------------------------------------------------------ */
 
 typedef struct rf_sample {
@@ -326,11 +304,6 @@ static void smooth3(const float *in, int w, int h, float *out) {
     }
 }
 
-static int cmp_dbl(const void *a, const void *b) {
-  double x = *(const double *)a, y = *(const double *)b;
-  return (x > y) - (x < y);
-}
-
 /* median temperature of the pixels the mesh covers minus that of the
  * uncovered pixels of the box around it (robust to a start several pixels off) */
 static double contour_contrast(const rf_ctx *c, const rf_scratch *sc, size_t ns, const hearth_rigid *T) {
@@ -348,11 +321,7 @@ static double contour_contrast(const rf_ctx *c, const rf_scratch *sc, size_t ns,
         if (sc->hit[p]) in[ni++] = sc->smooth[p];
         else out[no++] = sc->smooth[p];
       }
-    if (ni && no) {
-      qsort(in, ni, sizeof *in, cmp_dbl);
-      qsort(out, no, sizeof *out, cmp_dbl);
-      med = in[ni / 2] - out[no / 2];
-    }
+    if (ni && no) med = rf_select(in, ni, ni / 2) - rf_select(out, no, no / 2);
   }
   free(in);
   free(out);

@@ -31,12 +31,26 @@ typedef struct zpair {
   float zr;  /* recon units */
 } zpair;
 
+#define SCALE_BATCH 4096 /* rays per cast */
+#define SCALE_MARGIN 4   /* px around the mesh's projected vertices */
+
+/* per worker: one batch of rays */
+typedef struct scale_scratch {
+  float org[3 * SCALE_BATCH], dir[3 * SCALE_BATCH];
+  hearth_ray_hit hits[SCALE_BATCH];
+  size_t pix[SCALE_BATCH]; /* grid index of each ray */
+  float dz[SCALE_BATCH];   /* z of each ray's unit direction (camera frame) */
+} scale_scratch;
+
 typedef struct scale_ctx {
+  const hearth_mesh *mesh;
   const hearth_raycaster *rc;
   const hearth_scale_view *views;
   const hearth_scale_opts *o;
   double s;            /* current estimate (for the baseline) */
-  float **dirs;        /* per view: cached pixel rays (3 per sampled pixel) */
+  float **dirs;        /* per view: its camera's pixel rays (3 per sampled pixel), shared
+                          by the views of one camera */
+  scale_scratch **scratch; /* per worker */
   zpair **pairs;       /* per view */
   size_t *n_pairs;
   int failed;
@@ -46,19 +60,66 @@ static uint16_t depth_at(const hearth_image *d, size_t x, size_t y) {
   return ((const uint16_t *)d->data)[y * d->width + x];
 }
 
+/* the grid box [b[0], b[1]) x [b[2], b[3]) being cast, and whether a hit
+ * touched one of its sides that is not the grid's own border */
+typedef struct scale_box {
+  size_t b[4], gw, gh;
+  int border_hit;
+} scale_box;
+
+/* cast the batch's n rays: the rendered depth of each front-facing hit */
+static void scale_flush(const scale_ctx *c, scale_scratch *sc, size_t n, size_t gw, float *zr,
+                        scale_box *bx) {
+  hearth_raycast_batch_mt(c->rc, n, sc->org, sc->dir, 0.0f, INFINITY, sc->hits, 1);
+  for (size_t i = 0; i < n; i++) {
+    const hearth_ray_hit *h = &sc->hits[i];
+    if (h->prim == UINT32_MAX) continue;
+    size_t p = sc->pix[i], gx = p % gw, gy = p / gw;
+    if ((gx == bx->b[0] && gx > 0) || (gx + 1 == bx->b[1] && gx + 1 < bx->gw) ||
+        (gy == bx->b[2] && gy > 0) || (gy + 1 == bx->b[3] && gy + 1 < bx->gh))
+      bx->border_hit = 1;
+    if (h->front) zr[p] = (float)((double)h->t * (double)sc->dz[i]);
+  }
+}
+
+/* cast the sampled pixels of bx from T into zr, in 4 x 4 tiles so that
+ * each packet of 16 rays is a tight bundle */
+static void scale_cast(const scale_ctx *c, scale_scratch *sc, const float *dirs, const hearth_rigid *T,
+                       float *zr, scale_box *bx) {
+  const float o[3] = {(float)T->t[0], (float)T->t[1], (float)T->t[2]};
+  const size_t gw = bx->gw;
+  size_t n = 0;
+  for (size_t ty = bx->b[2]; ty < bx->b[3]; ty += 4)
+    for (size_t tx = bx->b[0]; tx < bx->b[1]; tx += 4)
+      for (size_t gy = ty; gy < ty + 4 && gy < bx->b[3]; gy++)
+        for (size_t gx = tx; gx < tx + 4 && gx < bx->b[1]; gx++) {
+          const float *d = dirs + 3 * (gy * gw + gx);
+          if (isnan(d[0])) continue;
+          double dc[3] = {(double)d[0], (double)d[1], (double)d[2]}, dw[3];
+          hearth_rigid_rotate(T, dc, dw);
+          for (int i = 0; i < 3; i++) {
+            sc->org[3 * n + (size_t)i] = o[i];
+            sc->dir[3 * n + (size_t)i] = (float)dw[i];
+          }
+          sc->dz[n] = d[2];
+          sc->pix[n++] = gy * gw + gx;
+          if (n == SCALE_BATCH) {
+            scale_flush(c, sc, n, gw, zr, bx);
+            n = 0;
+          }
+        }
+  if (n) scale_flush(c, sc, n, gw, zr, bx);
+}
+
 /* cast one view's sampled pixels and keep the pairs that are off edges */
-static void scale_view(scale_ctx *c, size_t v) {
+static void scale_view(scale_ctx *c, size_t v, scale_scratch *sc) {
   const hearth_scale_view *sv = &c->views[v];
   const hearth_image *D = sv->depth;
   size_t st = (size_t)(c->o->pixel_stride > 0 ? c->o->pixel_stride : 1);
   size_t gw = (D->width + st - 1) / st, gh = (D->height + st - 1) / st, n = gw * gh;
-  float *zr = hearth_alloc_array(n, sizeof *zr);
+  float *zr = hearth_alloc_array(n ? n : 1, sizeof *zr);
   zpair *out = hearth_alloc_array(n ? n : 1, sizeof *out);
-  if (!c->dirs[v] && (c->dirs[v] = hearth_alloc_array(n ? n : 1, 3 * sizeof(float)))) {
-    /* undistorted rays of the sampled pixels, once per view (NaN: not invertible) */
-    hearth_camera_ray_grid(&sv->depth_cam, st, c->dirs[v]);
-  }
-  if (!zr || !out || !c->dirs[v]) {
+  if (!zr || !out) {
     free(zr);
     free(out);
     c->failed = 1;
@@ -69,18 +130,22 @@ static void scale_view(scale_ctx *c, size_t v) {
   for (int i = 0; i < 3; i++) Tb.t[i] /= c->s;
   hearth_rigid_inverse(&Tb, &T_rgb_from_depth);
   hearth_rigid_compose(&sv->T_world_from_rgb, &T_rgb_from_depth, &T_world_from_depth);
-  for (size_t gy = 0; gy < gh; gy++)
-    for (size_t gx = 0; gx < gw; gx++) {
-      double dc[3], dw[3];
-      const float *d = c->dirs[v] + 3 * (gy * gw + gx);
-      zr[gy * gw + gx] = INFINITY;
-      if (isnan(d[0])) continue;
-      for (int i = 0; i < 3; i++) dc[i] = (double)d[i];
-      hearth_rigid_rotate(&T_world_from_depth, dc, dw);
-      hearth_ray_hit h;
-      if (hearth_raycast(c->rc, T_world_from_depth.t, dw, 0.0, INFINITY, &h) && h.front)
-        zr[gy * gw + gx] = (float)((double)h.t * dc[2]);
-    }
+  for (size_t i = 0; i < n; i++) zr[i] = INFINITY;
+  /* only the samples inside the box the mesh projects to can hit it; the
+   * whole grid when a hit touches the box's border */
+  scale_box bx = {{0, gw, 0, gh}, gw, gh, 0};
+  int pb[4];
+  if (rf_mesh_box(c->mesh, &sv->depth_cam, &T_world_from_depth, SCALE_MARGIN, pb)) {
+    bx.b[0] = ((size_t)pb[0] + st - 1) / st;
+    bx.b[1] = ((size_t)pb[2] + st - 1) / st;
+    bx.b[2] = ((size_t)pb[1] + st - 1) / st;
+    bx.b[3] = ((size_t)pb[3] + st - 1) / st;
+  }
+  scale_cast(c, sc, c->dirs[v], &T_world_from_depth, zr, &bx);
+  if (bx.border_hit) {
+    bx = (scale_box){{0, gw, 0, gh}, gw, gh, 0};
+    scale_cast(c, sc, c->dirs[v], &T_world_from_depth, zr, &bx);
+  }
   double er = c->o->edge_rel;
   size_t k = 0;
   for (size_t gy = 0; gy < gh; gy++)
@@ -108,23 +173,64 @@ static void scale_view(scale_ctx *c, size_t v) {
 }
 
 static void scale_range(void *ctx, size_t b, size_t e, int t) {
+  scale_ctx *c = ctx;
+  for (size_t v = b; v < e; v++) scale_view(c, v, c->scratch[t]);
+}
+
+/* the pixel rays of the views' depth cameras: one grid per distinct camera
+ * (views with the same intrinsics share it) */
+typedef struct grid_job {
+  const hearth_scale_view *views;
+  size_t *owner; /* the distinct cameras' first views */
+  float **dirs;
+  size_t stride;
+  int failed;
+} grid_job;
+
+static void grid_range(void *ctx, size_t b, size_t e, int t) {
+  grid_job *g = ctx;
   (void)t;
-  for (size_t v = b; v < e; v++) scale_view(ctx, v);
+  for (size_t i = b; i < e; i++) {
+    size_t v = g->owner[i];
+    const hearth_image *D = g->views[v].depth;
+    size_t gw = (D->width + g->stride - 1) / g->stride, gh = (D->height + g->stride - 1) / g->stride;
+    size_t n = gw * gh;
+    if (!(g->dirs[v] = hearth_alloc_array(n ? n : 1, 3 * sizeof(float)))) {
+      g->failed = 1;
+      continue;
+    }
+    /* undistorted rays of the sampled pixels (NaN: not invertible) */
+    hearth_camera_ray_grid(&g->views[v].depth_cam, g->stride, g->dirs[v]);
+  }
 }
 
-static int cmp_double(const void *a, const void *b) {
-  double x = *(const double *)a, y = *(const double *)b;
-  return (x > y) - (x < y);
-}
-
-/* the q-quantile of a[0..n) (sorts a) */
-static double quantile(double *a, size_t n, double q) {
-  if (!n) return 0.0;
-  qsort(a, n, sizeof *a, cmp_double);
-  double pos = q * (double)(n - 1);
-  size_t i = (size_t)pos;
-  if (i + 1 >= n) return a[n - 1];
-  return a[i] + (pos - (double)i) * (a[i + 1] - a[i]);
+/* dirs[v] for every view; own[v] = 1 where the grid is view v's own to free */
+static hearth_status make_grids(const hearth_scale_view *views, size_t n_views, size_t stride,
+                                int threads, float **dirs, uint8_t *own) {
+  size_t *owner = hearth_alloc_array(n_views, sizeof *owner), *same = hearth_alloc_array(n_views, sizeof *same);
+  if (!owner || !same) {
+    free(owner);
+    free(same);
+    return HEARTH_E_NOMEM;
+  }
+  size_t n_own = 0;
+  for (size_t v = 0; v < n_views; v++) {
+    same[v] = v;
+    for (size_t i = 0; i < n_own && same[v] == v; i++)
+      if (!memcmp(&views[owner[i]].depth_cam, &views[v].depth_cam, sizeof views[v].depth_cam))
+        same[v] = owner[i];
+    if (same[v] == v) owner[n_own++] = v;
+  }
+  grid_job g = {views, owner, dirs, stride, 0};
+  hearth_status s = hearth_parallel_for(n_own, threads, grid_range, &g);
+  if (!s && g.failed) s = HEARTH_E_NOMEM;
+  for (size_t v = 0; v < n_views; v++) {
+    own[v] = same[v] == v;
+    if (!own[v]) dirs[v] = dirs[same[v]];
+  }
+  free(owner);
+  free(same);
+  return s;
 }
 
 /* robust fit of zm = s zr over all pairs: median ratio, then trimmed least
@@ -135,7 +241,7 @@ static void robust_fit(zpair *const *pairs, const size_t *n_pairs, size_t n_view
   for (size_t v = 0; v < n_views; v++)
     for (size_t i = 0; i < n_pairs[v]; i++) tmp[n++] = (double)pairs[v][i].zm / (double)pairs[v][i].zr;
   res->n_candidates = n;
-  double s = quantile(tmp, n, 0.5);
+  double s = rf_quantile(tmp, n, 0.5);
   double band = 0;
   for (int it = 0; it < 4; it++) {
     /* band from the residuals of every candidate around the current fit */
@@ -143,7 +249,7 @@ static void robust_fit(zpair *const *pairs, const size_t *n_pairs, size_t n_view
     for (size_t v = 0; v < n_views; v++)
       for (size_t i = 0; i < n_pairs[v]; i++)
         tmp[m++] = fabs((double)pairs[v][i].zm - s * (double)pairs[v][i].zr);
-    double mad = quantile(tmp, m, 0.5);
+    double mad = rf_quantile(tmp, m, 0.5);
     band = o->inlier_sigmas * 1.4826 * mad;
     if (band < o->min_band_mm * 1e-3) band = o->min_band_mm * 1e-3;
     double sxy = 0, sxx = 0;
@@ -176,8 +282,8 @@ static void robust_fit(zpair *const *pairs, const size_t *n_pairs, size_t n_view
   res->views_used = used;
   res->inlier_fraction = n ? (double)m / (double)n : 0.0;
   res->residual_rms_mm = m ? sqrt(ss / (double)m) : 0.0;
-  res->residual_p90_mm = quantile(tmp, m, 0.9);
-  res->residual_median_mm = quantile(tmp, m, 0.5);
+  res->residual_p90_mm = rf_quantile(tmp, m, 0.9);
+  res->residual_median_mm = rf_quantile(tmp, m, 0.5);
 }
 
 hearth_status hearth_scale_estimate(const hearth_mesh *recon_mesh, const hearth_raycaster *rc,
@@ -210,23 +316,34 @@ hearth_status hearth_scale_estimate(const hearth_mesh *recon_mesh, const hearth_
   }
   zpair **pairs = calloc(n_views, sizeof *pairs);
   float **dirs = calloc(n_views, sizeof *dirs);
+  uint8_t *own_dirs = calloc(n_views, 1);
   size_t *n_pairs = calloc(n_views, sizeof *n_pairs);
   double *tmp = NULL;
-  if (!pairs || !n_pairs || !dirs) {
+  int nt = opts->threads > 0 ? opts->threads : hearth_default_threads();
+  if ((size_t)nt > n_views) nt = (int)n_views;
+  scale_scratch **scratch = calloc((size_t)nt, sizeof *scratch);
+  int nomem = !pairs || !n_pairs || !dirs || !own_dirs || !scratch;
+  for (int t = 0; t < nt && !nomem; t++) nomem = !(scratch[t] = malloc(sizeof **scratch));
+  if (nomem) {
     s = hearth_err_set(err, HEARTH_E_NOMEM, "scale: out of memory");
+    goto done;
+  }
+  size_t stride = (size_t)(opts->pixel_stride > 0 ? opts->pixel_stride : 1);
+  if ((s = make_grids(views, n_views, stride, nt, dirs, own_dirs))) {
+    hearth_err_set(err, s, s == HEARTH_E_NOMEM ? "scale: out of memory" : "scale: cannot start worker threads");
     goto done;
   }
   /* first round: the baseline taken as if recon units were metres; each
      later round uses the latest scale */
   double scale = 1.0;
   for (int round = 0; round < SCALE_MAX_ROUNDS; round++) {
-    scale_ctx c = {rc, views, opts, scale, dirs, pairs, n_pairs, 0};
+    scale_ctx c = {recon_mesh, rc, views, opts, scale, dirs, scratch, pairs, n_pairs, 0};
     for (size_t v = 0; v < n_views; v++) {
       free(pairs[v]);
       pairs[v] = NULL;
       n_pairs[v] = 0;
     }
-    if ((s = hearth_parallel_for(n_views, opts->threads, scale_range, &c))) {
+    if ((s = hearth_parallel_for(n_views, nt, scale_range, &c))) {
       hearth_err_set(err, s, "scale: cannot start worker threads");
       goto done;
     }
@@ -261,8 +378,12 @@ hearth_status hearth_scale_estimate(const hearth_mesh *recon_mesh, const hearth_
 done:
   for (size_t v = 0; v < n_views; v++) {
     if (pairs) free(pairs[v]);
-    if (dirs) free(dirs[v]);
+    if (dirs && own_dirs && own_dirs[v]) free(dirs[v]);
   }
+  if (scratch)
+    for (int t = 0; t < nt; t++) free(scratch[t]);
+  free(scratch);
+  free(own_dirs);
   free(dirs);
   free(pairs);
   free(n_pairs);

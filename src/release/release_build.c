@@ -10,6 +10,9 @@
  * Before a stage runs, the temporaries a killed writer left in its output
  * directories are removed, so a resumed build ends with the same files as an
  * uninterrupted one.
+ * The parameters that shape the outputs come from the caller, else from the
+ * release's build.json (the last build's), else the defaults, and are
+ * recorded there before any stage runs (release_params.c).
  * Instances run in parallel (one worker per job); each stage gets
  * threads / jobs workers. Stages are deterministic for any thread count, so
  * the bytes do not depend on -j. */
@@ -173,12 +176,52 @@ static hearth_status stamp_write(const char *root, const char *stamp, const char
 void hearth_build_opts_default(hearth_build_opts *o) {
   memset(o, 0, sizeof *o);
   o->shard_count = 1;
-  o->resolution = 1024;
-  o->fusion = HEARTH_FUSE_MAX;
-  o->rgb_resolution = 1024;
-  o->bake_rgb = 1;
-  o->calibrate = 1;
-  o->calib_overlays = 1;
+  o->fusion = HEARTH_BUILD_FUSION_UNSET;
+  o->min_cos = -1.0;
+  o->bake_rgb = -1;
+  o->calibrate = -1;
+  o->calib_overlays = -1;
+}
+
+/* Fill o's unset parameters from root/build.json (unless the caller said
+ * to ignore it), else from the defaults, and record the result there
+ * (rewritten only when it changes). */
+static hearth_status resolve_params(const char *root, hearth_build_opts *o, hearth_err *err) {
+  char path[PATH_SZ];
+  snprintf(path, sizeof path, "%s/build.json", root);
+  hb_params p, old;
+  hb_params_default(&p);
+  int have_old = 0;
+  if (hearth_path_exists(path)) {
+    hearth_status s = hb_params_read(path, &old, err);
+    if (s && !o->ignore_recorded) {
+      if (err) {
+        char msg[sizeof err->msg];
+        snprintf(msg, sizeof msg, "%s", err->msg);
+        hearth_err_set(err, s, "build: %s (the recorded parameters: delete the file to build with the defaults)",
+                       msg);
+      }
+      return s;
+    }
+    have_old = !s;
+    if (have_old && !o->ignore_recorded) p = old;
+  }
+  if (o->resolution) p.resolution = o->resolution;
+  if (o->fusion != HEARTH_BUILD_FUSION_UNSET) p.fusion = o->fusion;
+  if (o->min_cos >= 0.0) p.min_cos = o->min_cos;
+  if (o->rgb_resolution) p.rgb_resolution = o->rgb_resolution;
+  if (o->bake_rgb >= 0) p.bake_rgb = o->bake_rgb != 0;
+  if (o->calibrate >= 0) p.calibrate = o->calibrate != 0;
+  if (o->calib_overlays >= 0) p.calib_overlays = o->calib_overlays != 0;
+  o->resolution = p.resolution;
+  o->fusion = p.fusion;
+  o->min_cos = p.min_cos;
+  o->rgb_resolution = p.rgb_resolution;
+  o->bake_rgb = p.bake_rgb;
+  o->calibrate = p.calibrate;
+  o->calib_overlays = p.calib_overlays;
+  if (o->dry_run || (have_old && hb_params_same(&old, &p))) return HEARTH_OK;
+  return hb_params_write(path, &p, err);
 }
 
 void hearth_build_report_free(hearth_build_report *r) {
@@ -586,7 +629,6 @@ hearth_status hearth_build_release(const char *root, const hearth_build_opts *o_
   if (o.shard_count < 1 || o.shard_index < 0 || o.shard_index >= o.shard_count)
     return hearth_err_set(err, HEARTH_E_ARG, "build: shard %d/%d: expected 0 <= index < count",
                           o.shard_index, o.shard_count);
-  if (!o.resolution) o.resolution = 1024;
   FILE *log = o.log ? o.log : stdout;
   double t_start = hearth_now();
   int threads = o.threads > 0 ? o.threads : hearth_default_threads();
@@ -596,6 +638,10 @@ hearth_status hearth_build_release(const char *root, const hearth_build_opts *o_
   hearth_release_doc rel = {0};
   hearth_status s = hearth_release_read(path, &rel, err);
   if (s) return s;
+  if ((s = resolve_params(root, &o, err))) {
+    hearth_release_free(&rel);
+    return s;
+  }
 
   /* release-level stages once, with every thread: detection and calibration
    * (when the release has calibration captures), then the caller's own */
@@ -658,7 +704,7 @@ hearth_status hearth_build_release(const char *root, const hearth_build_opts *o_
   hearth_release_free(&rel);
   c.n = n;
   for (int st = 0; st < ST_COUNT; st++) c.use_stage[st] = stage_available(st);
-  if (!o.bake_rgb || !o.rgb_resolution) c.use_stage[ST_BAKE] = 0;
+  if (!o.bake_rgb) c.use_stage[ST_BAKE] = 0;
   for (size_t i = 0; i < n; i++) {
     plan_instance(root, &c.plans[i]);
     c.res[i].n_states = c.plans[i].n_states;

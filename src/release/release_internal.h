@@ -4,6 +4,24 @@
 
 #include "hearth/release.h"
 
+/* The parameters of a build that shape its outputs, as build.json at the
+ * release root records them (docs/dataset.md). */
+typedef struct hb_params {
+  size_t resolution;      /* temperature maps, 2..16384 */
+  hearth_fusion fusion;
+  double min_cos;         /* [0, 1) */
+  size_t rgb_resolution;  /* baked colour texture, 16..16384 */
+  int bake_rgb, calibrate, calib_overlays;
+} hb_params;
+/* 1024, max, 0, 1024, bake, calibrate, overlays */
+void hb_params_default(hb_params *p);
+int hb_params_same(const hb_params *a, const hb_params *b);
+hearth_status hb_params_parse(const char *text, size_t len, const char *name, hb_params *p,
+                              hearth_err *err);
+hearth_status hb_params_read(const char *path, hb_params *p, hearth_err *err);
+/* Atomic; the same parameters give the same bytes. */
+hearth_status hb_params_write(const char *path, const hb_params *p, hearth_err *err);
+
 /* Fill stages[] (at most max) with the calibration stages that apply to
  * root: detect + calibrate when calibration/captures/ exists; returns how
  * many. overlays: detection writes its overlay pictures. */

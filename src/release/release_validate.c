@@ -15,6 +15,7 @@
 #include "hearth/dataset.h"
 #include "hearth/release.h"
 #include "hearth/thermal.h"
+#include "release/release_internal.h"
 
 #define PATH_SZ 4096
 
@@ -652,6 +653,13 @@ hearth_status hearth_validate_release(const char *root, const hearth_validate_op
     return HEARTH_OK;
   }
   if (hearth_release_read(path, &rel, &e)) add_err(out, path, &e);
+  /* the parameters of the last build (optional) */
+  snprintf(path, sizeof path, "%s/build.json", root);
+  if (file_exists(path)) {
+    hb_params bp;
+    nfiles++;
+    if (hb_params_read(path, &bp, &e)) add_err(out, path, &e);
+  }
   check_calibration(root, o, out, &nfiles);
 
   /* directories under instances/ that release.json does not list */

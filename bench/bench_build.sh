@@ -1,0 +1,83 @@
+#!/usr/bin/env bash
+# The whole job against its core: `hearth build -j2` of a 2-instance
+# virtual-rig release (cup + canned_drink, 2 states each, 30 views,
+# calibration captures) per stage, against `hearth map` of all its states in
+# the same run (the target: the build at most 12x the mapping); then
+# `hearth demo` followed by `hearth build` of its release, which must run no
+# stage; then the peak memory of `hearth map --rgb` beside plain `hearth map`.
+# Times are wall clock and CPU (user + sys) on a possibly shared machine:
+# compare the ratios, not the seconds, across machines.
+#   bench/bench_build.sh [BUILD_DIR] [WORK_DIR]
+# The synthetic release is made once in WORK_DIR/pristine and reused.
+set -euo pipefail
+build=$(cd "${1:-build}" && pwd)
+work=${2:-/tmp/hearth_bench_build}
+h="$build/hearth"
+mkdir -p "$work"
+now() { date +%s.%N; }
+# run a command, leave its wall and CPU seconds in $wall and $cpu
+timed() {
+  local t0 t1
+  t0=$(now)
+  if [ -x /usr/bin/time ]; then
+    /usr/bin/time -f "%U %S %M" -o "$work/time.txt" "$@"
+    cpu=$(awk '{printf "%.2f", $1 + $2}' "$work/time.txt")
+  else
+    "$@"
+    cpu=nan
+  fi
+  t1=$(now)
+  wall=$(awk -v a="$t0" -v b="$t1" 'BEGIN{printf "%.2f", b - a}')
+}
+
+if [ ! -f "$work/pristine/release.json" ]; then
+  rm -rf "$work/pristine"
+  echo "making the release (once): hearth synth --categories cup,canned_drink"
+  "$h" synth --out "$work/pristine" --categories cup,canned_drink --quiet
+fi
+rm -rf "$work/rel"
+cp -a "$work/pristine" "$work/rel"
+
+echo "== hearth build -j2 (fresh)"
+timed "$h" build "$work/rel" -j2 > "$work/build.log"
+build_wall=$wall build_cpu=$cpu
+# per stage: the sum over instances/states of each stage run's own seconds
+awk '
+  /^build: [a-z]+: done \(/ { n = $2; sub(":", "", n); s = $0; sub(/.*\(/, "", s); t[n] += s + 0; c[n]++ }
+  /^build \[[0-9]+\/[0-9]+\] .*: done \(/ {
+    split($0, a, "] "); split(a[2], w, " "); n = w[2]; sub(":", "", n)
+    s = $0; sub(/.*\(/, "", s); t[n] += s + 0; c[n]++ }
+  END {
+    split("detect calibrate scale bake transfer refine map overlay", order, " ")
+    for (i = 1; i <= 8; i++) if (order[i] in t)
+      printf "  %-10s %3d run(s) %7.2f s\n", order[i], c[order[i]], t[order[i]]
+  }' "$work/build.log"
+grep "^build summary" "$work/build.log" | sed 's/^/  /'
+
+echo "== hearth map (every state, all threads)"
+timed "$h" map "$work/rel" > "$work/map.log"
+map_wall=$wall map_cpu=$cpu
+echo "  $(grep -c '^map ' "$work/map.log") state(s)"
+
+echo "== hearth demo, then hearth build of its release"
+rm -rf "$work/demo"
+"$h" demo "$work/demo" --quiet > "$work/demo.log" 2>&1 || { cat "$work/demo.log"; exit 1; }
+timed "$h" build "$work/demo/release" > "$work/rebuild.log"
+rebuild_runs=$(sed -n 's/.* \([0-9]*\) stage(s) run.*/\1/p' "$work/rebuild.log")
+echo "  $(grep '^build summary' "$work/rebuild.log")"
+
+echo "== peak memory (cup_01, first state)"
+state=$(sed -n 's/.*"states": *\["\([^"]*\)".*/\1/p' "$work/rel/instances/cup_01/instance.json")
+rss() { if [ -x /usr/bin/time ]; then /usr/bin/time -f "%M" -o "$work/rss.txt" "$@" > /dev/null && cat "$work/rss.txt"; else echo 0; fi; }
+rss_map=$(rss "$h" map "$work/rel" --instance cup_01 --state "$state")
+rss_rgb=$(rss "$h" map "$work/rel" --instance cup_01 --state "$state" --rgb)
+
+echo
+printf "build -j2      %7.2f s wall %7.2f s CPU\n" "$build_wall" "$build_cpu"
+printf "map, 4 states  %7.2f s wall %7.2f s CPU\n" "$map_wall" "$map_cpu"
+awk -v a="$build_wall" -v b="$map_wall" -v c="$build_cpu" -v d="$map_cpu" 'BEGIN {
+  printf "ratio build / map: %.1fx wall, %.1fx CPU (target: at most 12x)\n", a / b, (d > 0 ? c / d : 0) }'
+printf "build after demo: %s stage(s) run (must be 0)\n" "${rebuild_runs:-?}"
+awk -v a="$rss_map" -v b="$rss_rgb" 'BEGIN {
+  printf "peak RSS: map %.0f MiB, map --rgb %.0f MiB (%.2fx)\n", a / 1024, b / 1024, (a > 0 ? b / a : 0) }'
+[ "${rebuild_runs:-1}" = 0 ]
