@@ -16,7 +16,11 @@ static const char *k_about =
     "stages: calibration/.stamps/) with a hash of its parameters and of its inputs'\n"
     "sizes and modification times; a stage is redone only when that changes or an\n"
     "output is missing. Outputs are written atomically and stamped last, so an\n"
-    "interrupted run simply resumes. Output bytes do not depend on -j.\n";
+    "interrupted run simply resumes. Output bytes do not depend on -j.\n"
+    "\n"
+    "The parameters that shape the outputs (resolution, fusion, min-cos, colour\n"
+    "texture, baking, overlays) are recorded in ROOT/build.json; a later build\n"
+    "without those options reuses them, so a build after `hearth demo` runs no stage.\n";
 
 static const char *k_tail =
     "A progress bar is drawn on a terminal, plain lines otherwise; the summary lists\n"
@@ -37,14 +41,23 @@ int hearth_cmd_build(int argc, char **argv) {
                 "e.g. a Slurm array: --shard $SLURM_ARRAY_TASK_ID/N; each shard re-checks calibration "
                 "(identical results, atomic)"),
       CLI_STR("--instance", "ID", &o.only_instance, "only this instance"),
-      CLI_SIZE("--resolution", "R", &o.resolution, 2, 16384, "temperature-map size R x R"),
+      CLI_SIZE("--resolution", "R", &o.resolution, 2, 16384, "temperature-map size R x R",
+               .def = "as recorded in build.json, else 1024"),
       CLI_CHOICE("--fusion", &fusion, cli_fusion_names, cli_fusion_values,
-                 "fusion across views, as `hearth map --fusion`"),
+                 "fusion across views, as `hearth map --fusion`",
+                 .def = "as recorded in build.json, else max"),
       CLI_NUM("--min-cos", "C", &o.min_cos, 0, 1, "most oblique view accepted, as a cosine",
-              .flags = CLI_HI_OPEN),
-      CLI_SIZE("--rgb-resolution", "N", &o.rgb_resolution, 16, 16384, "baked colour texture size"),
+              .flags = CLI_HI_OPEN, .def = "as recorded in build.json, else 0"),
+      CLI_SIZE("--rgb-resolution", "N", &o.rgb_resolution, 16, 16384, "baked colour texture size",
+               .def = "as recorded in build.json, else 1024"),
+      CLI_FLAG("--bake", &o.bake_rgb, 1, "bake the colour texture from the colour views",
+               .def = "as recorded in build.json, else on"),
       CLI_FLAG("--no-bake", &o.bake_rgb, 0, "keep the reconstruction's colour texture (no baking)"),
+      CLI_FLAG("--overlays", &o.calib_overlays, 1, "calibration detection overlays",
+               .def = "as recorded in build.json, else on"),
       CLI_FLAG("--no-overlays", &o.calib_overlays, 0, "no calibration detection overlays"),
+      CLI_FLAG("--defaults", &o.ignore_recorded, 1,
+               "ignore the parameters recorded in build.json: unset ones take the defaults"),
       CLI_FLAG("--force", &o.force, 1, "redo every stage"),
       CLI_FLAG("--dry-run", &o.dry_run, 1, "say what would run, run nothing"),
       CLI_FLAG("--quiet", &o.quiet, 1, "summary only"),
