@@ -149,26 +149,6 @@ static hearth_status write_provenance(const char *path, const hearth_map_job *jo
   return s;
 }
 
-/* replace directory final_dir by tmp_dir as one rename (old one removed) */
-static hearth_status swap_dir(const char *tmp_dir, const char *final_dir, hearth_err *err) {
-  char old[PATH_SZ];
-  int had_old = 0;
-  if (hearth_path_exists(final_dir)) {
-    if (joinf(old, "%s.old-%ld", final_dir, (long)getpid()))
-      return hearth_err_set(err, HEARTH_E_LIMIT, "%s: path too long", final_dir);
-    if (rename(final_dir, old) != 0)
-      return hearth_err_set(err, HEARTH_E_IO, "%s: cannot move aside: %s", final_dir, strerror(errno));
-    had_old = 1;
-  }
-  if (rename(tmp_dir, final_dir) != 0) {
-    int e = errno;
-    if (had_old) rename(old, final_dir);
-    return hearth_err_set(err, HEARTH_E_IO, "%s: cannot rename into place: %s", final_dir, strerror(e));
-  }
-  if (had_old) return hearth_remove_tree(old, err);
-  return HEARTH_OK;
-}
-
 /* the first failing job, in job order, as the run's error (parallel jobs
  * each keep their own status and message) */
 static hearth_status first_failure(const hearth_status *st, const hearth_err *errs, size_t n,
@@ -371,9 +351,9 @@ hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats
   char parent[PATH_SZ];
   joinf(parent, "%s/instances/%s/derived", root, inst);
   if (!job->out_dir && (s = hearth_mkdirs(parent, err))) goto done;
-  if (joinf(tmp_dir, "%s.tmp-XXXXXX", out_dir) || !mkdtemp(tmp_dir)) {
-    s = hearth_err_set(err, HEARTH_E_IO, "%s: cannot create a temporary directory: %s", out_dir,
-                       strerror(errno));
+  /* what a killed earlier run left beside out_dir goes first */
+  if ((s = hearth_sweep_temps_of(out_dir, NULL, err))) goto done;
+  if ((s = hearth_temp_dir(out_dir, tmp_dir, PATH_SZ, err))) {
     tmp_dir[0] = 0;
     goto done;
   }
@@ -388,7 +368,7 @@ hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats
   joinf(path, "%s/provenance.json", tmp_dir);
   if ((s = write_provenance(path, job, &man, idx, n, &r, &rig, rig_path, poses_path, mesh_path, err)))
     goto done;
-  if ((s = swap_dir(tmp_dir, out_dir, err))) goto done;
+  if ((s = hearth_replace_dir(tmp_dir, out_dir, err))) goto done;
   tmp_dir[0] = 0;
   if (job->timing) {
     job->timing->read = t_read;
