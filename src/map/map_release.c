@@ -416,7 +416,7 @@ hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err) {
   } else {
     hearth_instance_doc idoc;
     joinf(path, "%s/instances/%s/instance.json", root, inst);
-    if ((s = hearth_instance_read(path, &idoc, err))) return s;
+    if ((s = hearth_instance_load(root, inst, &idoc, err))) return s;
     if (!idoc.n_states) return hearth_err_set(err, HEARTH_E_INCONSISTENT, "%s: no states", path);
     snprintf(state, sizeof state, "%s", idoc.states[0]);
   }

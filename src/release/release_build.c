@@ -548,8 +548,7 @@ static void plan_instance(const char *root, inst_plan *p) {
   char path[PATH_SZ];
   hearth_err e = {0};
   hearth_instance_doc doc;
-  snprintf(path, sizeof path, "%s/instances/%s/instance.json", root, p->id);
-  if (hearth_instance_read(path, &doc, &e)) {
+  if (hearth_instance_load(root, p->id, &doc, &e)) {
     snprintf(p->why, sizeof p->why, "%s", e.msg);
     return;
   }

@@ -80,7 +80,7 @@ hearth_status hearth_release_stats_compute(const char *root, hearth_release_stat
     const char *id = rel.instances[i];
     hearth_instance_doc doc;
     snprintf(path, sizeof path, "%s/instances/%s/instance.json", root, id);
-    if ((s = hearth_instance_read(path, &doc, err))) goto done;
+    if ((s = hearth_instance_load(root, id, &doc, err))) goto done;
     st->n_instances++;
     int cat = -1;
     for (int c = 0; c < 18; c++)
