@@ -448,7 +448,11 @@ hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err) {
       goto done;
     }
     joinf(path, "%s/instances/%s/raw/%s/%s", root, inst, state, vf->rgb);
-    if ((s = hearth_jpeg_read(path, &imgs[k], err))) goto done;
+    /* the size is the colour camera's, checked before the pixels are decoded */
+    char why[PATH_SZ + 32];
+    snprintf(why, sizeof why, "(the colour camera of %s)", rig_path);
+    hearth_image_expect want = {(size_t)rig.rgb.width, (size_t)rig.rgb.height, 0, 0, 0, why};
+    if ((s = hearth_jpeg_read_expect(path, &want, &imgs[k], err))) goto done;
     if (imgs[k].channels != 3) {
       s = hearth_err_set(err, HEARTH_E_UNSUPPORTED, "%s: expected an RGB image", path);
       goto done;

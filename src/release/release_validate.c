@@ -147,15 +147,19 @@ static void check_image(hearth_problems *p, const char *path, img_kind kind, siz
   if (!ok) {
     hearth_problems_add(p, path, "%s", why);
   } else {
-    if ((w && ii.w != w) || (h && ii.h != h))
+    int fine = 1;
+    if ((w && ii.w != w) || (h && ii.h != h)) {
       hearth_problems_add(p, path, "image is %zux%zu, expected %zux%zu", ii.w, ii.h, w ? w : ii.w,
                           h ? h : ii.h);
+      fine = 0;
+    }
     int cok = 0;
     for (const int *c = channels_ok; *c; c++) cok |= *c == ii.channels;
     if (!cok) hearth_problems_add(p, path, "image has %d channel(s), which this file may not have", ii.channels);
     if (bits && ii.bits != bits)
       hearth_problems_add(p, path, "image is %d-bit, expected %d-bit", ii.bits, bits);
-    if (decode) {
+    /* a header that disagrees is reported without decoding what it declares */
+    if (decode && fine && cok) {
       hearth_image img = {0};
       hearth_status s = kind == IMG_PNG ? hearth_png_read_mem(d, n, path, &img, &e)
                                         : hearth_jpeg_read_mem(d, n, path, &img, &e);
