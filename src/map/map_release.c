@@ -169,6 +169,7 @@ typedef struct csv_jobs {
   hearth_csv_opts opts;
   hearth_status *st;
   hearth_err *errs;
+  const char *rig_path; /* where opts' size comes from */
 } csv_jobs;
 
 static void read_csv_range(void *ctx, size_t b, size_t e, int t) {
@@ -180,7 +181,8 @@ static void read_csv_range(void *ctx, size_t b, size_t e, int t) {
       c->st[k] = hearth_err_set(&c->errs[k], HEARTH_E_LIMIT, "%s/instances/%s/raw/%s: path too long", c->root, c->inst, c->state);
       continue;
     }
-    c->st[k] = hearth_thermal_read_csv(path, &c->opts, &c->imgs[k], &c->errs[k]);
+    c->st[k] = hearth_thermal_read_csv_camera(path, c->opts.width, c->opts.height, c->rig_path,
+                                              &c->imgs[k], &c->errs[k]);
   }
 }
 
@@ -312,7 +314,7 @@ hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats
   if (!lb_started) layout_build_run(&lb);
   /* the CSVs in parallel; the first failing view (in order) is reported */
   {
-    csv_jobs cj = {root, inst, job->state, &man, idx, imgs, {(size_t)rig.thermal.width, (size_t)rig.thermal.height}, NULL, NULL};
+    csv_jobs cj = {root, inst, job->state, &man, idx, imgs, {(size_t)rig.thermal.width, (size_t)rig.thermal.height}, NULL, NULL, rig_path};
     cj.st = calloc(n ? n : 1, sizeof *cj.st);
     cj.errs = calloc(n ? n : 1, sizeof *cj.errs);
     if (!cj.st || !cj.errs) {

@@ -127,7 +127,6 @@ hearth_status hearth_overlay_run(const hearth_overlay_job *job, size_t *n_writte
   char title[160];
   snprintf(title, sizeof title, "%s %s  left: before  right: after (white outline)", inst, state);
   hearth_draw_text(&sheet, 4, 4, title, white, 1);
-  hearth_csv_opts copts = {cw, ch};
   for (size_t k = 0; k < man.n_views; k++) {
     const hearth_view_files *vf = &man.views[k];
     const hearth_view_pose *pa = hearth_poses_find(&after, state, vf->view);
@@ -138,7 +137,7 @@ hearth_status hearth_overlay_run(const hearth_overlay_job *job, size_t *n_writte
       goto done;
     }
     rf_pathf(path, "%s/instances/%s/raw/%s/%s", root, inst, state, vf->thermal);
-    if ((s = hearth_thermal_read_csv(path, &copts, &temps, err))) goto done;
+    if ((s = hearth_thermal_read_csv_camera(path, cw, ch, rig_path, &temps, err))) goto done;
     /* the per-view file: before in magenta under after in white */
     if (pb && (s = hearth_overlay_render(rc, &rig.thermal, &temps, &pb->T_world_from_cam, zoom,
                                          job->lo, job->hi, magenta, &ov, err)))
