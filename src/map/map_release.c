@@ -474,9 +474,11 @@ hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err) {
   hearth_image_free(&mesh.texture);
   const uint8_t grey[3] = {128, 128, 128};
   if ((s = hearth_map_texture(&r, 0, 255, 8, grey, &mesh.texture, err))) goto done;
-  joinf(path, "%s/instances/%s/derived/rgb_texture.png", root, inst);
+  if (job->out_texture) snprintf(path, PATH_SZ, "%s", job->out_texture);
+  else joinf(path, "%s/instances/%s/derived/rgb_texture.png", root, inst);
   if ((s = hearth_png_write(path, &mesh.texture, err))) goto done;
-  joinf(path, "%s/instances/%s/derived/mesh.glb", root, inst);
+  if (job->out_mesh) snprintf(path, PATH_SZ, "%s", job->out_mesh);
+  else joinf(path, "%s/instances/%s/derived/mesh.glb", root, inst);
   s = hearth_glb_write(path, &mesh, err);
 done:
   hearth_map_result_free(&r);
