@@ -7,9 +7,10 @@
  * differs, or an output is missing. Stamps are written atomically after the
  * stage's outputs, which are themselves written atomically, so a killed run
  * leaves no stamp for the unfinished stage and a re-run redoes exactly that.
- * Before a stage runs, the temporaries a killed writer left in its output
- * directories are removed, so a resumed build ends with the same files as an
- * uninterrupted one.
+ * Every run, up to date or not, first removes the temporaries killed writers
+ * left (core.h's pattern, writer no longer running) anywhere in its
+ * instances and calibration/, so a resumed build ends with the same files as
+ * an uninterrupted one and validates.
  * Instances run in parallel (one worker per job); each stage gets
  * threads / jobs workers. Stages are deterministic for any thread count, so
  * the bytes do not depend on -j. */
