@@ -206,14 +206,17 @@ hearth_status hearth_sweep_temps(const char *dir, const char *base, int depth, s
       break;
     }
     struct stat st;
-    if (lstat(path, &st) != 0) continue;
     size_t bl;
     long pid;
     if (!hearth_temp_parse(nm, &bl, &pid) || (base && (bl != blen || strncmp(nm, base, bl)))) {
-      if (depth > 0 && S_ISDIR(st.st_mode))
-        s = hearth_sweep_temps(path, base, depth - 1, n_removed, err);
+      /* only directories are looked at further (the entry's type when the
+       * file system gives it, else lstat) */
+      int is_dir = e->d_type == DT_DIR ||
+                   (e->d_type == DT_UNKNOWN && lstat(path, &st) == 0 && S_ISDIR(st.st_mode));
+      if (depth > 0 && is_dir) s = hearth_sweep_temps(path, base, depth - 1, n_removed, err);
       continue;
     }
+    if (lstat(path, &st) != 0) continue;
     if (hearth_temp_writer_alive(pid)) continue;
     if (S_ISDIR(st.st_mode)) {
       s = hearth_remove_tree(path, err);
