@@ -72,12 +72,59 @@ void *hearth_calloc_array(size_t n, size_t size);
 /* ---- files ----------------------------------------------------------------- */
 /* Read a whole file; *data is malloc'ed (caller frees) and NUL-terminated
  * (the NUL is not counted in *size). Files larger than max_size are refused
- * with HEARTH_E_LIMIT. */
+ * with HEARTH_E_LIMIT. Only regular files are read: a FIFO, device, socket
+ * or directory in place of the file is refused ("not a regular file (a
+ * FIFO)") without blocking, as by hearth_open_regular. */
 hearth_status hearth_read_file(const char *path, size_t max_size, uint8_t **data,
                                size_t *size, hearth_err *err);
+/* Open path for reading only if it is a regular file: opened non-blocking
+ * (a FIFO without a writer cannot hang the caller), its type checked on the
+ * open descriptor, then switched back to blocking reads. *fd (the caller
+ * closes it) and *size (optional) are set on success. */
+hearth_status hearth_open_regular(const char *path, int *fd, size_t *size, hearth_err *err);
+/* Without opening: HEARTH_OK for a regular file (symbolic links followed),
+ * HEARTH_E_NOT_FOUND "missing", HEARTH_E_IO "not a regular file (a FIFO)". */
+hearth_status hearth_check_regular(const char *path, hearth_err *err);
 
-/* Write data to path atomically: a temporary name in the same directory,
- * flushed, then renamed over path. On failure nothing is left behind. */
+/* ---- temporaries --------------------------------------------------------------
+ * Every temporary hearth writes (atomic files, directories written whole,
+ * a directory moved aside for replacement, a release tree being made, an
+ * HDF5 file being collected) is named
+ *
+ *     <final name>.tmp-<pid>-<six letters or digits>
+ *
+ * beside its final name, <pid> being the writer's process id in decimal.
+ * A temporary whose writer is no longer running was left by a killed
+ * process; hearth_sweep_temps removes those and nothing else, so a sweep is
+ * safe while other hearth processes write on the same machine. */
+/* Create an empty temporary file for final (mkstemp, mode 0644) and put its
+ * name in buf; *fd (optional; NULL: closed) is open for writing. */
+hearth_status hearth_temp_file(const char *final, char *buf, size_t bufsz, int *fd,
+                               hearth_err *err);
+/* Create an empty temporary directory for final (mkdtemp); name in buf. */
+hearth_status hearth_temp_dir(const char *final, char *buf, size_t bufsz, hearth_err *err);
+/* 1 if name (a file name, no directory) has the temporary pattern; then
+ * *base_len (optional) is the length of its final name and *pid
+ * (optional) its writer's process id. */
+int hearth_temp_parse(const char *name, size_t *base_len, long *pid);
+/* 1 if process pid is running (on this machine). */
+int hearth_temp_writer_alive(long pid);
+/* Remove from dir the temporaries (files and whole directories) whose
+ * writer is not running: of final name base only, or of any name when base
+ * is NULL; down to depth levels of subdirectories (0: dir only). A missing
+ * dir is not an error. *n_removed (optional) is increased by the count. */
+hearth_status hearth_sweep_temps(const char *dir, const char *base, int depth, size_t *n_removed,
+                                 hearth_err *err);
+/* The same for the temporaries of one final path (in its directory). */
+hearth_status hearth_sweep_temps_of(const char *final, size_t *n_removed, hearth_err *err);
+/* Put directory tmp_dir in the place of final_dir: the old one (if any) is
+ * moved aside to a temporary name, tmp_dir renamed into place, the old one
+ * removed; on failure the old one is back in place. */
+hearth_status hearth_replace_dir(const char *tmp_dir, const char *final_dir, hearth_err *err);
+
+/* Write data to path atomically: a temporary file beside it, flushed, then
+ * renamed over path. On failure nothing is left behind, and a write error
+ * carries the system's reason ("write failed: No space left on device"). */
 hearth_status hearth_write_file_atomic(const char *path, const void *data, size_t size,
                                        hearth_err *err);
 
@@ -92,16 +139,11 @@ typedef struct hearth_atomic_file {
 } hearth_atomic_file;
 hearth_status hearth_atomic_open(hearth_atomic_file *af, const char *path, hearth_err *err);
 hearth_status hearth_atomic_commit(hearth_atomic_file *af, hearth_err *err);
+/* Abort (errno is kept for the caller's message). */
 void hearth_atomic_abort(hearth_atomic_file *af);
-/* 1 if name has the shape of what an interrupted atomic write leaves: a
- * temporary "<name>.tmp-" plus six letters or digits (a file, or a directory
- * written whole), or a directory moved aside for replacement,
- * "<name>.old-<pid>". */
-int hearth_is_atomic_temp(const char *name);
-/* Remove such leftovers (files and whole directories) from dir, not
- * recursively; a missing dir is not an error. *n_removed (optional) counts
- * them. Only for directories no other process is writing to. */
-hearth_status hearth_remove_stale_temps(const char *dir, size_t *n_removed, hearth_err *err);
+/* Abort after a failed write and report it with errno's reason:
+ * `return hearth_atomic_fail(&af, err);` right after the failing call. */
+hearth_status hearth_atomic_fail(hearth_atomic_file *af, hearth_err *err);
 
 /* mkdir -p (mode 0755); directories that exist already are fine. */
 hearth_status hearth_mkdirs(const char *path, hearth_err *err);

@@ -165,6 +165,10 @@ hearth_status hearth_instance_write(const char *path, const hearth_instance_doc 
                                     hearth_err *err);
 hearth_status hearth_instance_parse(const char *text, size_t len, const char *name,
                                     hearth_instance_doc *d, hearth_err *err);
+/* <root>/instances/<id>/instance.json, read and checked to describe the
+ * instance of its directory (its id equal to `id`). */
+hearth_status hearth_instance_load(const char *root, const char *id, hearth_instance_doc *d,
+                                   hearth_err *err);
 
 typedef struct hearth_release_doc {
   char name[128];

@@ -40,11 +40,28 @@ size_t hearth_image_bytes(const hearth_image *img);
 /* Limits applied to untrusted image files. */
 #define HEARTH_IMAGE_MAX_DIM 16384
 
+/* What a caller expects of an image file. The readers check it against the
+ * file's header before allocating any pixels, so a small file declaring a
+ * huge image costs nothing. A zeroed struct (or NULL) expects nothing. */
+typedef struct hearth_image_expect {
+  size_t width, height; /* the size the image must have; 0: any */
+  int channels;         /* channels as read (after PNG expansion); 0: any */
+  size_t max_pixels;    /* at most width * height pixels; 0: only HEARTH_IMAGE_MAX_DIM */
+  int header_only;      /* fill width, height, channels and type; data stays NULL */
+  const char *why;      /* appended to a size error, e.g. "(the colour camera of
+                           rig.json)"; NULL: nothing */
+} hearth_image_expect;
+
 /* PNG: reads 8- or 16-bit gray, gray+alpha, RGB or RGBA (palette and low
  * bit depths are expanded to 8-bit). Writes U8 or U16 images, 1-4 channels,
  * atomically. `name` names the data in messages; read_mem copies what it
  * needs (data may be freed after the call). */
 hearth_status hearth_png_read(const char *path, hearth_image *img, hearth_err *err);
+/* The same, refusing what does not meet want (NULL: anything) before
+ * allocating: HEARTH_E_SIZE, HEARTH_E_UNSUPPORTED (channels) or
+ * HEARTH_E_LIMIT (max_pixels), naming path. */
+hearth_status hearth_png_read_expect(const char *path, const hearth_image_expect *want,
+                                     hearth_image *img, hearth_err *err);
 hearth_status hearth_png_read_mem(const void *data, size_t size, const char *name,
                                   hearth_image *img, hearth_err *err);
 hearth_status hearth_png_write(const char *path, const hearth_image *img, hearth_err *err);
@@ -67,11 +84,15 @@ hearth_status hearth_apng_encode(const uint8_t *frames, size_t width, size_t hei
 
 /* JPEG (8-bit gray or RGB; U8 images). quality 1..100. Writes atomically. */
 hearth_status hearth_jpeg_read(const char *path, hearth_image *img, hearth_err *err);
+hearth_status hearth_jpeg_read_expect(const char *path, const hearth_image_expect *want,
+                                      hearth_image *img, hearth_err *err);
 hearth_status hearth_jpeg_read_mem(const void *data, size_t size, const char *name,
                                    hearth_image *img, hearth_err *err);
 /* Luma only (1 channel): the stored Y plane of a colour JPEG, decoded
  * without chroma or colour conversion (fast; for detection). */
 hearth_status hearth_jpeg_read_gray(const char *path, hearth_image *img, hearth_err *err);
+hearth_status hearth_jpeg_read_gray_expect(const char *path, const hearth_image_expect *want,
+                                           hearth_image *img, hearth_err *err);
 hearth_status hearth_jpeg_write(const char *path, const hearth_image *img, int quality,
                                 hearth_err *err);
 

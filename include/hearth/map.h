@@ -157,7 +157,8 @@ hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats
                              hearth_err *err);
 
 /* hearth map --rgb: bake the colour texture from the colour views into
- * derived/rgb_texture.png and embed it in derived/mesh.glb. */
+ * derived/rgb_texture.png and embed it in derived/mesh.glb. Every input is
+ * read before anything is written. */
 typedef struct hearth_bake_job {
   const char *root;
   const char *instance;
@@ -166,10 +167,24 @@ typedef struct hearth_bake_job {
   int pixel_stride;        /* default 2 */
   const char *mesh_path, *poses_path, *rig_path;
   int threads;
+  const char *out_texture; /* NULL: derived/rgb_texture.png */
+  const char *out_mesh;    /* NULL: derived/mesh.glb */
 } hearth_bake_job;
 /* Defaults: resolution 1024, pixel stride 2, all cores, the standard paths. */
 void hearth_bake_job_default(hearth_bake_job *job);
 hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err);
+
+/* hearth map --rgb on one instance, all or nothing: the colour texture is
+ * baked (bake) and the n_states states mapped (map, its state and out_dir
+ * unused) into temporaries beside their places in derived/, which replace
+ * the old outputs only when every step has succeeded; on failure every
+ * output is as it was and no temporary is left. Temporaries of killed
+ * earlier runs are removed first. stats (optional, n_states) receives each
+ * state's counters; seconds (optional, n_states + 1) the bake's time, then
+ * each state's. */
+hearth_status hearth_map_bake_run(const hearth_map_job *map, const hearth_bake_job *bake,
+                                  const char *const *states, size_t n_states,
+                                  hearth_map_result *stats, double *seconds, hearth_err *err);
 
 #ifdef __cplusplus
 }

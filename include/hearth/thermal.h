@@ -1,4 +1,4 @@
-/* hearth/thermal.h - area io (src/io/io_csv.c): apparent-temperature
+/* hearth/thermal.h - area io (src/io/io_csv.c, io_thermal.c): apparent-temperature
  * matrices (thermal CSV).
  *
  * The canonical file is 192 lines of 256 comma-separated decimal numbers in
@@ -68,6 +68,13 @@ hearth_status hearth_thermal_read_csv(const char *path, const hearth_csv_opts *o
 hearth_status hearth_thermal_parse_csv(const char *text, size_t len, const char *name,
                                        const hearth_csv_opts *opts, hearth_image *out,
                                        hearth_err *err);
+/* Read a CSV that must be width x height because a camera document (e.g.
+ * "R/calibration/rig.json") says so: as hearth_thermal_read_csv, but a file
+ * that is a whole matrix of another size is reported against camera_doc
+ * (HEARTH_E_INCONSISTENT, naming both files). */
+hearth_status hearth_thermal_read_csv_camera(const char *path, size_t width, size_t height,
+                                             const char *camera_doc, hearth_image *out,
+                                             hearth_err *err);
 /* Write the canonical form of a 1-channel F32 image with `decimals` (0..9)
  * fixed decimals, '.' as the decimal point whatever the locale (atomic). */
 hearth_status hearth_thermal_write_csv(const char *path, const hearth_image *temps,

@@ -230,12 +230,12 @@ static void det_range(void *vctx, size_t b, size_t e, int ti) {
     } else {
       /* detection reads the luma plane only (no chroma work); the overlay,
        * if wanted, decodes the colour image too */
-      j->st = hearth_jpeg_read_gray(j->path, &img, &j->err);
-      if (!j->st && c->want_rgb_w > 0 &&
-          (img.width != (size_t)c->want_rgb_w || img.height != (size_t)c->want_rgb_h))
-        j->st = hearth_err_set(&j->err, HEARTH_E_SIZE,
-                               "%s: image is %zux%zu, the colour camera (factory.json) is %dx%d",
-                               j->path, img.width, img.height, c->want_rgb_w, c->want_rgb_h);
+      /* the colour camera's size (factory.json), checked from the header
+       * before the pixels are decoded */
+      hearth_image_expect want = {(size_t)c->want_rgb_w, (size_t)c->want_rgb_h, 0, 0, 0,
+                                  "(the colour camera of factory.json)"};
+      j->st = hearth_jpeg_read_gray_expect(j->path, c->want_rgb_w > 0 ? &want : NULL, &img,
+                                           &j->err);
       if (!j->st) j->st = hearth_detect_plate_color(&img, &c->run->detect, &j->det, &j->err);
       if (!j->st && c->run->overlays) {
         hearth_image_free(&img);
@@ -436,10 +436,7 @@ hearth_status hearth_calib_write_opencv_yaml(const char *path, const hearth_rig 
   fputs("\nstereo_rms_px: ", fp);
   yaml_num(fp, rig->stereo_rms_px);
   fputs("\n", fp);
-  if (ferror(fp)) {
-    hearth_atomic_abort(&af);
-    return hearth_err_set(err, HEARTH_E_IO, "%s: write failed", path);
-  }
+  if (ferror(fp)) return hearth_atomic_fail(&af, err);
   return hearth_atomic_commit(&af, err);
 }
 
@@ -477,11 +474,33 @@ static hearth_status write_report(const char *path, const hearth_calib_report *r
   hearth_format_fixed(b, sizeof b, r->rig.stereo_rms_px, 5);
   fputs(b, fp);
   fputs("\n}\n", fp);
-  if (ferror(fp)) {
-    hearth_atomic_abort(&af);
-    return hearth_err_set(err, HEARTH_E_IO, "%s: write failed", path);
-  }
+  if (ferror(fp)) return hearth_atomic_fail(&af, err);
   return hearth_atomic_commit(&af, err);
+}
+
+/* The colour camera of factory.json must have the size of the colour
+ * captures the detections were made on (their headers are read, not their
+ * pixels); detections of a capture that is no longer there are taken as
+ * they are. */
+static hearth_status check_factory_size(const char *root, const char *pfac,
+                                        const hearth_factory_calib *fc,
+                                        const hearth_detections *dets, hearth_err *err) {
+  const hearth_image_expect header = {.header_only = 1};
+  for (size_t i = 0; i < dets->n; i++) {
+    const hearth_detection *d = &dets->frames[i];
+    if (strcmp(d->camera, "rgb")) continue;
+    char path[4096];
+    snprintf(path, sizeof path, "%s/calibration/captures/stereo/%s_rgb.jpg", root, d->frame);
+    if (!hearth_path_exists(path)) continue;
+    hearth_image img = {0};
+    hearth_status st = hearth_jpeg_read_expect(path, &header, &img, err);
+    if (st) return st;
+    if (img.width != (size_t)fc->rgb.width || img.height != (size_t)fc->rgb.height)
+      return hearth_err_set(err, HEARTH_E_INCONSISTENT,
+                            "%s: the colour camera is %dx%d, but capture %s is %zux%zu", pfac,
+                            fc->rgb.width, fc->rgb.height, path, img.width, img.height);
+  }
+  return HEARTH_OK;
 }
 
 hearth_status hearth_calib_calibrate_release(const char *root, const hearth_calib_opts *o,
@@ -503,7 +522,8 @@ hearth_status hearth_calib_calibrate_release(const char *root, const hearth_cali
   if (!hearth_path_exists(pdet))
     return hearth_err_set(err, HEARTH_E_NOT_FOUND, "%s: missing (run `hearth detect` first)", pdet);
   if ((st = hearth_detections_read(pdet, &dets, err))) return st;
-  if ((st = hearth_factory_read(pfac, &fc, err))) {
+  if ((st = hearth_factory_read(pfac, &fc, err)) ||
+      (st = check_factory_size(root, pfac, &fc, &dets, err))) {
     hearth_detections_free(&dets);
     return st;
   }

@@ -26,16 +26,16 @@ hearth_status cli_instances(const char *root, const char *only, cli_names *out, 
 hearth_status cli_states(const char *root, const char *instance, const char *only, cli_names *out,
                          hearth_err *err) {
   memset(out, 0, sizeof *out);
+  /* read (and its id checked against the directory) even for one named
+   * state: an instance.json describing another instance is refused */
+  hearth_instance_doc doc;
+  hearth_status s = hearth_instance_load(root, instance, &doc, err);
+  if (s) return s;
   if (only) {
     snprintf(out->names[0], sizeof out->names[0], "%s", only);
     out->n = 1;
     return HEARTH_OK;
   }
-  char path[4096];
-  snprintf(path, sizeof path, "%s/instances/%s/instance.json", root, instance);
-  hearth_instance_doc doc;
-  hearth_status s = hearth_instance_read(path, &doc, err);
-  if (s) return s;
   for (size_t i = 0; i < doc.n_states && out->n < CLI_MAX_NAMES; i++)
     snprintf(out->names[out->n++], sizeof out->names[0], "%s", doc.states[i]);
   return HEARTH_OK;

@@ -25,7 +25,8 @@ static const char *guess_kind(const char *path) {
   if (ends_with(path, ".jpg") || ends_with(path, ".jpeg")) return "jpeg";
   if (ends_with(path, ".npy")) return "npy";
   if (ends_with(path, ".glb")) return "glb";
-  if (!strcmp(base, "rig.json") || !strcmp(base, "factory.json")) return "rig";
+  if (!strcmp(base, "rig.json")) return "rig";
+  if (!strcmp(base, "factory.json")) return "factory";
   if (!strcmp(base, "manifest.json")) return "manifest";
   if (!strncmp(base, "poses", 5) && ends_with(base, ".json")) return "poses";
   if (!strcmp(base, "detections.json")) return "detections";
@@ -134,6 +135,14 @@ static hearth_status inspect_one(const char *path, const char *kind, hearth_err 
     printf("  T_thermal_from_rgb t [%.5f %.5f %.5f] m, thermal rms %.3f px, stereo rms %.3f px\n",
            r.T_thermal_from_rgb.t[0], r.T_thermal_from_rgb.t[1], r.T_thermal_from_rgb.t[2],
            r.thermal_rms_px, r.stereo_rms_px);
+  } else if (!strcmp(kind, "factory")) {
+    hearth_factory_calib f;
+    if ((s = hearth_factory_read(path, &f, err))) return s;
+    printf("%s: factory calibration\n", path);
+    print_cam("rgb", &f.rgb);
+    print_cam("depth", &f.depth);
+    printf("  T_depth_from_rgb t [%.5f %.5f %.5f] m\n", f.T_depth_from_rgb.t[0],
+           f.T_depth_from_rgb.t[1], f.T_depth_from_rgb.t[2]);
   } else if (!strcmp(kind, "manifest")) {
     hearth_manifest m = {0};
     if ((s = hearth_manifest_read(path, &m, err))) return s;
@@ -180,8 +189,8 @@ static hearth_status inspect_one(const char *path, const char *kind, hearth_err 
 
 /* the kinds of --as */
 static const char *const k_kinds[] = {"csv",   "png",        "jpeg",  "npy",      "glb",
-                                      "rig",   "manifest",   "poses", "detections", "scale",
-                                      "instance", "release", "depth-intrinsics", NULL};
+                                      "rig",   "factory",    "manifest", "poses", "detections",
+                                      "scale", "instance",   "release", "depth-intrinsics", NULL};
 
 int hearth_cmd_inspect(int argc, char **argv) {
   int as = -1;

@@ -36,6 +36,26 @@ static int write_text(const char *dir, const char *name, const char *s) {
   return 0;
 }
 
+/* 1 (after saying why) when the run measured nothing about the policy: no
+ * episode ran, or every episode ended in the policy's error (a server that
+ * is gone or misbehaves), so a 0 % would be a wrong answer, not a score */
+static int measured_nothing(const hearth_eval_results *r) {
+  if (r->n == 0) {
+    fprintf(stderr, "hearth sim eval: no episode ran: nothing was measured\n");
+    return 1;
+  }
+  size_t errs = 0, first = 0;
+  for (size_t i = r->n; i-- > 0;)
+    if (r->eps[i].error) errs++, first = i;
+  if (errs < r->n) return 0;
+  const hearth_eval_episode *e = &r->eps[first];
+  fprintf(stderr,
+          "hearth sim eval: every episode (%zu of %zu) failed because the policy erred, so "
+          "nothing was measured; the first (%s instruction %d episode %d): %s\n",
+          errs, r->n, hearth_sim_task_name(e->task), e->instruction + 1, e->episode, e->reason);
+  return 1;
+}
+
 /* --task: bits (1 << task) of hearth_eval_opts.tasks */
 static const char *const k_task_names[] = {"H1", "H2", "H3", "all", NULL};
 static const int k_task_bits[] = {1 << 1, 1 << 2, 1 << 3, (1 << 1) | (1 << 2) | (1 << 3)};
@@ -89,6 +109,8 @@ int hearth_cmd_sim_eval(int argc, char **argv) {
   rc = 0;
   if (txt) fputs(txt, stdout);
   else rc = 1;
+  /* the table is shown, but a run that measured nothing writes no results */
+  if (!rc && measured_nothing(&res)) rc = 1;
   if (out && !rc) {
     char *js = hearth_eval_format_json(&res), *md = hearth_eval_format_markdown(&res);
     if (hearth_mkdirs(out, &err)) rc = cli_fail("sim eval", &err);

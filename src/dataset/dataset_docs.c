@@ -311,6 +311,20 @@ hearth_status hearth_instance_read(const char *path, hearth_instance_doc *d, hea
   return hr_read_doc(path, instance_from_json, d, err);
 }
 
+hearth_status hearth_instance_load(const char *root, const char *id, hearth_instance_doc *d,
+                                   hearth_err *err) {
+  char path[4096];
+  int n = snprintf(path, sizeof path, "%s/instances/%s/instance.json", root, id);
+  if (n < 0 || (size_t)n >= sizeof path)
+    return hearth_err_set(err, HEARTH_E_LIMIT, "%s/instances/%s: path too long", root, id);
+  hearth_status s = hearth_instance_read(path, d, err);
+  if (s) return s;
+  if (strcmp(d->id, id))
+    return hearth_err_set(err, HEARTH_E_INCONSISTENT,
+                          "%s: id: \"%s\", but the directory is instances/%s", path, d->id, id);
+  return HEARTH_OK;
+}
+
 static hearth_status instance_validate(const char *text, size_t len, const char *name,
                                        hearth_err *err) {
   hearth_instance_doc d;

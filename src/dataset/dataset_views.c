@@ -58,6 +58,10 @@ static hearth_status records_from_json(hj_ctx *c, const json_t *root, const char
   return HEARTH_OK;
 }
 
+/* a view's five file entries, in the order of docs/dataset.md */
+static const char *const k_file_keys[5] = {"rgb", "cutout", "depth", "depth_intrinsics",
+                                           "thermal"};
+
 static hearth_status view_files_from_json(hj_ctx *c, const json_t *v, void *elem) {
   hearth_view_files *f = elem;
   if (!json_is_object(v))
@@ -68,13 +72,74 @@ static hearth_status view_files_from_json(hj_ctx *c, const json_t *v, void *elem
     return s;
   if ((s = hj_get_int(c, v, "elevation_index", 0, HR_MAX_INDEX, &f->elevation_index))) return s;
   if ((s = hj_get_int(c, v, "azimuth_index", 0, HR_MAX_INDEX, &f->azimuth_index))) return s;
-  static const char *const keys[5] = {"rgb", "cutout", "depth", "depth_intrinsics", "thermal"};
   char *dst[5] = {f->rgb, f->cutout, f->depth, f->depth_intrinsics, f->thermal};
   for (int k = 0; k < 5; k++)
-    if ((s = hr_get_checked(c, v, keys[k], dst[k], sizeof f->rgb, hj_relative_path_ok,
+    if ((s = hr_get_checked(c, v, k_file_keys[k], dst[k], sizeof f->rgb, hj_relative_path_ok,
                             "a relative path without '..' or empty components")))
       return s;
   return HEARTH_OK;
+}
+
+/* the five file entries of every view, each with "." components dropped,
+ * so that two spellings of one file compare equal */
+typedef struct file_ref {
+  char norm[128];
+  size_t view;
+  int key;
+} file_ref;
+
+static const char *view_file(const hearth_view_files *f, int key) {
+  const char *v[5] = {f->rgb, f->cutout, f->depth, f->depth_intrinsics, f->thermal};
+  return v[key];
+}
+
+static void normalise_path(const char *in, char *out, size_t cap) {
+  size_t n = 0;
+  for (const char *p = in; *p;) {
+    const char *e = strchr(p, '/');
+    size_t len = e ? (size_t)(e - p) : strlen(p);
+    if (!(len == 1 && p[0] == '.')) {
+      if (n && n + 1 < cap) out[n++] = '/';
+      for (size_t i = 0; i < len && n + 1 < cap; i++) out[n++] = p[i];
+    }
+    p += len + (e ? 1 : 0);
+  }
+  out[n] = 0;
+}
+
+static void key_file_ref(const void *ctx, size_t i, const char **a, const char **b) {
+  const file_ref *r = ctx;
+  *a = r[i].norm;
+  *b = NULL;
+}
+
+/* Two views naming one file (the same thermal CSV, say) would give both the
+ * same measurement: refused at the second reference, naming both views. */
+static hearth_status check_file_refs(hj_ctx *c, const hearth_manifest *m) {
+  size_t n = m->n_views * 5;
+  file_ref *r = hearth_alloc_array(n ? n : 1, sizeof *r);
+  if (!r) return hj_fail(c, HEARTH_E_NOMEM, "cannot allocate %zu file references", n);
+  for (size_t v = 0; v < m->n_views; v++)
+    for (int k = 0; k < 5; k++) {
+      file_ref *q = &r[v * 5 + (size_t)k];
+      normalise_path(view_file(&m->views[v], k), q->norm, sizeof q->norm);
+      q->view = v;
+      q->key = k;
+    }
+  size_t first, second;
+  hearth_status s = HEARTH_OK;
+  if (hr_find_duplicate(n, key_file_ref, r, &first, &second)) {
+    const file_ref *a = &r[first], *b = &r[second];
+    hj_push_index(c, b->view);
+    hj_push_key(c, k_file_keys[b->key]);
+    s = hj_fail(c, HEARTH_E_INCONSISTENT,
+                "view \"%s\" names \"%s\", the file of view \"%s\" (views[%zu].%s): each "
+                "view needs files of its own",
+                m->views[b->view].view, view_file(&m->views[b->view], b->key),
+                m->views[a->view].view, a->view, k_file_keys[a->key]);
+  }
+  free(r);
+  return s;
 }
 
 static hearth_status manifest_from_json(hj_ctx *c, const json_t *root, void *out) {
@@ -101,6 +166,10 @@ static hearth_status manifest_from_json(hj_ctx *c, const json_t *root, void *out
     hj_push_key(c, "view");
     s = hj_fail(c, HEARTH_E_INCONSISTENT, "duplicate view name \"%s\" (also views[%zu])",
                 m.views[second].view, first);
+    free(m.views);
+    return s;
+  }
+  if ((s = check_file_refs(c, &m))) {
     free(m.views);
     return s;
   }

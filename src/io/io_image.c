@@ -41,6 +41,28 @@ hearth_status hearth_image_alloc(hearth_image *img, size_t width, size_t height,
   return HEARTH_OK;
 }
 
+hearth_status hearth_image_expect_check(const hearth_image_expect *want, size_t w, size_t h,
+                                        int channels, char *msg, size_t msgsz) {
+  if (!want) return HEARTH_OK;
+  if ((want->width && w != want->width) || (want->height && h != want->height)) {
+    snprintf(msg, msgsz, "image is %zux%zu, expected %zux%zu%s%s", w, h,
+             want->width ? want->width : w, want->height ? want->height : h,
+             want->why ? " " : "", want->why ? want->why : "");
+    return HEARTH_E_SIZE;
+  }
+  if (want->channels && channels != want->channels) {
+    snprintf(msg, msgsz, "image has %d channel(s), expected %d", channels, want->channels);
+    return HEARTH_E_UNSUPPORTED;
+  }
+  size_t px;
+  if (want->max_pixels && (!hearth_mul_size(w, h, &px) || px > want->max_pixels)) {
+    snprintf(msg, msgsz, "image is %zux%zu, more than the limit of %zu pixels", w, h,
+             want->max_pixels);
+    return HEARTH_E_LIMIT;
+  }
+  return HEARTH_OK;
+}
+
 void hearth_image_free(hearth_image *img) {
   if (!img) return;
   free(img->data);

@@ -5,6 +5,7 @@
  * entropy data) are treated as errors: a damaged file is never accepted.
  * As in io_png.c, setjmp sits in a small function whose changing state lives
  * in a context struct owned by the caller. */
+#include <errno.h>
 #include <setjmp.h>
 #include <stdlib.h>
 #include <string.h>
@@ -12,6 +13,7 @@
 #include <stdio.h>
 #include <jpeglib.h>
 #include "hearth/image.h"
+#include "io_internal.h"
 
 #define JPEG_MAX_FILE_BYTES ((size_t)1 << 30)
 
@@ -50,6 +52,7 @@ typedef struct jpeg_reader {
   hearth_status status; /* our own check failures */
   char msg[256];
   int want_gray;         /* decode to luma only (Y of a YCbCr file) */
+  const hearth_image_expect *want; /* NULL: any image */
   hearth_image img;
 } jpeg_reader;
 
@@ -100,6 +103,12 @@ static int jpeg_decode(jpeg_reader *r) {
              "size %zux%zu is more than %zu file bytes can hold (truncated?)", w, h, r->size);
     return 2;
   }
+  if ((r->status = hearth_image_expect_check(r->want, w, h, channels, r->msg, sizeof r->msg)))
+    return 2;
+  if (r->want && r->want->header_only) {
+    r->img = (hearth_image){w, h, channels, HEARTH_PIX_U8, NULL};
+    return 0;
+  }
   jpeg_start_decompress(&r->cinfo);
   if ((int)r->cinfo.output_components != channels || r->cinfo.output_width != w ||
       r->cinfo.output_height != h) {
@@ -129,7 +138,8 @@ static int jpeg_decode(jpeg_reader *r) {
 }
 
 static hearth_status jpeg_read_mem(const void *data, size_t size, const char *name, int want_gray,
-                                   hearth_image *img, hearth_err *err) {
+                                   const hearth_image_expect *want, hearth_image *img,
+                                   hearth_err *err) {
   if (!name) name = "<memory>";
   memset(img, 0, sizeof *img);
   if (size < 3 || !data || memcmp(data, "\xff\xd8\xff", 3) != 0)
@@ -141,6 +151,7 @@ static hearth_status jpeg_read_mem(const void *data, size_t size, const char *na
   r->data = data;
   r->size = size;
   r->want_gray = want_gray;
+  r->want = want;
   init_errmgr(&r->jerr);
   r->cinfo.err = &r->jerr.pub;
   int rc = jpeg_decode(r);
@@ -159,27 +170,38 @@ static hearth_status jpeg_read_mem(const void *data, size_t size, const char *na
 
 hearth_status hearth_jpeg_read_mem(const void *data, size_t size, const char *name,
                                    hearth_image *img, hearth_err *err) {
-  return jpeg_read_mem(data, size, name, 0, img, err);
+  return jpeg_read_mem(data, size, name, 0, NULL, img, err);
 }
 
-static hearth_status jpeg_read_file(const char *path, int want_gray, hearth_image *img,
+static hearth_status jpeg_read_file(const char *path, int want_gray,
+                                    const hearth_image_expect *want, hearth_image *img,
                                     hearth_err *err) {
   memset(img, 0, sizeof *img);
   uint8_t *buf;
   size_t n;
   hearth_status s = hearth_read_file(path, JPEG_MAX_FILE_BYTES, &buf, &n, err);
   if (s) return s;
-  s = jpeg_read_mem(buf, n, path, want_gray, img, err);
+  s = jpeg_read_mem(buf, n, path, want_gray, want, img, err);
   free(buf);
   return s;
 }
 
 hearth_status hearth_jpeg_read(const char *path, hearth_image *img, hearth_err *err) {
-  return jpeg_read_file(path, 0, img, err);
+  return jpeg_read_file(path, 0, NULL, img, err);
+}
+
+hearth_status hearth_jpeg_read_expect(const char *path, const hearth_image_expect *want,
+                                      hearth_image *img, hearth_err *err) {
+  return jpeg_read_file(path, 0, want, img, err);
 }
 
 hearth_status hearth_jpeg_read_gray(const char *path, hearth_image *img, hearth_err *err) {
-  return jpeg_read_file(path, 1, img, err);
+  return jpeg_read_file(path, 1, NULL, img, err);
+}
+
+hearth_status hearth_jpeg_read_gray_expect(const char *path, const hearth_image_expect *want,
+                                           hearth_image *img, hearth_err *err) {
+  return jpeg_read_file(path, 1, want, img, err);
 }
 
 /* ---- writing ------------------------------------------------------------------ */
@@ -236,10 +258,18 @@ hearth_status hearth_jpeg_write(const char *path, const hearth_image *img, int q
   }
   init_errmgr(&w->jerr);
   w->cinfo.err = &w->jerr.pub;
+  errno = 0;
   int rc = jpeg_encode(w, img, quality, af.fp);
+  int e = errno;
   jpeg_destroy_compress(&w->cinfo);
   if (rc) {
-    s = hearth_err_set(err, HEARTH_E_IO, "%s: cannot encode JPEG: %s", path, w->jerr.msg);
+    /* a failed fwrite shows as libjpeg's "output file write error": the
+     * system's reason is added */
+    if (e && ferror(af.fp))
+      s = hearth_err_set(err, HEARTH_E_IO, "%s: cannot write JPEG: %s (%s)", path, strerror(e),
+                         w->jerr.msg);
+    else
+      s = hearth_err_set(err, HEARTH_E_IO, "%s: cannot encode JPEG: %s", path, w->jerr.msg);
     free(w);
     hearth_atomic_abort(&af);
     return s;

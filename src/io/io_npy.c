@@ -3,6 +3,7 @@
  * little-endian header length (2 bytes in 1.0, 4 in 2.0), then a Python dict
  * literal with exactly the keys 'descr', 'fortran_order' and 'shape', padded
  * with spaces and ending in '\n', then the raw array data. */
+#include <errno.h>
 #include <stdlib.h>
 #include <string.h>
 #include "hearth/npy.h"
@@ -397,6 +398,7 @@ hearth_status hearth_npy_write(const char *path, hearth_npy_dtype dtype, int ndi
   hearth_atomic_file af;
   hearth_status st = hearth_atomic_open(&af, path, err);
   if (st) return st;
+  errno = 0;
   int bad = fwrite(head, 1, total, af.fp) != total;
   if (!bad && bytes) {
     if (dtype == HEARTH_NPY_F32 && !host_is_little()) {
@@ -409,9 +411,6 @@ hearth_status hearth_npy_write(const char *path, hearth_npy_dtype dtype, int ndi
       bad = fwrite(data, 1, bytes, af.fp) != bytes;
     }
   }
-  if (bad) {
-    hearth_atomic_abort(&af);
-    return hearth_err_set(err, HEARTH_E_IO, "%s: write failed", path);
-  }
+  if (bad) return hearth_atomic_fail(&af, err);
   return hearth_atomic_commit(&af, err);
 }

@@ -14,6 +14,7 @@
 #include "hearth/image.h"
 #include "io_deflate.h"
 #include "io_png.h"
+#include "io_internal.h"
 
 /* files larger than this are refused before decoding */
 #define PNG_MAX_FILE_BYTES ((size_t)1 << 30)
@@ -35,6 +36,7 @@ typedef struct png_reader {
   hearth_status status; /* set by our own checks inside the decode */
   hearth_image img;
   png_bytep *rows;
+  const hearth_image_expect *want; /* NULL: any image */
 } png_reader;
 
 static void on_png_error(png_structp png, png_const_charp msg) {
@@ -103,8 +105,14 @@ static int png_decode(png_structp png, png_infop info, png_reader *r) {
              (unsigned)w, (unsigned)h, raw, r->size);
     return 2;
   }
-  hearth_err aerr;
   hearth_pixtype type = out_depth == 16 ? HEARTH_PIX_U16 : HEARTH_PIX_U8;
+  if ((r->status = hearth_image_expect_check(r->want, w, h, channels, r->msg, sizeof r->msg)))
+    return 2;
+  if (r->want && r->want->header_only) {
+    r->img = (hearth_image){w, h, channels, type, NULL};
+    return 0;
+  }
+  hearth_err aerr;
   if (hearth_image_alloc(&r->img, w, h, channels, type, &aerr) != HEARTH_OK) {
     r->status = aerr.status;
     snprintf(r->msg, sizeof r->msg, "%s", aerr.msg);
@@ -130,8 +138,9 @@ static int png_decode(png_structp png, png_infop info, png_reader *r) {
   return 0;
 }
 
-hearth_status hearth_png_read_mem(const void *data, size_t size, const char *name,
-                                  hearth_image *img, hearth_err *err) {
+static hearth_status png_read_mem(const void *data, size_t size, const char *name,
+                                  const hearth_image_expect *want, hearth_image *img,
+                                  hearth_err *err) {
   if (!name) name = "<memory>";
   memset(img, 0, sizeof *img);
   if (!data && size) return hearth_err_set(err, HEARTH_E_ARG, "%s: no data", name);
@@ -142,6 +151,7 @@ hearth_status hearth_png_read_mem(const void *data, size_t size, const char *nam
   memset(&r, 0, sizeof r);
   r.data = data;
   r.size = size;
+  r.want = want;
   png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &r, on_png_error,
                                            on_png_warning);
   png_infop info = png ? png_create_info_struct(png) : NULL;
@@ -169,15 +179,25 @@ hearth_status hearth_png_read_mem(const void *data, size_t size, const char *nam
   return HEARTH_OK;
 }
 
-hearth_status hearth_png_read(const char *path, hearth_image *img, hearth_err *err) {
+hearth_status hearth_png_read_mem(const void *data, size_t size, const char *name,
+                                  hearth_image *img, hearth_err *err) {
+  return png_read_mem(data, size, name, NULL, img, err);
+}
+
+hearth_status hearth_png_read_expect(const char *path, const hearth_image_expect *want,
+                                     hearth_image *img, hearth_err *err) {
   memset(img, 0, sizeof *img);
   uint8_t *buf;
   size_t n;
   hearth_status s = hearth_read_file(path, PNG_MAX_FILE_BYTES, &buf, &n, err);
   if (s) return s;
-  s = hearth_png_read_mem(buf, n, path, img, err);
+  s = png_read_mem(buf, n, path, want, img, err);
   free(buf);
   return s;
+}
+
+hearth_status hearth_png_read(const char *path, hearth_image *img, hearth_err *err) {
+  return hearth_png_read_expect(path, NULL, img, err);
 }
 
 /* ---- writing ------------------------------------------------------------------ */

@@ -149,26 +149,6 @@ static hearth_status write_provenance(const char *path, const hearth_map_job *jo
   return s;
 }
 
-/* replace directory final_dir by tmp_dir as one rename (old one removed) */
-static hearth_status swap_dir(const char *tmp_dir, const char *final_dir, hearth_err *err) {
-  char old[PATH_SZ];
-  int had_old = 0;
-  if (hearth_path_exists(final_dir)) {
-    if (joinf(old, "%s.old-%ld", final_dir, (long)getpid()))
-      return hearth_err_set(err, HEARTH_E_LIMIT, "%s: path too long", final_dir);
-    if (rename(final_dir, old) != 0)
-      return hearth_err_set(err, HEARTH_E_IO, "%s: cannot move aside: %s", final_dir, strerror(errno));
-    had_old = 1;
-  }
-  if (rename(tmp_dir, final_dir) != 0) {
-    int e = errno;
-    if (had_old) rename(old, final_dir);
-    return hearth_err_set(err, HEARTH_E_IO, "%s: cannot rename into place: %s", final_dir, strerror(e));
-  }
-  if (had_old) return hearth_remove_tree(old, err);
-  return HEARTH_OK;
-}
-
 /* the first failing job, in job order, as the run's error (parallel jobs
  * each keep their own status and message) */
 static hearth_status first_failure(const hearth_status *st, const hearth_err *errs, size_t n,
@@ -189,6 +169,7 @@ typedef struct csv_jobs {
   hearth_csv_opts opts;
   hearth_status *st;
   hearth_err *errs;
+  const char *rig_path; /* where opts' size comes from */
 } csv_jobs;
 
 static void read_csv_range(void *ctx, size_t b, size_t e, int t) {
@@ -200,7 +181,8 @@ static void read_csv_range(void *ctx, size_t b, size_t e, int t) {
       c->st[k] = hearth_err_set(&c->errs[k], HEARTH_E_LIMIT, "%s/instances/%s/raw/%s: path too long", c->root, c->inst, c->state);
       continue;
     }
-    c->st[k] = hearth_thermal_read_csv(path, &c->opts, &c->imgs[k], &c->errs[k]);
+    c->st[k] = hearth_thermal_read_csv_camera(path, c->opts.width, c->opts.height, c->rig_path,
+                                              &c->imgs[k], &c->errs[k]);
   }
 }
 
@@ -332,7 +314,7 @@ hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats
   if (!lb_started) layout_build_run(&lb);
   /* the CSVs in parallel; the first failing view (in order) is reported */
   {
-    csv_jobs cj = {root, inst, job->state, &man, idx, imgs, {(size_t)rig.thermal.width, (size_t)rig.thermal.height}, NULL, NULL};
+    csv_jobs cj = {root, inst, job->state, &man, idx, imgs, {(size_t)rig.thermal.width, (size_t)rig.thermal.height}, NULL, NULL, rig_path};
     cj.st = calloc(n ? n : 1, sizeof *cj.st);
     cj.errs = calloc(n ? n : 1, sizeof *cj.errs);
     if (!cj.st || !cj.errs) {
@@ -380,9 +362,9 @@ hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats
   char parent[PATH_SZ];
   joinf(parent, "%s/instances/%s/derived", root, inst);
   if (!job->out_dir && (s = hearth_mkdirs(parent, err))) goto done;
-  if (joinf(tmp_dir, "%s.tmp-XXXXXX", out_dir) || !mkdtemp(tmp_dir)) {
-    s = hearth_err_set(err, HEARTH_E_IO, "%s: cannot create a temporary directory: %s", out_dir,
-                       strerror(errno));
+  /* what a killed earlier run left beside out_dir goes first */
+  if ((s = hearth_sweep_temps_of(out_dir, NULL, err))) goto done;
+  if ((s = hearth_temp_dir(out_dir, tmp_dir, PATH_SZ, err))) {
     tmp_dir[0] = 0;
     goto done;
   }
@@ -397,7 +379,7 @@ hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats
   joinf(path, "%s/provenance.json", tmp_dir);
   if ((s = write_provenance(path, job, &man, idx, n, &r, &rig, rig_path, poses_path, mesh_path, err)))
     goto done;
-  if ((s = swap_dir(tmp_dir, out_dir, err))) goto done;
+  if ((s = hearth_replace_dir(tmp_dir, out_dir, err))) goto done;
   tmp_dir[0] = 0;
   if (job->timing) {
     job->timing->read = t_read;
@@ -511,7 +493,7 @@ hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err) {
   } else {
     hearth_instance_doc idoc;
     joinf(path, "%s/instances/%s/instance.json", root, inst);
-    if ((s = hearth_instance_read(path, &idoc, err))) return s;
+    if ((s = hearth_instance_load(root, inst, &idoc, err))) return s;
     if (!idoc.n_states) return hearth_err_set(err, HEARTH_E_INCONSISTENT, "%s: no states", path);
     snprintf(state, sizeof state, "%s", idoc.states[0]);
   }
@@ -552,7 +534,11 @@ hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err) {
       goto done;
     }
     joinf(path, "%s/instances/%s/raw/%s/%s", root, inst, state, vf->rgb);
-    if ((s = hearth_jpeg_read(path, &imgs[k], err))) goto done;
+    /* the size is the colour camera's, checked before the pixels are decoded */
+    char why[PATH_SZ + 32];
+    snprintf(why, sizeof why, "(the colour camera of %s)", rig_path);
+    hearth_image_expect want = {(size_t)rig.rgb.width, (size_t)rig.rgb.height, 0, 0, 0, why};
+    if ((s = hearth_jpeg_read_expect(path, &want, &imgs[k], err))) goto done;
     if (imgs[k].channels != 3) {
       s = hearth_err_set(err, HEARTH_E_UNSUPPORTED, "%s: expected an RGB image", path);
       goto done;
@@ -584,9 +570,11 @@ hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err) {
   hearth_image_free(&mesh.texture);
   const uint8_t grey[3] = {128, 128, 128};
   if ((s = hearth_map_texture(&r, 0, 255, 8, grey, &mesh.texture, err))) goto done;
-  joinf(path, "%s/instances/%s/derived/rgb_texture.png", root, inst);
+  if (job->out_texture) snprintf(path, PATH_SZ, "%s", job->out_texture);
+  else joinf(path, "%s/instances/%s/derived/rgb_texture.png", root, inst);
   if ((s = hearth_png_write(path, &mesh.texture, err))) goto done;
-  joinf(path, "%s/instances/%s/derived/mesh.glb", root, inst);
+  if (job->out_mesh) snprintf(path, PATH_SZ, "%s", job->out_mesh);
+  else joinf(path, "%s/instances/%s/derived/mesh.glb", root, inst);
   s = hearth_glb_write(path, &mesh, err);
 done:
   hearth_map_result_free(&r);

@@ -125,6 +125,17 @@ static void seed_rng(hearth_rng *r) {
   hearth_rng_seed(r, s);
 }
 
+/* A protocol check's message ("websocket handshake: ...", "websocket
+ * frame: ...") with the server named once: "websocket HOST:PORT: handshake: ...". */
+static void with_host(hearth_err *err, const char *host) {
+  if (!err) return;
+  const char *m = err->msg;
+  if (!strncmp(m, "websocket ", 10)) m += 10;
+  char rest[sizeof err->msg];
+  snprintf(rest, sizeof rest, "%s", m);
+  snprintf(err->msg, sizeof err->msg, "websocket %s: %s", host, rest);
+}
+
 hearth_status hearth_ws_connect(const char *url, double timeout_s, hearth_ws **out, hearth_err *err) {
   *out = NULL;
   if (strncmp(url, "ws://", 5) != 0)
@@ -223,9 +234,11 @@ hearth_status hearth_ws_connect(const char *url, double timeout_s, hearth_ws **o
     }
     st = fill(c, deadline, timeout_s, err);
   }
-  if (!st) st = hearth_ws_check_handshake((const char *)c->rbuf, hend, key, err);
+  /* the transport's own errors name the host already; the protocol
+   * check's get it added */
+  if (!st && (st = hearth_ws_check_handshake((const char *)c->rbuf, hend, key, err)))
+    with_host(err, hostport);
   if (st) {
-    hearth_err_prefix(err, "websocket %s: ", hostport);
     c->closed = 1;
     hearth_ws_close(c, 0);
     return st;
@@ -256,7 +269,7 @@ static hearth_status next_frame(hearth_ws *c, hearth_ws_header *h, double deadli
     hearth_status st = hearth_ws_parse_header(c->rbuf, c->rlen, 0, WS_MAX_MESSAGE, h, &need, err);
     if (st) {
       c->closed = 1;
-      hearth_err_prefix(err, "websocket %s: ", c->host);
+      with_host(err, c->host);
       return st;
     }
     if (!need && c->rlen - h->header_len >= h->payload_len) return HEARTH_OK;

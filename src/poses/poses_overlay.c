@@ -249,6 +249,7 @@ typedef struct ov_ctx {
   const hearth_manifest *man;
   const hearth_poses *before, *after; /* before: NULL when there is none */
   const char *after_path, *dir;
+  const char *rig_path;               /* the camera's document, named in size errors */
   const ov_grid *big, *small;         /* at the job's zoom and at 1 */
   ov_scratch **scratch;               /* per worker */
   hearth_image (*thumbs)[2];          /* per view: the sheet's before and after cells */
@@ -269,10 +270,9 @@ static hearth_status ov_view(const ov_ctx *c, ov_scratch *s, size_t k, hearth_im
                           state, vf->view);
   char path[RF_PATH];
   size_t cw = (size_t)c->cam->width, ch = (size_t)c->cam->height;
-  hearth_csv_opts copts = {cw, ch};
   rf_pathf(path, "%s/instances/%s/raw/%s/%s", job->root, job->instance, state, vf->thermal);
   hearth_image_free(&s->temps);
-  hearth_status st = hearth_thermal_read_csv(path, &copts, &s->temps, err);
+  hearth_status st = hearth_thermal_read_csv_camera(path, cw, ch, c->rig_path, &s->temps, err);
   if (st) return st;
   double lo = job->lo, hi = job->hi;
   if (!(lo < hi)) ov_auto_range(&s->temps, s->vals, &lo, &hi);
@@ -365,7 +365,7 @@ hearth_status hearth_overlay_run(const hearth_overlay_job *job, size_t *n_writte
   if ((size_t)nt > man.n_views) nt = (int)man.n_views;
   if (nt < 1) nt = 1;
   c = (ov_ctx){job, &mesh, rc, &rig.thermal, &man, have_before ? &before : NULL, &after, after_path, dir,
-               &big, zoom != 1 ? &small : &big, NULL, NULL, NULL, NULL};
+               rig_path, &big, zoom != 1 ? &small : &big, NULL, NULL, NULL, NULL};
   c.scratch = calloc((size_t)nt, sizeof *c.scratch);
   c.thumbs = calloc(man.n_views, sizeof *c.thumbs);
   c.st = calloc(man.n_views, sizeof *c.st);

@@ -239,7 +239,7 @@ hearth_status hearth_refine_run(const hearth_refine_job *job, hearth_refine_summ
       }
       slot[k] = (size_t)(vp - start.views);
       rf_pathf(path, "%s/instances/%s/raw/%s/%s", root, inst, state, vf->thermal);
-      if ((s = hearth_thermal_read_csv(path, &copts, &imgs[k], err))) {
+      if ((s = hearth_thermal_read_csv_camera(path, copts.width, copts.height, rig_path, &imgs[k], err))) {
         free(slot);
         goto done;
       }

@@ -473,19 +473,18 @@ hearth_status hearth_scale_run(const hearth_scale_job *job, hearth_scale_result 
                            poses_path, man[k].state, vf->view);
         goto done;
       }
-      rf_pathf(path, "%s/instances/%s/raw/%s/%s", root, inst, man[k].state, vf->depth);
-      if ((s = hearth_png_read(path, &depths[f], err))) goto done;
-      if (depths[f].type != HEARTH_PIX_U16 || depths[f].channels != 1) {
-        s = hearth_err_set(err, HEARTH_E_UNSUPPORTED, "%s: expected a 16-bit grey depth PNG", path);
-        goto done;
-      }
+      /* the intrinsics first: the depth PNG's header is checked against
+         their size before its pixels are allocated */
       hearth_depth_intrinsics di;
       rf_pathf(path, "%s/instances/%s/raw/%s/%s", root, inst, man[k].state, vf->depth_intrinsics);
       if ((s = hearth_depth_intrinsics_read(path, &di, err))) goto done;
-      if (depths[f].width != (size_t)di.depth.width || depths[f].height != (size_t)di.depth.height) {
-        s = hearth_err_set(err, HEARTH_E_SIZE, "%s: says %dx%d but depth image %s is %zux%zu", path,
-                           di.depth.width, di.depth.height, vf->depth, depths[f].width,
-                           depths[f].height);
+      char why[RF_PATH + 32];
+      snprintf(why, sizeof why, "(the size in %s)", vf->depth_intrinsics);
+      hearth_image_expect want = {(size_t)di.depth.width, (size_t)di.depth.height, 1, 0, 0, why};
+      rf_pathf(path, "%s/instances/%s/raw/%s/%s", root, inst, man[k].state, vf->depth);
+      if ((s = hearth_png_read_expect(path, &want, &depths[f], err))) goto done;
+      if (depths[f].type != HEARTH_PIX_U16) {
+        s = hearth_err_set(err, HEARTH_E_UNSUPPORTED, "%s: expected a 16-bit grey depth PNG", path);
         goto done;
       }
       views[f] = (hearth_scale_view){&depths[f], di.depth, di.T_depth_from_rgb, vp->T_world_from_cam};

@@ -7,9 +7,10 @@
  * differs, or an output is missing. Stamps are written atomically after the
  * stage's outputs, which are themselves written atomically, so a killed run
  * leaves no stamp for the unfinished stage and a re-run redoes exactly that.
- * Before a stage runs, the temporaries a killed writer left in its output
- * directories are removed, so a resumed build ends with the same files as an
- * uninterrupted one.
+ * Every run, up to date or not, first removes the temporaries killed writers
+ * left (core.h's pattern, writer no longer running) anywhere in its
+ * instances and calibration/, so a resumed build ends with the same files as
+ * an uninterrupted one and validates.
  * The parameters that shape the outputs come from the caller, else from the
  * release's build.json (the last build's), else the defaults, and are
  * recorded there before any stage runs (release_params.c).
@@ -61,8 +62,8 @@ hearth_status hearth_build_files_add(hearth_build_files *f, const char *fmt, ...
   return HEARTH_OK;
 }
 
-/* Remove what interrupted writes left (temporary files, whole temporary
- * directories, directories moved aside) from the directories of a stage's
+/* Remove what killed writers left (temporary files, whole temporary
+ * directories, directories moved aside: hearth_sweep_temps) from the directories of a stage's
  * outputs (relative to root) and of its stamp (absolute) and, with parents,
  * from the directories holding those (a temperature map's state directory is
  * written whole next to the old one). An instance stage's directories belong
@@ -94,7 +95,7 @@ static hearth_status sweep_temps(const char *root, const hearth_build_files *out
   size_t total = 0;
   for (size_t j = 0; j < nd && !s; j++) {
     size_t n = 0;
-    s = hearth_remove_stale_temps(dirs[j], &n, err);
+    s = hearth_sweep_temps(dirs[j], NULL, 0, &n, err);
     total += n;
   }
   free(dirs);
@@ -129,7 +130,13 @@ static uint64_t inputs_hash(const char *root, const char *params, const hearth_b
 
 static int stamp_fresh(const char *root, const char *stamp, const char *params,
                        const hearth_build_files *in, const hearth_build_files *out) {
-  json_t *o = json_load_file(stamp, 0, NULL);
+  /* through hearth_read_file: a stamp that is not a regular file is stale,
+   * never waited on */
+  uint8_t *text = NULL;
+  size_t len = 0;
+  if (hearth_read_file(stamp, (size_t)16 << 20, &text, &len, NULL)) return 0;
+  json_t *o = json_loadb((const char *)text, len, 0, NULL);
+  free(text);
   if (!o) return 0;
   char want[32];
   snprintf(want, sizeof want, "%016llx", (unsigned long long)inputs_hash(root, params, in));
@@ -526,9 +533,25 @@ done:
   return ok;
 }
 
+/* the temporaries killed writers left anywhere in a tree, removed on every
+ * run (up to date or not); those of running writers stay */
+static size_t sweep_tree(const char *dir, int depth, int dry_run) {
+  size_t n = 0;
+  if (!dry_run) hearth_sweep_temps(dir, NULL, depth, &n, NULL);
+  return n;
+}
+
 static void build_instance(build_ctx *c, size_t idx) {
   inst_plan *p = &c->plans[idx];
   hearth_build_instance *r = &c->res[idx];
+  char dir[PATH_SZ];
+  snprintf(dir, sizeof dir, "%s/instances/%s", c->root, p->id);
+  size_t swept = sweep_tree(dir, 8, c->o->dry_run);
+  if (swept) {
+    pthread_mutex_lock(&c->mu);
+    c->temps_removed += swept;
+    pthread_mutex_unlock(&c->mu);
+  }
   if (!p->readable) {
     r->failed = 1;
     snprintf(r->failed_stage, sizeof r->failed_stage, "read");
@@ -569,8 +592,7 @@ static void plan_instance(const char *root, inst_plan *p) {
   char path[PATH_SZ];
   hearth_err e = {0};
   hearth_instance_doc doc;
-  snprintf(path, sizeof path, "%s/instances/%s/instance.json", root, p->id);
-  if (hearth_instance_read(path, &doc, &e)) {
+  if (hearth_instance_load(root, p->id, &doc, &e)) {
     snprintf(p->why, sizeof p->why, "%s", e.msg);
     return;
   }
@@ -653,6 +675,10 @@ hearth_status hearth_build_release(const char *root, const hearth_build_opts *o_
                           o.n_release_stages, HEARTH_BUILD_MAX_STAGES);
   }
   for (size_t i = 0; i < o.n_release_stages; i++) stages[n_stages++] = o.release_stages[i];
+  rep->temps_removed += sweep_tree(root, 0, o.dry_run);
+  char cdir[PATH_SZ];
+  snprintf(cdir, sizeof cdir, "%s/calibration", root);
+  rep->temps_removed += sweep_tree(cdir, 8, o.dry_run);
   for (size_t i = 0; i < n_stages; i++) {
     int ran = 0;
     size_t swept = 0;

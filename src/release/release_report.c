@@ -189,7 +189,7 @@ hearth_status hearth_report_write(const char *root, const char *out_dir, const c
     const char *inst = rel.instances[i];
     hearth_instance_doc doc;
     snprintf(path, sizeof path, "%s/instances/%s/instance.json", root, inst);
-    if ((s = hearth_instance_read(path, &doc, err))) goto done;
+    if ((s = hearth_instance_load(root, inst, &doc, err))) goto done;
     /* the colour texture: baked if present, else the reconstruction's */
     char dst[PATH_SZ];
     snprintf(dst, sizeof dst, "%s/%s_colour.png", out_dir, inst);

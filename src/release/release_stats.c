@@ -80,7 +80,7 @@ hearth_status hearth_release_stats_compute(const char *root, hearth_release_stat
     const char *id = rel.instances[i];
     hearth_instance_doc doc;
     snprintf(path, sizeof path, "%s/instances/%s/instance.json", root, id);
-    if ((s = hearth_instance_read(path, &doc, err))) goto done;
+    if ((s = hearth_instance_load(root, id, &doc, err))) goto done;
     st->n_instances++;
     int cat = -1;
     for (int c = 0; c < 18; c++)
@@ -114,15 +114,17 @@ hearth_status hearth_release_stats_compute(const char *root, hearth_release_stat
         if (is_file(dp)) st->n_depth++;
         /* sizes of the raw data, from the first complete view */
         if (first_view && has_rgb && has_th && is_file(dp)) {
+          /* the images' sizes from their headers (no pixels decoded) */
           hearth_image img = {0};
           hearth_csv_opts any = {0, 0};
-          if (!hearth_jpeg_read(a, &img, NULL)) st->rgb_w = img.width, st->rgb_h = img.height;
-          hearth_image_free(&img);
+          const hearth_image_expect header = {.header_only = 1};
+          if (!hearth_jpeg_read_expect(a, &header, &img, NULL))
+            st->rgb_w = img.width, st->rgb_h = img.height;
           if (!hearth_thermal_read_csv(b, &any, &img, NULL))
             st->thermal_w = img.width, st->thermal_h = img.height;
           hearth_image_free(&img);
-          if (!hearth_png_read(dp, &img, NULL)) st->depth_w = img.width, st->depth_h = img.height;
-          hearth_image_free(&img);
+          if (!hearth_png_read_expect(dp, &header, &img, NULL))
+            st->depth_w = img.width, st->depth_h = img.height;
           first_view = 0;
         }
       }

@@ -148,15 +148,19 @@ static void check_image(hearth_problems *p, const char *path, img_kind kind, siz
   if (!ok) {
     hearth_problems_add(p, path, "%s", why);
   } else {
-    if ((w && ii.w != w) || (h && ii.h != h))
+    int fine = 1;
+    if ((w && ii.w != w) || (h && ii.h != h)) {
       hearth_problems_add(p, path, "image is %zux%zu, expected %zux%zu", ii.w, ii.h, w ? w : ii.w,
                           h ? h : ii.h);
+      fine = 0;
+    }
     int cok = 0;
     for (const int *c = channels_ok; *c; c++) cok |= *c == ii.channels;
     if (!cok) hearth_problems_add(p, path, "image has %d channel(s), which this file may not have", ii.channels);
     if (bits && ii.bits != bits)
       hearth_problems_add(p, path, "image is %d-bit, expected %d-bit", ii.bits, bits);
-    if (decode) {
+    /* a header that disagrees is reported without decoding what it declares */
+    if (decode && fine && cok) {
       hearth_image img = {0};
       hearth_status s = kind == IMG_PNG ? hearth_png_read_mem(d, n, path, &img, &e)
                                         : hearth_jpeg_read_mem(d, n, path, &img, &e);
@@ -167,9 +171,12 @@ static void check_image(hearth_problems *p, const char *path, img_kind kind, siz
   free(d);
 }
 
-static int file_exists(const char *path) {
+/* 1 if anything is at path; a FIFO, device or directory in place of a file
+ * is then reported by the reader that follows ("not a regular file (a
+ * FIFO)"), never called missing and never waited on */
+static int present(const char *path) {
   struct stat st;
-  return stat(path, &st) == 0 && S_ISREG(st.st_mode);
+  return stat(path, &st) == 0;
 }
 
 static void check_csv(hearth_problems *p, const char *path, size_t *nfiles) {
@@ -204,7 +211,7 @@ static void check_poses(hearth_problems *p, const char *path, const state_views 
   hearth_poses poses = {0};
   hearth_err e = {0};
   (*nfiles)++;
-  if (!file_exists(path)) {
+  if (!present(path)) {
     hearth_problems_add(p, path, "missing");
     return;
   }
@@ -234,10 +241,21 @@ static void check_provenance(hearth_problems *p, const char *path, const char *i
                              const state_views *sv, size_t R, size_t *nfiles) {
   (*nfiles)++;
   json_error_t je;
-  json_t *o = json_load_file(path, JSON_REJECT_DUPLICATES, &je);
+  hearth_err e = {0};
+  uint8_t *text = NULL;
+  size_t len = 0;
+  if (!present(path)) {
+    hearth_problems_add(p, path, "missing");
+    return;
+  }
+  if (hearth_read_file(path, (size_t)16 << 20, &text, &len, &e)) {
+    add_err(p, path, &e);
+    return;
+  }
+  json_t *o = json_loadb((const char *)text, len, JSON_REJECT_DUPLICATES, &je);
+  free(text);
   if (!o) {
-    if (!file_exists(path)) hearth_problems_add(p, path, "missing");
-    else hearth_problems_add(p, path, "line %d, column %d: %s", je.line, je.column, je.text);
+    hearth_problems_add(p, path, "line %d, column %d: %s", je.line, je.column, je.text);
     return;
   }
   if (!json_is_object(o)) {
@@ -298,7 +316,7 @@ static int read_map(hearth_problems *p, const char *path, hearth_npy_dtype dt, h
                     size_t *nfiles) {
   hearth_err e = {0};
   (*nfiles)++;
-  if (!file_exists(path)) {
+  if (!present(path)) {
     hearth_problems_add(p, path, "missing");
     return 0;
   }
@@ -366,7 +384,7 @@ static void check_state_maps(hearth_problems *p, const char *dir, const char *in
   }
   static const int rgb_only[] = {3, 0};
   snprintf(path, sizeof path, "%s/thermal_turbo.png", dir);
-  if (!file_exists(path)) {
+  if (!present(path)) {
     (*nfiles)++;
     hearth_problems_add(p, path, "missing");
   } else {
@@ -408,9 +426,13 @@ static void check_leftovers(hearth_problems *p, const char *dir, int depth) {
     char path[PATH_SZ];
     struct stat st;
     snprintf(path, sizeof path, "%s/%s", dir, names[i]);
-    if (hearth_is_atomic_temp(names[i]))
-      hearth_problems_add(p, path, "left by an interrupted write (hearth build removes it)");
-    else if (depth < 8 && lstat(path, &st) == 0 && S_ISDIR(st.st_mode))
+    long pid;
+    if (hearth_temp_parse(names[i], NULL, &pid)) {
+      if (hearth_temp_writer_alive(pid))
+        hearth_problems_add(p, path, "a temporary of process %ld, which is still writing", pid);
+      else
+        hearth_problems_add(p, path, "left by an interrupted write (hearth build removes it)");
+    } else if (depth < 8 && lstat(path, &st) == 0 && S_ISDIR(st.st_mode))
       check_leftovers(p, path, depth + 1);
     free(names[i]);
   }
@@ -426,7 +448,7 @@ static void check_instance(const char *root, const char *id, const hearth_valida
   snprintf(path, sizeof path, "%s/instance.json", dir);
   hearth_instance_doc doc;
   (*nfiles)++;
-  if (!file_exists(path)) {
+  if (!present(path)) {
     hearth_problems_add(p, dir, "instance listed in release.json has no instance.json");
     return;
   }
@@ -448,7 +470,7 @@ static void check_instance(const char *root, const char *id, const hearth_valida
     snprintf(sdir, sizeof sdir, "%s/raw/%s", dir, doc.states[k]);
     snprintf(path, sizeof path, "%s/manifest.json", sdir);
     (*nfiles)++;
-    if (!file_exists(path)) {
+    if (!present(path)) {
       hearth_problems_add(p, path, "missing (state '%s' is listed in instance.json)", doc.states[k]);
       continue;
     }
@@ -467,29 +489,29 @@ static void check_instance(const char *root, const char *id, const hearth_valida
         const char *rel, *what;
       } files[5] = {{vf->rgb, "rgb"}, {vf->cutout, "cutout"}, {vf->depth, "depth"},
                     {vf->depth_intrinsics, "depth_intrinsics"}, {vf->thermal, "thermal"}};
-      int present[5];
+      int have[5];
       for (int j = 0; j < 5; j++) {
         snprintf(f, sizeof f, "%s/%s", sdir, files[j].rel);
-        present[j] = file_exists(f);
-        if (!present[j]) {
+        have[j] = present(f);
+        if (!have[j]) {
           (*nfiles)++;
           hearth_problems_add(p, f, "missing (view %s's %s in %s/manifest.json)", vf->view,
                               files[j].what, doc.states[k]);
         }
       }
-      if (present[0]) {
+      if (have[0]) {
         snprintf(f, sizeof f, "%s/%s", sdir, vf->rgb);
         check_image(p, f, IMG_JPEG, 1920, 1080, rgb3, 8, o->decode_images, nfiles);
       }
-      if (present[1]) {
+      if (have[1]) {
         snprintf(f, sizeof f, "%s/%s", sdir, vf->cutout);
         check_image(p, f, IMG_PNG, 1920, 1080, cut, 8, o->decode_images, nfiles);
       }
-      if (present[2]) {
+      if (have[2]) {
         snprintf(f, sizeof f, "%s/%s", sdir, vf->depth);
         check_image(p, f, IMG_PNG, 640, 576, gray, 16, o->decode_images, nfiles);
       }
-      if (present[3]) {
+      if (have[3]) {
         hearth_depth_intrinsics di;
         snprintf(f, sizeof f, "%s/%s", sdir, vf->depth_intrinsics);
         (*nfiles)++;
@@ -498,7 +520,7 @@ static void check_instance(const char *root, const char *id, const hearth_valida
           hearth_problems_add(p, f, "width x height %dx%d, but depth/%s.png is 640x576",
                               (int)di.depth.width, (int)di.depth.height, vf->view);
       }
-      if (present[4]) {
+      if (have[4]) {
         snprintf(f, sizeof f, "%s/%s", sdir, vf->thermal);
         check_csv(p, f, nfiles);
       }
@@ -516,11 +538,11 @@ static void check_instance(const char *root, const char *id, const hearth_valida
   snprintf(path, sizeof path, "%s/derived/scale.json", dir);
   (*nfiles)++;
   hearth_scale_doc sd;
-  if (!file_exists(path)) hearth_problems_add(p, path, "missing");
+  if (!present(path)) hearth_problems_add(p, path, "missing");
   else if (hearth_scale_doc_read(path, &sd, &e)) add_err(p, path, &e);
   snprintf(path, sizeof path, "%s/derived/mesh.glb", dir);
   (*nfiles)++;
-  if (!file_exists(path)) {
+  if (!present(path)) {
     hearth_problems_add(p, path, "missing");
   } else {
     hearth_mesh mesh = {0};
@@ -555,7 +577,7 @@ static void check_calibration(const char *root, const hearth_validate_opts *o, h
   check_leftovers(p, path, 0);
   snprintf(path, sizeof path, "%s/calibration/rig.json", root);
   (*nfiles)++;
-  if (!file_exists(path)) {
+  if (!present(path)) {
     if (!o->raw_only) hearth_problems_add(p, path, "missing");
   } else if (hearth_rig_read(path, &rig, &e)) {
     add_err(p, path, &e);
@@ -567,13 +589,13 @@ static void check_calibration(const char *root, const hearth_validate_opts *o, h
                         (int)rig.depth.height);
   }
   snprintf(path, sizeof path, "%s/calibration/factory.json", root);
-  if (file_exists(path)) {
+  if (present(path)) {
     hearth_factory_calib f;
     (*nfiles)++;
     if (hearth_factory_read(path, &f, &e)) add_err(p, path, &e);
   }
   snprintf(path, sizeof path, "%s/calibration/detections.json", root);
-  if (file_exists(path)) {
+  if (present(path)) {
     hearth_detections d = {0};
     (*nfiles)++;
     if (hearth_detections_read(path, &d, &e)) add_err(p, path, &e);
@@ -647,7 +669,7 @@ hearth_status hearth_validate_release(const char *root, const hearth_validate_op
   snprintf(path, sizeof path, "%s/release.json", root);
   hearth_release_doc rel = {0};
   nfiles++;
-  if (!file_exists(path)) {
+  if (!present(path)) {
     hearth_problems_add(out, path, "missing (is %s a release root?)", root);
     if (files_checked) *files_checked = nfiles;
     return HEARTH_OK;
@@ -655,7 +677,7 @@ hearth_status hearth_validate_release(const char *root, const hearth_validate_op
   if (hearth_release_read(path, &rel, &e)) add_err(out, path, &e);
   /* the parameters of the last build (optional) */
   snprintf(path, sizeof path, "%s/build.json", root);
-  if (file_exists(path)) {
+  if (present(path)) {
     hb_params bp;
     nfiles++;
     if (hb_params_read(path, &bp, &e)) add_err(out, path, &e);

@@ -718,10 +718,11 @@ hearth_status hearth_synth_release(const hearth_synth_opts *o, hearth_err *err) 
                             root);
     existed = 1;
   }
-  snprintf(tmp, sizeof tmp, "%s.synth-tmp-%ld", root, (long)getpid());
-  if (hearth_path_exists(tmp)) hearth_remove_tree(tmp, NULL);
-  st = hearth_mkdirs(tmp, err);
-  if (!st) st = build_tree(o, tmp, err);
+  /* built beside root under the temporary pattern (core.h); trees that
+   * killed earlier runs left there go first */
+  if ((st = hearth_sweep_temps_of(root, NULL, err))) return st;
+  if ((st = hearth_temp_dir(root, tmp, sizeof tmp, err))) return st;
+  st = build_tree(o, tmp, err);
   if (!st) {
     if (existed && rmdir(root) != 0)
       st = hearth_err_set(err, HEARTH_E_IO, "%s: cannot replace the empty directory: %s", root,

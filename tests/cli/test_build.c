@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/wait.h>
+#include <unistd.h>
 #include "test_util.h"
 
 static int run(const char *cmd, char *out, size_t cap) {
@@ -76,30 +77,42 @@ int main(void) {
   CHECK(strstr(out, "\"instances\": 10") && strstr(out, "\"object_states\": 20") &&
         strstr(out, "\"temperature_maps\": 20") && strstr(out, "\"rgb_thermal_pairs\": 40"));
 
-  /* an output removed: exactly its stage re-runs. Temporaries a killed
-     writer would leave (in its output and stamp directories) go before it
-     runs; a look-alike that is not one stays, as do those of fresh stages. */
+  /* an output removed: exactly its stage re-runs. Temporaries killed
+     writers left (dead process ids) go on every run, wherever they are in
+     the instance; a running writer's stays, as does a look-alike that is not
+     one. */
   const char *d3 = "instances/cup_03/derived";
+  pid_t child = fork();
+  if (child == 0) _exit(0);
+  waitpid(child, NULL, 0);
+  long dead = (long)child, live = (long)getpid();
   snprintf(cmd, sizeof cmd,
-           "cd '%s' && rm %s/hot/mask.npy && mkdir %s/hot.tmp-Qw3Er5 %s/hot.old-4242 && "
-           "touch %s/hot/mask.npy.tmp-Ab12Cd %s/hot.tmp-Qw3Er5/mask.npy %s/hot.old-4242/mask.npy "
-           "%s/.stamps/map-hot.json.tmp-q9Z0xY %s/notes.tmp-1234567 "
-           "%s/overlay/neutral/v00.png.tmp-Zz9y8X && '%s' build '%s' %s",
-           root, d3, d3, d3, d3, d3, d3, d3, d3, d3, HEARTH_EXE, root, opts);
+           "cd '%s' && rm %s/hot/mask.npy && mkdir %s/hot.tmp-%ld-Qw3Er5 %s/hot.tmp-%ld-Old000 && "
+           "touch %s/hot/mask.npy.tmp-%ld-Ab12Cd %s/hot.tmp-%ld-Qw3Er5/mask.npy %s/hot.tmp-%ld-Old000/mask.npy "
+           "%s/.stamps/map-hot.json.tmp-%ld-q9Z0xY %s/notes.tmp-1234567 "
+           "%s/overlay/neutral/v00.png.tmp-%ld-Zz9y8X %s/overlay/neutral/v01.png.tmp-%ld-Zz9y8X && "
+           "'%s' build '%s' %s",
+           root, d3, d3, dead, d3, dead, d3, dead, d3, dead, d3, dead, d3, dead, d3, d3, dead, d3,
+           live, HEARTH_EXE, root, opts);
   rc = run(cmd, out, sizeof out);
   CHECK_MSG(rc == 0 && strstr(out, " 1 stage(s) run") && strstr(out, "cup_03 map hot: done"), "%s", out);
-  CHECK_MSG(strstr(out, "removed 4 temporary file(s)/folder(s)"), "%s", out);
+  CHECK_MSG(strstr(out, "removed 5 temporary file(s)/folder(s)"), "%s", out);
   snprintf(cmd, sizeof cmd,
-           "cd '%s' && test ! -e %s/hot/mask.npy.tmp-Ab12Cd && test ! -e %s/.stamps/map-hot.json.tmp-q9Z0xY "
-           "&& test ! -e %s/hot.tmp-Qw3Er5 && test ! -e %s/hot.old-4242 "
-           "&& test -e %s/notes.tmp-1234567 && test -e %s/overlay/neutral/v00.png.tmp-Zz9y8X",
-           root, d3, d3, d3, d3, d3, d3);
+           "cd '%s' && test ! -e %s/hot/mask.npy.tmp-%ld-Ab12Cd && test ! -e %s/.stamps/map-hot.json.tmp-%ld-q9Z0xY "
+           "&& test ! -e %s/hot.tmp-%ld-Qw3Er5 && test ! -e %s/hot.tmp-%ld-Old000 "
+           "&& test ! -e %s/overlay/neutral/v00.png.tmp-%ld-Zz9y8X "
+           "&& test -e %s/notes.tmp-1234567 && test -e %s/overlay/neutral/v01.png.tmp-%ld-Zz9y8X",
+           root, d3, dead, d3, dead, d3, dead, d3, dead, d3, dead, d3, d3, live);
   CHECK_MSG(system(cmd) == 0, "stale temporaries: wrong files removed");
-  /* validate names the one left (its stage did not run) */
+  /* validate names the one left (its writer still runs) */
   snprintf(cmd, sizeof cmd, "'%s' validate '%s'", HEARTH_EXE, root);
   rc = run(cmd, out, sizeof out);
-  CHECK_MSG(rc != 0 && strstr(out, "overlay/neutral/v00.png.tmp-Zz9y8X: left by an interrupted write") &&
-                !strstr(out, "notes.tmp-1234567"), "validate: %s", out);
+  char want[256];
+  snprintf(want, sizeof want, "overlay/neutral/v01.png.tmp-%ld-Zz9y8X: a temporary of process %ld, "
+           "which is still writing", live, live);
+  CHECK_MSG(rc != 0 && strstr(out, want) && !strstr(out, "notes.tmp-1234567"), "validate: %s", out);
+  snprintf(cmd, sizeof cmd, "rm '%s/%s/overlay/neutral/v01.png.tmp-%ld-Zz9y8X'", root, d3, live);
+  CHECK(system(cmd) == 0);
 
   /* interrupted: start from the pristine tree, kill -9 after a few stages */
   snprintf(cmd, sizeof cmd,

@@ -569,6 +569,13 @@ static void test_bad_documents(void) {
       {"state", "\"boiling\"", HEARTH_E_RANGE, "state", "neutral, hot"},
       {"views", "[]", HEARTH_E_SIZE, "views", "at least 1"},
       {"views[0]", "\"v00\"", HEARTH_E_PARSE, "views[0]", "expected an object"},
+      /* two views naming one file: refused at the second, naming both */
+      {"views[7].thermal", "\"thermal/v02.csv\"", HEARTH_E_INCONSISTENT, "views[7].thermal",
+       "view \"v07\" names \"thermal/v02.csv\", the file of view \"v02\" (views[2].thermal)"},
+      {"views[5].rgb", "\"./rgb/./v01.jpg\"", HEARTH_E_INCONSISTENT, "views[5].rgb",
+       "the file of view \"v01\" (views[1].rgb)"},
+      {"views[3].depth", "\"cutout/v00.png\"", HEARTH_E_INCONSISTENT, "views[3].depth",
+       "the file of view \"v00\" (views[0].cutout)"},
   };
   run_bad("manifest", "manifest.json", rd_manifest, manifest, N(manifest));
 
@@ -693,6 +700,30 @@ static size_t count_entries(const char *dir) {
 }
 
 /* writers refuse what the readers would refuse, and leave nothing behind */
+/* instance.json read from its directory must describe that instance */
+static void test_instance_load(void) {
+  hearth_err err = {0};
+  char dir[1200], path[1300];
+  snprintf(dir, sizeof dir, "%s/load/instances/cup_03", g_dir);
+  CHECK_OK(hearth_mkdirs(dir, &err), &err);
+  hearth_instance_doc in, back;
+  memset(&in, 0, sizeof in);
+  snprintf(in.id, sizeof in.id, "cup_04");
+  snprintf(in.category, sizeof in.category, "cup");
+  in.n_states = 1;
+  snprintf(in.states[0], HEARTH_NAME_MAX, "hot");
+  snprintf(path, sizeof path, "%s/instance.json", dir);
+  CHECK_OK(hearth_instance_write(path, &in, &err), &err);
+  snprintf(dir, sizeof dir, "%s/load", g_dir);
+  CHECK(hearth_instance_load(dir, "cup_03", &back, &err) == HEARTH_E_INCONSISTENT);
+  CHECK_MSG(strstr(err.msg, "cup_03/instance.json: id: \"cup_04\", but the directory is "
+                            "instances/cup_03"), "%s", err.msg);
+  snprintf(in.id, sizeof in.id, "cup_03");
+  CHECK_OK(hearth_instance_write(path, &in, &err), &err);
+  CHECK_OK(hearth_instance_load(dir, "cup_03", &back, &err), &err);
+  CHECK(!strcmp(back.id, "cup_03"));
+}
+
 static void test_writer_refusals(void) {
   hearth_err err = {0};
   char sub[1100];
@@ -753,6 +784,7 @@ static void test_writer_refusals(void) {
 
 int main(void) {
   g_dir = test_tmpdir("io_release");
+  test_instance_load();
   test_round_trips();
   test_exact_numbers();
   test_plate();

@@ -179,8 +179,33 @@ static void test_bad_writes(const char *dir) {
   CHECK(no_temp_files(dir));
 }
 
+/* the size a caller expects is checked from the header, and the error
+ * names the file */
+static void test_expect(const char *dir) {
+  hearth_err err = {0};
+  hearth_image img = {0}, back = {0};
+  char path[1200];
+  snprintf(path, sizeof path, "%s/expect.jpg", dir);
+  CHECK_OK(hearth_image_alloc(&img, 64, 48, 3, HEARTH_PIX_U8, &err), &err);
+  CHECK_OK(hearth_jpeg_write(path, &img, 90, &err), &err);
+  hearth_image_free(&img);
+  hearth_image_expect rig = {1920, 1080, 3, 0, 0, "(the colour camera of rig.json)"};
+  CHECK(hearth_jpeg_read_expect(path, &rig, &back, &err) == HEARTH_E_SIZE && !back.data);
+  CHECK_MSG(strstr(err.msg, "expect.jpg: image is 64x48, expected 1920x1080 (the colour camera "
+                            "of rig.json)"), "%s", err.msg);
+  CHECK(hearth_jpeg_read_gray_expect(path, &rig, &back, &err) == HEARTH_E_SIZE);
+  hearth_image_expect ok = {64, 48, 3, 0, 0, NULL};
+  CHECK_OK(hearth_jpeg_read_expect(path, &ok, &back, &err), &err);
+  CHECK(back.data && back.channels == 3);
+  hearth_image_free(&back);
+  hearth_image_expect head = {.header_only = 1};
+  CHECK_OK(hearth_jpeg_read_expect(path, &head, &back, &err), &err);
+  CHECK(!back.data && back.width == 64 && back.height == 48 && back.channels == 3);
+}
+
 int main(void) {
   const char *dir = test_tmpdir("io_jpeg");
+  test_expect(dir);
   test_round_trip(dir);
   test_bad_inputs(dir);
   test_bad_writes(dir);

@@ -364,8 +364,58 @@ static void report_encode_time(void) {
   hearth_image_free(&img);
 }
 
+/* a caller's expectation is checked from the header, before the pixels:
+ * a file declaring 16384 x 16384 RGBA16 is refused without 2 GiB */
+static void test_expect(const char *dir) {
+  hearth_err err = {0};
+  hearth_image img = {0}, back = {0};
+  char path[1200];
+  snprintf(path, sizeof path, "%s/expect.png", dir);
+  CHECK_OK(hearth_image_alloc(&img, 40, 30, 1, HEARTH_PIX_U16, &err), &err);
+  CHECK_OK(hearth_png_write(path, &img, &err), &err);
+  hearth_image_expect ok = {40, 30, 1, 0, 0, NULL};
+  CHECK_OK(hearth_png_read_expect(path, &ok, &back, &err), &err);
+  CHECK(back.data && back.width == 40);
+  hearth_image_free(&back);
+  hearth_image_expect size = {64, 30, 0, 0, 0, "(the depth intrinsics)"};
+  CHECK(hearth_png_read_expect(path, &size, &back, &err) == HEARTH_E_SIZE && !back.data);
+  CHECK_MSG(strstr(err.msg, "expect.png: image is 40x30, expected 64x30 (the depth intrinsics)"),
+            "%s", err.msg);
+  hearth_image_expect ch = {0, 0, 3, 0, 0, NULL};
+  CHECK(hearth_png_read_expect(path, &ch, &back, &err) == HEARTH_E_UNSUPPORTED);
+  hearth_image_expect px = {0, 0, 0, 1000, 0, NULL};
+  CHECK(hearth_png_read_expect(path, &px, &back, &err) == HEARTH_E_LIMIT);
+  CHECK_MSG(strstr(err.msg, "more than the limit of 1000 pixels"), "%s", err.msg);
+  hearth_image_expect head = {.header_only = 1};
+  CHECK_OK(hearth_png_read_expect(path, &head, &back, &err), &err);
+  CHECK(!back.data && back.width == 40 && back.height == 30 && back.channels == 1 &&
+        back.type == HEARTH_PIX_U16);
+  hearth_image_free(&img);
+  /* the huge declaration: header + 2 MB of (invalid) data + IEND */
+  bytes b = {0};
+  static const uint8_t sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  put(&b, sig, 8);
+  const uint8_t ihdr[13] = {0, 0, 0x40, 0, 0, 0, 0x40, 0, 16, 6, 0, 0, 0};
+  put_chunk(&b, "IHDR", ihdr, 13);
+  uint8_t *zeros = calloc(2000000, 1);
+  put_chunk(&b, "IDAT", zeros, 2000000);
+  free(zeros);
+  put_chunk(&b, "IEND", NULL, 0);
+  snprintf(path, sizeof path, "%s/huge.png", dir);
+  write_bytes(path, b.p, b.n);
+  free(b.p);
+  hearth_image_expect depth = {640, 576, 1, 0, 0, NULL};
+  double t0 = hearth_now();
+  CHECK(hearth_png_read_expect(path, &depth, &back, &err) == HEARTH_E_SIZE && !back.data);
+  CHECK_MSG(strstr(err.msg, "image is 16384x16384, expected 640x576"), "%s", err.msg);
+  CHECK_MSG(hearth_now() - t0 < 1.0, "took %.2f s", hearth_now() - t0);
+  CHECK_OK(hearth_png_read_expect(path, &head, &back, &err), &err);
+  CHECK(back.width == 16384 && back.channels == 4 && back.type == HEARTH_PIX_U16 && !back.data);
+}
+
 int main(void) {
   const char *dir = test_tmpdir("io_png");
+  test_expect(dir);
   test_round_trips(dir);
   test_u16_full_range(dir);
   test_handmade_decode();

@@ -2,8 +2,11 @@
  * base64, RFC 6455's accept example and frame examples), the handshake
  * check's errors, and the client against python3-websockets: metadata,
  * a fragmented request, ping/pong */
+#include <arpa/inet.h>
+#include <netinet/in.h>
 #include <signal.h>
 #include <string.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
@@ -13,6 +16,53 @@
 
 static void hex(const uint8_t *d, size_t n, char *out) {
   for (size_t i = 0; i < n; i++) sprintf(out + 2 * i, "%02x", d[i]);
+}
+
+/* A one-connection server on 127.0.0.1: mode 0 answers the handshake with
+ * "200 OK", 1 says nothing, 2 completes the handshake and then sends a
+ * frame with reserved bits set. Returns the port; *pid is the server. */
+static int fake_server(int mode, pid_t *pid) {
+  int s = socket(AF_INET, SOCK_STREAM, 0);
+  struct sockaddr_in a;
+  memset(&a, 0, sizeof a);
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t l = sizeof a;
+  if (s < 0 || bind(s, (struct sockaddr *)&a, sizeof a) || listen(s, 1) ||
+      getsockname(s, (struct sockaddr *)&a, &l))
+    return -1;
+  *pid = fork();
+  if (*pid == 0) {
+    int c = accept(s, NULL, NULL);
+    char req[4096] = {0}, reply[512];
+    ssize_t n = read(c, req, sizeof req - 1);
+    (void)n;
+    if (mode == 0) {
+      snprintf(reply, sizeof reply, "HTTP/1.1 200 OK\r\nContent-Length: 0\r\n\r\n");
+    } else if (mode == 2) {
+      char key[64] = {0}, acc[29];
+      const char *k = strstr(req, "Sec-WebSocket-Key: ");
+      if (k) sscanf(k + 19, "%63[^\r]", key);
+      hearth_ws_accept(key, acc);
+      snprintf(reply, sizeof reply,
+               "HTTP/1.1 101 Switching Protocols\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+               "Sec-WebSocket-Accept: %s\r\n\r\n\xc2", acc);
+    }
+    if (mode != 1 && write(c, reply, strlen(reply) + (mode == 2)) < 0) _exit(1);
+    sleep(3);
+    _exit(0);
+  }
+  close(s);
+  return ntohs(a.sin_port);
+}
+
+/* the server named once, no empty prefix */
+static int named_once(const char *msg, int port) {
+  char want[64];
+  snprintf(want, sizeof want, "websocket 127.0.0.1:%d: ", port);
+  const char *w = strstr(msg, "websocket");
+  return !strncmp(msg, want, strlen(want)) && w && !strstr(w + 1, "websocket") &&
+         !strstr(msg, ": :");
 }
 
 int main(void) {
@@ -73,5 +123,36 @@ int main(void) {
   hearth_ws *c = NULL;
   CHECK(hearth_ws_connect("ws://127.0.0.1:1", 2.0, &c, &err) == HEARTH_E_IO && strstr(err.msg, "connect"));
   CHECK(hearth_ws_connect("http://x", 2.0, &c, &err) == HEARTH_E_ARG);
+  /* a server that misbehaves: each message names it once */
+  for (int mode = 0; mode < 3; mode++) {
+    pid_t pid = -1;
+    int port = fake_server(mode, &pid);
+    CHECK(port > 0);
+    char url[64];
+    snprintf(url, sizeof url, "ws://127.0.0.1:%d/", port);
+    memset(&err, 0, sizeof err);
+    hearth_status st = hearth_ws_connect(url, mode == 1 ? 0.3 : 5.0, &c, &err);
+    if (mode == 2) {
+      CHECK_OK(st, &err);
+      uint8_t *msg = NULL;
+      size_t n = 0;
+      int op = 0;
+      if (!st) {
+        st = hearth_ws_recv(c, &msg, &n, &op, 5.0, &err);
+        free(msg);
+        hearth_ws_close(c, 0);
+      }
+      CHECK_MSG(st == HEARTH_E_PARSE && strstr(err.msg, ": frame: reserved bits"), "%s", err.msg);
+    } else if (mode == 0) {
+      CHECK_MSG(st == HEARTH_E_PARSE && strstr(err.msg, ": handshake: line 1"), "%s", err.msg);
+    } else {
+      CHECK_MSG(st == HEARTH_E_IO && strstr(err.msg, "no reply"), "%s", err.msg);
+    }
+    CHECK_MSG(named_once(err.msg, port), "mode %d: %s", mode, err.msg);
+    if (pid > 0) {
+      kill(pid, SIGKILL);
+      waitpid(pid, NULL, 0);
+    }
+  }
   return g_test_failures ? 1 : 0;
 }
