@@ -68,7 +68,9 @@ hearth_status hearth_tsdf_extract(const hearth_tsdf *t, hearth_mesh *out, hearth
 hearth_status hearth_mesh_keep_largest(hearth_mesh *m, hearth_err *err);
 
 /* Close every boundary loop of at most max_edges edges with a fan around a
- * new vertex at the loop's centroid, oriented like its neighbours.
+ * new vertex at the loop's centroid, oriented like its neighbours. A
+ * boundary through a vertex twice (holes touching there) is split there
+ * into separate loops.
  * n_filled (may be NULL) receives the number of loops closed. */
 hearth_status hearth_mesh_fill_holes(hearth_mesh *m, size_t max_edges, size_t *n_filled,
                                      hearth_err *err);
@@ -88,7 +90,8 @@ void hearth_mesh_edge_stats(const hearth_mesh *m, size_t *n_boundary, size_t *n_
 typedef struct hearth_recon_tsdf_opts {
   double voxel_m;          /* default 0.002 */
   double trunc_m;          /* default (0) 2 voxels; thin walls need it small */
-  size_t hole_max_edges;   /* default 400 */
+  size_t hole_max_edges;   /* default 4000: enough for the unseen base of an
+                              object standing on the turntable */
   size_t target_triangles; /* default 20000; 0: no simplification */
   const char *poses;       /* poses file relative to the release root; default
                               ground_truth/instances/<id>/poses_rgb.json */

@@ -120,9 +120,29 @@ hearth_status hearth_mesh_keep_largest(hearth_mesh *m, hearth_err *err) {
 }
 
 /* ---- hole filling ---------------------------------------------------------- */
-typedef struct half {
-  uint64_t key; /* (from << 32) | to */
-} half;
+/* Close the boundary loop loop[0..n) (each loop[q] -> loop[q+1] a boundary
+ * edge used forwards by its triangle) with a fan around its centroid. */
+static hearth_status fan_fill(hearth_mesh *m, const uint32_t *loop, size_t n, hearth_err *err) {
+  size_t nv = m->n_vertices, nt = m->n_triangles;
+  float *np = realloc(m->positions, (nv + 1) * 3 * sizeof *np);
+  if (!np) return hearth_err_set(err, HEARTH_E_NOMEM, "fill holes");
+  m->positions = np;
+  uint32_t *ni = realloc(m->indices, (nt + n) * 3 * sizeof *ni);
+  if (!ni) return hearth_err_set(err, HEARTH_E_NOMEM, "fill holes");
+  m->indices = ni;
+  double c[3] = {0, 0, 0};
+  for (size_t q = 0; q < n; q++)
+    for (int a = 0; a < 3; a++) c[a] += np[3 * (size_t)loop[q] + a] / (double)n;
+  for (int a = 0; a < 3; a++) np[3 * nv + a] = (float)c[a];
+  for (size_t q = 0; q < n; q++) {
+    ni[3 * (nt + q)] = loop[(q + 1) % n];
+    ni[3 * (nt + q) + 1] = loop[q];
+    ni[3 * (nt + q) + 2] = (uint32_t)nv;
+  }
+  m->n_vertices = nv + 1;
+  m->n_triangles = nt + n;
+  return HEARTH_OK;
+}
 
 hearth_status hearth_mesh_fill_holes(hearth_mesh *m, size_t max_edges, size_t *n_filled,
                                      hearth_err *err) {
@@ -161,19 +181,28 @@ hearth_status hearth_mesh_fill_holes(hearth_mesh *m, size_t max_edges, size_t *n
   hearth_status s = HEARTH_OK;
   if (!used || !loop) s = hearth_err_set(err, HEARTH_E_NOMEM, "fill holes");
   size_t filled = 0;
+  uint32_t *at = malloc((m->n_vertices ? m->n_vertices : 1) * sizeof *at);
+  if (!at && !s) s = hearth_err_set(err, HEARTH_E_NOMEM, "fill holes");
+  for (size_t v = 0; at && v < m->n_vertices; v++) at[v] = UINT32_MAX;
   for (size_t e0 = 0; e0 < nb && !s; e0++) {
     if (used[e0]) continue;
-    /* walk from edge e0 along boundary edges starting where the last ended */
+    /* walk boundary edges head to tail; whenever the walk comes back to a
+     * vertex of its path, the path from there is a closed loop (two holes
+     * touching at a vertex give two loops) */
     size_t n = 0, e = e0;
-    uint32_t start = (uint32_t)(dir[e0] >> 32);
-    int closed = 0;
     for (;;) {
       used[e] = 1;
-      loop[n++] = (uint32_t)(dir[e] >> 32);
-      uint32_t to = (uint32_t)dir[e];
-      if (to == start) {
-        closed = 1;
-        break;
+      uint32_t from = (uint32_t)(dir[e] >> 32), to = (uint32_t)dir[e];
+      at[from] = (uint32_t)n;
+      loop[n++] = from;
+      if (at[to] != UINT32_MAX) {
+        size_t j = at[to], len = n - j;
+        if (len >= 3 && len <= max_edges) {
+          if ((s = fan_fill(m, loop + j, len, err))) break;
+          filled++;
+        }
+        for (size_t q = j; q < n; q++) at[loop[q]] = UINT32_MAX;
+        n = j;
       }
       uint64_t k = (uint64_t)to << 32;
       size_t lo = 0, hi = nb;
@@ -191,41 +220,9 @@ hearth_status hearth_mesh_fill_holes(hearth_mesh *m, size_t max_edges, size_t *n
       if (next == nb) break;
       e = next;
     }
-    if (!closed || n < 3 || n > max_edges) continue;
-    /* a loop through a vertex twice (two holes touching) would make the
-     * fan non-manifold there: left open */
-    int twice = 0;
-    for (size_t q = 0; q < n && !twice; q++)
-      for (size_t r = q + 1; r < n && !twice; r++) twice = loop[q] == loop[r];
-    if (twice) continue;
-    /* fan around the centroid: one new vertex, n triangles */
-    size_t nv = m->n_vertices, nt = m->n_triangles;
-    float *np = realloc(m->positions, (nv + 1) * 3 * sizeof *np);
-    if (!np) {
-      s = hearth_err_set(err, HEARTH_E_NOMEM, "fill holes");
-      break;
-    }
-    m->positions = np;
-    uint32_t *ni = realloc(m->indices, (nt + n) * 3 * sizeof *ni);
-    if (!ni) {
-      s = hearth_err_set(err, HEARTH_E_NOMEM, "fill holes");
-      break;
-    }
-    m->indices = ni;
-    double c[3] = {0, 0, 0};
-    for (size_t q = 0; q < n; q++)
-      for (int a = 0; a < 3; a++) c[a] += np[3 * (size_t)loop[q] + a] / (double)n;
-    for (int a = 0; a < 3; a++) np[3 * nv + a] = (float)c[a];
-    for (size_t q = 0; q < n; q++) {
-      /* boundary edge loop[q] -> loop[q+1] is used forwards by its triangle */
-      ni[3 * (nt + q)] = loop[(q + 1) % n];
-      ni[3 * (nt + q) + 1] = loop[q];
-      ni[3 * (nt + q) + 2] = (uint32_t)nv;
-    }
-    m->n_vertices = nv + 1;
-    m->n_triangles = nt + n;
-    filled++;
+    for (size_t q = 0; q < n; q++) at[loop[q]] = UINT32_MAX;
   }
+  free(at);
   free(used);
   free(loop);
   free(dir);

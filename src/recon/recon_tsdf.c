@@ -112,7 +112,7 @@ void hearth_recon_tsdf_opts_default(hearth_recon_tsdf_opts *o) {
   memset(o, 0, sizeof *o);
   o->voxel_m = 0.002;
   o->trunc_m = 0;
-  o->hole_max_edges = 400;
+  o->hole_max_edges = 4000;
   o->target_triangles = 20000;
   o->poses = NULL;
 }

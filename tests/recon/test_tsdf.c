@@ -2,9 +2,10 @@
  * tetrahedra, cleaning, hole filling and simplification, and an end-to-end
  * run on a small virtual-rig release against its true mesh.
  *
- * With arguments ROOT INSTANCE [VOXEL_M] it only reconstructs that
- * instance of an existing release and prints the surface errors
- * (bench/recon_tsdf.sh uses it). */
+ * With arguments ROOT INSTANCE [VOXEL_M [TRIANGLES [TRUNC_M]]] it only
+ * reconstructs that instance of an existing release and prints the
+ * surface errors (bench/recon_tsdf.sh uses it); RECON_TSDF_DUMP=FILE.glb
+ * also writes the mesh. */
 #include <float.h>
 #include <time.h>
 #include "hearth/dataset.h"
@@ -356,13 +357,12 @@ static int run_release(const char *root, const char *instance, double voxel, siz
   CHECK_OK(hearth_glb_read(path, NULL, &gt, &err), &err);
   double mx_a, mx_b;
   const char *dump = getenv("RECON_TSDF_DUMP");
-  if (dump) {
-    CHECK_OK(hearth_glb_write(dump, &m, &err), &err);
-  }
+  if (dump) CHECK_OK(hearth_glb_write(dump, &m, &err), &err);
   mesh_to_mesh(&m, &gt, rms_a, &mx_a);
   mesh_to_mesh(&gt, &m, rms_b, &mx_b);
   size_t nb, nn;
   hearth_mesh_edge_stats(&m, &nb, &nn);
+  CHECK_MSG(nb == 0 && nn == 0, "%s: %zu boundary, %zu non-manifold edges", instance, nb, nn);
   printf("%s: voxel %.1f mm, %zu triangles (%zu boundary, %zu non-manifold edges), %.2f s; "
          "RMS recon->true %.3f mm (max %.2f), true->recon %.3f mm (max %.2f)\n",
          instance, voxel * 1e3, m.n_triangles, nb, nn,
@@ -384,7 +384,9 @@ static void test_release(void) {
   CHECK(system(cmd) == 0);
   double a, b;
   if (run_release(root, "cup_01", 0.003, 20000, 0, &a, &b) == 0) {
-    CHECK_MSG(a < 2.5e-3 && b < 4e-3, "RMS %g %g", a, b);
+    /* 10 views leave the cup's inside partly unseen: the true inner
+     * walls lie up to a few mm from the reconstruction */
+    CHECK_MSG(a < 1.5e-3 && b < 3.5e-3, "RMS %g %g", a, b);
   }
 }
 
