@@ -1,0 +1,405 @@
+/* Geometry from depth: TSDF fusion of analytic sphere depth maps, marching
+ * tetrahedra, cleaning, hole filling and simplification, and an end-to-end
+ * run on a small virtual-rig release against its true mesh.
+ *
+ * With arguments ROOT INSTANCE [VOXEL_M [TRIANGLES [TRUNC_M]]] it only
+ * reconstructs that instance of an existing release and prints the
+ * surface errors (bench/recon_tsdf.sh uses it); RECON_TSDF_DUMP=FILE.glb
+ * also writes the mesh. */
+#include <float.h>
+#include <time.h>
+#include "hearth/dataset.h"
+#include "hearth/recon_geom.h"
+#include "../test_util.h"
+
+/* ---- point to mesh distance through a uniform grid of triangles ---------- */
+typedef struct tri_grid {
+  const hearth_mesh *m;
+  double lo[3], cell;
+  int n[3];
+  size_t *start; /* n0*n1*n2 + 1 */
+  uint32_t *tris;
+} tri_grid;
+
+static size_t cell_of(const tri_grid *g, int i, int j, int k) {
+  return ((size_t)k * g->n[1] + j) * g->n[0] + i;
+}
+
+static void tri_grid_build(tri_grid *g, const hearth_mesh *m, double cell) {
+  memset(g, 0, sizeof *g);
+  g->m = m;
+  g->cell = cell;
+  double hi[3];
+  hearth_mesh_bounds(m, g->lo, hi);
+  for (int a = 0; a < 3; a++) g->n[a] = (int)((hi[a] - g->lo[a]) / cell) + 1;
+  size_t nc = (size_t)g->n[0] * g->n[1] * g->n[2];
+  g->start = calloc(nc + 1, sizeof *g->start);
+  for (int pass = 0; pass < 2; pass++) {
+    size_t *fill = pass ? calloc(nc, sizeof *fill) : NULL;
+    for (size_t t = 0; t < m->n_triangles; t++) {
+      int lo[3], up[3];
+      for (int a = 0; a < 3; a++) {
+        double mn = DBL_MAX, mx = -DBL_MAX;
+        for (int c = 0; c < 3; c++) {
+          double x = m->positions[3 * (size_t)m->indices[3 * t + c] + a];
+          mn = x < mn ? x : mn;
+          mx = x > mx ? x : mx;
+        }
+        lo[a] = (int)((mn - g->lo[a]) / cell);
+        up[a] = (int)((mx - g->lo[a]) / cell);
+        if (up[a] >= g->n[a]) up[a] = g->n[a] - 1;
+      }
+      for (int k = lo[2]; k <= up[2]; k++)
+        for (int j = lo[1]; j <= up[1]; j++)
+          for (int i = lo[0]; i <= up[0]; i++) {
+            size_t c = cell_of(g, i, j, k);
+            if (pass)
+              g->tris[g->start[c] + fill[c]++] = (uint32_t)t;
+            else
+              g->start[c + 1]++;
+          }
+    }
+    if (!pass) {
+      for (size_t c = 0; c < nc; c++) g->start[c + 1] += g->start[c];
+      g->tris = malloc((g->start[nc] + 1) * sizeof *g->tris);
+    }
+    free(fill);
+  }
+}
+
+static void tri_grid_free(tri_grid *g) {
+  free(g->start);
+  free(g->tris);
+}
+
+static double dot3(const double a[3], const double b[3]) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+/* Squared distance from p to triangle abc (Voronoi regions of the
+ * triangle, Ericson's closest-point construction written out). */
+static double point_tri_d2(const double p[3], const double a[3], const double b[3],
+                           const double c[3]) {
+  double ab[3], ac[3], ap[3], q[3];
+  for (int i = 0; i < 3; i++) {
+    ab[i] = b[i] - a[i];
+    ac[i] = c[i] - a[i];
+    ap[i] = p[i] - a[i];
+  }
+  double d1 = dot3(ab, ap), d2 = dot3(ac, ap);
+  if (d1 <= 0 && d2 <= 0) {
+    memcpy(q, a, sizeof q);
+    goto out;
+  }
+  double bp[3] = {p[0] - b[0], p[1] - b[1], p[2] - b[2]};
+  double d3 = dot3(ab, bp), d4 = dot3(ac, bp);
+  if (d3 >= 0 && d4 <= d3) {
+    memcpy(q, b, sizeof q);
+    goto out;
+  }
+  double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+    double v = d1 / (d1 - d3);
+    for (int i = 0; i < 3; i++) q[i] = a[i] + v * ab[i];
+    goto out;
+  }
+  double cp[3] = {p[0] - c[0], p[1] - c[1], p[2] - c[2]};
+  double d5 = dot3(ab, cp), d6 = dot3(ac, cp);
+  if (d6 >= 0 && d5 <= d6) {
+    memcpy(q, c, sizeof q);
+    goto out;
+  }
+  double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) {
+    double w = d2 / (d2 - d6);
+    for (int i = 0; i < 3; i++) q[i] = a[i] + w * ac[i];
+    goto out;
+  }
+  double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+    double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    for (int i = 0; i < 3; i++) q[i] = b[i] + w * (c[i] - b[i]);
+    goto out;
+  }
+  {
+    double den = 1.0 / (va + vb + vc), v = vb * den, w = vc * den;
+    for (int i = 0; i < 3; i++) q[i] = a[i] + ab[i] * v + ac[i] * w;
+  }
+out:
+  return (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
+         (p[2] - q[2]) * (p[2] - q[2]);
+}
+
+/* Distance from p to the mesh of g (searching rings of cells outwards). */
+static double tri_grid_dist(const tri_grid *g, const double p[3]) {
+  int c0[3];
+  for (int a = 0; a < 3; a++) c0[a] = (int)floor((p[a] - g->lo[a]) / g->cell);
+  double best = DBL_MAX;
+  int maxr = g->n[0] + g->n[1] + g->n[2];
+  for (int r = 0; r <= maxr; r++) {
+    for (int k = c0[2] - r; k <= c0[2] + r; k++)
+      for (int j = c0[1] - r; j <= c0[1] + r; j++)
+        for (int i = c0[0] - r; i <= c0[0] + r; i++) {
+          if (abs(i - c0[0]) != r && abs(j - c0[1]) != r && abs(k - c0[2]) != r) continue;
+          if (i < 0 || j < 0 || k < 0 || i >= g->n[0] || j >= g->n[1] || k >= g->n[2])
+            continue;
+          size_t c = cell_of(g, i, j, k);
+          for (size_t q = g->start[c]; q < g->start[c + 1]; q++) {
+            const uint32_t *f = g->m->indices + 3 * (size_t)g->tris[q];
+            double v[3][3];
+            for (int e = 0; e < 3; e++)
+              for (int a = 0; a < 3; a++) v[e][a] = g->m->positions[3 * (size_t)f[e] + a];
+            double d2 = point_tri_d2(p, v[0], v[1], v[2]);
+            if (d2 < best) best = d2;
+          }
+        }
+    /* every point within r cells of p's cell has been seen */
+    if (best < DBL_MAX && sqrt(best) <= r * g->cell) break;
+  }
+  return sqrt(best);
+}
+
+/* RMS and max distance of a's vertices to mesh b. */
+static void mesh_to_mesh(const hearth_mesh *a, const hearth_mesh *b, double *rms, double *mx) {
+  tri_grid g;
+  tri_grid_build(&g, b, 0.004);
+  double s = 0, m = 0;
+  for (size_t v = 0; v < a->n_vertices; v++) {
+    double p[3] = {a->positions[3 * v], a->positions[3 * v + 1], a->positions[3 * v + 2]};
+    double d = tri_grid_dist(&g, p);
+    s += d * d;
+    if (d > m) m = d;
+  }
+  *rms = a->n_vertices ? sqrt(s / a->n_vertices) : 0;
+  *mx = m;
+  tri_grid_free(&g);
+}
+
+/* ---- analytic sphere --------------------------------------------------- */
+#define SPHERE_R 0.05
+
+/* A camera at distance dist from the origin in direction (az, el), looking
+ * at the origin, y axis roughly down the world z. */
+static void look_at(double az, double el, double dist, hearth_rigid *T) {
+  double c[3] = {dist * cos(el) * cos(az), dist * cos(el) * sin(az), dist * sin(el)};
+  double z[3] = {-c[0] / dist, -c[1] / dist, -c[2] / dist};
+  double up[3] = {0, 0, -1};
+  if (fabs(z[2]) > 0.99) up[0] = 1, up[2] = 0;
+  /* x = z cross up, y = z cross x */
+  double x[3] = {z[1] * up[2] - z[2] * up[1], z[2] * up[0] - z[0] * up[2],
+                 z[0] * up[1] - z[1] * up[0]};
+  double l = sqrt(dot3(x, x));
+  for (int a = 0; a < 3; a++) x[a] /= l;
+  double y[3] = {z[1] * x[2] - z[2] * x[1], z[2] * x[0] - z[0] * x[2], z[0] * x[1] - z[1] * x[0]};
+  for (int a = 0; a < 3; a++) {
+    T->R[3 * a] = x[a];
+    T->R[3 * a + 1] = y[a];
+    T->R[3 * a + 2] = z[a];
+    T->t[a] = c[a];
+  }
+}
+
+/* Depth (mm) of the sphere seen by cam at pose T; 0 off the sphere. */
+static void render_sphere(const hearth_camera *cam, const hearth_rigid *T, hearth_image *img) {
+  hearth_err err = {0};
+  CHECK_OK(hearth_image_alloc(img, cam->width, cam->height, 1, HEARTH_PIX_U16, &err), &err);
+  uint16_t *d = img->data;
+  for (int v = 0; v < cam->height; v++)
+    for (int u = 0; u < cam->width; u++) {
+      double rc[3] = {(u - cam->cx) / cam->fx, (v - cam->cy) / cam->fy, 1.0}, rw[3];
+      hearth_rigid_rotate(T, rc, rw);
+      /* |c + s rw|^2 = R^2, s the depth along z (rc has z = 1) */
+      double b = dot3(T->t, rw), a = dot3(rw, rw), cc = dot3(T->t, T->t) - SPHERE_R * SPHERE_R;
+      double disc = b * b - a * cc;
+      if (disc < 0) continue;
+      double s = (-b - sqrt(disc)) / a;
+      if (s > 0) d[(size_t)v * cam->width + u] = (uint16_t)lround(s * 1000.0);
+    }
+}
+
+static void sphere_stats(const hearth_mesh *m, double *rms_to, double *rms_from) {
+  double s = 0;
+  for (size_t v = 0; v < m->n_vertices; v++) {
+    const float *p = m->positions + 3 * v;
+    double r = sqrt((double)p[0] * p[0] + (double)p[1] * p[1] + (double)p[2] * p[2]);
+    s += (r - SPHERE_R) * (r - SPHERE_R);
+  }
+  *rms_to = sqrt(s / (double)m->n_vertices);
+  /* sphere samples on a Fibonacci spiral to the nearest triangle */
+  tri_grid g;
+  tri_grid_build(&g, m, 0.004);
+  const int n = 2000;
+  s = 0;
+  for (int i = 0; i < n; i++) {
+    double z = 1.0 - (2.0 * i + 1.0) / n, r = sqrt(1.0 - z * z), ph = i * 2.399963229728653;
+    double p[3] = {SPHERE_R * r * cos(ph), SPHERE_R * r * sin(ph), SPHERE_R * z};
+    double d = tri_grid_dist(&g, p);
+    s += d * d;
+  }
+  *rms_from = sqrt(s / n);
+  tri_grid_free(&g);
+}
+
+static void fuse_sphere(hearth_mesh *m, double voxel) {
+  hearth_err err = {0};
+  hearth_camera cam = {640, 576, 500, 500, 319.5, 287.5, {0}};
+  hearth_tsdf vol;
+  double lo[3] = {-0.065, -0.065, -0.065}, hi[3] = {0.065, 0.065, 0.065};
+  CHECK_OK(hearth_tsdf_init(&vol, lo, hi, voxel, 4 * voxel, &err), &err);
+  const double els[3] = {-1.0, 0.0, 1.0};
+  for (int e = 0; e < 3; e++)
+    for (int a = 0; a < 6; a++) {
+      hearth_rigid T;
+      look_at(a * M_PI / 3 + e * 0.5, els[e], 0.35, &T);
+      hearth_image img;
+      render_sphere(&cam, &T, &img);
+      CHECK_OK(hearth_tsdf_integrate(&vol, &img, &cam, &T, NULL, &err), &err);
+      hearth_image_free(&img);
+    }
+  CHECK_OK(hearth_tsdf_extract(&vol, m, &err), &err);
+  hearth_tsdf_free(&vol);
+}
+
+static void test_sphere(void) {
+  hearth_err err = {0};
+  hearth_mesh m;
+  fuse_sphere(&m, 0.002);
+  CHECK(m.n_triangles > 1000);
+  CHECK_OK(hearth_mesh_keep_largest(&m, &err), &err);
+  CHECK_OK(hearth_mesh_validate(&m, "sphere", &err), &err);
+  size_t nb, nn;
+  hearth_mesh_edge_stats(&m, &nb, &nn);
+  CHECK_MSG(nb == 0 && nn == 0, "%zu boundary, %zu non-manifold edges", nb, nn);
+  double to, from;
+  sphere_stats(&m, &to, &from);
+  printf("sphere: %zu triangles, RMS mesh->sphere %.3f mm, sphere->mesh %.3f mm\n",
+         m.n_triangles, to * 1e3, from * 1e3);
+  CHECK_MSG(to < 0.6e-3 && from < 0.6e-3, "RMS %g %g", to, from);
+  /* outward normals: the signed volume is positive and near 4/3 pi R^3 */
+  double vol = 0;
+  for (size_t t = 0; t < m.n_triangles; t++) {
+    const float *a = m.positions + 3 * (size_t)m.indices[3 * t];
+    const float *b = m.positions + 3 * (size_t)m.indices[3 * t + 1];
+    const float *c = m.positions + 3 * (size_t)m.indices[3 * t + 2];
+    vol += (a[0] * ((double)b[1] * c[2] - (double)b[2] * c[1]) -
+            a[1] * ((double)b[0] * c[2] - (double)b[2] * c[0]) +
+            a[2] * ((double)b[0] * c[1] - (double)b[1] * c[0])) / 6.0;
+  }
+  double want = 4.0 / 3.0 * M_PI * SPHERE_R * SPHERE_R * SPHERE_R;
+  CHECK_MSG(fabs(vol - want) < 0.03 * want, "volume %g, sphere %g", vol, want);
+
+  /* simplification to a target count with bounded error, still closed */
+  hearth_mesh s;
+  CHECK_OK(hearth_mesh_copy(&m, &s, &err), &err);
+  CHECK_OK(hearth_mesh_simplify(&s, 2000, &err), &err);
+  CHECK_MSG(s.n_triangles <= 2000 && s.n_triangles >= 1900, "%zu triangles", s.n_triangles);
+  hearth_mesh_edge_stats(&s, &nb, &nn);
+  CHECK_MSG(nb == 0 && nn == 0, "simplified: %zu boundary, %zu non-manifold", nb, nn);
+  double sto, sfrom;
+  sphere_stats(&s, &sto, &sfrom);
+  printf("simplified to %zu: RMS %.3f / %.3f mm\n", s.n_triangles, sto * 1e3, sfrom * 1e3);
+  CHECK_MSG(sto < 0.8e-3 && sfrom < 0.8e-3, "RMS %g %g", sto, sfrom);
+  hearth_mesh_free(&s);
+
+  /* cut a cap off (triangles with a vertex above z = 0.045) and close it */
+  CHECK_OK(hearth_mesh_copy(&m, &s, &err), &err);
+  size_t w = 0;
+  for (size_t t = 0; t < s.n_triangles; t++) {
+    int cut = 0;
+    for (int c = 0; c < 3; c++) cut |= s.positions[3 * (size_t)s.indices[3 * t + c] + 2] > 0.045f;
+    if (cut) continue;
+    memmove(s.indices + 3 * w++, s.indices + 3 * t, 3 * sizeof *s.indices);
+  }
+  s.n_triangles = w;
+  hearth_mesh_edge_stats(&s, &nb, &nn);
+  CHECK(nb > 20);
+  size_t filled = 0;
+  CHECK_OK(hearth_mesh_fill_holes(&s, 10, &filled, &err), &err);
+  CHECK(filled == 0); /* the loop is longer than 10 edges */
+  CHECK_OK(hearth_mesh_fill_holes(&s, 1000, &filled, &err), &err);
+  CHECK(filled == 1);
+  hearth_mesh_edge_stats(&s, &nb, &nn);
+  CHECK_MSG(nb == 0 && nn == 0, "filled: %zu boundary, %zu non-manifold", nb, nn);
+  CHECK_OK(hearth_mesh_validate(&s, "filled", &err), &err);
+  hearth_mesh_free(&s);
+  hearth_mesh_free(&m);
+}
+
+static void test_errors(void) {
+  hearth_err err = {0};
+  hearth_tsdf vol;
+  double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+  CHECK(hearth_tsdf_init(&vol, lo, hi, 0, 1, &err) == HEARTH_E_ARG);
+  CHECK(hearth_tsdf_init(&vol, lo, hi, 1e-4, 1e-3, &err) == HEARTH_E_LIMIT);
+  hearth_mesh m;
+  CHECK(hearth_recon_tsdf("/nonexistent", "cup_01", NULL, 0, NULL, &m, &err) ==
+        HEARTH_E_IO);
+}
+
+/* Reconstruct instance of release root and compare with its true mesh. */
+static int run_release(const char *root, const char *instance, double voxel, size_t target,
+                       double trunc, double *rms_a, double *rms_b) {
+  hearth_err err = {0};
+  hearth_recon_tsdf_opts o;
+  hearth_recon_tsdf_opts_default(&o);
+  o.voxel_m = voxel;
+  o.target_triangles = target;
+  o.trunc_m = trunc;
+  hearth_mesh m, gt;
+  struct timespec t0, t1;
+  clock_gettime(CLOCK_MONOTONIC, &t0);
+  hearth_status s = hearth_recon_tsdf(root, instance, NULL, 0, &o, &m, &err);
+  clock_gettime(CLOCK_MONOTONIC, &t1);
+  CHECK_OK(s, &err);
+  if (s) return -1;
+  char path[1200];
+  snprintf(path, sizeof path, "%s/ground_truth/instances/%s/mesh.glb", root, instance);
+  CHECK_OK(hearth_glb_read(path, NULL, &gt, &err), &err);
+  double mx_a, mx_b;
+  const char *dump = getenv("RECON_TSDF_DUMP");
+  if (dump) CHECK_OK(hearth_glb_write(dump, &m, &err), &err);
+  mesh_to_mesh(&m, &gt, rms_a, &mx_a);
+  mesh_to_mesh(&gt, &m, rms_b, &mx_b);
+  size_t nb, nn;
+  hearth_mesh_edge_stats(&m, &nb, &nn);
+  CHECK_MSG(nb == 0 && nn == 0, "%s: %zu boundary, %zu non-manifold edges", instance, nb, nn);
+  printf("%s: voxel %.1f mm, %zu triangles (%zu boundary, %zu non-manifold edges), %.2f s; "
+         "RMS recon->true %.3f mm (max %.2f), true->recon %.3f mm (max %.2f)\n",
+         instance, voxel * 1e3, m.n_triangles, nb, nn,
+         (t1.tv_sec - t0.tv_sec) + 1e-9 * (t1.tv_nsec - t0.tv_nsec), *rms_a * 1e3, mx_a * 1e3,
+         *rms_b * 1e3, mx_b * 1e3);
+  hearth_mesh_free(&m);
+  hearth_mesh_free(&gt);
+  return 0;
+}
+
+static void test_release(void) {
+  const char *dir = test_tmpdir("recon_tsdf");
+  char root[1100], cmd[1400];
+  snprintf(root, sizeof root, "%s/rel", dir);
+  snprintf(cmd, sizeof cmd,
+           "%s synth --out '%s' --categories cup --states neutral --views 10 --no-calibration "
+           "--draft-rgb --texture 256 --map-res 64 --quiet",
+           HEARTH_EXE, root);
+  CHECK(system(cmd) == 0);
+  double a, b;
+  if (run_release(root, "cup_01", 0.003, 20000, 0, &a, &b) == 0) {
+    /* 10 views leave the cup's inside partly unseen: the true inner
+     * walls lie up to a few mm from the reconstruction */
+    CHECK_MSG(a < 1.5e-3 && b < 3.5e-3, "RMS %g %g", a, b);
+  }
+}
+
+int main(int argc, char **argv) {
+  if (argc >= 3) {
+    double a, b;
+    double voxel = argc >= 4 ? atof(argv[3]) : 0.002;
+    size_t target = argc >= 5 ? (size_t)atol(argv[4]) : 20000;
+    double trunc = argc >= 6 ? atof(argv[5]) : 0;
+    return run_release(argv[1], argv[2], voxel, target, trunc, &a, &b) ? 1 : g_test_failures;
+  }
+  test_errors();
+  test_sphere();
+  test_release();
+  return g_test_failures;
+}
