@@ -25,12 +25,12 @@ hearth_status sim_obj_write(const char *path, const hearth_mesh *m, hearth_err *
   return hearth_atomic_commit(&af, err);
 }
 
-hearth_status sim_mjcf_write_scene(const hearth_sim_env *e, const char *xml_path, hearth_err *err) {
+void sim_mjcf_scene_text(const hearth_sim_env *e, const char *dir, hearth_strbuf *out) {
   const sim_task_def *td = sim_task_get(e->task);
   int study = strcmp(td->scene, "study") == 0;
-  hearth_strbuf b = {0};
+  hearth_strbuf b = *out;
   hearth_strbuf_printf(&b, "<mujoco model=\"hearth_%s\">\n<compiler angle=\"radian\" autolimits=\"true\" meshdir=\"%s\" texturedir=\"%s\"/>\n",
-                       td->name, e->work_dir, e->work_dir);
+                       td->name, dir, dir);
   hearth_strbuf_printf(&b, "<option timestep=\"%s\" impratio=\"10\" cone=\"elliptic\"/>\n", sim_num(HEARTH_SIM_TIMESTEP).s);
   /* one sample per pixel: the thermal view's pixels are then exactly the
    * texture's (no edge blends with the room colour), and the CPU renderer
@@ -110,6 +110,12 @@ hearth_status sim_mjcf_write_scene(const hearth_sim_env *e, const char *xml_path
   hearth_strbuf_printf(&b, "</worldbody>\n");
   sim_robot_emit_actuators(&b);
   hearth_strbuf_printf(&b, "</mujoco>\n");
+  *out = b;
+}
+
+hearth_status sim_mjcf_write_scene(const hearth_sim_env *e, const char *xml_path, hearth_err *err) {
+  hearth_strbuf b = {0};
+  sim_mjcf_scene_text(e, e->work_dir, &b);
   if (b.failed) {
     hearth_strbuf_free(&b);
     return hearth_err_set(err, HEARTH_E_NOMEM, "sim: out of memory building the MJCF");
