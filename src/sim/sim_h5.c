@@ -212,11 +212,10 @@ static char *h5_read_str(hid_t obj, const char *name) {
   hid_t t = H5Aget_type(a);
   char *out = NULL;
   if (H5Tget_class(t) == H5T_STRING && H5Tis_variable_str(t)) {
-    hid_t mt = vlen_utf8();
+    /* the attribute's own type: HDF5 converts no string between ASCII and UTF-8 */
     char *s = NULL;
-    if (H5Aread(a, mt, &s) >= 0 && s) out = strdup(s);
+    if (H5Aread(a, t, &s) >= 0 && s) out = strdup(s);
     if (s) H5free_memory(s);
-    H5Tclose(mt);
   } else if (H5Tget_class(t) == H5T_STRING) {
     size_t n = H5Tget_size(t);
     out = calloc(1, n + 1);
