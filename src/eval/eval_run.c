@@ -198,6 +198,7 @@ static hearth_status check_server(const hearth_eval_opts *o, eval_ws_policy *p, 
     snprintf(r->warning, sizeof r->warning,
              "policy server %s declares %s in its metadata, but --no-thermal leaves observation/thermal_image out",
              p->url, p->thermal_why);
+  if (!o->quiet) fprintf(stderr, "sim eval: policy server %s: metadata %s\n", p->url, p->metadata_json);
   if (r->warning[0] && !o->quiet) fprintf(stderr, "sim eval: warning: %s\n", r->warning);
   return HEARTH_OK;
 }
