@@ -21,8 +21,9 @@ static const char *k_about_collect =
     "Layouts: objects jittered in 5 x 5 cm squares around fixed spots, fixed\n"
     "orientations, redrawn until both candidates are at least 70% visible in the\n"
     "front view. Even layouts put the first instruction's object in slot A, odd\n"
-    "ones in slot B; a layout where the expert fails either instruction is replaced\n"
-    "by the next unused layout of the same parity, so assignments stay balanced.\n"
+    "ones in slot B. Slot k of the file tries layout k; where the expert fails either\n"
+    "instruction it tries layout k + 200000 j (j = 1..19, the same parity), so\n"
+    "assignments stay balanced and a slot's layout depends on the slot alone.\n"
     "\n"
     "One file holds both instructions (demo_0, demo_1 from layout 1, ...). LIBERO's\n"
     "loaders read data.attrs['problem_info']['language_instruction'] as one string:\n"
@@ -35,8 +36,8 @@ static const char *k_about_collect =
     "\n"
     "Scale-out: --shard I/N collects the slots k with k % N == I (e.g. a Slurm array:\n"
     "--shard $SLURM_ARRAY_TASK_ID/N, the same --layouts and seed in every shard);\n"
-    "`hearth sim merge OUT.hdf5 PARTS...` then writes the bytes one run writes. A\n"
-    "slot whose layout fails is retried with layouts of its own (k + 200000 j).\n";
+    "`hearth sim merge OUT.hdf5 PARTS...` then writes the bytes one run writes\n"
+    "(docs/cluster.md).\n";
 
 static const char *k_about_merge =
     "Merge the files of the shards of one `hearth sim collect --shard I/N` run (all N,\n"
