@@ -15,7 +15,8 @@ pkgs="build-essential cmake pkg-config clang libclang-rt-14-dev git
   libembree-dev libjansson-dev libpng-dev zlib1g-dev libjpeg62-turbo-dev
   liblapacke-dev liblapack-dev libblas-dev libhdf5-dev
   libmujoco-dev libosmesa6-dev libegl-dev libegl-mesa0
-  python3 python3-numpy python3-h5py python3-opencv python3-websockets python3-msgpack"
+  python3 python3-numpy python3-h5py python3-opencv python3-websockets python3-msgpack
+  munge slurmctld slurmd slurm-client"
 missing=""
 for p in $pkgs; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"

@@ -55,10 +55,10 @@ typedef struct hearth_eval_opts {
   uint64_t layout_base;    /* episode k uses layout layout_base + k; default HEARTH_EVAL_LAYOUT_BASE */
   const char *release_root;
   int use_ground_truth;
-  int render_size;         /* sim view side; default 256 */
+  int render_size;         /* sim view side; default 256 (as collection stores) */
   int shadows;             /* as hearth_sim_opts.shadows; default 0 */
   const char *gl;          /* as hearth_sim_opts.gl */
-  int image_size;          /* policy image side; default 224 */
+  int image_size;          /* policy image side; default 224 (openpi's model input) */
   int max_steps;           /* 0 = hearth_eval_time_limit(task) */
   int replan_steps;        /* default 5 */
   int wait_steps;          /* no-op steps before querying; default 10 */
@@ -84,24 +84,42 @@ typedef struct hearth_eval_results {
   hearth_eval_episode *eps;
   size_t n;
   char policy[256];
-  int thermal;
+  int thermal;             /* server policies: 1 observation/thermal_image is sent, 0 not;
+                            * -1 for the other policies */
+  int thermal_used;        /* server policies: 1 sent and the server's metadata declares it
+                            * reads it; 0 not sent; -1 sent, the metadata says nothing */
   double seconds;
-  char metadata[512];      /* server metadata (JSON-ish summary), if any */
+  char *metadata_json;     /* the server's whole metadata map as JSON (malloc'd), NULL
+                            * without a server */
+  int render_size, image_size, replan_steps, wait_steps, shadows; /* the options run */
+  char renderer[256];      /* hearth_sim_renderer of the evaluation's env */
+  char warning[512];       /* "" or what the reader must know (thermal use unknown) */
 } hearth_eval_results;
 
 /* Run every episode; r is filled on success (the caller frees it with
  * hearth_eval_results_free, which accepts a zeroed struct). A policy's
  * failure fails its episode and the run goes on; a simulator failure stops
- * the run with an error. */
+ * the run with an error. A server policy is connected before the first
+ * episode: an unreachable server is an error, and so is the thermal
+ * condition (o->thermal) with a server whose metadata declares that it
+ * ignores the thermal view ("hearth_thermal": false, or "image_keys"
+ * without "observation/thermal_image"); a server that declares nothing
+ * gets a warning (r->warning, on stderr unless quiet) and thermal_used -1. */
 hearth_status hearth_eval_run(const hearth_eval_opts *o, hearth_eval_results *r, hearth_err *err);
 void hearth_eval_results_free(hearth_eval_results *r);
+/* Episodes failed by the policy (server errors, bad replies), as opposed
+ * to task failures. */
+size_t hearth_eval_policy_errors(const hearth_eval_results *r);
 
 /* Success rates: per (task, instruction) and task (NaN where no episode);
  * overall over every episode. Returns the overall fraction. */
 double hearth_eval_rates(const hearth_eval_results *r, double per_instr[4][2], double per_task[4]);
 /* The paper's table (Task, Thermal, Instr. 1, Instr. 2, Average) as text
- * (ends with a line "overall <pct> (k/n)"), Markdown and JSON (with every
- * episode). malloc'd strings (the caller frees them). */
+ * (the setup and server metadata first; ends with a line "overall <pct>
+ * (k/n)"), Markdown and JSON (with the setup, the metadata and every
+ * episode). Thermal reads "w/", "w/o", or "w/?" when the server did not
+ * declare whether it reads the thermal view. malloc'd strings (the caller
+ * frees them). */
 char *hearth_eval_format_text(const hearth_eval_results *r);
 char *hearth_eval_format_markdown(const hearth_eval_results *r);
 char *hearth_eval_format_json(const hearth_eval_results *r);

@@ -128,29 +128,56 @@ typedef struct hearth_sim_collect_opts {
   hearth_sim_task task;
   const char *release_root;
   int use_ground_truth;
-  int layouts;          /* default 200: 2 instructions each */
+  int layouts;          /* slots of the whole collection, 1..HEARTH_SIM_MAX_LAYOUTS; default
+                         * 200: 2 instructions each */
   uint64_t seed;        /* default 1 */
-  int image_size;       /* stored image side; default 128 (LIBERO) */
+  int image_size;       /* rendered and stored image side; default 256 (openpi's LIBERO
+                         * data; what hearth_eval_opts.render_size renders by default) */
   int max_steps;        /* default 400 */
-  int keep_failures;    /* store failed demos too (default 0: retry with the next layout) */
+  int keep_failures;    /* store failed demos too (default 0: retry the slot with its next
+                         * candidate layout) */
   int shadows;          /* as hearth_sim_opts.shadows; default 0 */
   const char *gl;       /* as hearth_sim_opts.gl */
+  int shard_index, shard_count; /* this process fills the slots k with k % count == index;
+                         * count 0 or 1: all of them. The files of a shard are merged
+                         * with hearth_sim_merge */
+  int split_instructions; /* one file per instruction: out_path without ".hdf5", plus
+                         * "_instr1.hdf5" and "_instr2.hdf5" (hearth_sim_split_path) */
   int quiet;
   const char *out_path; /* .hdf5, written atomically (layout: docs/simulation.md) */
 } hearth_sim_collect_opts;
 void hearth_sim_collect_opts_default(hearth_sim_collect_opts *o);
 
+/* Slot k of a collection tries layout k, then, while the expert fails on
+ * one of the two instructions, layouts k + j * 2 * HEARTH_SIM_MAX_LAYOUTS
+ * for j = 1 .. HEARTH_SIM_SLOT_TRIES - 1 (the same parity as k, never
+ * another slot's): which layout fills a slot depends on the slot alone,
+ * so shards together store what one run stores. */
+#define HEARTH_SIM_MAX_LAYOUTS 100000
+#define HEARTH_SIM_SLOT_TRIES 20
+
 typedef struct hearth_sim_collect_stats {
   int attempts[2], successes[2]; /* per instruction */
-  int demos;
+  int demos;                     /* per file */
   long steps;
   double seconds;
   int rejected_layouts;          /* layouts skipped because the expert failed */
+  int slots;                     /* slots this process filled */
 } hearth_sim_collect_stats;
-/* Collect layouts x 2 demonstrations with the scripted expert into
- * out_path; stats may be NULL. */
+/* Collect the slots of this shard x 2 demonstrations with the scripted
+ * expert into out_path (or its two split files); stats may be NULL. */
 hearth_status hearth_sim_collect(const hearth_sim_collect_opts *o, hearth_sim_collect_stats *stats,
                                  hearth_err *err);
+/* The file of instruction ins (0 or 1) of a split collection written to
+ * out_path: "<out_path without .hdf5>_instr<ins + 1>.hdf5", into buf. */
+void hearth_sim_split_path(const char *out_path, int ins, char *buf, size_t bufsz);
+
+/* Merge the files of the shards 0..N-1 of one collection (any order, each
+ * once; for a split collection, the files of one instruction) into
+ * out_path, written atomically: the same bytes as one unsharded run.
+ * *n_demos (may be NULL) receives the demos written. */
+hearth_status hearth_sim_merge(const char *out_path, const char *const *parts, int n_parts, int *n_demos,
+                               hearth_err *err);
 
 /* Render the task's scene (layout 0 of seed, instruction 0) to
  * <out_prefix>_rgb.png, <out_prefix>_thermal.png and (with the wrist view)

@@ -16,6 +16,7 @@ void sim_cli_drop_assets(const char *tmpdir);
 /* the subcommands (argv[0] is the subcommand's name) */
 int hearth_cmd_sim_render(int argc, char **argv);
 int hearth_cmd_sim_collect(int argc, char **argv);
+int hearth_cmd_sim_merge(int argc, char **argv);
 int hearth_cmd_sim_eval(int argc, char **argv);
 int hearth_cmd_sim_export(int argc, char **argv);
 

@@ -1,4 +1,5 @@
-/* hearth sim render, hearth sim collect: scene pictures and demonstrations */
+/* hearth sim render, collect, merge: scene pictures, demonstrations and
+ * the merge of a sharded collection */
 #include <stdio.h>
 #include <stdlib.h>
 #include <unistd.h>
@@ -20,14 +21,29 @@ static const char *k_about_collect =
     "Layouts: objects jittered in 5 x 5 cm squares around fixed spots, fixed\n"
     "orientations, redrawn until both candidates are at least 70% visible in the\n"
     "front view. Even layouts put the first instruction's object in slot A, odd\n"
-    "ones in slot B; a layout where the expert fails either instruction is replaced\n"
-    "by the next unused layout of the same parity, so assignments stay balanced.\n"
+    "ones in slot B. Slot k of the file tries layout k; where the expert fails either\n"
+    "instruction it tries layout k + 200000 j (j = 1..19, the same parity), so\n"
+    "assignments stay balanced and a slot's layout depends on the slot alone.\n"
     "\n"
     "One file holds both instructions (demo_0, demo_1 from layout 1, ...). LIBERO's\n"
     "loaders read data.attrs['problem_info']['language_instruction'] as one string:\n"
     "it holds the first instruction; every demo has its own `language_instruction`\n"
-    "attribute, and data.attrs['instructions'] lists both (JSON). Images are stored\n"
-    "in OpenGL row order (bottom row first, data.attrs['image_row_order']).\n";
+    "attribute, and data.attrs['instructions'] lists both (JSON). With\n"
+    "--split-instructions, OUT_instr1.hdf5 and OUT_instr2.hdf5 (OUT without .hdf5)\n"
+    "each hold one instruction, named by their problem_info as LIBERO reads it.\n"
+    "Images are stored in OpenGL row order (bottom row first,\n"
+    "data.attrs['macros_image_convention'] 'opengl').\n"
+    "\n"
+    "Scale-out: --shard I/N collects the slots k with k % N == I (e.g. a Slurm array:\n"
+    "--shard $SLURM_ARRAY_TASK_ID/N, the same --layouts and seed in every shard);\n"
+    "`hearth sim merge OUT.hdf5 PARTS...` then writes the bytes one run writes\n"
+    "(docs/cluster.md).\n";
+
+static const char *k_about_merge =
+    "Merge the files of the shards of one `hearth sim collect --shard I/N` run (all N,\n"
+    "in any order) into OUT.hdf5, written atomically: the same bytes as the file of\n"
+    "one unsharded run with the same options. For --split-instructions, merge the\n"
+    "files of each instruction separately.\n";
 
 /* --task of render and collect: hearth_sim_task values */
 static const char *const k_task_names[] = {"H1", "H2", "H3", NULL};
@@ -96,7 +112,8 @@ int hearth_cmd_sim_collect(int argc, char **argv) {
       CLI_INT("--layouts", "N", &o.layouts, 1, 100000,
               "layouts (200 as in the paper: 400 demos per task)"),
       CLI_U64("--seed", "N", &o.seed, "layout seed"),
-      CLI_INT("--size", "N", &o.image_size, 16, 1024, "stored image side (128 is LIBERO's)"),
+      CLI_INT("--size", "N", &o.image_size, 16, 1024,
+              "rendered and stored image side (256: openpi's LIBERO data and what sim eval renders)"),
       CLI_INT("--max-steps", "N", &o.max_steps, 1, 100000,
               "time limit per episode in control steps"),
       CLI_STR("--release", "ROOT", &release, "assets from a release (derived/)",
@@ -106,6 +123,11 @@ int hearth_cmd_sim_collect(int argc, char **argv) {
       CLI_FLAG("--keep-failures", &o.keep_failures, 1, "also store episodes that did not succeed"),
       CLI_FLAG("--shadows", &o.shadows, 1, "shadow-mapped light in the RGB views (off by default)"),
       CLI_STR("--gl", "osmesa|egl", &o.gl, "GL back end", .def = "$HEARTH_GL, else osmesa"),
+      CLI_SHARD("--shard", "I/N", &o.shard_index, &o.shard_count,
+                "collect only the slots k with k % N == I (merge the N files with sim merge)",
+                .def = "0/1"),
+      CLI_FLAG("--split-instructions", &o.split_instructions, 1,
+               "one LIBERO file per instruction: OUT_instr1.hdf5, OUT_instr2.hdf5"),
       CLI_FLAG("--quiet", &o.quiet, 1, "no progress output"),
       CLI_END,
   };
@@ -125,8 +147,34 @@ int hearth_cmd_sim_collect(int argc, char **argv) {
   for (int i = 0; i < 2; i++)
     printf("instruction %d \"%s\": %d/%d successful\n", i + 1, hearth_sim_instruction_text(o.task, i),
            s.successes[i], s.attempts[i]);
-  printf("%d demos, %d layouts replaced, %ld steps, %.1f s (%.1f steps/s) -> %s\n", s.demos,
-         s.rejected_layouts, s.steps, s.seconds, s.seconds > 0 ? s.steps / s.seconds : 0.0,
-         o.out_path);
+  char outs[8600];
+  if (o.split_instructions) {
+    char a[4200], b[4200];
+    hearth_sim_split_path(o.out_path, 0, a, sizeof a);
+    hearth_sim_split_path(o.out_path, 1, b, sizeof b);
+    snprintf(outs, sizeof outs, "%s, %s", a, b);
+  } else {
+    snprintf(outs, sizeof outs, "%s", o.out_path);
+  }
+  if (o.shard_count > 1)
+    printf("shard %d/%d: %d of %d slots\n", o.shard_index, o.shard_count, s.slots, o.layouts);
+  printf("%d demos%s, %d layouts replaced, %ld steps, %.1f s (%.1f steps/s) -> %s\n", s.demos,
+         o.split_instructions ? " per file" : "", s.rejected_layouts, s.steps, s.seconds,
+         s.seconds > 0 ? s.steps / s.seconds : 0.0, outs);
+  return 0;
+}
+
+int hearth_cmd_sim_merge(int argc, char **argv) {
+  const cli_opt opts[] = {CLI_END};
+  const cli_command cmd = {.name = "hearth sim merge", .args = "OUT.hdf5 PART.hdf5...", .min_args = 2,
+                           .max_args = -1, .about = k_about_merge, .opts = opts,
+                           .usage = "hearth sim merge OUT.hdf5 PART.hdf5... [options]"};
+  cli_args a;
+  int rc = cli_parse(&cmd, argc, argv, &a);
+  if (rc != CLI_RUN) return rc;
+  hearth_err err = {0};
+  int n = 0;
+  if (hearth_sim_merge(a.v[0], (const char *const *)(a.v + 1), a.n - 1, &n, &err)) return cli_fail("sim merge", &err);
+  printf("%d parts, %d demos -> %s\n", a.n - 1, n, a.v[0]);
   return 0;
 }

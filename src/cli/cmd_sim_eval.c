@@ -16,7 +16,15 @@ static const char *k_about =
     "per task, after the 10 no-op steps of a server policy). Prints the paper's table\n"
     "(Task, Thermal, Instr. 1, Instr. 2, Average) ending with a line `overall <pct>`.\n"
     "A policy that errs (server gone, garbage, timeout) fails that episode with the\n"
-    "reason; the evaluation goes on (reconnecting for the next episode).\n"
+    "reason; the evaluation goes on (reconnecting for the next episode). Such policy\n"
+    "errors are counted apart from task failures; when every episode is one, the\n"
+    "command exits with status 1 after writing the results.\n"
+    "\n"
+    "A server is connected before the first episode; its metadata map is printed and\n"
+    "stored in results.json. The thermal condition with a server whose metadata says\n"
+    "it ignores the thermal view (\"hearth_thermal\": false, or \"image_keys\" without\n"
+    "\"observation/thermal_image\") is refused; a server that says neither gets a\n"
+    "warning, Thermal \"w/?\" and \"thermal_used\": \"unknown\".\n"
     "\n"
     "policies (--policy):\n"
     "  oracle               the scripted expert (privileged state): an upper bound\n"
@@ -26,7 +34,10 @@ static const char *k_about =
     "                       observations observation/image, observation/wrist_image\n"
     "                       (224x224, rotated 180 deg, resized with padding),\n"
     "                       observation/thermal_image, observation/state (8), prompt;\n"
-    "                       action chunks, replanning every 5 steps\n";
+    "                       action chunks, replanning every 5 steps\n"
+    "\n"
+    "Views render at 256 px (--size), the side `hearth sim collect` stores, and are\n"
+    "resized to 224 px (--image-size) for the policy, as openpi's LIBERO client does.\n";
 
 static int write_text(const char *dir, const char *name, const char *s) {
   char path[4200];
@@ -64,7 +75,7 @@ int hearth_cmd_sim_eval(int argc, char **argv) {
   hearth_eval_opts o;
   hearth_eval_opts_default(&o);
   const char *out = NULL, *release = NULL;
-  int tasks = (int)o.tasks;
+  int tasks = (int)o.tasks, gt = 0;
   const cli_opt opts[] = {
       CLI_STR("--policy", "SPEC", &o.policy, "the policy, as listed above"),
       CLI_CHOICE("--task", &tasks, k_task_names, k_task_bits, "tasks", .flags = CLI_NOCASE),
@@ -74,7 +85,9 @@ int hearth_cmd_sim_eval(int argc, char **argv) {
       CLI_U64("--seed", "N", &o.seed, "layout seed (as collection)"),
       CLI_STR("--release", "ROOT", &release, "assets from a release (derived/)",
               .def = "virtual rig"),
-      CLI_INT("--size", "N", &o.render_size, 16, 2048, "rendered view side"),
+      CLI_FLAG("--ground-truth", &gt, 1,
+               "with --release: a virtual-rig release's ground_truth/ assets (as sim collect)"),
+      CLI_INT("--size", "N", &o.render_size, 16, 2048, "rendered view side (as sim collect stores)"),
       CLI_FLAG("--shadows", &o.shadows, 1, "shadow-mapped light in the RGB views (as at collection)"),
       CLI_STR("--gl", "osmesa|egl", &o.gl, "GL back end", .def = "$HEARTH_GL, else osmesa"),
       CLI_INT("--image-size", "N", &o.image_size, 8, 1024, "policy image side"),
@@ -97,7 +110,7 @@ int hearth_cmd_sim_eval(int argc, char **argv) {
   o.tasks = (unsigned)tasks;
   char root[4200], tmpdir[4200] = "";
   /* the same virtual-rig assets as `hearth sim collect` makes by default */
-  if (sim_cli_assets(release, 0, root, sizeof root, tmpdir, sizeof tmpdir, &o.use_ground_truth, o.quiet))
+  if (sim_cli_assets(release, gt, root, sizeof root, tmpdir, sizeof tmpdir, &o.use_ground_truth, o.quiet))
     return 1;
   o.release_root = root;
   hearth_eval_results res;
@@ -119,6 +132,14 @@ int hearth_cmd_sim_eval(int argc, char **argv) {
     free(js), free(md);
   }
   free(txt);
+  size_t perr = hearth_eval_policy_errors(&res);
+  if (!rc && res.n > 0 && perr == res.n) {
+    fprintf(stderr,
+            "sim eval: every episode (%zu) failed because of the policy (server errors, not task failures): "
+            "see the reasons above\n",
+            res.n);
+    rc = 1;
+  }
   hearth_eval_results_free(&res);
   return rc;
 }

@@ -17,8 +17,12 @@ static const char k_about[] =
     "subcommands:\n"
     "  render    write PNGs of each task's scene: front RGB, front thermal, wrist RGB\n"
     "  collect   collect scripted-expert demonstrations into a LIBERO HDF5 file\n"
-    "  eval      score a policy on the tasks the way the paper does\n"
-    "  export    write collections as a LeRobot dataset (v2.1) for openpi training\n";
+    "  merge     merge the files of a sharded collection into the file of one run
+"
+    "  eval      score a policy on the tasks the way the paper does
+"
+    "  export    write collections as a LeRobot dataset (v2.1) for openpi training
+";
 
 static const char k_tail[] = "Run `hearth sim <subcommand> --help` for its options.\n";
 
@@ -39,6 +43,7 @@ int main(int argc, char **argv) {
   if (rc != CLI_RUN) return rc;
   if (strcmp(sub.v[0], "render") == 0) return hearth_cmd_sim_render(sub.n, sub.v);
   if (strcmp(sub.v[0], "collect") == 0) return hearth_cmd_sim_collect(sub.n, sub.v);
+  if (strcmp(sub.v[0], "merge") == 0) return hearth_cmd_sim_merge(sub.n, sub.v);
   if (strcmp(sub.v[0], "eval") == 0) return hearth_cmd_sim_eval(sub.n, sub.v);
   if (strcmp(sub.v[0], "export") == 0) return hearth_cmd_sim_export(sub.n, sub.v);
   return cli_usage_error(&k_cmd, "unknown subcommand '%s' (see 'hearth sim --help')", sub.v[0]);

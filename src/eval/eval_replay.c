@@ -25,12 +25,11 @@ static int h5_read_str_attr(hid_t obj, const char *name, char *buf, size_t n) {
     if (tmp && H5Aread(a, t, tmp) >= 0) snprintf(buf, n, "%s", tmp), ok = 1;
     free(tmp);
   } else if (H5Tget_class(t) == H5T_STRING) {
+    /* variable length: read with the attribute's own type (HDF5 converts
+     * no string between ASCII and UTF-8) */
     char *s = NULL;
-    hid_t mt = H5Tcopy(H5T_C_S1);
-    H5Tset_size(mt, H5T_VARIABLE);
-    if (H5Aread(a, mt, &s) >= 0 && s) snprintf(buf, n, "%s", s), ok = 1;
-    free(s);
-    H5Tclose(mt);
+    if (H5Aread(a, t, &s) >= 0 && s) snprintf(buf, n, "%s", s), ok = 1;
+    if (s) H5free_memory(s);
   }
   H5Tclose(t);
   H5Aclose(a);
@@ -84,7 +83,7 @@ hearth_status eval_replay_load(const char *spec, eval_replay_file *r, hearth_err
   if (f < 0) return hearth_err_set(err, HEARTH_E_IO, "%s: cannot open as HDF5", path);
   hearth_status st = HEARTH_OK;
   hid_t data = H5Gopen2(f, "data", H5P_DEFAULT);
-  char ea[2048];
+  char ea[16384];
   long long ndemo = 0;
   if (data < 0 || !h5_read_str_attr(data, "env_args", ea, sizeof ea) || !h5_read_int_attr(data, "num_demos", &ndemo)) {
     st = hearth_err_set(err, HEARTH_E_NOT_FOUND, "%s: expected group data with attributes env_args and num_demos", path);

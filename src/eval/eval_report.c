@@ -29,7 +29,24 @@ static const char *pct(double f, char *buf) {
 }
 
 static const char *thermal_label(const hearth_eval_results *r) {
-  return r->thermal < 0 ? "-" : r->thermal ? "w/" : "w/o";
+  return r->thermal < 0 ? "-" : !r->thermal ? "w/o" : r->thermal_used < 0 ? "w/?" : "w/";
+}
+
+/* what the run was: sizes, replanning, lighting, renderer, and for a
+ * server what it said about the thermal view */
+static void setup_lines(const hearth_eval_results *r, hearth_strbuf *b) {
+  hearth_strbuf_printf(b, "setup: render %d px", r->render_size);
+  if (r->thermal >= 0)
+    hearth_strbuf_printf(b, ", policy images %d px, replan every %d steps after %d no-op steps", r->image_size,
+                         r->replan_steps, r->wait_steps);
+  hearth_strbuf_printf(b, ", shadows %s, renderer %s\n", r->shadows ? "on" : "off", r->renderer[0] ? r->renderer : "-");
+  if (r->thermal >= 0)
+    hearth_strbuf_printf(b, "thermal image: %s\n",
+                         !r->thermal ? "not sent (--no-thermal)"
+                         : r->thermal_used > 0 ? "sent; the server declares it reads it"
+                                               : "sent; the server does not declare whether it reads it (unknown)");
+  if (r->metadata_json) hearth_strbuf_printf(b, "server metadata: %s\n", r->metadata_json);
+  if (r->warning[0]) hearth_strbuf_printf(b, "warning: %s\n", r->warning);
 }
 
 static void counts(const hearth_eval_results *r, int *ok, int *tot) {
@@ -47,6 +64,7 @@ char *hearth_eval_format_text(const hearth_eval_results *r) {
                            hearth_sim_task_name(r->eps[i].task), r->eps[i].instruction + 1, r->eps[i].episode,
                            (unsigned long long)r->eps[i].layout, r->eps[i].reason);
   hearth_strbuf_printf(&b, "policy %s\n", r->policy);
+  setup_lines(r, &b);
   hearth_strbuf_printf(&b, "%-6s %-8s %9s %9s %9s\n", "Task", "Thermal", "Instr. 1", "Instr. 2", "Average");
   for (int t = 1; t <= 3; t++) {
     if (isnan(pt[t])) continue;
@@ -57,6 +75,10 @@ char *hearth_eval_format_text(const hearth_eval_results *r) {
   int ok, tot;
   counts(r, &ok, &tot);
   char a[32];
+  size_t perr = hearth_eval_policy_errors(r);
+  if (perr)
+    hearth_strbuf_printf(&b, "policy errors: %zu of %d episodes failed because of the policy, not the task\n", perr,
+                         tot);
   hearth_strbuf_printf(&b, "overall %s (%d/%d)\n", pct(all, a), ok, tot);
   return hearth_strbuf_take(&b);
 }
@@ -91,11 +113,30 @@ char *hearth_eval_format_json(const hearth_eval_results *r) {
   json_t *root = json_object();
   json_object_set_new(root, "policy", json_string(r->policy));
   json_object_set_new(root, "thermal", r->thermal < 0 ? json_null() : json_boolean(r->thermal));
+  json_object_set_new(root, "thermal_used", r->thermal < 0 ? json_null()
+                                            : r->thermal_used < 0 ? json_string("unknown")
+                                                                  : json_boolean(r->thermal_used));
+  json_t *meta = NULL;
+  if (r->metadata_json) {
+    json_error_t je;
+    meta = json_loads(r->metadata_json, 0, &je);
+  }
+  json_object_set_new(root, "server_metadata", meta ? meta : json_null());
+  json_object_set_new(root, "render_size", json_integer(r->render_size));
+  json_object_set_new(root, "image_size", json_integer(r->image_size));
+  json_object_set_new(root, "replan_steps", json_integer(r->replan_steps));
+  json_object_set_new(root, "wait_steps", json_integer(r->wait_steps));
+  json_object_set_new(root, "shadows", json_boolean(r->shadows));
+  json_object_set_new(root, "renderer", json_string(r->renderer));
+  json_object_set_new(root, "warning", r->warning[0] ? json_string(r->warning) : json_null());
   json_object_set_new(root, "overall_success", jnum(all));
   int ok, tot;
   counts(r, &ok, &tot);
+  size_t perr = hearth_eval_policy_errors(r);
   json_object_set_new(root, "successes", json_integer(ok));
   json_object_set_new(root, "episodes_total", json_integer(tot));
+  json_object_set_new(root, "policy_errors", json_integer((json_int_t)perr));
+  json_object_set_new(root, "task_failures", json_integer(tot - ok - (json_int_t)perr));
   json_t *tasks = json_object();
   for (int t = 1; t <= 3; t++) {
     if (isnan(pt[t])) continue;

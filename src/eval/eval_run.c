@@ -87,6 +87,12 @@ static hearth_status run_episode(ep_ctx *x, hearth_eval_episode *ep, int limit, 
   if (x->ws) {
     x->ws->nchunk = x->ws->next = 0;
     if (eval_ws_ensure(x->ws, &perr)) perror_ = 1;
+    else if (o->thermal && x->ws->thermal_decl == 0) {
+      /* a reconnection's metadata disowns the thermal view */
+      snprintf(perr.msg, sizeof perr.msg, "policy server %s: its metadata now declares %s: it ignores the thermal view",
+               x->ws->url, x->ws->thermal_why);
+      perror_ = 1;
+    }
   }
   double state[4096], *nstate = NULL;
   size_t ns = 0;
@@ -166,6 +172,37 @@ static hearth_status run_episode(ep_ctx *x, hearth_eval_episode *ep, int limit, 
   return HEARTH_OK;
 }
 
+/* connect to the server before any episode and hold its metadata against
+ * the thermal condition */
+static hearth_status check_server(const hearth_eval_opts *o, eval_ws_policy *p, hearth_eval_results *r,
+                                  hearth_err *err) {
+  hearth_status st = eval_ws_ensure(p, err);
+  if (st) {
+    hearth_err_prefix(err, "eval: before the first episode: ");
+    return st;
+  }
+  if (o->thermal && p->thermal_decl == 0)
+    return hearth_err_set(err, HEARTH_E_ARG,
+                          "eval: policy server %s: its metadata declares %s, so it ignores the thermal view, but "
+                          "the thermal condition is on: evaluate it with --no-thermal (the RGB-only condition) "
+                          "or serve a policy that reads observation/thermal_image",
+                          p->url, p->thermal_why);
+  r->thermal_used = !o->thermal ? 0 : p->thermal_decl == 1 ? 1 : -1;
+  if (r->thermal_used < 0)
+    snprintf(r->warning, sizeof r->warning,
+             "policy server %s declares neither \"hearth_thermal\" nor \"image_keys\" in its metadata: whether "
+             "it reads observation/thermal_image is unknown (thermal_used \"unknown\"; a policy trained without "
+             "it ignores the key)",
+             p->url);
+  else if (!o->thermal && p->thermal_decl == 1)
+    snprintf(r->warning, sizeof r->warning,
+             "policy server %s declares %s in its metadata, but --no-thermal leaves observation/thermal_image out",
+             p->url, p->thermal_why);
+  if (!o->quiet) fprintf(stderr, "sim eval: policy server %s: metadata %s\n", p->url, p->metadata_json);
+  if (r->warning[0] && !o->quiet) fprintf(stderr, "sim eval: warning: %s\n", r->warning);
+  return HEARTH_OK;
+}
+
 static hearth_status push_ep(hearth_eval_results *r, const hearth_eval_episode *ep, hearth_err *err) {
   hearth_eval_episode *n = realloc(r->eps, (r->n + 1) * sizeof *n);
   if (!n) return hearth_err_set(err, HEARTH_E_NOMEM, "eval: results");
@@ -219,6 +256,9 @@ hearth_status hearth_eval_run(const hearth_eval_opts *o, hearth_eval_results *r,
   wsp.image_size = o->image_size;
   wsp.thermal = o->thermal;
   wsp.replan = o->replan_steps;
+  r->render_size = o->render_size, r->image_size = o->image_size, r->replan_steps = o->replan_steps;
+  r->wait_steps = is_ws ? o->wait_steps : 0, r->shadows = o->shadows;
+  if (is_ws) st = check_server(o, &wsp, r, err);
   for (int task = 1; task <= 3 && !st; task++) {
     if (is_replay ? task != (int)rf.task : !(o->tasks & (1u << task))) continue;
     hearth_sim_opts so;
@@ -236,6 +276,7 @@ hearth_status hearth_eval_run(const hearth_eval_opts *o, hearth_eval_results *r,
         if ((int)rf.demos[i].T + 1 > so.max_steps) so.max_steps = (int)rf.demos[i].T + 1;
     hearth_sim_env *env = NULL;
     if ((st = hearth_sim_env_new(&so, &env, err))) break;
+    if (!r->renderer[0]) snprintf(r->renderer, sizeof r->renderer, "%s", hearth_sim_renderer(env));
     ep_ctx x = {o, env, is_ws ? &wsp : NULL, NULL, NULL};
     if (is_replay) {
       for (int i = 0; i < rf.n && !st; i++) {
@@ -262,8 +303,9 @@ hearth_status hearth_eval_run(const hearth_eval_opts *o, hearth_eval_results *r,
     }
     hearth_sim_env_free(env);
   }
-  snprintf(r->metadata, sizeof r->metadata, "%s", wsp.metadata);
-  if (wsp.c) eval_ws_drop(&wsp, 1000);
+  if (wsp.metadata_json && !(r->metadata_json = strdup(wsp.metadata_json)) && !st)
+    st = hearth_err_set(err, HEARTH_E_NOMEM, "eval: results");
+  eval_ws_free(&wsp);
   eval_replay_free(&rf);
   r->seconds = hearth_now() - t0;
   if (st) hearth_eval_results_free(r);
@@ -273,7 +315,14 @@ hearth_status hearth_eval_run(const hearth_eval_opts *o, hearth_eval_results *r,
 void hearth_eval_results_free(hearth_eval_results *r) {
   if (!r) return;
   free(r->eps);
+  free(r->metadata_json);
   memset(r, 0, sizeof *r);
+}
+
+size_t hearth_eval_policy_errors(const hearth_eval_results *r) {
+  size_t n = 0;
+  for (size_t i = 0; i < r->n; i++) n += r->eps[i].error != 0;
+  return n;
 }
 
 

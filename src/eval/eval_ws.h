@@ -13,12 +13,20 @@ typedef struct eval_ws_policy {
   int image_size, thermal, replan;
   double chunk[64][7];     /* the actions of the last reply still to run */
   int nchunk, next;
-  char metadata[512];      /* a summary of the server's metadata */
+  char *metadata_json;     /* the server's metadata map as JSON (malloc'd), from
+                              the last connection; NULL before one */
+  int thermal_decl;        /* what the metadata says about observation/thermal_image:
+                              1 read, 0 ignored, -1 nothing said */
+  char thermal_why[256];   /* the metadata entry that decided thermal_decl */
 } eval_ws_policy;
 
-/* Connect if not connected, and read the metadata the server sends
- * first (summarised in p->metadata). */
+/* Connect if not connected, and read the metadata the server sends first
+ * (into p->metadata_json and p->thermal_decl: "hearth_thermal": false, or an
+ * "image_keys" list without "observation/thermal_image", declares the
+ * thermal view ignored; "hearth_thermal": true or a list with it, read). */
 hearth_status eval_ws_ensure(eval_ws_policy *p, hearth_err *err);
+/* Free what p holds and close its connection (code 1000). */
+void eval_ws_free(eval_ws_policy *p);
 /* Send the observation with its prompt, receive a chunk of actions into
  * p->chunk (p->replan of them; p->next = 0). A text reply (openpi's
  * traceback) is the server's error. */

@@ -1,12 +1,13 @@
 /* demonstration collection with the scripted expert, stored in LIBERO's
- * HDF5 layout (plus obs/agentview_thermal) */
-#include <hdf5.h>
+ * HDF5 layout (plus obs/agentview_thermal) by sim_h5.c; one process or one
+ * shard of many */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "sim/sim_env.h"
+#include "sim/sim_h5.h"
+#include "sim/sim_mjcf.h"
 
 void hearth_sim_collect_opts_default(hearth_sim_collect_opts *o) {
   memset(o, 0, sizeof *o);
@@ -14,136 +15,30 @@ void hearth_sim_collect_opts_default(hearth_sim_collect_opts *o) {
   o->use_ground_truth = 1;
   o->layouts = 200;
   o->seed = 1;
-  o->image_size = 128;
+  o->image_size = 256;
   o->max_steps = 400;
 }
 
-typedef struct demo_buf {
-  size_t T, cap, nstate, img;
-  double *actions, *states, *joint, *grip, *ee;
-  uint8_t *front, *thermal, *wrist;
-} demo_buf;
-
-static void demo_free(demo_buf *b) {
-  free(b->actions), free(b->states), free(b->joint), free(b->grip), free(b->ee);
-  free(b->front), free(b->thermal), free(b->wrist);
-  memset(b, 0, sizeof *b);
-}
-
-static int demo_grow(demo_buf *b, size_t cap) {
-  if (cap <= b->cap) return 1;
-  double **dp[] = {&b->actions, &b->states, &b->joint, &b->grip, &b->ee};
-  size_t dn[] = {7, b->nstate, 7, 2, 6};
-  for (int i = 0; i < 5; i++) {
-    void *q = realloc(*dp[i], cap * dn[i] * sizeof(double));
-    if (!q) return 0;
-    *dp[i] = q;
-  }
-  uint8_t **ip[] = {&b->front, &b->thermal, &b->wrist};
-  for (int i = 0; i < 3; i++) {
-    void *q = realloc(*ip[i], cap * b->img);
-    if (!q) return 0;
-    *ip[i] = q;
-  }
-  b->cap = cap;
-  return 1;
-}
-
-/* ---- HDF5 helpers ---------------------------------------------------------- */
-static int h5_str_attr(hid_t obj, const char *name, const char *val) {
-  hid_t t = H5Tcopy(H5T_C_S1);
-  H5Tset_size(t, strlen(val) + 1);
-  hid_t sp = H5Screate(H5S_SCALAR);
-  hid_t a = H5Acreate2(obj, name, t, sp, H5P_DEFAULT, H5P_DEFAULT);
-  int ok = a >= 0 && H5Awrite(a, t, val) >= 0;
-  if (a >= 0) H5Aclose(a);
-  H5Sclose(sp), H5Tclose(t);
-  return ok;
-}
-static int h5_int_attr(hid_t obj, const char *name, long long v) {
-  hid_t sp = H5Screate(H5S_SCALAR);
-  hid_t a = H5Acreate2(obj, name, H5T_STD_I64LE, sp, H5P_DEFAULT, H5P_DEFAULT);
-  int ok = a >= 0 && H5Awrite(a, H5T_NATIVE_LLONG, &v) >= 0;
-  if (a >= 0) H5Aclose(a);
-  H5Sclose(sp);
-  return ok;
-}
-static int h5_write(hid_t g, const char *name, hid_t ftype, hid_t mtype, int rank,
-                    const hsize_t *dims, const void *data) {
-  hid_t sp = H5Screate_simple(rank, dims, NULL);
-  hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
-  H5Pset_obj_track_times(dcpl, 0); /* same inputs, same bytes */
-  if (rank == 4 && dims[0] > 0) {
-    hsize_t ch[4] = {1, dims[1], dims[2], dims[3]};
-    H5Pset_chunk(dcpl, 4, ch);
-    H5Pset_deflate(dcpl, 1);
-  }
-  hid_t ds = H5Dcreate2(g, name, ftype, sp, H5P_DEFAULT, dcpl, H5P_DEFAULT);
-  int ok = ds >= 0 && H5Dwrite(ds, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) >= 0;
-  if (ds >= 0) H5Dclose(ds);
-  H5Pclose(dcpl), H5Sclose(sp);
-  return ok;
-}
-static hid_t h5_group(hid_t parent, const char *name) {
-  hid_t gcpl = H5Pcreate(H5P_GROUP_CREATE);
-  H5Pset_obj_track_times(gcpl, 0);
-  hid_t g = H5Gcreate2(parent, name, H5P_DEFAULT, gcpl, H5P_DEFAULT);
-  H5Pclose(gcpl);
-  return g;
-}
-
-static int write_demo(hid_t data, int idx, const demo_buf *b, int instruction, const char *instr,
-                      uint64_t layout, int S) {
-  char name[32];
-  snprintf(name, sizeof name, "demo_%d", idx);
-  hid_t g = h5_group(data, name);
-  if (g < 0) return 0;
-  hsize_t T = b->T;
-  int ok = h5_int_attr(g, "num_samples", (long long)T) && h5_int_attr(g, "layout", (long long)layout) &&
-           h5_int_attr(g, "instruction_index", instruction) && h5_str_attr(g, "language_instruction", instr);
-  uint8_t *rew = calloc(T ? T : 1, 1), *don = calloc(T ? T : 1, 1);
-  double *pos = malloc((T ? T : 1) * 3 * sizeof(double)), *ori = malloc((T ? T : 1) * 3 * sizeof(double));
-  if (!rew || !don || !pos || !ori) ok = 0;
-  if (ok && T) {
-    rew[T - 1] = don[T - 1] = 1;
-    for (size_t t = 0; t < T; t++)
-      for (int i = 0; i < 3; i++) pos[3 * t + i] = b->ee[6 * t + i], ori[3 * t + i] = b->ee[6 * t + 3 + i];
-    hsize_t d7[2] = {T, 7}, dS[2] = {T, b->nstate}, d1[1] = {T}, d2[2] = {T, 2}, d6[2] = {T, 6},
-            d3[2] = {T, 3}, dI[4] = {T, (hsize_t)S, (hsize_t)S, 3};
-    ok = h5_write(g, "actions", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 2, d7, b->actions) &&
-         h5_write(g, "states", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 2, dS, b->states) &&
-         h5_write(g, "rewards", H5T_STD_U8LE, H5T_NATIVE_UINT8, 1, d1, rew) &&
-         h5_write(g, "dones", H5T_STD_U8LE, H5T_NATIVE_UINT8, 1, d1, don);
-    hid_t o = ok ? h5_group(g, "obs") : -1;
-    if (o < 0) ok = 0;
-    if (ok)
-      ok = h5_write(o, "agentview_rgb", H5T_STD_U8LE, H5T_NATIVE_UINT8, 4, dI, b->front) &&
-           h5_write(o, "agentview_thermal", H5T_STD_U8LE, H5T_NATIVE_UINT8, 4, dI, b->thermal) &&
-           h5_write(o, "eye_in_hand_rgb", H5T_STD_U8LE, H5T_NATIVE_UINT8, 4, dI, b->wrist) &&
-           h5_write(o, "joint_states", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 2, d7, b->joint) &&
-           h5_write(o, "gripper_states", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 2, d2, b->grip) &&
-           h5_write(o, "ee_states", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 2, d6, b->ee) &&
-           h5_write(o, "ee_pos", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 2, d3, pos) &&
-           h5_write(o, "ee_ori", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 2, d3, ori);
-    if (o >= 0) H5Gclose(o);
-  }
-  free(rew), free(don), free(pos), free(ori);
-  H5Gclose(g);
-  return ok;
+void hearth_sim_split_path(const char *out_path, int ins, char *buf, size_t bufsz) {
+  size_t n = strlen(out_path);
+  if (n >= 5 && strcmp(out_path + n - 5, ".hdf5") == 0) n -= 5;
+  snprintf(buf, bufsz, "%.*s_instr%d.hdf5", (int)n, out_path, ins + 1);
 }
 
 /* one rollout of the expert from (layout, instruction) into b */
-static hearth_status rollout(hearth_sim_env *e, uint64_t seed, uint64_t layout, int ins, demo_buf *b,
+static hearth_status rollout(hearth_sim_env *e, uint64_t seed, uint64_t layout, int ins, sim_demo *b,
                              int *success, hearth_err *err) {
   hearth_status st = hearth_sim_reset(e, seed, layout, ins, err);
   if (st) return st;
   b->T = 0;
+  b->layout = layout;
+  b->instruction = ins;
   *success = 0;
   size_t px = b->img;
   for (int t = 0; t < e->max_steps; t++) {
     hearth_sim_obs ob;
     if ((st = hearth_sim_observe(e, &ob, err))) return st;
-    if (!demo_grow(b, b->T + 1 > b->cap ? b->cap * 2 + 64 : b->cap))
+    if (!sim_demo_grow(b, b->T + 1 > b->cap ? b->cap * 2 + 64 : b->cap))
       return hearth_err_set(err, HEARTH_E_NOMEM, "sim collect: out of memory");
     size_t i = b->T;
     memcpy(b->front + i * px, ob.agentview_rgb, px);
@@ -153,6 +48,12 @@ static hearth_status rollout(hearth_sim_env *e, uint64_t seed, uint64_t layout, 
     memcpy(b->grip + 2 * i, ob.gripper_states, sizeof ob.gripper_states);
     memcpy(b->ee + 6 * i, ob.ee_pos, sizeof ob.ee_pos);
     memcpy(b->ee + 6 * i + 3, ob.ee_ori, sizeof ob.ee_ori);
+    /* LIBERO's robot state: gripper qpos, ee pos, ee quat in robosuite's
+     * x y z w order */
+    double *r = b->robot + SIM_ROBOT_STATE_DIM * i;
+    r[0] = ob.gripper_states[0], r[1] = ob.gripper_states[1];
+    r[2] = ob.ee_pos[0], r[3] = ob.ee_pos[1], r[4] = ob.ee_pos[2];
+    r[5] = ob.ee_quat[1], r[6] = ob.ee_quat[2], r[7] = ob.ee_quat[3], r[8] = ob.ee_quat[0];
     hearth_sim_state(e, b->states + b->nstate * i, b->nstate);
     double a[7];
     hearth_sim_expert_action(e, a);
@@ -167,14 +68,33 @@ static hearth_status rollout(hearth_sim_env *e, uint64_t seed, uint64_t layout, 
   return HEARTH_OK;
 }
 
-hearth_status hearth_sim_collect(const hearth_sim_collect_opts *o, hearth_sim_collect_stats *stats,
-                                 hearth_err *err) {
-  hearth_sim_collect_stats dummy;
-  if (!stats) stats = &dummy;
-  memset(stats, 0, sizeof *stats);
-  if (!o->out_path) return hearth_err_set(err, HEARTH_E_ARG, "sim collect: no output path");
-  if (o->layouts < 1 || o->layouts > 100000)
-    return hearth_err_set(err, HEARTH_E_RANGE, "sim collect: layouts must be 1..100000, got %d", o->layouts);
+/* the state of one collection: its env, the files it writes and the two
+ * rollouts of the slot at hand */
+typedef struct collect_run {
+  const hearth_sim_collect_opts *o;
+  hearth_sim_env *env;
+  int nfile;              /* 1, or 2 with split_instructions */
+  char path[2][4200];
+  sim_h5_out out[2];
+  sim_h5_meta meta[2];
+  char *model_file;       /* the scene's MJCF, stored with every demo */
+  sim_demo demo[2];       /* instruction 0, 1 */
+} collect_run;
+
+static void run_free(collect_run *c) {
+  for (int i = 0; i < 2; i++) {
+    sim_h5_abort(&c->out[i]);
+    sim_h5_meta_free(&c->meta[i]);
+    sim_demo_free(&c->demo[i]);
+  }
+  free(c->model_file);
+  hearth_sim_env_free(c->env);
+}
+
+/* the env, the description of each file and the files themselves */
+static hearth_status run_open(collect_run *c, hearth_err *err) {
+  const hearth_sim_collect_opts *o = c->o;
+  for (int i = 0; i < 2; i++) c->out[i].f = c->out[i].data = -1;
   hearth_sim_opts so;
   hearth_sim_opts_default(&so);
   so.task = o->task;
@@ -184,110 +104,93 @@ hearth_status hearth_sim_collect(const hearth_sim_collect_opts *o, hearth_sim_co
   so.max_steps = o->max_steps;
   so.shadows = o->shadows;
   so.gl = o->gl;
-  hearth_sim_env *e = NULL;
-  hearth_status st = hearth_sim_env_new(&so, &e, err);
+  hearth_status st = hearth_sim_env_new(&so, &c->env, err);
   if (st) return st;
-  if (!o->quiet) fprintf(stderr, "renderer: %s\n", hearth_sim_renderer(e));
-  double t0 = hearth_now();
-  char tmp[4200];
-  snprintf(tmp, sizeof tmp, "%s.tmp%ld", o->out_path, (long)getpid());
-  H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
-  hid_t fcpl = H5Pcreate(H5P_FILE_CREATE);
-  hid_t f = H5Fcreate(tmp, H5F_ACC_TRUNC, fcpl, H5P_DEFAULT);
-  H5Pclose(fcpl);
-  if (f < 0) {
-    hearth_sim_env_free(e);
-    return hearth_err_set(err, HEARTH_E_IO, "%s: cannot create the HDF5 file", tmp);
+  if (!o->quiet) fprintf(stderr, "renderer: %s\n", hearth_sim_renderer(c->env));
+  hearth_strbuf mj = {0};
+  sim_mjcf_scene_text(c->env, ".", &mj);
+  if (!(c->model_file = hearth_strbuf_take(&mj)))
+    return hearth_err_set(err, HEARTH_E_NOMEM, "sim collect: out of memory");
+  c->nfile = o->split_instructions ? 2 : 1;
+  for (int i = 0; i < 2; i++) {
+    c->demo[i].nstate = hearth_sim_state(c->env, NULL, 0);
+    c->demo[i].img = (size_t)o->image_size * (size_t)o->image_size * 3;
   }
-  hid_t data = h5_group(f, "data");
-  demo_buf b = {0};
-  b.nstate = hearth_sim_state(e, NULL, 0);
-  b.img = (size_t)o->image_size * (size_t)o->image_size * 3;
-  demo_buf b2 = {0};
-  b2.nstate = b.nstate, b2.img = b.img;
-  hearth_progress pr;
-  hearth_progress_begin(&pr, "collect", (size_t)o->layouts * 2, o->quiet);
-  int ndemo = 0;
-  long stored = 0;
-  /* a layout is kept when the expert succeeds on both instructions (or
-   * with keep_failures); a rejected layout is replaced by the next unused
-   * one of the same parity, so the candidate-to-slot assignment (layout
-   * parity) stays balanced: layout k of the file has parity k & 1 */
-  uint64_t next[2] = {0, 1};
-  long max_tries = 20L * o->layouts + 100;
-  for (int k = 0; k < o->layouts && !st; k++) {
-    int par = k & 1, kept = 0;
-    while (!kept && !st) {
-      if (stats->rejected_layouts >= max_tries) {
-        st = hearth_err_set(err, HEARTH_E_NUMERIC,
-                            "sim collect %s: the expert failed on %d layouts (stored %d of %d); "
-                            "check the assets or pass --keep-failures",
-                            hearth_sim_task_name(o->task), stats->rejected_layouts, k, o->layouts);
-        break;
-      }
-      uint64_t l = next[par];
-      next[par] += 2;
-      int ok[2] = {0, 0};
-      demo_buf *bb[2] = {&b, &b2};
-      for (int ins = 0; ins < 2 && !st; ins++) {
-        st = rollout(e, o->seed, l, ins, bb[ins], &ok[ins], err);
-        if (st) break;
-        stats->attempts[ins]++;
-        stats->successes[ins] += ok[ins];
-        stats->steps += (long)bb[ins]->T;
-      }
-      if (st) break;
-      if (!(ok[0] && ok[1]) && !o->keep_failures) {
-        stats->rejected_layouts++;
-        continue;
-      }
-      kept = 1;
-      for (int ins = 0; ins < 2 && !st; ins++) {
-        if (!write_demo(data, ndemo, bb[ins], ins, hearth_sim_instruction_text(o->task, ins), l,
-                        o->image_size))
-          st = hearth_err_set(err, HEARTH_E_IO, "%s: writing demo_%d failed", tmp, ndemo);
-        ndemo++;
-        stored += (long)bb[ins]->T;
-      }
-      hearth_progress_step(&pr, 2);
+  for (int i = 0; i < c->nfile && !st; i++) {
+    if (c->nfile == 2) hearth_sim_split_path(o->out_path, i, c->path[i], sizeof c->path[i]);
+    else snprintf(c->path[i], sizeof c->path[i], "%s", o->out_path);
+    st = sim_h5_describe(o, c->nfile == 2 ? i : 0, c->nfile == 2 ? 1 : 2, c->env->gl, &c->meta[i], err);
+    if (!st) st = sim_h5_create(&c->out[i], c->path[i], err);
+  }
+  return st;
+}
+
+/* fill slot k: its first candidate layout where the expert succeeds on
+ * both instructions (any with keep_failures), stored in every file */
+static hearth_status fill_slot(collect_run *c, int k, hearth_sim_collect_stats *stats, hearth_err *err) {
+  const hearth_sim_collect_opts *o = c->o;
+  for (int j = 0; j < HEARTH_SIM_SLOT_TRIES; j++) {
+    uint64_t l = (uint64_t)k + (uint64_t)j * 2u * HEARTH_SIM_MAX_LAYOUTS;
+    int ok[2] = {0, 0};
+    for (int ins = 0; ins < 2; ins++) {
+      hearth_status st = rollout(c->env, o->seed, l, ins, &c->demo[ins], &ok[ins], err);
+      if (st) return st;
+      stats->attempts[ins]++;
+      stats->successes[ins] += ok[ins];
+      stats->steps += (long)c->demo[ins].T;
     }
+    if (!(ok[0] && ok[1]) && !o->keep_failures) {
+      stats->rejected_layouts++;
+      continue;
+    }
+    for (int ins = 0; ins < 2; ins++) {
+      sim_h5_out *out = &c->out[c->nfile == 2 ? ins : 0];
+      hearth_status st = sim_h5_add_demo(out, &c->demo[ins], o->image_size,
+                                         hearth_sim_instruction_text(o->task, ins), c->model_file, err);
+      if (st) return st;
+    }
+    return HEARTH_OK;
+  }
+  return hearth_err_set(err, HEARTH_E_NUMERIC,
+                        "sim collect %s: the expert failed on all %d candidate layouts of slot %d (layouts %d, "
+                        "%d + 200000 j ...); check the assets or pass --keep-failures",
+                        hearth_sim_task_name(o->task), HEARTH_SIM_SLOT_TRIES, k, k, k);
+}
+
+hearth_status hearth_sim_collect(const hearth_sim_collect_opts *o, hearth_sim_collect_stats *stats,
+                                 hearth_err *err) {
+  hearth_sim_collect_stats dummy;
+  if (!stats) stats = &dummy;
+  memset(stats, 0, sizeof *stats);
+  if (!o->out_path) return hearth_err_set(err, HEARTH_E_ARG, "sim collect: no output path");
+  if (o->layouts < 1 || o->layouts > HEARTH_SIM_MAX_LAYOUTS)
+    return hearth_err_set(err, HEARTH_E_RANGE, "sim collect: layouts must be 1..%d, got %d", HEARTH_SIM_MAX_LAYOUTS,
+                          o->layouts);
+  int count = o->shard_count > 1 ? o->shard_count : 1, index = o->shard_count > 1 ? o->shard_index : 0;
+  if (index < 0 || index >= count)
+    return hearth_err_set(err, HEARTH_E_ARG, "sim collect: shard %d/%d: expected 0 <= index < count", o->shard_index,
+                          o->shard_count);
+  if (index >= o->layouts)
+    return hearth_err_set(err, HEARTH_E_ARG, "sim collect: shard %d/%d has no slot of %d layout(s): use at most %d shards",
+                          index, count, o->layouts, o->layouts);
+  double t0 = hearth_now();
+  collect_run c = {.o = o};
+  hearth_status st = run_open(&c, err);
+  int slots = (o->layouts - index + count - 1) / count;
+  hearth_progress pr;
+  hearth_progress_begin(&pr, "collect", (size_t)slots * 2, o->quiet || st);
+  for (int k = index; k < o->layouts && !st; k += count) {
+    st = fill_slot(&c, k, stats, err);
+    if (!st) stats->slots++;
+    hearth_progress_step(&pr, 2);
   }
   hearth_progress_end(&pr);
-  demo_free(&b2);
-  if (!st) {
-    /* one file holds both instructions of a task. LIBERO's loaders read
-     * problem_info["language_instruction"] as one string: it names the
-     * first instruction; each demo carries its own language_instruction
-     * attribute and data/instructions lists both (JSON) */
-    char pi[1024], ea[1024], il[512];
-    snprintf(pi, sizeof pi,
-             "{\"problem_name\": \"hearth_%s\", \"domain_name\": \"hearth\", "
-             "\"language_instruction\": \"%s\"}",
-             hearth_sim_task_name(o->task), hearth_sim_instruction_text(o->task, 0));
-    snprintf(il, sizeof il, "[\"%s\", \"%s\"]", hearth_sim_instruction_text(o->task, 0),
-             hearth_sim_instruction_text(o->task, 1));
-    snprintf(ea, sizeof ea,
-             "{\"env_name\": \"hearth_%s\", \"type\": 1, \"env_kwargs\": {\"control_freq\": 20, "
-             "\"camera_heights\": %d, \"camera_widths\": %d, \"controller\": \"OSC_POSE\", "
-             "\"seed\": %llu, \"asset_source\": \"%s\", \"shadows\": %s, \"renderer\": \"%s\"}}",
-             hearth_sim_task_name(o->task), o->image_size, o->image_size, (unsigned long long)o->seed,
-             o->use_ground_truth ? "virtual_rig_ground_truth" : "release_derived",
-             o->shadows ? "true" : "false", e->gl);
-    if (!h5_str_attr(data, "problem_info", pi) || !h5_str_attr(data, "env_args", ea) ||
-        !h5_int_attr(data, "num_demos", ndemo) || !h5_int_attr(data, "total", stored) ||
-        !h5_str_attr(data, "instructions", il) ||
-        !h5_str_attr(data, "image_row_order", "opengl_bottom_row_first") ||
-        !h5_str_attr(data, "thermal_colormap", "turbo 10..60 degC"))
-      st = hearth_err_set(err, HEARTH_E_IO, "%s: writing attributes failed", tmp);
+  sim_h5_shard shard = {index, count, o->layouts};
+  for (int i = 0; i < c.nfile && !st; i++) {
+    stats->demos = c.out[i].ndemo;
+    st = sim_h5_finish(&c.out[i], &c.meta[i], count > 1 ? &shard : NULL, err);
   }
-  H5Gclose(data);
-  if (H5Fclose(f) < 0 && !st) st = hearth_err_set(err, HEARTH_E_IO, "%s: closing failed", tmp);
-  if (!st && rename(tmp, o->out_path) != 0)
-    st = hearth_err_set(err, HEARTH_E_IO, "%s: cannot rename into place", o->out_path);
-  if (st) unlink(tmp);
-  demo_free(&b);
-  hearth_sim_env_free(e);
-  stats->demos = ndemo;
+  run_free(&c);
   stats->seconds = hearth_now() - t0;
   return st;
 }

@@ -3,7 +3,6 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "hearth/geom.h"
 #include "sim/sim_env.h"
 #include "sim/sim_mjcf.h"
 #include "sim/sim_robot.h"
@@ -25,12 +24,12 @@ hearth_status sim_obj_write(const char *path, const hearth_mesh *m, hearth_err *
   return hearth_atomic_commit(&af, err);
 }
 
-hearth_status sim_mjcf_write_scene(const hearth_sim_env *e, const char *xml_path, hearth_err *err) {
+void sim_mjcf_scene_text(const hearth_sim_env *e, const char *dir, hearth_strbuf *out) {
   const sim_task_def *td = sim_task_get(e->task);
-  int study = strcmp(td->scene, "study") == 0;
-  hearth_strbuf b = {0};
+  const sim_scene_look *lk = sim_scene_look_get(td->scene);
+  hearth_strbuf b = *out;
   hearth_strbuf_printf(&b, "<mujoco model=\"hearth_%s\">\n<compiler angle=\"radian\" autolimits=\"true\" meshdir=\"%s\" texturedir=\"%s\"/>\n",
-                       td->name, e->work_dir, e->work_dir);
+                       td->name, dir, dir);
   hearth_strbuf_printf(&b, "<option timestep=\"%s\" impratio=\"10\" cone=\"elliptic\"/>\n", sim_num(HEARTH_SIM_TIMESTEP).s);
   /* one sample per pixel: the thermal view's pixels are then exactly the
    * texture's (no edge blends with the room colour), and the CPU renderer
@@ -42,13 +41,15 @@ hearth_status sim_mjcf_write_scene(const hearth_sim_env *e, const char *xml_path
                        "<headlight ambient=\"0.35 0.35 0.35\" diffuse=\"0.45 0.45 0.45\" specular=\"0.1 0.1 0.1\"/></visual>\n",
                        e->width, e->height, shadow);
   hearth_strbuf_printf(&b, "<asset>\n");
-  hearth_strbuf_printf(&b, "<texture name=\"floor_tex\" type=\"2d\" builtin=\"checker\" rgb1=\"%s\" rgb2=\"%s\" width=\"256\" height=\"256\"/>\n",
-                       study ? "0.45 0.42 0.40" : "0.75 0.75 0.72", study ? "0.40 0.37 0.35" : "0.65 0.65 0.62");
-  hearth_strbuf_printf(&b, "<material name=\"floor\" texture=\"floor_tex\" texrepeat=\"8 8\"/>\n");
-  hearth_strbuf_printf(&b, "<material name=\"table\" rgba=\"%s\" specular=\"0.1\"/>\n",
-                       study ? "0.55 0.38 0.22 1" : "0.86 0.86 0.84 1");
-  hearth_strbuf_printf(&b, "<material name=\"wall\" rgba=\"%s\" specular=\"0\"/>\n",
-                       study ? "0.78 0.74 0.66 1" : "0.85 0.87 0.88 1");
+  hearth_strbuf_printf(&b, "<texture name=\"floor_tex\" type=\"2d\" builtin=\"checker\" rgb1=\"%s %s %s\" rgb2=\"%s %s %s\" width=\"256\" height=\"256\"/>\n",
+                       sim_num(lk->floor1[0]).s, sim_num(lk->floor1[1]).s, sim_num(lk->floor1[2]).s, sim_num(lk->floor2[0]).s,
+                       sim_num(lk->floor2[1]).s, sim_num(lk->floor2[2]).s);
+  hearth_strbuf_printf(&b, "<material name=\"floor\" texture=\"floor_tex\" texrepeat=\"%d %d\"/>\n", lk->floor_repeat,
+                       lk->floor_repeat);
+  hearth_strbuf_printf(&b, "<material name=\"table\" rgba=\"%s %s %s 1\" specular=\"0.1\"/>\n", sim_num(lk->table[0]).s,
+                       sim_num(lk->table[1]).s, sim_num(lk->table[2]).s);
+  hearth_strbuf_printf(&b, "<material name=\"wall\" rgba=\"%s %s %s 1\" specular=\"0\"/>\n", sim_num(lk->wall[0]).s,
+                       sim_num(lk->wall[1]).s, sim_num(lk->wall[2]).s);
   hearth_strbuf_printf(&b, "<material name=\"mat\" rgba=\"0.15 0.35 0.65 1\" specular=\"0\"/>\n");
   hearth_strbuf_printf(&b, "<material name=\"robot_white\" rgba=\"0.92 0.92 0.92 1\" specular=\"0.3\"/>\n");
   hearth_strbuf_printf(&b, "<material name=\"robot_dark\" rgba=\"0.2 0.2 0.22 1\" specular=\"0.2\"/>\n");
@@ -75,17 +76,10 @@ hearth_status sim_mjcf_write_scene(const hearth_sim_env *e, const char *xml_path
                          sim_num((tz - 0.05) / 2).s, sim_num(i & 1 ? 0.44 : -0.44).s, sim_num(i & 2 ? 0.54 : -0.54).s, sim_num((tz - 0.05) / 2).s);
   hearth_strbuf_printf(&b, "<geom name=\"mat\" type=\"box\" size=\"%s %s 0.001\" pos=\"%s %s %s\" material=\"mat\" group=\"0\"/>\n",
                        sim_num(SIM_MAT_HALF).s, sim_num(SIM_MAT_HALF).s, sim_num(sim_mat_centre[0]).s, sim_num(sim_mat_centre[1]).s, sim_num(tz + 0.001).s);
-  /* front camera: LIBERO's agentview position, looking down at the table */
-  {
-    double eye[3] = {0.66, 0, 1.61}, tgt[3] = {-0.08, 0, tz}, f[3], x[3] = {0, 1, 0}, z[3], y[3];
-    for (int i = 0; i < 3; i++) f[i] = tgt[i] - eye[i];
-    double n = hearth_norm3(f);
-    for (int i = 0; i < 3; i++) z[i] = -f[i] / n;
-    hearth_cross3(z, x, y);
-    hearth_strbuf_printf(&b, "<camera name=\"agentview\" pos=\"%s %s %s\" xyaxes=\"%s %s %s %s %s %s\" fovy=\"45\"/>\n",
-                         sim_num(eye[0]).s, sim_num(eye[1]).s, sim_num(eye[2]).s, sim_num(x[0]).s, sim_num(x[1]).s, sim_num(x[2]).s, sim_num(y[0]).s,
-                         sim_num(y[1]).s, sim_num(y[2]).s);
-  }
+  /* front camera: LIBERO's agentview pose over this scene's table */
+  hearth_strbuf_printf(&b, "<camera name=\"agentview\" pos=\"%s 0 %s\" quat=\"%s %s %s %s\" fovy=\"45\"/>\n",
+                       sim_num(SIM_CAM_FRONT_X).s, sim_num(tz + lk->cam_height).s, sim_num(sim_cam_front_quat[0]).s,
+                       sim_num(sim_cam_front_quat[1]).s, sim_num(sim_cam_front_quat[2]).s, sim_num(sim_cam_front_quat[3]).s);
   sim_robot_emit_bodies(&b);
   for (int k = 0; k < SIM_NOBJ; k++) {
     const sim_asset *a = &e->assets[k];
@@ -110,6 +104,12 @@ hearth_status sim_mjcf_write_scene(const hearth_sim_env *e, const char *xml_path
   hearth_strbuf_printf(&b, "</worldbody>\n");
   sim_robot_emit_actuators(&b);
   hearth_strbuf_printf(&b, "</mujoco>\n");
+  *out = b;
+}
+
+hearth_status sim_mjcf_write_scene(const hearth_sim_env *e, const char *xml_path, hearth_err *err) {
+  hearth_strbuf b = {0};
+  sim_mjcf_scene_text(e, e->work_dir, &b);
   if (b.failed) {
     hearth_strbuf_free(&b);
     return hearth_err_set(err, HEARTH_E_NOMEM, "sim: out of memory building the MJCF");

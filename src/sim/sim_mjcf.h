@@ -20,6 +20,10 @@ static inline sim_num_text sim_num(double x) {
   return n;
 }
 
+/* Append the env's scene as MJCF text to out, naming its meshes and
+ * textures under dir (the scratch directory for the model MuJoCo loads;
+ * "." for the copy stored in collection files). */
+void sim_mjcf_scene_text(const hearth_sim_env *e, const char *dir, hearth_strbuf *out);
 /* Write the env's scene (room, table, mat, cameras, robot, its four
  * objects at their nominal spots, actuators) as MJCF to xml_path; the
  * meshes and textures it names are e->work_dir/obj<k>.obj, rgb<k>.png and

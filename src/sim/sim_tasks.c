@@ -1,5 +1,7 @@
 /* The three tasks as data: objects, instructions, where things stand on the
  * table, and the layout draw that jitters them. */
+#include <string.h>
+
 #include "sim/sim_tasks.h"
 #include "hearth/core.h"
 
@@ -29,6 +31,21 @@ const double sim_spots[SIM_NOBJ][2] = {{0.05, 0.00}, {0.05, 0.19}, {-0.17, 0.29}
 const double sim_mat_centre[2] = {-0.05, -0.22};
 
 const sim_task_def *sim_task_get(hearth_sim_task t) { return &k_tasks[t - 1]; }
+
+/* the study: a light-gray floor and plaster walls around a dark wooden
+ * desk; the kitchen: gray ceramic tiles and yellow linen walls around a
+ * light wooden table */
+static const sim_scene_look k_looks[2] = {
+    {"study", {0.62, 0.62, 0.61}, {0.57, 0.57, 0.56}, 8, {0.36, 0.24, 0.15}, {0.80, 0.79, 0.77}, 0.7433500240372424},
+    {"kitchen", {0.52, 0.52, 0.51}, {0.44, 0.44, 0.44}, 14, {0.78, 0.66, 0.48}, {0.90, 0.83, 0.60}, 0.7103500240372423},
+};
+
+const sim_scene_look *sim_scene_look_get(const char *scene) {
+  return strcmp(scene, "study") == 0 ? &k_looks[0] : &k_looks[1];
+}
+
+const double sim_cam_front_quat[4] = {0.6380177736282349, 0.3048497438430786, 0.30484986305236816,
+                                      0.6380177736282349};
 
 hearth_sim_task hearth_sim_task_parse(const char *s) {
   if (!s) return 0;

@@ -21,6 +21,28 @@ typedef struct sim_task_def {
 /* The row of a valid task (1..3). */
 const sim_task_def *sim_task_get(hearth_sim_task t);
 
+/* How a scene looks (after LIBERO's study and kitchen table scenes): RGB
+ * colours of the checkered floor (and its repeats over the 6 m floor), the
+ * table top and legs, the walls, and the front camera's height above the
+ * table top (LIBERO's agentview sits 0.743 m above its study table, 0.710
+ * m above its kitchen table). */
+typedef struct sim_scene_look {
+  const char *name;
+  double floor1[3], floor2[3];
+  int floor_repeat;
+  double table[3], wall[3];
+  double cam_height;
+} sim_scene_look;
+/* The look of scene "study" or "kitchen" (the kitchen for any other name). */
+const sim_scene_look *sim_scene_look_get(const char *scene);
+
+/* The front camera ("agentview") as LIBERO places it: 0.6586 m in front of
+ * the table centre, looking back along -x and down 38.9 degrees, so that its
+ * optical axis meets the table top at x = -0.22 (orientation as a w x y z
+ * quaternion, x axis along world +y). */
+#define SIM_CAM_FRONT_X 0.6586131746834771
+extern const double sim_cam_front_quat[4];
+
 /* Nominal spots on the table top (world x, y; x towards the front camera,
  * y to the image's right): slot A, slot B, distractor 1, distractor 2; and
  * the mat (centre, half side), where the target must end. */

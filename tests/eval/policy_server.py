@@ -8,7 +8,9 @@ binary keys __ndarray__, data, dtype, shape.
 
 It checks every field the client sends (keys, key types, dtypes, shapes, the
 180-degree rotation is not checkable here, but padding/size are) and fails
-loudly otherwise. Modes make it misbehave for the client's error paths.
+loudly otherwise. Modes make it misbehave for the client's error paths;
+--declare-thermal and --image-keys add what hearth's openpi adapter declares
+to the metadata.
 """
 import argparse
 import asyncio
@@ -74,8 +76,13 @@ def check_obs(obs, args):
 async def handler(ws, path, args, state):
     state["connections"] += 1
     conn = state["connections"]
-    await ws.send(msgpack.packb({"server": "hearth-test", "action_horizon": args.horizon,
-                                 "shape": np.array([args.horizon, 7])}, default=pack_array))
+    meta = {"server": "hearth-test", "action_horizon": args.horizon, "shape": np.array([args.horizon, 7])}
+    # what hearth's openpi adapter declares; a stock server declares nothing
+    if args.declare_thermal != "none":
+        meta["hearth_thermal"] = args.declare_thermal == "true"
+    if args.image_keys is not None:
+        meta["image_keys"] = [k for k in args.image_keys.split(",") if k]
+    await ws.send(msgpack.packb(meta, default=pack_array))
     nreq = 0
     try:
         while True:
@@ -89,7 +96,7 @@ async def handler(ws, path, args, state):
             with open(args.log, "a") as f:
                 f.write(json.dumps({"conn": conn, "req": nreq, "prompt": obs["prompt"],
                                     "state": [float(x) for x in obs["observation/state"]]}) + "\n")
-            bad = nreq == args.bad_at and (args.bad_conn == 0 or conn == args.bad_conn)
+            bad = (args.bad_at == 0 or nreq == args.bad_at) and (args.bad_conn == 0 or conn == args.bad_conn)
             if bad and args.mode == "disconnect":
                 ws.transport.abort()
                 return
@@ -105,6 +112,10 @@ async def handler(ws, path, args, state):
                 raise RuntimeError("policy exploded on purpose")
             if bad and args.mode == "short":
                 actions = np.zeros((2, 7), np.float32)
+            elif bad and args.mode == "nan":
+                actions = np.full((args.horizon, 7), np.nan, np.float32)
+            elif bad and args.mode == "wide":
+                actions = np.zeros((args.horizon, 6), np.float32)
             elif args.actions:
                 # serve a recorded trajectory: the chunk starting at this step
                 acts = state["actions"][obs["prompt"]]
@@ -136,7 +147,10 @@ async def main():
     ap.add_argument("--horizon", type=int, default=10)
     ap.add_argument("--replan", type=int, default=5)
     ap.add_argument("--mode", default="ok")
-    ap.add_argument("--bad-at", type=int, default=2)
+    ap.add_argument("--bad-at", type=int, default=2, help="the request that goes wrong; 0: every one")
+    ap.add_argument("--declare-thermal", choices=["none", "true", "false"], default="none",
+                    help="metadata hearth_thermal (none: the key is left out)")
+    ap.add_argument("--image-keys", default=None, help="metadata image_keys, comma-separated")
     ap.add_argument("--bad-conn", type=int, default=1)
     ap.add_argument("--sleep", type=float, default=3.0)
     ap.add_argument("--actions", default="")

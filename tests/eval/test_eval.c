@@ -4,7 +4,9 @@
  * serving a demo's actions succeeds, a misbehaving server fails episodes
  * with reasons while the evaluation goes on, and the RGB-only probe: a
  * selector seeing only RGB cannot beat chance at choosing the H1/H2 target,
- * one seeing the thermal view can */
+ * one seeing the thermal view can; the server's metadata decides whether
+ * the thermal condition may run, and a run failed wholly by the server
+ * exits non-zero */
 #include <signal.h>
 #include <string.h>
 #include <sys/wait.h>
@@ -246,6 +248,88 @@ static void test_ws_failure(const char *mode, const char *want, int thermal_clie
   stop_server(&s);
 }
 
+/* the server's metadata held against the thermal condition: a server that
+ * declares it ignores the thermal view is refused before any episode, one
+ * that declares nothing is "unknown", never silently "w/" */
+static void test_ws_thermal(const char *decl, const char *keys, int thermal, hearth_status want_st, int want_used) {
+  server s = {0};
+  char th[8];
+  snprintf(th, sizeof th, "%d", thermal);
+  const char *extra[12] = {"--size", "32", "--thermal", th, "--declare-thermal", decl};
+  int n = 6;
+  if (keys) extra[n++] = "--image-keys", extra[n++] = keys;
+  extra[n] = NULL;
+  if (!start_server(&s, "meta", extra)) return;
+  hearth_eval_opts o;
+  base_opts(&o);
+  o.policy = s.url;
+  o.tasks = 1u << HEARTH_SIM_H1;
+  o.episodes = 1;
+  o.max_steps = 5;
+  o.wait_steps = 1;
+  o.timeout_s = 5;
+  o.thermal = thermal;
+  hearth_eval_results r;
+  hearth_err err = {0};
+  hearth_status st = hearth_eval_run(&o, &r, &err);
+  if (want_st) {
+    CHECK_MSG(st == want_st && strstr(err.msg, "ignores the thermal view") && strstr(err.msg, "--no-thermal"),
+              "decl %s keys %s: %s", decl, keys ? keys : "-", err.msg);
+    CHECK_MSG(count_lines(s.log) == 0, "the server got requests before the refusal");
+  } else {
+    CHECK_OK(st, &err);
+    CHECK_MSG(r.thermal_used == want_used, "decl %s keys %s thermal %d: thermal_used %d, expected %d", decl,
+              keys ? keys : "-", thermal, r.thermal_used, want_used);
+    char *js = hearth_eval_format_json(&r), *txt = hearth_eval_format_text(&r);
+    const char *used = want_used < 0 ? "\"thermal_used\": \"unknown\"" : want_used ? "\"thermal_used\": true"
+                                                                           : "\"thermal_used\": false";
+    CHECK_MSG(js && strstr(js, used) && strstr(js, "\"server\": \"hearth-test\"") && strstr(js, "\"render_size\": 48") &&
+                  strstr(js, "\"image_size\": 32") && strstr(js, "\"replan_steps\": 5") && strstr(js, "\"renderer\": \"osmesa"),
+              "results.json: %s", js ? js : "(null)");
+    const char *label = want_used < 0 ? "H1     w/?" : thermal ? "H1     w/ " : "H1     w/o";
+    CHECK_MSG(txt && strstr(txt, label) && strstr(txt, "server metadata: {\"server\":\"hearth-test\""), "text: %s",
+              txt ? txt : "(null)");
+    CHECK(want_used >= 0 || (strstr(r.warning, "unknown") && txt && strstr(txt, "warning: ")));
+    free(js), free(txt);
+    hearth_eval_results_free(&r);
+  }
+  stop_server(&s);
+}
+
+/* the command exits non-zero when every episode failed because of the
+ * server, and says so; results are written all the same */
+static void test_cli_all_policy_errors(void) {
+  server s = {0};
+  const char *extra[] = {"--size", "32", "--mode", "error", "--bad-at", "0", "--bad-conn", "0", NULL};
+  if (!start_server(&s, "allbad", extra)) return;
+  char cmd[4000], out[1300];
+  snprintf(out, sizeof out, "%s/cli_eval", g_dir);
+  snprintf(cmd, sizeof cmd,
+           "'%s' sim eval --policy %s --release '%s' --ground-truth --task H1 --episodes 1 --size 48 --image-size 32 "
+           "--max-steps 6 --wait 1 --timeout 5 --quiet --out '%s' > '%s.log' 2>&1",
+           HEARTH_EXE, s.url, g_root, out, out);
+  int rc = system(cmd);
+  CHECK_MSG(WIFEXITED(rc) && WEXITSTATUS(rc) == 1, "hearth sim eval exited %d", WIFEXITED(rc) ? WEXITSTATUS(rc) : -1);
+  char path[1400], buf[8192] = "";
+  snprintf(path, sizeof path, "%s.log", out);
+  FILE *f = fopen(path, "r");
+  if (f) {
+    buf[fread(buf, 1, sizeof buf - 1, f)] = 0;
+    fclose(f);
+  }
+  CHECK_MSG(strstr(buf, "every episode (2) failed because of the policy") && strstr(buf, "policy errors: 2 of 2"),
+            "output: %s", buf);
+  snprintf(path, sizeof path, "%s/results.json", out);
+  f = fopen(path, "r");
+  buf[0] = 0;
+  if (f) {
+    buf[fread(buf, 1, sizeof buf - 1, f)] = 0;
+    fclose(f);
+  }
+  CHECK_MSG(strstr(buf, "\"policy_errors\": 2") && strstr(buf, "\"task_failures\": 0"), "results.json: %s", buf);
+  stop_server(&s);
+}
+
 /* ---- the RGB-only probe ------------------------------------------------------ */
 /* temperature of a Turbo colour: nearest of 256 samples over 10..60 degC */
 static double turbo_temp(const uint8_t *c, const uint8_t lut[256][3]) {
@@ -351,7 +435,18 @@ int main(void) {
   test_ws_failure("rawgarbage", "websocket", 1, 1);
   test_ws_failure("slow", "no reply", 1, 1);
   test_ws_failure("short", "H >= 5", 1, 1);
+  test_ws_failure("nan", "reply.actions[0][0] is NaN: action 0 of the chunk, element 0 (dx)", 1, 1);
+  test_ws_failure("wide", "shape (10, 6): width 6, expected 7", 1, 1);
   stamp("ws failures");
+  test_ws_thermal("false", NULL, 1, HEARTH_E_ARG, 0);
+  test_ws_thermal("none", "observation/image,observation/wrist_image", 1, HEARTH_E_ARG, 0);
+  test_ws_thermal("none", NULL, 1, HEARTH_OK, -1); /* a stock server */
+  test_ws_thermal("true", NULL, 1, HEARTH_OK, 1);
+  test_ws_thermal("none", "observation/image,observation/wrist_image,observation/thermal_image", 1, HEARTH_OK, 1);
+  test_ws_thermal("false", NULL, 0, HEARTH_OK, 0); /* the RGB-only condition */
+  stamp("ws metadata");
+  test_cli_all_policy_errors();
+  stamp("cli: all policy errors");
   test_oracle();
   stamp("test_oracle();");
   return g_test_failures ? 1 : 0;

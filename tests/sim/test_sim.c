@@ -3,7 +3,7 @@
  * the target released on the mat, candidates look identical in RGB but
  * differ in thermal, layouts keep both candidates visible, and the
  * collected HDF5 file has LIBERO's keys, shapes and attributes and is the
- * same bytes for the same seed */
+ * same bytes for the same seed, also when collected in shards and merged */
 #include <hdf5.h>
 #include <jansson.h>
 #include <math.h>
@@ -185,10 +185,12 @@ static int read_str_attr(hid_t f, const char *obj, const char *name, char *out, 
   if (H5Aexists_by_name(f, obj, name, H5P_DEFAULT) <= 0) return 0;
   hid_t a = H5Aopen_by_name(f, obj, name, H5P_DEFAULT, H5P_DEFAULT);
   hid_t t = H5Aget_type(a);
-  size_t n = H5Tget_size(t);
-  int ok = H5Tget_class(t) == H5T_STRING && !H5Tis_variable_str(t) && n < cap &&
-           H5Aread(a, t, out) >= 0;
-  if (ok) out[n] = 0;
+  /* every string attribute is variable-length UTF-8 (h5py reads str) */
+  int ok = H5Tget_class(t) == H5T_STRING && H5Tis_variable_str(t) && H5Tget_cset(t) == H5T_CSET_UTF8;
+  char *s = NULL;
+  if (ok) ok = H5Aread(a, t, &s) >= 0 && s && strlen(s) < cap;
+  if (ok) snprintf(out, cap, "%s", s);
+  if (s) H5free_memory(s);
   H5Tclose(t), H5Aclose(a);
   return ok;
 }
@@ -237,6 +239,9 @@ static void check_file(const char *path, int S) {
   for (size_t i = 0; il && i < 2; i++) CHECK(strcmp(json_string_value(json_array_get(il, i)), want[i]) == 0);
   json_decref(il);
   CHECK(read_str_attr(f, "data", "image_row_order", s, sizeof s) && strstr(s, "bottom"));
+  CHECK(read_str_attr(f, "data", "macros_image_convention", s, sizeof s) && strcmp(s, "opengl") == 0);
+  CHECK(read_str_attr(f, "data", "env_name", s, sizeof s) && strcmp(s, "hearth_H1") == 0);
+  CHECK(read_str_attr(f, "data", "bddl_file_content", s, sizeof s) && strstr(s, "(:goal"));
   CHECK(read_int_attr(f, "data", "num_demos") == 2);
   long long total = 0;
   for (int k = 0; k < 2; k++) {
@@ -248,6 +253,7 @@ static void check_file(const char *path, int S) {
     CHECK(read_str_attr(f, g, "language_instruction", s, sizeof s) && strcmp(s, want[k]) == 0);
     struct { const char *key; int rank; hsize_t d1, d2, d3; } want_ds[] = {
         {"actions", 2, 7, 0, 0},           {"rewards", 1, 0, 0, 0},
+        {"robot_states", 2, 9, 0, 0},
         {"dones", 1, 0, 0, 0},             {"obs/agentview_rgb", 4, (hsize_t)S, (hsize_t)S, 3},
         {"obs/agentview_thermal", 4, (hsize_t)S, (hsize_t)S, 3},
         {"obs/eye_in_hand_rgb", 4, (hsize_t)S, (hsize_t)S, 3},
@@ -313,6 +319,86 @@ static hearth_status collect(const char *root, const char *path, int S, int max_
   return hearth_sim_collect(&o, s, err);
 }
 
+static int same_file(const char *a, const char *b) {
+  uint8_t *x, *y;
+  long nx = file_bytes(a, &x), ny = file_bytes(b, &y);
+  int same = nx > 0 && nx == ny && x && y && memcmp(x, y, (size_t)nx) == 0;
+  free(x), free(y);
+  return same;
+}
+
+static hearth_status collect_shard(const char *root, const char *path, int layouts, int shard, int shards,
+                                   int split, hearth_err *err) {
+  hearth_sim_collect_opts o;
+  hearth_sim_collect_opts_default(&o);
+  o.task = HEARTH_SIM_H1;
+  o.release_root = root;
+  o.layouts = layouts;
+  o.image_size = 24;
+  o.seed = 5;
+  o.quiet = 1;
+  o.max_steps = 12;
+  o.keep_failures = 1;
+  o.shard_index = shard, o.shard_count = shards;
+  o.split_instructions = split;
+  o.out_path = path;
+  hearth_sim_collect_stats s;
+  return hearth_sim_collect(&o, &s, err);
+}
+
+/* scale-out: the shards of a collection merged give the bytes of one run,
+ * also for split files; merging refuses what is not one collection */
+static void check_shards(const char *root, const char *dir) {
+  hearth_err err = {0};
+  char one[1200], part[3][1200], merged[1200];
+  snprintf(one, sizeof one, "%s/one.hdf5", dir);
+  snprintf(merged, sizeof merged, "%s/merged.hdf5", dir);
+  CHECK_OK(collect_shard(root, one, 3, 0, 1, 0, &err), &err);
+  for (int i = 0; i < 3; i++) {
+    snprintf(part[i], sizeof part[i], "%s/part%d.hdf5", dir, i);
+    CHECK_OK(collect_shard(root, part[i], 3, i, 3, 0, &err), &err);
+  }
+  const char *order[3] = {part[2], part[0], part[1]}; /* any order */
+  int n = 0;
+  CHECK_OK(hearth_sim_merge(merged, order, 3, &n, &err), &err);
+  CHECK(n == 6);
+  CHECK_MSG(same_file(one, merged), "3 shards merged differ from one run");
+  /* split files: two shards per instruction file */
+  char sone[1200], sp[2][1200], f1[1200], f2[1200];
+  snprintf(sone, sizeof sone, "%s/sone.hdf5", dir);
+  CHECK_OK(collect_shard(root, sone, 3, 0, 1, 1, &err), &err);
+  for (int i = 0; i < 2; i++) {
+    snprintf(sp[i], sizeof sp[i], "%s/sp%d.hdf5", dir, i);
+    CHECK_OK(collect_shard(root, sp[i], 3, i, 2, 1, &err), &err);
+  }
+  for (int ins = 0; ins < 2; ins++) {
+    char a[1200], b[1200], ref[1200], out[1200];
+    hearth_sim_split_path(sp[0], ins, a, sizeof a);
+    hearth_sim_split_path(sp[1], ins, b, sizeof b);
+    hearth_sim_split_path(sone, ins, ref, sizeof ref);
+    snprintf(out, sizeof out, "%s/smerged_%d.hdf5", dir, ins);
+    const char *two[2] = {a, b};
+    CHECK_OK(hearth_sim_merge(out, two, 2, &n, &err), &err);
+    CHECK(n == 3);
+    CHECK_MSG(same_file(ref, out), "split instruction %d: merged shards differ from one run", ins + 1);
+  }
+  hearth_sim_split_path(sp[0], 0, f1, sizeof f1);
+  hearth_sim_split_path(sp[1], 1, f2, sizeof f2);
+  /* refusals, each naming what is wrong */
+  const char *missing[2] = {part[0], part[1]};
+  CHECK(hearth_sim_merge(merged, missing, 2, NULL, &err) == HEARTH_E_ARG && strstr(err.msg, "give all 3"));
+  const char *twice[3] = {part[0], part[1], part[1]};
+  CHECK(hearth_sim_merge(merged, twice, 3, NULL, &err) == HEARTH_E_ARG && strstr(err.msg, "both shard 1/3"));
+  const char *mixed[2] = {f1, f2};
+  CHECK_MSG(hearth_sim_merge(merged, mixed, 2, NULL, &err) == HEARTH_E_ARG && strstr(err.msg, "differ in data@"),
+            "%s", err.msg);
+  const char *whole[1] = {one};
+  CHECK(hearth_sim_merge(merged, whole, 1, NULL, &err) == HEARTH_E_ARG && strstr(err.msg, "hearth_shard"));
+  CHECK(same_file(one, merged)); /* a refused merge leaves the output as it was */
+  CHECK(collect_shard(root, one, 3, 3, 3, 0, &err) == HEARTH_E_ARG);
+  CHECK(collect_shard(root, one, 2, 2, 3, 0, &err) == HEARTH_E_ARG && strstr(err.msg, "no slot"));
+}
+
 static void check_collect(const char *root, const char *dir) {
   char path[3][1200];
   const int S = 32;
@@ -341,6 +427,16 @@ static void check_collect(const char *root, const char *dir) {
     char cmd[4000];
     snprintf(cmd, sizeof cmd, "/usr/bin/python3 '%s/bench/sim_check_hdf5.py' '%s' >&2", src, path[0]);
     CHECK_MSG(system(cmd) == 0, "h5py check of %s failed", path[0]);
+    /* every LIBERO / robomimic key with its type, strings as str */
+    snprintf(cmd, sizeof cmd, "/usr/bin/python3 '%s/tests/sim/check_libero_keys.py' '%s' --size %d >&2", src,
+             path[0], S);
+    CHECK_MSG(system(cmd) == 0, "LIBERO key check of %s failed", path[0]);
+    char split1[1200];
+    snprintf(cmd, sizeof cmd, "%s/sone.hdf5", dir);
+    hearth_sim_split_path(cmd, 1, split1, sizeof split1);
+    snprintf(cmd, sizeof cmd, "/usr/bin/python3 '%s/tests/sim/check_libero_keys.py' '%s' --instructions 1 >&2",
+             src, split1);
+    CHECK_MSG(system(cmd) == 0, "LIBERO key check of %s failed", split1);
   } else {
     fprintf(stderr, "test_sim: no /usr/bin/python3 with h5py: skipping the h5py check\n");
   }
@@ -359,6 +455,8 @@ int main(void) {
   stamp("H2");
   check_task(root, HEARTH_SIM_H3);
   stamp("H3");
+  check_shards(root, dirbuf);
+  stamp("shards and merge");
   check_collect(root, dirbuf);
   stamp("collect checks");
   return g_test_failures ? 1 : 0;
