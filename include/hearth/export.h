@@ -42,7 +42,7 @@ extern "C" {
  * 2 acos(w) in [0, 2 pi)). A plain rotation vector flips sign near half a
  * turn, where the hand works; this one does not. */
 #define HEARTH_LEROBOT_QUAT_REF \
-  { 0.0, 1.0, 0.0, 0.0 }
+  { 0.0, 1.0, 0.0, 0.0 } /* = HEARTH_SIM_STATE_QUAT_REF of sim.h */
 void hearth_lerobot_axis_angle(const double rotvec[3], double out[3]);
 /* state[8] = ee_pos (3), hearth_lerobot_axis_angle(ee_ori) (3), gripper (2). */
 void hearth_lerobot_state(const double ee_pos[3], const double ee_ori[3], const double gripper[2],

@@ -42,6 +42,15 @@ void hearth_matrix_to_rotvec(const double R[9], double w[3]);
 void hearth_rotvec_to_matrix_jac(const double w[3], double R[9], double dR[27]);
 /* Angle of the relative rotation between two matrices, radians (0..pi). */
 double hearth_rotation_angle_between(const double Ra[9], const double Rb[9]);
+/* Axis * angle of the rotation given as rotation vector w, continuous near
+ * q_ref: the rotation's unit quaternion (w x y z) is taken in the
+ * hemisphere of q_ref, then written as axis * 2 acos(qw) (angle in
+ * [0, 2 pi); robosuite's quat2axisangle, which openpi's LIBERO client
+ * sends). A plain rotation vector (angle <= pi) jumps by 2 pi where the
+ * rotation passes half a turn; this one does not while the rotation stays
+ * within a quarter turn of q_ref. */
+void hearth_rotvec_to_axis_angle_near(const double w[3], const double q_ref[4], double out[3]);
+
 /* Re-orthonormalise a nearly orthonormal matrix (SVD-free polar iteration). */
 void hearth_orthonormalize(double R[9]);
 

@@ -21,6 +21,14 @@
 extern "C" {
 #endif
 
+/* The orientation the policy state's axis-angle is continuous around (w x y
+ * z): the hand pointing straight down, half a turn about world x. The
+ * LeRobot export (export.h) and the evaluation's observation both write
+ * hearth_rotvec_to_axis_angle_near(ee_ori, this), so a policy sees in
+ * evaluation the state it was trained on. */
+#define HEARTH_SIM_STATE_QUAT_REF \
+  { 0.0, 1.0, 0.0, 0.0 }
+
 #define HEARTH_SIM_TABLE_Z 0.90
 #define HEARTH_SIM_CONTROL_HZ 20
 #define HEARTH_SIM_TIMESTEP 0.002

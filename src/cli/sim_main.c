@@ -17,12 +17,9 @@ static const char k_about[] =
     "subcommands:\n"
     "  render    write PNGs of each task's scene: front RGB, front thermal, wrist RGB\n"
     "  collect   collect scripted-expert demonstrations into a LIBERO HDF5 file\n"
-    "  merge     merge the files of a sharded collection into the file of one run
-"
-    "  eval      score a policy on the tasks the way the paper does
-"
-    "  export    write collections as a LeRobot dataset (v2.1) for openpi training
-";
+    "  merge     merge the files of a sharded collection into the file of one run\n"
+    "  eval      score a policy on the tasks the way the paper does\n"
+    "  export    write collections as a LeRobot dataset (v2.1) for openpi training\n";
 
 static const char k_tail[] = "Run `hearth sim <subcommand> --help` for its options.\n";
 

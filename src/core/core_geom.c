@@ -295,3 +295,22 @@ void hearth_orthonormalize(double R[9]) {
   }
   memcpy(R, X, sizeof X);
 }
+
+void hearth_rotvec_to_axis_angle_near(const double w[3], const double q_ref[4], double out[3]) {
+  double th = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+  double q[4] = {1, 0, 0, 0};
+  if (th > 0) {
+    double s = sin(0.5 * th) / th;
+    q[0] = cos(0.5 * th), q[1] = w[0] * s, q[2] = w[1] * s, q[3] = w[2] * s;
+  }
+  if (q[0] * q_ref[0] + q[1] * q_ref[1] + q[2] * q_ref[2] + q[3] * q_ref[3] < 0)
+    for (int k = 0; k < 4; k++) q[k] = -q[k];
+  double qw = q[0] > 1 ? 1 : q[0] < -1 ? -1 : q[0];
+  double den = sqrt(1.0 - qw * qw);
+  if (den == 0) {
+    out[0] = out[1] = out[2] = 0;
+    return;
+  }
+  double a = acos(qw);
+  for (int k = 0; k < 3; k++) out[k] = q[k + 1] * 2.0 * a / den;
+}

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "hearth/eval.h"
+#include "hearth/geom.h"
 #include "hearth/msgpack.h"
 
 void hearth_eval_resize_with_pad(const uint8_t *in, int w, int h, uint8_t *out, int ow, int oh) {
@@ -67,7 +68,9 @@ hearth_status hearth_eval_encode_obs(const hearth_sim_obs *obs, const char *prom
   if (st) return st;
   double state[8];
   memcpy(state, obs->ee_pos, 3 * sizeof(double));
-  memcpy(state + 3, obs->ee_ori, 3 * sizeof(double));
+  /* continuous axis-angle, as the LeRobot export stores the state */
+  const double q_ref[4] = HEARTH_SIM_STATE_QUAT_REF;
+  hearth_rotvec_to_axis_angle_near(obs->ee_ori, q_ref, state + 3);
   memcpy(state + 6, obs->gripper_states, 2 * sizeof(double));
   uint8_t le[64];
   for (int k = 0; k < 8; k++) {

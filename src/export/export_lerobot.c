@@ -17,6 +17,7 @@
 
 #include "export/export_internal.h"
 #include "hearth/export.h"
+#include "hearth/geom.h"
 #include "hearth/image.h"
 #include "hearth/parquet.h"
 
@@ -28,24 +29,8 @@ void hearth_lerobot_opts_default(hearth_lerobot_opts *o) {
 
 /* ---- per-frame conversions -------------------------------------------------- */
 void hearth_lerobot_axis_angle(const double rotvec[3], double out[3]) {
-  double th = sqrt(rotvec[0] * rotvec[0] + rotvec[1] * rotvec[1] + rotvec[2] * rotvec[2]);
-  double q[4] = {1, 0, 0, 0};
-  if (th > 0) {
-    double s = sin(0.5 * th) / th;
-    q[0] = cos(0.5 * th), q[1] = rotvec[0] * s, q[2] = rotvec[1] * s, q[3] = rotvec[2] * s;
-  }
   const double ref[4] = HEARTH_LEROBOT_QUAT_REF;
-  if (q[0] * ref[0] + q[1] * ref[1] + q[2] * ref[2] + q[3] * ref[3] < 0)
-    for (int k = 0; k < 4; k++) q[k] = -q[k];
-  /* robosuite's quat2axisangle (x y z w there) */
-  double w = q[0] > 1 ? 1 : q[0] < -1 ? -1 : q[0];
-  double den = sqrt(1.0 - w * w);
-  if (den == 0) {
-    out[0] = out[1] = out[2] = 0;
-    return;
-  }
-  double a = acos(w);
-  for (int k = 0; k < 3; k++) out[k] = q[k + 1] * 2.0 * a / den;
+  hearth_rotvec_to_axis_angle_near(rotvec, ref, out);
 }
 
 void hearth_lerobot_state(const double ee_pos[3], const double ee_ori[3], const double gripper[2],

@@ -7,11 +7,13 @@
  * The writer emits one mesh / node / primitive with computed normals and an
  * optional embedded PNG base-colour texture, laid out so the Khronos
  * validator reports no errors. */
+#include <errno.h>
 #include <jansson.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #include "hearth/mesh.h"
 
 #define GLB_MAGIC 0x46546C67u      /* "glTF" */
@@ -839,15 +841,12 @@ static hearth_status fold_tiles(glb_ctx *c, const glb_prim *prims, size_t n_prim
                         ut.clamped == 1 ? "s" : "");
 }
 
-/* Split the container into its JSON and BIN chunks. */
-static hearth_status split_chunks(const uint8_t *d, size_t size, const char *name,
-                                  const uint8_t **json, size_t *json_len, const uint8_t **bin,
-                                  size_t *bin_len, hearth_err *err) {
-  *bin = NULL;
-  *bin_len = 0;
-  if (size < 12)
+/* The 12-byte GLB header of a file of file_size bytes (n of them at d). */
+static hearth_status check_header(const uint8_t *d, size_t n, size_t file_size, const char *name,
+                                  hearth_err *err) {
+  if (n < 12)
     return hearth_err_set(err, HEARTH_E_PARSE, "%s: %zu bytes is too short for a GLB header",
-                          name, size);
+                          name, n);
   if (rd_u32(d) != GLB_MAGIC)
     return hearth_err_set(err, HEARTH_E_PARSE,
                           "%s: header: bad magic 0x%08x; expected \"glTF\" (0x46546c67)", name,
@@ -855,10 +854,21 @@ static hearth_status split_chunks(const uint8_t *d, size_t size, const char *nam
   if (rd_u32(d + 4) != 2)
     return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "%s: header: container version %u; expected 2",
                           name, rd_u32(d + 4));
-  if ((size_t)rd_u32(d + 8) != size)
+  if ((size_t)rd_u32(d + 8) != file_size)
     return hearth_err_set(err, HEARTH_E_PARSE,
                           "%s: header: length field %u does not match the file size %zu", name,
-                          rd_u32(d + 8), size);
+                          rd_u32(d + 8), file_size);
+  return HEARTH_OK;
+}
+
+/* Split the container into its JSON and BIN chunks. */
+static hearth_status split_chunks(const uint8_t *d, size_t size, const char *name,
+                                  const uint8_t **json, size_t *json_len, const uint8_t **bin,
+                                  size_t *bin_len, hearth_err *err) {
+  *bin = NULL;
+  *bin_len = 0;
+  hearth_status hs = check_header(d, size, size, name, err);
+  if (hs) return hs;
   size_t pos = 12;
   int chunk = 0;
   while (pos < size) {
@@ -1168,7 +1178,18 @@ hearth_status hearth_glb_read(const char *path, const hearth_glb_read_opts *opts
   uint8_t *data = NULL;
   size_t size = 0;
   if (out) memset(out, 0, sizeof *out);
-  hearth_status s = hearth_read_file(path, GLB_MAX_FILE, &data, &size, err);
+  /* the 12-byte header first: a file that is not a GLB, or whose declared
+   * length is not its size, is refused before anything large is read */
+  int fd = -1;
+  size_t fsize = 0;
+  hearth_status s = hearth_open_regular(path, &fd, &fsize, err);
+  if (s) return s;
+  uint8_t head[12];
+  ssize_t got = read(fd, head, sizeof head);
+  close(fd);
+  if (got < 0) return hearth_err_set(err, HEARTH_E_IO, "%s: cannot read: %s", path, strerror(errno));
+  if ((s = check_header(head, (size_t)got, fsize, path, err))) return s;
+  s = hearth_read_file(path, GLB_MAX_FILE, &data, &size, err);
   if (s) return s;
   s = hearth_glb_parse(data, size, path, opts, out, err);
   free(data);

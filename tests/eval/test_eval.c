@@ -317,16 +317,12 @@ static void test_cli_all_policy_errors(void) {
     buf[fread(buf, 1, sizeof buf - 1, f)] = 0;
     fclose(f);
   }
-  CHECK_MSG(strstr(buf, "every episode (2) failed because of the policy") && strstr(buf, "policy errors: 2 of 2"),
+  CHECK_MSG(strstr(buf, "every episode (2 of 2) failed because the policy erred") &&
+                strstr(buf, "policy errors: 2 of 2"),
             "output: %s", buf);
+  /* a run that measured nothing writes no results */
   snprintf(path, sizeof path, "%s/results.json", out);
-  f = fopen(path, "r");
-  buf[0] = 0;
-  if (f) {
-    buf[fread(buf, 1, sizeof buf - 1, f)] = 0;
-    fclose(f);
-  }
-  CHECK_MSG(strstr(buf, "\"policy_errors\": 2") && strstr(buf, "\"task_failures\": 0"), "results.json: %s", buf);
+  CHECK_MSG(access(path, F_OK) != 0, "%s written by a run that measured nothing", path);
   stop_server(&s);
 }
 

@@ -208,6 +208,21 @@ static const fault_case k_cases[] = {
      {NULL},
      20},
 
+    /* a 3 GB mesh (sparse) is refused on its 12-byte header, not read whole */
+    {"glb_huge_bad_magic_scale",
+     COPY "truncate -s 3G $I/recon/mesh.glb",
+     "$HEARTH scale R --threads 2",
+     {"recon/mesh.glb: header: bad magic 0x00000000"},
+     {TEMPS},
+     20},
+    {"glb_huge_bad_length_scale",
+     COPY "printf 'glTF\\002\\000\\000\\000\\144\\000\\000\\000' > $I/recon/mesh.glb && "
+     "truncate -s 3G $I/recon/mesh.glb",
+     "$HEARTH scale R --threads 2",
+     {"recon/mesh.glb: header: length field 100 does not match the file size 3221225472"},
+     {TEMPS},
+     20},
+
     /* ---- 6. messages that say which file and why ------------------------- */
     {"jpeg_wrong_size_map_rgb",
      COPY "cp \"$SHARED/small.jpg\" $I/raw/neutral/rgb/v00.jpg",
