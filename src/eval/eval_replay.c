@@ -79,6 +79,9 @@ hearth_status eval_replay_load(const char *spec, eval_replay_file *r, hearth_err
     *hash = 0;
   }
   H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+  /* a FIFO or a directory would block or confuse HDF5: regular files only */
+  hearth_status rs = hearth_check_regular(path, err);
+  if (rs) return rs;
   hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
   if (f < 0) return hearth_err_set(err, HEARTH_E_IO, "%s: cannot open as HDF5", path);
   hearth_status st = HEARTH_OK;

@@ -178,7 +178,7 @@ static hearth_status check_server(const hearth_eval_opts *o, eval_ws_policy *p, 
                                   hearth_err *err) {
   hearth_status st = eval_ws_ensure(p, err);
   if (st) {
-    hearth_err_prefix(err, "eval: before the first episode: ");
+    hearth_err_prefix(err, "eval: before the first episode");
     return st;
   }
   if (o->thermal && p->thermal_decl == 0)

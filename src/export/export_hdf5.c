@@ -55,6 +55,9 @@ hearth_status ex_source_open(const char *path, ex_source *s, hearth_err *err) {
   s->file_id = -1;
   snprintf(s->path, sizeof s->path, "%s", path);
   H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+  /* a FIFO or a directory would block or confuse HDF5: regular files only */
+  hearth_status rs = hearth_check_regular(path, err);
+  if (rs) return rs;
   hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
   if (f < 0) return hearth_err_set(err, HEARTH_E_IO, "%s: cannot open as HDF5", path);
   s->file_id = f;

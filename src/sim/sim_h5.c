@@ -112,7 +112,9 @@ static hid_t h5_group(hid_t parent, const char *name) {
 hearth_status sim_h5_create(sim_h5_out *o, const char *path, hearth_err *err) {
   memset(o, 0, sizeof *o);
   o->f = o->data = -1;
-  hearth_status st = hearth_atomic_open(&o->af, path, err);
+  /* temporaries of this file left by a killed collection go first */
+  hearth_status st = hearth_sweep_temps_of(path, NULL, err);
+  if (!st) st = hearth_atomic_open(&o->af, path, err);
   if (st) return st;
   H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
   o->f = H5Fcreate(o->af.tmp_path, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
@@ -265,6 +267,9 @@ hearth_status sim_h5_open(sim_h5_in *in, const char *path, hearth_err *err) {
   in->f = in->data = -1;
   snprintf(in->path, sizeof in->path, "%s", path);
   H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+  /* a FIFO or a directory would block or confuse HDF5: regular files only */
+  hearth_status rs = hearth_check_regular(path, err);
+  if (rs) return rs;
   in->f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
   if (in->f < 0) return hearth_err_set(err, HEARTH_E_IO, "%s: cannot open as HDF5", path);
   in->data = H5Gopen2(in->f, "data", H5P_DEFAULT);
