@@ -130,6 +130,7 @@ int hearth_cmd_recon(int argc, char **argv) {
   };
   const cli_command cmd = {.name = "hearth recon", .args = "ROOT", .min_args = 1, .max_args = 1,
                            .about = k_about, .opts = opts, .tail = k_tail};
+  if (argc < 2) return cli_usage_error(&cmd, "missing ROOT (see 'hearth recon --help')");
   cli_args args;
   int rc = cli_parse(&cmd, argc, argv, &args);
   if (rc != CLI_RUN) return rc;

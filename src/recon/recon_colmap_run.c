@@ -27,9 +27,12 @@ typedef struct run_ctx {
   hearth_err *err;
 } run_ctx;
 
+/* buf = a/b; buf may be a */
 static hearth_status join(char *buf, const char *a, const char *b, hearth_err *err) {
-  if (hearth_path_join(buf, 4096, a, b))
+  char tmp[4096];
+  if (hearth_path_join(tmp, sizeof tmp, a, b))
     return hearth_err_set(err, HEARTH_E_LIMIT, "%s/%s: path too long", a, b);
+  memcpy(buf, tmp, strlen(tmp) + 1);
   return HEARTH_OK;
 }
 
