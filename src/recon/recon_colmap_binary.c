@@ -243,7 +243,6 @@ hearth_status rc_parse_binary(hearth_colmap_file which, const uint8_t *data, siz
                               const char *name, hearth_colmap_model *m, hearth_err *err) {
   static const size_t k_size[3] = {sizeof(hearth_colmap_camera), sizeof(hearth_colmap_image),
                                    sizeof(hearth_colmap_point)};
-  static const char *const k_kind[3] = {"camera", "image", "3-D point"};
   bn b = {.data = data, .len = len, .name = name, .err = err};
   rc_vec v = {.size = k_size[which]}, w = {.size = sizeof(rc_where)};
   hearth_status s;
@@ -252,21 +251,5 @@ hearth_status rc_parse_binary(hearth_colmap_file which, const uint8_t *data, siz
   else s = bn_points(&b, m, &v, &w);
   if (!s && b.off != b.len)
     s = bn_fail(&b, b.off, HEARTH_E_PARSE, "%zu bytes after the last record", b.len - b.off);
-  if (!s) {
-    size_t a, c;
-    uint64_t id;
-    int r = rc_sort_by_id(v.data, v.n, v.size, w.data, &id, &a, &c);
-    if (r < 0) s = hearth_err_set(err, HEARTH_E_NOMEM, "%s: out of memory sorting", name);
-    else if (r == 0)
-      s = hearth_err_set(err, HEARTH_E_INCONSISTENT,
-                         "%s: byte offset %zu: duplicate %s id %llu (also at byte offset %zu)", name,
-                         c, k_kind[which], (unsigned long long)id, a);
-  }
-  free(w.data);
-  if (s) {
-    free(v.data);
-    v = (rc_vec){0};
-  }
-  rc_model_set(m, which, &v);
-  return s;
+  return rc_finish(m, which, &v, &w, s, name, 1, err);
 }

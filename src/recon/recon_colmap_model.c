@@ -105,7 +105,7 @@ hearth_status rc_camera_finish(hearth_colmap_camera *cam, hearth_err *err) {
                                       cam->height, &cam->camera, err);
 }
 
-void rc_model_set(hearth_colmap_model *m, hearth_colmap_file which, rc_vec *v) {
+static void rc_model_set(hearth_colmap_model *m, hearth_colmap_file which, rc_vec *v) {
   switch (which) {
     case HEARTH_COLMAP_CAMERAS:
       free(m->cameras);
@@ -124,6 +124,32 @@ void rc_model_set(hearth_colmap_model *m, hearth_colmap_file which, rc_vec *v) {
       break;
   }
   memset(v, 0, sizeof *v);
+}
+
+hearth_status rc_finish(hearth_colmap_model *m, hearth_colmap_file which, rc_vec *v, rc_vec *w,
+                        hearth_status s, const char *name, int binary, hearth_err *err) {
+  static const char *const k_kind[3] = {"camera", "image", "3-D point"};
+  if (!s) {
+    size_t a, b;
+    uint64_t id;
+    int r = rc_sort_by_id(v->data, v->n, v->size, w->data, &id, &a, &b);
+    if (r < 0) s = hearth_err_set(err, HEARTH_E_NOMEM, "%s: out of memory sorting", name);
+    else if (r == 0 && binary)
+      s = hearth_err_set(err, HEARTH_E_INCONSISTENT,
+                         "%s: byte offset %zu: duplicate %s id %llu (also at byte offset %zu)", name,
+                         b, k_kind[which], (unsigned long long)id, a);
+    else if (r == 0)
+      s = hearth_err_set(err, HEARTH_E_INCONSISTENT, "%s:%zu: duplicate %s id %llu (also on line %zu)",
+                         name, b, k_kind[which], (unsigned long long)id, a);
+  }
+  free(w->data);
+  memset(w, 0, sizeof *w);
+  if (s) {
+    free(v->data);
+    memset(v, 0, sizeof *v);
+  }
+  rc_model_set(m, which, v);
+  return s;
 }
 
 void hearth_colmap_model_free(hearth_colmap_model *m) {

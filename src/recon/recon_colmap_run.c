@@ -217,9 +217,9 @@ static hearth_status run_step(run_ctx *r, step_kind kind, const char *step, cons
     if (!r->job->quiet)
       fprintf(stderr, "%s%s: %zu of %zu views registered (%.1fs)\n", sp.p.is_tty ? "\n" : "", label,
               sp.registered, r->n_views, *seconds);
-  } else if (!s) {
-    hearth_progress_end(&sp.p);
-  } else if (sp.p.is_tty && !r->job->quiet) {
+  } else if (!s && (sp.p.is_tty || sp.p.done < sp.p.total)) {
+    hearth_progress_end(&sp.p); /* a plain line at 100 % is there already */
+  } else if (s && sp.p.is_tty && !r->job->quiet) {
     fputc('\n', stderr);
   }
   if (s && kind == STEP_MAP && sp.no_pair)

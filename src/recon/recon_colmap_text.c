@@ -302,7 +302,6 @@ hearth_status rc_parse_text(hearth_colmap_file which, const uint8_t *data, size_
                             const char *name, hearth_colmap_model *m, hearth_err *err) {
   static const size_t k_size[3] = {sizeof(hearth_colmap_camera), sizeof(hearth_colmap_image),
                                    sizeof(hearth_colmap_point)};
-  static const char *const k_kind[3] = {"camera", "image", "3-D point"};
   tx t = {.p = (const char *)data, .end = (const char *)data + len, .name = name, .err = err};
   t.c_locale = newlocale(LC_ALL_MASK, "C", (locale_t)0);
   if (t.c_locale == (locale_t)0)
@@ -313,20 +312,5 @@ hearth_status rc_parse_text(hearth_colmap_file which, const uint8_t *data, size_
   else if (which == HEARTH_COLMAP_IMAGES) s = tx_images(&t, m, &v, &w);
   else s = tx_points(&t, m, &v, &w);
   freelocale(t.c_locale);
-  if (!s) {
-    size_t a, b;
-    uint64_t id;
-    int r = rc_sort_by_id(v.data, v.n, v.size, w.data, &id, &a, &b);
-    if (r < 0) s = hearth_err_set(err, HEARTH_E_NOMEM, "%s: out of memory sorting", name);
-    else if (r == 0)
-      s = hearth_err_set(err, HEARTH_E_INCONSISTENT, "%s:%zu: duplicate %s id %llu (also on line %zu)",
-                         name, b, k_kind[which], (unsigned long long)id, a);
-  }
-  free(w.data);
-  if (s) {
-    free(v.data);
-    v = (rc_vec){0};
-  }
-  rc_model_set(m, which, &v);
-  return s;
+  return rc_finish(m, which, &v, &w, s, name, 0, err);
 }

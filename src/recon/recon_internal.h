@@ -38,8 +38,12 @@ int rc_image_pose(hearth_colmap_image *im, char *why, size_t whysz);
 /* Check a camera against m and convert it: message prefix is the caller's. */
 hearth_status rc_camera_finish(hearth_colmap_camera *cam, hearth_err *err);
 
-/* Replace m's array for `which` with the vector's records (sorted). */
-void rc_model_set(hearth_colmap_model *m, hearth_colmap_file which, rc_vec *v);
+/* The end of a file's parse with status s: on success the records of v are
+ * sorted by id (w: ids and positions, lines or byte offsets as `binary`
+ * says) and a duplicate id is an error; then m's array for `which` is
+ * replaced by them, or emptied on failure. v and w are released. */
+hearth_status rc_finish(hearth_colmap_model *m, hearth_colmap_file which, rc_vec *v, rc_vec *w,
+                        hearth_status s, const char *name, int binary, hearth_err *err);
 
 hearth_status rc_parse_text(hearth_colmap_file which, const uint8_t *data, size_t len,
                             const char *name, hearth_colmap_model *m, hearth_err *err);

@@ -11,6 +11,7 @@
 
 #include "hearth/recon.h"
 #include "recon/colmap_fixture.h"
+#include "recon/recon_release.h"
 #include "test_util.h"
 
 static char g_dir[1024];
@@ -440,37 +441,9 @@ static void test_names(void) {
   /* the unregistered image: a two-view instance whose v02 is not in the model */
   char root[1200];
   snprintf(root, sizeof root, "%s", tpath("release"));
-  char cmd[1400];
-  snprintf(cmd, sizeof cmd, "mkdir -p '%s/instances/cup_01/raw/neutral' '%s/instances/cup_01/raw/hot'", root, root);
-  CHECK(system(cmd) == 0);
-  hearth_instance_doc inst;
-  memset(&inst, 0, sizeof inst);
-  snprintf(inst.id, sizeof inst.id, "cup_01");
-  snprintf(inst.category, sizeof inst.category, "cup");
-  inst.n_states = 2;
-  snprintf(inst.states[0], HEARTH_NAME_MAX, "neutral");
-  snprintf(inst.states[1], HEARTH_NAME_MAX, "hot");
-  char path[1400];
-  snprintf(path, sizeof path, "%s/instances/cup_01/instance.json", root);
-  CHECK_OK(hearth_instance_write(path, &inst, &err), &err);
-  for (int s = 0; s < 2; s++) {
-    hearth_view_files v[3];
-    memset(v, 0, sizeof v);
-    for (int i = 0; i < 3; i++) {
-      snprintf(v[i].view, sizeof v[i].view, "v%02d", i);
-      v[i].azimuth_index = i;
-      snprintf(v[i].rgb, sizeof v[i].rgb, "rgb/v%02d.jpg", i);
-      snprintf(v[i].cutout, sizeof v[i].cutout, "cutout/v%02d.png", i);
-      snprintf(v[i].depth, sizeof v[i].depth, "depth/v%02d.png", i);
-      snprintf(v[i].depth_intrinsics, sizeof v[i].depth_intrinsics, "depth/v%02d.json", i);
-      snprintf(v[i].thermal, sizeof v[i].thermal, "thermal/v%02d.csv", i);
-    }
-    hearth_manifest man = {.n_views = s ? 1 : 3, .views = v};
-    snprintf(man.instance, sizeof man.instance, "cup_01");
-    snprintf(man.state, sizeof man.state, "%s", inst.states[s]);
-    snprintf(path, sizeof path, "%s/instances/cup_01/raw/%s/manifest.json", root, inst.states[s]);
-    CHECK_OK(hearth_manifest_write(path, &man, &err), &err);
-  }
+  static const char *const states[] = {"neutral", "hot"};
+  static const size_t n_views[] = {3, 1};
+  rr_write_instance(root, "cup_01", "cup", 2, states, n_views);
   char bin[1200];
   snprintf(bin, sizeof bin, "%s", tpath("bin"));
   CHECK_OK(hearth_colmap_read(bin, &m, &err), &err);

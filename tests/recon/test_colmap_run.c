@@ -13,6 +13,7 @@
 
 #include "hearth/image.h"
 #include "hearth/recon.h"
+#include "recon/recon_release.h"
 #include "test_util.h"
 
 static char g_dir[1024], g_root[1200], g_fake[1200], g_log[1200];
@@ -83,21 +84,11 @@ static const char k_fake[] =
 static void make_release(void) {
   hearth_err err = {0};
   char cmd[4096], path[2048];
-  snprintf(cmd, sizeof cmd,
-           "mkdir -p '%s/calibration' '%s/instances/cup_01/raw/neutral/rgb' "
-           "'%s/instances/cup_01/raw/neutral/cutout' '%s/instances/cup_01/raw/hot/rgb' "
-           "'%s/instances/cup_01/raw/hot/cutout'",
-           g_root, g_root, g_root, g_root, g_root);
+  static const char *const states[] = {"neutral", "hot"};
+  static const size_t n_views[] = {2, 2};
+  rr_write_instance(g_root, "cup_01", "cup", 2, states, n_views);
+  snprintf(cmd, sizeof cmd, "mkdir -p '%s/calibration'", g_root);
   CHECK(system(cmd) == 0);
-  hearth_instance_doc inst;
-  memset(&inst, 0, sizeof inst);
-  snprintf(inst.id, sizeof inst.id, "cup_01");
-  snprintf(inst.category, sizeof inst.category, "cup");
-  inst.n_states = 2;
-  snprintf(inst.states[0], HEARTH_NAME_MAX, "neutral");
-  snprintf(inst.states[1], HEARTH_NAME_MAX, "hot");
-  snprintf(path, sizeof path, "%s/instances/cup_01/instance.json", g_root);
-  CHECK_OK(hearth_instance_write(path, &inst, &err), &err);
   hearth_factory_calib fac;
   memset(&fac, 0, sizeof fac);
   fac.rgb = (hearth_camera){64, 48, 70, 71, 31.5, 23.25, {0.01, -0.002, 0.0003, 0.0004, 0.005}};
@@ -106,21 +97,11 @@ static void make_release(void) {
   snprintf(path, sizeof path, "%s/calibration/factory.json", g_root);
   CHECK_OK(hearth_factory_write(path, &fac, &err), &err);
   for (int s = 0; s < 2; s++) {
-    const char *state = inst.states[s];
-    hearth_view_files v[2];
-    memset(v, 0, sizeof v);
     for (int i = 0; i < 2; i++) {
-      snprintf(v[i].view, sizeof v[i].view, "v%02d", i);
-      v[i].azimuth_index = i;
-      snprintf(v[i].rgb, sizeof v[i].rgb, "rgb/v%02d.jpg", i);
-      snprintf(v[i].cutout, sizeof v[i].cutout, "cutout/v%02d.png", i);
-      snprintf(v[i].depth, sizeof v[i].depth, "depth/v%02d.png", i);
-      snprintf(v[i].depth_intrinsics, sizeof v[i].depth_intrinsics, "depth/v%02d.json", i);
-      snprintf(v[i].thermal, sizeof v[i].thermal, "thermal/v%02d.csv", i);
       hearth_image rgb, cut;
       CHECK_OK(hearth_image_alloc(&rgb, 64, 48, 3, HEARTH_PIX_U8, &err), &err);
       memset(rgb.data, 90 + 40 * i, hearth_image_bytes(&rgb));
-      snprintf(path, sizeof path, "%s/instances/cup_01/raw/%s/%s", g_root, state, v[i].rgb);
+      snprintf(path, sizeof path, "%s/instances/cup_01/raw/%s/rgb/v%02d.jpg", g_root, states[s], i);
       CHECK_OK(hearth_jpeg_write(path, &rgb, 90, &err), &err);
       /* neutral: 8-bit mask; hot: RGBA with the object in alpha */
       int ch = s ? 4 : 1;
@@ -132,16 +113,11 @@ static void make_release(void) {
           for (int c = 0; c < ch; c++)
             px[(y * 64 + x) * (size_t)ch + (size_t)c] = ch == 4 ? (c == 3 ? (on ? 200 : 0) : 77) : (on ? 1 : 0);
         }
-      snprintf(path, sizeof path, "%s/instances/cup_01/raw/%s/%s", g_root, state, v[i].cutout);
+      snprintf(path, sizeof path, "%s/instances/cup_01/raw/%s/cutout/v%02d.png", g_root, states[s], i);
       CHECK_OK(hearth_png_write(path, &cut, &err), &err);
       hearth_image_free(&rgb);
       hearth_image_free(&cut);
     }
-    hearth_manifest man = {.n_views = 2, .views = v};
-    snprintf(man.instance, sizeof man.instance, "cup_01");
-    snprintf(man.state, sizeof man.state, "%s", state);
-    snprintf(path, sizeof path, "%s/instances/cup_01/raw/%s/manifest.json", g_root, state);
-    CHECK_OK(hearth_manifest_write(path, &man, &err), &err);
   }
 }
 
