@@ -69,7 +69,9 @@ static inline double fx_px(int j) { return 10.0 + 3.25 * j; }
 static inline double fx_py(int j) { return 20.0 + 1.5 * j; }
 
 /* ---- text ---------------------------------------------------------------------- */
-static inline int fx_write_text(const char *dir) {
+/* tabs: one line of points3D.txt separates with a tab, which hearth reads
+ * and COLMAP 3.8's reader (single spaces only) does not */
+static inline int fx_write_text_as(const char *dir, int tabs) {
   char p[1024];
   snprintf(p, sizeof p, "%s/cameras.txt", dir);
   FILE *f = fopen(p, "wb");
@@ -107,7 +109,7 @@ static inline int fx_write_text(const char *dir) {
              "#   POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as (IMAGE_ID, POINT2D_IDX)\n");
   for (size_t i = 0; i < FX_N_POINTS; i++) {
     const fx_point *pt = &k_fx_points[i];
-    fprintf(f, "%llu\t%.17g %.17g %.17g %u %u %u %.17g", (unsigned long long)pt->id, pt->xyz[0],
+    fprintf(f, "%llu%c%.17g %.17g %.17g %u %u %u %.17g", (unsigned long long)pt->id, tabs ? '\t' : ' ', pt->xyz[0],
             pt->xyz[1], pt->xyz[2], pt->rgb[0], pt->rgb[1], pt->rgb[2], pt->error);
     for (int k = 0; k < pt->track_length; k++)
       fprintf(f, " %u %u", (unsigned)pt->image[k], (unsigned)pt->point2d[k]);
@@ -116,6 +118,8 @@ static inline int fx_write_text(const char *dir) {
   fclose(f);
   return 0;
 }
+
+static inline int fx_write_text(const char *dir) { return fx_write_text_as(dir, 1); }
 
 /* ---- binary ---------------------------------------------------------------------- */
 typedef struct fx_buf {

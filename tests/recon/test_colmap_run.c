@@ -13,6 +13,7 @@
 
 #include "hearth/image.h"
 #include "hearth/recon.h"
+#include "recon/colmap_fixture.h"
 #include "recon/recon_release.h"
 #include "test_util.h"
 
@@ -312,6 +313,65 @@ static void test_cli(void) {
   }
 }
 
+/* with COLMAP installed: its own writer's binary and text forms of the
+ * fixture import to the same bytes, and to the fixture's poses (COLMAP
+ * renormalises the quaternions, so up to rounding) */
+static void test_real_colmap(void) {
+  if (!hearth_program_found("colmap")) {
+    printf("colmap not on PATH: its model_converter check skipped\n");
+    return;
+  }
+  hearth_err err = {0};
+  char fx[1200], bin[1200], txt[1200], cmd[4096];
+  snprintf(fx, sizeof fx, "%s/real_fixture", g_dir);
+  snprintf(bin, sizeof bin, "%s/real_bin", g_dir);
+  snprintf(txt, sizeof txt, "%s/real_txt", g_dir);
+  snprintf(cmd, sizeof cmd, "mkdir -p '%s' '%s' '%s'", fx, bin, txt);
+  CHECK(system(cmd) == 0);
+  CHECK(fx_write_text_as(fx, 0) == 0);
+  const char *to_bin[] = {"colmap", "model_converter", "--input_path", fx, "--output_path", bin,
+                          "--output_type", "BIN", NULL};
+  const char *to_txt[] = {"colmap", "model_converter", "--input_path", bin, "--output_path", txt,
+                          "--output_type", "TXT", NULL};
+  CHECK_OK(hearth_exec("colmap model_converter", to_bin, NULL, NULL, NULL, &err), &err);
+  CHECK_OK(hearth_exec("colmap model_converter", to_txt, NULL, NULL, NULL, &err), &err);
+  const char *dirs[3] = {fx, bin, txt};
+  hearth_poses p[3];
+  hearth_recon_cameras c[3];
+  char out[3][1300], cams[3][1300];
+  for (int k = 0; k < 3; k++) {
+    hearth_colmap_model m;
+    CHECK_OK(hearth_colmap_read(dirs[k], &m, &err), &err);
+    CHECK(m.format == (k == 1 ? HEARTH_COLMAP_BINARY : HEARTH_COLMAP_TEXT));
+    CHECK(m.n_cameras == 3 && m.n_images == 4 && m.n_points == 3);
+    CHECK_OK(hearth_colmap_to_poses(&m, "neutral", &p[k], &c[k], &err), &err);
+    snprintf(out[k], sizeof out[k], "%s/real_%d.json", g_dir, k);
+    CHECK(hearth_recon_cameras_path(out[k], cams[k], sizeof cams[k]) == HEARTH_OK);
+    CHECK_OK(hearth_poses_write(out[k], &p[k], &err), &err);
+    CHECK_OK(hearth_recon_cameras_write(cams[k], &c[k], &err), &err);
+    hearth_colmap_model_free(&m);
+  }
+  char *a = slurp(out[1]), *b = slurp(out[2]), *ca = slurp(cams[0]), *cb = slurp(cams[1]);
+  CHECK(a && b && !strcmp(a, b));
+  CHECK(ca && cb && !strcmp(ca, cb));
+  free(a);
+  free(b);
+  free(ca);
+  free(cb);
+  CHECK(p[0].n == 4 && p[1].n == 4);
+  for (size_t i = 0; i < p[0].n && i < p[1].n; i++) {
+    CHECK(!strcmp(p[0].views[i].view, p[1].views[i].view));
+    for (int k = 0; k < 9; k++)
+      CHECK_NEAR(p[0].views[i].T_world_from_cam.R[k], p[1].views[i].T_world_from_cam.R[k], 1e-14);
+    for (int k = 0; k < 3; k++)
+      CHECK_NEAR(p[0].views[i].T_world_from_cam.t[k], p[1].views[i].T_world_from_cam.t[k], 1e-14);
+  }
+  for (int k = 0; k < 3; k++) {
+    hearth_poses_free(&p[k]);
+    hearth_recon_cameras_free(&c[k]);
+  }
+}
+
 int main(void) {
   snprintf(g_dir, sizeof g_dir, "%s", test_tmpdir("recon_colmap_run"));
   snprintf(g_root, sizeof g_root, "%s/release", g_dir);
@@ -328,5 +388,6 @@ int main(void) {
   test_exec();
   test_run();
   test_cli();
+  test_real_colmap();
   TEST_MAIN_END();
 }
