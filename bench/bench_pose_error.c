@@ -3,15 +3,18 @@
  * the similarity's scale, and the rotation and camera-centre errors left
  * (centre errors in the reference's units and relative to the mean camera
  * distance from the centroid of the reference centres).
- * usage: build/bench_pose_error EST.json REF.json */
+ * With --views, one line per common view as well.
+ * usage: build/bench_pose_error EST.json REF.json [--views] */
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 
 #include "hearth/recon.h"
 
 int main(int argc, char **argv) {
-  if (argc != 3) {
-    fprintf(stderr, "usage: %s EST.json REF.json\n", argv[0]);
+  int per_view = argc == 4 && !strcmp(argv[3], "--views");
+  if (argc != 3 && !per_view) {
+    fprintf(stderr, "usage: %s EST.json REF.json [--views]\n", argv[0]);
     return 2;
   }
   hearth_err err = {0};
@@ -45,6 +48,20 @@ int main(int argc, char **argv) {
            "median %.4f %% of the mean camera distance %.3f m\n",
            1e3 * a.pos_median, 1e3 * a.pos_rms, 1e3 * a.pos_max,
            spread > 0 ? 100.0 * a.pos_median / spread : 0.0, spread);
+    const hearth_similarity *S = &a.ref_from_est;
+    for (size_t i = 0; per_view && i < est.n; i++) {
+      const hearth_view_pose *e = &est.views[i], *r = hearth_poses_find(&ref, e->state, e->view);
+      if (!r) continue;
+      double x[3], Ra[9], d2 = 0;
+      hearth_rigid_rotate(&S->T, e->T_world_from_cam.t, x);
+      for (int k = 0; k < 3; k++) {
+        double d = S->s * x[k] + S->T.t[k] - r->T_world_from_cam.t[k];
+        d2 += d * d;
+      }
+      hearth_mat3_mul(S->T.R, e->T_world_from_cam.R, Ra);
+      printf("  %s/%s: rotation %.4f deg, centre %.3f mm\n", e->state, e->view,
+             hearth_rotation_angle_between(Ra, r->T_world_from_cam.R) * 180.0 / M_PI, 1e3 * sqrt(d2));
+    }
   }
   hearth_poses_free(&est);
   hearth_poses_free(&ref);

@@ -178,7 +178,6 @@ typedef enum step_kind { STEP_EXTRACT, STEP_MATCH, STEP_MAP } step_kind;
 typedef struct step_progress {
   step_kind kind;
   hearth_progress p;
-  size_t registered;
   int no_pair; /* the mapper found no initial pair */
 } step_progress;
 
@@ -191,10 +190,8 @@ static void on_line(void *ctx, const char *line) {
     sp->p.total = (size_t)b * b;
     hearth_progress_step(&sp->p, 1);
   } else if (sp->kind == STEP_MAP) {
-    if (sscanf(line, "Registering image #%u (%u)", &a, &b) == 2 && b > sp->p.done) {
-      sp->registered = b;
+    if (sscanf(line, "Registering image #%u (%u)", &a, &b) == 2 && b > sp->p.done)
       hearth_progress_step(&sp->p, b - sp->p.done);
-    }
     if (strstr(line, "No good initial image pair found")) sp->no_pair = 1;
   }
 }
@@ -214,9 +211,10 @@ static hearth_status run_step(run_ctx *r, step_kind kind, const char *step, cons
   s = hearth_exec(label, argv, log, on_line, &sp, r->err);
   *seconds = hearth_now() - t0;
   if (kind == STEP_MAP) {
+    /* the progress counted the largest model while it grew; the model
+     * imported says how many views it holds */
     if (!r->job->quiet)
-      fprintf(stderr, "%s%s: %zu of %zu views registered (%.1fs)\n", sp.p.is_tty ? "\n" : "", label,
-              sp.registered, r->n_views, *seconds);
+      fprintf(stderr, "%s%s: done (%.1fs)\n", sp.p.is_tty ? "\n" : "", label, *seconds);
   } else if (!s && (sp.p.is_tty || sp.p.done < sp.p.total)) {
     hearth_progress_end(&sp.p); /* a plain line at 100 % is there already */
   } else if (s && sp.p.is_tty && !r->job->quiet) {
