@@ -225,8 +225,9 @@ hearth_status hearth_recon_match_instance(const char *root, const char *instance
 
 /* ---- comparing pose sets ----------------------------------------------------- */
 /* The similarity x_ref = s R x_est + t that best maps the camera centres of
- * est onto those of ref (least squares over the views both have, Umeyama's
- * closed form), and the errors left after it: per common view the angle
+ * est onto those of ref (least squares over the views both have, in closed
+ * form: Horn's quaternion solution, the same optimum as Umeyama's SVD one),
+ * and the errors left after it: per common view the angle
  * between R R_est and R_ref and the distance between the mapped and the
  * reference centre (reference units). At least 3 common views whose centres
  * are not all on one line are needed (HEARTH_E_NUMERIC otherwise). */
