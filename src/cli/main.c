@@ -14,6 +14,7 @@ typedef int (*cmd_fn)(int argc, char **argv);
 HEARTH_CMD(synth)
 HEARTH_CMD(detect)
 HEARTH_CMD(calibrate)
+HEARTH_CMD(recon)
 HEARTH_CMD(scale)
 HEARTH_CMD(transfer)
 HEARTH_CMD(refine)
@@ -60,6 +61,7 @@ static const command k_cmds[] = {
     {"inspect", hearth_cmd_inspect, "read and summarise one file (CSV, PNG, JPEG, NPY, GLB, JSON)"},
     {"detect", hearth_cmd_detect, "find plate hole centres in the calibration captures"},
     {"calibrate", hearth_cmd_calibrate, "thermal intrinsics and RGB-thermal stereo from detections"},
+    {"recon", hearth_cmd_recon, "camera poses from COLMAP: run it on an instance, or import a model"},
     {"scale", hearth_cmd_scale, "recover metric scale from recorded depth"},
     {"transfer", hearth_cmd_transfer, "thermal poses from colour poses through the rig transform"},
     {"refine", hearth_cmd_refine, "refine thermal poses automatically"},

@@ -1,0 +1,150 @@
+/* hearth recon: camera poses from COLMAP, either by running it over an
+ * instance (`hearth recon ROOT --instance ID --poses colmap`) or by importing
+ * a sparse model it made (`hearth recon import-colmap MODEL_DIR ...`). */
+#include <stdio.h>
+#include <string.h>
+#include "cli/cli.h"
+#include "hearth/recon.h"
+
+static const char *const k_states[] = {"neutral", "hot", "warm", "iced", "used", NULL};
+
+static const char *k_import_about =
+    "Reads a COLMAP sparse model (cameras, images, points3D; binary .bin files when\n"
+    "all three are there, else text .txt) and writes its registered images as hearth\n"
+    "poses (T_world_from_cam, OpenCV camera axes, in the model's frame and scale) and\n"
+    "their cameras beside them in <FILE without .json>_cameras.json (principal points\n"
+    "moved from COLMAP's pixel convention to hearth's: cx - 0.5, cy - 0.5).\n"
+    "A view is named by its image file's stem (neutral/v07.jpg -> v07); its state is\n"
+    "the first folder of the image name when that is a state, else --state.\n"
+    "Camera models: SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV, and\n"
+    "FULL_OPENCV with k4 = k5 = k6 = 0; fisheye and other models are refused.\n";
+
+static int cmd_import(int argc, char **argv) {
+  const char *out = NULL, *root = NULL, *instance = NULL;
+  int state = 0, force = 0;
+  const cli_opt opts[] = {
+      CLI_STR("--out", "FILE.json", &out, "poses file to write",
+              .def = "ROOT/instances/ID/recon/poses_rgb.json with --root and --instance"),
+      CLI_CHOICE("--state", &state, k_states, NULL,
+                 "state of images whose name has no state folder"),
+      CLI_STR("--root", "ROOT", &root, "release root: check the poses against an instance's views"),
+      CLI_STR("--instance", "ID", &instance, "the instance (with --root)"),
+      CLI_FLAG("--force", &force, 1, "replace an existing recon/poses_rgb.json (with --root)"),
+      CLI_END,
+  };
+  const cli_command cmd = {.name = "hearth recon import-colmap", .args = "MODEL_DIR",
+                           .min_args = 1, .max_args = 1, .about = k_import_about, .opts = opts};
+  cli_args args;
+  int rc = cli_parse(&cmd, argc, argv, &args);
+  if (rc != CLI_RUN) return rc;
+  if (!root != !instance) return cli_usage_error(&cmd, "--root and --instance go together");
+  if (!out && !root) return cli_usage_error(&cmd, "--out FILE.json is required (or --root and --instance)");
+  char out_buf[4096], cam_path[4096];
+  if (!out) {
+    if (snprintf(out_buf, sizeof out_buf, "%s/instances/%s/recon/poses_rgb.json", root, instance) >=
+        (int)sizeof out_buf)
+      return cli_usage_error(&cmd, "--root: path too long");
+    out = out_buf;
+    if (hearth_path_exists(out) && !force) {
+      fprintf(stderr, "hearth recon import-colmap: %s exists (poses in the frame of the "
+                      "reconstruction beside it); --force replaces it\n", out);
+      return 1;
+    }
+  }
+  if (hearth_recon_cameras_path(out, cam_path, sizeof cam_path))
+    return cli_usage_error(&cmd, "--out: path too long");
+  hearth_err err = {0};
+  hearth_colmap_model m;
+  hearth_status s = hearth_colmap_read(args.v[0], &m, &err);
+  if (s) return cli_fail("recon import-colmap", &err);
+  hearth_poses poses;
+  hearth_recon_cameras cams;
+  s = hearth_colmap_to_poses(&m, k_states[state], &poses, &cams, &err);
+  hearth_recon_coverage cov = {0};
+  if (!s && root) s = hearth_recon_match_instance(root, instance, &poses, &cov, &err);
+  char dir[4096];
+  snprintf(dir, sizeof dir, "%s", out);
+  char *slash = strrchr(dir, '/');
+  if (!s && slash && slash != dir) {
+    *slash = 0;
+    s = hearth_mkdirs(dir, &err);
+  }
+  if (!s) s = hearth_poses_write(out, &poses, &err);
+  if (!s) s = hearth_recon_cameras_write(cam_path, &cams, &err);
+  if (!s) {
+    printf("import-colmap %s (%s): %zu camera(s), %zu image(s), %zu point(s) -> %s, %s\n",
+           args.v[0], m.format == HEARTH_COLMAP_BINARY ? "binary" : "text", m.n_cameras,
+           m.n_images, m.n_points, out, cam_path);
+    if (root) {
+      printf("%s: %zu of %zu views have a pose", instance, cov.n_views - cov.n_missing, cov.n_views);
+      for (size_t i = 0; i < cov.n_missing && i < HEARTH_RECON_MISSING_LISTED; i++)
+        printf("%s%s", i ? ", " : "; without: ", cov.missing[i]);
+      printf("%s\n", cov.n_missing > HEARTH_RECON_MISSING_LISTED ? ", ..." : "");
+    }
+  }
+  hearth_poses_free(&poses);
+  hearth_recon_cameras_free(&cams);
+  hearth_colmap_model_free(&m);
+  return s ? cli_fail("recon import-colmap", &err) : 0;
+}
+
+static const char *k_about =
+    "Camera poses of an instance's colour views from a structure-from-motion tool.\n"
+    "--poses colmap runs COLMAP (Debian's `colmap`, CPU only): feature_extractor with the\n"
+    "cut-outs as masks and one camera shared by all views, exhaustive_matcher and mapper\n"
+    "over every view of every state, then imports the model with the most registered\n"
+    "views into recon/poses_rgb.json (and recon/poses_rgb_cameras.json, the cameras).\n"
+    "Views COLMAP could not register get no pose. Each step's output is logged in the\n"
+    "workspace, which a failure keeps for inspection.\n";
+
+static const char *k_tail =
+    "Import a model made elsewhere: hearth recon import-colmap MODEL_DIR --out FILE.json\n"
+    "(see hearth recon import-colmap --help).\n";
+
+int hearth_cmd_recon(int argc, char **argv) {
+  if (argc >= 2 && !strcmp(argv[1], "import-colmap")) return cmd_import(argc - 1, argv + 1);
+  static const char *const k_poses[] = {"colmap", NULL};
+  static const char *const k_intr[] = {"calibration", "estimate", NULL};
+  static const int k_intr_values[] = {HEARTH_COLMAP_INTR_CALIBRATION, HEARTH_COLMAP_INTR_ESTIMATE};
+  int poses = -1;
+  int intr = HEARTH_COLMAP_INTR_CALIBRATION;
+  hearth_colmap_job job = {0};
+  const cli_opt opts[] = {
+      CLI_STR("--instance", "ID", &job.instance, "the instance", .flags = CLI_REQUIRED),
+      CLI_CHOICE("--poses", &poses, k_poses, NULL, "where the poses come from",
+                 .flags = CLI_REQUIRED),
+      CLI_CHOICE("--intrinsics", &intr, k_intr, k_intr_values,
+                 "calibration: the colour camera of calibration/rig.json (else factory.json), "
+                 "held fixed; estimate: COLMAP's self-calibration"),
+      CLI_STR("--out", "FILE.json", &job.out, "poses file to write",
+              .def = "ROOT/instances/ID/recon/poses_rgb.json"),
+      CLI_STR("--work", "DIR", &job.work, "keep COLMAP's workspace (database, model, logs) here",
+              .def = "a temporary folder, removed after success"),
+      CLI_STR("--colmap", "PROGRAM", &job.colmap, "the COLMAP program", .def = "colmap on PATH"),
+      CLI_FLAG("--no-masks", &job.no_masks, 1, "features from the whole image, not only the cut-out"),
+      CLI_INT("--threads", "N", &job.threads, 1, 1024, "threads COLMAP may use",
+              .def = "HEARTH_THREADS or all cores"),
+      CLI_FLAG("--force", &job.force, 1, "replace an existing poses file"),
+      CLI_FLAG("--quiet", &job.quiet, 1, "no progress output"),
+      CLI_END,
+  };
+  const cli_command cmd = {.name = "hearth recon", .args = "ROOT", .min_args = 1, .max_args = 1,
+                           .about = k_about, .opts = opts, .tail = k_tail};
+  if (argc < 2) return cli_usage_error(&cmd, "missing ROOT (see 'hearth recon --help')");
+  cli_args args;
+  int rc = cli_parse(&cmd, argc, argv, &args);
+  if (rc != CLI_RUN) return rc;
+  (void)poses; /* one route so far */
+  job.root = args.v[0];
+  job.intrinsics = (hearth_colmap_intrinsics)intr;
+  hearth_colmap_result res;
+  hearth_err err = {0};
+  if (hearth_colmap_run(&job, &res, &err)) return cli_fail("recon", &err);
+  printf("recon %s: %zu of %zu views registered (%.0f%%), %zu points, %zu model(s); "
+         "extract %.1fs, match %.1fs, map %.1fs -> %s\n",
+         job.instance, res.n_registered, res.n_views,
+         res.n_views ? 100.0 * (double)res.n_registered / (double)res.n_views : 0.0, res.n_points,
+         res.n_models, res.seconds[0], res.seconds[1], res.seconds[2], res.out);
+  if (res.work[0]) printf("workspace: %s\n", res.work);
+  return 0;
+}
