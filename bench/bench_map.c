@@ -27,7 +27,8 @@ int main(int argc, char **argv) {
     else if (!strcmp(argv[i], "--resolution") && i + 1 < argc) R = strtoul(argv[++i], NULL, 10);
     else if (!strcmp(argv[i], "--keep") && i + 1 < argc) keep = argv[++i];
     else {
-      fprintf(stderr, "usage: %s [--triangles N] [--threads T] [--resolution R] [--keep DIR]\n", argv[0]);
+      fprintf(stderr, "usage: %s [--triangles N] [--threads T] [--resolution R] [--keep DIR]\n",
+              argv[0]);
       return 2;
     }
   }
@@ -58,7 +59,8 @@ int main(int argc, char **argv) {
   }
   char mesh_path[1200], poses_path[1200], rig_path[1200], path[1400];
   snprintf(mesh_path, sizeof mesh_path, "%s/ground_truth/instances/cup_01/mesh.glb", root);
-  snprintf(poses_path, sizeof poses_path, "%s/ground_truth/instances/cup_01/poses_thermal.json", root);
+  snprintf(poses_path, sizeof poses_path, "%s/ground_truth/instances/cup_01/poses_thermal.json",
+           root);
   snprintf(rig_path, sizeof rig_path, "%s/ground_truth/rig.json", root);
 
   /* everything, end to end: read inputs, build, cast, fuse, fill, write */
@@ -126,14 +128,16 @@ int main(int argc, char **argv) {
       return 1;
     }
     views[v].image = &imgs[v];
-    views[v].T_world_from_cam = hearth_poses_find(&poses, "hot", man.views[v].view)->T_world_from_cam;
+    views[v].T_world_from_cam =
+        hearth_poses_find(&poses, "hot", man.views[v].view)->T_world_from_cam;
   }
   double t_csv = hearth_now() - t0;
   hearth_map_opts o;
   hearth_map_opts_default(&o);
   o.resolution = R;
   o.threads = threads;
-  hearth_map_timing best = {.raster = 1e30, .cast = 1e30, .fuse = 1e30, .fill = 1e30, .total = 1e30}, tm;
+  hearth_map_timing best = {.raster = 1e30, .cast = 1e30, .fuse = 1e30, .fill = 1e30, .total = 1e30},
+                    tm;
   double t_bvh = 1e30;
   for (int k = 0; k < reps; k++) {
     hearth_map_result r;
@@ -175,33 +179,42 @@ int main(int argc, char **argv) {
   }
   printf("mapping benchmark: %zu triangles, %zu views, R = %zu, %d thread(s), best of %d\n",
          mesh.n_triangles, man.n_views, R, threads, reps);
-  printf("  end to end (read CSVs + mesh, build, cast, splat, fuse, fill, write): %7.1f ms\n", 1e3 * t_all);
+  printf("  end to end (read CSVs + mesh, build, cast, splat, fuse, fill, write): %7.1f ms\n",
+         1e3 * t_all);
   /* every run, not only the best: the first one starts with cold caches */
   int n_runs = reps < 64 ? reps : 64;
   qsort(t_runs, (size_t)n_runs, sizeof *t_runs, cmp_double);
   printf("    all %d runs: median %.1f ms, slowest %.1f ms\n", n_runs, 1e3 * t_runs[n_runs / 2],
          1e3 * t_runs[n_runs - 1]);
-  printf("  the same with traced rays (Embree BVH + casting, --trace-rays):        %7.1f ms\n", 1e3 * t_traced);
-  printf("  in memory total:                                                     %7.1f ms\n", 1e3 * best.total);
-  printf("    UV raster + islands %6.1f ms (%4.1f%%)\n", 1e3 * best.raster, 100 * best.raster / best.total);
+  printf("  the same with traced rays (Embree BVH + casting, --trace-rays):        %7.1f ms\n",
+         1e3 * t_traced);
+  printf("  in memory total:                                                     %7.1f ms\n",
+         1e3 * best.total);
+  printf("    UV raster + islands %6.1f ms (%4.1f%%)\n", 1e3 * best.raster,
+         100 * best.raster / best.total);
   printf("    (an Embree BVH over the mesh: %.1f ms, not needed by the fan)\n", 1e3 * t_bvh);
-  printf("    cast + splat        %6.1f ms (%4.1f%%)\n", 1e3 * best.cast, 100 * best.cast / best.total);
-  printf("    fusion              %6.1f ms (%4.1f%%)\n", 1e3 * best.fuse, 100 * best.fuse / best.total);
-  printf("    fill                %6.1f ms (%4.1f%%)\n", 1e3 * best.fill, 100 * best.fill / best.total);
-  printf("  reading one thread: 30 CSVs %.1f ms, mesh + documents %.1f ms\n", 1e3 * t_csv, 1e3 * t_mesh);
+  printf("    cast + splat        %6.1f ms (%4.1f%%)\n", 1e3 * best.cast,
+         100 * best.cast / best.total);
+  printf("    fusion              %6.1f ms (%4.1f%%)\n", 1e3 * best.fuse,
+         100 * best.fuse / best.total);
+  printf("    fill                %6.1f ms (%4.1f%%)\n", 1e3 * best.fill,
+         100 * best.fill / best.total);
+  printf("  reading one thread: 30 CSVs %.1f ms, mesh + documents %.1f ms\n", 1e3 * t_csv,
+         1e3 * t_mesh);
   /* the best end-to-end run's own phases: reading (documents, CSVs in
      parallel) beside the mesh and the layout on a thread of their own;
      writing (maps, Turbo PNG, provenance, swap) */
   /* reading and the layout run side by side: their wall time together is
      what the later phases leave of the total */
   double front = e2e.total - (e2e.cast + e2e.fuse + e2e.fill + e2e.write);
-  printf("  end to end, best run by phase: read %.1f ms beside mesh + layout (UV raster, islands, pixel grid, fan) "
-         "%.1f ms: %.1f ms (%.0f%%); cast+splat %.1f (%.0f%%), fusion %.1f (%.0f%%), fill %.1f (%.0f%%), "
-         "write %.1f (%.0f%%)\n",
-         1e3 * e2e.read, 1e3 * e2e.raster, 1e3 * front, 100 * front / e2e.total, 1e3 * e2e.cast,
-         100 * e2e.cast / e2e.total, 1e3 * e2e.fuse, 100 * e2e.fuse / e2e.total, 1e3 * e2e.fill,
-         100 * e2e.fill / e2e.total, 1e3 * e2e.write, 100 * e2e.write / e2e.total);
-  printf("  reference: the same %zu rays cast alone %.1f ms; mapping/reference = %.2f\n", nr, 1e3 * t_ref,
-         best.total / t_ref);
+  printf(
+      "  end to end, best run by phase: read %.1f ms beside mesh + layout (UV raster, islands, pixel grid, fan) "
+      "%.1f ms: %.1f ms (%.0f%%); cast+splat %.1f (%.0f%%), fusion %.1f (%.0f%%), fill %.1f (%.0f%%), "
+      "write %.1f (%.0f%%)\n",
+      1e3 * e2e.read, 1e3 * e2e.raster, 1e3 * front, 100 * front / e2e.total, 1e3 * e2e.cast,
+      100 * e2e.cast / e2e.total, 1e3 * e2e.fuse, 100 * e2e.fuse / e2e.total, 1e3 * e2e.fill,
+      100 * e2e.fill / e2e.total, 1e3 * e2e.write, 100 * e2e.write / e2e.total);
+  printf("  reference: the same %zu rays cast alone %.1f ms; mapping/reference = %.2f\n", nr,
+         1e3 * t_ref, best.total / t_ref);
   return 0;
 }

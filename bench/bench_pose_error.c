@@ -44,10 +44,11 @@ int main(int argc, char **argv) {
     }
     printf("similarity: scale %.6g over %zu common views\n", a.ref_from_est.s, a.n_common);
     printf("rotation error: median %.4f deg, max %.4f deg\n", a.rot_median_deg, a.rot_max_deg);
-    printf("centre error: median %.3f mm, rms %.3f mm, max %.3f mm (reference in metres); "
-           "median %.4f %% of the mean camera distance %.3f m\n",
-           1e3 * a.pos_median, 1e3 * a.pos_rms, 1e3 * a.pos_max,
-           spread > 0 ? 100.0 * a.pos_median / spread : 0.0, spread);
+    printf(
+        "centre error: median %.3f mm, rms %.3f mm, max %.3f mm (reference in metres); "
+        "median %.4f %% of the mean camera distance %.3f m\n",
+        1e3 * a.pos_median, 1e3 * a.pos_rms, 1e3 * a.pos_max,
+        spread > 0 ? 100.0 * a.pos_median / spread : 0.0, spread);
     const hearth_similarity *S = &a.ref_from_est;
     for (size_t i = 0; per_view && i < est.n; i++) {
       const hearth_view_pose *e = &est.views[i], *r = hearth_poses_find(&ref, e->state, e->view);
@@ -60,7 +61,8 @@ int main(int argc, char **argv) {
       }
       hearth_mat3_mul(S->T.R, e->T_world_from_cam.R, Ra);
       printf("  %s/%s: rotation %.4f deg, centre %.3f mm\n", e->state, e->view,
-             hearth_rotation_angle_between(Ra, r->T_world_from_cam.R) * 180.0 / M_PI, 1e3 * sqrt(d2));
+             hearth_rotation_angle_between(Ra, r->T_world_from_cam.R) * 180.0 / M_PI,
+             1e3 * sqrt(d2));
     }
   }
   hearth_poses_free(&est);

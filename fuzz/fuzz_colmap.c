@@ -37,7 +37,7 @@ static void parse_one(hearth_colmap_file which, hearth_colmap_format f, const ui
   hearth_err err;
   hearth_status s = hearth_colmap_parse(which, f, d, n, "fuzz", m, &err);
   if (s) {
-    size_t count = which == HEARTH_COLMAP_CAMERAS ? m->n_cameras
+    size_t count = which == HEARTH_COLMAP_CAMERAS  ? m->n_cameras
                    : which == HEARTH_COLMAP_IMAGES ? m->n_images
                                                    : m->n_points;
     if (count || strncmp(err.msg, "fuzz", 4) != 0) abort();

@@ -36,8 +36,7 @@ static void run(const uint8_t *data, size_t size, const hearth_csv_opts *opts, i
                                               &info, &err)
                 : hearth_thermal_parse_csv((const char *)data, size, "fuzz.csv", opts, &img, &err);
   if (s == HEARTH_OK) {
-    if (img.channels != 1 || img.type != HEARTH_PIX_F32 || !img.data || !img.width ||
-        !img.height)
+    if (img.channels != 1 || img.type != HEARTH_PIX_F32 || !img.data || !img.width || !img.height)
       abort();
     const float *t = img.data;
     for (size_t i = 0; i < img.width * img.height; i++)

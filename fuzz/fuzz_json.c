@@ -40,7 +40,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   hearth_detections_free(&d);
 
   hearth_scale_doc sc;
-  if (hearth_scale_doc_parse(text, size, "fuzz", &sc, &err) == HEARTH_OK && !(sc.scale > 0)) abort();
+  if (hearth_scale_doc_parse(text, size, "fuzz", &sc, &err) == HEARTH_OK && !(sc.scale > 0))
+    abort();
   hearth_instance_doc in;
   hearth_instance_parse(text, size, "fuzz", &in, &err);
   hearth_release_doc rel;

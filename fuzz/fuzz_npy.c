@@ -12,8 +12,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   if (s == HEARTH_OK) {
     if (a.ndim < 0 || a.ndim > 4 || !a.data) abort();
     size_t bytes = hearth_npy_count(&a) * (a.dtype == HEARTH_NPY_F32 ? 4 : 1);
-    if (bytes > size || memcmp((const uint8_t *)data + size - bytes, a.data, bytes) != 0)
-      abort();
+    if (bytes > size || memcmp((const uint8_t *)data + size - bytes, a.data, bytes) != 0) abort();
   } else if (a.data || strncmp(err.msg, "fuzz.npy: ", 10) != 0) {
     abort();
   }

@@ -10,8 +10,7 @@
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   hearth_err err;
   hearth_thermo_model m;
-  if (hearth_thermo_model_parse((const char *)data, size, "fuzz", &m, &err) != HEARTH_OK)
-    return 0;
+  if (hearth_thermo_model_parse((const char *)data, size, "fuzz", &m, &err) != HEARTH_OK) return 0;
   if (hearth_thermo_net_check(&m.net, &err) != HEARTH_OK) abort();
   double lo = m.net.T_air, hi = m.net.T_air;
   for (size_t i = 0; i < m.net.n; i++) {

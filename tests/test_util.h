@@ -10,43 +10,43 @@
 
 static int g_test_failures = 0;
 
-#define CHECK(cond)                                                              \
-  do {                                                                           \
-    if (!(cond)) {                                                               \
-      fprintf(stderr, "%s:%d: CHECK failed: %s\n", __FILE__, __LINE__, #cond);   \
-      g_test_failures++;                                                         \
-    }                                                                            \
+#define CHECK(cond)                                                            \
+  do {                                                                         \
+    if (!(cond)) {                                                             \
+      fprintf(stderr, "%s:%d: CHECK failed: %s\n", __FILE__, __LINE__, #cond); \
+      g_test_failures++;                                                       \
+    }                                                                          \
   } while (0)
 
-#define CHECK_MSG(cond, ...)                                                     \
-  do {                                                                           \
-    if (!(cond)) {                                                               \
-      fprintf(stderr, "%s:%d: CHECK failed: %s: ", __FILE__, __LINE__, #cond);   \
-      fprintf(stderr, __VA_ARGS__);                                              \
-      fputc('\n', stderr);                                                       \
-      g_test_failures++;                                                         \
-    }                                                                            \
+#define CHECK_MSG(cond, ...)                                                   \
+  do {                                                                         \
+    if (!(cond)) {                                                             \
+      fprintf(stderr, "%s:%d: CHECK failed: %s: ", __FILE__, __LINE__, #cond); \
+      fprintf(stderr, __VA_ARGS__);                                            \
+      fputc('\n', stderr);                                                     \
+      g_test_failures++;                                                       \
+    }                                                                          \
   } while (0)
 
-#define CHECK_NEAR(a, b, tol)                                                    \
-  do {                                                                           \
-    double _a = (double)(a), _b = (double)(b);                                   \
-    if (!(fabs(_a - _b) <= (tol))) {                                             \
-      fprintf(stderr, "%s:%d: CHECK_NEAR failed: %s = %.12g, %s = %.12g (tol %g)\n", \
-              __FILE__, __LINE__, #a, _a, #b, _b, (double)(tol));               \
-      g_test_failures++;                                                         \
-    }                                                                            \
+#define CHECK_NEAR(a, b, tol)                                                                  \
+  do {                                                                                         \
+    double _a = (double)(a), _b = (double)(b);                                                 \
+    if (!(fabs(_a - _b) <= (tol))) {                                                           \
+      fprintf(stderr, "%s:%d: CHECK_NEAR failed: %s = %.12g, %s = %.12g (tol %g)\n", __FILE__, \
+              __LINE__, #a, _a, #b, _b, (double)(tol));                                        \
+      g_test_failures++;                                                                       \
+    }                                                                                          \
   } while (0)
 
 /* status must be HEARTH_OK; prints the error otherwise */
-#define CHECK_OK(expr, errp)                                                     \
-  do {                                                                           \
-    hearth_status _s = (expr);                                                   \
-    if (_s != HEARTH_OK) {                                                       \
-      fprintf(stderr, "%s:%d: %s failed: %s: %s\n", __FILE__, __LINE__, #expr,    \
-              hearth_status_name(_s), (errp)->msg);                              \
-      g_test_failures++;                                                         \
-    }                                                                            \
+#define CHECK_OK(expr, errp)                                                   \
+  do {                                                                         \
+    hearth_status _s = (expr);                                                 \
+    if (_s != HEARTH_OK) {                                                     \
+      fprintf(stderr, "%s:%d: %s failed: %s: %s\n", __FILE__, __LINE__, #expr, \
+              hearth_status_name(_s), (errp)->msg);                            \
+      g_test_failures++;                                                       \
+    }                                                                          \
   } while (0)
 
 /* A fresh directory under $HEARTH_TEST_TMP (or /tmp) for this test. */
@@ -64,10 +64,10 @@ static inline const char *test_tmpdir(const char *name) {
   return buf;
 }
 
-#define TEST_MAIN_END()                                                          \
-  do {                                                                           \
+#define TEST_MAIN_END()                                                            \
+  do {                                                                             \
     if (g_test_failures) fprintf(stderr, "%d check(s) failed\n", g_test_failures); \
-    return g_test_failures ? 1 : 0;                                              \
+    return g_test_failures ? 1 : 0;                                                \
   } while (0)
 
 #endif

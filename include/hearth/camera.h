@@ -21,17 +21,17 @@ extern "C" {
 #endif
 
 typedef struct hearth_camera {
-  int width, height;   /* pixels */
+  int width, height;     /* pixels */
   double fx, fy, cx, cy; /* pixels */
-  double dist[5];      /* k1 k2 p1 p2 k3 */
+  double dist[5];        /* k1 k2 p1 p2 k3 */
 } hearth_camera;
 
 /* Jacobians filled by hearth_camera_project when the pointers are non-NULL
  * (row-major, 2 rows): */
 typedef struct hearth_project_jac {
-  double d_point[6];   /* d(u,v) / d(X,Y,Z) in the camera frame */
-  double d_intr[8];    /* d(u,v) / d(fx, fy, cx, cy) */
-  double d_dist[10];   /* d(u,v) / d(k1, k2, p1, p2, k3) */
+  double d_point[6]; /* d(u,v) / d(X,Y,Z) in the camera frame */
+  double d_intr[8];  /* d(u,v) / d(fx, fy, cx, cy) */
+  double d_dist[10]; /* d(u,v) / d(k1, k2, p1, p2, k3) */
 } hearth_project_jac;
 
 /* The distortion polynomial above, (x, y) -> (xd, yd), inline for loops
@@ -57,8 +57,7 @@ static inline void hearth_distort_xyf(const float dist[5], float x, float y, flo
 
 /* Distort normalised coordinates (x, y) -> (xd, yd), optionally with the
  * 2x2 Jacobian d(xd,yd)/d(x,y) (row-major). */
-void hearth_distort(const double dist[5], double x, double y, double *xd, double *yd,
-                    double J[4]);
+void hearth_distort(const double dist[5], double x, double y, double *xd, double *yd, double J[4]);
 
 /* Project a point in the camera frame to pixels. Returns 0 if Z <= 0
  * (u, v untouched), 1 otherwise. */

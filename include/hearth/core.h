@@ -75,8 +75,8 @@ void *hearth_calloc_array(size_t n, size_t size);
  * with HEARTH_E_LIMIT. Only regular files are read: a FIFO, device, socket
  * or directory in place of the file is refused ("not a regular file (a
  * FIFO)") without blocking, as by hearth_open_regular. */
-hearth_status hearth_read_file(const char *path, size_t max_size, uint8_t **data,
-                               size_t *size, hearth_err *err);
+hearth_status hearth_read_file(const char *path, size_t max_size, uint8_t **data, size_t *size,
+                               hearth_err *err);
 /* Open path for reading only if it is a regular file: opened non-blocking
  * (a FIFO without a writer cannot hang the caller), its type checked on the
  * open descriptor, then switched back to blocking reads. *fd (the caller
@@ -197,7 +197,7 @@ int hearth_format_fixed(char *buf, size_t bufsz, double x, int decimals);
  * hearth_strbuf_free. An allocation or formatting failure sets `failed`;
  * later appends then do nothing, so callers check once at the end. */
 typedef struct hearth_strbuf {
-  char *data;   /* len bytes plus a NUL, or NULL while empty */
+  char *data; /* len bytes plus a NUL, or NULL while empty */
   size_t len, cap;
   int failed;
 } hearth_strbuf;
@@ -215,15 +215,17 @@ void hearth_strbuf_free(hearth_strbuf *b);
 /* ---- deterministic random numbers ------------------------------------------ */
 /* A small counter-based generator (SplitMix64 seeding, xoshiro256**):
  * same seed, same stream on every machine. */
-typedef struct hearth_rng { uint64_t s[4]; } hearth_rng;
+typedef struct hearth_rng {
+  uint64_t s[4];
+} hearth_rng;
 void hearth_rng_seed(hearth_rng *r, uint64_t seed);
 /* Derive an independent stream for a named sub-task (e.g. view index);
  * the parent is not advanced, so forks do not depend on call order. */
 void hearth_rng_fork(const hearth_rng *parent, uint64_t stream, hearth_rng *child);
 uint64_t hearth_rng_u64(hearth_rng *r);
-double hearth_rng_uniform(hearth_rng *r);            /* [0, 1) */
+double hearth_rng_uniform(hearth_rng *r);                     /* [0, 1) */
 double hearth_rng_range(hearth_rng *r, double lo, double hi); /* [lo, hi) */
-double hearth_rng_normal(hearth_rng *r);             /* N(0, 1) */
+double hearth_rng_normal(hearth_rng *r);                      /* N(0, 1) */
 
 /* ---- progress -------------------------------------------------------------- */
 /* A progress reporter for long jobs, on stderr: a bar on a terminal, plain

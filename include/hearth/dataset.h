@@ -71,7 +71,7 @@ hearth_status hearth_factory_write(const char *path, const hearth_factory_calib 
 /* ---- manifest.json ------------------------------------------------------- */
 /* One state's views and the files of each, relative to raw/<state>/. */
 typedef struct hearth_view_files {
-  char view[HEARTH_NAME_MAX];   /* "v00" */
+  char view[HEARTH_NAME_MAX]; /* "v00" */
   int elevation_index, azimuth_index;
   char rgb[128], cutout[128], depth[128], depth_intrinsics[128], thermal[128];
 } hearth_view_files;
@@ -121,10 +121,10 @@ const hearth_view_pose *hearth_poses_find(const hearth_poses *p, const char *sta
 void hearth_plate_hole(int i, double xyz[3]);
 
 typedef struct hearth_detection {
-  char frame[HEARTH_NAME_MAX];  /* "f000", "p003" */
-  char camera[16];              /* "thermal" | "rgb" */
+  char frame[HEARTH_NAME_MAX]; /* "f000", "p003" */
+  char camera[16];             /* "thermal" | "rgb" */
   int found;
-  char reason[256];             /* when !found */
+  char reason[256];                      /* when !found */
   double centres[HEARTH_PLATE_HOLES][2]; /* (u, v) pixels in plate order, when found */
 } hearth_detection;
 
@@ -149,13 +149,13 @@ typedef struct hearth_scale_doc {
 hearth_status hearth_scale_doc_read(const char *path, hearth_scale_doc *s, hearth_err *err);
 hearth_status hearth_scale_doc_write(const char *path, const hearth_scale_doc *s, hearth_err *err);
 hearth_status hearth_scale_doc_parse(const char *text, size_t len, const char *name,
-                                 hearth_scale_doc *s, hearth_err *err);
+                                     hearth_scale_doc *s, hearth_err *err);
 
 /* ---- release.json / instance.json ---------------------------------------- */
 #define HEARTH_MAX_STATES 8
 typedef struct hearth_instance_doc {
-  char id[HEARTH_NAME_MAX];        /* "cup_03" */
-  char category[HEARTH_NAME_MAX];  /* "cup" */
+  char id[HEARTH_NAME_MAX];       /* "cup_03" */
+  char category[HEARTH_NAME_MAX]; /* "cup" */
   size_t n_states;
   char states[HEARTH_MAX_STATES][HEARTH_NAME_MAX];
   char notes[512];
@@ -179,8 +179,7 @@ typedef struct hearth_release_doc {
 } hearth_release_doc;
 void hearth_release_free(hearth_release_doc *d);
 hearth_status hearth_release_read(const char *path, hearth_release_doc *d, hearth_err *err);
-hearth_status hearth_release_write(const char *path, const hearth_release_doc *d,
-                                   hearth_err *err);
+hearth_status hearth_release_write(const char *path, const hearth_release_doc *d, hearth_err *err);
 hearth_status hearth_release_parse(const char *text, size_t len, const char *name,
                                    hearth_release_doc *d, hearth_err *err);
 

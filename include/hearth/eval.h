@@ -35,36 +35,37 @@ int hearth_eval_time_limit(hearth_sim_task t);
  * openpi's image_tools.resize_with_pad: scale to fit out_w x out_h keeping
  * the aspect ratio (bilinear), centre, pad with zeros. RGB U8, in[w*h*3]
  * into the caller's out[out_w*out_h*3]. */
-void hearth_eval_resize_with_pad(const uint8_t *in, int w, int h, uint8_t *out, int out_w, int out_h);
+void hearth_eval_resize_with_pad(const uint8_t *in, int w, int h, uint8_t *out, int out_w,
+                                 int out_h);
 /* Build the openpi LIBERO request (msgpack map): observation/image,
  * observation/wrist_image (and observation/thermal_image if thermal), each
  * rotated 180 degrees from OpenGL order and resized with padding to
  * size x size; observation/state (8 x <f8: ee pos, axis-angle, gripper);
  * prompt. Appended to w (initialised by the caller, who frees it). */
 struct hearth_mp_writer;
-hearth_status hearth_eval_encode_obs(const hearth_sim_obs *obs, const char *prompt, int thermal, int size,
-                                     struct hearth_mp_writer *w, hearth_err *err);
+hearth_status hearth_eval_encode_obs(const hearth_sim_obs *obs, const char *prompt, int thermal,
+                                     int size, struct hearth_mp_writer *w, hearth_err *err);
 
 /* ---- evaluation ------------------------------------------------------------ */
 typedef struct hearth_eval_opts {
-  unsigned tasks;          /* bit (1 << task): default all three */
-  const char *policy;      /* "oracle", "replay:FILE.hdf5[#K]", "ws://HOST:PORT" */
-  int episodes;            /* per instruction; default 10 */
-  int thermal;             /* send observation/thermal_image; default 1 */
-  uint64_t seed;           /* layout stream; default 1 (collection's default) */
-  uint64_t layout_base;    /* episode k uses layout layout_base + k; default HEARTH_EVAL_LAYOUT_BASE */
+  unsigned tasks;       /* bit (1 << task): default all three */
+  const char *policy;   /* "oracle", "replay:FILE.hdf5[#K]", "ws://HOST:PORT" */
+  int episodes;         /* per instruction; default 10 */
+  int thermal;          /* send observation/thermal_image; default 1 */
+  uint64_t seed;        /* layout stream; default 1 (collection's default) */
+  uint64_t layout_base; /* episode k uses layout layout_base + k; default HEARTH_EVAL_LAYOUT_BASE */
   const char *release_root;
   int use_ground_truth;
-  int render_size;         /* sim view side; default 256 (as collection stores) */
-  int shadows;             /* as hearth_sim_opts.shadows; default 0 */
-  const char *gl;          /* as hearth_sim_opts.gl */
-  int image_size;          /* policy image side; default 224 (openpi's model input) */
-  int max_steps;           /* 0 = hearth_eval_time_limit(task) */
-  int replan_steps;        /* default 5 */
-  int wait_steps;          /* no-op steps before querying; default 10 */
-  double timeout_s;        /* per server reply and connect; default 120 */
-  const char *video_dir;   /* animated PNG per episode if set */
-  int video_every;         /* keep every k-th frame; default 2 */
+  int render_size;       /* sim view side; default 256 (as collection stores) */
+  int shadows;           /* as hearth_sim_opts.shadows; default 0 */
+  const char *gl;        /* as hearth_sim_opts.gl */
+  int image_size;        /* policy image side; default 224 (openpi's model input) */
+  int max_steps;         /* 0 = hearth_eval_time_limit(task) */
+  int replan_steps;      /* default 5 */
+  int wait_steps;        /* no-op steps before querying; default 10 */
+  double timeout_s;      /* per server reply and connect; default 120 */
+  const char *video_dir; /* animated PNG per episode if set */
+  int video_every;       /* keep every k-th frame; default 2 */
   int quiet;
 } hearth_eval_opts;
 void hearth_eval_opts_default(hearth_eval_opts *o);
@@ -74,26 +75,26 @@ typedef struct hearth_eval_episode {
   int instruction, episode;
   uint64_t seed, layout;
   int success, steps;
-  int error;               /* the policy failed (server gone, bad reply ...) */
-  char reason[512];        /* why it failed ("time limit", the error) */
-  double state_diff;       /* replay: max |state - stored state| over the replayed steps; else -1 */
-  int expected_success;    /* replay: 1 (the stored demo succeeded), else -1 */
+  int error;            /* the policy failed (server gone, bad reply ...) */
+  char reason[512];     /* why it failed ("time limit", the error) */
+  double state_diff;    /* replay: max |state - stored state| over the replayed steps; else -1 */
+  int expected_success; /* replay: 1 (the stored demo succeeded), else -1 */
 } hearth_eval_episode;
 
 typedef struct hearth_eval_results {
   hearth_eval_episode *eps;
   size_t n;
   char policy[256];
-  int thermal;             /* server policies: 1 observation/thermal_image is sent, 0 not;
+  int thermal;      /* server policies: 1 observation/thermal_image is sent, 0 not;
                             * -1 for the other policies */
-  int thermal_used;        /* server policies: 1 sent and the server's metadata declares it
+  int thermal_used; /* server policies: 1 sent and the server's metadata declares it
                             * reads it; 0 not sent; -1 sent, the metadata says nothing */
   double seconds;
-  char *metadata_json;     /* the server's whole metadata map as JSON (malloc'd), NULL
+  char *metadata_json; /* the server's whole metadata map as JSON (malloc'd), NULL
                             * without a server */
   int render_size, image_size, replan_steps, wait_steps, shadows; /* the options run */
-  char renderer[256];      /* hearth_sim_renderer of the evaluation's env */
-  char warning[512];       /* "" or what the reader must know (thermal use unknown) */
+  char renderer[256]; /* hearth_sim_renderer of the evaluation's env */
+  char warning[512];  /* "" or what the reader must know (thermal use unknown) */
 } hearth_eval_results;
 
 /* Run every episode; r is filled on success (the caller frees it with

@@ -25,9 +25,9 @@ typedef enum hearth_pixtype {
 
 typedef struct hearth_image {
   size_t width, height;
-  int channels;          /* 1..4 */
-  hearth_pixtype type;   /* bytes per sample = (int)type */
-  void *data;            /* owned; width*height*channels samples */
+  int channels;        /* 1..4 */
+  hearth_pixtype type; /* bytes per sample = (int)type */
+  void *data;          /* owned; width*height*channels samples */
 } hearth_image;
 
 /* Allocate a zeroed image; sizes are overflow-checked. img need not be
@@ -74,13 +74,13 @@ hearth_status hearth_png_encode(const hearth_image *img, uint8_t **out, size_t *
  * delay_num / delay_den seconds, looping forever. The first frame is also
  * the default image, so a plain PNG reader shows it. Rows are unfiltered
  * and stored uncompressed (quick to write, frame-sized chunks). */
-hearth_status hearth_apng_write(const char *path, const uint8_t *frames, size_t width, size_t height,
-                                size_t n_frames, unsigned delay_num, unsigned delay_den,
-                                hearth_err *err);
+hearth_status hearth_apng_write(const char *path, const uint8_t *frames, size_t width,
+                                size_t height, size_t n_frames, unsigned delay_num,
+                                unsigned delay_den, hearth_err *err);
 /* The same file in memory (*out malloc'ed, the caller frees). */
-hearth_status hearth_apng_encode(const uint8_t *frames, size_t width, size_t height, size_t n_frames,
-                                 unsigned delay_num, unsigned delay_den, uint8_t **out,
-                                 size_t *size, hearth_err *err);
+hearth_status hearth_apng_encode(const uint8_t *frames, size_t width, size_t height,
+                                 size_t n_frames, unsigned delay_num, unsigned delay_den,
+                                 uint8_t **out, size_t *size, hearth_err *err);
 
 /* JPEG (8-bit gray or RGB; U8 images). quality 1..100. Writes atomically. */
 hearth_status hearth_jpeg_read(const char *path, hearth_image *img, hearth_err *err);
@@ -109,8 +109,7 @@ hearth_status hearth_turbo_image(const hearth_image *temps, double lo, double hi
  * in pixels (pixel centres at integers). */
 void hearth_draw_line(hearth_image *img, double x0, double y0, double x1, double y1,
                       const uint8_t rgb[3], int thickness);
-void hearth_draw_circle(hearth_image *img, double cx, double cy, double r,
-                        const uint8_t rgb[3]);
+void hearth_draw_circle(hearth_image *img, double cx, double cy, double r, const uint8_t rgb[3]);
 /* Resample a U8 image into a new width x height image (for thumbnails),
  * per axis: the area average when shrinking, linear interpolation between
  * pixel centres when enlarging. */
@@ -122,8 +121,8 @@ hearth_status hearth_image_resize(const hearth_image *src, size_t width, size_t 
 void hearth_image_blit(hearth_image *dst, const hearth_image *src, size_t x, size_t y);
 /* Write text with a built-in 5x7 pixel font, each font pixel scale x scale
  * image pixels (scale >= 1), the top-left of the first glyph at (x, y). */
-void hearth_draw_text(hearth_image *img, size_t x, size_t y, const char *text,
-                      const uint8_t rgb[3], int scale);
+void hearth_draw_text(hearth_image *img, size_t x, size_t y, const char *text, const uint8_t rgb[3],
+                      int scale);
 
 #ifdef __cplusplus
 }

@@ -35,24 +35,24 @@ typedef enum hearth_fusion {
 
 /* Mask values of a map (also the values of mask.npy). */
 enum {
-  HEARTH_TEXEL_NONE = 0,       /* no surface at this texel */
+  HEARTH_TEXEL_NONE = 0, /* no surface at this texel */
   HEARTH_TEXEL_OBSERVED = 1,
   HEARTH_TEXEL_FILLED = 2,
-  HEARTH_TEXEL_UNOBSERVED = 3  /* surface, but its island was never observed */
+  HEARTH_TEXEL_UNOBSERVED = 3 /* surface, but its island was never observed */
 };
 
 typedef struct hearth_map_opts {
-  size_t resolution;      /* R; default 1024 */
-  hearth_fusion fusion;   /* default HEARTH_FUSE_MAX */
-  double min_cos;         /* reject hits seen more obliquely than this cosine; default 0 */
-  int pixel_stride;       /* cast every k-th pixel in x and y (colour baking); default 1 */
-  int keep_edges;         /* 1: also use pixels at depth discontinuities (the paper's literal
+  size_t resolution;    /* R; default 1024 */
+  hearth_fusion fusion; /* default HEARTH_FUSE_MAX */
+  double min_cos;       /* reject hits seen more obliquely than this cosine; default 0 */
+  int pixel_stride;     /* cast every k-th pixel in x and y (colour baking); default 1 */
+  int keep_edges;       /* 1: also use pixels at depth discontinuities (the paper's literal
                              rule); default 0: such pixels mix two surfaces through the
                              lens blur and are skipped (always skipped by ROBUST) */
-  int threads;            /* 0 = hearth_default_threads() */
-  int trace_rays;         /* 1: trace every view's rays (Embree) even where the fan could
+  int threads;          /* 0 = hearth_default_threads() */
+  int trace_rays;       /* 1: trace every view's rays (Embree) even where the fan could
                              rasterise it; default 0 (the same hits up to float rounding) */
-  int skip_best_cos;      /* 1: leave the result's best_cos NULL, saving an R*R map per
+  int skip_best_cos;    /* 1: leave the result's best_cos NULL, saving an R*R map per
                              worker; default 0 */
 } hearth_map_opts;
 void hearth_map_opts_default(hearth_map_opts *o);
@@ -66,13 +66,13 @@ typedef struct hearth_map_view {
 
 typedef struct hearth_map_result {
   size_t R;
-  int channels;               /* 1 for temperature, 3 for colour */
-  float *observed;            /* R*R*channels; NaN where mask != OBSERVED */
-  float *filled;              /* R*R*channels; NaN where mask not in {OBSERVED, FILLED} */
-  uint8_t *mask;              /* R*R, HEARTH_TEXEL_* */
-  float *best_cos;            /* R*R: largest viewing cosine among observing views (0 if none);
+  int channels;        /* 1 for temperature, 3 for colour */
+  float *observed;     /* R*R*channels; NaN where mask != OBSERVED */
+  float *filled;       /* R*R*channels; NaN where mask not in {OBSERVED, FILLED} */
+  uint8_t *mask;       /* R*R, HEARTH_TEXEL_* */
+  float *best_cos;     /* R*R: largest viewing cosine among observing views (0 if none);
                                  NULL with opts.skip_best_cos */
-  uint32_t *view_hits;        /* n_views: pixels of each view that landed on the surface */
+  uint32_t *view_hits; /* n_views: pixels of each view that landed on the surface */
   size_t n_views;
   size_t n_surface, n_observed, n_filled, n_unobserved;
 } hearth_map_result;
@@ -88,8 +88,8 @@ void hearth_map_result_free(hearth_map_result *r);
  * Deterministic: the same bytes for any thread count. */
 hearth_status hearth_map_views(const hearth_mesh *mesh, const hearth_raycaster *rc,
                                const hearth_camera *cam, const hearth_map_view *views,
-                               size_t n_views, const hearth_map_opts *opts,
-                               hearth_map_result *out, hearth_err *err);
+                               size_t n_views, const hearth_map_opts *opts, hearth_map_result *out,
+                               hearth_err *err);
 
 /* Time spent in each phase (seconds), for benchmarks. hearth_map_views_timed
  * fills raster (UV raster and islands, with the pixel grid and its fan made
@@ -123,9 +123,9 @@ void hearth_map_layout_free(hearth_map_layout *l);
  * must be the layout's: HEARTH_E_INCONSISTENT otherwise). timing->raster is
  * left as it is (the layout's time is the caller's to measure). */
 hearth_status hearth_map_views_with_layout(const hearth_map_layout *l, const hearth_raycaster *rc,
-                                          const hearth_map_view *views, size_t n_views,
-                                          const hearth_map_opts *opts, hearth_map_result *out,
-                                          hearth_map_timing *timing, hearth_err *err);
+                                           const hearth_map_view *views, size_t n_views,
+                                           const hearth_map_opts *opts, hearth_map_result *out,
+                                           hearth_map_timing *timing, hearth_err *err);
 
 /* Copy the filled map into a new R x R RGB U8 image for a texture (the
  * caller frees it with hearth_image_free): Turbo over [lo, hi] degC for
@@ -143,18 +143,17 @@ typedef struct hearth_map_job {
   const char *instance;
   const char *state;
   hearth_map_opts map;
-  const char *mesh_path;   /* NULL: derived/mesh.glb */
-  const char *poses_path;  /* NULL: derived/poses_thermal.json */
-  const char *rig_path;    /* NULL: calibration/rig.json */
-  const char *views;       /* NULL: all; else comma-separated view names */
-  const char *out_dir;     /* NULL: derived/<state> */
+  const char *mesh_path;     /* NULL: derived/mesh.glb */
+  const char *poses_path;    /* NULL: derived/poses_thermal.json */
+  const char *rig_path;      /* NULL: calibration/rig.json */
+  const char *views;         /* NULL: all; else comma-separated view names */
+  const char *out_dir;       /* NULL: derived/<state> */
   double turbo_lo, turbo_hi; /* 10, 60 */
   hearth_map_timing *timing; /* optional: phase times of the run */
 } hearth_map_job;
 void hearth_map_job_default(hearth_map_job *job);
 /* stats (optional) receives the result's counters (arrays not kept). */
-hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats,
-                             hearth_err *err);
+hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats, hearth_err *err);
 
 /* hearth map --rgb: bake the colour texture from the colour views into
  * derived/rgb_texture.png and embed it in derived/mesh.glb. Every input is
@@ -162,9 +161,9 @@ hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats
 typedef struct hearth_bake_job {
   const char *root;
   const char *instance;
-  const char *state;       /* which state's colour views (NULL: the first state) */
-  size_t resolution;       /* default 1024 */
-  int pixel_stride;        /* default 2 */
+  const char *state; /* which state's colour views (NULL: the first state) */
+  size_t resolution; /* default 1024 */
+  int pixel_stride;  /* default 2 */
   const char *mesh_path, *poses_path, *rig_path;
   int threads;
   const char *out_texture; /* NULL: derived/rgb_texture.png */

@@ -23,10 +23,10 @@ extern "C" {
 
 typedef struct hearth_mesh {
   size_t n_vertices;
-  float *positions;   /* 3 * n_vertices */
-  float *uvs;         /* 2 * n_vertices, or NULL if the mesh has none */
+  float *positions; /* 3 * n_vertices */
+  float *uvs;       /* 2 * n_vertices, or NULL if the mesh has none */
   size_t n_triangles;
-  uint32_t *indices;  /* 3 * n_triangles, counter-clockwise front faces */
+  uint32_t *indices;    /* 3 * n_triangles, counter-clockwise front faces */
   hearth_image texture; /* base colour (RGB/RGBA U8), data NULL if none */
 } hearth_mesh;
 /* A mesh owns its arrays and its texture's data; every function that fills
@@ -36,8 +36,8 @@ typedef struct hearth_mesh {
 void hearth_mesh_free(hearth_mesh *m);
 /* Allocate (uninitialised) positions, indices and, with with_uvs, uvs for
  * the given counts; no texture. m need not be initialised. */
-hearth_status hearth_mesh_alloc(hearth_mesh *m, size_t n_vertices, size_t n_triangles,
-                                int with_uvs, hearth_err *err);
+hearth_status hearth_mesh_alloc(hearth_mesh *m, size_t n_vertices, size_t n_triangles, int with_uvs,
+                                hearth_err *err);
 /* A deep copy of src, texture included, into dst (overwritten, not freed). */
 hearth_status hearth_mesh_copy(const hearth_mesh *src, hearth_mesh *dst, hearth_err *err);
 /* Axis-aligned bounds. */
@@ -61,10 +61,10 @@ typedef struct hearth_glb_report {
 } hearth_glb_report;
 
 typedef struct hearth_glb_read_opts {
-  int require_uvs;        /* fail with HEARTH_E_NOT_FOUND naming the primitive if no UVs */
-  int load_texture;       /* decode the base colour texture of the first material if embedded */
-  size_t max_triangles;   /* 0: default limit (50 million) */
-  int keep_uv_tiles;      /* 1: UVs as stored; 0 (default): islands folded into [0,1]^2 */
+  int require_uvs;           /* fail with HEARTH_E_NOT_FOUND naming the primitive if no UVs */
+  int load_texture;          /* decode the base colour texture of the first material if embedded */
+  size_t max_triangles;      /* 0: default limit (50 million) */
+  int keep_uv_tiles;         /* 1: UVs as stored; 0 (default): islands folded into [0,1]^2 */
   hearth_glb_report *report; /* optional, written on success; NULL: not wanted */
 } hearth_glb_read_opts;
 /* Defaults (all zero): UVs not required, no texture decoded, the
@@ -121,43 +121,40 @@ void hearth_glb_read_opts_default(hearth_glb_read_opts *o);
  * island and triangle counts and a first triangle (mesh, primitive,
  * index); without, such islands stay as stored. Overlaps between islands
  * folded from different tiles are not checked. */
-hearth_status hearth_glb_read(const char *path, const hearth_glb_read_opts *opts,
-                              hearth_mesh *out, hearth_err *err);
+hearth_status hearth_glb_read(const char *path, const hearth_glb_read_opts *opts, hearth_mesh *out,
+                              hearth_err *err);
 hearth_status hearth_glb_parse(const void *data, size_t size, const char *name,
-                               const hearth_glb_read_opts *opts, hearth_mesh *out,
-                               hearth_err *err);
+                               const hearth_glb_read_opts *opts, hearth_mesh *out, hearth_err *err);
 /* Write one mesh (POSITION, TEXCOORD_0 if present, NORMAL computed, uint32
  * indices) and, if m->texture is set, an embedded PNG base-colour texture.
  * The file passes the Khronos glTF validator. Atomic. encode writes the
  * same bytes to *out (malloc'ed, the caller frees it). */
 hearth_status hearth_glb_write(const char *path, const hearth_mesh *m, hearth_err *err);
-hearth_status hearth_glb_encode(const hearth_mesh *m, uint8_t **out, size_t *size,
-                                hearth_err *err);
+hearth_status hearth_glb_encode(const hearth_mesh *m, uint8_t **out, size_t *size, hearth_err *err);
 
 /* ---- ray casting (Embree) ------------------------------------------------ */
 typedef struct hearth_raycaster hearth_raycaster;
 
 typedef struct hearth_ray_hit {
-  float t;          /* distance along the (unit) direction */
-  uint32_t prim;    /* triangle index */
-  float b1, b2;     /* barycentrics of vertices 1 and 2 of the triangle */
-  int front;        /* 1 if the ray hit the front (counter-clockwise) side */
+  float t;       /* distance along the (unit) direction */
+  uint32_t prim; /* triangle index */
+  float b1, b2;  /* barycentrics of vertices 1 and 2 of the triangle */
+  int front;     /* 1 if the ray hit the front (counter-clockwise) side */
 } hearth_ray_hit;
 
 /* Build an acceleration structure over m (m must outlive it and stay
  * unchanged); released with hearth_raycaster_free (NULL is fine). Rays are
  * in the mesh's frame and units; a direction need not be a unit vector, t
  * is measured in units of its length (a distance for unit directions). */
-hearth_status hearth_raycaster_new(const hearth_mesh *m, hearth_raycaster **out,
-                                   hearth_err *err);
+hearth_status hearth_raycaster_new(const hearth_mesh *m, hearth_raycaster **out, hearth_err *err);
 void hearth_raycaster_free(hearth_raycaster *rc);
 /* Nearest hit in (tnear, tfar). Returns 1 on a hit. Thread-safe. */
 int hearth_raycast(const hearth_raycaster *rc, const double org[3], const double dir[3],
                    double tnear, double tfar, hearth_ray_hit *hit);
 /* Cast n rays (org/dir 3*n floats) into the caller's hits[n];
  * hits[i].prim = UINT32_MAX where none. */
-void hearth_raycast_batch(const hearth_raycaster *rc, size_t n, const float *org,
-                          const float *dir, float tnear, float tfar, hearth_ray_hit *hits);
+void hearth_raycast_batch(const hearth_raycaster *rc, size_t n, const float *org, const float *dir,
+                          float tnear, float tfar, hearth_ray_hit *hits);
 /* The same with an explicit worker count (0 = hearth_default_threads(),
  * 1 = the calling thread only, for callers that are already parallel). */
 void hearth_raycast_batch_mt(const hearth_raycaster *rc, size_t n, const float *org,
@@ -207,8 +204,8 @@ hearth_status hearth_ray_fan_cast(const hearth_ray_fan *f, const hearth_mesh *m,
 /* Label connected UV islands: triangles sharing an edge in UV space (same two
  * UV coordinates, bit-exact after welding identical UVs) belong to one
  * island. The caller's island_of_tri[n_triangles] gets 0..n_islands-1. */
-hearth_status hearth_uv_islands(const hearth_mesh *m, uint32_t *island_of_tri,
-                                uint32_t *n_islands, hearth_err *err);
+hearth_status hearth_uv_islands(const hearth_mesh *m, uint32_t *island_of_tri, uint32_t *n_islands,
+                                hearth_err *err);
 
 /* Fold UV islands into [0,1]^2 by whole tiles. With a REPEAT sampler the
  * texture at u + k (k an integer) is the texture at u, so an island lying

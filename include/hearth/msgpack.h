@@ -73,19 +73,19 @@ int hearth_mp_str_eq(const hearth_mp_value *v, const char *s);
 typedef struct hearth_mp_ndarray {
   const uint8_t *data; /* points into the input */
   size_t nbytes;
-  char dtype[8];       /* e.g. "<f4", "|u1" */
-  char kind;           /* 'f', 'u', 'i', 'b' */
+  char dtype[8]; /* e.g. "<f4", "|u1" */
+  char kind;     /* 'f', 'u', 'i', 'b' */
   size_t itemsize;
   int big_endian;
   int ndim;
   size_t shape[HEARTH_MP_MAX_DIMS];
-  size_t count;        /* product of shape */
+  size_t count; /* product of shape */
 } hearth_mp_ndarray;
 /* Check that v is an ndarray map (binary keys, __ndarray__ true, dtype a
  * supported numeric type, shape non-negative, len(data) = count * itemsize).
  * `where` names the value in errors (e.g. "reply.actions"). */
-hearth_status hearth_mp_ndarray_get(const hearth_mp_value *v, const char *where, hearth_mp_ndarray *out,
-                                    hearth_err *err);
+hearth_status hearth_mp_ndarray_get(const hearth_mp_value *v, const char *where,
+                                    hearth_mp_ndarray *out, hearth_err *err);
 /* Element k of a numeric ndarray as a double (any byte order). */
 double hearth_mp_ndarray_at(const hearth_mp_ndarray *a, size_t k);
 

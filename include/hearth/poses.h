@@ -33,25 +33,25 @@ typedef struct hearth_scale_view {
 } hearth_scale_view;
 
 typedef struct hearth_scale_opts {
-  int pixel_stride;       /* cast every k-th depth pixel in x and y; default 2 */
-  double edge_rel;        /* neighbour depth jump (relative) marking an edge; default 0.02 */
-  double inlier_sigmas;   /* inlier band in robust sigmas; default 3 */
-  double min_band_mm;     /* the band is at least this wide; default 1 */
-  int min_pixels_per_view;/* a view counts as used with this many inliers; default 50 */
-  int threads;            /* 0 = hearth_default_threads() */
+  int pixel_stride;        /* cast every k-th depth pixel in x and y; default 2 */
+  double edge_rel;         /* neighbour depth jump (relative) marking an edge; default 0.02 */
+  double inlier_sigmas;    /* inlier band in robust sigmas; default 3 */
+  double min_band_mm;      /* the band is at least this wide; default 1 */
+  int min_pixels_per_view; /* a view counts as used with this many inliers; default 50 */
+  int threads;             /* 0 = hearth_default_threads() */
 } hearth_scale_opts;
 void hearth_scale_opts_default(hearth_scale_opts *o);
 
 typedef struct hearth_scale_result {
-  double scale;               /* metres per recon unit */
+  double scale; /* metres per recon unit */
   int views_used;
-  size_t n_candidates;        /* pixels with a measurement and a rendered surface, off edges */
+  size_t n_candidates; /* pixels with a measurement and a rendered surface, off edges */
   size_t n_inliers;
-  double residual_median_mm;  /* median |z_measured - s z_rendered| over inliers */
-  double residual_rms_mm;     /* over inliers */
-  double residual_p90_mm;     /* over inliers */
+  double residual_median_mm; /* median |z_measured - s z_rendered| over inliers */
+  double residual_rms_mm;    /* over inliers */
+  double residual_p90_mm;    /* over inliers */
   double inlier_fraction;
-  int iterations;             /* outer (baseline) iterations used */
+  int iterations; /* outer (baseline) iterations used */
 } hearth_scale_result;
 
 /* Robust scale: per pixel, z_measured / z_rendered of the recon mesh, edges,
@@ -69,7 +69,7 @@ hearth_status hearth_scale_estimate(const hearth_mesh *recon_mesh, const hearth_
 typedef struct hearth_scale_job {
   const char *root;
   const char *instance;
-  const char *state;      /* NULL: depth frames of every state */
+  const char *state; /* NULL: depth frames of every state */
   hearth_scale_opts opts;
 } hearth_scale_job;
 /* Defaults: every state, hearth_scale_opts_default. */
@@ -79,27 +79,27 @@ hearth_status hearth_scale_run(const hearth_scale_job *job, hearth_scale_result 
 
 /* ---- refinement ------------------------------------------------------------ */
 typedef struct hearth_refine_opts {
-  double search_px;        /* first edge-search half window; default 14 */
-  int iterations;          /* Gauss-Newton iterations; default 12 */
-  size_t max_samples;      /* silhouette samples per iteration; default 400 */
-  double min_contrast_c;   /* |object - background| below this: pose kept; default 1.5 */
-  double max_rot_deg;      /* refinement may move the pose at most this far; default 3 */
-  double max_t_mm;         /* default 15 */
-  int threads;             /* over views; 0 = hearth_default_threads() */
+  double search_px;      /* first edge-search half window; default 14 */
+  int iterations;        /* Gauss-Newton iterations; default 12 */
+  size_t max_samples;    /* silhouette samples per iteration; default 400 */
+  double min_contrast_c; /* |object - background| below this: pose kept; default 1.5 */
+  double max_rot_deg;    /* refinement may move the pose at most this far; default 3 */
+  double max_t_mm;       /* default 15 */
+  int threads;           /* over views; 0 = hearth_default_threads() */
 } hearth_refine_opts;
 void hearth_refine_opts_default(hearth_refine_opts *o);
 
 typedef struct hearth_refine_view_result {
-  hearth_rigid T_world_from_cam; /* the returned pose (start unless accepted) */
-  int accepted;                  /* 1: refined pose replaced the start */
-  double cost_start, cost_final; /* the criterion (mean truncated squared edge distance, px^2) */
-  double d_rot_deg, d_t_mm;      /* change from the start */
-  double contrast_c;             /* median object - background across the contour */
-  double confidence;             /* 0..1: inlier fraction x conditioning */
+  hearth_rigid T_world_from_cam;    /* the returned pose (start unless accepted) */
+  int accepted;                     /* 1: refined pose replaced the start */
+  double cost_start, cost_final;    /* the criterion (mean truncated squared edge distance, px^2) */
+  double d_rot_deg, d_t_mm;         /* change from the start */
+  double contrast_c;                /* median object - background across the contour */
+  double confidence;                /* 0..1: inlier fraction x conditioning */
   double sigma_rot_deg, sigma_t_mm; /* weakest-direction standard deviations */
   size_t n_samples, n_inliers;
   double seconds;
-  char reason[96];               /* why a pose was kept, or "refined" */
+  char reason[96]; /* why a pose was kept, or "refined" */
 } hearth_refine_view_result;
 
 /* Refine each view's T_world_from_cam (views[i].image: F32 temperatures)
@@ -138,13 +138,13 @@ hearth_status hearth_pose_nudges_read(const char *path, hearth_pose_nudge **out,
 typedef struct hearth_refine_job {
   const char *root;
   const char *instance;
-  const char *state;        /* NULL: all states */
-  const char *mesh_path;    /* NULL: derived/mesh.glb */
-  const char *rig_path;     /* NULL: calibration/rig.json */
-  const char *start_path;   /* NULL: derived/poses_thermal_transferred.json */
-  const char *out_path;     /* NULL: derived/poses_thermal.json */
-  const char *report_path;  /* NULL: derived/refine_report.json */
-  int no_auto;              /* 1: only apply nudges */
+  const char *state;       /* NULL: all states */
+  const char *mesh_path;   /* NULL: derived/mesh.glb */
+  const char *rig_path;    /* NULL: calibration/rig.json */
+  const char *start_path;  /* NULL: derived/poses_thermal_transferred.json */
+  const char *out_path;    /* NULL: derived/poses_thermal.json */
+  const char *report_path; /* NULL: derived/refine_report.json */
+  int no_auto;             /* 1: only apply nudges */
   const hearth_pose_nudge *nudges;
   size_t n_nudges;
   /* evaluation only: perturb the start poses (random, seeded) and/or
@@ -187,10 +187,10 @@ hearth_status hearth_overlay_render(const hearth_raycaster *rc, const hearth_cam
 typedef struct hearth_overlay_job {
   const char *root, *instance, *state;
   const char *mesh_path, *rig_path;
-  const char *before_path;  /* NULL: derived/poses_thermal_transferred.json */
-  const char *after_path;   /* NULL: derived/poses_thermal.json */
-  int zoom;                 /* default 3 */
-  double lo, hi;            /* default auto */
+  const char *before_path; /* NULL: derived/poses_thermal_transferred.json */
+  const char *after_path;  /* NULL: derived/poses_thermal.json */
+  int zoom;                /* default 3 */
+  double lo, hi;           /* default auto */
   int threads;
 } hearth_overlay_job;
 /* Defaults: every state, zoom 3, automatic temperature range, all cores. */
@@ -206,10 +206,10 @@ hearth_status hearth_overlay_run(const hearth_overlay_job *job, size_t *n_writte
  * derived/poses_thermal.json. */
 typedef struct hearth_transfer_job {
   const char *root;
-  const char *instance;    /* required */
-  const char *rig_path;    /* NULL: <root>/calibration/rig.json */
-  const char *poses_path;  /* NULL: <root>/instances/<id>/derived/poses_rgb.json */
-  int keep_refined;        /* 1: do not overwrite a refined poses_thermal.json */
+  const char *instance;   /* required */
+  const char *rig_path;   /* NULL: <root>/calibration/rig.json */
+  const char *poses_path; /* NULL: <root>/instances/<id>/derived/poses_rgb.json */
+  int keep_refined;       /* 1: do not overwrite a refined poses_thermal.json */
 } hearth_transfer_job;
 /* Defaults: the standard paths, keep_refined 0. */
 void hearth_transfer_job_default(hearth_transfer_job *job);

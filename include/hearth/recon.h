@@ -84,30 +84,30 @@ typedef struct hearth_colmap_camera {
   size_t n_params;
   double params[HEARTH_COLMAP_MAX_PARAMS]; /* as stored, COLMAP's pixel convention */
   uint64_t width, height;
-  hearth_camera camera;                    /* the same camera in hearth's conventions */
+  hearth_camera camera; /* the same camera in hearth's conventions */
 } hearth_colmap_camera;
 
 typedef struct hearth_colmap_image {
   uint32_t id, camera_id;
   double q_cam_from_world[4]; /* qw qx qy qz as stored */
   double t_cam_from_world[3];
-  hearth_rigid T_world_from_cam; /* the inverse, from the normalised quaternion */
+  hearth_rigid T_world_from_cam;     /* the inverse, from the normalised quaternion */
   char name[HEARTH_COLMAP_NAME_MAX]; /* relative to COLMAP's image folder, '/' separated */
-  size_t n_points2d;          /* 2-D points (features) of the image */
-  size_t n_observations;      /* those with a 3-D point */
+  size_t n_points2d;                 /* 2-D points (features) of the image */
+  size_t n_observations;             /* those with a 3-D point */
 } hearth_colmap_image;
 
 typedef struct hearth_colmap_point {
   uint64_t id;
   double xyz[3];
   uint8_t rgb[3];
-  double error;               /* mean reprojection error, pixels */
-  size_t track_length;        /* images observing the point */
+  double error;        /* mean reprojection error, pixels */
+  size_t track_length; /* images observing the point */
 } hearth_colmap_point;
 
 typedef enum hearth_colmap_format {
-  HEARTH_COLMAP_TEXT = 0,     /* cameras.txt, images.txt, points3D.txt */
-  HEARTH_COLMAP_BINARY = 1    /* cameras.bin, images.bin, points3D.bin */
+  HEARTH_COLMAP_TEXT = 0,  /* cameras.txt, images.txt, points3D.txt */
+  HEARTH_COLMAP_BINARY = 1 /* cameras.bin, images.bin, points3D.bin */
 } hearth_colmap_format;
 
 typedef enum hearth_colmap_file {
@@ -205,8 +205,7 @@ hearth_status hearth_recon_cameras_write(const char *path, const hearth_recon_ca
                                          hearth_err *err);
 hearth_status hearth_recon_cameras_parse(const char *text, size_t len, const char *name,
                                          hearth_recon_cameras *c, hearth_err *err);
-hearth_status hearth_recon_cameras_read(const char *path, hearth_recon_cameras *c,
-                                        hearth_err *err);
+hearth_status hearth_recon_cameras_read(const char *path, hearth_recon_cameras *c, hearth_err *err);
 
 /* Poses against instance `instance` of the release at root: every pose must
  * be a colour view (raw/<state>/manifest.json) of a state of instance.json
@@ -233,7 +232,7 @@ hearth_status hearth_recon_match_instance(const char *root, const char *instance
  * are not all on one line are needed (HEARTH_E_NUMERIC otherwise). */
 typedef struct hearth_pose_alignment {
   hearth_similarity ref_from_est;
-  size_t n_common;               /* views in both sets */
+  size_t n_common; /* views in both sets */
   double rot_median_deg, rot_max_deg;
   double pos_median, pos_rms, pos_max; /* reference units */
 } hearth_pose_alignment;
@@ -264,26 +263,26 @@ typedef enum hearth_colmap_intrinsics {
 } hearth_colmap_intrinsics;
 
 typedef struct hearth_colmap_job {
-  const char *root;        /* release root */
-  const char *instance;    /* instance id */
-  const char *out;         /* poses file; NULL: <instance>/recon/poses_rgb.json */
-  const char *work;        /* workspace kept there; NULL: a temporary one, removed on success */
-  const char *colmap;      /* the program; NULL: "colmap" on PATH */
+  const char *root;     /* release root */
+  const char *instance; /* instance id */
+  const char *out;      /* poses file; NULL: <instance>/recon/poses_rgb.json */
+  const char *work;     /* workspace kept there; NULL: a temporary one, removed on success */
+  const char *colmap;   /* the program; NULL: "colmap" on PATH */
   hearth_colmap_intrinsics intrinsics;
-  int no_masks;            /* 1: features everywhere, not only inside the cut-outs */
-  int threads;             /* 0: hearth_default_threads() */
-  int force;               /* 1: replace an existing out file */
-  int quiet;               /* 1: no progress on stderr */
+  int no_masks; /* 1: features everywhere, not only inside the cut-outs */
+  int threads;  /* 0: hearth_default_threads() */
+  int force;    /* 1: replace an existing out file */
+  int quiet;    /* 1: no progress on stderr */
 } hearth_colmap_job;
 
 typedef struct hearth_colmap_result {
-  size_t n_views;          /* colour views of all states given to COLMAP */
-  size_t n_registered;     /* views with a pose in the chosen model */
-  size_t n_models;         /* models the mapper made */
-  size_t n_points;         /* 3-D points of the chosen model */
-  double seconds[3];       /* feature_extractor, exhaustive_matcher, mapper */
-  char out[4096];          /* the poses file written */
-  char work[4096];         /* the workspace (removed unless job.work or a failure) */
+  size_t n_views;      /* colour views of all states given to COLMAP */
+  size_t n_registered; /* views with a pose in the chosen model */
+  size_t n_models;     /* models the mapper made */
+  size_t n_points;     /* 3-D points of the chosen model */
+  double seconds[3];   /* feature_extractor, exhaustive_matcher, mapper */
+  char out[4096];      /* the poses file written */
+  char work[4096];     /* the workspace (removed unless job.work or a failure) */
 } hearth_colmap_result;
 
 /* Run feature_extractor (cut-outs as masks, one shared camera, CPU SIFT),

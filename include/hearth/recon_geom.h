@@ -41,8 +41,8 @@ typedef struct hearth_tsdf {
 
 /* A volume covering the box [lo, hi] (metres) with samples voxel apart;
  * all samples unobserved. t is overwritten, not freed. */
-hearth_status hearth_tsdf_init(hearth_tsdf *t, const double lo[3], const double hi[3],
-                               double voxel, double trunc, hearth_err *err);
+hearth_status hearth_tsdf_init(hearth_tsdf *t, const double lo[3], const double hi[3], double voxel,
+                               double trunc, hearth_err *err);
 void hearth_tsdf_free(hearth_tsdf *t); /* accepts a zeroed volume */
 
 /* Fuse one depth map (U16 millimetres, 1 channel, 0 = no measurement) seen
@@ -54,9 +54,8 @@ void hearth_tsdf_free(hearth_tsdf *t); /* accepts a zeroed volume */
  * camera's z axis, samples more than trunc behind the surface are left
  * alone, and each observation adds weight 1 (a running mean). */
 hearth_status hearth_tsdf_integrate(hearth_tsdf *t, const hearth_image *depth,
-                                    const hearth_camera *cam,
-                                    const hearth_rigid *T_world_from_cam, const uint8_t *mask,
-                                    hearth_err *err);
+                                    const hearth_camera *cam, const hearth_rigid *T_world_from_cam,
+                                    const uint8_t *mask, hearth_err *err);
 
 /* The zero level set as a triangle mesh (no UVs), vertices shared between
  * neighbouring cells. Only tetrahedra whose four samples are all observed
@@ -108,10 +107,9 @@ void hearth_recon_tsdf_opts_default(hearth_recon_tsdf_opts *o);
  * T_world_from_rgb * inverse(T_depth_from_rgb) from the (metric) colour
  * poses. The volume bounds are those of the masked points plus a margin.
  * The result is cleaned, hole-filled and simplified as the options say. */
-hearth_status hearth_recon_tsdf(const char *root, const char *instance,
-                                const char *const *states, size_t n_states,
-                                const hearth_recon_tsdf_opts *opts, hearth_mesh *out,
-                                hearth_err *err);
+hearth_status hearth_recon_tsdf(const char *root, const char *instance, const char *const *states,
+                                size_t n_states, const hearth_recon_tsdf_opts *opts,
+                                hearth_mesh *out, hearth_err *err);
 
 #ifdef __cplusplus
 }

@@ -41,9 +41,9 @@ hearth_status hearth_problems_add(hearth_problems *p, const char *path, const ch
 
 /* ---- validate ---------------------------------------------------------------- */
 typedef struct hearth_validate_opts {
-  int threads;        /* 0 = hearth_default_threads() */
-  int raw_only;       /* 1: a capture not yet built: skip derived/ */
-  int decode_images;  /* 1: decode every JPEG/PNG fully (default 0: headers + trailer) */
+  int threads;       /* 0 = hearth_default_threads() */
+  int raw_only;      /* 1: a capture not yet built: skip derived/ */
+  int decode_images; /* 1: decode every JPEG/PNG fully (default 0: headers + trailer) */
 } hearth_validate_opts;
 void hearth_validate_opts_default(hearth_validate_opts *o);
 
@@ -60,33 +60,32 @@ void hearth_validate_opts_default(hearth_validate_opts *o);
  * out of memory). files_checked (may be NULL) receives the count of files
  * examined. */
 hearth_status hearth_validate_release(const char *root, const hearth_validate_opts *o,
-                                      hearth_problems *out, size_t *files_checked,
-                                      hearth_err *err);
+                                      hearth_problems *out, size_t *files_checked, hearth_err *err);
 
 /* ---- stats ------------------------------------------------------------------- */
 #define HEARTH_N_STATE_KINDS 5 /* neutral hot warm iced used */
 typedef struct hearth_release_stats {
   size_t n_categories;
-  size_t instances_per_category[18];      /* indexed like hearth_categories */
+  size_t instances_per_category[18]; /* indexed like hearth_categories */
   size_t n_instances;
-  size_t n_states;                        /* object states (instance x state) */
+  size_t n_states; /* object states (instance x state) */
   size_t states_by_kind[HEARTH_N_STATE_KINDS];
-  size_t n_instances_nonneutral;          /* instances with a state other than neutral */
+  size_t n_instances_nonneutral; /* instances with a state other than neutral */
   size_t n_categories_nonneutral;
-  size_t views_min, views_max;            /* views per object state */
-  size_t n_elevations, n_azimuths;        /* distinct indices (0 if mixed per state) */
-  size_t n_pairs;                         /* views with both an RGB image and a thermal matrix */
-  size_t n_depth;                         /* views with a depth map */
+  size_t views_min, views_max;     /* views per object state */
+  size_t n_elevations, n_azimuths; /* distinct indices (0 if mixed per state) */
+  size_t n_pairs;                  /* views with both an RGB image and a thermal matrix */
+  size_t n_depth;                  /* views with a depth map */
   size_t rgb_w, rgb_h, thermal_w, thermal_h, depth_w, depth_h; /* of the first view (0 unknown) */
   /* derived assets present */
   size_t n_meshes, n_rgb_textures, n_scales, n_poses_rgb, n_poses_thermal;
-  size_t n_maps;                          /* states with temperature_filled.npy + mask.npy */
-  size_t n_turbo;                         /* states with thermal_turbo.png */
+  size_t n_maps;  /* states with temperature_filled.npy + mask.npy */
+  size_t n_turbo; /* states with thermal_turbo.png */
   size_t n_provenance;
-  size_t map_resolution;                  /* R of the first map (0 none) */
-  int has_calibration;                    /* calibration/rig.json present */
+  size_t map_resolution; /* R of the first map (0 none) */
+  int has_calibration;   /* calibration/rig.json present */
   int has_ground_truth;
-  uint64_t raw_bytes, derived_bytes;      /* file sizes under raw/ and derived/ */
+  uint64_t raw_bytes, derived_bytes; /* file sizes under raw/ and derived/ */
 } hearth_release_stats;
 
 hearth_status hearth_release_stats_compute(const char *root, hearth_release_stats *st,
@@ -115,8 +114,8 @@ hearth_status hearth_build_files_add(hearth_build_files *f, const char *fmt, ...
  * add stages of its own, run after them. */
 #define HEARTH_BUILD_MAX_STAGES 8
 typedef struct hearth_build_stage {
-  const char *name;     /* "detect" */
-  const char *params;   /* its parameters as text: a change forces a re-run */
+  const char *name;   /* "detect" */
+  const char *params; /* its parameters as text: a change forces a re-run */
   /* fill the stage's inputs and outputs (relative to root) */
   hearth_status (*files)(void *ctx, const char *root, hearth_build_files *in,
                          hearth_build_files *out, hearth_err *err);
@@ -132,32 +131,32 @@ typedef struct hearth_build_stage {
  * so a later build without options changes nothing. */
 #define HEARTH_BUILD_FUSION_UNSET ((hearth_fusion)-1)
 typedef struct hearth_build_opts {
-  int jobs;                   /* instances in parallel; 0 = min(cores, instances) */
-  int threads;                /* total worker threads; 0 = hearth_default_threads() */
+  int jobs;                     /* instances in parallel; 0 = min(cores, instances) */
+  int threads;                  /* total worker threads; 0 = hearth_default_threads() */
   int shard_index, shard_count; /* this machine does instances with index % count == index */
-  const char *only_instance;  /* NULL: all of release.json */
-  size_t resolution;          /* temperature-map R; 0 unset (default 1024) */
-  hearth_fusion fusion;       /* HEARTH_BUILD_FUSION_UNSET (default HEARTH_FUSE_MAX) */
-  double min_cos;             /* negative: unset (default 0) */
-  size_t rgb_resolution;      /* baked colour texture side; 0 unset (default 1024) */
-  int bake_rgb;               /* 1 bake, 0 keep the recon's texture; -1 unset (default 1) */
-  int force;                  /* re-run every stage */
-  int quiet;                  /* no progress output */
-  int dry_run;                /* list what would run, run nothing (build.json untouched) */
-  int calibrate;              /* 1: detect + calibrate when calibration/captures/ exists;
+  const char *only_instance;    /* NULL: all of release.json */
+  size_t resolution;            /* temperature-map R; 0 unset (default 1024) */
+  hearth_fusion fusion;         /* HEARTH_BUILD_FUSION_UNSET (default HEARTH_FUSE_MAX) */
+  double min_cos;               /* negative: unset (default 0) */
+  size_t rgb_resolution;        /* baked colour texture side; 0 unset (default 1024) */
+  int bake_rgb;                 /* 1 bake, 0 keep the recon's texture; -1 unset (default 1) */
+  int force;                    /* re-run every stage */
+  int quiet;                    /* no progress output */
+  int dry_run;                  /* list what would run, run nothing (build.json untouched) */
+  int calibrate;                /* 1: detect + calibrate when calibration/captures/ exists;
                                  -1 unset (default 1) */
-  int calib_overlays;         /* 1: detection draws its overlay pictures; -1 unset (default 1) */
-  int ignore_recorded;        /* 1: unset parameters take their defaults, not build.json's */
-  size_t n_release_stages;    /* extra release-level stages (at most HEARTH_BUILD_MAX_STAGES) */
+  int calib_overlays;           /* 1: detection draws its overlay pictures; -1 unset (default 1) */
+  int ignore_recorded;          /* 1: unset parameters take their defaults, not build.json's */
+  size_t n_release_stages;      /* extra release-level stages (at most HEARTH_BUILD_MAX_STAGES) */
   const hearth_build_stage *release_stages;
-  FILE *log;                  /* plain lines / summary; default stdout */
+  FILE *log; /* plain lines / summary; default stdout */
 } hearth_build_opts;
 void hearth_build_opts_default(hearth_build_opts *o);
 
 /* What happened to one instance. */
 typedef struct hearth_build_instance {
   char id[64];
-  int failed;                 /* 1: a stage failed (later stages skipped) */
+  int failed; /* 1: a stage failed (later stages skipped) */
   char failed_stage[32];
   char reason[1024];
   size_t n_states, states_mapped;
@@ -165,11 +164,11 @@ typedef struct hearth_build_instance {
 } hearth_build_instance;
 
 typedef struct hearth_build_report {
-  size_t n_instances;         /* of this shard */
+  size_t n_instances;               /* of this shard */
   hearth_build_instance *instances; /* owned */
   size_t stages_run, stages_up_to_date;
-  size_t temps_removed;       /* temporaries of killed runs removed before re-running stages */
-  int release_failed;         /* a release-level stage failed (no instance was built) */
+  size_t temps_removed; /* temporaries of killed runs removed before re-running stages */
+  int release_failed;   /* a release-level stage failed (no instance was built) */
   char release_reason[1024];
   double seconds;
 } hearth_build_report;
@@ -197,9 +196,9 @@ typedef struct hearth_report_entry {
   char instance[64], state[64];
   int has_truth;
   size_t R, n_surface, n_observed, n_compared;
-  double coverage;               /* observed / surface texels */
+  double coverage;                /* observed / surface texels */
   double median_abs_c, p95_abs_c; /* |observed - true| over observed texels; NaN without truth */
-  double mean_signed_c;          /* mean (observed - true) */
+  double mean_signed_c;           /* mean (observed - true) */
 } hearth_report_entry;
 
 typedef struct hearth_report {

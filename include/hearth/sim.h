@@ -33,7 +33,11 @@ extern "C" {
 #define HEARTH_SIM_CONTROL_HZ 20
 #define HEARTH_SIM_TIMESTEP 0.002
 
-typedef enum hearth_sim_task { HEARTH_SIM_H1 = 1, HEARTH_SIM_H2 = 2, HEARTH_SIM_H3 = 3 } hearth_sim_task;
+typedef enum hearth_sim_task {
+  HEARTH_SIM_H1 = 1,
+  HEARTH_SIM_H2 = 2,
+  HEARTH_SIM_H3 = 3
+} hearth_sim_task;
 
 /* Parse "H1".."H3" (case-insensitive); 0 if unknown. */
 hearth_sim_task hearth_sim_task_parse(const char *s);
@@ -55,16 +59,16 @@ typedef struct hearth_sim_opts {
   hearth_sim_task task;
   const char *release_root;
   int use_ground_truth;
-  int width, height;     /* rendered size of every view; default 256 */
-  int max_steps;         /* time limit in control steps; default 400 */
-  int render_wrist;      /* default 1 */
-  int shadows;           /* shadow-mapped light in the RGB views; default 0
+  int width, height;    /* rendered size of every view; default 256 */
+  int max_steps;        /* time limit in control steps; default 400 */
+  int render_wrist;     /* default 1 */
+  int shadows;          /* shadow-mapped light in the RGB views; default 0
                           * (a shadow-map pass per lit view, costly on the
                           * CPU; the thermal view is unlit either way) */
-  const char *gl;        /* "osmesa" (CPU, default) or "egl" (GPU through
+  const char *gl;       /* "osmesa" (CPU, default) or "egl" (GPU through
                           * EGL's device platform, else Mesa's surfaceless
                           * platform); NULL: $HEARTH_GL, else "osmesa" */
-  const char *work_dir;  /* scratch for the MJCF/mesh files; NULL = a fresh dir under
+  const char *work_dir; /* scratch for the MJCF/mesh files; NULL = a fresh dir under
                           * $TMPDIR (else /tmp), removed with the env */
 } hearth_sim_opts;
 void hearth_sim_opts_default(hearth_sim_opts *o);
@@ -85,8 +89,8 @@ const char *hearth_sim_renderer(const hearth_sim_env *env);
  * asking for `instruction` (0 or 1). Positions are redrawn from the
  * layout's own stream until both candidates are at least 70% visible from
  * the front camera (ray casts: independent of the image size). */
-hearth_status hearth_sim_reset(hearth_sim_env *env, uint64_t seed, uint64_t layout,
-                               int instruction, hearth_err *err);
+hearth_status hearth_sim_reset(hearth_sim_env *env, uint64_t seed, uint64_t layout, int instruction,
+                               hearth_err *err);
 
 /* One control step (25 physics steps): action [dx dy dz dax day daz grip] in
  * [-1, 1] (clipped; non-finite is HEARTH_E_RANGE), 1.0 = 0.05 m / 0.5 rad
@@ -95,14 +99,14 @@ hearth_status hearth_sim_step(hearth_sim_env *env, const double action[7], heart
 
 typedef struct hearth_sim_obs {
   int width, height;
-  uint8_t *agentview_rgb;      /* width*height*3, owned by the env, valid until next observe */
+  uint8_t *agentview_rgb; /* width*height*3, owned by the env, valid until next observe */
   uint8_t *agentview_thermal;
-  uint8_t *eye_in_hand_rgb;    /* NULL if the wrist view is off */
+  uint8_t *eye_in_hand_rgb; /* NULL if the wrist view is off */
   double joint_states[7];
-  double gripper_states[2];    /* left finger, minus right finger position (m) */
-  double ee_pos[3];            /* grip site, world, m */
-  double ee_ori[3];            /* axis-angle of the end-effector rotation */
-  double ee_quat[4];           /* w x y z */
+  double gripper_states[2]; /* left finger, minus right finger position (m) */
+  double ee_pos[3];         /* grip site, world, m */
+  double ee_ori[3];         /* axis-angle of the end-effector rotation */
+  double ee_quat[4];        /* w x y z */
 } hearth_sim_obs;
 
 /* Render the views and read the robot state into obs (its image buffers
@@ -136,20 +140,20 @@ typedef struct hearth_sim_collect_opts {
   hearth_sim_task task;
   const char *release_root;
   int use_ground_truth;
-  int layouts;          /* slots of the whole collection, 1..HEARTH_SIM_MAX_LAYOUTS; default
+  int layouts;                  /* slots of the whole collection, 1..HEARTH_SIM_MAX_LAYOUTS; default
                          * 200: 2 instructions each */
-  uint64_t seed;        /* default 1 */
-  int image_size;       /* rendered and stored image side; default 256 (openpi's LIBERO
+  uint64_t seed;                /* default 1 */
+  int image_size;               /* rendered and stored image side; default 256 (openpi's LIBERO
                          * data; what hearth_eval_opts.render_size renders by default) */
-  int max_steps;        /* default 400 */
-  int keep_failures;    /* store failed demos too (default 0: retry the slot with its next
+  int max_steps;                /* default 400 */
+  int keep_failures;            /* store failed demos too (default 0: retry the slot with its next
                          * candidate layout) */
-  int shadows;          /* as hearth_sim_opts.shadows; default 0 */
-  const char *gl;       /* as hearth_sim_opts.gl */
+  int shadows;                  /* as hearth_sim_opts.shadows; default 0 */
+  const char *gl;               /* as hearth_sim_opts.gl */
   int shard_index, shard_count; /* this process fills the slots k with k % count == index;
                          * count 0 or 1: all of them. The files of a shard are merged
                          * with hearth_sim_merge */
-  int split_instructions; /* one file per instruction: out_path without ".hdf5", plus
+  int split_instructions;       /* one file per instruction: out_path without ".hdf5", plus
                          * "_instr1.hdf5" and "_instr2.hdf5" (hearth_sim_split_path) */
   int quiet;
   const char *out_path; /* .hdf5, written atomically (layout: docs/simulation.md) */
@@ -169,8 +173,8 @@ typedef struct hearth_sim_collect_stats {
   int demos;                     /* per file */
   long steps;
   double seconds;
-  int rejected_layouts;          /* layouts skipped because the expert failed */
-  int slots;                     /* slots this process filled */
+  int rejected_layouts; /* layouts skipped because the expert failed */
+  int slots;            /* slots this process filled */
 } hearth_sim_collect_stats;
 /* Collect the slots of this shard x 2 demonstrations with the scripted
  * expert into out_path (or its two split files); stats may be NULL. */
@@ -184,8 +188,8 @@ void hearth_sim_split_path(const char *out_path, int ins, char *buf, size_t bufs
  * once; for a split collection, the files of one instruction) into
  * out_path, written atomically: the same bytes as one unsharded run.
  * *n_demos (may be NULL) receives the demos written. */
-hearth_status hearth_sim_merge(const char *out_path, const char *const *parts, int n_parts, int *n_demos,
-                               hearth_err *err);
+hearth_status hearth_sim_merge(const char *out_path, const char *const *parts, int n_parts,
+                               int *n_demos, hearth_err *err);
 
 /* Render the task's scene (layout 0 of seed, instruction 0) to
  * <out_prefix>_rgb.png, <out_prefix>_thermal.png and (with the wrist view)

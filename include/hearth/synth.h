@@ -22,34 +22,34 @@ extern "C" {
 
 /* Strings are borrowed: they must stay valid during hearth_synth_release. */
 typedef struct hearth_synth_opts {
-  uint64_t seed;                 /* default 1 */
-  const char *out_root;          /* release root to create (must not exist, or be empty) */
+  uint64_t seed;        /* default 1 */
+  const char *out_root; /* release root to create (must not exist, or be empty) */
   /* categories to make (hearth_synth_opts_default: one, "cup"); 0 = every
      procedural category */
   size_t n_categories;
   const char *categories[HEARTH_SYNTH_MAX_ITEMS];
-  int instances_per_category;    /* default 1 */
+  int instances_per_category; /* default 1 */
   /* states per instance; 0 = the category's defaults (neutral + its second state) */
   size_t n_states;
   const char *states[8];
-  int n_views;                   /* views per state, <= 30; default 30 (3 x 10) */
-  size_t triangles;              /* target mesh detail; default 20000 (100..5000000) */
-  size_t texture_size;           /* RGB texture side; default 1024 */
-  size_t map_resolution;         /* R of ground-truth temperature maps; default 1024 */
-  int calibration;               /* write calibration/ captures; default 1 */
-  int n_thermal_frames;          /* default 27 */
-  int n_stereo_pairs;            /* default 24 */
-  int rgb_full_size;             /* 1 (default): object colour views rendered at full size;
+  int n_views;           /* views per state, <= 30; default 30 (3 x 10) */
+  size_t triangles;      /* target mesh detail; default 20000 (100..5000000) */
+  size_t texture_size;   /* RGB texture side; default 1024 */
+  size_t map_resolution; /* R of ground-truth temperature maps; default 1024 */
+  int calibration;       /* write calibration/ captures; default 1 */
+  int n_thermal_frames;  /* default 27 */
+  int n_stereo_pairs;    /* default 24 */
+  int rgb_full_size;     /* 1 (default): object colour views rendered at full size;
                                     0: draft, rendered at a quarter of the size and enlarged 4x to
                                     the full 1920x1080 frame (for tests only) */
   /* put a given UV-mapped GLB on the turntable instead of a procedural object */
   const char *mesh_path;
-  double mesh_size_m;            /* largest extent after scaling; default 0.12 */
-  const char *mesh_category;     /* whose states to use; default "cup" */
-  int contact_sheet;             /* write instances/<id>/raw/<state>/contact_sheet.png */
-  double netd_c;                 /* thermal noise, default 0.05 degC */
-  int threads;                   /* 0 = hearth_default_threads() */
-  int quiet;                     /* no progress output */
+  double mesh_size_m;        /* largest extent after scaling; default 0.12 */
+  const char *mesh_category; /* whose states to use; default "cup" */
+  int contact_sheet;         /* write instances/<id>/raw/<state>/contact_sheet.png */
+  double netd_c;             /* thermal noise, default 0.05 degC */
+  int threads;               /* 0 = hearth_default_threads() */
+  int quiet;                 /* no progress output */
 } hearth_synth_opts;
 
 void hearth_synth_opts_default(hearth_synth_opts *o);

@@ -77,8 +77,8 @@ hearth_status hearth_thermal_read_csv_camera(const char *path, size_t width, siz
                                              hearth_err *err);
 /* Write the canonical form of a 1-channel F32 image with `decimals` (0..9)
  * fixed decimals, '.' as the decimal point whatever the locale (atomic). */
-hearth_status hearth_thermal_write_csv(const char *path, const hearth_image *temps,
-                                       int decimals, hearth_err *err);
+hearth_status hearth_thermal_write_csv(const char *path, const hearth_image *temps, int decimals,
+                                       hearth_err *err);
 
 /* ---- what the reader recognised ------------------------------------------- */
 typedef enum hearth_csv_layout {
@@ -102,20 +102,20 @@ typedef struct hearth_csv_meta {
 
 typedef struct hearth_thermal_info {
   hearth_csv_layout layout;
-  size_t width, height;        /* of the matrix read */
-  char separator;              /* ',', ';' or '\t' */
-  char decimal_mark;           /* '.' or ',' (',' if any value uses one); 0: integers only */
-  const char *encoding;        /* "ascii", "utf-8", "utf-8-bom", "utf-16le-bom",
+  size_t width, height;         /* of the matrix read */
+  char separator;               /* ',', ';' or '\t' */
+  char decimal_mark;            /* '.' or ',' (',' if any value uses one); 0: integers only */
+  const char *encoding;         /* "ascii", "utf-8", "utf-8-bom", "utf-16le-bom",
                                 * "utf-16be-bom" or "8-bit" (static strings) */
-  const char *line_ends;       /* "LF", "CRLF", "CR", "mixed" or "none" (static) */
+  const char *line_ends;        /* "LF", "CRLF", "CR", "mixed" or "none" (static) */
   size_t first_line, last_line; /* the matrix, index row or label row included */
-  size_t header_lines;         /* lines before first_line (metadata, blanks, size line) */
-  size_t size_line;            /* line of the "W,H" size line; 0 if none */
-  const char *label;           /* the axis corner or frame label; NULL for others */
-  const char *unit;            /* "degC" if the metadata says so; NULL if it does not say */
-  hearth_csv_meta *meta;       /* metadata lines in file order (at most 256 kept) */
+  size_t header_lines;          /* lines before first_line (metadata, blanks, size line) */
+  size_t size_line;             /* line of the "W,H" size line; 0 if none */
+  const char *label;            /* the axis corner or frame label; NULL for others */
+  const char *unit;             /* "degC" if the metadata says so; NULL if it does not say */
+  hearth_csv_meta *meta;        /* metadata lines in file order (at most 256 kept) */
   size_t n_meta;
-  size_t n_meta_lines;         /* metadata lines in the file (may exceed n_meta) */
+  size_t n_meta_lines; /* metadata lines in the file (may exceed n_meta) */
 } hearth_thermal_info;
 
 /* As hearth_thermal_parse_csv / hearth_thermal_read_csv, and when info is

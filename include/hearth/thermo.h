@@ -42,28 +42,28 @@ extern "C" {
 
 typedef struct hearth_thermo_region {
   char name[HEARTH_THERMO_NAME_MAX]; /* 1..31 of [A-Za-z0-9_-] */
-  double C;          /* heat capacity, J/K, > 0 */
-  double T;          /* temperature, degC */
-  double area;       /* area exposed to the air, m^2, >= 0 */
-  double h_conv;     /* convection coefficient, W/(m^2 K), >= 0 */
-  double emissivity; /* 0..1 */
-  double power;      /* heat put in by the caller, W (a heater; 0 by default) */
-  int label;         /* texture region label (0..5), or -1: owns no texels */
+  double C;                          /* heat capacity, J/K, > 0 */
+  double T;                          /* temperature, degC */
+  double area;                       /* area exposed to the air, m^2, >= 0 */
+  double h_conv;                     /* convection coefficient, W/(m^2 K), >= 0 */
+  double emissivity;                 /* 0..1 */
+  double power;                      /* heat put in by the caller, W (a heater; 0 by default) */
+  int label;                         /* texture region label (0..5), or -1: owns no texels */
 } hearth_thermo_region;
 
 /* A contact link of region `region` to a body at a fixed temperature (the
  * table, a finger) for the next step: conductance G = h_contact * area. */
 typedef struct hearth_thermo_contact {
   size_t region;
-  double G;        /* W/K, >= 0 */
-  double T_other;  /* degC */
+  double G;       /* W/K, >= 0 */
+  double T_other; /* degC */
 } hearth_thermo_contact;
 
 typedef struct hearth_thermo_net {
   size_t n;
   hearth_thermo_region region[HEARTH_THERMO_MAX_REGIONS];
   double G[HEARTH_THERMO_MAX_REGIONS][HEARTH_THERMO_MAX_REGIONS]; /* symmetric, zero diagonal */
-  double T_air;    /* degC */
+  double T_air;                                                   /* degC */
   size_t n_contacts;
   hearth_thermo_contact contact[HEARTH_THERMO_MAX_CONTACTS];
 } hearth_thermo_net;
@@ -105,8 +105,8 @@ typedef struct hearth_thermo_link {
 /* One backward Euler step of all nets together (n_nets <= HEARTH_THERMO_MAX_NETS),
  * joined by links. */
 hearth_status hearth_thermo_step_coupled(hearth_thermo_net *const *nets, size_t n_nets,
-                                         const hearth_thermo_link *links, size_t n_links,
-                                         double dt, double *heat_in, hearth_err *err);
+                                         const hearth_thermo_link *links, size_t n_links, double dt,
+                                         double *heat_in, hearth_err *err);
 
 /* ---- regions over a texture ---------------------------------------------- */
 /* Texel regions from a temperature map (hearth_map_result's R, mask,
@@ -121,17 +121,16 @@ hearth_status hearth_thermo_step_coupled(hearth_thermo_net *const *nets, size_t 
  * (k_out <= k). Deterministic. */
 typedef struct hearth_thermo_regions {
   size_t R;
-  size_t k;                                  /* regions found */
-  uint8_t *label;                            /* R*R */
-  float *offset;                             /* R*R, degC */
-  double mean[HEARTH_THERMO_MAX_CLUSTERS];   /* degC */
+  size_t k;                                /* regions found */
+  uint8_t *label;                          /* R*R */
+  float *offset;                           /* R*R, degC */
+  double mean[HEARTH_THERMO_MAX_CLUSTERS]; /* degC */
   size_t n_observed[HEARTH_THERMO_MAX_CLUSTERS];
   size_t n_texels[HEARTH_THERMO_MAX_CLUSTERS];
 } hearth_thermo_regions;
 hearth_status hearth_thermo_regions_from_map(size_t R, const uint8_t *mask, const float *observed,
-                                             const float *filled, const uint32_t *island,
-                                             size_t k, hearth_thermo_regions *out,
-                                             hearth_err *err);
+                                             const float *filled, const uint32_t *island, size_t k,
+                                             hearth_thermo_regions *out, hearth_err *err);
 /* frees the arrays and zeroes r; accepts a zeroed struct */
 void hearth_thermo_regions_free(hearth_thermo_regions *r);
 /* out[t] = T_label[label[t]] + offset[t] (R*R floats; NaN where label is
@@ -142,8 +141,8 @@ void hearth_thermo_regions_texture(const hearth_thermo_regions *r, const double 
 /* ---- parameters per category (docs/thermal-model.md has the sources) ------- */
 typedef struct hearth_thermo_material {
   const char *name;
-  double c;          /* specific heat, J/(kg K) */
-  double k;          /* conductivity, W/(m K) */
+  double c; /* specific heat, J/(kg K) */
+  double k; /* conductivity, W/(m K) */
   double emissivity;
   const char *source; /* short reference key of docs/thermal-model.md */
 } hearth_thermo_material;
@@ -162,15 +161,14 @@ hearth_status hearth_thermo_category_net(const char *category, double T0, double
 /* ---- thermal_model.json (schema: docs/thermal-model.md) ---------------------- */
 typedef struct hearth_thermo_model {
   char category[HEARTH_THERMO_NAME_MAX];
-  hearth_thermo_net net;  /* contacts are never stored */
-  char offsets[256];      /* texture offsets file relative to the document, or "" */
+  hearth_thermo_net net; /* contacts are never stored */
+  char offsets[256];     /* texture offsets file relative to the document, or "" */
 } hearth_thermo_model;
 /* strict: unknown keys, wrong types, bad ranges and unknown region names
  * are errors naming `name` and the JSON path */
 hearth_status hearth_thermo_model_parse(const char *text, size_t len, const char *name,
                                         hearth_thermo_model *out, hearth_err *err);
-hearth_status hearth_thermo_model_read(const char *path, hearth_thermo_model *out,
-                                       hearth_err *err);
+hearth_status hearth_thermo_model_read(const char *path, hearth_thermo_model *out, hearth_err *err);
 /* written atomically, deterministic text, validated by the parser first */
 hearth_status hearth_thermo_model_write(const char *path, const hearth_thermo_model *m,
                                         hearth_err *err);

@@ -26,7 +26,8 @@ void hearth_ws_accept(const char *key, char out[29]);
 /* Check an HTTP handshake response (up to and including the blank line):
  * status 101, Upgrade: websocket, Connection: upgrade and the accept value
  * for `key`; no extension may be negotiated. Errors name the line. */
-hearth_status hearth_ws_check_handshake(const char *resp, size_t len, const char *key, hearth_err *err);
+hearth_status hearth_ws_check_handshake(const char *resp, size_t len, const char *key,
+                                        hearth_err *err);
 
 enum {
   HEARTH_WS_CONT = 0x0,
@@ -63,7 +64,8 @@ void hearth_ws_apply_mask(uint8_t *p, size_t n, const uint8_t mask[4], uint64_t 
  * seconds (poll). A connection is an opaque handle made by hearth_ws_connect
  * and released by hearth_ws_close; one thread at a time. */
 typedef struct hearth_ws hearth_ws;
-hearth_status hearth_ws_connect(const char *url, double timeout_s, hearth_ws **out, hearth_err *err);
+hearth_status hearth_ws_connect(const char *url, double timeout_s, hearth_ws **out,
+                                hearth_err *err);
 /* Send one message (HEARTH_WS_BINARY or HEARTH_WS_TEXT), masked, in
  * fragments of at most frag_size bytes (0 = one frame). */
 hearth_status hearth_ws_send(hearth_ws *c, int opcode, const void *data, size_t n, size_t frag_size,
@@ -75,7 +77,8 @@ hearth_status hearth_ws_send(hearth_ws *c, int opcode, const void *data, size_t 
 hearth_status hearth_ws_recv(hearth_ws *c, uint8_t **data, size_t *n, int *opcode, double timeout_s,
                              hearth_err *err);
 /* Send a ping with payload and wait for the matching pong. */
-hearth_status hearth_ws_ping(hearth_ws *c, const void *payload, size_t n, double timeout_s, hearth_err *err);
+hearth_status hearth_ws_ping(hearth_ws *c, const void *payload, size_t n, double timeout_s,
+                             hearth_err *err);
 /* Close handshake with `code` (bounded wait), then free. NULL is fine. */
 void hearth_ws_close(hearth_ws *c, int code);
 /* Close code and reason of the server's close frame, if one came (else 0);

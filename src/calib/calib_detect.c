@@ -205,12 +205,9 @@ static double select_kth(double *v, size_t n, size_t k) {
         j--;
       }
     }
-    if (k <= j)
-      hi = j;
-    else if (k >= i)
-      lo = i;
-    else
-      return v[k];
+    if (k <= j) hi = j;
+    else if (k >= i) lo = i;
+    else return v[k];
   }
   return v[k];
 }
@@ -276,8 +273,8 @@ static void px_row(const pixsrc *P, size_t w, long y, long x0, long x1, float *o
 /* columns of row offset dy where ia dx^2 + 2 ib dx dy + id dy^2 <= r2
  * (dx = x - cx), widened by a pixel each side against rounding; 0 if the
  * row misses the ellipse (with the same slack) */
-static int ellipse_span(double ia, double ib, double id, double dy, double r2, double cx,
-                        long *x0, long *x1) {
+static int ellipse_span(double ia, double ib, double id, double dy, double r2, double cx, long *x0,
+                        long *x1) {
   double disc = ib * ib * dy * dy - ia * (id * dy * dy - r2);
   if (disc < 0) disc = 0;
   double sq = sqrt(disc), lo = (-ib * dy - sq) / ia, hi = (-ib * dy + sq) / ia;
@@ -481,8 +478,7 @@ static hearth_status detect_multi(const uint8_t *U, size_t W, size_t H, double s
       h4[3][U[i + 3]]++;
     }
     for (; i < n; i++) h4[0][U[i]]++;
-    for (int k = 0; k < 256; k++)
-      hist[k] = (size_t)h4[0][k] + h4[1][k] + h4[2][k] + h4[3][k];
+    for (int k = 0; k < 256; k++) hist[k] = (size_t)h4[0][k] + h4[1][k] + h4[2][k] + h4[3][k];
   }
   int med = 0, p995 = 255;
   size_t acc = 0;

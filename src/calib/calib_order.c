@@ -336,10 +336,8 @@ int hearth_plate_order(const double (*pts)[2], size_t n, double centres[HEARTH_P
               if (!c.has[i]) continue;
               int a = m0 * c.lab_a[i] + m1 * c.lab_b[i], b = m2 * c.lab_a[i] + m3 * c.lab_b[i];
               int pi = plate_index(a - mina, b - minb);
-              if (pi < 0 || seen[pi])
-                good = 0;
-              else
-                seen[pi] = 1;
+              if (pi < 0 || seen[pi]) good = 0;
+              else seen[pi] = 1;
             }
             if (good) {
               matches++;

@@ -144,8 +144,8 @@ static hearth_status up4(const hearth_image *src, hearth_image *dst, hearth_err 
 
 /* the image enlarged s times (4: thermal, 0.5: colour), through
  * hearth_image_resize where the shortcuts above do not apply */
-static hearth_status overlay_scale(const hearth_image *img, int thermal, double s, hearth_image *big,
-                                   hearth_err *err) {
+static hearth_status overlay_scale(const hearth_image *img, int thermal, double s,
+                                   hearth_image *big, hearth_err *err) {
   size_t w = (size_t)lround((double)img->width * s), h = (size_t)lround((double)img->height * s);
   hearth_image rgb = {0};
   hearth_status st;
@@ -160,7 +160,8 @@ static hearth_status overlay_scale(const hearth_image *img, int thermal, double 
     const uint8_t nan_rgb[3] = {0, 0, 0};
     if ((st = hearth_turbo_image(img, lo, hi > lo ? hi : lo + 1, nan_rgb, &rgb, err))) return st;
     if (w == 4 * rgb.width && h == 4 * rgb.height) {
-      if (!(st = hearth_image_alloc(big, w, h, 3, HEARTH_PIX_U8, err)) && (st = up4(&rgb, big, err)))
+      if (!(st = hearth_image_alloc(big, w, h, 3, HEARTH_PIX_U8, err)) &&
+          (st = up4(&rgb, big, err)))
         hearth_image_free(big);
     } else {
       st = hearth_image_resize(&rgb, w, h, big, err);
@@ -232,10 +233,14 @@ static void det_range(void *vctx, size_t b, size_t e, int ti) {
        * if wanted, decodes the colour image too */
       /* the colour camera's size (factory.json), checked from the header
        * before the pixels are decoded */
-      hearth_image_expect want = {(size_t)c->want_rgb_w, (size_t)c->want_rgb_h, 0, 0, 0,
+      hearth_image_expect want = {(size_t)c->want_rgb_w,
+                                  (size_t)c->want_rgb_h,
+                                  0,
+                                  0,
+                                  0,
                                   "(the colour camera of factory.json)"};
-      j->st = hearth_jpeg_read_gray_expect(j->path, c->want_rgb_w > 0 ? &want : NULL, &img,
-                                           &j->err);
+      j->st =
+          hearth_jpeg_read_gray_expect(j->path, c->want_rgb_w > 0 ? &want : NULL, &img, &j->err);
       if (!j->st) j->st = hearth_detect_plate_color(&img, &c->run->detect, &j->det, &j->err);
       if (!j->st && c->run->overlays) {
         hearth_image_free(&img);
@@ -359,10 +364,8 @@ hearth_status hearth_calib_detect_release(const char *root, const hearth_detect_
   for (size_t i = 0; i < nj; i++) dets.frames[i] = jobs[i].det;
   snprintf(path, sizeof path, "%s/calibration/detections.json", root);
   st = hearth_detections_write(path, &dets, err);
-  if (!st && out)
-    *out = dets;
-  else
-    hearth_detections_free(&dets);
+  if (!st && out) *out = dets;
+  else hearth_detections_free(&dets);
 done:
   if (jobs)
     for (size_t i = 0; i < nj; i++) free(jobs[i].png);
@@ -462,8 +465,7 @@ static hearth_status write_report(const char *path, const hearth_calib_report *r
               f[i].frame, f[i].used ? "true" : "false");
       if (isfinite(f[i].rms_px) && hearth_format_fixed(b, sizeof b, f[i].rms_px, 5) > 0)
         fputs(b, fp);
-      else
-        fputs("null", fp);
+      else fputs("null", fp);
       fprintf(fp, ", \"note\": \"%s\"}", f[i].note);
     }
   }

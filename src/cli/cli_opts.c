@@ -50,8 +50,8 @@ typedef struct word {
   size_t k;            /* W_OPT: index in the flat table */
   const char *spelled; /* the option as written: a table name, or buf */
   char buf[64];
-  const char *value;   /* the value; NULL when none came */
-  int joined;          /* the value was part of the word (--opt=value, -j4) */
+  const char *value; /* the value; NULL when none came */
+  int joined;        /* the value was part of the word (--opt=value, -j4) */
 } word;
 
 static void set_spelled(word *w, const char *s, size_t len) {
@@ -155,14 +155,10 @@ static void range_text(const cli_opt *o, char *buf, size_t sz) {
   int has_lo = o->lo > -CLI_INF, has_hi = o->hi < CLI_INF;
   if (has_lo && has_hi && !(o->flags & (CLI_LO_OPEN | CLI_HI_OPEN)))
     snprintf(buf, sz, " in %g..%g", o->lo, o->hi);
-  else if (has_lo && has_hi)
-    snprintf(buf, sz, " %s %g and %s %g", ge, o->lo, le, o->hi);
-  else if (has_lo)
-    snprintf(buf, sz, " %s %g", ge, o->lo);
-  else if (has_hi)
-    snprintf(buf, sz, " %s %g", le, o->hi);
-  else
-    buf[0] = 0;
+  else if (has_lo && has_hi) snprintf(buf, sz, " %s %g and %s %g", ge, o->lo, le, o->hi);
+  else if (has_lo) snprintf(buf, sz, " %s %g", ge, o->lo);
+  else if (has_hi) snprintf(buf, sz, " %s %g", le, o->hi);
+  else buf[0] = 0;
 }
 
 /* What a value of o looks like, for messages. */
@@ -170,12 +166,8 @@ static void expect_text(const cli_opt *o, char *buf, size_t sz) {
   char r[400];
   switch (o->kind) {
     case CLI_KIND_INT:
-    case CLI_KIND_SIZE:
-      snprintf(buf, sz, "an integer in %.0f..%.0f", o->lo, o->hi);
-      break;
-    case CLI_KIND_U64:
-      snprintf(buf, sz, "a non-negative integer");
-      break;
+    case CLI_KIND_SIZE: snprintf(buf, sz, "an integer in %.0f..%.0f", o->lo, o->hi); break;
+    case CLI_KIND_U64: snprintf(buf, sz, "a non-negative integer"); break;
     case CLI_KIND_NUM:
       range_text(o, r, sizeof r);
       snprintf(buf, sz, "a number%s", r);
@@ -192,18 +184,10 @@ static void expect_text(const cli_opt *o, char *buf, size_t sz) {
       snprintf(buf, sz, "two comma-separated numbers%s%s", r,
                (o->flags & CLI_ASCENDING) ? ", the first below the second" : "");
       break;
-    case CLI_KIND_SHARD:
-      snprintf(buf, sz, "I/N with 0 <= I < N");
-      break;
-    case CLI_KIND_CALL:
-      snprintf(buf, sz, "%s", o->expect ? o->expect : "a value");
-      break;
-    case CLI_KIND_STR:
-      snprintf(buf, sz, "%s", o->metavar ? o->metavar : "a value");
-      break;
-    default:
-      snprintf(buf, sz, "a value");
-      break;
+    case CLI_KIND_SHARD: snprintf(buf, sz, "I/N with 0 <= I < N"); break;
+    case CLI_KIND_CALL: snprintf(buf, sz, "%s", o->expect ? o->expect : "a value"); break;
+    case CLI_KIND_STR: snprintf(buf, sz, "%s", o->metavar ? o->metavar : "a value"); break;
+    default: snprintf(buf, sz, "a value"); break;
   }
 }
 
@@ -264,17 +248,14 @@ static int store(const cli_opt *o, const char *v, char *why, size_t whysz) {
       if (!parse_num(v, strlen(v), &x) || !in_range(o, x)) return -1;
       *(double *)o->dst = x;
       return 0;
-    case CLI_KIND_STR:
-      *(const char **)o->dst = v;
-      return 0;
+    case CLI_KIND_STR: *(const char **)o->dst = v; return 0;
     case CLI_KIND_CHOICE: {
       int k = choice_index(o, v);
       if (k < 0) return -1;
       *(int *)o->dst = o->values ? o->values[k] : k;
       return 0;
     }
-    case CLI_KIND_LIST:
-      return store_list(o, v, why, whysz);
+    case CLI_KIND_LIST: return store_list(o, v, why, whysz);
     case CLI_KIND_PAIR: {
       const char *comma = strchr(v, ',');
       if (!comma || !parse_num(v, (size_t)(comma - v), &x) ||
@@ -299,10 +280,8 @@ static int store(const cli_opt *o, const char *v, char *why, size_t whysz) {
       *(int *)o->dst2 = (int)b;
       return 0;
     }
-    case CLI_KIND_CALL:
-      return o->parse(o->dst, v, why, whysz) ? -1 : 0;
-    default:
-      return -1;
+    case CLI_KIND_CALL: return o->parse(o->dst, v, why, whysz) ? -1 : 0;
+    default: return -1;
   }
 }
 
@@ -327,18 +306,12 @@ static void default_of(const cli_opt *o, char *buf, size_t sz) {
     return;
   }
   switch (o->kind) {
-    case CLI_KIND_INT:
-      snprintf(buf, sz, "%d", *(const int *)o->dst);
-      break;
-    case CLI_KIND_SIZE:
-      snprintf(buf, sz, "%zu", *(const size_t *)o->dst);
-      break;
+    case CLI_KIND_INT: snprintf(buf, sz, "%d", *(const int *)o->dst); break;
+    case CLI_KIND_SIZE: snprintf(buf, sz, "%zu", *(const size_t *)o->dst); break;
     case CLI_KIND_U64:
       snprintf(buf, sz, "%llu", (unsigned long long)*(const uint64_t *)o->dst);
       break;
-    case CLI_KIND_NUM:
-      snprintf(buf, sz, "%g", *(const double *)o->dst);
-      break;
+    case CLI_KIND_NUM: snprintf(buf, sz, "%g", *(const double *)o->dst); break;
     case CLI_KIND_STR:
       if (*(const char *const *)o->dst) snprintf(buf, sz, "%s", *(const char *const *)o->dst);
       break;
@@ -349,8 +322,7 @@ static void default_of(const cli_opt *o, char *buf, size_t sz) {
           break;
         }
       break;
-    default:
-      break;
+    default: break;
   }
 }
 
@@ -429,14 +401,10 @@ static void help_opts(FILE *out, const cli_opt *t, size_t col, int headed) {
 static void args_text(const cli_command *cmd, char *buf, size_t sz) {
   buf[0] = 0;
   if (!cmd->args) return;
-  if (cmd->max_args < 0 && cmd->min_args)
-    snprintf(buf, sz, " %s [%s...]", cmd->args, cmd->args);
-  else if (cmd->max_args < 0)
-    snprintf(buf, sz, " [%s...]", cmd->args);
-  else if (cmd->min_args)
-    snprintf(buf, sz, " %s", cmd->args);
-  else
-    snprintf(buf, sz, " [%s]", cmd->args);
+  if (cmd->max_args < 0 && cmd->min_args) snprintf(buf, sz, " %s [%s...]", cmd->args, cmd->args);
+  else if (cmd->max_args < 0) snprintf(buf, sz, " [%s...]", cmd->args);
+  else if (cmd->min_args) snprintf(buf, sz, " %s", cmd->args);
+  else snprintf(buf, sz, " [%s]", cmd->args);
 }
 
 static void usage_line(const cli_command *cmd, FILE *out) {
@@ -511,7 +479,8 @@ static int fail(const cli_command *cmd, FILE *err, const char *fmt, ...) {
 static int take_value(const cli_command *cmd, const cli_opt *o, const word *w, FILE *err) {
   char exp[512], why[512];
   if (!takes_value(o)) {
-    if (w->joined) return fail(cmd, err, "option %s takes no value, found '%s'", w->spelled, w->value);
+    if (w->joined)
+      return fail(cmd, err, "option %s takes no value, found '%s'", w->spelled, w->value);
     *(int *)o->dst = o->value;
     return 0;
   }

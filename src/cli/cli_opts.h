@@ -59,24 +59,24 @@ typedef struct cli_list {
 } cli_list;
 
 typedef struct cli_opt {
-  const char *name;    /* "--resolution" */
-  const char *alias;   /* short alias ("-j") or NULL */
+  const char *name;  /* "--resolution" */
+  const char *alias; /* short alias ("-j") or NULL */
   cli_kind kind;
-  void *dst;           /* where the value goes (its type follows the kind) */
-  void *dst2;          /* PAIR, SHARD: the second number; GROUP: const char ** set to the
+  void *dst;                      /* where the value goes (its type follows the kind) */
+  void *dst2;                     /* PAIR, SHARD: the second number; GROUP: const char ** set to the
                           first of the group's options given (NULL if none was) */
-  const char *metavar; /* "R" in "--resolution R"; CHOICE: NULL lists the names */
-  const char *help;    /* one sentence or two; wrapped by the help printer */
-  const char *def;     /* the default as --help shows it; NULL: *dst's value for numbers,
+  const char *metavar;            /* "R" in "--resolution R"; CHOICE: NULL lists the names */
+  const char *help;               /* one sentence or two; wrapped by the help printer */
+  const char *def;                /* the default as --help shows it; NULL: *dst's value for numbers,
                           choices and strings that are set, nothing otherwise */
-  double lo, hi;       /* INT, SIZE, NUM, PAIR: the accepted range */
-  unsigned flags;      /* CLI_REQUIRED, CLI_LO_OPEN, ... */
-  int value;           /* FLAG: the value stored */
-  const char *const *choices; /* CHOICE: the names, NULL-terminated */
-  const int *values;          /* CHOICE: the value of each name; NULL: its index */
-  size_t max;                 /* LIST: most items accepted */
+  double lo, hi;                  /* INT, SIZE, NUM, PAIR: the accepted range */
+  unsigned flags;                 /* CLI_REQUIRED, CLI_LO_OPEN, ... */
+  int value;                      /* FLAG: the value stored */
+  const char *const *choices;     /* CHOICE: the names, NULL-terminated */
+  const int *values;              /* CHOICE: the value of each name; NULL: its index */
+  size_t max;                     /* LIST: most items accepted */
   int (*check)(const char *item); /* LIST: non-zero when an item is acceptable, or NULL */
-  const char *expect;  /* LIST: what an item must be; CALL: what the value must be */
+  const char *expect;             /* LIST: what an item must be; CALL: what the value must be */
   /* CALL: store value into dst; returns 0, or non-zero with the reason in why */
   int (*parse)(void *dst, const char *value, char *why, size_t whysz);
   const struct cli_opt *group; /* GROUP: the table included */
@@ -85,50 +85,80 @@ typedef struct cli_opt {
 /* Table entries. The destination's type is checked at compile time; more
  * fields (.alias, .def, .flags, ...) may follow the help text. */
 #define CLI_PTR_(T, p) ((void *)(1 ? (p) : (T *)0))
-#define CLI_FLAG(nm, p, v, ...) \
-  {.name = (nm), .kind = CLI_KIND_FLAG, .dst = CLI_PTR_(int, p), .value = (v), .help = __VA_ARGS__}
+#define CLI_FLAG(nm, p, v, ...)                                                 \
+  {                                                                             \
+    .name = (nm), .kind = CLI_KIND_FLAG, .dst = CLI_PTR_(int, p), .value = (v), \
+    .help = __VA_ARGS__                                                         \
+  }
 #define CLI_INT(nm, mv, p, l, h, ...)                                                        \
-  {.name = (nm), .metavar = (mv), .kind = CLI_KIND_INT, .dst = CLI_PTR_(int, p), .lo = (l), \
-   .hi = (h), .help = __VA_ARGS__}
-#define CLI_SIZE(nm, mv, p, l, h, ...)                                                          \
-  {.name = (nm), .metavar = (mv), .kind = CLI_KIND_SIZE, .dst = CLI_PTR_(size_t, p), .lo = (l), \
-   .hi = (h), .help = __VA_ARGS__}
-#define CLI_U64(nm, mv, p, ...) \
-  {.name = (nm), .metavar = (mv), .kind = CLI_KIND_U64, .dst = CLI_PTR_(uint64_t, p), .help = __VA_ARGS__}
-#define CLI_NUM(nm, mv, p, l, h, ...)                                                          \
-  {.name = (nm), .metavar = (mv), .kind = CLI_KIND_NUM, .dst = CLI_PTR_(double, p), .lo = (l), \
-   .hi = (h), .help = __VA_ARGS__}
-#define CLI_STR(nm, mv, p, ...) \
-  {.name = (nm), .metavar = (mv), .kind = CLI_KIND_STR, .dst = CLI_PTR_(const char *, p), .help = __VA_ARGS__}
-#define CLI_CHOICE(nm, p, names, vals, ...)                                                   \
-  {.name = (nm), .kind = CLI_KIND_CHOICE, .dst = CLI_PTR_(int, p), .choices = (names), \
-   .values = (vals), .help = __VA_ARGS__}
-#define CLI_LIST(nm, mv, p, mx, chk, exp, ...)                                             \
-  {.name = (nm), .metavar = (mv), .kind = CLI_KIND_LIST, .dst = CLI_PTR_(cli_list, p), \
-   .max = (mx), .check = (chk), .expect = (exp), .help = __VA_ARGS__}
-#define CLI_PAIR(nm, mv, p1, p2, l, h, ...)                                                   \
-  {.name = (nm), .metavar = (mv), .kind = CLI_KIND_PAIR, .dst = CLI_PTR_(double, p1),     \
-   .dst2 = CLI_PTR_(double, p2), .lo = (l), .hi = (h), .help = __VA_ARGS__}
-#define CLI_SHARD(nm, mv, pi, pn, ...)                                                                \
-  {.name = (nm), .metavar = (mv), .kind = CLI_KIND_SHARD, .dst = CLI_PTR_(int, pi),                 \
-   .dst2 = CLI_PTR_(int, pn), .help = __VA_ARGS__}
-#define CLI_CALL(nm, mv, p, fn, exp, ...) \
-  {.name = (nm), .metavar = (mv), .kind = CLI_KIND_CALL, .dst = (p), .parse = (fn), .expect = (exp), .help = __VA_ARGS__}
-#define CLI_GROUP(heading, tab, seen) \
-  {.kind = CLI_KIND_GROUP, .help = (heading), .group = (tab), .dst2 = CLI_PTR_(const char *, seen)}
-#define CLI_END {.kind = CLI_KIND_END}
+  {                                                                                          \
+    .name = (nm), .metavar = (mv), .kind = CLI_KIND_INT, .dst = CLI_PTR_(int, p), .lo = (l), \
+    .hi = (h), .help = __VA_ARGS__                                                           \
+  }
+#define CLI_SIZE(nm, mv, p, l, h, ...)                                                           \
+  {                                                                                              \
+    .name = (nm), .metavar = (mv), .kind = CLI_KIND_SIZE, .dst = CLI_PTR_(size_t, p), .lo = (l), \
+    .hi = (h), .help = __VA_ARGS__                                                               \
+  }
+#define CLI_U64(nm, mv, p, ...)                                                        \
+  {                                                                                    \
+    .name = (nm), .metavar = (mv), .kind = CLI_KIND_U64, .dst = CLI_PTR_(uint64_t, p), \
+    .help = __VA_ARGS__                                                                \
+  }
+#define CLI_NUM(nm, mv, p, l, h, ...)                                                           \
+  {                                                                                             \
+    .name = (nm), .metavar = (mv), .kind = CLI_KIND_NUM, .dst = CLI_PTR_(double, p), .lo = (l), \
+    .hi = (h), .help = __VA_ARGS__                                                              \
+  }
+#define CLI_STR(nm, mv, p, ...)                                                            \
+  {                                                                                        \
+    .name = (nm), .metavar = (mv), .kind = CLI_KIND_STR, .dst = CLI_PTR_(const char *, p), \
+    .help = __VA_ARGS__                                                                    \
+  }
+#define CLI_CHOICE(nm, p, names, vals, ...)                                             \
+  {                                                                                     \
+    .name = (nm), .kind = CLI_KIND_CHOICE, .dst = CLI_PTR_(int, p), .choices = (names), \
+    .values = (vals), .help = __VA_ARGS__                                               \
+  }
+#define CLI_LIST(nm, mv, p, mx, chk, exp, ...)                                          \
+  {                                                                                     \
+    .name = (nm), .metavar = (mv), .kind = CLI_KIND_LIST, .dst = CLI_PTR_(cli_list, p), \
+    .max = (mx), .check = (chk), .expect = (exp), .help = __VA_ARGS__                   \
+  }
+#define CLI_PAIR(nm, mv, p1, p2, l, h, ...)                                            \
+  {                                                                                    \
+    .name = (nm), .metavar = (mv), .kind = CLI_KIND_PAIR, .dst = CLI_PTR_(double, p1), \
+    .dst2 = CLI_PTR_(double, p2), .lo = (l), .hi = (h), .help = __VA_ARGS__            \
+  }
+#define CLI_SHARD(nm, mv, pi, pn, ...)                                               \
+  {                                                                                  \
+    .name = (nm), .metavar = (mv), .kind = CLI_KIND_SHARD, .dst = CLI_PTR_(int, pi), \
+    .dst2 = CLI_PTR_(int, pn), .help = __VA_ARGS__                                   \
+  }
+#define CLI_CALL(nm, mv, p, fn, exp, ...)                                            \
+  {                                                                                  \
+    .name = (nm), .metavar = (mv), .kind = CLI_KIND_CALL, .dst = (p), .parse = (fn), \
+    .expect = (exp), .help = __VA_ARGS__                                             \
+  }
+#define CLI_GROUP(heading, tab, seen)                          \
+  {                                                            \
+    .kind = CLI_KIND_GROUP, .help = (heading), .group = (tab), \
+    .dst2 = CLI_PTR_(const char *, seen)                       \
+  }
+#define CLI_END \
+  { .kind = CLI_KIND_END }
 
 typedef struct cli_command {
-  const char *name;  /* as messages start: "hearth map", "hearth sim render" */
-  const char *args;  /* metavar of the positional arguments ("ROOT", "FILE"), NULL: none */
-  int min_args;      /* how many positional arguments must be given */
-  int max_args;      /* how many may be; -1: any number */
-  const char *about; /* the description paragraphs of --help, each line ending in '\n' */
-  const cli_opt *opts; /* the table, ending with CLI_END */
-  const char *tail;  /* printed after the options, or NULL */
+  const char *name;        /* as messages start: "hearth map", "hearth sim render" */
+  const char *args;        /* metavar of the positional arguments ("ROOT", "FILE"), NULL: none */
+  int min_args;            /* how many positional arguments must be given */
+  int max_args;            /* how many may be; -1: any number */
+  const char *about;       /* the description paragraphs of --help, each line ending in '\n' */
+  const cli_opt *opts;     /* the table, ending with CLI_END */
+  const char *tail;        /* printed after the options, or NULL */
   void (*more)(FILE *out); /* prints help that the library knows (lists), or NULL */
-  const char *usage; /* the usage line after "usage: "; NULL: made from the table */
-  int stop_at_arg;   /* the options end at the first positional argument: it and all
+  const char *usage;       /* the usage line after "usage: "; NULL: made from the table */
+  int stop_at_arg;         /* the options end at the first positional argument: it and all
                         after it are a subcommand's */
 } cli_command;
 

@@ -28,7 +28,8 @@ int sim_cli_assets(const char *release, int gt, char *root, size_t rootsz, char 
   hearth_synth_opts so;
   hearth_synth_opts_default(&so);
   so.out_root = root;
-  const char *cats[] = {"cup", "canned_drink", "electric_kettle", "eraser", "orange", "smartphone", "sponge"};
+  const char *cats[] = {"cup",    "canned_drink", "electric_kettle", "eraser",
+                        "orange", "smartphone",   "sponge"};
   so.n_categories = 7;
   for (int i = 0; i < 7; i++) so.categories[i] = cats[i];
   so.n_states = 3;

@@ -8,7 +8,7 @@ const char *const cli_fusion_names[] = {"max", "robust", NULL};
 const int cli_fusion_values[] = {HEARTH_FUSE_MAX, HEARTH_FUSE_ROBUST};
 
 int cli_fail(const char *cmd, const hearth_err *err) {
-  fprintf(stderr, "hearth %s: %s (%s)\n", cmd, err->msg[0] ? err->msg : hearth_strerror(err->status),
-          hearth_status_name(err->status));
+  fprintf(stderr, "hearth %s: %s (%s)\n", cmd,
+          err->msg[0] ? err->msg : hearth_strerror(err->status), hearth_status_name(err->status));
   return 1;
 }

@@ -36,10 +36,11 @@ int hearth_cmd_build(int argc, char **argv) {
               .def = "all cores, at most one per instance"),
       CLI_INT("--threads", "N", &o.threads, 1, 4096, "total worker threads",
               .def = "HEARTH_THREADS or all cores"),
-      CLI_SHARD("--shard", "I/N", &o.shard_index, &o.shard_count,
-                "build only instances I, I+N, I+2N, ... of release.json (I from 0 to N-1), "
-                "e.g. a Slurm array: --shard $SLURM_ARRAY_TASK_ID/N; each shard re-checks calibration "
-                "(identical results, atomic)"),
+      CLI_SHARD(
+          "--shard", "I/N", &o.shard_index, &o.shard_count,
+          "build only instances I, I+N, I+2N, ... of release.json (I from 0 to N-1), "
+          "e.g. a Slurm array: --shard $SLURM_ARRAY_TASK_ID/N; each shard re-checks calibration "
+          "(identical results, atomic)"),
       CLI_STR("--instance", "ID", &o.only_instance, "only this instance"),
       CLI_SIZE("--resolution", "R", &o.resolution, 2, 16384, "temperature-map size R x R",
                .def = "as recorded in build.json, else 1024"),
@@ -63,8 +64,13 @@ int hearth_cmd_build(int argc, char **argv) {
       CLI_FLAG("--quiet", &o.quiet, 1, "summary only"),
       CLI_END,
   };
-  const cli_command cmd = {.name = "hearth build", .args = "ROOT", .min_args = 1, .max_args = 1,
-                           .about = k_about, .opts = opts, .tail = k_tail};
+  const cli_command cmd = {.name = "hearth build",
+                           .args = "ROOT",
+                           .min_args = 1,
+                           .max_args = 1,
+                           .about = k_about,
+                           .opts = opts,
+                           .tail = k_tail};
   cli_args args;
   int rc = cli_parse(&cmd, argc, argv, &args);
   if (rc != CLI_RUN) return rc;

@@ -42,8 +42,12 @@ int hearth_cmd_calibrate(int argc, char **argv) {
       CLI_GROUP("with --detect, the options of `hearth detect`", detect_opts, &detect_opt),
       CLI_END,
   };
-  const cli_command cmd = {.name = "hearth calibrate", .args = "ROOT", .min_args = 1,
-                           .max_args = 1, .about = k_about, .opts = opts};
+  const cli_command cmd = {.name = "hearth calibrate",
+                           .args = "ROOT",
+                           .min_args = 1,
+                           .max_args = 1,
+                           .about = k_about,
+                           .opts = opts};
   cli_args args;
   int rc = cli_parse(&cmd, argc, argv, &args);
   if (rc != CLI_RUN) return rc;
@@ -57,7 +61,8 @@ int hearth_cmd_calibrate(int argc, char **argv) {
     if (hearth_calib_detect_release(root, &run, &d, &err)) return cli_fail("calibrate", &err);
     size_t found = 0;
     for (size_t i = 0; i < d.n; i++) found += (size_t)d.frames[i].found;
-    printf("detect: plate found in %zu of %zu frames; calibration/detections.json written\n", found, d.n);
+    printf("detect: plate found in %zu of %zu frames; calibration/detections.json written\n", found,
+           d.n);
     hearth_detections_free(&d);
   }
   hearth_calib_report rep;

@@ -31,8 +31,12 @@ int hearth_cmd_demo(int argc, char **argv) {
       CLI_FLAG("--quiet", &quiet, 1, "only the final summary"),
       CLI_END,
   };
-  const cli_command cmd = {.name = "hearth demo", .args = "DIR", .min_args = 0, .max_args = 1,
-                           .about = k_about, .opts = opts};
+  const cli_command cmd = {.name = "hearth demo",
+                           .args = "DIR",
+                           .min_args = 0,
+                           .max_args = 1,
+                           .about = k_about,
+                           .opts = opts};
   cli_args args;
   int rc = cli_parse(&cmd, argc, argv, &args);
   if (rc != CLI_RUN) return rc;
@@ -108,8 +112,9 @@ int hearth_cmd_demo(int argc, char **argv) {
     hearth_problems_free(&pr);
     return 1;
   }
-  size_t off = (size_t)snprintf(vtext, cap, "hearth validate: %zu file(s) checked, %zu problem(s)\n",
-                                nfiles, pr.n);
+  size_t off =
+      (size_t)snprintf(vtext, cap, "hearth validate: %zu file(s) checked, %zu problem(s)\n", nfiles,
+                       pr.n);
   for (size_t i = 0; i < pr.n && off < cap; i++) {
     off += (size_t)snprintf(vtext + off, cap - off, "%s: %s\n", pr.items[i].path, pr.items[i].what);
     fprintf(stderr, "%s: %s\n", pr.items[i].path, pr.items[i].what);
@@ -128,15 +133,17 @@ int hearth_cmd_demo(int argc, char **argv) {
     printf("\n");
     hearth_release_stats_print(&st, stdout);
   }
-  printf("\n%-18s %-8s %9s %12s %10s\n", "instance", "state", "observed", "median|err|", "p95|err|");
+  printf("\n%-18s %-8s %9s %12s %10s\n", "instance", "state", "observed", "median|err|",
+         "p95|err|");
   for (size_t i = 0; i < rep.n; i++) {
     const hearth_report_entry *e = &rep.entries[i];
     printf("%-18s %-8s %8.1f%% %10.2f C %8.2f C\n", e->instance, e->state, 100.0 * e->coverage,
            e->median_abs_c, e->p95_abs_c);
   }
   hearth_report_free(&rep);
-  printf("\ndemo: done in %.0f s. validate: %zu problem(s) in %zu file(s).\n"
-         "  release: %s\n  report:  %s/index.html  (open it in a browser; no server needed)\n",
-         hearth_now() - t0, n_problems, nfiles, root, report_dir);
+  printf(
+      "\ndemo: done in %.0f s. validate: %zu problem(s) in %zu file(s).\n"
+      "  release: %s\n  report:  %s/index.html  (open it in a browser; no server needed)\n",
+      hearth_now() - t0, n_problems, nfiles, root, report_dir);
   return n_problems ? 1 : 0;
 }

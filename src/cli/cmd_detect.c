@@ -41,8 +41,12 @@ int hearth_cmd_detect(int argc, char **argv) {
       CLI_FLAG("--quiet", &run.quiet, 1, "no per-frame lines"),
       CLI_END,
   };
-  const cli_command cmd = {.name = "hearth detect", .args = "ROOT", .min_args = 1, .max_args = 1,
-                           .about = k_about, .opts = opts};
+  const cli_command cmd = {.name = "hearth detect",
+                           .args = "ROOT",
+                           .min_args = 1,
+                           .max_args = 1,
+                           .about = k_about,
+                           .opts = opts};
   cli_args args;
   int rc = cli_parse(&cmd, argc, argv, &args);
   if (rc != CLI_RUN) return rc;

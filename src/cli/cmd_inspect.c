@@ -58,8 +58,8 @@ static hearth_status inspect_csv(const char *path, hearth_err *err) {
     hi = p[i] > hi ? p[i] : hi;
     sum += p[i];
   }
-  printf("%s: thermal CSV %zux%zu, min %.2f, mean %.2f, max %.2f degC\n", path, im.width,
-         im.height, lo, n ? sum / (double)n : 0.0, hi);
+  printf("%s: thermal CSV %zux%zu, min %.2f, mean %.2f, max %.2f degC\n", path, im.width, im.height,
+         lo, n ? sum / (double)n : 0.0, hi);
   char sep[8], dec[8];
   snprintf(sep, sizeof sep, in.separator == '\t' ? "tab" : "'%c'", in.separator);
   snprintf(dec, sizeof dec, in.decimal_mark ? "'%c'" : "none", in.decimal_mark);
@@ -68,8 +68,8 @@ static hearth_status inspect_csv(const char *path, hearth_err *err) {
   if (in.size_line) printf(" (size line %zu)", in.size_line);
   printf(", separator %s, decimal mark %s, encoding %s, line ends %s\n", sep, dec, in.encoding,
          in.line_ends);
-  printf("  matrix lines %zu..%zu after %zu header line(s), unit %s\n", in.first_line,
-         in.last_line, in.header_lines, in.unit ? "degC (stated)" : "degC (not stated)");
+  printf("  matrix lines %zu..%zu after %zu header line(s), unit %s\n", in.first_line, in.last_line,
+         in.header_lines, in.unit ? "degC (stated)" : "degC (not stated)");
   for (size_t i = 0; i < in.n_meta; i++)
     printf("  metadata line %zu: %s%s%s\n", in.meta[i].line, in.meta[i].key,
            in.meta[i].value[0] ? " = " : "", in.meta[i].value);
@@ -105,7 +105,8 @@ static hearth_status inspect_one(const char *path, const char *kind, hearth_err 
       lo = v < lo ? v : lo;
       hi = v > hi ? v : hi;
     }
-    printf("), %zu finite of %zu, range [%g, %g]\n", finite, n, finite ? lo : 0.0, finite ? hi : 0.0);
+    printf("), %zu finite of %zu, range [%g, %g]\n", finite, n, finite ? lo : 0.0,
+           finite ? hi : 0.0);
     hearth_npy_free(&a);
   } else if (!strcmp(kind, "glb")) {
     hearth_glb_read_opts o = {.load_texture = 1};
@@ -119,11 +120,12 @@ static hearth_status inspect_one(const char *path, const char *kind, hearth_err 
       if (isl && hearth_uv_islands(&m, isl, &n_isl, NULL)) n_isl = 0;
       free(isl);
     }
-    printf("%s: GLB %zu vertices, %zu triangles, UVs %s (%u islands), texture %s%zux%zu\n"
-           "  bounds [%.4f %.4f %.4f] .. [%.4f %.4f %.4f] (size %.4f x %.4f x %.4f)\n",
-           path, m.n_vertices, m.n_triangles, m.uvs ? "yes" : "no", n_isl,
-           m.texture.data ? "" : "none ", m.texture.width, m.texture.height, lo[0], lo[1], lo[2],
-           hi[0], hi[1], hi[2], hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+    printf(
+        "%s: GLB %zu vertices, %zu triangles, UVs %s (%u islands), texture %s%zux%zu\n"
+        "  bounds [%.4f %.4f %.4f] .. [%.4f %.4f %.4f] (size %.4f x %.4f x %.4f)\n",
+        path, m.n_vertices, m.n_triangles, m.uvs ? "yes" : "no", n_isl,
+        m.texture.data ? "" : "none ", m.texture.width, m.texture.height, lo[0], lo[1], lo[2],
+        hi[0], hi[1], hi[2], hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
     hearth_mesh_free(&m);
   } else if (!strcmp(kind, "rig")) {
     hearth_rig r;
@@ -188,9 +190,10 @@ static hearth_status inspect_one(const char *path, const char *kind, hearth_err 
 }
 
 /* the kinds of --as */
-static const char *const k_kinds[] = {"csv",   "png",        "jpeg",  "npy",      "glb",
-                                      "rig",   "factory",    "manifest", "poses", "detections",
-                                      "scale", "instance",   "release", "depth-intrinsics", NULL};
+static const char *const k_kinds[] =
+    {"csv",      "png",   "jpeg",       "npy",   "glb",      "rig",     "factory",
+     "manifest", "poses", "detections", "scale", "instance", "release", "depth-intrinsics",
+     NULL};
 
 int hearth_cmd_inspect(int argc, char **argv) {
   int as = -1;
@@ -199,8 +202,12 @@ int hearth_cmd_inspect(int argc, char **argv) {
                  .def = "from the name"),
       CLI_END,
   };
-  const cli_command cmd = {.name = "hearth inspect", .args = "FILE", .min_args = 1,
-                           .max_args = -1, .about = k_about, .opts = opts};
+  const cli_command cmd = {.name = "hearth inspect",
+                           .args = "FILE",
+                           .min_args = 1,
+                           .max_args = -1,
+                           .about = k_about,
+                           .opts = opts};
   cli_args args;
   int rc = cli_parse(&cmd, argc, argv, &args);
   if (rc != CLI_RUN) return rc;

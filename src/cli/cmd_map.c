@@ -22,10 +22,11 @@ typedef struct map_ctx {
 static void print_state(const char *instance, const char *state, const hearth_map_result *st,
                         double secs) {
   double n = st->n_surface ? (double)st->n_surface : 1.0;
-  printf("map %s/%s: %zu views, surface %zu texels: %.1f%% observed, %.1f%% filled, "
-         "%.1f%% unobserved (%.2f s)\n",
-         instance, state, st->n_views, st->n_surface, 100.0 * (double)st->n_observed / n,
-         100.0 * (double)st->n_filled / n, 100.0 * (double)st->n_unobserved / n, secs);
+  printf(
+      "map %s/%s: %zu views, surface %zu texels: %.1f%% observed, %.1f%% filled, "
+      "%.1f%% unobserved (%.2f s)\n",
+      instance, state, st->n_views, st->n_surface, 100.0 * (double)st->n_observed / n,
+      100.0 * (double)st->n_filled / n, 100.0 * (double)st->n_unobserved / n, secs);
 }
 
 static hearth_status map_one(void *vctx, const char *instance, const char *state, hearth_err *err) {
@@ -46,8 +47,8 @@ static hearth_status map_rgb_one(void *vctx, const char *instance, hearth_err *e
   hearth_status s = cli_states(c->root, instance, c->only_state, c->states, err);
   if (s) return s;
   const hearth_map_job *job = &c->job;
-  hearth_bake_job bj = {job->root, instance, NULL, 1024, 2, job->mesh_path, NULL, job->rig_path,
-                        job->map.threads, NULL, NULL};
+  hearth_bake_job bj = {job->root,     instance,         NULL, 1024, 2, job->mesh_path, NULL,
+                        job->rig_path, job->map.threads, NULL, NULL};
   size_t n = c->states->n;
   const char **names = calloc(n ? n : 1, sizeof *names);
   hearth_map_result *st = calloc(n ? n : 1, sizeof *st);
@@ -98,11 +99,16 @@ int hearth_cmd_map(int argc, char **argv) {
       CLI_FLAG("--rgb", &rgb, 1,
                "also bake the colour texture from the colour views into "
                "derived/rgb_texture.png and derived/mesh.glb"),
-      CLI_INT("--threads", "N", &ctx.job.map.threads, 1, 1024, "worker threads", .def = "all cores"),
+      CLI_INT("--threads", "N", &ctx.job.map.threads, 1, 1024, "worker threads",
+              .def = "all cores"),
       CLI_END,
   };
-  const cli_command cmd = {.name = "hearth map", .args = "ROOT", .min_args = 1, .max_args = 1,
-                           .about = k_about, .opts = opts};
+  const cli_command cmd = {.name = "hearth map",
+                           .args = "ROOT",
+                           .min_args = 1,
+                           .max_args = 1,
+                           .about = k_about,
+                           .opts = opts};
   cli_args args;
   int rc = cli_parse(&cmd, argc, argv, &args);
   if (rc != CLI_RUN) return rc;

@@ -40,8 +40,12 @@ int hearth_cmd_overlay(int argc, char **argv) {
                .flags = CLI_ASCENDING, .def = "2..98 % of each image"),
       CLI_END,
   };
-  const cli_command cmd = {.name = "hearth overlay", .args = "ROOT", .min_args = 1,
-                           .max_args = 1, .about = k_about, .opts = opts};
+  const cli_command cmd = {.name = "hearth overlay",
+                           .args = "ROOT",
+                           .min_args = 1,
+                           .max_args = 1,
+                           .about = k_about,
+                           .opts = opts};
   cli_args args;
   int rc = cli_parse(&cmd, argc, argv, &args);
   if (rc != CLI_RUN) return rc;

@@ -32,13 +32,18 @@ static int cmd_import(int argc, char **argv) {
       CLI_FLAG("--force", &force, 1, "replace an existing recon/poses_rgb.json (with --root)"),
       CLI_END,
   };
-  const cli_command cmd = {.name = "hearth recon import-colmap", .args = "MODEL_DIR",
-                           .min_args = 1, .max_args = 1, .about = k_import_about, .opts = opts};
+  const cli_command cmd = {.name = "hearth recon import-colmap",
+                           .args = "MODEL_DIR",
+                           .min_args = 1,
+                           .max_args = 1,
+                           .about = k_import_about,
+                           .opts = opts};
   cli_args args;
   int rc = cli_parse(&cmd, argc, argv, &args);
   if (rc != CLI_RUN) return rc;
   if (!root != !instance) return cli_usage_error(&cmd, "--root and --instance go together");
-  if (!out && !root) return cli_usage_error(&cmd, "--out FILE.json is required (or --root and --instance)");
+  if (!out && !root)
+    return cli_usage_error(&cmd, "--out FILE.json is required (or --root and --instance)");
   char out_buf[4096], cam_path[4096];
   if (!out) {
     if (snprintf(out_buf, sizeof out_buf, "%s/instances/%s/recon/poses_rgb.json", root, instance) >=
@@ -46,8 +51,10 @@ static int cmd_import(int argc, char **argv) {
       return cli_usage_error(&cmd, "--root: path too long");
     out = out_buf;
     if (hearth_path_exists(out) && !force) {
-      fprintf(stderr, "hearth recon import-colmap: %s exists (poses in the frame of the "
-                      "reconstruction beside it); --force replaces it\n", out);
+      fprintf(stderr,
+              "hearth recon import-colmap: %s exists (poses in the frame of the "
+              "reconstruction beside it); --force replaces it\n",
+              out);
       return 1;
     }
   }
@@ -73,10 +80,11 @@ static int cmd_import(int argc, char **argv) {
   if (!s) s = hearth_recon_cameras_write(cam_path, &cams, &err);
   if (!s) {
     printf("import-colmap %s (%s): %zu camera(s), %zu image(s), %zu point(s) -> %s, %s\n",
-           args.v[0], m.format == HEARTH_COLMAP_BINARY ? "binary" : "text", m.n_cameras,
-           m.n_images, m.n_points, out, cam_path);
+           args.v[0], m.format == HEARTH_COLMAP_BINARY ? "binary" : "text", m.n_cameras, m.n_images,
+           m.n_points, out, cam_path);
     if (root) {
-      printf("%s: %zu of %zu views have a pose", instance, cov.n_views - cov.n_missing, cov.n_views);
+      printf("%s: %zu of %zu views have a pose", instance, cov.n_views - cov.n_missing,
+             cov.n_views);
       for (size_t i = 0; i < cov.n_missing && i < HEARTH_RECON_MISSING_LISTED; i++)
         printf("%s%s", i ? ", " : "; without: ", cov.missing[i]);
       printf("%s\n", cov.n_missing > HEARTH_RECON_MISSING_LISTED ? ", ..." : "");
@@ -121,15 +129,21 @@ int hearth_cmd_recon(int argc, char **argv) {
       CLI_STR("--work", "DIR", &job.work, "keep COLMAP's workspace (database, model, logs) here",
               .def = "a temporary folder, removed after success"),
       CLI_STR("--colmap", "PROGRAM", &job.colmap, "the COLMAP program", .def = "colmap on PATH"),
-      CLI_FLAG("--no-masks", &job.no_masks, 1, "features from the whole image, not only the cut-out"),
+      CLI_FLAG("--no-masks", &job.no_masks, 1,
+               "features from the whole image, not only the cut-out"),
       CLI_INT("--threads", "N", &job.threads, 1, 1024, "threads COLMAP may use",
               .def = "HEARTH_THREADS or all cores"),
       CLI_FLAG("--force", &job.force, 1, "replace an existing poses file"),
       CLI_FLAG("--quiet", &job.quiet, 1, "no progress output"),
       CLI_END,
   };
-  const cli_command cmd = {.name = "hearth recon", .args = "ROOT", .min_args = 1, .max_args = 1,
-                           .about = k_about, .opts = opts, .tail = k_tail};
+  const cli_command cmd = {.name = "hearth recon",
+                           .args = "ROOT",
+                           .min_args = 1,
+                           .max_args = 1,
+                           .about = k_about,
+                           .opts = opts,
+                           .tail = k_tail};
   if (argc < 2) return cli_usage_error(&cmd, "missing ROOT (see 'hearth recon --help')");
   cli_args args;
   int rc = cli_parse(&cmd, argc, argv, &args);
@@ -140,11 +154,12 @@ int hearth_cmd_recon(int argc, char **argv) {
   hearth_colmap_result res;
   hearth_err err = {0};
   if (hearth_colmap_run(&job, &res, &err)) return cli_fail("recon", &err);
-  printf("recon %s: %zu of %zu views registered (%.0f%%), %zu points, %zu model(s); "
-         "extract %.1fs, match %.1fs, map %.1fs -> %s\n",
-         job.instance, res.n_registered, res.n_views,
-         res.n_views ? 100.0 * (double)res.n_registered / (double)res.n_views : 0.0, res.n_points,
-         res.n_models, res.seconds[0], res.seconds[1], res.seconds[2], res.out);
+  printf(
+      "recon %s: %zu of %zu views registered (%.0f%%), %zu points, %zu model(s); "
+      "extract %.1fs, match %.1fs, map %.1fs -> %s\n",
+      job.instance, res.n_registered, res.n_views,
+      res.n_views ? 100.0 * (double)res.n_registered / (double)res.n_views : 0.0, res.n_points,
+      res.n_models, res.seconds[0], res.seconds[1], res.seconds[2], res.out);
   if (res.work[0]) printf("workspace: %s\n", res.work);
   return 0;
 }

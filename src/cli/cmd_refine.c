@@ -97,8 +97,12 @@ int hearth_cmd_refine(int argc, char **argv) {
       CLI_GROUP("evaluation (virtual-rig releases)", eval_opts, NULL),
       CLI_END,
   };
-  const cli_command cmd = {.name = "hearth refine", .args = "ROOT", .min_args = 1,
-                           .max_args = 1, .about = k_about, .opts = opts};
+  const cli_command cmd = {.name = "hearth refine",
+                           .args = "ROOT",
+                           .min_args = 1,
+                           .max_args = 1,
+                           .about = k_about,
+                           .opts = opts};
   cli_args args;
   int rc = cli_parse(&cmd, argc, argv, &args);
   if (rc != CLI_RUN) {

@@ -19,10 +19,11 @@ static hearth_status scale_one(void *ctx, const char *instance, hearth_err *err)
   double t0 = hearth_now();
   hearth_status s = hearth_scale_run(job, &res, err);
   if (!s)
-    printf("scale %s: %.6f m/unit from %d views, %zu of %zu pixels inliers, residual median "
-           "%.2f mm, p90 %.2f mm (%.2f s)\n",
-           instance, res.scale, res.views_used, res.n_inliers, res.n_candidates,
-           res.residual_median_mm, res.residual_p90_mm, hearth_now() - t0);
+    printf(
+        "scale %s: %.6f m/unit from %d views, %zu of %zu pixels inliers, residual median "
+        "%.2f mm, p90 %.2f mm (%.2f s)\n",
+        instance, res.scale, res.views_used, res.n_inliers, res.n_candidates,
+        res.residual_median_mm, res.residual_p90_mm, hearth_now() - t0);
   return s;
 }
 
@@ -39,8 +40,12 @@ int hearth_cmd_scale(int argc, char **argv) {
       CLI_INT("--threads", "N", &job.opts.threads, 1, 1024, "worker threads", .def = "all cores"),
       CLI_END,
   };
-  const cli_command cmd = {.name = "hearth scale", .args = "ROOT", .min_args = 1, .max_args = 1,
-                           .about = k_about, .opts = opts};
+  const cli_command cmd = {.name = "hearth scale",
+                           .args = "ROOT",
+                           .min_args = 1,
+                           .max_args = 1,
+                           .about = k_about,
+                           .opts = opts};
   cli_args args;
   int rc = cli_parse(&cmd, argc, argv, &args);
   if (rc != CLI_RUN) return rc;

@@ -112,8 +112,9 @@ int hearth_cmd_sim_collect(int argc, char **argv) {
       CLI_INT("--layouts", "N", &o.layouts, 1, 100000,
               "layouts (200 as in the paper: 400 demos per task)"),
       CLI_U64("--seed", "N", &o.seed, "layout seed"),
-      CLI_INT("--size", "N", &o.image_size, 16, 1024,
-              "rendered and stored image side (256: openpi's LIBERO data and what sim eval renders)"),
+      CLI_INT(
+          "--size", "N", &o.image_size, 16, 1024,
+          "rendered and stored image side (256: openpi's LIBERO data and what sim eval renders)"),
       CLI_INT("--max-steps", "N", &o.max_steps, 1, 100000,
               "time limit per episode in control steps"),
       CLI_STR("--release", "ROOT", &release, "assets from a release (derived/)",
@@ -136,7 +137,8 @@ int hearth_cmd_sim_collect(int argc, char **argv) {
   if (rc != CLI_RUN) return rc;
   o.task = (hearth_sim_task)task;
   char root[4096], tmpdir[4096];
-  if (sim_cli_assets(release, gt, root, sizeof root, tmpdir, sizeof tmpdir, &o.use_ground_truth, o.quiet))
+  if (sim_cli_assets(release, gt, root, sizeof root, tmpdir, sizeof tmpdir, &o.use_ground_truth,
+                     o.quiet))
     return 1;
   o.release_root = root;
   hearth_err err = {0};
@@ -145,8 +147,8 @@ int hearth_cmd_sim_collect(int argc, char **argv) {
   sim_cli_drop_assets(tmpdir);
   if (st) return cli_fail("sim collect", &err);
   for (int i = 0; i < 2; i++)
-    printf("instruction %d \"%s\": %d/%d successful\n", i + 1, hearth_sim_instruction_text(o.task, i),
-           s.successes[i], s.attempts[i]);
+    printf("instruction %d \"%s\": %d/%d successful\n", i + 1,
+           hearth_sim_instruction_text(o.task, i), s.successes[i], s.attempts[i]);
   char outs[8600];
   if (o.split_instructions) {
     char a[4200], b[4200];
@@ -166,15 +168,20 @@ int hearth_cmd_sim_collect(int argc, char **argv) {
 
 int hearth_cmd_sim_merge(int argc, char **argv) {
   const cli_opt opts[] = {CLI_END};
-  const cli_command cmd = {.name = "hearth sim merge", .args = "OUT.hdf5 PART.hdf5...", .min_args = 2,
-                           .max_args = -1, .about = k_about_merge, .opts = opts,
+  const cli_command cmd = {.name = "hearth sim merge",
+                           .args = "OUT.hdf5 PART.hdf5...",
+                           .min_args = 2,
+                           .max_args = -1,
+                           .about = k_about_merge,
+                           .opts = opts,
                            .usage = "hearth sim merge OUT.hdf5 PART.hdf5... [options]"};
   cli_args a;
   int rc = cli_parse(&cmd, argc, argv, &a);
   if (rc != CLI_RUN) return rc;
   hearth_err err = {0};
   int n = 0;
-  if (hearth_sim_merge(a.v[0], (const char *const *)(a.v + 1), a.n - 1, &n, &err)) return cli_fail("sim merge", &err);
+  if (hearth_sim_merge(a.v[0], (const char *const *)(a.v + 1), a.n - 1, &n, &err))
+    return cli_fail("sim merge", &err);
   printf("%d parts, %d demos -> %s\n", a.n - 1, n, a.v[0]);
   return 0;
 }

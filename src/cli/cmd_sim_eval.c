@@ -87,8 +87,10 @@ int hearth_cmd_sim_eval(int argc, char **argv) {
               .def = "virtual rig"),
       CLI_FLAG("--ground-truth", &gt, 1,
                "with --release: a virtual-rig release's ground_truth/ assets (as sim collect)"),
-      CLI_INT("--size", "N", &o.render_size, 16, 2048, "rendered view side (as sim collect stores)"),
-      CLI_FLAG("--shadows", &o.shadows, 1, "shadow-mapped light in the RGB views (as at collection)"),
+      CLI_INT("--size", "N", &o.render_size, 16, 2048,
+              "rendered view side (as sim collect stores)"),
+      CLI_FLAG("--shadows", &o.shadows, 1,
+               "shadow-mapped light in the RGB views (as at collection)"),
       CLI_STR("--gl", "osmesa|egl", &o.gl, "GL back end", .def = "$HEARTH_GL, else osmesa"),
       CLI_INT("--image-size", "N", &o.image_size, 8, 1024, "policy image side"),
       CLI_INT("--max-steps", "N", &o.max_steps, 1, 100000, "time limit in control steps",
@@ -110,7 +112,8 @@ int hearth_cmd_sim_eval(int argc, char **argv) {
   o.tasks = (unsigned)tasks;
   char root[4200], tmpdir[4200] = "";
   /* the same virtual-rig assets as `hearth sim collect` makes by default */
-  if (sim_cli_assets(release, gt, root, sizeof root, tmpdir, sizeof tmpdir, &o.use_ground_truth, o.quiet))
+  if (sim_cli_assets(release, gt, root, sizeof root, tmpdir, sizeof tmpdir, &o.use_ground_truth,
+                     o.quiet))
     return 1;
   o.release_root = root;
   hearth_eval_results res;
@@ -127,8 +130,9 @@ int hearth_cmd_sim_eval(int argc, char **argv) {
   if (out && !rc) {
     char *js = hearth_eval_format_json(&res), *md = hearth_eval_format_markdown(&res);
     if (hearth_mkdirs(out, &err)) rc = cli_fail("sim eval", &err);
-    else rc = write_text(out, "results.txt", txt) || write_text(out, "results.json", js) ||
-              write_text(out, "results.md", md);
+    else
+      rc = write_text(out, "results.txt", txt) || write_text(out, "results.json", js) ||
+           write_text(out, "results.md", md);
     free(js), free(md);
   }
   free(txt);

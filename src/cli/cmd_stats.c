@@ -22,8 +22,12 @@ int hearth_cmd_stats(int argc, char **argv) {
       CLI_CHOICE("--format", &as_json, k_formats, NULL, "what standard output shows"),
       CLI_END,
   };
-  const cli_command cmd = {.name = "hearth stats", .args = "ROOT", .min_args = 1, .max_args = 1,
-                           .about = k_about, .opts = opts};
+  const cli_command cmd = {.name = "hearth stats",
+                           .args = "ROOT",
+                           .min_args = 1,
+                           .max_args = 1,
+                           .about = k_about,
+                           .opts = opts};
   cli_args args;
   int rc = cli_parse(&cmd, argc, argv, &args);
   if (rc != CLI_RUN) return rc;
@@ -39,7 +43,8 @@ int hearth_cmd_stats(int argc, char **argv) {
   rc = 0;
   if (as_json) fputs(js, stdout);
   else hearth_release_stats_print(&st, stdout);
-  if (json_path && hearth_write_file_atomic(json_path, js, strlen(js), &err)) rc = cli_fail("stats", &err);
+  if (json_path && hearth_write_file_atomic(json_path, js, strlen(js), &err))
+    rc = cli_fail("stats", &err);
   free(js);
   return rc;
 }

@@ -36,7 +36,8 @@ int hearth_cmd_synth(int argc, char **argv) {
       CLI_INT("--instances", "N", &o.instances_per_category, 1, 99, "instances per category"),
       CLI_LIST("--states", "s1,s2", &states, 8, state_ok, "neutral, hot, warm, iced or used",
                "states per instance", .def = "the category's own, e.g. cup: neutral,hot"),
-      CLI_INT("--views", "N", &o.n_views, 1, 30, "views per state, 1..30; 30 = 3 elevations x 10 azimuths"),
+      CLI_INT("--views", "N", &o.n_views, 1, 30,
+              "views per state, 1..30; 30 = 3 elevations x 10 azimuths"),
       CLI_SIZE("--triangles", "N", &o.triangles, 100, 5000000, "mesh detail"),
       CLI_SIZE("--texture", "N", &o.texture_size, 16, 8192, "RGB texture side"),
       CLI_SIZE("--map-res", "R", &o.map_resolution, 8, 8192,
@@ -59,7 +60,9 @@ int hearth_cmd_synth(int argc, char **argv) {
       CLI_FLAG("--quiet", &o.quiet, 1, "no progress output"),
       CLI_END,
   };
-  const cli_command cmd = {.name = "hearth synth", .about = k_about, .opts = opts,
+  const cli_command cmd = {.name = "hearth synth",
+                           .about = k_about,
+                           .opts = opts,
                            .more = list_categories};
   int rc = cli_parse(&cmd, argc, argv, NULL);
   if (rc != CLI_RUN) return rc;
@@ -77,11 +80,14 @@ int hearth_cmd_synth(int argc, char **argv) {
     for (size_t i = 0; i < states.n; i++) o.states[i] = states.items[i];
   }
   if (o.mesh_path && !hearth_category_valid(o.mesh_category))
-    return cli_usage_error(&cmd, "option --mesh-category: expected one of the paper's 18 "
-                           "categories, found '%s'", o.mesh_category);
+    return cli_usage_error(&cmd,
+                           "option --mesh-category: expected one of the paper's 18 "
+                           "categories, found '%s'",
+                           o.mesh_category);
   hearth_err err = {0};
   double t0 = hearth_now();
   if (hearth_synth_release(&o, &err) != HEARTH_OK) return cli_fail("synth", &err);
-  if (!o.quiet) fprintf(stderr, "hearth synth: wrote %s in %.1f s\n", o.out_root, hearth_now() - t0);
+  if (!o.quiet)
+    fprintf(stderr, "hearth synth: wrote %s in %.1f s\n", o.out_root, hearth_now() - t0);
   return 0;
 }

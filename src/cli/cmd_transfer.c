@@ -30,8 +30,12 @@ int hearth_cmd_transfer(int argc, char **argv) {
       CLI_FLAG("--keep-refined", &keep, 1, "leave an existing derived/poses_thermal.json in place"),
       CLI_END,
   };
-  const cli_command cmd = {.name = "hearth transfer", .args = "ROOT", .min_args = 1,
-                           .max_args = 1, .about = k_about, .opts = opts};
+  const cli_command cmd = {.name = "hearth transfer",
+                           .args = "ROOT",
+                           .min_args = 1,
+                           .max_args = 1,
+                           .about = k_about,
+                           .opts = opts};
   cli_args args;
   int rc = cli_parse(&cmd, argc, argv, &args);
   if (rc != CLI_RUN) return rc;

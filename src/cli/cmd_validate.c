@@ -30,8 +30,13 @@ int hearth_cmd_validate(int argc, char **argv) {
       CLI_FLAG("--quiet", &quiet, 1, "print problems only, no summary line"),
       CLI_END,
   };
-  const cli_command cmd = {.name = "hearth validate", .args = "ROOT", .min_args = 1,
-                           .max_args = 1, .about = k_about, .opts = opts, .tail = k_tail};
+  const cli_command cmd = {.name = "hearth validate",
+                           .args = "ROOT",
+                           .min_args = 1,
+                           .max_args = 1,
+                           .about = k_about,
+                           .opts = opts,
+                           .tail = k_tail};
   cli_args args;
   int rc = cli_parse(&cmd, argc, argv, &args);
   if (rc != CLI_RUN) return rc;

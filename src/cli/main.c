@@ -44,8 +44,10 @@ static int run_sim(int argc, char **argv) {
   args[0] = self;
   for (int i = 1; i < argc; i++) args[i] = argv[i];
   execv(self, args);
-  fprintf(stderr, "hearth sim: cannot run %s (%s): this build has no simulation (HEARTH_SIM=OFF)\n"
-                  "or hearth-sim was not installed next to hearth\n", self, strerror(errno));
+  fprintf(stderr,
+          "hearth sim: cannot run %s (%s): this build has no simulation (HEARTH_SIM=OFF)\n"
+          "or hearth-sim was not installed next to hearth\n",
+          self, strerror(errno));
   free(args);
   return 2;
 }
@@ -57,11 +59,14 @@ typedef struct command {
 } command;
 
 static const command k_cmds[] = {
-    {"synth", hearth_cmd_synth, "make a release with the virtual capture rig (ground truth included)"},
+    {"synth", hearth_cmd_synth,
+     "make a release with the virtual capture rig (ground truth included)"},
     {"inspect", hearth_cmd_inspect, "read and summarise one file (CSV, PNG, JPEG, NPY, GLB, JSON)"},
     {"detect", hearth_cmd_detect, "find plate hole centres in the calibration captures"},
-    {"calibrate", hearth_cmd_calibrate, "thermal intrinsics and RGB-thermal stereo from detections"},
-    {"recon", hearth_cmd_recon, "camera poses from COLMAP: run it on an instance, or import a model"},
+    {"calibrate", hearth_cmd_calibrate,
+     "thermal intrinsics and RGB-thermal stereo from detections"},
+    {"recon", hearth_cmd_recon,
+     "camera poses from COLMAP: run it on an instance, or import a model"},
     {"scale", hearth_cmd_scale, "recover metric scale from recorded depth"},
     {"transfer", hearth_cmd_transfer, "thermal poses from colour poses through the rig transform"},
     {"refine", hearth_cmd_refine, "refine thermal poses automatically"},
@@ -80,8 +85,9 @@ static void list_commands(FILE *out) {
   fprintf(out, "\ncommands:\n");
   for (size_t i = 0; i < N_CMDS; i++)
     if (k_cmds[i].fn) fprintf(out, "  %-10s %s\n", k_cmds[i].name, k_cmds[i].summary);
-  fprintf(out, "\nEnvironment: HEARTH_THREADS sets the default worker count.\n"
-               "Conventions and file layout: docs/conventions.md, docs/dataset.md.\n");
+  fprintf(out,
+          "\nEnvironment: HEARTH_THREADS sets the default worker count.\n"
+          "Conventions and file layout: docs/conventions.md, docs/dataset.md.\n");
 }
 
 int main(int argc, char **argv) {

@@ -25,9 +25,14 @@ static const char k_tail[] = "Run `hearth sim <subcommand> --help` for its optio
 
 static const cli_opt k_opts[] = {CLI_END};
 
-static const cli_command k_cmd = {.name = "hearth sim", .args = "SUBCOMMAND", .min_args = 1,
-                                  .max_args = -1, .about = k_about, .opts = k_opts,
-                                  .tail = k_tail, .usage = "hearth sim <subcommand> [options]",
+static const cli_command k_cmd = {.name = "hearth sim",
+                                  .args = "SUBCOMMAND",
+                                  .min_args = 1,
+                                  .max_args = -1,
+                                  .about = k_about,
+                                  .opts = k_opts,
+                                  .tail = k_tail,
+                                  .usage = "hearth sim <subcommand> [options]",
                                   .stop_at_arg = 1};
 
 int main(int argc, char **argv) {

@@ -4,13 +4,18 @@
 #include "hearth/camera.h"
 
 void hearth_camera_K(const hearth_camera *cam, double K[9]) {
-  K[0] = cam->fx; K[1] = 0.0;     K[2] = cam->cx;
-  K[3] = 0.0;     K[4] = cam->fy; K[5] = cam->cy;
-  K[6] = 0.0;     K[7] = 0.0;     K[8] = 1.0;
+  K[0] = cam->fx;
+  K[1] = 0.0;
+  K[2] = cam->cx;
+  K[3] = 0.0;
+  K[4] = cam->fy;
+  K[5] = cam->cy;
+  K[6] = 0.0;
+  K[7] = 0.0;
+  K[8] = 1.0;
 }
 
-void hearth_distort(const double dist[5], double x, double y, double *xd, double *yd,
-                    double J[4]) {
+void hearth_distort(const double dist[5], double x, double y, double *xd, double *yd, double J[4]) {
   const double k1 = dist[0], k2 = dist[1], p1 = dist[2], p2 = dist[3], k3 = dist[4];
   hearth_distort_xy(dist, x, y, xd, yd);
   if (J) {
@@ -41,8 +46,14 @@ int hearth_camera_project(const hearth_camera *cam, const double Xc[3], double u
       jac->d_point[r * 3 + 1] = A[r * 2 + 1] * iz;
       jac->d_point[r * 3 + 2] = -(A[r * 2 + 0] * x + A[r * 2 + 1] * y) * iz;
     }
-    jac->d_intr[0] = xd;  jac->d_intr[1] = 0.0; jac->d_intr[2] = 1.0; jac->d_intr[3] = 0.0;
-    jac->d_intr[4] = 0.0; jac->d_intr[5] = yd;  jac->d_intr[6] = 0.0; jac->d_intr[7] = 1.0;
+    jac->d_intr[0] = xd;
+    jac->d_intr[1] = 0.0;
+    jac->d_intr[2] = 1.0;
+    jac->d_intr[3] = 0.0;
+    jac->d_intr[4] = 0.0;
+    jac->d_intr[5] = yd;
+    jac->d_intr[6] = 0.0;
+    jac->d_intr[7] = 1.0;
     double r2 = x * x + y * y, r4 = r2 * r2, r6 = r4 * r2, xy = x * y;
     double *dd = jac->d_dist;
     dd[0] = cam->fx * x * r2;
@@ -60,8 +71,8 @@ int hearth_camera_project(const hearth_camera *cam, const double Xc[3], double u
 }
 
 /* Pixel residual of a normalised point against the target pixel. */
-static double reproj_residual(const hearth_camera *cam, double x, double y, double tu,
-                              double tv, double *ex, double *ey) {
+static double reproj_residual(const hearth_camera *cam, double x, double y, double tu, double tv,
+                              double *ex, double *ey) {
   double xd, yd;
   hearth_distort(cam->dist, x, y, &xd, &yd, NULL);
   /* residual in distorted normalised coordinates, scored in pixels */
@@ -158,10 +169,13 @@ size_t hearth_camera_ray_grid(const hearth_camera *cam, size_t stride, float *di
     double prev[2] = {0, 0}, step[2] = {0, 0};
     for (size_t gx = 0; gx < gw; gx++) {
       float *d = dirs + 3 * (gy * gw + gx);
-      double tu = ((double)(gx * stride) - cam->cx) / cam->fx, tv = ((double)(gy * stride) - cam->cy) / cam->fy;
+      double tu = ((double)(gx * stride) - cam->cx) / cam->fx,
+             tv = ((double)(gy * stride) - cam->cy) / cam->fy;
       double xy[2], res = -1.0;
-      if (ok && warm == 2) res = undistort_from(cam, tu, tv, prev[0] + step[0], prev[1] + step[1], 1e-9, xy);
-      if (ok && !(res >= 0.0 && res <= HEARTH_GRID_MAX_RESIDUAL)) res = undistort_from(cam, tu, tv, tu, tv, 1e-9, xy);
+      if (ok && warm == 2)
+        res = undistort_from(cam, tu, tv, prev[0] + step[0], prev[1] + step[1], 1e-9, xy);
+      if (ok && !(res >= 0.0 && res <= HEARTH_GRID_MAX_RESIDUAL))
+        res = undistort_from(cam, tu, tv, tu, tv, 1e-9, xy);
       if (!(res >= 0.0 && res <= HEARTH_GRID_MAX_RESIDUAL)) {
         d[0] = d[1] = d[2] = NAN;
         failed++;

@@ -81,8 +81,8 @@ hearth_status hearth_read_file(const char *path, size_t max_size, uint8_t **data
   if (s) return s;
   if ((uint64_t)n > (uint64_t)max_size) {
     close(fd);
-    return hearth_err_set(err, HEARTH_E_LIMIT, "%s: %zu bytes exceeds the limit of %zu bytes",
-                          path, n, max_size);
+    return hearth_err_set(err, HEARTH_E_LIMIT, "%s: %zu bytes exceeds the limit of %zu bytes", path,
+                          n, max_size);
   }
   uint8_t *buf = malloc(n + 1);
   if (!buf) {

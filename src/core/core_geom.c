@@ -144,9 +144,15 @@ static void rodrigues_coeffs(double th, double *a, double *b, double *c, double 
 }
 
 static void skew(const double w[3], double W[9]) {
-  W[0] = 0.0;   W[1] = -w[2]; W[2] = w[1];
-  W[3] = w[2];  W[4] = 0.0;   W[5] = -w[0];
-  W[6] = -w[1]; W[7] = w[0];  W[8] = 0.0;
+  W[0] = 0.0;
+  W[1] = -w[2];
+  W[2] = w[1];
+  W[3] = w[2];
+  W[4] = 0.0;
+  W[5] = -w[0];
+  W[6] = -w[1];
+  W[7] = w[0];
+  W[8] = 0.0;
 }
 
 void hearth_rotvec_to_matrix(const double w[3], double R[9]) {
@@ -280,10 +286,9 @@ void hearth_orthonormalize(double R[9]) {
       return;
     }
     /* inverse transpose = cofactor matrix / det */
-    double C[9] = {
-        X[4] * X[8] - X[5] * X[7], X[5] * X[6] - X[3] * X[8], X[3] * X[7] - X[4] * X[6],
-        X[2] * X[7] - X[1] * X[8], X[0] * X[8] - X[2] * X[6], X[1] * X[6] - X[0] * X[7],
-        X[1] * X[5] - X[2] * X[4], X[2] * X[3] - X[0] * X[5], X[0] * X[4] - X[1] * X[3]};
+    double C[9] = {X[4] * X[8] - X[5] * X[7], X[5] * X[6] - X[3] * X[8], X[3] * X[7] - X[4] * X[6],
+                   X[2] * X[7] - X[1] * X[8], X[0] * X[8] - X[2] * X[6], X[1] * X[6] - X[0] * X[7],
+                   X[1] * X[5] - X[2] * X[4], X[2] * X[3] - X[0] * X[5], X[0] * X[4] - X[1] * X[3]};
     double change = 0.0;
     for (int i = 0; i < 9; i++) {
       double nx = 0.5 * (X[i] + C[i] / det);

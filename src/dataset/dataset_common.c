@@ -42,8 +42,8 @@ hearth_status hr_get_nonempty(hj_ctx *c, const json_t *obj, const char *key, cha
 }
 
 /* a required string that passes check(), with a description of what passes */
-hearth_status hr_get_checked(hj_ctx *c, const json_t *obj, const char *key, char *buf,
-                             size_t bufsz, int (*check)(const char *), const char *expected) {
+hearth_status hr_get_checked(hj_ctx *c, const json_t *obj, const char *key, char *buf, size_t bufsz,
+                             int (*check)(const char *), const char *expected) {
   hearth_status s = hj_get_string(c, obj, key, buf, bufsz);
   if (s) return s;
   if (!check(buf)) {
@@ -96,8 +96,7 @@ int hr_find_duplicate(size_t n, hr_key_fn key, const void *ctx, size_t *first, s
     int same = !strcmp(k[j].a, k[j - 1].a) && (!k[j].b || !strcmp(k[j].b, k[j - 1].b));
     if (same && (!found || k[j].i < *second)) {
       size_t g = j - 1;
-      while (g > 0 && !strcmp(k[g - 1].a, k[j].a) && (!k[j].b || !strcmp(k[g - 1].b, k[j].b)))
-        g--;
+      while (g > 0 && !strcmp(k[g - 1].a, k[j].a) && (!k[j].b || !strcmp(k[g - 1].b, k[j].b))) g--;
       *first = k[g].i;
       *second = k[j].i;
       found = 1;
@@ -106,4 +105,3 @@ int hr_find_duplicate(size_t n, hr_key_fn key, const void *ctx, size_t *first, s
   free(k);
   return found;
 }
-

@@ -12,10 +12,10 @@
 
 /* ---- names ------------------------------------------------------------------------ */
 
-const char *const hearth_categories[18] = {
-    "sponge", "eraser", "bottled_drink", "tissue",  "headset", "storage_bag",
-    "glasses_case", "smartphone", "canned_drink", "mouse", "pillow", "wallet",
-    "cup", "pot", "cushion", "electric_kettle", "orange", "laptop"};
+const char *const hearth_categories[18] =
+    {"sponge",       "eraser",     "bottled_drink", "tissue",          "headset", "storage_bag",
+     "glasses_case", "smartphone", "canned_drink",  "mouse",           "pillow",  "wallet",
+     "cup",          "pot",        "cushion",       "electric_kettle", "orange",  "laptop"};
 
 int hearth_category_valid(const char *name) {
   if (!name) return 0;
@@ -104,8 +104,7 @@ hearth_status hearth_rig_read(const char *path, hearth_rig *rig, hearth_err *err
   return hr_read_doc(path, rig_from_json, rig, err);
 }
 
-static hearth_status rig_validate(const char *text, size_t len, const char *name,
-                                  hearth_err *err) {
+static hearth_status rig_validate(const char *text, size_t len, const char *name, hearth_err *err) {
   hearth_rig r;
   return hearth_rig_parse(text, len, name, &r, err);
 }
@@ -230,7 +229,7 @@ static hearth_status scale_from_json(hj_ctx *c, const json_t *root, void *out) {
 }
 
 hearth_status hearth_scale_doc_parse(const char *text, size_t len, const char *name,
-                                 hearth_scale_doc *s, hearth_err *err) {
+                                     hearth_scale_doc *s, hearth_err *err) {
   return hr_parse_doc(text, len, name, scale_from_json, s, err);
 }
 
@@ -265,12 +264,11 @@ static hearth_status instance_from_json(hj_ctx *c, const json_t *root, void *out
   if ((s = hr_get_checked(c, root, "id", d.id, sizeof d.id, hearth_instance_id_valid,
                           "an instance id <category>_<NN> with one of the 18 categories")))
     return s;
-  if ((s = hr_get_checked(c, root, "category", d.category, sizeof d.category,
-                          hearth_category_valid, "one of the 18 categories of docs/dataset.md")))
+  if ((s = hr_get_checked(c, root, "category", d.category, sizeof d.category, hearth_category_valid,
+                          "one of the 18 categories of docs/dataset.md")))
     return s;
   size_t cl = strlen(d.category);
-  if (strncmp(d.id, d.category, cl) != 0 || d.id[cl] != '_' ||
-      !hearth_instance_id_valid(d.id)) {
+  if (strncmp(d.id, d.category, cl) != 0 || d.id[cl] != '_' || !hearth_instance_id_valid(d.id)) {
     size_t m = hj_push_key(c, "id");
     s = hj_fail(c, HEARTH_E_INCONSISTENT, "\"%s\" does not belong to category \"%s\"", d.id,
                 d.category);
@@ -341,9 +339,8 @@ hearth_status hearth_instance_write(const char *path, const hearth_instance_doc 
   int ok = o && st;
   for (size_t i = 0; ok && i < d->n_states; i++)
     ok = json_array_append_new(st, hj_str(d->states[i])) == 0;
-  ok = ok && hj_set(o, "id", hj_str(d->id)) &&
-       hj_set(o, "category", hj_str(d->category)) && hj_set(o, "states", json_incref(st)) &&
-       hj_set(o, "notes", hj_str(d->notes));
+  ok = ok && hj_set(o, "id", hj_str(d->id)) && hj_set(o, "category", hj_str(d->category)) &&
+       hj_set(o, "states", json_incref(st)) && hj_set(o, "notes", hj_str(d->notes));
   json_decref(st);
   if (!ok) {
     json_decref(o);
@@ -432,15 +429,13 @@ static hearth_status release_validate(const char *text, size_t len, const char *
   return s;
 }
 
-hearth_status hearth_release_write(const char *path, const hearth_release_doc *d,
-                                   hearth_err *err) {
+hearth_status hearth_release_write(const char *path, const hearth_release_doc *d, hearth_err *err) {
   json_t *o = json_object();
   json_t *iv = json_array();
   int ok = o && iv;
   for (size_t i = 0; ok && i < d->n_instances; i++)
     ok = json_array_append_new(iv, hj_str(d->instances[i])) == 0;
-  ok = ok && hj_set(o, "name", hj_str(d->name)) &&
-       hj_set(o, "version", hj_str(d->version)) &&
+  ok = ok && hj_set(o, "name", hj_str(d->name)) && hj_set(o, "version", hj_str(d->version)) &&
        hj_set(o, "software_version", hj_str(d->software_version)) &&
        hj_set(o, "instances", json_incref(iv));
   json_decref(iv);

@@ -13,8 +13,8 @@ hearth_status hr_read_doc(const char *path, hr_from_json_fn fn, void *out, heart
 
 hearth_status hr_get_nonempty(hj_ctx *c, const json_t *obj, const char *key, char *buf,
                               size_t bufsz);
-hearth_status hr_get_checked(hj_ctx *c, const json_t *obj, const char *key, char *buf,
-                             size_t bufsz, int (*check)(const char *), const char *expected);
+hearth_status hr_get_checked(hj_ctx *c, const json_t *obj, const char *key, char *buf, size_t bufsz,
+                             int (*check)(const char *), const char *expected);
 
 /* duplicate detection over n items keyed by one or two strings (b may be
  * NULL): returns 1 and the indices of the earliest repeated pair (first <

@@ -63,8 +63,7 @@ hearth_status hj_fail(hj_ctx *c, hearth_status s, const char *fmt, ...) {
   va_start(ap, fmt);
   vsnprintf(what, sizeof what, fmt, ap);
   va_end(ap);
-  return hearth_err_set(c->err, s, "%s: %s: %s", c->file, c->len ? c->path : "(top level)",
-                        what);
+  return hearth_err_set(c->err, s, "%s: %s: %s", c->file, c->len ? c->path : "(top level)", what);
 }
 
 /* ---- loading ------------------------------------------------------------- */
@@ -85,11 +84,11 @@ hearth_status hj_load(hj_ctx *c, const char *text, size_t len, json_t **root) {
   json_error_t je;
   json_t *v = json_loadb(text ? text : "", len, JSON_REJECT_DUPLICATES, &je);
   if (!v)
-    return hearth_err_set(c->err, HEARTH_E_PARSE, "%s: line %d, column %d: %s", c->file,
-                          je.line, je.column, je.text);
+    return hearth_err_set(c->err, HEARTH_E_PARSE, "%s: line %d, column %d: %s", c->file, je.line,
+                          je.column, je.text);
   if (!json_is_object(v)) {
-    hearth_status s = hj_fail(c, HEARTH_E_PARSE, "expected a JSON object, found %s",
-                              hj_type_name(v));
+    hearth_status s =
+        hj_fail(c, HEARTH_E_PARSE, "expected a JSON object, found %s", hj_type_name(v));
     json_decref(v);
     return s;
   }
@@ -128,8 +127,7 @@ hearth_status hj_integer(hj_ctx *c, const json_t *v, long long lo, long long hi,
     return hj_fail(c, HEARTH_E_PARSE, "expected an integer, found %s", hj_type_name(v));
   long long x = (long long)json_integer_value(v);
   if (x < lo || x > hi)
-    return hj_fail(c, HEARTH_E_RANGE, "expected an integer in [%lld, %lld], found %lld", lo, hi,
-                   x);
+    return hj_fail(c, HEARTH_E_RANGE, "expected an integer in [%lld, %lld], found %lld", lo, hi, x);
   *out = x;
   return HEARTH_OK;
 }
@@ -162,8 +160,7 @@ hearth_status hj_array(hj_ctx *c, const json_t *v, size_t min, size_t max, size_
   if (k < min)
     return hj_fail(c, HEARTH_E_SIZE, "expected at least %zu element%s, found %zu", min,
                    min == 1 ? "" : "s", k);
-  if (k > max)
-    return hj_fail(c, HEARTH_E_LIMIT, "%zu elements exceeds the limit of %zu", k, max);
+  if (k > max) return hj_fail(c, HEARTH_E_LIMIT, "%zu elements exceeds the limit of %zu", k, max);
   *n = k;
   return HEARTH_OK;
 }
@@ -441,8 +438,8 @@ json_t *hj_camera_new(const hearth_camera *cam) {
   json_t *o = json_object();
   double K[9] = {cam->fx, 0, cam->cx, 0, cam->fy, cam->cy, 0, 0, 1};
   int ok = hj_set(o, "width", json_integer(cam->width)) &&
-           hj_set(o, "height", json_integer(cam->height)) &&
-           hj_set(o, "K", hj_mat_new(K, 3, 3)) && hj_set(o, "dist", hj_vec_new(cam->dist, 5));
+           hj_set(o, "height", json_integer(cam->height)) && hj_set(o, "K", hj_mat_new(K, 3, 3)) &&
+           hj_set(o, "dist", hj_vec_new(cam->dist, 5));
   if (!ok) {
     json_decref(o);
     return NULL;
@@ -672,9 +669,7 @@ static void hj_emit(hj_buf *b, const json_t *v, int indent, size_t col) {
       hb_str(b, "]");
       return;
     }
-    case JSON_STRING:
-      hb_quoted(b, json_string_value(v), json_string_length(v));
-      return;
+    case JSON_STRING: hb_quoted(b, json_string_value(v), json_string_length(v)); return;
     case JSON_INTEGER: {
       char s[32];
       snprintf(s, sizeof s, "%" JSON_INTEGER_FORMAT, json_integer_value(v));

@@ -72,8 +72,7 @@ hearth_status hj_get_number(hj_ctx *c, const json_t *obj, const char *key, doubl
 hearth_status hj_get_integer(hj_ctx *c, const json_t *obj, const char *key, long long lo,
                              long long hi, long long *out);
 hearth_status hj_get_int(hj_ctx *c, const json_t *obj, const char *key, int lo, int hi, int *out);
-hearth_status hj_get_string(hj_ctx *c, const json_t *obj, const char *key, char *buf,
-                            size_t bufsz);
+hearth_status hj_get_string(hj_ctx *c, const json_t *obj, const char *key, char *buf, size_t bufsz);
 hearth_status hj_get_object(hj_ctx *c, const json_t *obj, const char *key, json_t **out);
 hearth_status hj_get_camera(hj_ctx *c, const json_t *obj, const char *key, hearth_camera *cam);
 hearth_status hj_get_rigid(hj_ctx *c, const json_t *obj, const char *key, hearth_rigid *T);

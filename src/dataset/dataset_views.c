@@ -59,8 +59,7 @@ static hearth_status records_from_json(hj_ctx *c, const json_t *root, const char
 }
 
 /* a view's five file entries, in the order of docs/dataset.md */
-static const char *const k_file_keys[5] = {"rgb", "cutout", "depth", "depth_intrinsics",
-                                           "thermal"};
+static const char *const k_file_keys[5] = {"rgb", "cutout", "depth", "depth_intrinsics", "thermal"};
 
 static hearth_status view_files_from_json(hj_ctx *c, const json_t *v, void *elem) {
   hearth_view_files *f = elem;
@@ -239,8 +238,7 @@ const hearth_view_pose *hearth_poses_find(const hearth_poses *p, const char *sta
                                           const char *view) {
   if (!p || !state || !view) return NULL;
   for (size_t i = 0; i < p->n; i++)
-    if (!strcmp(p->views[i].state, state) && !strcmp(p->views[i].view, view))
-      return &p->views[i];
+    if (!strcmp(p->views[i].state, state) && !strcmp(p->views[i].view, view)) return &p->views[i];
   return NULL;
 }
 
@@ -297,8 +295,10 @@ static hearth_status poses_from_json(hj_ctx *c, const json_t *root, void *out) {
   size_t first, second;
   if (hr_find_duplicate(n, key_poses, &p, &first, &second)) {
     hj_push_index(c, second);
-    s = hj_fail(c, HEARTH_E_INCONSISTENT, "duplicate pose for state \"%s\", view \"%s\" "
-                "(also views[%zu])", p.views[second].state, p.views[second].view, first);
+    s = hj_fail(c, HEARTH_E_INCONSISTENT,
+                "duplicate pose for state \"%s\", view \"%s\" "
+                "(also views[%zu])",
+                p.views[second].state, p.views[second].view, first);
     free(p.views);
     return s;
   }
@@ -382,8 +382,10 @@ static hearth_status pattern_from_json(hj_ctx *c, const json_t *root) {
     if ((s = hj_get_int(c, pv, ints[i].key, 0, 1 << 20, &x))) return s;
     if (x != ints[i].want) {
       hj_push_key(c, ints[i].key);
-      return hj_fail(c, HEARTH_E_UNSUPPORTED, "expected %d (the plate of docs/dataset.md), "
-                     "found %d", ints[i].want, x);
+      return hj_fail(c, HEARTH_E_UNSUPPORTED,
+                     "expected %d (the plate of docs/dataset.md), "
+                     "found %d",
+                     ints[i].want, x);
     }
   }
   static const struct {
@@ -395,8 +397,10 @@ static hearth_status pattern_from_json(hj_ctx *c, const json_t *root) {
     if ((s = hj_get_number(c, pv, reals[i].key, &x))) return s;
     if (!(fabs(x - reals[i].want) <= 1e-9)) {
       hj_push_key(c, reals[i].key);
-      return hj_fail(c, HEARTH_E_UNSUPPORTED, "expected %.9g (the plate of docs/dataset.md), "
-                     "found %.17g", reals[i].want, x);
+      return hj_fail(c, HEARTH_E_UNSUPPORTED,
+                     "expected %.9g (the plate of docs/dataset.md), "
+                     "found %.17g",
+                     reals[i].want, x);
     }
   }
   hj_pop(c, m);
@@ -446,8 +450,10 @@ static hearth_status detections_from_json(hj_ctx *c, const json_t *root, void *o
   size_t first, second;
   if (hr_find_duplicate(n, key_detections, &d, &first, &second)) {
     hj_push_index(c, second);
-    s = hj_fail(c, HEARTH_E_INCONSISTENT, "duplicate frame \"%s\" of camera \"%s\" "
-                "(also frames[%zu])", d.frames[second].frame, d.frames[second].camera, first);
+    s = hj_fail(c, HEARTH_E_INCONSISTENT,
+                "duplicate frame \"%s\" of camera \"%s\" "
+                "(also frames[%zu])",
+                d.frames[second].frame, d.frames[second].camera, first);
     free(d.frames);
     return s;
   }
@@ -492,8 +498,7 @@ hearth_status hearth_detections_write(const char *path, const hearth_detections 
          hj_set(v, "found", json_boolean(f->found));
     if (ok && f->found)
       ok = hj_set(v, "centres", hj_mat_new(&f->centres[0][0], HEARTH_PLATE_HOLES, 2));
-    else if (ok)
-      ok = hj_set(v, "reason", hj_str(f->reason));
+    else if (ok) ok = hj_set(v, "reason", hj_str(f->reason));
     if (!ok || json_array_append_new(fv, v) != 0) {
       if (ok) ok = 0;
       else json_decref(v);

@@ -30,8 +30,10 @@ void hearth_eval_resize_with_pad(const uint8_t *in, int w, int h, uint8_t *out, 
       int xa = (int)fx, xb = xa + 1 < w ? xa + 1 : xa;
       double tx = fx - xa;
       for (int c = 0; c < 3; c++) {
-        double v = (1 - ty) * ((1 - tx) * in[3 * ((size_t)ya * w + xa) + c] + tx * in[3 * ((size_t)ya * w + xb) + c]) +
-                   ty * ((1 - tx) * in[3 * ((size_t)yb * w + xa) + c] + tx * in[3 * ((size_t)yb * w + xb) + c]);
+        double v = (1 - ty) * ((1 - tx) * in[3 * ((size_t)ya * w + xa) + c] +
+                               tx * in[3 * ((size_t)ya * w + xb) + c]) +
+                   ty * ((1 - tx) * in[3 * ((size_t)yb * w + xa) + c] +
+                         tx * in[3 * ((size_t)yb * w + xb) + c]);
         int q = (int)lround(v);
         out[3 * ((size_t)(y + y0) * ow + x + x0) + c] = (uint8_t)(q < 0 ? 0 : q > 255 ? 255 : q);
       }
@@ -40,15 +42,16 @@ void hearth_eval_resize_with_pad(const uint8_t *in, int w, int h, uint8_t *out, 
 }
 
 /* rotate 180 degrees (OpenGL rows -> openpi's LIBERO convention), resize */
-static hearth_status put_image(hearth_mp_writer *w, const char *key, const uint8_t *img, int iw, int ih,
-                               int size, hearth_err *err) {
+static hearth_status put_image(hearth_mp_writer *w, const char *key, const uint8_t *img, int iw,
+                               int ih, int size, hearth_err *err) {
   size_t n = (size_t)iw * ih * 3;
   uint8_t *rot = malloc(n), *out = malloc((size_t)size * size * 3);
   if (!rot || !out) {
     free(rot), free(out);
     return hearth_err_set(err, HEARTH_E_NOMEM, "eval: image buffers");
   }
-  for (size_t k = 0; k < (size_t)iw * ih; k++) memcpy(rot + 3 * k, img + 3 * ((size_t)iw * ih - 1 - k), 3);
+  for (size_t k = 0; k < (size_t)iw * ih; k++)
+    memcpy(rot + 3 * k, img + 3 * ((size_t)iw * ih - 1 - k), 3);
   hearth_eval_resize_with_pad(rot, iw, ih, out, size, size);
   size_t shape[3] = {(size_t)size, (size_t)size, 3};
   hearth_mp_put_cstr(w, key);
@@ -57,14 +60,19 @@ static hearth_status put_image(hearth_mp_writer *w, const char *key, const uint8
   return HEARTH_OK;
 }
 
-hearth_status hearth_eval_encode_obs(const hearth_sim_obs *obs, const char *prompt, int thermal, int size,
-                                     hearth_mp_writer *w, hearth_err *err) {
-  if (!obs->eye_in_hand_rgb) return hearth_err_set(err, HEARTH_E_ARG, "eval: the wrist view is off");
+hearth_status hearth_eval_encode_obs(const hearth_sim_obs *obs, const char *prompt, int thermal,
+                                     int size, hearth_mp_writer *w, hearth_err *err) {
+  if (!obs->eye_in_hand_rgb)
+    return hearth_err_set(err, HEARTH_E_ARG, "eval: the wrist view is off");
   hearth_mp_put_map(w, thermal ? 5 : 4);
-  hearth_status st = put_image(w, "observation/image", obs->agentview_rgb, obs->width, obs->height, size, err);
-  if (!st) st = put_image(w, "observation/wrist_image", obs->eye_in_hand_rgb, obs->width, obs->height, size, err);
+  hearth_status st =
+      put_image(w, "observation/image", obs->agentview_rgb, obs->width, obs->height, size, err);
+  if (!st)
+    st = put_image(w, "observation/wrist_image", obs->eye_in_hand_rgb, obs->width, obs->height,
+                   size, err);
   if (!st && thermal)
-    st = put_image(w, "observation/thermal_image", obs->agentview_thermal, obs->width, obs->height, size, err);
+    st = put_image(w, "observation/thermal_image", obs->agentview_thermal, obs->width, obs->height,
+                   size, err);
   if (st) return st;
   double state[8];
   memcpy(state, obs->ee_pos, 3 * sizeof(double));

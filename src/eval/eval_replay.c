@@ -53,8 +53,10 @@ static double *h5_read_2d(hid_t g, const char *name, size_t *rows, size_t *cols)
   if (H5Sget_simple_extent_ndims(sp) == 2) {
     H5Sget_simple_extent_dims(sp, dims, NULL);
     if (dims[0] < 100000 && dims[1] < 100000) {
-      buf = hearth_alloc_array(dims[0] * dims[1] > 0 ? (size_t)(dims[0] * dims[1]) : 1, sizeof(double));
-      if (buf && H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) < 0) free(buf), buf = NULL;
+      buf = hearth_alloc_array(dims[0] * dims[1] > 0 ? (size_t)(dims[0] * dims[1]) : 1,
+                               sizeof(double));
+      if (buf && H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) < 0)
+        free(buf), buf = NULL;
     }
   }
   H5Sclose(sp);
@@ -74,7 +76,8 @@ hearth_status eval_replay_load(const char *spec, eval_replay_file *r, hearth_err
     char *end;
     k = strtol(hash + 1, &end, 10);
     if (*end || k < 0 || k > 1000000)
-      return hearth_err_set(err, HEARTH_E_ARG, "replay: \"%s\": expected FILE.hdf5#K with K a demo index", spec);
+      return hearth_err_set(err, HEARTH_E_ARG,
+                            "replay: \"%s\": expected FILE.hdf5#K with K a demo index", spec);
     only = (int)k;
     *hash = 0;
   }
@@ -88,8 +91,10 @@ hearth_status eval_replay_load(const char *spec, eval_replay_file *r, hearth_err
   hid_t data = H5Gopen2(f, "data", H5P_DEFAULT);
   char ea[16384];
   long long ndemo = 0;
-  if (data < 0 || !h5_read_str_attr(data, "env_args", ea, sizeof ea) || !h5_read_int_attr(data, "num_demos", &ndemo)) {
-    st = hearth_err_set(err, HEARTH_E_NOT_FOUND, "%s: expected group data with attributes env_args and num_demos", path);
+  if (data < 0 || !h5_read_str_attr(data, "env_args", ea, sizeof ea) ||
+      !h5_read_int_attr(data, "num_demos", &ndemo)) {
+    st = hearth_err_set(err, HEARTH_E_NOT_FOUND,
+                        "%s: expected group data with attributes env_args and num_demos", path);
     goto done;
   }
   json_error_t je;
@@ -100,11 +105,14 @@ hearth_status eval_replay_load(const char *spec, eval_replay_file *r, hearth_err
   if (seed && json_is_integer(seed)) r->seed = (uint64_t)json_integer_value(seed);
   json_decref(j);
   if (!r->task || !seed) {
-    st = hearth_err_set(err, HEARTH_E_PARSE, "%s: data.env_args: expected env_name \"hearth_H1..3\" and env_kwargs.seed", path);
+    st = hearth_err_set(err, HEARTH_E_PARSE,
+                        "%s: data.env_args: expected env_name \"hearth_H1..3\" and env_kwargs.seed",
+                        path);
     goto done;
   }
   if (ndemo < 0 || ndemo > 100000 || (only >= 0 && only >= ndemo)) {
-    st = hearth_err_set(err, HEARTH_E_RANGE, "%s: demo %d requested, file has %lld", path, only, ndemo);
+    st = hearth_err_set(err, HEARTH_E_RANGE, "%s: demo %d requested, file has %lld", path, only,
+                        ndemo);
     goto done;
   }
   int first = only >= 0 ? only : 0, count = only >= 0 ? 1 : (int)ndemo;
@@ -124,13 +132,16 @@ hearth_status eval_replay_load(const char *spec, eval_replay_file *r, hearth_err
       d->actions = h5_read_2d(g, "actions", &ar, &ac);
       d->states = h5_read_2d(g, "states", &sr, &sc);
     }
-    if (g < 0 || !h5_read_int_attr(g, "layout", &lay) || !h5_read_int_attr(g, "instruction_index", &ins) ||
-        !d->actions || ac != 7 || (d->states && sr != ar) || ins < 0 || ins > 1 || lay < 0)
-      st = hearth_err_set(err, HEARTH_E_PARSE,
-                          "%s: data/%s: expected attributes layout, instruction_index and datasets actions (T,7), states (T,S)",
-                          path, name);
+    if (g < 0 || !h5_read_int_attr(g, "layout", &lay) ||
+        !h5_read_int_attr(g, "instruction_index", &ins) || !d->actions || ac != 7 ||
+        (d->states && sr != ar) || ins < 0 || ins > 1 || lay < 0)
+      st = hearth_err_set(
+          err, HEARTH_E_PARSE,
+          "%s: data/%s: expected attributes layout, instruction_index and datasets actions (T,7), states (T,S)",
+          path, name);
     if (g >= 0) H5Gclose(g);
-    d->index = first + i, d->instruction = (int)ins, d->layout = (uint64_t)lay, d->T = ar, d->S = d->states ? sc : 0;
+    d->index = first + i, d->instruction = (int)ins, d->layout = (uint64_t)lay, d->T = ar,
+    d->S = d->states ? sc : 0;
     r->n = i + 1;
   }
 done:

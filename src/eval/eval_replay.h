@@ -16,8 +16,8 @@ typedef struct eval_replay_demo {
 } eval_replay_demo;
 
 typedef struct eval_replay_file {
-  hearth_sim_task task;     /* from env_name "hearth_H<k>" */
-  uint64_t seed;            /* the layout stream, env_kwargs.seed */
+  hearth_sim_task task; /* from env_name "hearth_H<k>" */
+  uint64_t seed;        /* the layout stream, env_kwargs.seed */
   int n;
   eval_replay_demo *demos;
 } eval_replay_file;

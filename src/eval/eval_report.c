@@ -37,14 +37,16 @@ static const char *thermal_label(const hearth_eval_results *r) {
 static void setup_lines(const hearth_eval_results *r, hearth_strbuf *b) {
   hearth_strbuf_printf(b, "setup: render %d px", r->render_size);
   if (r->thermal >= 0)
-    hearth_strbuf_printf(b, ", policy images %d px, replan every %d steps after %d no-op steps", r->image_size,
-                         r->replan_steps, r->wait_steps);
-  hearth_strbuf_printf(b, ", shadows %s, renderer %s\n", r->shadows ? "on" : "off", r->renderer[0] ? r->renderer : "-");
+    hearth_strbuf_printf(b, ", policy images %d px, replan every %d steps after %d no-op steps",
+                         r->image_size, r->replan_steps, r->wait_steps);
+  hearth_strbuf_printf(b, ", shadows %s, renderer %s\n", r->shadows ? "on" : "off",
+                       r->renderer[0] ? r->renderer : "-");
   if (r->thermal >= 0)
     hearth_strbuf_printf(b, "thermal image: %s\n",
                          !r->thermal ? "not sent (--no-thermal)"
-                         : r->thermal_used > 0 ? "sent; the server declares it reads it"
-                                               : "sent; the server does not declare whether it reads it (unknown)");
+                         : r->thermal_used > 0
+                             ? "sent; the server declares it reads it"
+                             : "sent; the server does not declare whether it reads it (unknown)");
   if (r->metadata_json) hearth_strbuf_printf(b, "server metadata: %s\n", r->metadata_json);
   if (r->warning[0]) hearth_strbuf_printf(b, "warning: %s\n", r->warning);
 }
@@ -61,24 +63,27 @@ char *hearth_eval_format_text(const hearth_eval_results *r) {
   for (size_t i = 0; i < r->n; i++)
     if (!r->eps[i].success)
       hearth_strbuf_printf(&b, "failed: %s instr %d episode %d (layout %llu): %s\n",
-                           hearth_sim_task_name(r->eps[i].task), r->eps[i].instruction + 1, r->eps[i].episode,
-                           (unsigned long long)r->eps[i].layout, r->eps[i].reason);
+                           hearth_sim_task_name(r->eps[i].task), r->eps[i].instruction + 1,
+                           r->eps[i].episode, (unsigned long long)r->eps[i].layout,
+                           r->eps[i].reason);
   hearth_strbuf_printf(&b, "policy %s\n", r->policy);
   setup_lines(r, &b);
-  hearth_strbuf_printf(&b, "%-6s %-8s %9s %9s %9s\n", "Task", "Thermal", "Instr. 1", "Instr. 2", "Average");
+  hearth_strbuf_printf(&b, "%-6s %-8s %9s %9s %9s\n", "Task", "Thermal", "Instr. 1", "Instr. 2",
+                       "Average");
   for (int t = 1; t <= 3; t++) {
     if (isnan(pt[t])) continue;
     char a[32], c[32], d[32];
-    hearth_strbuf_printf(&b, "%-6s %-8s %9s %9s %9s\n", hearth_sim_task_name((hearth_sim_task)t), thermal_label(r),
-                         pct(pi[t][0], a), pct(pi[t][1], c), pct(pt[t], d));
+    hearth_strbuf_printf(&b, "%-6s %-8s %9s %9s %9s\n", hearth_sim_task_name((hearth_sim_task)t),
+                         thermal_label(r), pct(pi[t][0], a), pct(pi[t][1], c), pct(pt[t], d));
   }
   int ok, tot;
   counts(r, &ok, &tot);
   char a[32];
   size_t perr = hearth_eval_policy_errors(r);
   if (perr)
-    hearth_strbuf_printf(&b, "policy errors: %zu of %d episodes failed because of the policy, not the task\n", perr,
-                         tot);
+    hearth_strbuf_printf(
+        &b, "policy errors: %zu of %d episodes failed because of the policy, not the task\n", perr,
+        tot);
   hearth_strbuf_printf(&b, "overall %s (%d/%d)\n", pct(all, a), ok, tot);
   return hearth_strbuf_take(&b);
 }
@@ -88,17 +93,20 @@ char *hearth_eval_format_markdown(const hearth_eval_results *r) {
   double all = hearth_eval_rates(r, pi, pt);
   hearth_strbuf b = {0};
   hearth_strbuf_printf(&b, "Task success rates (%%), policy `%s`\n\n", r->policy);
-  hearth_strbuf_printf(&b, "| Task | Thermal | Instr. 1 | Instr. 2 | Average |\n|---|---|---:|---:|---:|\n");
+  hearth_strbuf_printf(
+      &b, "| Task | Thermal | Instr. 1 | Instr. 2 | Average |\n|---|---|---:|---:|---:|\n");
   for (int t = 1; t <= 3; t++) {
     if (isnan(pt[t])) continue;
     char a[32], c[32], d[32];
-    hearth_strbuf_printf(&b, "| %s | %s | %s | %s | %s |\n", hearth_sim_task_name((hearth_sim_task)t), thermal_label(r),
+    hearth_strbuf_printf(&b, "| %s | %s | %s | %s | %s |\n",
+                         hearth_sim_task_name((hearth_sim_task)t), thermal_label(r),
                          pct(pi[t][0], a), pct(pi[t][1], c), pct(pt[t], d));
   }
   int ok, tot;
   counts(r, &ok, &tot);
   char a[32];
-  hearth_strbuf_printf(&b, "| **Overall** | %s | | | **%s** (%d/%d) |\n", thermal_label(r), pct(all, a), ok, tot);
+  hearth_strbuf_printf(&b, "| **Overall** | %s | | | **%s** (%d/%d) |\n", thermal_label(r),
+                       pct(all, a), ok, tot);
   return hearth_strbuf_take(&b);
 }
 
@@ -113,9 +121,10 @@ char *hearth_eval_format_json(const hearth_eval_results *r) {
   json_t *root = json_object();
   json_object_set_new(root, "policy", json_string(r->policy));
   json_object_set_new(root, "thermal", r->thermal < 0 ? json_null() : json_boolean(r->thermal));
-  json_object_set_new(root, "thermal_used", r->thermal < 0 ? json_null()
-                                            : r->thermal_used < 0 ? json_string("unknown")
-                                                                  : json_boolean(r->thermal_used));
+  json_object_set_new(root, "thermal_used",
+                      r->thermal < 0        ? json_null()
+                      : r->thermal_used < 0 ? json_string("unknown")
+                                            : json_boolean(r->thermal_used));
   json_t *meta = NULL;
   if (r->metadata_json) {
     json_error_t je;
@@ -161,7 +170,8 @@ char *hearth_eval_format_json(const hearth_eval_results *r) {
     json_object_set_new(je, "steps", json_integer(e->steps));
     json_object_set_new(je, "policy_error", json_boolean(e->error));
     json_object_set_new(je, "reason", json_string(e->reason));
-    if (e->state_diff >= 0) json_object_set_new(je, "replay_max_state_diff", json_real(e->state_diff));
+    if (e->state_diff >= 0)
+      json_object_set_new(je, "replay_max_state_diff", json_real(e->state_diff));
     json_array_append_new(eps, je);
   }
   json_object_set_new(root, "episodes", eps);

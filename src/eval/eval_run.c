@@ -54,7 +54,8 @@ static void video_add(video *v, const hearth_sim_obs *ob) {
   const uint8_t *views[3] = {ob->agentview_rgb, ob->agentview_thermal, ob->eye_in_hand_rgb};
   for (int y = 0; y < H; y++)
     for (int k = 0; k < W / ob->width; k++)
-      memcpy(f + ((size_t)y * W + (size_t)k * ob->width) * 3, views[k] + (size_t)(H - 1 - y) * ob->width * 3,
+      memcpy(f + ((size_t)y * W + (size_t)k * ob->width) * 3,
+             views[k] + (size_t)(H - 1 - y) * ob->width * 3,
              (size_t)ob->width * 3); /* top row first */
   v->n++;
 }
@@ -89,7 +90,8 @@ static hearth_status run_episode(ep_ctx *x, hearth_eval_episode *ep, int limit, 
     if (eval_ws_ensure(x->ws, &perr)) perror_ = 1;
     else if (o->thermal && x->ws->thermal_decl == 0) {
       /* a reconnection's metadata disowns the thermal view */
-      snprintf(perr.msg, sizeof perr.msg, "policy server %s: its metadata now declares %s: it ignores the thermal view",
+      snprintf(perr.msg, sizeof perr.msg,
+               "policy server %s: its metadata now declares %s: it ignores the thermal view",
                x->ws->url, x->ws->thermal_why);
       perror_ = 1;
     }
@@ -99,7 +101,8 @@ static hearth_status run_episode(ep_ctx *x, hearth_eval_episode *ep, int limit, 
   if (x->demo && x->demo->states) {
     ns = hearth_sim_state(e, state, 4096);
     if (ns != x->demo->S) {
-      snprintf(ep->reason, sizeof ep->reason, "replay: state length %zu differs from the file's %zu", ns, x->demo->S);
+      snprintf(ep->reason, sizeof ep->reason,
+               "replay: state length %zu differs from the file's %zu", ns, x->demo->S);
       ep->error = 1;
       return HEARTH_OK;
     }
@@ -168,42 +171,48 @@ static hearth_status run_episode(ep_ctx *x, hearth_eval_episode *ep, int limit, 
     snprintf(ep->reason, sizeof ep->reason, "%s", perr.msg);
     if (x->ws) eval_ws_drop(x->ws, perr.status == HEARTH_E_PARSE ? 1002 : 1001);
   } else if (!ep->success)
-    snprintf(ep->reason, sizeof ep->reason, x->demo ? "replay ended without success" : "time limit (%d steps)", limit);
+    snprintf(ep->reason, sizeof ep->reason,
+             x->demo ? "replay ended without success" : "time limit (%d steps)", limit);
   return HEARTH_OK;
 }
 
 /* connect to the server before any episode and hold its metadata against
  * the thermal condition */
-static hearth_status check_server(const hearth_eval_opts *o, eval_ws_policy *p, hearth_eval_results *r,
-                                  hearth_err *err) {
+static hearth_status check_server(const hearth_eval_opts *o, eval_ws_policy *p,
+                                  hearth_eval_results *r, hearth_err *err) {
   hearth_status st = eval_ws_ensure(p, err);
   if (st) {
     hearth_err_prefix(err, "eval: before the first episode");
     return st;
   }
   if (o->thermal && p->thermal_decl == 0)
-    return hearth_err_set(err, HEARTH_E_ARG,
-                          "eval: policy server %s: its metadata declares %s, so it ignores the thermal view, but "
-                          "the thermal condition is on: evaluate it with --no-thermal (the RGB-only condition) "
-                          "or serve a policy that reads observation/thermal_image",
-                          p->url, p->thermal_why);
+    return hearth_err_set(
+        err, HEARTH_E_ARG,
+        "eval: policy server %s: its metadata declares %s, so it ignores the thermal view, but "
+        "the thermal condition is on: evaluate it with --no-thermal (the RGB-only condition) "
+        "or serve a policy that reads observation/thermal_image",
+        p->url, p->thermal_why);
   r->thermal_used = !o->thermal ? 0 : p->thermal_decl == 1 ? 1 : -1;
   if (r->thermal_used < 0)
-    snprintf(r->warning, sizeof r->warning,
-             "policy server %s declares neither \"hearth_thermal\" nor \"image_keys\" in its metadata: whether "
-             "it reads observation/thermal_image is unknown (thermal_used \"unknown\"; a policy trained without "
-             "it ignores the key)",
-             p->url);
+    snprintf(
+        r->warning, sizeof r->warning,
+        "policy server %s declares neither \"hearth_thermal\" nor \"image_keys\" in its metadata: whether "
+        "it reads observation/thermal_image is unknown (thermal_used \"unknown\"; a policy trained without "
+        "it ignores the key)",
+        p->url);
   else if (!o->thermal && p->thermal_decl == 1)
-    snprintf(r->warning, sizeof r->warning,
-             "policy server %s declares %s in its metadata, but --no-thermal leaves observation/thermal_image out",
-             p->url, p->thermal_why);
-  if (!o->quiet) fprintf(stderr, "sim eval: policy server %s: metadata %s\n", p->url, p->metadata_json);
+    snprintf(
+        r->warning, sizeof r->warning,
+        "policy server %s declares %s in its metadata, but --no-thermal leaves observation/thermal_image out",
+        p->url, p->thermal_why);
+  if (!o->quiet)
+    fprintf(stderr, "sim eval: policy server %s: metadata %s\n", p->url, p->metadata_json);
   if (r->warning[0] && !o->quiet) fprintf(stderr, "sim eval: warning: %s\n", r->warning);
   return HEARTH_OK;
 }
 
-static hearth_status push_ep(hearth_eval_results *r, const hearth_eval_episode *ep, hearth_err *err) {
+static hearth_status push_ep(hearth_eval_results *r, const hearth_eval_episode *ep,
+                             hearth_err *err) {
   hearth_eval_episode *n = realloc(r->eps, (r->n + 1) * sizeof *n);
   if (!n) return hearth_err_set(err, HEARTH_E_NOMEM, "eval: results");
   r->eps = n;
@@ -211,14 +220,15 @@ static hearth_status push_ep(hearth_eval_results *r, const hearth_eval_episode *
   return HEARTH_OK;
 }
 
-static hearth_status episode_with_video(ep_ctx *x, hearth_eval_episode *ep, int limit, hearth_err *err) {
+static hearth_status episode_with_video(ep_ctx *x, hearth_eval_episode *ep, int limit,
+                                        hearth_err *err) {
   video v = {0};
   x->vid = x->o->video_dir ? &v : NULL;
   hearth_status st = run_episode(x, ep, limit, err);
   if (!st && x->vid) {
     char path[4200];
-    snprintf(path, sizeof path, "%s/%s_instr%d_ep%02d.png", x->o->video_dir, hearth_sim_task_name(ep->task),
-             ep->instruction + 1, ep->episode);
+    snprintf(path, sizeof path, "%s/%s_instr%d_ep%02d.png", x->o->video_dir,
+             hearth_sim_task_name(ep->task), ep->instruction + 1, ep->episode);
     st = video_write(&v, path, err);
   }
   free(v.frames);
@@ -230,16 +240,20 @@ hearth_status hearth_eval_run(const hearth_eval_opts *o, hearth_eval_results *r,
   memset(r, 0, sizeof *r);
   if (!o->policy) return hearth_err_set(err, HEARTH_E_ARG, "eval: no policy");
   if (o->episodes < 1 || o->episodes > 100000)
-    return hearth_err_set(err, HEARTH_E_RANGE, "eval: episodes must be 1..100000, got %d", o->episodes);
+    return hearth_err_set(err, HEARTH_E_RANGE, "eval: episodes must be 1..100000, got %d",
+                          o->episodes);
   if (o->replan_steps < 1 || o->replan_steps > 64)
-    return hearth_err_set(err, HEARTH_E_RANGE, "eval: replan steps must be 1..64, got %d", o->replan_steps);
+    return hearth_err_set(err, HEARTH_E_RANGE, "eval: replan steps must be 1..64, got %d",
+                          o->replan_steps);
   if (o->image_size < 8 || o->image_size > 1024 || o->render_size < 16 || o->render_size > 2048)
-    return hearth_err_set(err, HEARTH_E_RANGE, "eval: image size must be 8..1024 and render size 16..2048");
+    return hearth_err_set(err, HEARTH_E_RANGE,
+                          "eval: image size must be 8..1024 and render size 16..2048");
   int is_ws = strncmp(o->policy, "ws://", 5) == 0;
   int is_replay = strncmp(o->policy, "replay:", 7) == 0;
   if (!is_ws && !is_replay && strcmp(o->policy, "oracle") != 0)
-    return hearth_err_set(err, HEARTH_E_ARG, "eval: policy \"%s\": expected oracle, replay:FILE.hdf5[#K] or ws://HOST:PORT",
-                          o->policy);
+    return hearth_err_set(
+        err, HEARTH_E_ARG,
+        "eval: policy \"%s\": expected oracle, replay:FILE.hdf5[#K] or ws://HOST:PORT", o->policy);
   snprintf(r->policy, sizeof r->policy, "%s", o->policy);
   r->thermal = is_ws ? o->thermal : -1;
   if (o->video_dir) {
@@ -297,8 +311,9 @@ hearth_status hearth_eval_run(const hearth_eval_opts *o, hearth_eval_results *r,
           st = episode_with_video(&x, &ep, limit, err);
           if (!st) st = push_ep(r, &ep, err);
           if (!st && !o->quiet)
-            fprintf(stderr, "eval %s instr %d episode %d: %s%s%s\n", hearth_sim_task_name(so.task), ins + 1, k,
-                    ep.success ? "success" : "failure", ep.success ? "" : ": ", ep.success ? "" : ep.reason);
+            fprintf(stderr, "eval %s instr %d episode %d: %s%s%s\n", hearth_sim_task_name(so.task),
+                    ins + 1, k, ep.success ? "success" : "failure", ep.success ? "" : ": ",
+                    ep.success ? "" : ep.reason);
         }
     }
     hearth_sim_env_free(env);
@@ -324,5 +339,3 @@ size_t hearth_eval_policy_errors(const hearth_eval_results *r) {
   for (size_t i = 0; i < r->n; i++) n += r->eps[i].error != 0;
   return n;
 }
-
-

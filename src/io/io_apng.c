@@ -17,8 +17,8 @@
 
 /* per frame: its unfiltered rows and their zlib stream */
 typedef struct apng_scratch {
-  size_t row, raw_n;  /* bytes of one row with its filter byte; of all rows */
-  uint8_t *raw, *z;   /* raw_n; hearth_deflate_bound(raw_n) + 6 */
+  size_t row, raw_n; /* bytes of one row with its filter byte; of all rows */
+  uint8_t *raw, *z;  /* raw_n; hearth_deflate_bound(raw_n) + 6 */
 } apng_scratch;
 
 /* frame `rgb` as a zlib stream in s->z; returns its length */
@@ -33,29 +33,30 @@ static size_t frame_stream(apng_scratch *s, const uint8_t *rgb, size_t height) {
   return k + 4;
 }
 
-static hearth_status apng_encode(const char *name, const uint8_t *frames, size_t width, size_t height,
-                                 size_t n_frames, unsigned delay_num, unsigned delay_den,
-                                 uint8_t **out, size_t *size, hearth_err *err) {
+static hearth_status apng_encode(const char *name, const uint8_t *frames, size_t width,
+                                 size_t height, size_t n_frames, unsigned delay_num,
+                                 unsigned delay_den, uint8_t **out, size_t *size, hearth_err *err) {
   *out = NULL;
   *size = 0;
   if (!frames || n_frames < 1)
     return hearth_err_set(err, HEARTH_E_ARG, "%s: no frames to write", name);
   if (width < 1 || height < 1 || width > 0x7fffffffu || height > 0x7fffffffu)
-    return hearth_err_set(err, HEARTH_E_SIZE, "%s: frame size %zux%zu cannot be stored in PNG", name,
-                          width, height);
+    return hearth_err_set(err, HEARTH_E_SIZE, "%s: frame size %zux%zu cannot be stored in PNG",
+                          name, width, height);
   /* sequence numbers (2 per frame after the first) stay below 2^31 */
   if (n_frames > 0x3fffffffu)
-    return hearth_err_set(err, HEARTH_E_LIMIT, "%s: %zu frames: at most %u fit an APNG", name, n_frames,
-                          0x3fffffffu);
+    return hearth_err_set(err, HEARTH_E_LIMIT, "%s: %zu frames: at most %u fit an APNG", name,
+                          n_frames, 0x3fffffffu);
   if (delay_num > 65535 || delay_den > 65535)
-    return hearth_err_set(err, HEARTH_E_RANGE, "%s: frame delay %u/%u: both parts must be 0..65535", name,
-                          delay_num, delay_den);
+    return hearth_err_set(err, HEARTH_E_RANGE, "%s: frame delay %u/%u: both parts must be 0..65535",
+                          name, delay_num, delay_den);
   /* sizes: a frame, its rows with filter bytes, its stream's room */
   apng_scratch s = {0};
   size_t frame_bytes, zcap;
   if (!hearth_mul_size(width, 3, &s.row) || !hearth_mul_size(s.row, height, &frame_bytes) ||
       !hearth_mul_size(s.row + 1, height, &s.raw_n) || s.raw_n > (size_t)-1 / 2)
-    return hearth_err_set(err, HEARTH_E_NOMEM, "%s: frame size %zux%zu overflows", name, width, height);
+    return hearth_err_set(err, HEARTH_E_NOMEM, "%s: frame size %zux%zu overflows", name, width,
+                          height);
   s.row += 1;
   zcap = hearth_deflate_bound(s.raw_n) + 6;
   s.raw = malloc(s.raw_n);
@@ -116,18 +117,20 @@ static hearth_status apng_encode(const char *name, const uint8_t *frames, size_t
   return HEARTH_OK;
 }
 
-hearth_status hearth_apng_encode(const uint8_t *frames, size_t width, size_t height, size_t n_frames,
-                                 unsigned delay_num, unsigned delay_den, uint8_t **out,
-                                 size_t *size, hearth_err *err) {
-  return apng_encode("<memory>", frames, width, height, n_frames, delay_num, delay_den, out, size, err);
+hearth_status hearth_apng_encode(const uint8_t *frames, size_t width, size_t height,
+                                 size_t n_frames, unsigned delay_num, unsigned delay_den,
+                                 uint8_t **out, size_t *size, hearth_err *err) {
+  return apng_encode("<memory>", frames, width, height, n_frames, delay_num, delay_den, out, size,
+                     err);
 }
 
-hearth_status hearth_apng_write(const char *path, const uint8_t *frames, size_t width, size_t height,
-                                size_t n_frames, unsigned delay_num, unsigned delay_den,
-                                hearth_err *err) {
+hearth_status hearth_apng_write(const char *path, const uint8_t *frames, size_t width,
+                                size_t height, size_t n_frames, unsigned delay_num,
+                                unsigned delay_den, hearth_err *err) {
   uint8_t *buf;
   size_t n;
-  hearth_status s = apng_encode(path, frames, width, height, n_frames, delay_num, delay_den, &buf, &n, err);
+  hearth_status s =
+      apng_encode(path, frames, width, height, n_frames, delay_num, delay_den, &buf, &n, err);
   if (s) return s;
   s = hearth_write_file_atomic(path, buf, n, err);
   free(buf);

@@ -142,8 +142,8 @@ static void excerpt(const char *s, size_t a, size_t b, char *out, size_t outsz) 
   out[k] = 0;
 }
 
-static hearth_status cell_error(const csv_ctx *c, const csv_row *r, const csv_cell *cell,
-                                int kind, double v, hearth_err *err) {
+static hearth_status cell_error(const csv_ctx *c, const csv_row *r, const csv_cell *cell, int kind,
+                                double v, hearth_err *err) {
   const char *s = c->s, *name = c->name;
   char ex[48];
   size_t col = csv_column(c, r->start, cell->at);
@@ -172,7 +172,8 @@ static hearth_status cell_error(const csv_ctx *c, const csv_row *r, const csv_ce
                             "%s: line %zu, column %zu: %s, expected \"number\" followed by a "
                             "separator or the end of the line",
                             name, r->line_no, col,
-                            cell->bad_quote == 1 ? "unterminated quote" : "text after closing quote");
+                            cell->bad_quote == 1 ? "unterminated quote"
+                                                 : "text after closing quote");
     default:
       return hearth_err_set(err, HEARTH_E_PARSE,
                             "%s: line %zu, column %zu: '%s' is not a number, expected a "
@@ -258,7 +259,9 @@ static size_t fast_cells(const char *s, size_t *pp, size_t b, char sep, float *v
   for (;;) {
     double v;
     size_t q = p;
-    if (!plain_cell(s, &q, b, sep, 0, &v) || !(v >= HEARTH_THERMAL_MIN_C && v <= HEARTH_THERMAL_MAX_C)) break;
+    if (!plain_cell(s, &q, b, sep, 0, &v) ||
+        !(v >= HEARTH_THERMAL_MIN_C && v <= HEARTH_THERMAL_MAX_C))
+      break;
     p = q;
     vals[n++] = (float)v;
     if (p >= b || ++p >= b) { /* the line's end, or one trailing separator */
@@ -341,7 +344,7 @@ static hearth_status scan(const csv_ctx *c, size_t pos, csv_buf *B, hearth_err *
       vals[nvals++] = kind == CELL_OK ? (float)v : 0.0f;
       r.ncells++;
       if (p >= b) break;
-      p++; /* over the separator */
+      p++;               /* over the separator */
       if (p >= b) break; /* one trailing separator */
     }
     if (r.ncells == r.nempty) { /* an empty line, or separators only */
@@ -443,7 +446,7 @@ typedef struct csv_layout {
   size_t index;       /* the index row (axis-labelled), or NONE */
   size_t size;        /* the size line, or NONE */
   size_t size_w, size_h;
-  size_t meta_end;    /* rows before this are metadata */
+  size_t meta_end; /* rows before this are metadata */
 } csv_layout;
 
 static hearth_status blank_inside(const csv_ctx *c, size_t blank, size_t above, size_t below,
@@ -618,8 +621,7 @@ static hearth_status check_not_indices(const csv_ctx *c, const csv_buf *B, const
   size_t h = L->last - L->first + 1, i = 0;
   while (i < w && v[i] == (float)i) i++;
   int whole = w >= 2 && i == w;
-  for (i = 1; i < w && v[i] == (float)(i - 1); i++) {
-  }
+  for (i = 1; i < w && v[i] == (float)(i - 1); i++) {}
   int after_first = !whole && w >= 3 && i == w;
   if (whole || after_first) {
     csv_cell cell;
@@ -631,8 +633,7 @@ static hearth_status check_not_indices(const csv_ctx *c, const csv_buf *B, const
                           "temperatures",
                           c->name, r->line_no, col, whole ? w - 1 : w - 2);
   }
-  for (i = 0; h >= 2 && i < h && B->vals[R[L->first + i].voff] == (float)i; i++) {
-  }
+  for (i = 0; h >= 2 && i < h && B->vals[R[L->first + i].voff] == (float)i; i++) {}
   if (h >= 2 && i == h)
     return hearth_err_set(err, HEARTH_E_PARSE,
                           "%s: line %zu, column 1: the first column reads 0, 1, ..., %zu down to "
@@ -709,8 +710,8 @@ static hearth_status check_matrix(const csv_ctx *c, const csv_buf *B, const csv_
     return hearth_err_set(err, HEARTH_E_SIZE,
                           "%s: line %zu, column 1: size line says %zux%zu, expected the %zux%zu "
                           "of the matrix below (lines %zu..%zu)",
-                          name, R[L->size].line_no, L->size_w, L->size_h, w, h,
-                          R[L->top].line_no, R[L->last].line_no);
+                          name, R[L->size].line_no, L->size_w, L->size_h, w, h, R[L->top].line_no,
+                          R[L->last].line_no);
   if (L->kind == HEARTH_CSV_PLAIN && (st = check_not_indices(c, B, L, w, err))) return st;
   *w_out = w;
   return HEARTH_OK;
@@ -748,8 +749,11 @@ static hearth_status fill_info(const csv_ctx *c, const csv_text *t, const csv_bu
   for (size_t i = L->first; i <= L->last && !comma; i++) comma = R[i].qcomma;
   info->decimal_mark = comma ? ',' : memchr(m, '.', mn) ? '.' : 0;
   info->encoding = encoding;
-  info->line_ends = t->cr_only ? "CR" : B->n_lf && B->n_crlf ? "mixed" : B->n_crlf ? "CRLF"
-                                 : B->n_lf ? "LF" : "none";
+  info->line_ends = t->cr_only             ? "CR"
+                    : B->n_lf && B->n_crlf ? "mixed"
+                    : B->n_crlf            ? "CRLF"
+                    : B->n_lf              ? "LF"
+                                           : "none";
   info->first_line = R[L->top].line_no;
   info->last_line = R[L->last].line_no;
   info->header_lines = info->first_line - 1;
@@ -793,8 +797,8 @@ hearth_status hearth_thermal_parse_csv_ex(const char *text, size_t len, const ch
   if (!name) name = "(thermal csv)";
   if (!text && len) return hearth_err_set(err, HEARTH_E_ARG, "%s: text is NULL", name);
   if (len > CSV_MAX_BYTES)
-    return hearth_err_set(err, HEARTH_E_LIMIT, "%s: %zu bytes exceeds the limit of %zu bytes",
-                          name, len, CSV_MAX_BYTES);
+    return hearth_err_set(err, HEARTH_E_LIMIT, "%s: %zu bytes exceeds the limit of %zu bytes", name,
+                          len, CSV_MAX_BYTES);
   size_t want_w = opts ? opts->width : 256, want_h = opts ? opts->height : 192;
   csv_text t;
   hearth_status st = csv_text_open(&t, text ? text : "", len, name, err);

@@ -20,7 +20,7 @@ typedef struct csv_ctx {
   const char *s;    /* UTF-8 or 8-bit text with '\n' line ends */
   size_t len;
   char sep;
-  int utf8;         /* columns count UTF-8 characters; else bytes */
+  int utf8; /* columns count UTF-8 characters; else bytes */
 } csv_ctx;
 
 /* one cell as found by the tokenizer */
@@ -104,10 +104,10 @@ int csv_utf8_valid(const char *s, size_t a, size_t b);
 /* ---- metadata (io_csv_text.c) ---------------------------------------------- */
 /* What the metadata lines say of the temperature unit. */
 typedef struct csv_unit {
-  int celsius;              /* a line says degC */
-  int other;                /* 1: another or an unknown unit (refused) */
-  size_t line, start, at;   /* where (line, line start, byte of the cell) */
-  char what[48];            /* the unit as written, printable */
+  int celsius;            /* a line says degC */
+  int other;              /* 1: another or an unknown unit (refused) */
+  size_t line, start, at; /* where (line, line start, byte of the cell) */
+  char what[48];          /* the unit as written, printable */
 } csv_unit;
 /* Look at the metadata line s[start..end) for a unit. */
 void csv_unit_scan(const csv_ctx *c, size_t line, size_t start, size_t end, csv_unit *u);

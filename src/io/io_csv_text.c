@@ -117,7 +117,10 @@ int csv_utf8_valid(const char *s, size_t a, size_t b) {
       i++;
       continue;
     }
-    size_t n = c >= 0xC2 && c <= 0xDF ? 1 : c >= 0xE0 && c <= 0xEF ? 2 : c >= 0xF0 && c <= 0xF4 ? 3 : 0;
+    size_t n = c >= 0xC2 && c <= 0xDF   ? 1
+               : c >= 0xE0 && c <= 0xEF ? 2
+               : c >= 0xF0 && c <= 0xF4 ? 3
+                                        : 0;
     if (!n || i + n >= b) return 0;
     unsigned c1 = u[i + 1];
     /* no overlong forms, surrogates or code points past U+10FFFF */
@@ -208,8 +211,8 @@ static void trim(const char *s, size_t *a, size_t *b) {
 /* Key and value spans of a line: see hearth_csv_meta. The value may be
  * several spans (cells), from index *v0 of sp; or one span (*va, *vb) cut
  * from a lone cell. */
-static void key_value(const csv_ctx *c, spans *sp, size_t *ka, size_t *kb, size_t *va,
-                      size_t *vb, size_t *v0) {
+static void key_value(const csv_ctx *c, spans *sp, size_t *ka, size_t *kb, size_t *va, size_t *vb,
+                      size_t *v0) {
   const char *s = c->s;
   *ka = *kb = *va = *vb = 0;
   *v0 = sp->n;
@@ -292,13 +295,12 @@ static int unit_at(const char *s, size_t i, size_t b, size_t *len) {
   static const struct {
     const char *w;
     int unit;
-  } words[] = {{"celsius", 'C'},       {"centigrade", 'C'},   {"fahrenheit", 'F'},
-               {"kelvin", 'K'},        {"degc", 'C'},         {"deg c", 'C'},
-               {"degf", 'F'},          {"deg f", 'F'},        {"\xE2\x84\x83", 'C'},
-               {"\xE2\x84\x89", 'F'}, {"\xA1\xE6", 'C'},     {"\xA1\xC9", 'C'},
+  } words[] = {{"celsius", 'C'},      {"centigrade", 'C'},   {"fahrenheit", 'F'}, {"kelvin", 'K'},
+               {"degc", 'C'},         {"deg c", 'C'},        {"degf", 'F'},       {"deg f", 'F'},
+               {"\xE2\x84\x83", 'C'}, {"\xE2\x84\x89", 'F'}, {"\xA1\xE6", 'C'},   {"\xA1\xC9", 'C'},
                {"\x81\x8E", 'C'}};
-  static const char *const degree[] = {"\xC2\xB0", "\xC2\xBA", "\xA1\xC6",
-                                       "\xA1\xE3", "\x81\x8B", "\xB0", "\xBA"};
+  static const char *const degree[] = {"\xC2\xB0", "\xC2\xBA", "\xA1\xC6", "\xA1\xE3",
+                                       "\x81\x8B", "\xB0",     "\xBA"};
   for (size_t w = 0; w < sizeof words / sizeof words[0]; w++) {
     size_t n = strlen(words[w].w);
     if (i + n <= b && has_word(s, i, i + n, words[w].w) &&

@@ -2,8 +2,8 @@
 #include <stdlib.h>
 #include "hearth/thermal.h"
 
-hearth_status hearth_thermal_write_csv(const char *path, const hearth_image *temps,
-                                       int decimals, hearth_err *err) {
+hearth_status hearth_thermal_write_csv(const char *path, const hearth_image *temps, int decimals,
+                                       hearth_err *err) {
   if (!path || !temps || !temps->data)
     return hearth_err_set(err, HEARTH_E_ARG, "thermal csv: NULL argument");
   if (temps->channels != 1 || temps->type != HEARTH_PIX_F32)
@@ -39,8 +39,8 @@ hearth_status hearth_thermal_write_csv(const char *path, const hearth_image *tem
       int m = hearth_format_fixed(buf + k, cap + 1 - k, v, decimals);
       if (m < 0) {
         free(buf);
-        return hearth_err_set(err, HEARTH_E_RANGE, "%s: pixel (%zu, %zu) cannot be formatted",
-                              path, x, y);
+        return hearth_err_set(err, HEARTH_E_RANGE, "%s: pixel (%zu, %zu) cannot be formatted", path,
+                              x, y);
       }
       k += (size_t)m;
       buf[k++] = x + 1 < w ? ',' : '\n';

@@ -15,12 +15,14 @@
 #include <string.h>
 
 /* RFC 1951: match lengths 3..258 by length code 257..285 */
-static const uint16_t k_len_base[29] = {3,  4,  5,  6,  7,  8,  9,  10, 11,  13,  15,  17,  19,  23, 27,
-                                        31, 35, 43, 51, 59, 67, 83, 99, 115, 131, 163, 195, 227, 258};
+static const uint16_t k_len_base[29] = {3,  4,  5,  6,   7,   8,   9,   10,  11, 13,
+                                        15, 17, 19, 23,  27,  31,  35,  43,  51, 59,
+                                        67, 83, 99, 115, 131, 163, 195, 227, 258};
 static const uint8_t k_len_extra[29] = {0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2,
                                         2, 3, 3, 3, 3, 4, 4, 4, 4, 5, 5, 5, 5, 0};
 /* the order in which the code-length code's lengths are sent */
-static const uint8_t k_cl_order[19] = {16, 17, 18, 0, 8, 7, 9, 6, 10, 5, 11, 4, 12, 3, 13, 2, 14, 1, 15};
+static const uint8_t k_cl_order[19] = {16, 17, 18, 0, 8,  7, 9,  6, 10, 5,
+                                       11, 4,  12, 3, 13, 2, 14, 1, 15};
 
 enum { N_LL = 286, N_CL = 19, END_OF_BLOCK = 256, MIN_RUN = 3, MAX_RUN = 258 };
 
@@ -290,7 +292,8 @@ int hearth_deflate_rle(const uint8_t *in, size_t n, int final, uint8_t *out, siz
     } else {
       unsigned L = t - 256, c = len_sym[L], s = 257 + c;
       /* the length code, its extra bits and the distance code (0, one bit) */
-      put_bits(&w, ll_code[s] | (uint32_t)(L - k_len_base[c]) << ll_len[s], ll_len[s] + k_len_extra[c] + 1);
+      put_bits(&w, ll_code[s] | (uint32_t)(L - k_len_base[c]) << ll_len[s],
+               ll_len[s] + k_len_extra[c] + 1);
     }
   }
   put_bits(&w, ll_code[END_OF_BLOCK], ll_len[END_OF_BLOCK]);

@@ -51,7 +51,7 @@ typedef struct jpeg_reader {
   size_t size;
   hearth_status status; /* our own check failures */
   char msg[256];
-  int want_gray;         /* decode to luma only (Y of a YCbCr file) */
+  int want_gray;                   /* decode to luma only (Y of a YCbCr file) */
   const hearth_image_expect *want; /* NULL: any image */
   hearth_image img;
 } jpeg_reader;
@@ -71,8 +71,7 @@ static int jpeg_decode(jpeg_reader *r) {
   }
   if (r->cinfo.data_precision != 8) {
     r->status = HEARTH_E_UNSUPPORTED;
-    snprintf(r->msg, sizeof r->msg, "%d-bit samples: expected 8-bit JPEG",
-             r->cinfo.data_precision);
+    snprintf(r->msg, sizeof r->msg, "%d-bit samples: expected 8-bit JPEG", r->cinfo.data_precision);
     return 2;
   }
   int channels;
@@ -158,10 +157,8 @@ static hearth_status jpeg_read_mem(const void *data, size_t size, const char *na
   /* safe even if creation failed: the struct was zeroed (no memory manager) */
   jpeg_destroy_decompress(&r->cinfo);
   hearth_status s = HEARTH_OK;
-  if (rc == 1)
-    s = hearth_err_set(err, HEARTH_E_PARSE, "%s: invalid JPEG: %s", name, r->jerr.msg);
-  else if (rc == 2)
-    s = hearth_err_set(err, r->status, "%s: %s", name, r->msg);
+  if (rc == 1) s = hearth_err_set(err, HEARTH_E_PARSE, "%s: invalid JPEG: %s", name, r->jerr.msg);
+  else if (rc == 2) s = hearth_err_set(err, r->status, "%s: %s", name, r->msg);
   if (s) hearth_image_free(&r->img);
   else *img = r->img;
   free(r);
@@ -246,8 +243,8 @@ hearth_status hearth_jpeg_write(const char *path, const hearth_image *img, int q
   if (quality < 1 || quality > 100)
     return hearth_err_set(err, HEARTH_E_RANGE, "%s: quality %d: expected 1..100", path, quality);
   if (img->width < 1 || img->height < 1 || img->width > 65500 || img->height > 65500)
-    return hearth_err_set(err, HEARTH_E_SIZE, "%s: image size %zux%zu: JPEG allows 1..65500",
-                          path, img->width, img->height);
+    return hearth_err_set(err, HEARTH_E_SIZE, "%s: image size %zux%zu: JPEG allows 1..65500", path,
+                          img->width, img->height);
   hearth_atomic_file af;
   hearth_status s = hearth_atomic_open(&af, path, err);
   if (s) return s;
@@ -268,8 +265,7 @@ hearth_status hearth_jpeg_write(const char *path, const hearth_image *img, int q
     if (e && ferror(af.fp))
       s = hearth_err_set(err, HEARTH_E_IO, "%s: cannot write JPEG: %s (%s)", path, strerror(e),
                          w->jerr.msg);
-    else
-      s = hearth_err_set(err, HEARTH_E_IO, "%s: cannot encode JPEG: %s", path, w->jerr.msg);
+    else s = hearth_err_set(err, HEARTH_E_IO, "%s: cannot encode JPEG: %s", path, w->jerr.msg);
     free(w);
     hearth_atomic_abort(&af);
     return s;

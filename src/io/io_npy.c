@@ -50,8 +50,8 @@ static void skip_ws(hdr *h) {
 }
 
 static hearth_status hdr_fail(hdr *h, hearth_status st, const char *what, const char *expected) {
-  return hearth_err_set(h->err, st, "%s: header byte %zu: %s, expected %s", h->name,
-                        h->base + h->i, what, expected);
+  return hearth_err_set(h->err, st, "%s: header byte %zu: %s, expected %s", h->name, h->base + h->i,
+                        what, expected);
 }
 
 static const char *found_desc(hdr *h, char *buf, size_t bufsz) {
@@ -146,8 +146,8 @@ static hearth_status read_dim(hdr *h, size_t *v) {
   size_t start = h->i, x = 0;
   while (h->i < h->n && h->s[h->i] >= '0' && h->s[h->i] <= '9') {
     size_t d = (size_t)(h->s[h->i] - '0');
-    if (x > (((size_t)-1) - d) / 10) return hdr_fail(h, HEARTH_E_LIMIT, "dimension overflows",
-                                                     "a dimension that fits in memory");
+    if (x > (((size_t)-1) - d) / 10)
+      return hdr_fail(h, HEARTH_E_LIMIT, "dimension overflows", "a dimension that fits in memory");
     x = x * 10 + d;
     h->i++;
   }
@@ -173,8 +173,8 @@ static hearth_status read_shape(hdr *h, int *ndim, size_t shape[4]) {
   }
   for (;;) {
     size_t d = 0;
-    if (k == 4) return hdr_fail(h, HEARTH_E_UNSUPPORTED, "more than 4 dimensions",
-                                "an array of rank 0..4");
+    if (k == 4)
+      return hdr_fail(h, HEARTH_E_UNSUPPORTED, "more than 4 dimensions", "an array of rank 0..4");
     if ((st = read_dim(h, &d))) return st;
     shape[k++] = d;
     skip_ws(h);
@@ -188,8 +188,7 @@ static hearth_status read_shape(hdr *h, int *ndim, size_t shape[4]) {
       continue;
     }
     if (h->i < h->n && h->s[h->i] == ')') {
-      if (k == 1)
-        return hdr_fail(h, HEARTH_E_PARSE, "'(n)' is not a tuple", "',' as in '(n,)'");
+      if (k == 1) return hdr_fail(h, HEARTH_E_PARSE, "'(n)' is not a tuple", "',' as in '(n,)'");
       h->i++;
       break;
     }
@@ -253,7 +252,7 @@ static hearth_status parse_dict(hdr *h, hearth_npy *out) {
   }
   if (!have_descr || !have_fortran || !have_shape)
     return hdr_fail(h, HEARTH_E_PARSE,
-                    !have_descr ? "missing 'descr'"
+                    !have_descr     ? "missing 'descr'"
                     : !have_fortran ? "missing 'fortran_order'"
                                     : "missing 'shape'",
                     "the keys 'descr', 'fortran_order' and 'shape'");
@@ -313,11 +312,15 @@ hearth_status hearth_npy_parse(const void *data, size_t size, const char *name, 
   for (int i = 0; i < out->ndim; i++)
     if (!hearth_mul_size(count, out->shape[i], &count)) {
       memset(out, 0, sizeof *out);
-      return hearth_err_set(err, HEARTH_E_LIMIT, "%s: shape overflows the address space, expected an array that fits in memory", name);
+      return hearth_err_set(
+          err, HEARTH_E_LIMIT,
+          "%s: shape overflows the address space, expected an array that fits in memory", name);
     }
   if (!hearth_mul_size(count, dtype_size(out->dtype), &bytes)) {
     memset(out, 0, sizeof *out);
-    return hearth_err_set(err, HEARTH_E_LIMIT, "%s: shape overflows the address space, expected an array that fits in memory", name);
+    return hearth_err_set(
+        err, HEARTH_E_LIMIT,
+        "%s: shape overflows the address space, expected an array that fits in memory", name);
   }
   size_t dstart = hstart + hlen, have = size - dstart, item = dtype_size(out->dtype);
   if (have != bytes) {
@@ -364,8 +367,7 @@ hearth_status hearth_npy_write(const char *path, hearth_npy_dtype dtype, int ndi
   if (dtype != HEARTH_NPY_F32 && dtype != HEARTH_NPY_U8)
     return hearth_err_set(err, HEARTH_E_ARG, "%s: dtype %d, expected F32 or U8", path, (int)dtype);
   if (ndim < 0 || ndim > 4 || (ndim > 0 && !shape))
-    return hearth_err_set(err, HEARTH_E_ARG, "%s: rank %d, expected 0..4 with a shape", path,
-                          ndim);
+    return hearth_err_set(err, HEARTH_E_ARG, "%s: rank %d, expected 0..4 with a shape", path, ndim);
   size_t count = 1, bytes;
   for (int i = 0; i < ndim; i++)
     if (!hearth_mul_size(count, shape[i], &count))

@@ -31,8 +31,8 @@ static int host_is_little_endian(void) {
 typedef struct png_reader {
   const uint8_t *data;
   size_t size, pos;
-  char msg[512];       /* libpng's error text */
-  char warn[256];      /* its first warning, which often explains the error */
+  char msg[512];        /* libpng's error text */
+  char warn[256];       /* its first warning, which often explains the error */
   hearth_status status; /* set by our own checks inside the decode */
   hearth_image img;
   png_bytep *rows;
@@ -152,8 +152,7 @@ static hearth_status png_read_mem(const void *data, size_t size, const char *nam
   r.data = data;
   r.size = size;
   r.want = want;
-  png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &r, on_png_error,
-                                           on_png_warning);
+  png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &r, on_png_error, on_png_warning);
   png_infop info = png ? png_create_info_struct(png) : NULL;
   if (!png || !info) {
     png_destroy_read_struct(png ? &png : NULL, NULL, NULL);
@@ -169,8 +168,7 @@ static hearth_status png_read_mem(const void *data, size_t size, const char *nam
       hearth_status s = HEARTH_E_PARSE;
       if (strstr(r.msg, "limit") || strstr(r.warn, "limit")) s = HEARTH_E_LIMIT;
       else if (strstr(r.msg, "memory")) s = HEARTH_E_NOMEM;
-      if (r.warn[0])
-        return hearth_err_set(err, s, "%s: invalid PNG: %s (%s)", name, r.msg, r.warn);
+      if (r.warn[0]) return hearth_err_set(err, s, "%s: invalid PNG: %s (%s)", name, r.msg, r.warn);
       return hearth_err_set(err, s, "%s: invalid PNG: %s", name, r.msg);
     }
     return hearth_err_set(err, r.status, "%s: %s", name, r.msg);
@@ -203,17 +201,14 @@ hearth_status hearth_png_read(const char *path, hearth_image *img, hearth_err *e
 /* ---- writing ------------------------------------------------------------------ */
 
 static hearth_status check_writable(const hearth_image *img, const char *name, hearth_err *err) {
-  if (!img || !img->data)
-    return hearth_err_set(err, HEARTH_E_ARG, "%s: no image to write", name);
+  if (!img || !img->data) return hearth_err_set(err, HEARTH_E_ARG, "%s: no image to write", name);
   if (img->type != HEARTH_PIX_U8 && img->type != HEARTH_PIX_U16)
     return hearth_err_set(err, HEARTH_E_UNSUPPORTED,
                           "%s: PNG stores U8 or U16 pixels, not %d-byte samples", name,
                           (int)img->type);
   if (img->channels < 1 || img->channels > 4)
-    return hearth_err_set(err, HEARTH_E_ARG, "%s: %d channels: expected 1..4", name,
-                          img->channels);
-  if (img->width < 1 || img->height < 1 || img->width > 0x7fffffffu ||
-      img->height > 0x7fffffffu)
+    return hearth_err_set(err, HEARTH_E_ARG, "%s: %d channels: expected 1..4", name, img->channels);
+  if (img->width < 1 || img->height < 1 || img->width > 0x7fffffffu || img->height > 0x7fffffffu)
     return hearth_err_set(err, HEARTH_E_SIZE, "%s: image size %zux%zu cannot be stored in PNG",
                           name, img->width, img->height);
   if (hearth_image_bytes(img) == 0)
@@ -239,11 +234,11 @@ static hearth_status check_writable(const hearth_image *img, const char *name, h
 typedef struct band_job {
   const hearth_image *img;
   size_t stride, bpp, n_bands;
-  uint8_t **out;      /* per band: its deflate output */
+  uint8_t **out; /* per band: its deflate output */
   size_t *out_len;
-  uLong *adler;       /* per band: Adler-32 of its filtered bytes */
+  uLong *adler; /* per band: Adler-32 of its filtered bytes */
   size_t *raw_len;
-  int *failed;        /* per band */
+  int *failed; /* per band */
 } band_job;
 
 static void encode_bands(void *ctx, size_t b, size_t e, int t) {
@@ -256,7 +251,8 @@ static void encode_bands(void *ctx, size_t b, size_t e, int t) {
   for (size_t band = b; band < e; band++) {
     j->failed[band] = 1;
     if (!raw) continue;
-    size_t y0 = band * PNG_BAND_ROWS, y1 = y0 + PNG_BAND_ROWS < img->height ? y0 + PNG_BAND_ROWS : img->height;
+    size_t y0 = band * PNG_BAND_ROWS,
+           y1 = y0 + PNG_BAND_ROWS < img->height ? y0 + PNG_BAND_ROWS : img->height;
     for (size_t y = y0; y < y1; y++) {
       const uint8_t *src = (const uint8_t *)img->data + y * j->stride;
       uint8_t *dst = raw + (y - y0) * rowb;
@@ -278,7 +274,8 @@ static void encode_bands(void *ctx, size_t b, size_t e, int t) {
     j->raw_len[band] = n;
     j->adler[band] = adler32(adler32(0L, Z_NULL, 0), raw, (uInt)n);
     j->out[band] = malloc(hearth_deflate_bound(n));
-    if (j->out[band] && hearth_deflate_rle(raw, n, band + 1 == j->n_bands, j->out[band], &j->out_len[band]))
+    if (j->out[band] &&
+        hearth_deflate_rle(raw, n, band + 1 == j->n_bands, j->out[band], &j->out_len[band]))
       j->failed[band] = 0;
   }
   free(raw);
@@ -311,8 +308,15 @@ static hearth_status png_encode_mem(const hearth_image *img, const char *name, u
   *size = 0;
   size_t bpp = (size_t)img->channels * (size_t)img->type, stride = img->width * bpp;
   size_t nb = (img->height + PNG_BAND_ROWS - 1) / PNG_BAND_ROWS;
-  band_job j = {img, stride, bpp, nb, calloc(nb, sizeof(uint8_t *)), calloc(nb, sizeof(size_t)),
-                calloc(nb, sizeof(uLong)), calloc(nb, sizeof(size_t)), calloc(nb, sizeof(int))};
+  band_job j = {img,
+                stride,
+                bpp,
+                nb,
+                calloc(nb, sizeof(uint8_t *)),
+                calloc(nb, sizeof(size_t)),
+                calloc(nb, sizeof(uLong)),
+                calloc(nb, sizeof(size_t)),
+                calloc(nb, sizeof(int))};
   hearth_status s = HEARTH_OK;
   if (!j.out || !j.out_len || !j.adler || !j.raw_len || !j.failed) {
     s = hearth_err_set(err, HEARTH_E_NOMEM, "%s: out of memory encoding PNG", name);
@@ -353,8 +357,8 @@ static hearth_status png_encode_mem(const hearth_image *img, const char *name, u
   uint8_t ztail[4];
   hearth_png_put32(ztail, (uint32_t)adler);
   for (size_t k = 0; k < nb; k++)
-    o = hearth_png_put_chunk(o, "IDAT", k == 0 ? zhdr : NULL, k == 0 ? 2 : 0, j.out[k], j.out_len[k],
-                             k + 1 == nb ? ztail : NULL, k + 1 == nb ? 4 : 0);
+    o = hearth_png_put_chunk(o, "IDAT", k == 0 ? zhdr : NULL, k == 0 ? 2 : 0, j.out[k],
+                             j.out_len[k], k + 1 == nb ? ztail : NULL, k + 1 == nb ? 4 : 0);
   o = hearth_png_put_chunk(o, "IEND", NULL, 0, NULL, 0, NULL, 0);
   *out = buf;
   *size = (size_t)(o - buf);

@@ -32,8 +32,7 @@ hearth_status hearth_turbo_image(const hearth_image *temps, double lo, double hi
   if (!temps || !temps->data || temps->type != HEARTH_PIX_F32 || temps->channels != 1)
     return hearth_err_set(err, HEARTH_E_ARG, "turbo: expected a 1-channel F32 image");
   if (!isfinite(lo) || !isfinite(hi) || !(hi > lo))
-    return hearth_err_set(err, HEARTH_E_RANGE, "turbo: range [%g, %g]: expected lo < hi", lo,
-                          hi);
+    return hearth_err_set(err, HEARTH_E_RANGE, "turbo: range [%g, %g]: expected lo < hi", lo, hi);
   hearth_status s = hearth_image_alloc(rgb, temps->width, temps->height, 3, HEARTH_PIX_U8, err);
   if (s) return s;
   static const uint8_t k_black[3] = {0, 0, 0};

@@ -29,8 +29,8 @@ int map_worker_alloc(map_worker *w, const hearth_map_layout *l, int C, int recor
   w->splats = hearth_alloc_array(np, sizeof(splat));
   w->touches = hearth_alloc_array(np, 4 * sizeof(touch));
   w->touches_tmp = hearth_alloc_array(np, 4 * sizeof(touch));
-  int ok = w->hit_t && w->hit_tri && w->hit_b1 && w->hit_b2 && w->ray_org && w->ray_dir && w->hits && w->sil &&
-           w->splats && w->touches && w->touches_tmp;
+  int ok = w->hit_t && w->hit_tri && w->hit_b1 && w->hit_b2 && w->ray_org && w->ray_dir &&
+           w->hits && w->sil && w->splats && w->touches && w->touches_tmp;
   if (l->fan) {
     w->fan_scratch = calloc(1, hearth_ray_fan_scratch_size(l->fan, l->mesh->n_vertices));
     ok &= w->fan_scratch != NULL;
@@ -62,7 +62,8 @@ void map_worker_free(map_worker *w) {
 }
 
 static float image_value(const hearth_image *img, size_t idx, int c) {
-  if (img->type == HEARTH_PIX_F32) return ((const float *)img->data)[idx * (size_t)img->channels + (size_t)c];
+  if (img->type == HEARTH_PIX_F32)
+    return ((const float *)img->data)[idx * (size_t)img->channels + (size_t)c];
   return (float)((const uint8_t *)img->data)[idx * (size_t)img->channels + (size_t)c];
 }
 
@@ -77,7 +78,8 @@ typedef struct pix_box {
 } pix_box;
 
 /* record a hit (or a miss) of grid pixel p = (px, py) */
-static void keep_hit(map_worker *w, size_t p, size_t px, size_t py, const hearth_ray_hit *h, pix_box *box) {
+static void keep_hit(map_worker *w, size_t p, size_t px, size_t py, const hearth_ray_hit *h,
+                     pix_box *box) {
   if (h->prim != UINT32_MAX && h->front) {
     if (px < box->x0) box->x0 = px;
     if (px > box->x1) box->x1 = px;
@@ -99,7 +101,8 @@ static void keep_hit(map_worker *w, size_t p, size_t px, size_t py, const hearth
 static void cast_fan(map_ctx *m, size_t v, map_worker *w, pix_box *box) {
   const hearth_map_layout *l = m->l;
   size_t fb[4];
-  if (hearth_ray_fan_cast(l->fan, l->mesh, &m->views[v].T_world_from_cam, w->fan_scratch, w->hits, fb, NULL)) {
+  if (hearth_ray_fan_cast(l->fan, l->mesh, &m->views[v].T_world_from_cam, w->fan_scratch, w->hits,
+                          fb, NULL)) {
     m->failed = 2; /* cannot happen: the bounding sphere lies in front */
     return;
   }
@@ -134,7 +137,8 @@ static void cast_rays(const map_ctx *m, size_t v, map_worker *w, pix_box *box) {
     size_t p = l->tile_order[i];
     const float *d = l->pix_dir + 3 * p;
     double wd[3];
-    for (int k = 0; k < 3; k++) wd[k] = T->R[3 * k] * d[0] + T->R[3 * k + 1] * d[1] + T->R[3 * k + 2] * d[2];
+    for (int k = 0; k < 3; k++)
+      wd[k] = T->R[3 * k] * d[0] + T->R[3 * k + 1] * d[1] + T->R[3 * k + 2] * d[2];
     /* squared distance of the sphere centre from the ray (unit direction),
      * or from the origin when the centre lies behind it */
     double along = oc[0] * wd[0] + oc[1] * wd[1] + oc[2] * wd[2];
@@ -147,7 +151,8 @@ static void cast_rays(const map_ctx *m, size_t v, map_worker *w, pix_box *box) {
   }
   /* views already run in parallel: cast on this thread only, unless there
      is a single worker for all views */
-  hearth_raycast_batch_mt(m->rc, n, org, dir, 0.0f, INFINITY, hits, m->n_threads > 1 ? 1 : m->cast_threads);
+  hearth_raycast_batch_mt(m->rc, n, org, dir, 0.0f, INFINITY, hits,
+                          m->n_threads > 1 ? 1 : m->cast_threads);
   for (size_t i = 0; i < n; i++) {
     size_t p = l->tile_order[i];
     hearth_ray_hit h = hits[i];
@@ -169,8 +174,8 @@ static void cast_rays(const map_ctx *m, size_t v, map_worker *w, pix_box *box) {
  * minimum and maximum filters of the hit distance (a miss is +inf). Only
  * pixels inside box (the hits' bounding box) get flags; the filters read up
  * to 2 pixels beyond it, where ht holds the misses. */
-static void silhouettes(const hearth_map_layout *l, const float *ht, const pix_box *box, float *lo, float *hi,
-                        float *tmp_lo, float *tmp_hi, uint8_t *sil) {
+static void silhouettes(const hearth_map_layout *l, const float *ht, const pix_box *box, float *lo,
+                        float *hi, float *tmp_lo, float *tmp_hi, uint8_t *sil) {
   size_t W = l->pw, H = l->ph;
   size_t ry0 = box->y0 >= 2 ? box->y0 - 2 : 0, ry1 = box->y1 + 2 < H ? box->y1 + 2 : H - 1;
   for (size_t y = ry0; y <= ry1; y++) {
@@ -237,7 +242,8 @@ static size_t splat_hits(const map_ctx *m, size_t v, map_worker *w, const pix_bo
       if (edges && sil[p]) continue;
       const float *nrm = l->tri_normal + 3 * (size_t)tri, *dc = l->pix_dir + 3 * p;
       float d[3];
-      for (int k = 0; k < 3; k++) d[k] = (float)(Rw[3 * k] * dc[0] + Rw[3 * k + 1] * dc[1] + Rw[3 * k + 2] * dc[2]);
+      for (int k = 0; k < 3; k++)
+        d[k] = (float)(Rw[3 * k] * dc[0] + Rw[3 * k + 1] * dc[1] + Rw[3 * k + 2] * dc[2]);
       float cosv = -(nrm[0] * d[0] + nrm[1] * d[1] + nrm[2] * d[2]);
       if (cosv < min_cos) continue;
       hits++;
@@ -304,8 +310,8 @@ static const touch *sorted_touches(map_worker *w, size_t n_sp, size_t R, size_t 
 }
 
 /* max fusion: a view's mean at texel q folded into a worker's maxima */
-static inline void fold_max(uint32_t *mc, float *mcos, uint32_t q, int C, float wsum, float best_cos,
-                            const float sum[3]) {
+static inline void fold_max(uint32_t *mc, float *mcos, uint32_t q, int C, float wsum,
+                            float best_cos, const float sum[3]) {
   /* + 0.0f: a negative zero becomes +0, so equal means give one code */
   if (mcos && best_cos > mcos[q]) mcos[q] = best_cos;
   for (int c = 0; c < C; c++) {
@@ -315,7 +321,8 @@ static inline void fold_max(uint32_t *mc, float *mcos, uint32_t q, int C, float 
 }
 
 /* mean and robust fusion: a view's record of texel q, at d (see REC_WORDS) */
-static inline void put_record(float *d, int mean, int C, float wsum, float best_cos, const float sum[3]) {
+static inline void put_record(float *d, int mean, int C, float wsum, float best_cos,
+                              const float sum[3]) {
   d[0] = wsum;
   d[1] = best_cos;
   /* + 0.0f: a negative zero becomes +0, so equal means cannot make the

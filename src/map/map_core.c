@@ -28,8 +28,8 @@ void hearth_map_result_free(hearth_map_result *r) {
 
 /* the views' channels in *C (1: F32 gray temperatures, 3: U8 RGB; 1 when
    there is no view), each view's image checked against the camera */
-static hearth_status view_channels(const hearth_camera *cam, const hearth_map_view *views, size_t n_views,
-                                   int *C_out, hearth_err *err) {
+static hearth_status view_channels(const hearth_camera *cam, const hearth_map_view *views,
+                                   size_t n_views, int *C_out, hearth_err *err) {
   int C = 0;
   for (size_t v = 0; v < n_views; v++) {
     const hearth_image *im = views[v].image;
@@ -37,10 +37,13 @@ static hearth_status view_channels(const hearth_camera *cam, const hearth_map_vi
     if (im->width != (size_t)cam->width || im->height != (size_t)cam->height)
       return hearth_err_set(err, HEARTH_E_SIZE, "map: view %zu is %zux%zu, the camera is %dx%d", v,
                             im->width, im->height, cam->width, cam->height);
-    int c = im->type == HEARTH_PIX_F32 && im->channels == 1 ? 1
-            : im->type == HEARTH_PIX_U8 && im->channels >= 3 ? 3 : 0;
-    if (!c) return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "map: view %zu: need F32 gray or U8 RGB", v);
-    if (C && c != C) return hearth_err_set(err, HEARTH_E_INCONSISTENT, "map: views mix image kinds");
+    int c = im->type == HEARTH_PIX_F32 && im->channels == 1  ? 1
+            : im->type == HEARTH_PIX_U8 && im->channels >= 3 ? 3
+                                                             : 0;
+    if (!c)
+      return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "map: view %zu: need F32 gray or U8 RGB", v);
+    if (C && c != C)
+      return hearth_err_set(err, HEARTH_E_INCONSISTENT, "map: views mix image kinds");
     C = c;
   }
   *C_out = C ? C : 1;
@@ -50,8 +53,8 @@ static hearth_status view_channels(const hearth_camera *cam, const hearth_map_vi
 /* A view whose camera has the whole mesh (its bounding sphere, with a
    margin) in front is rasterised through the fan; any other view casts
    rays. Sets view_fan[v]; returns whether any view casts rays. */
-static int choose_fan_views(const hearth_map_layout *l, const hearth_map_view *views, size_t n_views,
-                            const hearth_map_opts *opts, uint8_t *view_fan) {
+static int choose_fan_views(const hearth_map_layout *l, const hearth_map_view *views,
+                            size_t n_views, const hearth_map_opts *opts, uint8_t *view_fan) {
   const double *sphere = l->sphere;
   int need_rays = 0;
   for (size_t v = 0; v < n_views; v++) {
@@ -93,7 +96,8 @@ static void free_phase_state(map_ctx *m) {
 /* The result's arrays (observed and best_cos made here unless max fusion's
    maps are them) and the fusion into them, band by band, gathering the
    islands' boxes for the fill into *parts (n_threads sets, made here). */
-static hearth_status fuse_views(map_ctx *m, hearth_map_result *out, island_box **parts, hearth_err *err) {
+static hearth_status fuse_views(map_ctx *m, hearth_map_result *out, island_box **parts,
+                                hearth_err *err) {
   const size_t R = m->l->R, N = R * R, C = (size_t)m->C;
   const int nt = m->n_threads, want_cos = !m->opts->skip_best_cos;
   out->R = R;
@@ -161,10 +165,11 @@ static hearth_status count_texels(hearth_map_result *out, int nt, hearth_err *er
   return HEARTH_OK;
 }
 
-hearth_status hearth_map_views_with_layout(const hearth_map_layout *l, const hearth_raycaster *rc_in,
-                                          const hearth_map_view *views, size_t n_views,
-                                          const hearth_map_opts *opts_in, hearth_map_result *out,
-                                          hearth_map_timing *timing, hearth_err *err) {
+hearth_status hearth_map_views_with_layout(const hearth_map_layout *l,
+                                           const hearth_raycaster *rc_in,
+                                           const hearth_map_view *views, size_t n_views,
+                                           const hearth_map_opts *opts_in, hearth_map_result *out,
+                                           hearth_map_timing *timing, hearth_err *err) {
   double t_start = hearth_now();
   memset(out, 0, sizeof *out);
   hearth_map_opts opts;
@@ -173,9 +178,10 @@ hearth_status hearth_map_views_with_layout(const hearth_map_layout *l, const hea
   if (opts.pixel_stride < 1) opts.pixel_stride = 1;
   if (!views && n_views) return hearth_err_set(err, HEARTH_E_ARG, "map: missing views");
   if (opts.resolution != l->R || (size_t)opts.pixel_stride != l->stride)
-    return hearth_err_set(err, HEARTH_E_INCONSISTENT,
-                          "map: the layout was made for resolution %zu, stride %zu; asked for %zu, %d", l->R,
-                          l->stride, opts.resolution, opts.pixel_stride);
+    return hearth_err_set(
+        err, HEARTH_E_INCONSISTENT,
+        "map: the layout was made for resolution %zu, stride %zu; asked for %zu, %d", l->R,
+        l->stride, opts.resolution, opts.pixel_stride);
   int C = 0;
   hearth_status s = view_channels(&l->cam, views, n_views, &C, err);
   if (s) return s;
@@ -201,8 +207,14 @@ hearth_status hearth_map_views_with_layout(const hearth_map_layout *l, const hea
   }
   int nt = opts.threads > 0 ? opts.threads : hearth_default_threads();
   if ((size_t)nt > n_views) nt = n_views ? (int)n_views : 1;
-  m = (map_ctx){.l = l, .rc = rc_in ? rc_in : own_rc, .views = views, .n_views = n_views, .opts = &opts,
-                .C = C, .n_threads = nt, .cast_threads = opts.threads > 0 ? opts.threads : hearth_default_threads(),
+  m = (map_ctx){.l = l,
+                .rc = rc_in ? rc_in : own_rc,
+                .views = views,
+                .n_views = n_views,
+                .opts = &opts,
+                .C = C,
+                .n_threads = nt,
+                .cast_threads = opts.threads > 0 ? opts.threads : hearth_default_threads(),
                 .view_fan = view_fan};
   if (!alloc_phase_state(&m, &mx, &rec, out)) {
     s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory for %d threads at R=%zu", nt, l->R);
@@ -210,7 +222,8 @@ hearth_status hearth_map_views_with_layout(const hearth_map_layout *l, const hea
   }
   hearth_parallel_chunks(n_views, 1, nt, map_cast_views, &m);
   if (m.failed == 2) {
-    s = hearth_err_set(err, HEARTH_E_NUMERIC, "map: a view's camera does not have the mesh in front after all");
+    s = hearth_err_set(err, HEARTH_E_NUMERIC,
+                       "map: a view's camera does not have the mesh in front after all");
     goto done;
   }
   if (m.failed) {
@@ -222,8 +235,8 @@ hearth_status hearth_map_views_with_layout(const hearth_map_layout *l, const hea
   if ((s = fuse_views(&m, out, &parts, err))) goto done;
   double t_fill0 = hearth_now();
   if (timing) timing->fuse = t_fill0 - t_fuse0;
-  if (map_fill_islands(l->R, (size_t)C, l->island_of_texel, l->n_islands, parts, nt, out->mask, out->observed,
-                       out->filled, nt)) {
+  if (map_fill_islands(l->R, (size_t)C, l->island_of_texel, l->n_islands, parts, nt, out->mask,
+                       out->observed, out->filled, nt)) {
     s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory while filling");
     goto done;
   }
@@ -264,7 +277,7 @@ hearth_status hearth_map_views_timed(const hearth_mesh *mesh, const hearth_rayca
 
 hearth_status hearth_map_views(const hearth_mesh *mesh, const hearth_raycaster *rc,
                                const hearth_camera *cam, const hearth_map_view *views,
-                               size_t n_views, const hearth_map_opts *opts,
-                               hearth_map_result *out, hearth_err *err) {
+                               size_t n_views, const hearth_map_opts *opts, hearth_map_result *out,
+                               hearth_err *err) {
   return hearth_map_views_timed(mesh, rc, cam, views, n_views, opts, out, NULL, err);
 }

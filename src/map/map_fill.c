@@ -26,8 +26,8 @@ static void box_add_run(island_box *bx, size_t x0, size_t x1, size_t y, int seed
 }
 
 /* run by run of one island along each row */
-void map_fill_prepare_rows(size_t R, size_t C, const uint32_t *island_of_texel, size_t y0, size_t y1,
-                           hearth_map_result *out, island_box *box) {
+void map_fill_prepare_rows(size_t R, size_t C, const uint32_t *island_of_texel, size_t y0,
+                           size_t y1, hearth_map_result *out, island_box *box) {
   for (size_t y = y0; y < y1; y++) {
     const size_t row = y * R;
     uint32_t run_isl = UINT32_MAX;
@@ -62,13 +62,13 @@ void map_fill_prepare_rows(size_t R, size_t C, const uint32_t *island_of_texel, 
 typedef struct fill_ctx {
   size_t R, C;
   const uint32_t *island_of_texel;
-  uint8_t *mask;         /* observed texels in; filled ones marked */
+  uint8_t *mask; /* observed texels in; filled ones marked */
   const float *observed;
-  float *filled;         /* out: the filled texels' values */
+  float *filled; /* out: the filled texels' values */
   const island_box *box;
   const uint32_t *order; /* islands with work, largest box first */
   uint32_t n;
-  int *failed;           /* per worker: out of memory */
+  int *failed; /* per worker: out of memory */
 } fill_ctx;
 
 static size_t box_area(const island_box *b) {
@@ -77,11 +77,11 @@ static size_t box_area(const island_box *b) {
 
 /* one island's scratch over its W x H box; the fill of the island owns it */
 typedef struct island_scratch {
-  int16_t *srow;  /* W * H: nearest seed row in the column, -1 none (rows < R <= 16384 fit) */
-  int16_t *cur;   /* W */
-  int32_t *env;   /* W: columns on the lower envelope */
-  int64_t *zn;    /* W + 1: where each takes over from the one before: x = zn / zd */
-  int64_t *zd;    /* exactly (zd > 0; the first has none) */
+  int16_t *srow; /* W * H: nearest seed row in the column, -1 none (rows < R <= 16384 fit) */
+  int16_t *cur;  /* W */
+  int32_t *env;  /* W: columns on the lower envelope */
+  int64_t *zn;   /* W + 1: where each takes over from the one before: x = zn / zd */
+  int64_t *zd;   /* exactly (zd > 0; the first has none) */
 } island_scratch;
 
 static void island_scratch_free(island_scratch *s) {
@@ -94,7 +94,8 @@ static void island_scratch_free(island_scratch *s) {
 
 /* pass 1: the nearest seed row above (downward sweep), then below; a texel
    is a seed exactly where the downward sweep put its own row */
-static void nearest_seed_rows(const fill_ctx *c, uint32_t isl, size_t W, size_t H, island_scratch *s) {
+static void nearest_seed_rows(const fill_ctx *c, uint32_t isl, size_t W, size_t H,
+                              island_scratch *s) {
   const island_box *b = &c->box[isl];
   const uint32_t *iot = c->island_of_texel;
   const uint8_t *mask = c->mask;
@@ -221,9 +222,9 @@ static void merge_boxes(const island_box *parts, int nw, uint32_t n_islands, isl
   }
 }
 
-hearth_status map_fill_islands(size_t R, size_t C, const uint32_t *island_of_texel, uint32_t n_islands,
-                               const island_box *parts, int nw, uint8_t *mask, const float *observed,
-                               float *filled, int nthreads) {
+hearth_status map_fill_islands(size_t R, size_t C, const uint32_t *island_of_texel,
+                               uint32_t n_islands, const island_box *parts, int nw, uint8_t *mask,
+                               const float *observed, float *filled, int nthreads) {
   island_box *box = hearth_alloc_array((size_t)n_islands + 1, sizeof *box);
   isl_work *work = hearth_alloc_array((size_t)n_islands + 1, sizeof *work);
   uint32_t *order = hearth_alloc_array((size_t)n_islands + 1, sizeof *order);

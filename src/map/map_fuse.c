@@ -108,7 +108,7 @@ typedef struct band_scratch {
   uint32_t *cnt; /* robust: records per texel of a band, then offsets */
   vw *all;       /* robust: every record's pair of the band, texel by texel */
   size_t all_cap;
-  vw *tmp;       /* robust: one texel's pairs, sorted */
+  vw *tmp; /* robust: one texel's pairs, sorted */
 } band_scratch;
 
 /* texels [q0, q1), max fusion: the workers' maxima, decoded (worker 0's
@@ -148,7 +148,8 @@ static void clear_band(const map_ctx *m, hearth_map_result *out, size_t q0, size
 
 /* texels [q0, q1), mean fusion: each view counts with its total weight at
    a texel */
-static void fold_mean(const map_ctx *m, hearth_map_result *out, band_scratch *bs, size_t q0, size_t q1) {
+static void fold_mean(const map_ctx *m, hearth_map_result *out, band_scratch *bs, size_t q0,
+                      size_t q1) {
   const view_records *r = m->rec;
   const size_t C = (size_t)m->C, RW = REC_WORDS(C);
   double *acc = bs->acc;
@@ -175,7 +176,8 @@ static void fold_mean(const map_ctx *m, hearth_map_result *out, band_scratch *bs
 /* texels [q0, q1), robust fusion (one channel): the weighted median of
    every view's (value, weight) at a texel, gathered in view order. Returns
    0 out of memory. */
-static int fold_robust(const map_ctx *m, hearth_map_result *out, band_scratch *bs, size_t q0, size_t q1) {
+static int fold_robust(const map_ctx *m, hearth_map_result *out, band_scratch *bs, size_t q0,
+                       size_t q1) {
   const view_records *r = m->rec;
   const size_t RW = REC_WORDS(m->C), nq = q1 - q0;
   uint32_t *cnt = bs->cnt;
@@ -229,7 +231,8 @@ void map_fuse_bands(void *ctx, size_t b, size_t e, int t) {
     bs.cnt = hearth_alloc_array(band + 1, sizeof *bs.cnt);
     bs.tmp = hearth_alloc_array(nv ? nv : 1, sizeof *bs.tmp);
   }
-  if ((fusion == HEARTH_FUSE_MEAN && !bs.acc) || (fusion == HEARTH_FUSE_ROBUST && (!bs.cnt || !bs.tmp))) {
+  if ((fusion == HEARTH_FUSE_MEAN && !bs.acc) ||
+      (fusion == HEARTH_FUSE_ROBUST && (!bs.cnt || !bs.tmp))) {
     fp->nomem[t] = 1;
     goto done;
   }

@@ -32,13 +32,13 @@ struct hearth_map_layout {
   uint32_t *island_of_tri;
   uint32_t *island_of_texel; /* R * R; UINT32_MAX off the surface */
   uint32_t n_islands;
-  float *tri_normal;        /* 3 per triangle, unit */
-  double sphere[4];         /* mesh bounding sphere: rays that miss it are not cast */
-  size_t pw, ph, np;        /* pixel grid: every stride-th pixel */
-  float *pix_dir;           /* 3 per grid pixel, camera frame, unit (0: never cast) */
-  uint32_t *pix_index;      /* image pixel index of each grid pixel */
-  uint32_t *tile_order;     /* grid pixels in 4x4 tiles: coherent packets of 16 */
-  hearth_ray_fan *fan;      /* the pixel grid as a ray fan; NULL where it cannot hold it */
+  float *tri_normal;    /* 3 per triangle, unit */
+  double sphere[4];     /* mesh bounding sphere: rays that miss it are not cast */
+  size_t pw, ph, np;    /* pixel grid: every stride-th pixel */
+  float *pix_dir;       /* 3 per grid pixel, camera frame, unit (0: never cast) */
+  uint32_t *pix_index;  /* image pixel index of each grid pixel */
+  uint32_t *tile_order; /* grid pixels in 4x4 tiles: coherent packets of 16 */
+  hearth_ray_fan *fan;  /* the pixel grid as a ray fan; NULL where it cannot hold it */
 };
 
 /* a view's record of a texel: the texel's index (in the q arrays), then
@@ -72,14 +72,15 @@ typedef struct touch {
 typedef struct map_worker {
   float *hit_t, *hit_b1, *hit_b2; /* np: the hit distance (+inf: none) and barycentrics */
   uint32_t *hit_tri;              /* np: the hit triangle (UINT32_MAX: none) */
-  float *ray_org, *ray_dir;       /* 3 * np: traced rays; after the cast, the silhouette filters' scratch */
-  hearth_ray_hit *hits;           /* np */
-  uint8_t *sil;                   /* np: silhouette flags */
-  splat *splats;                  /* np */
-  touch *touches, *touches_tmp;   /* 4 * np: a view's touches and the sort's second buffer */
-  void *fan_scratch;              /* the ray fan's scratch (NULL without a fan) */
-  uint32_t *rec_q;                /* 4 * np: mean and robust fusion: a view's records, made */
-  float *rec_d;                   /* here, then kept in view_records (NULL for max fusion) */
+  float *ray_org,
+      *ray_dir;         /* 3 * np: traced rays; after the cast, the silhouette filters' scratch */
+  hearth_ray_hit *hits; /* np */
+  uint8_t *sil;         /* np: silhouette flags */
+  splat *splats;        /* np */
+  touch *touches, *touches_tmp; /* 4 * np: a view's touches and the sort's second buffer */
+  void *fan_scratch;            /* the ray fan's scratch (NULL without a fan) */
+  uint32_t *rec_q;              /* 4 * np: mean and robust fusion: a view's records, made */
+  float *rec_d;                 /* here, then kept in view_records (NULL for max fusion) */
 } map_worker;
 
 /* Max fusion: each worker folds its views' means into maps of its own (the
@@ -108,15 +109,15 @@ typedef struct map_ctx {
   const hearth_map_view *views;
   size_t n_views;
   const hearth_map_opts *opts;
-  int C;               /* channels */
-  int n_threads;       /* workers over views */
-  int cast_threads;    /* threads for ray casting when one worker does every view */
+  int C;                   /* channels */
+  int n_threads;           /* workers over views */
+  int cast_threads;        /* threads for ray casting when one worker does every view */
   const uint8_t *view_fan; /* per view: the mesh lies in front, the fan applies */
-  map_worker *workers; /* n_threads */
-  max_maps *max;       /* max fusion, else NULL */
-  view_records *rec;   /* mean and robust fusion, else NULL */
-  uint32_t *view_hits; /* per view: pixels on the surface */
-  _Atomic int failed;  /* 1 out of memory, 2 a view not in front after all */
+  map_worker *workers;     /* n_threads */
+  max_maps *max;           /* max fusion, else NULL */
+  view_records *rec;       /* mean and robust fusion, else NULL */
+  uint32_t *view_hits;     /* per view: pixels on the surface */
+  _Atomic int failed;      /* 1 out of memory, 2 a view not in front after all */
 } map_ctx;
 
 /* a float as an unsigned integer of the same order (-0 below +0, NaN not
@@ -174,13 +175,13 @@ void map_fuse_bands(void *ctx, size_t b, size_t e, int t);
 /* For rows [y0, y1) of fused maps: the mask of the observed texels, the
  * filled map as far as observed (NaN elsewhere, for the fill to write),
  * and the islands' boxes grown by the rows' texels. */
-void map_fill_prepare_rows(size_t R, size_t C, const uint32_t *island_of_texel, size_t y0, size_t y1,
-                           hearth_map_result *out, island_box *box);
+void map_fill_prepare_rows(size_t R, size_t C, const uint32_t *island_of_texel, size_t y0,
+                           size_t y1, hearth_map_result *out, island_box *box);
 /* Fill every island that has observed texels and unobserved ones, from the
  * islands' boxes (nw sets of n_islands + 1); writes filled and marks mask
  * for filled texels. */
-hearth_status map_fill_islands(size_t R, size_t C, const uint32_t *island_of_texel, uint32_t n_islands,
-                               const island_box *parts, int nw, uint8_t *mask, const float *observed,
-                               float *filled, int nthreads);
+hearth_status map_fill_islands(size_t R, size_t C, const uint32_t *island_of_texel,
+                               uint32_t n_islands, const island_box *parts, int nw, uint8_t *mask,
+                               const float *observed, float *filled, int nthreads);
 
 #endif

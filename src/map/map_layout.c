@@ -40,7 +40,8 @@ static void *grid_build_run(void *arg) {
         if (isnan(g->pix_dir[k])) g->pix_dir[k] = 0.0f;
   }
   for (size_t y = 0; y < ph; y++)
-    for (size_t x = 0; x < pw; x++) g->pix_index[y * pw + x] = (uint32_t)(y * st * (size_t)g->cam->width + x * st);
+    for (size_t x = 0; x < pw; x++)
+      g->pix_index[y * pw + x] = (uint32_t)(y * st * (size_t)g->cam->width + x * st);
   size_t k = 0;
   for (size_t ty = 0; ty < ph; ty += 4)
     for (size_t tx = 0; tx < pw; tx += 4)
@@ -75,7 +76,8 @@ static void tri_normals(void *ctx, size_t b, size_t e, int t) {
     const uint32_t *ix = mesh->indices + 3 * i;
     const float *a = mesh->positions + 3 * ix[0], *bb = mesh->positions + 3 * ix[1],
                 *c = mesh->positions + 3 * ix[2];
-    double e1[3] = {bb[0] - a[0], bb[1] - a[1], bb[2] - a[2]}, e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    double e1[3] = {bb[0] - a[0], bb[1] - a[1], bb[2] - a[2]},
+           e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
     double nn[3];
     hearth_cross3(e1, e2, nn);
     double len = hearth_norm3(nn);
@@ -105,11 +107,13 @@ static hearth_status alloc_grid(hearth_map_layout *l, hearth_err *err) {
   l->ph = ((size_t)l->cam.height + st - 1) / st;
   l->np = l->pw * l->ph;
   if (l->np > UINT32_MAX / 4)
-    return hearth_err_set(err, HEARTH_E_LIMIT, "map: a %zu x %zu pixel grid exceeds the limit", l->pw, l->ph);
+    return hearth_err_set(err, HEARTH_E_LIMIT, "map: a %zu x %zu pixel grid exceeds the limit",
+                          l->pw, l->ph);
   l->pix_dir = hearth_alloc_array(l->np, 3 * sizeof *l->pix_dir);
   l->pix_index = hearth_alloc_array(l->np, sizeof *l->pix_index);
   l->tile_order = hearth_alloc_array(l->np, sizeof *l->tile_order);
-  if (!l->pix_dir || !l->pix_index || !l->tile_order) return hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
+  if (!l->pix_dir || !l->pix_index || !l->tile_order)
+    return hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
   const size_t nt = l->mesh->n_triangles;
   l->island_of_tri = hearth_alloc_array(nt ? nt : 1, sizeof *l->island_of_tri);
   if (!l->island_of_tri) return hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
@@ -127,8 +131,9 @@ static hearth_status build_layout(hearth_map_layout *l, hearth_err *err) {
   int gb_started = 0, isl_started = 0;
   hearth_status s = alloc_grid(l, err);
   if (s) goto done;
-  gb = (grid_build){&l->cam, l->stride, l->pw, l->ph, l->pix_dir, l->pix_index, l->tile_order, NULL, 0,
-                    mesh, l->island_of_tri, 0, HEARTH_OK, {0}};
+  gb = (grid_build){&l->cam,       l->stride, l->pw, l->ph, l->pix_dir,       l->pix_index,
+                    l->tile_order, NULL,      0,     mesh,  l->island_of_tri, 0,
+                    HEARTH_OK,     {0}};
   gb_started = pthread_create(&gb_tid, NULL, grid_build_run, &gb) == 0;
   if (!gb_started) grid_build_run(&gb); /* no thread: make it here */
   isl_started = pthread_create(&isl_tid, NULL, islands_run, &gb) == 0;
@@ -183,11 +188,14 @@ hearth_status hearth_map_layout_new(const hearth_mesh *mesh, const hearth_camera
   if (opts_in) opts = *opts_in;
   else hearth_map_opts_default(&opts);
   if (!mesh || !cam) return hearth_err_set(err, HEARTH_E_ARG, "map: missing mesh or camera");
-  if (!mesh->uvs) return hearth_err_set(err, HEARTH_E_NOT_FOUND, "map: the mesh has no UVs (TEXCOORD_0)");
+  if (!mesh->uvs)
+    return hearth_err_set(err, HEARTH_E_NOT_FOUND, "map: the mesh has no UVs (TEXCOORD_0)");
   size_t R = opts.resolution;
-  if (R < 2 || R > 16384) return hearth_err_set(err, HEARTH_E_RANGE, "map: resolution %zu outside 2..16384", R);
+  if (R < 2 || R > 16384)
+    return hearth_err_set(err, HEARTH_E_RANGE, "map: resolution %zu outside 2..16384", R);
   if (opts.pixel_stride < 1) opts.pixel_stride = 1;
-  if (cam->width <= 0 || cam->height <= 0) return hearth_err_set(err, HEARTH_E_ARG, "map: camera has no size");
+  if (cam->width <= 0 || cam->height <= 0)
+    return hearth_err_set(err, HEARTH_E_ARG, "map: camera has no size");
   hearth_status s = hearth_mesh_validate(mesh, "map mesh", err);
   if (s) return s;
   hearth_map_layout *l = calloc(1, sizeof *l);

@@ -16,8 +16,7 @@
 
 #define PATH_SZ 4096
 
-static hearth_status joinf(char *buf, const char *fmt, ...)
-    __attribute__((format(printf, 2, 3)));
+static hearth_status joinf(char *buf, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 static hearth_status joinf(char *buf, const char *fmt, ...) {
   va_list ap;
   va_start(ap, fmt);
@@ -126,8 +125,9 @@ static hearth_status write_provenance(const char *path, const hearth_map_job *jo
   json_object_set_new(pj, "min_cos", json_real(job->map.min_cos));
   json_object_set_new(pj, "views", json_string(job->views && *job->views ? job->views : "all"));
   json_object_set_new(pj, "keep_edges", json_boolean(job->map.keep_edges));
-  json_object_set_new(pj, "visibility", json_string(job->map.trace_rays ? "traced rays"
-                                                                         : "rasterised where the mesh is in front"));
+  json_object_set_new(pj, "visibility",
+                      json_string(job->map.trace_rays ? "traced rays"
+                                                      : "rasterised where the mesh is in front"));
   json_object_set_new(pj, "turbo_range_c", vec_json((double[]){job->turbo_lo, job->turbo_hi}, 2));
   json_object_set_new(pj, "splat", json_string("bilinear"));
   json_object_set_new(pj, "fill", json_string("nearest observed texel within the UV island"));
@@ -177,8 +177,11 @@ static void read_csv_range(void *ctx, size_t b, size_t e, int t) {
   (void)t;
   for (size_t k = b; k < e; k++) {
     char path[PATH_SZ];
-    if (joinf(path, "%s/instances/%s/raw/%s/%s", c->root, c->inst, c->state, c->man->views[c->idx[k]].thermal)) {
-      c->st[k] = hearth_err_set(&c->errs[k], HEARTH_E_LIMIT, "%s/instances/%s/raw/%s: path too long", c->root, c->inst, c->state);
+    if (joinf(path, "%s/instances/%s/raw/%s/%s", c->root, c->inst, c->state,
+              c->man->views[c->idx[k]].thermal)) {
+      c->st[k] =
+          hearth_err_set(&c->errs[k], HEARTH_E_LIMIT, "%s/instances/%s/raw/%s: path too long",
+                         c->root, c->inst, c->state);
       continue;
     }
     c->st[k] = hearth_thermal_read_csv_camera(path, c->opts.width, c->opts.height, c->rig_path,
@@ -214,7 +217,8 @@ static void write_outputs(void *ctx, size_t b, size_t e, int t) {
       hearth_image tex = {0};
       const uint8_t black[3] = {0, 0, 0};
       s = hearth_map_texture(o->r, o->lo, o->hi, 4, black, &tex, err);
-      if (!s && !(s = joinf(path, "%s/thermal_turbo.png", o->dir))) s = hearth_png_write(path, &tex, err);
+      if (!s && !(s = joinf(path, "%s/thermal_turbo.png", o->dir)))
+        s = hearth_png_write(path, &tex, err);
       hearth_image_free(&tex);
     }
     if (s && !err->msg[0]) hearth_err_set(err, s, "%s: path too long", o->dir);
@@ -281,8 +285,9 @@ hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats
   if ((s = hearth_rig_read(rig_path, &rig, err))) goto done;
   if ((s = hearth_manifest_read(man_path, &man, err))) goto done;
   if (strcmp(man.instance, inst) || strcmp(man.state, job->state)) {
-    s = hearth_err_set(err, HEARTH_E_INCONSISTENT, "%s: names instance '%s' state '%s', expected '%s' '%s'",
-                       man_path, man.instance, man.state, inst, job->state);
+    s = hearth_err_set(err, HEARTH_E_INCONSISTENT,
+                       "%s: names instance '%s' state '%s', expected '%s' '%s'", man_path,
+                       man.instance, man.state, inst, job->state);
     goto done;
   }
   if ((s = hearth_poses_read(poses_path, &poses, err))) goto done;
@@ -298,8 +303,8 @@ hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats
     const hearth_view_files *vf = &man.views[idx[k]];
     const hearth_view_pose *vp = hearth_poses_find(&poses, job->state, vf->view);
     if (!vp) {
-      s = hearth_err_set(err, HEARTH_E_NOT_FOUND, "%s: no pose for state '%s' view '%s'", poses_path,
-                         job->state, vf->view);
+      s = hearth_err_set(err, HEARTH_E_NOT_FOUND, "%s: no pose for state '%s' view '%s'",
+                         poses_path, job->state, vf->view);
       goto done;
     }
     views[k].image = &imgs[k];
@@ -314,7 +319,16 @@ hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats
   if (!lb_started) layout_build_run(&lb);
   /* the CSVs in parallel; the first failing view (in order) is reported */
   {
-    csv_jobs cj = {root, inst, job->state, &man, idx, imgs, {(size_t)rig.thermal.width, (size_t)rig.thermal.height}, NULL, NULL, rig_path};
+    csv_jobs cj = {root,
+                   inst,
+                   job->state,
+                   &man,
+                   idx,
+                   imgs,
+                   {(size_t)rig.thermal.width, (size_t)rig.thermal.height},
+                   NULL,
+                   NULL,
+                   rig_path};
     cj.st = calloc(n ? n : 1, sizeof *cj.st);
     cj.errs = calloc(n ? n : 1, sizeof *cj.errs);
     if (!cj.st || !cj.errs) {
@@ -377,7 +391,8 @@ hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats
     if ((s = first_failure(oj.st, oj.errs, 2, err))) goto done;
   }
   joinf(path, "%s/provenance.json", tmp_dir);
-  if ((s = write_provenance(path, job, &man, idx, n, &r, &rig, rig_path, poses_path, mesh_path, err)))
+  if ((s = write_provenance(path, job, &man, idx, n, &r, &rig, rig_path, poses_path, mesh_path,
+                            err)))
     goto done;
   if ((s = hearth_replace_dir(tmp_dir, out_dir, err))) goto done;
   tmp_dir[0] = 0;
@@ -479,8 +494,8 @@ hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err) {
   if (!job || !job->root || !job->instance)
     return hearth_err_set(err, HEARTH_E_ARG, "bake: root and instance are required");
   const char *root = job->root, *inst = job->instance;
-  char rig_path[PATH_SZ], poses_path[PATH_SZ], mesh_path[PATH_SZ], man_path[PATH_SZ],
-      path[PATH_SZ], state[HEARTH_NAME_MAX];
+  char rig_path[PATH_SZ], poses_path[PATH_SZ], mesh_path[PATH_SZ], man_path[PATH_SZ], path[PATH_SZ],
+      state[HEARTH_NAME_MAX];
   if (job->rig_path) snprintf(rig_path, PATH_SZ, "%s", job->rig_path);
   else joinf(rig_path, "%s/calibration/rig.json", root);
   if (job->poses_path) snprintf(poses_path, PATH_SZ, "%s", job->poses_path);
@@ -529,8 +544,8 @@ hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err) {
     const hearth_view_files *vf = &man.views[k];
     const hearth_view_pose *vp = hearth_poses_find(&poses, state, vf->view);
     if (!vp) {
-      s = hearth_err_set(err, HEARTH_E_NOT_FOUND, "%s: no pose for state '%s' view '%s'", poses_path,
-                         state, vf->view);
+      s = hearth_err_set(err, HEARTH_E_NOT_FOUND, "%s: no pose for state '%s' view '%s'",
+                         poses_path, state, vf->view);
       goto done;
     }
     joinf(path, "%s/instances/%s/raw/%s/%s", root, inst, state, vf->rgb);
@@ -544,7 +559,8 @@ hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err) {
       goto done;
     }
     /* a frame of another size stays whole: the mapping refuses it */
-    if (grid.dir && imgs[k].width == (size_t)rig.rgb.width && imgs[k].height == (size_t)rig.rgb.height &&
+    if (grid.dir && imgs[k].width == (size_t)rig.rgb.width &&
+        imgs[k].height == (size_t)rig.rgb.height &&
         (s = bake_sparse(&grid, &mesh, &vp->T_world_from_cam, &imgs[k], err)))
       goto done;
     views[k].image = &imgs[k];

@@ -32,8 +32,8 @@ enum { TEX_NONE = 0, TEX_COLOUR = 1, TEX_LISTED = 2 };
 typedef struct colour_job {
   const hearth_map_result *r;
   uint8_t *px, *have;
-  uint32_t *cand;  /* the frontier pass: each row chunk's candidates at its first texel */
-  size_t *n_cand;  /* per row chunk (FRONTIER_ROWS rows) */
+  uint32_t *cand; /* the frontier pass: each row chunk's candidates at its first texel */
+  size_t *n_cand; /* per row chunk (FRONTIER_ROWS rows) */
   const uint8_t (*lut)[3];
   int lut_n;
   double lo, scale;
@@ -104,7 +104,8 @@ hearth_status hearth_map_texture(const hearth_map_result *r, double lo, double h
   const size_t n_chunks = (R + FRONTIER_ROWS - 1) / FRONTIER_ROWS;
   uint8_t *have = hearth_alloc_array(N, 1);
   uint8_t(*lut)[3] = C == 1 ? malloc(sizeof(uint8_t[LUT_N][3])) : NULL;
-  uint32_t *cand = hearth_alloc_array(N, sizeof *cand), *fresh = hearth_alloc_array(N, sizeof *fresh);
+  uint32_t *cand = hearth_alloc_array(N, sizeof *cand),
+           *fresh = hearth_alloc_array(N, sizeof *fresh);
   uint8_t *rgb = hearth_alloc_array(N, 3);
   size_t *n_cand = calloc(n_chunks, sizeof *n_cand);
   if (!have || (C == 1 && !lut) || !cand || !fresh || !rgb || !n_cand) {
@@ -113,7 +114,10 @@ hearth_status hearth_map_texture(const hearth_map_result *r, double lo, double h
     goto done;
   }
   for (int i = 0; C == 1 && i < LUT_N; i++) hearth_turbo((double)i / (LUT_N - 1), lut[i]);
-  colour_job cj = {r, px, have, cand, n_cand, (const uint8_t(*)[3])lut, LUT_N, lo, (LUT_N - 1) / (hi - lo), nan_rgb};
+  colour_job cj = {r,      px,     have,
+                   cand,   n_cand, (const uint8_t(*)[3])lut,
+                   LUT_N,  lo,     (LUT_N - 1) / (hi - lo),
+                   nan_rgb};
   hearth_parallel_chunks(R, 32, 0, colour_rows, &cj);
   /* padding: each round, a texel without colour takes the mean of its
      coloured 4-neighbours (deterministic: reads the previous round only).
@@ -139,7 +143,8 @@ hearth_status hearth_map_texture(const hearth_map_result *r, double lo, double h
           for (int c = 0; c < 3; c++) acc[c] += px[3 * nb[j] + (size_t)c];
           n++;
         }
-      for (int c = 0; c < 3; c++) rgb[3 * i + (size_t)c] = (uint8_t)((acc[c] + n / 2) / (n ? n : 1));
+      for (int c = 0; c < 3; c++)
+        rgb[3 * i + (size_t)c] = (uint8_t)((acc[c] + n / 2) / (n ? n : 1));
     }
     for (size_t i = 0; i < nc; i++) {
       memcpy(px + 3 * (size_t)cand[i], rgb + 3 * i, 3);

@@ -15,8 +15,8 @@ void hearth_mesh_free(hearth_mesh *m) {
   memset(m, 0, sizeof *m);
 }
 
-hearth_status hearth_mesh_alloc(hearth_mesh *m, size_t n_vertices, size_t n_triangles,
-                                int with_uvs, hearth_err *err) {
+hearth_status hearth_mesh_alloc(hearth_mesh *m, size_t n_vertices, size_t n_triangles, int with_uvs,
+                                hearth_err *err) {
   memset(m, 0, sizeof *m);
   size_t nv3, nt3, nv2;
   if (!hearth_mul_size(n_vertices, 3, &nv3) || !hearth_mul_size(n_triangles, 3, &nt3) ||
@@ -25,8 +25,7 @@ hearth_status hearth_mesh_alloc(hearth_mesh *m, size_t n_vertices, size_t n_tria
                           n_vertices, n_triangles);
   if (n_vertices > (size_t)UINT32_MAX)
     return hearth_err_set(err, HEARTH_E_LIMIT,
-                          "mesh of %zu vertices: more than 32-bit indices can address",
-                          n_vertices);
+                          "mesh of %zu vertices: more than 32-bit indices can address", n_vertices);
   /* allocate at least one element so a zero-size mesh still has buffers */
   m->positions = hearth_alloc_array(nv3 ? nv3 : 1, sizeof(float));
   m->indices = hearth_alloc_array(nt3 ? nt3 : 1, sizeof(uint32_t));
@@ -44,17 +43,15 @@ hearth_status hearth_mesh_alloc(hearth_mesh *m, size_t n_vertices, size_t n_tria
 
 hearth_status hearth_mesh_copy(const hearth_mesh *src, hearth_mesh *dst, hearth_err *err) {
   hearth_mesh out;
-  hearth_status s = hearth_mesh_alloc(&out, src->n_vertices, src->n_triangles, src->uvs != NULL,
-                                      err);
+  hearth_status s =
+      hearth_mesh_alloc(&out, src->n_vertices, src->n_triangles, src->uvs != NULL, err);
   if (s != HEARTH_OK) {
     memset(dst, 0, sizeof *dst);
     return s;
   }
   if (src->n_vertices) memcpy(out.positions, src->positions, src->n_vertices * 3 * sizeof(float));
-  if (src->uvs && src->n_vertices)
-    memcpy(out.uvs, src->uvs, src->n_vertices * 2 * sizeof(float));
-  if (src->n_triangles)
-    memcpy(out.indices, src->indices, src->n_triangles * 3 * sizeof(uint32_t));
+  if (src->uvs && src->n_vertices) memcpy(out.uvs, src->uvs, src->n_vertices * 2 * sizeof(float));
+  if (src->n_triangles) memcpy(out.indices, src->indices, src->n_triangles * 3 * sizeof(uint32_t));
   out.texture = src->texture;
   out.texture.data = NULL;
   if (src->texture.data) {
@@ -113,8 +110,8 @@ hearth_status hearth_mesh_validate(const hearth_mesh *m, const char *name, heart
                             "%s: vertex %zu: position (%g, %g, %g) is not finite", name, i,
                             (double)p[0], (double)p[1], (double)p[2]);
     if (m->uvs && (!isfinite(m->uvs[i * 2]) || !isfinite(m->uvs[i * 2 + 1])))
-      return hearth_err_set(err, HEARTH_E_RANGE, "%s: vertex %zu: UV (%g, %g) is not finite",
-                            name, i, (double)m->uvs[i * 2], (double)m->uvs[i * 2 + 1]);
+      return hearth_err_set(err, HEARTH_E_RANGE, "%s: vertex %zu: UV (%g, %g) is not finite", name,
+                            i, (double)m->uvs[i * 2], (double)m->uvs[i * 2 + 1]);
   }
   for (size_t t = 0; t < m->n_triangles; t++)
     for (int k = 0; k < 3; k++) {

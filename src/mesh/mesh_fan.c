@@ -71,8 +71,9 @@ const float *hearth_ray_fan_dirs(const hearth_ray_fan *f, size_t *w, size_t *h) 
  * p1, p2 swapped. |g'| <= G1 and |g''| <= G2 over the box; a direction's
  * second derivative is at most max(|xx|, |yy|) + |xy|. */
 static void lens_curvature(const hearth_camera *cam, float A, float B, float *hu, float *hv) {
-  const float k1 = (float)fabs(cam->dist[0]), k2 = (float)fabs(cam->dist[1]), p1 = (float)fabs(cam->dist[2]),
-              p2 = (float)fabs(cam->dist[3]), k3 = (float)fabs(cam->dist[4]);
+  const float k1 = (float)fabs(cam->dist[0]), k2 = (float)fabs(cam->dist[1]),
+              p1 = (float)fabs(cam->dist[2]), p2 = (float)fabs(cam->dist[3]),
+              k3 = (float)fabs(cam->dist[4]);
   float S = A * A + B * B;
   float G1 = k1 + S * (2.0f * k2 + 3.0f * k3 * S), G2 = 2.0f * k2 + 6.0f * k3 * S;
   float xxu = 6.0f * A * G1 + 4.0f * A * A * A * G2 + 6.0f * p2;
@@ -92,9 +93,11 @@ hearth_status hearth_ray_fan_new(const hearth_camera *cam, size_t stride, hearth
   if (stride < 1) stride = 1;
   if (cam->width <= 0 || cam->height <= 0 || !(cam->fx > 0.0) || !(cam->fy > 0.0))
     return hearth_err_set(err, HEARTH_E_ARG, "ray fan: the camera has no size or focal length");
-  size_t pw = ((size_t)cam->width + stride - 1) / stride, ph = ((size_t)cam->height + stride - 1) / stride;
+  size_t pw = ((size_t)cam->width + stride - 1) / stride,
+         ph = ((size_t)cam->height + stride - 1) / stride;
   if (pw > (size_t)INT32_MAX / 2 || ph > (size_t)INT32_MAX / 2 || pw * ph > (size_t)UINT32_MAX / 2)
-    return hearth_err_set(err, HEARTH_E_LIMIT, "ray fan: %zu x %zu pixels exceed the limit", pw, ph);
+    return hearth_err_set(err, HEARTH_E_LIMIT, "ray fan: %zu x %zu pixels exceed the limit", pw,
+                          ph);
   hearth_ray_fan *f = calloc(1, sizeof *f);
   if (!f) return hearth_err_set(err, HEARTH_E_NOMEM, "ray fan: out of memory");
   f->cam = *cam;
@@ -106,7 +109,8 @@ hearth_status hearth_ray_fan_new(const hearth_camera *cam, size_t stride, hearth
   f->pt = hearth_alloc_array(f->n, 2 * sizeof *f->pt);
   if (!f->dirs || !f->pt) {
     hearth_ray_fan_free(f);
-    return hearth_err_set(err, HEARTH_E_NOMEM, "ray fan: out of memory for %zu x %zu pixels", pw, ph);
+    return hearth_err_set(err, HEARTH_E_NOMEM, "ray fan: out of memory for %zu x %zu pixels", pw,
+                          ph);
   }
   hearth_camera_ray_grid(cam, stride, f->dirs);
   /* the pixels' points, and how far the lens map puts each point from its
@@ -158,7 +162,8 @@ typedef struct fan_best {
 } fan_best;
 
 size_t hearth_ray_fan_scratch_size(const hearth_ray_fan *f, size_t n_vertices) {
-  return (n_vertices ? n_vertices : 1) * (sizeof(fan_vertex) + sizeof(float)) + f->n * sizeof(fan_best);
+  return (n_vertices ? n_vertices : 1) * (sizeof(fan_vertex) + sizeof(float)) +
+         f->n * sizeof(fan_best);
 }
 
 /* one edge of a triangle: from its lower-index endpoint (ax, ay) along
@@ -212,14 +217,16 @@ hearth_status hearth_ray_fan_cast(const hearth_ray_fan *f, const hearth_mesh *m,
   /* vertices into the camera frame (x_cam = R^T (x - t)), projected to the
      plane and through the lens to pixels; one float value per vertex, shared
      by all its triangles */
-  const float r00 = (float)R[0], r01 = (float)R[1], r02 = (float)R[2], r10 = (float)R[3], r11 = (float)R[4],
-              r12 = (float)R[5], r20 = (float)R[6], r21 = (float)R[7], r22 = (float)R[8];
+  const float r00 = (float)R[0], r01 = (float)R[1], r02 = (float)R[2], r10 = (float)R[3],
+              r11 = (float)R[4], r12 = (float)R[5], r20 = (float)R[6], r21 = (float)R[7],
+              r22 = (float)R[8];
   const float t0 = (float)t[0], t1 = (float)t[1], t2 = (float)t[2];
   /* the pixels in float: their rounding (about 1e-7 relative, some 1e-4
      pixel) is far inside the slack */
-  const float kd[5] = {(float)cam->dist[0], (float)cam->dist[1], (float)cam->dist[2], (float)cam->dist[3],
-                       (float)cam->dist[4]};
-  const float ffx = (float)cam->fx, ffy = (float)cam->fy, fcx = (float)cam->cx, fcy = (float)cam->cy;
+  const float kd[5] = {(float)cam->dist[0], (float)cam->dist[1], (float)cam->dist[2],
+                       (float)cam->dist[3], (float)cam->dist[4]};
+  const float ffx = (float)cam->fx, ffy = (float)cam->fy, fcx = (float)cam->cx,
+              fcy = (float)cam->cy;
   int behind = 0;
   const float *restrict pos = m->positions;
   /* in blocks of 64: the positions split into one array per coordinate,
@@ -264,9 +271,10 @@ hearth_status hearth_ray_fan_cast(const hearth_ray_fan *f, const hearth_mesh *m,
       const float *p = pos + 3 * i;
       float z = r02 * (p[0] - t0) + r12 * (p[1] - t1) + r22 * (p[2] - t2);
       if (!(z > 0.0f))
-        return hearth_err_set(err, HEARTH_E_UNSUPPORTED,
-                              "ray fan: vertex %zu is not in front of the camera (z = %g): cast rays instead", i,
-                              (double)z);
+        return hearth_err_set(
+            err, HEARTH_E_UNSUPPORTED,
+            "ray fan: vertex %zu is not in front of the camera (z = %g): cast rays instead", i,
+            (double)z);
     }
   long bx0 = LONG_MAX, bx1 = -1, by0 = LONG_MAX, by1 = -1; /* the hits' box */
   const float slack = f->slack, inv_st = 1.0f / (float)f->stride;
@@ -300,8 +308,10 @@ hearth_status hearth_ray_fan_cast(const hearth_ray_fan *f, const hearth_mesh *m,
       if (!(A <= f->ax && B <= f->ay)) lens_curvature(cam, A, B, &hu, &hv);
       float mu = hu * d2 + slack, mv = hv * d2 + slack;
       long i0, i1, j0, j1;
-      grid_range((min3f(a->u, b->u, c->u) - mu) * inv_st, (max3f(a->u, b->u, c->u) + mu) * inv_st, pw, &i0, &i1);
-      grid_range((min3f(a->v, b->v, c->v) - mv) * inv_st, (max3f(a->v, b->v, c->v) + mv) * inv_st, ph, &j0, &j1);
+      grid_range((min3f(a->u, b->u, c->u) - mu) * inv_st, (max3f(a->u, b->u, c->u) + mu) * inv_st,
+                 pw, &i0, &i1);
+      grid_range((min3f(a->v, b->v, c->v) - mv) * inv_st, (max3f(a->v, b->v, c->v) + mv) * inv_st,
+                 ph, &j0, &j1);
       cand[nc].tri = (uint32_t)tri;
       cand[nc].i0 = (int32_t)i0;
       cand[nc].i1 = (int32_t)i1;
@@ -350,13 +360,15 @@ hearth_status hearth_ray_fan_cast(const hearth_ray_fan *f, const hearth_mesh *m,
       }
       const uint32_t *ix = m->indices + 3 * (size_t)best[p].tri;
       float x = f->pt[2 * p], y = f->pt[2 * p + 1];
-      fan_edge ea = edge_of(V, ix[1], ix[2]), eb = edge_of(V, ix[2], ix[0]), ec = edge_of(V, ix[0], ix[1]);
-      double wa = (double)edge_eval(&ea, x, y) * IZ[ix[0]], wb = (double)edge_eval(&eb, x, y) * IZ[ix[1]],
+      fan_edge ea = edge_of(V, ix[1], ix[2]), eb = edge_of(V, ix[2], ix[0]),
+               ec = edge_of(V, ix[0], ix[1]);
+      double wa = (double)edge_eval(&ea, x, y) * IZ[ix[0]],
+             wb = (double)edge_eval(&eb, x, y) * IZ[ix[1]],
              wc = (double)edge_eval(&ec, x, y) * IZ[ix[2]], ws = wa + wb + wc;
       /* depth 1/w along z; the distance along the unit direction is
          depth / d_z */
-      hits[p] = (hearth_ray_hit){(float)(1.0 / ((double)best[p].w * (double)f->dirs[3 * p + 2])), best[p].tri,
-                                 (float)(wb / ws), (float)(wc / ws), 1};
+      hits[p] = (hearth_ray_hit){(float)(1.0 / ((double)best[p].w * (double)f->dirs[3 * p + 2])),
+                                 best[p].tri, (float)(wb / ws), (float)(wc / ws), 1};
       best[p] = (fan_best){0.0f, 0};
     }
   return HEARTH_OK;

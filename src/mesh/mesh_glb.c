@@ -97,32 +97,35 @@ typedef struct glb_inst_list {
 
 static const char *mode_name(long long mode) {
   switch (mode) {
-  case 0: return "POINTS";
-  case 1: return "LINES";
-  case 2: return "LINE_LOOP";
-  case 3: return "LINE_STRIP";
-  case 4: return "TRIANGLES";
-  case 5: return "TRIANGLE_STRIP";
-  case 6: return "TRIANGLE_FAN";
-  default: return "unknown";
+    case 0: return "POINTS";
+    case 1: return "LINES";
+    case 2: return "LINE_LOOP";
+    case 3: return "LINE_STRIP";
+    case 4: return "TRIANGLES";
+    case 5: return "TRIANGLE_STRIP";
+    case 6: return "TRIANGLE_FAN";
+    default: return "unknown";
   }
 }
 
 static size_t comp_size_of(long long t) {
   switch (t) {
-  case GL_BYTE:
-  case GL_UNSIGNED_BYTE: return 1;
-  case GL_SHORT:
-  case GL_UNSIGNED_SHORT: return 2;
-  case GL_UNSIGNED_INT:
-  case GL_FLOAT: return 4;
-  default: return 0;
+    case GL_BYTE:
+    case GL_UNSIGNED_BYTE: return 1;
+    case GL_SHORT:
+    case GL_UNSIGNED_SHORT: return 2;
+    case GL_UNSIGNED_INT:
+    case GL_FLOAT: return 4;
+    default: return 0;
   }
 }
 
 static size_t ncomp_of(const char *type) {
-  static const struct { const char *s; size_t n; } tab[] = {
-      {"SCALAR", 1}, {"VEC2", 2}, {"VEC3", 3}, {"VEC4", 4}, {"MAT2", 4}, {"MAT3", 9}, {"MAT4", 16}};
+  static const struct {
+    const char *s;
+    size_t n;
+  } tab[] = {{"SCALAR", 1}, {"VEC2", 2}, {"VEC3", 3}, {"VEC4", 4},
+             {"MAT2", 4},   {"MAT3", 9}, {"MAT4", 16}};
   for (size_t i = 0; i < sizeof tab / sizeof tab[0]; i++)
     if (strcmp(type, tab[i].s) == 0) return tab[i].n;
   return 0;
@@ -183,8 +186,8 @@ static hearth_status resolve_accessor(glb_ctx *c, size_t idx, const char *where,
   if ((s = get_uint(c, acc, "bufferView", at, 0, &view_idx, &has_view))) return s;
   a->comp_size = comp_size_of((long long)ctype);
   if (!a->comp_size)
-    return hearth_err_set(c->err, HEARTH_E_PARSE, "%s: %s: invalid componentType %zu", c->name,
-                          at, ctype);
+    return hearth_err_set(c->err, HEARTH_E_PARSE, "%s: %s: invalid componentType %zu", c->name, at,
+                          ctype);
   json_t *type = json_object_get(acc, "type");
   if (!json_is_string(type) || !(a->ncomp = ncomp_of(json_string_value(type))))
     return hearth_err_set(c->err, HEARTH_E_PARSE, "%s: %s: invalid or missing \"type\"", c->name,
@@ -193,8 +196,8 @@ static hearth_status resolve_accessor(glb_ctx *c, size_t idx, const char *where,
     return hearth_err_set(c->err, HEARTH_E_PARSE, "%s: %s: count must be at least 1", c->name, at);
   json_t *norm = json_object_get(acc, "normalized");
   if (norm && !json_is_boolean(norm))
-    return hearth_err_set(c->err, HEARTH_E_PARSE, "%s: %s.normalized: expected a boolean",
-                          c->name, at);
+    return hearth_err_set(c->err, HEARTH_E_PARSE, "%s: %s.normalized: expected a boolean", c->name,
+                          at);
   a->normalized = norm && json_is_true(norm);
   a->comp_type = (int)ctype;
   a->count = count;
@@ -215,8 +218,8 @@ static hearth_status resolve_accessor(glb_ctx *c, size_t idx, const char *where,
   if (has_stride) {
     if (stride < 4 || stride > 252 || stride % 4)
       return hearth_err_set(c->err, HEARTH_E_PARSE,
-                            "%s: %s: byteStride %zu must be a multiple of 4 in [4, 252]",
-                            c->name, vat, stride);
+                            "%s: %s: byteStride %zu must be a multiple of 4 in [4, 252]", c->name,
+                            vat, stride);
     if (stride < elem)
       return hearth_err_set(c->err, HEARTH_E_PARSE,
                             "%s: %s: byteStride %zu is smaller than the %zu-byte element of %s",
@@ -266,19 +269,19 @@ static double acc_get(const glb_acc *a, size_t i, size_t comp) {
   if (!a->base) return 0.0;
   const uint8_t *p = a->base + i * a->stride + comp * a->comp_size;
   switch (a->comp_type) {
-  case GL_FLOAT: return rd_f32(p);
-  case GL_UNSIGNED_BYTE: return a->normalized ? p[0] / 255.0 : p[0];
-  case GL_UNSIGNED_SHORT: return a->normalized ? rd_u16(p) / 65535.0 : rd_u16(p);
-  case GL_UNSIGNED_INT: return rd_u32(p);
-  case GL_BYTE: {
-    double v = (int8_t)p[0];
-    return a->normalized ? fmax(v / 127.0, -1.0) : v;
-  }
-  case GL_SHORT: {
-    double v = (int16_t)rd_u16(p);
-    return a->normalized ? fmax(v / 32767.0, -1.0) : v;
-  }
-  default: return 0.0;
+    case GL_FLOAT: return rd_f32(p);
+    case GL_UNSIGNED_BYTE: return a->normalized ? p[0] / 255.0 : p[0];
+    case GL_UNSIGNED_SHORT: return a->normalized ? rd_u16(p) / 65535.0 : rd_u16(p);
+    case GL_UNSIGNED_INT: return rd_u32(p);
+    case GL_BYTE: {
+      double v = (int8_t)p[0];
+      return a->normalized ? fmax(v / 127.0, -1.0) : v;
+    }
+    case GL_SHORT: {
+      double v = (int16_t)rd_u16(p);
+      return a->normalized ? fmax(v / 32767.0, -1.0) : v;
+    }
+    default: return 0.0;
   }
 }
 
@@ -286,9 +289,9 @@ static uint32_t acc_index(const glb_acc *a, size_t i) {
   if (!a->base) return 0;
   const uint8_t *p = a->base + i * a->stride;
   switch (a->comp_type) {
-  case GL_UNSIGNED_BYTE: return p[0];
-  case GL_UNSIGNED_SHORT: return rd_u16(p);
-  default: return rd_u32(p);
+    case GL_UNSIGNED_BYTE: return p[0];
+    case GL_UNSIGNED_SHORT: return rd_u16(p);
+    default: return rd_u32(p);
   }
 }
 
@@ -387,18 +390,18 @@ static hearth_status visit_node(glb_ctx *c, walk_state *w, size_t idx, const dou
                           "%s: %s: cycle in the node hierarchy (reached again from %s)", c->name,
                           at, from);
   if (depth > GLB_MAX_DEPTH)
-    return hearth_err_set(c->err, HEARTH_E_LIMIT, "%s: %s: node hierarchy deeper than %d",
-                          c->name, at, GLB_MAX_DEPTH);
+    return hearth_err_set(c->err, HEARTH_E_LIMIT, "%s: %s: node hierarchy deeper than %d", c->name,
+                          at, GLB_MAX_DEPTH);
   if (++w->visits > GLB_MAX_NODE_VISITS)
-    return hearth_err_set(c->err, HEARTH_E_LIMIT, "%s: %s: more than %zu node instances",
-                          c->name, at, GLB_MAX_NODE_VISITS);
+    return hearth_err_set(c->err, HEARTH_E_LIMIT, "%s: %s: more than %zu node instances", c->name,
+                          at, GLB_MAX_NODE_VISITS);
   double L[16], M[16];
   if ((s = node_local(c, node, at, L))) return s;
   mat_mul(P, L, M);
   for (int k = 0; k < 16; k++)
     if (!isfinite(M[k]))
-      return hearth_err_set(c->err, HEARTH_E_RANGE, "%s: %s: non-finite world transform",
-                            c->name, at);
+      return hearth_err_set(c->err, HEARTH_E_RANGE, "%s: %s: non-finite world transform", c->name,
+                            at);
   size_t mesh = 0;
   int has_mesh = 0;
   if ((s = get_uint(c, node, "mesh", at, 0, &mesh, &has_mesh))) return s;
@@ -471,8 +474,7 @@ static hearth_status collect_instances(glb_ctx *c, glb_inst_list *list) {
       if (!json_is_integer(kv) || json_integer_value(kv) < 0)
         s = hearth_err_set(c->err, HEARTH_E_PARSE,
                            "%s: %s.nodes[%zu]: expected a non-negative integer", c->name, at, k);
-      else
-        s = visit_node(c, &w, (size_t)json_integer_value(kv), I, 0, at);
+      else s = visit_node(c, &w, (size_t)json_integer_value(kv), I, 0, at);
     }
   } else if (!s) {
     /* no scene: every node that is nobody's child is a root */
@@ -499,10 +501,10 @@ static hearth_status collect_instances(glb_ctx *c, glb_inst_list *list) {
 /* Where a primitive's UVs come from: the UV set its base colour texture
  * samples, the texture transform and the sampler's wrap modes. */
 typedef struct glb_uvsrc {
-  size_t set;       /* TEXCOORD_<set> */
-  int has_xform;    /* KHR_texture_transform present */
-  double xf[6];     /* u' = xf[0] u + xf[1] v + xf[2], v' = xf[3] u + xf[4] v + xf[5] */
-  uint8_t wrap[2];  /* hearth_uv_wrap of wrapS, wrapT */
+  size_t set;      /* TEXCOORD_<set> */
+  int has_xform;   /* KHR_texture_transform present */
+  double xf[6];    /* u' = xf[0] u + xf[1] v + xf[2], v' = xf[3] u + xf[4] v + xf[5] */
+  uint8_t wrap[2]; /* hearth_uv_wrap of wrapS, wrapT */
 } glb_uvsrc;
 
 typedef struct glb_prim {
@@ -519,21 +521,20 @@ static hearth_status wrap_mode(glb_ctx *c, json_t *smp, const char *key, const c
   hearth_status s = get_uint(c, smp, key, at, 0, &w, NULL);
   if (s) return s;
   switch (w) {
-  case 10497: *out = HEARTH_UV_REPEAT; return HEARTH_OK;
-  case 33648: *out = HEARTH_UV_MIRRORED_REPEAT; return HEARTH_OK;
-  case 33071: *out = HEARTH_UV_CLAMP_TO_EDGE; return HEARTH_OK;
-  default:
-    return hearth_err_set(c->err, HEARTH_E_PARSE,
-                          "%s: %s.%s: %zu is not a wrap mode; expected 10497 (REPEAT), 33648 "
-                          "(MIRRORED_REPEAT) or 33071 (CLAMP_TO_EDGE)",
-                          c->name, at, key, w);
+    case 10497: *out = HEARTH_UV_REPEAT; return HEARTH_OK;
+    case 33648: *out = HEARTH_UV_MIRRORED_REPEAT; return HEARTH_OK;
+    case 33071: *out = HEARTH_UV_CLAMP_TO_EDGE; return HEARTH_OK;
+    default:
+      return hearth_err_set(c->err, HEARTH_E_PARSE,
+                            "%s: %s.%s: %zu is not a wrap mode; expected 10497 (REPEAT), 33648 "
+                            "(MIRRORED_REPEAT) or 33071 (CLAMP_TO_EDGE)",
+                            c->name, at, key, w);
   }
 }
 
 /* The UV source of a primitive: TEXCOORD_0, REPEAT and no transform unless
  * its material has a base colour texture saying otherwise. */
-static hearth_status resolve_uv_source(glb_ctx *c, json_t *prim, const char *pat,
-                                       glb_uvsrc *out) {
+static hearth_status resolve_uv_source(glb_ctx *c, json_t *prim, const char *pat, glb_uvsrc *out) {
   hearth_status s;
   memset(out, 0, sizeof *out);
   out->xf[0] = out->xf[4] = 1.0;
@@ -614,15 +615,14 @@ static hearth_status resolve_primitive(glb_ctx *c, size_t mesh, size_t p, json_t
   /* morph targets, if any, are ignored: the base shape is used */
   json_t *attrs = json_object_get(prim, "attributes");
   if (!json_is_object(attrs))
-    return hearth_err_set(c->err, HEARTH_E_PARSE, "%s: %s: missing \"attributes\" object",
-                          c->name, at);
+    return hearth_err_set(c->err, HEARTH_E_PARSE, "%s: %s: missing \"attributes\" object", c->name,
+                          at);
   snprintf(where, sizeof where, "%s.attributes", at);
   size_t ai = 0;
   int has = 0;
   if ((s = get_uint(c, attrs, "POSITION", where, 0, &ai, &has))) return s;
   if (!has)
-    return hearth_err_set(c->err, HEARTH_E_NOT_FOUND, "%s: %s: no POSITION attribute", c->name,
-                          at);
+    return hearth_err_set(c->err, HEARTH_E_NOT_FOUND, "%s: %s: no POSITION attribute", c->name, at);
   snprintf(where, sizeof where, "%s.attributes.POSITION", at);
   if ((s = resolve_accessor(c, ai, where, &out->pos))) return s;
   int pt = out->pos.comp_type;
@@ -707,8 +707,7 @@ static hearth_status load_base_color(glb_ctx *c, json_t *prim, hearth_image *tex
   snprintf(at, sizeof at, "textures[%zu]", tex_idx);
   if ((s = get_uint(c, t, "source", at, 0, &img_idx, &has))) return s;
   if (!has) return HEARTH_OK; /* only an extension source: not decodable here */
-  if ((s = get_elem(c, json_object_get(c->root, "images"), "images", img_idx, at, &img)))
-    return s;
+  if ((s = get_elem(c, json_object_get(c->root, "images"), "images", img_idx, at, &img))) return s;
   snprintf(at, sizeof at, "images[%zu]", img_idx);
   if ((s = get_uint(c, img, "bufferView", at, 0, &view_idx, &has))) return s;
   if (!has) return HEARTH_OK; /* uri image: not embedded */
@@ -830,8 +829,8 @@ static hearth_status fold_tiles(glb_ctx *c, const glb_prim *prims, size_t n_prim
                           "island moves only by whole tiles; split the islands at the tile "
                           "borders or pack them into [0,1]",
                           c->name, ut.straddling, ut.straddling == 1 ? "" : "s",
-                          ut.straddling == 1 ? "s" : "", ut.triangles_left,
-                          ut.triangles_straddling, first);
+                          ut.straddling == 1 ? "s" : "", ut.triangles_left, ut.triangles_straddling,
+                          first);
   return hearth_err_set(c->err, HEARTH_E_UNSUPPORTED,
                         "%s: %u UV island%s (%zu triangles; %s) lie%s outside [0,1] under a "
                         "CLAMP_TO_EDGE sampler, which shows the texture's edge texels there, so "
@@ -845,8 +844,8 @@ static hearth_status fold_tiles(glb_ctx *c, const glb_prim *prims, size_t n_prim
 static hearth_status check_header(const uint8_t *d, size_t n, size_t file_size, const char *name,
                                   hearth_err *err) {
   if (n < 12)
-    return hearth_err_set(err, HEARTH_E_PARSE, "%s: %zu bytes is too short for a GLB header",
-                          name, n);
+    return hearth_err_set(err, HEARTH_E_PARSE, "%s: %zu bytes is too short for a GLB header", name,
+                          n);
   if (rd_u32(d) != GLB_MAGIC)
     return hearth_err_set(err, HEARTH_E_PARSE,
                           "%s: header: bad magic 0x%08x; expected \"glTF\" (0x46546c67)", name,
@@ -873,8 +872,8 @@ static hearth_status split_chunks(const uint8_t *d, size_t size, const char *nam
   int chunk = 0;
   while (pos < size) {
     if (size - pos < 8)
-      return hearth_err_set(err, HEARTH_E_PARSE,
-                            "%s: chunk %d at byte %zu: truncated chunk header", name, chunk, pos);
+      return hearth_err_set(err, HEARTH_E_PARSE, "%s: chunk %d at byte %zu: truncated chunk header",
+                            name, chunk, pos);
     size_t len = rd_u32(d + pos);
     uint32_t type = rd_u32(d + pos + 4);
     if (len > size - pos - 8)
@@ -897,9 +896,8 @@ static hearth_status split_chunks(const uint8_t *d, size_t size, const char *nam
       *bin = payload;
       *bin_len = len;
     } else if (type == GLB_CHUNK_JSON || type == GLB_CHUNK_BIN) {
-      return hearth_err_set(err, HEARTH_E_PARSE,
-                            "%s: chunk %d: a second or misplaced %s chunk", name, chunk,
-                            type == GLB_CHUNK_JSON ? "JSON" : "BIN");
+      return hearth_err_set(err, HEARTH_E_PARSE, "%s: chunk %d: a second or misplaced %s chunk",
+                            name, chunk, type == GLB_CHUNK_JSON ? "JSON" : "BIN");
     } /* other chunk types are skipped, as the spec says */
     pos += 8 + len;
     chunk++;
@@ -980,7 +978,7 @@ hearth_status hearth_glb_parse(const void *data, size_t size, const char *name,
     }
     if (strcmp(en, "KHR_texture_transform") == 0) continue;
     const char *why = strcmp(en, "KHR_draco_mesh_compression") == 0 ? " (Draco compression)"
-                      : strcmp(en, "EXT_meshopt_compression") == 0 ? " (meshopt compression)"
+                      : strcmp(en, "EXT_meshopt_compression") == 0  ? " (meshopt compression)"
                                                                     : "";
     s = hearth_err_set(err, HEARTH_E_UNSUPPORTED,
                        "%s: extensionsRequired[%zu]: \"%s\"%s is not supported; re-export the "
@@ -1010,8 +1008,8 @@ hearth_status hearth_glb_parse(const void *data, size_t size, const char *name,
   for (size_t i = 0; i < list.n; i++) {
     json_t *pr = json_object_get(json_array_get(c.meshes, list.v[i].mesh), "primitives");
     if (!json_is_array(pr)) {
-      s = hearth_err_set(err, HEARTH_E_PARSE, "%s: meshes[%zu].primitives: expected an array",
-                         name, list.v[i].mesh);
+      s = hearth_err_set(err, HEARTH_E_PARSE, "%s: meshes[%zu].primitives: expected an array", name,
+                         list.v[i].mesh);
       goto done;
     }
     if (!add_size(total_prims, json_array_size(pr), &total_prims)) {
@@ -1067,8 +1065,8 @@ hearth_status hearth_glb_parse(const void *data, size_t size, const char *name,
   out->indices = hearth_alloc_array(nt, 3 * sizeof(uint32_t));
   out->uvs = all_uv ? hearth_alloc_array(nv, 2 * sizeof(float)) : NULL;
   if (!out->positions || !out->indices || (all_uv && !out->uvs)) {
-    s = hearth_err_set(err, HEARTH_E_NOMEM, "%s: out of memory (%zu vertices, %zu triangles)",
-                       name, nv, nt);
+    s = hearth_err_set(err, HEARTH_E_NOMEM, "%s: out of memory (%zu vertices, %zu triangles)", name,
+                       nv, nt);
     goto done;
   }
   size_t vbase = 0, tbase = 0, k = 0;
@@ -1173,8 +1171,8 @@ done:
   return s;
 }
 
-hearth_status hearth_glb_read(const char *path, const hearth_glb_read_opts *opts,
-                              hearth_mesh *out, hearth_err *err) {
+hearth_status hearth_glb_read(const char *path, const hearth_glb_read_opts *opts, hearth_mesh *out,
+                              hearth_err *err) {
   uint8_t *data = NULL;
   size_t size = 0;
   if (out) memset(out, 0, sizeof *out);
@@ -1187,7 +1185,8 @@ hearth_status hearth_glb_read(const char *path, const hearth_glb_read_opts *opts
   uint8_t head[12];
   ssize_t got = read(fd, head, sizeof head);
   close(fd);
-  if (got < 0) return hearth_err_set(err, HEARTH_E_IO, "%s: cannot read: %s", path, strerror(errno));
+  if (got < 0)
+    return hearth_err_set(err, HEARTH_E_IO, "%s: cannot read: %s", path, strerror(errno));
   if ((s = check_header(head, (size_t)got, fsize, path, err))) return s;
   s = hearth_read_file(path, GLB_MAX_FILE, &data, &size, err);
   if (s) return s;
@@ -1273,9 +1272,9 @@ hearth_status hearth_glb_encode(const hearth_mesh *m, uint8_t **out, size_t *siz
   int ok = hearth_mul_size(nv, 12, &sz_pos) && hearth_mul_size(nt, 12, &sz_idx) &&
            (!m->uvs || hearth_mul_size(nv, 8, &sz_uv));
   off_nrm = sz_pos;
-  ok = ok && add_size(off_nrm, sz_pos, &off_uv) &&
-       add_size(off_uv, sz_uv, &off_idx) && add_size(off_idx, sz_idx, &off_png) &&
-       add_size(off_png, png_size, &bin_len) && bin_len <= UINT32_MAX - 64;
+  ok = ok && add_size(off_nrm, sz_pos, &off_uv) && add_size(off_uv, sz_uv, &off_idx) &&
+       add_size(off_idx, sz_idx, &off_png) && add_size(off_png, png_size, &bin_len) &&
+       bin_len <= UINT32_MAX - 64;
   if (!ok) {
     s = hearth_err_set(err, HEARTH_E_LIMIT, "glb encode: mesh too large for a GLB");
     goto done;
@@ -1399,9 +1398,9 @@ hearth_status hearth_glb_encode(const hearth_mesh *m, uint8_t **out, size_t *siz
   json_object_set_new(root, "materials", mats);
   if (png_size) {
     json_t *smp = json_object(), *smps = json_array();
-    json_object_set_new(smp, "magFilter", json_integer(9729));   /* LINEAR */
-    json_object_set_new(smp, "minFilter", json_integer(9987));   /* LINEAR_MIPMAP_LINEAR */
-    json_object_set_new(smp, "wrapS", json_integer(33071));      /* CLAMP_TO_EDGE */
+    json_object_set_new(smp, "magFilter", json_integer(9729)); /* LINEAR */
+    json_object_set_new(smp, "minFilter", json_integer(9987)); /* LINEAR_MIPMAP_LINEAR */
+    json_object_set_new(smp, "wrapS", json_integer(33071));    /* CLAMP_TO_EDGE */
     json_object_set_new(smp, "wrapT", json_integer(33071));
     json_array_append_new(smps, smp);
     json_object_set_new(root, "samplers", smps);

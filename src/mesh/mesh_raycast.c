@@ -71,8 +71,7 @@ static int probe_ng_sign(const hearth_raycaster *rc) {
   return 1;
 }
 
-hearth_status hearth_raycaster_new(const hearth_mesh *m, hearth_raycaster **out,
-                                   hearth_err *err) {
+hearth_status hearth_raycaster_new(const hearth_mesh *m, hearth_raycaster **out, hearth_err *err) {
   *out = NULL;
   hearth_status s = hearth_mesh_validate(m, "ray caster mesh", err);
   if (s != HEARTH_OK) return s;
@@ -105,9 +104,10 @@ hearth_status hearth_raycaster_new(const hearth_mesh *m, hearth_raycaster **out,
       enum RTCError e = rtcGetDeviceError(rc->device);
       rtcReleaseGeometry(g);
       hearth_raycaster_free(rc);
-      return hearth_err_set(err, HEARTH_E_NOMEM,
-                            "ray caster: cannot allocate buffers for %zu vertices, %zu triangles: %s",
-                            m->n_vertices, m->n_triangles, rtc_error_name(e));
+      return hearth_err_set(
+          err, HEARTH_E_NOMEM,
+          "ray caster: cannot allocate buffers for %zu vertices, %zu triangles: %s", m->n_vertices,
+          m->n_triangles, rtc_error_name(e));
     }
     if (m->n_vertices) memcpy(vb, m->positions, m->n_vertices * 3 * sizeof(float));
     for (size_t i = 0; i < m->n_triangles * 3; i++) ib[i] = m->indices[i];
@@ -165,8 +165,7 @@ static void no_hit(hearth_ray_hit *hit) {
 }
 
 /* Embree wants 0 <= tnear <= tfar and finite origin/direction. */
-static int ray_ok(float ox, float oy, float oz, float dx, float dy, float dz, float tn,
-                  float tf) {
+static int ray_ok(float ox, float oy, float oz, float dx, float dy, float dz, float tn, float tf) {
   if (!isfinite(ox) || !isfinite(oy) || !isfinite(oz) || !isfinite(dx) || !isfinite(dy) ||
       !isfinite(dz))
     return 0;
@@ -324,8 +323,8 @@ static void batch_range(void *vctx, size_t begin, size_t end, int thread_index) 
       h->prim = rh.hit.primID[k];
       h->b1 = rh.hit.u[k];
       h->b2 = rh.hit.v[k];
-      h->front = ng_front(rc->ng_sign, rh.hit.Ng_x[k], rh.hit.Ng_y[k], rh.hit.Ng_z[k], rh.ray.dir_x[k],
-                          rh.ray.dir_y[k], rh.ray.dir_z[k]);
+      h->front = ng_front(rc->ng_sign, rh.hit.Ng_x[k], rh.hit.Ng_y[k], rh.hit.Ng_z[k],
+                          rh.ray.dir_x[k], rh.ray.dir_y[k], rh.ray.dir_z[k]);
     }
   }
 }
@@ -342,8 +341,8 @@ static void batch_packets(void *vctx, size_t begin, size_t end, int thread_index
   batch_range(p->b, lo, hi, thread_index);
 }
 
-void hearth_raycast_batch(const hearth_raycaster *rc, size_t n, const float *org,
-                          const float *dir, float tnear, float tfar, hearth_ray_hit *hits) {
+void hearth_raycast_batch(const hearth_raycaster *rc, size_t n, const float *org, const float *dir,
+                          float tnear, float tfar, hearth_ray_hit *hits) {
   hearth_raycast_batch_mt(rc, n, org, dir, tnear, tfar, hits, 0);
 }
 

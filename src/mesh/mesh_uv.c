@@ -73,8 +73,8 @@ static int uv_weld(const hearth_mesh *m, uint32_t *uv_id, uint32_t *n_uv) {
   return 1;
 }
 
-hearth_status hearth_uv_islands(const hearth_mesh *m, uint32_t *island_of_tri,
-                                uint32_t *n_islands, hearth_err *err) {
+hearth_status hearth_uv_islands(const hearth_mesh *m, uint32_t *island_of_tri, uint32_t *n_islands,
+                                hearth_err *err) {
   *n_islands = 0;
   if (!m->uvs) return hearth_err_set(err, HEARTH_E_NOT_FOUND, "UV islands: the mesh has no UVs");
   hearth_status s = hearth_mesh_validate(m, "UV islands", err);
@@ -129,7 +129,8 @@ hearth_status hearth_uv_islands(const hearth_mesh *m, uint32_t *island_of_tri,
     for (uint32_t i = 0; i < len; i++) pairs[i] = ((uint64_t)other[b0 + i] << 32) | tri[b0 + i];
     qsort(pairs, len, sizeof *pairs, cmp_u64);
     for (uint32_t i = 1; i < len; i++)
-      if (pairs[i] >> 32 == pairs[i - 1] >> 32) uf_union(parent, (uint32_t)pairs[i - 1], (uint32_t)pairs[i]);
+      if (pairs[i] >> 32 == pairs[i - 1] >> 32)
+        uf_union(parent, (uint32_t)pairs[i - 1], (uint32_t)pairs[i]);
     free(pairs);
   }
   free(start);
@@ -162,10 +163,10 @@ oom:
 typedef struct tile_island {
   double lo[2], hi[2]; /* UV bounds over its triangles' corners */
   size_t n_tris, first_tri;
-  uint8_t wrap[2];     /* most restrictive hearth_uv_wrap of its triangles */
-  int8_t action;       /* 0 nothing, 1 move, 2 straddles, 3 clamped */
-  uint8_t mirror[2];   /* axis reflected (MIRRORED_REPEAT, odd tile) */
-  double tile[2];      /* the tile it lies in */
+  uint8_t wrap[2];   /* most restrictive hearth_uv_wrap of its triangles */
+  int8_t action;     /* 0 nothing, 1 move, 2 straddles, 3 clamped */
+  uint8_t mirror[2]; /* axis reflected (MIRRORED_REPEAT, odd tile) */
+  double tile[2];    /* the tile it lies in */
 } tile_island;
 
 /* the tile an extent [lo, hi] lies in (with the slack), or 0 if it spans
@@ -233,8 +234,8 @@ hearth_status hearth_uv_fold_tiles(hearth_mesh *m, const uint8_t *wrap, hearth_u
   for (uint32_t r = 0; r < n_uv; r++) {
     tile_island *is = &isl[r];
     if (!is->n_tris) continue;
-    int fits = tile_of(is->lo[0], is->hi[0], &is->tile[0]) &
-               tile_of(is->lo[1], is->hi[1], &is->tile[1]);
+    int fits =
+        tile_of(is->lo[0], is->hi[0], &is->tile[0]) & tile_of(is->lo[1], is->hi[1], &is->tile[1]);
     int clamped = 0;
     for (int a = 0; a < 2; a++)
       if (is->tile[a] != 0.0 && is->wrap[a] == HEARTH_UV_CLAMP_TO_EDGE) clamped = 1;
@@ -389,8 +390,10 @@ static void raster_band(void *vctx, size_t band0, size_t band1, int thread_index
     if (r_hi > (int64_t)R) r_hi = (int64_t)R;
     r_hi -= 1;
     /* the band's texels start empty */
-    for (size_t q = (size_t)r_lo * R; q < (size_t)(r_hi + 1) * R; q++) c->tri_of_texel[q] = UINT32_MAX;
-    if (c->bary) memset(c->bary + (size_t)r_lo * R * 3, 0, (size_t)(r_hi + 1 - r_lo) * R * 3 * sizeof(float));
+    for (size_t q = (size_t)r_lo * R; q < (size_t)(r_hi + 1) * R; q++)
+      c->tri_of_texel[q] = UINT32_MAX;
+    if (c->bary)
+      memset(c->bary + (size_t)r_lo * R * 3, 0, (size_t)(r_hi + 1 - r_lo) * R * 3 * sizeof(float));
     /* triangles in index order; a texel keeps the first (lowest) one */
     for (size_t t = 0; t < m->n_triangles; t++) {
       const int32_t *bb = c->bbox + t * 4;
@@ -443,10 +446,11 @@ static void raster_band(void *vctx, size_t band0, size_t band1, int thread_index
 
 hearth_status hearth_uv_rasterize(const hearth_mesh *m, size_t R, uint32_t *tri_of_texel,
                                   float *bary, hearth_err *err) {
-  if (!m->uvs) return hearth_err_set(err, HEARTH_E_NOT_FOUND, "UV rasterisation: the mesh has no UVs");
+  if (!m->uvs)
+    return hearth_err_set(err, HEARTH_E_NOT_FOUND, "UV rasterisation: the mesh has no UVs");
   if (R == 0 || R > 65536)
-    return hearth_err_set(err, HEARTH_E_RANGE,
-                          "UV rasterisation: resolution %zu outside 1..65536", R);
+    return hearth_err_set(err, HEARTH_E_RANGE, "UV rasterisation: resolution %zu outside 1..65536",
+                          R);
   if (m->n_triangles >= (size_t)UINT32_MAX)
     return hearth_err_set(err, HEARTH_E_LIMIT, "UV rasterisation: too many triangles (%zu)",
                           m->n_triangles);

@@ -11,8 +11,8 @@ typedef struct mp_ctx {
   const uint8_t *p;
   size_t len, pos;
   size_t max_depth, max_values;
-  size_t count;            /* values seen (pass 1) */
-  hearth_mp_value *arena;  /* pass 2 */
+  size_t count;           /* values seen (pass 1) */
+  hearth_mp_value *arena; /* pass 2 */
   size_t used;
   hearth_err *err;
 } mp_ctx;
@@ -57,8 +57,8 @@ static hearth_status parse_container(mp_ctx *c, size_t depth, uint64_t n, int is
   } else {
     c->count += (size_t)items;
     if (c->count > c->max_values)
-      return hearth_err_set(c->err, HEARTH_E_LIMIT, "msgpack: byte %zu: more than %zu values", start,
-                            c->max_values);
+      return hearth_err_set(c->err, HEARTH_E_LIMIT, "msgpack: byte %zu: more than %zu values",
+                            start, c->max_values);
   }
   for (uint64_t k = 0; k < items; k++) {
     hearth_status st = parse(c, depth + 1, kids ? kids + k : NULL);
@@ -68,7 +68,8 @@ static hearth_status parse_container(mp_ctx *c, size_t depth, uint64_t n, int is
 }
 
 static hearth_status parse_bytes(mp_ctx *c, hearth_mp_type t, uint64_t n, hearth_mp_value *out) {
-  hearth_status st = need(c, n > SIZE_MAX ? SIZE_MAX : (size_t)n, t == HEARTH_MP_STR ? "string" : "binary");
+  hearth_status st =
+      need(c, n > SIZE_MAX ? SIZE_MAX : (size_t)n, t == HEARTH_MP_STR ? "string" : "binary");
   if (st) return st;
   if (out) out->type = t, out->data = c->p + c->pos, out->len = (size_t)n;
   c->pos += (size_t)n;
@@ -84,16 +85,35 @@ static hearth_status parse(mp_ctx *c, size_t depth, hearth_mp_value *out) {
   /* fixed-width headers: a length or value of n bytes follows */
   int n = 0;
   switch (b) {
-  case 0xc4: case 0xc7: case 0xcc: case 0xd0: case 0xd9: n = 1; break;
-  case 0xc5: case 0xc8: case 0xcd: case 0xd1: case 0xda: case 0xdc: case 0xde: n = 2; break;
-  case 0xc6: case 0xc9: case 0xca: case 0xce: case 0xd2: case 0xdb: case 0xdd: case 0xdf: n = 4; break;
-  case 0xcb: case 0xcf: case 0xd3: n = 8; break;
-  case 0xd4: n = 1 + 1; break;
-  case 0xd5: n = 1 + 2; break;
-  case 0xd6: n = 1 + 4; break;
-  case 0xd7: n = 1 + 8; break;
-  case 0xd8: n = 1 + 16; break;
-  default: break;
+    case 0xc4:
+    case 0xc7:
+    case 0xcc:
+    case 0xd0:
+    case 0xd9: n = 1; break;
+    case 0xc5:
+    case 0xc8:
+    case 0xcd:
+    case 0xd1:
+    case 0xda:
+    case 0xdc:
+    case 0xde: n = 2; break;
+    case 0xc6:
+    case 0xc9:
+    case 0xca:
+    case 0xce:
+    case 0xd2:
+    case 0xdb:
+    case 0xdd:
+    case 0xdf: n = 4; break;
+    case 0xcb:
+    case 0xcf:
+    case 0xd3: n = 8; break;
+    case 0xd4: n = 1 + 1; break;
+    case 0xd5: n = 1 + 2; break;
+    case 0xd6: n = 1 + 4; break;
+    case 0xd7: n = 1 + 8; break;
+    case 0xd8: n = 1 + 16; break;
+    default: break;
   }
   if (n) {
     st = need(c, (size_t)n, "a header");
@@ -109,61 +129,82 @@ static hearth_status parse(mp_ctx *c, size_t depth, hearth_mp_value *out) {
   if ((b & 0xe0) == 0xa0) return parse_bytes(c, HEARTH_MP_STR, b & 0x1f, out);
   c->pos += (size_t)n;
   switch (b) {
-  case 0xc0: return HEARTH_OK; /* nil: memset left type NIL */
-  case 0xc2: case 0xc3:
-    if (out) out->type = HEARTH_MP_BOOL, out->b = b == 0xc3;
-    return HEARTH_OK;
-  case 0xc4: case 0xc5: case 0xc6: return parse_bytes(c, HEARTH_MP_BIN, rd_be(q, n), out);
-  case 0xd9: case 0xda: case 0xdb: return parse_bytes(c, HEARTH_MP_STR, rd_be(q, n), out);
-  case 0xdc: case 0xdd: return parse_container(c, depth, rd_be(q, n), 0, out);
-  case 0xde: case 0xdf: return parse_container(c, depth, rd_be(q, n), 1, out);
-  case 0xca: {
-    uint32_t u = (uint32_t)rd_be(q, 4);
-    float f;
-    memcpy(&f, &u, 4);
-    if (out) out->type = HEARTH_MP_FLOAT, out->f = f;
-    return HEARTH_OK;
-  }
-  case 0xcb: {
-    uint64_t u = rd_be(q, 8);
-    double f;
-    memcpy(&f, &u, 8);
-    if (out) out->type = HEARTH_MP_FLOAT, out->f = f;
-    return HEARTH_OK;
-  }
-  case 0xcc: case 0xcd: case 0xce: case 0xcf: {
-    uint64_t u = rd_be(q, n);
-    if (out) {
-      if (u > (uint64_t)INT64_MAX) out->type = HEARTH_MP_UINT, out->u = u;
-      else out->type = HEARTH_MP_INT, out->i = (int64_t)u;
+    case 0xc0: return HEARTH_OK; /* nil: memset left type NIL */
+    case 0xc2:
+    case 0xc3:
+      if (out) out->type = HEARTH_MP_BOOL, out->b = b == 0xc3;
+      return HEARTH_OK;
+    case 0xc4:
+    case 0xc5:
+    case 0xc6: return parse_bytes(c, HEARTH_MP_BIN, rd_be(q, n), out);
+    case 0xd9:
+    case 0xda:
+    case 0xdb: return parse_bytes(c, HEARTH_MP_STR, rd_be(q, n), out);
+    case 0xdc:
+    case 0xdd: return parse_container(c, depth, rd_be(q, n), 0, out);
+    case 0xde:
+    case 0xdf: return parse_container(c, depth, rd_be(q, n), 1, out);
+    case 0xca: {
+      uint32_t u = (uint32_t)rd_be(q, 4);
+      float f;
+      memcpy(&f, &u, 4);
+      if (out) out->type = HEARTH_MP_FLOAT, out->f = f;
+      return HEARTH_OK;
     }
-    return HEARTH_OK;
-  }
-  case 0xd0: case 0xd1: case 0xd2: case 0xd3: {
-    uint64_t u = rd_be(q, n);
-    int64_t v;
-    if (n == 1) v = (int8_t)u;
-    else if (n == 2) v = (int16_t)u;
-    else if (n == 4) v = (int32_t)u;
-    else memcpy(&v, &u, 8);
-    if (out) out->type = HEARTH_MP_INT, out->i = v;
-    return HEARTH_OK;
-  }
-  case 0xd4: case 0xd5: case 0xd6: case 0xd7: case 0xd8:
-    if (out) out->type = HEARTH_MP_EXT, out->i = (int8_t)q[0], out->data = q + 1, out->len = (size_t)n - 1;
-    return HEARTH_OK;
-  case 0xc7: case 0xc8: case 0xc9: {
-    uint64_t len = rd_be(q, n);
-    st = need(c, 1, "an ext type");
-    if (st) return st;
-    int8_t type = (int8_t)c->p[c->pos++];
-    st = parse_bytes(c, HEARTH_MP_EXT, len, out);
-    if (out) out->i = type;
-    return st;
-  }
-  default:
-    return hearth_err_set(c->err, HEARTH_E_PARSE, "msgpack: byte %zu: 0x%02x is not a valid type byte",
-                          at, b);
+    case 0xcb: {
+      uint64_t u = rd_be(q, 8);
+      double f;
+      memcpy(&f, &u, 8);
+      if (out) out->type = HEARTH_MP_FLOAT, out->f = f;
+      return HEARTH_OK;
+    }
+    case 0xcc:
+    case 0xcd:
+    case 0xce:
+    case 0xcf: {
+      uint64_t u = rd_be(q, n);
+      if (out) {
+        if (u > (uint64_t)INT64_MAX) out->type = HEARTH_MP_UINT, out->u = u;
+        else out->type = HEARTH_MP_INT, out->i = (int64_t)u;
+      }
+      return HEARTH_OK;
+    }
+    case 0xd0:
+    case 0xd1:
+    case 0xd2:
+    case 0xd3: {
+      uint64_t u = rd_be(q, n);
+      int64_t v;
+      if (n == 1) v = (int8_t)u;
+      else if (n == 2) v = (int16_t)u;
+      else if (n == 4) v = (int32_t)u;
+      else memcpy(&v, &u, 8);
+      if (out) out->type = HEARTH_MP_INT, out->i = v;
+      return HEARTH_OK;
+    }
+    case 0xd4:
+    case 0xd5:
+    case 0xd6:
+    case 0xd7:
+    case 0xd8:
+      if (out)
+        out->type = HEARTH_MP_EXT, out->i = (int8_t)q[0], out->data = q + 1,
+        out->len = (size_t)n - 1;
+      return HEARTH_OK;
+    case 0xc7:
+    case 0xc8:
+    case 0xc9: {
+      uint64_t len = rd_be(q, n);
+      st = need(c, 1, "an ext type");
+      if (st) return st;
+      int8_t type = (int8_t)c->p[c->pos++];
+      st = parse_bytes(c, HEARTH_MP_EXT, len, out);
+      if (out) out->i = type;
+      return st;
+    }
+    default:
+      return hearth_err_set(c->err, HEARTH_E_PARSE,
+                            "msgpack: byte %zu: 0x%02x is not a valid type byte", at, b);
   }
 }
 
@@ -186,8 +227,9 @@ hearth_status hearth_mp_decode(const uint8_t *buf, size_t len, const hearth_mp_l
   hearth_status st = parse(&c, 0, NULL);
   if (st) return st;
   if (c.pos != len)
-    return hearth_err_set(err, HEARTH_E_PARSE, "msgpack: byte %zu: expected the end, %zu bytes remain",
-                          c.pos, len - c.pos);
+    return hearth_err_set(err, HEARTH_E_PARSE,
+                          "msgpack: byte %zu: expected the end, %zu bytes remain", c.pos,
+                          len - c.pos);
   /* pass 2: fill */
   doc->values = hearth_calloc_array(c.count, sizeof(hearth_mp_value));
   if (!doc->values) return hearth_err_set(err, HEARTH_E_NOMEM, "msgpack: %zu values", c.count);
@@ -227,29 +269,33 @@ int hearth_mp_str_eq(const hearth_mp_value *v, const char *s) {
   return v && v->type == HEARTH_MP_STR && v->len == n && memcmp(v->data, s, n) == 0;
 }
 
-hearth_status hearth_mp_ndarray_get(const hearth_mp_value *v, const char *where, hearth_mp_ndarray *a,
-                                    hearth_err *err) {
+hearth_status hearth_mp_ndarray_get(const hearth_mp_value *v, const char *where,
+                                    hearth_mp_ndarray *a, hearth_err *err) {
   memset(a, 0, sizeof *a);
   if (!v || v->type != HEARTH_MP_MAP)
-    return hearth_err_set(err, HEARTH_E_PARSE, "%s: expected a numpy array (a map), got msgpack type %d",
-                          where, v ? (int)v->type : -1);
+    return hearth_err_set(err, HEARTH_E_PARSE,
+                          "%s: expected a numpy array (a map), got msgpack type %d", where,
+                          v ? (int)v->type : -1);
   const hearth_mp_value *flag = hearth_mp_map_get(v, "__ndarray__", HEARTH_MP_BIN);
   const hearth_mp_value *data = hearth_mp_map_get(v, "data", HEARTH_MP_BIN);
   const hearth_mp_value *dtype = hearth_mp_map_get(v, "dtype", HEARTH_MP_BIN);
   const hearth_mp_value *shape = hearth_mp_map_get(v, "shape", HEARTH_MP_BIN);
   if (!flag && hearth_mp_map_get(v, "__ndarray__", HEARTH_MP_STR))
-    return hearth_err_set(err, HEARTH_E_PARSE,
-                          "%s: ndarray keys must be msgpack binaries (b\"__ndarray__\"), got strings",
-                          where);
+    return hearth_err_set(
+        err, HEARTH_E_PARSE,
+        "%s: ndarray keys must be msgpack binaries (b\"__ndarray__\"), got strings", where);
   if (!flag || flag->type != HEARTH_MP_BOOL || !flag->b)
-    return hearth_err_set(err, HEARTH_E_PARSE, "%s: expected the key b\"__ndarray__\" set to true", where);
+    return hearth_err_set(err, HEARTH_E_PARSE, "%s: expected the key b\"__ndarray__\" set to true",
+                          where);
   if (!data || data->type != HEARTH_MP_BIN)
     return hearth_err_set(err, HEARTH_E_PARSE, "%s: expected b\"data\" as a binary", where);
   if (!dtype || dtype->type != HEARTH_MP_STR || dtype->len < 3 || dtype->len >= sizeof a->dtype)
-    return hearth_err_set(err, HEARTH_E_PARSE, "%s: expected b\"dtype\" as a string like \"<f4\"", where);
+    return hearth_err_set(err, HEARTH_E_PARSE, "%s: expected b\"dtype\" as a string like \"<f4\"",
+                          where);
   if (!shape || shape->type != HEARTH_MP_ARRAY || shape->n > HEARTH_MP_MAX_DIMS)
-    return hearth_err_set(err, HEARTH_E_PARSE, "%s: expected b\"shape\" as an array of at most %d ints",
-                          where, HEARTH_MP_MAX_DIMS);
+    return hearth_err_set(err, HEARTH_E_PARSE,
+                          "%s: expected b\"shape\" as an array of at most %d ints", where,
+                          HEARTH_MP_MAX_DIMS);
   memcpy(a->dtype, dtype->data, dtype->len);
   char order = a->dtype[0];
   a->kind = a->dtype[1];
@@ -258,12 +304,13 @@ hearth_status hearth_mp_ndarray_get(const hearth_mp_value *v, const char *where,
     if (a->dtype[k] < '0' || a->dtype[k] > '9') sz = -1;
     if (sz >= 0) sz = sz * 10 + (a->dtype[k] - '0');
   }
-  int ok_kind = (a->kind == 'f' && (sz == 4 || sz == 8)) ||
-                ((a->kind == 'u' || a->kind == 'i') && (sz == 1 || sz == 2 || sz == 4 || sz == 8)) ||
-                (a->kind == 'b' && sz == 1);
+  int ok_kind =
+      (a->kind == 'f' && (sz == 4 || sz == 8)) ||
+      ((a->kind == 'u' || a->kind == 'i') && (sz == 1 || sz == 2 || sz == 4 || sz == 8)) ||
+      (a->kind == 'b' && sz == 1);
   if (!ok_kind || (order != '<' && order != '>' && order != '|' && order != '='))
-    return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "%s: dtype \"%s\" is not a supported numeric type",
-                          where, a->dtype);
+    return hearth_err_set(err, HEARTH_E_UNSUPPORTED,
+                          "%s: dtype \"%s\" is not a supported numeric type", where, a->dtype);
   a->itemsize = (size_t)sz;
   a->big_endian = order == '>';
   a->ndim = (int)shape->n;
@@ -271,16 +318,18 @@ hearth_status hearth_mp_ndarray_get(const hearth_mp_value *v, const char *where,
   for (size_t k = 0; k < shape->n; k++) {
     const hearth_mp_value *d = &shape->items[k];
     if (d->type != HEARTH_MP_INT || d->i < 0)
-      return hearth_err_set(err, HEARTH_E_PARSE, "%s: shape[%zu] is not a non-negative int", where, k);
+      return hearth_err_set(err, HEARTH_E_PARSE, "%s: shape[%zu] is not a non-negative int", where,
+                            k);
     a->shape[k] = (size_t)d->i;
     if ((uint64_t)d->i > SIZE_MAX || !hearth_mul_size(count, (size_t)d->i, &count))
       return hearth_err_set(err, HEARTH_E_LIMIT, "%s: shape overflows", where);
   }
   size_t nb;
   if (!hearth_mul_size(count, a->itemsize, &nb) || nb != data->len)
-    return hearth_err_set(err, HEARTH_E_SIZE,
-                          "%s: data has %zu bytes but shape and dtype \"%s\" need %zu elements of %zu",
-                          where, data->len, a->dtype, count, a->itemsize);
+    return hearth_err_set(
+        err, HEARTH_E_SIZE,
+        "%s: data has %zu bytes but shape and dtype \"%s\" need %zu elements of %zu", where,
+        data->len, a->dtype, count, a->itemsize);
   a->count = count;
   a->data = data->data;
   a->nbytes = data->len;
@@ -297,22 +346,22 @@ double hearth_mp_ndarray_at(const hearth_mp_ndarray *a, size_t k) {
   uint64_t u = 0;
   for (size_t i = a->itemsize; i-- > 0;) u = u << 8 | b[i];
   switch (a->kind) {
-  case 'f':
-    if (a->itemsize == 4) {
-      uint32_t u32 = (uint32_t)u;
-      float f;
-      memcpy(&f, &u32, 4);
-      return f;
-    } else {
-      double d;
-      memcpy(&d, &u, 8);
-      return d;
+    case 'f':
+      if (a->itemsize == 4) {
+        uint32_t u32 = (uint32_t)u;
+        float f;
+        memcpy(&f, &u32, 4);
+        return f;
+      } else {
+        double d;
+        memcpy(&d, &u, 8);
+        return d;
+      }
+    case 'i': {
+      int sh = 64 - 8 * (int)a->itemsize;
+      return (double)((int64_t)(u << sh) >> sh);
     }
-  case 'i': {
-    int sh = 64 - 8 * (int)a->itemsize;
-    return (double)((int64_t)(u << sh) >> sh);
-  }
-  default: return (double)u;
+    default: return (double)u;
   }
 }
 

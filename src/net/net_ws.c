@@ -12,7 +12,8 @@ static uint32_t rol(uint32_t x, int n) { return x << n | x >> (32 - n); }
 static void sha1_block(uint32_t h[5], const uint8_t *p) {
   uint32_t w[80];
   for (int i = 0; i < 16; i++)
-    w[i] = (uint32_t)p[4 * i] << 24 | (uint32_t)p[4 * i + 1] << 16 | (uint32_t)p[4 * i + 2] << 8 | p[4 * i + 3];
+    w[i] = (uint32_t)p[4 * i] << 24 | (uint32_t)p[4 * i + 1] << 16 | (uint32_t)p[4 * i + 2] << 8 |
+           p[4 * i + 3];
   for (int i = 16; i < 80; i++) w[i] = rol(w[i - 3] ^ w[i - 8] ^ w[i - 14] ^ w[i - 16], 1);
   uint32_t a = h[0], b = h[1], c = h[2], d = h[3], e = h[4];
   for (int i = 0; i < 80; i++) {
@@ -87,7 +88,8 @@ static int has_token(const char *v, size_t n, const char *tok) {
   return 0;
 }
 
-hearth_status hearth_ws_check_handshake(const char *resp, size_t len, const char *key, hearth_err *err) {
+hearth_status hearth_ws_check_handshake(const char *resp, size_t len, const char *key,
+                                        hearth_err *err) {
   int upgrade = 0, connection = 0, accept_ok = 0;
   char want[29];
   hearth_ws_accept(key, want);
@@ -102,40 +104,51 @@ hearth_status hearth_ws_check_handshake(const char *resp, size_t len, const char
     line++;
     if (line == 1) {
       if (ll < 12 || strncmp(s, "HTTP/1.1 ", 9) != 0)
-        return hearth_err_set(err, HEARTH_E_PARSE, "websocket handshake: line 1: expected \"HTTP/1.1 101\", got \"%.*s\"",
+        return hearth_err_set(err, HEARTH_E_PARSE,
+                              "websocket handshake: line 1: expected \"HTTP/1.1 101\", got \"%.*s\"",
                               (int)(ll > 80 ? 80 : ll), s);
       if (strncmp(s + 9, "101", 3) != 0)
-        return hearth_err_set(err, HEARTH_E_PARSE,
-                              "websocket handshake: line 1: expected status 101 (switching protocols), got \"%.*s\"",
-                              (int)(ll > 80 ? 80 : ll), s);
+        return hearth_err_set(
+            err, HEARTH_E_PARSE,
+            "websocket handshake: line 1: expected status 101 (switching protocols), got \"%.*s\"",
+            (int)(ll > 80 ? 80 : ll), s);
       continue;
     }
     if (ll == 0) break;
     const char *colon = memchr(s, ':', ll);
     if (!colon)
-      return hearth_err_set(err, HEARTH_E_PARSE, "websocket handshake: line %d: expected \"Name: value\"", line);
+      return hearth_err_set(err, HEARTH_E_PARSE,
+                            "websocket handshake: line %d: expected \"Name: value\"", line);
     size_t nl_ = (size_t)(colon - s);
     const char *v = colon + 1;
     size_t vl = ll - nl_ - 1;
     while (vl && (*v == ' ' || *v == '\t')) v++, vl--;
     while (vl && (v[vl - 1] == ' ' || v[vl - 1] == '\t')) vl--;
     if (nl_ == 7 && strncasecmp(s, "Upgrade", 7) == 0) upgrade = has_token(v, vl, "websocket");
-    else if (nl_ == 10 && strncasecmp(s, "Connection", 10) == 0) connection = has_token(v, vl, "upgrade");
+    else if (nl_ == 10 && strncasecmp(s, "Connection", 10) == 0)
+      connection = has_token(v, vl, "upgrade");
     else if (nl_ == 20 && strncasecmp(s, "Sec-WebSocket-Accept", 20) == 0) {
       if (vl != 28 || memcmp(v, want, 28) != 0)
-        return hearth_err_set(err, HEARTH_E_PARSE,
-                              "websocket handshake: line %d: Sec-WebSocket-Accept \"%.*s\" does not match \"%s\"",
-                              line, (int)(vl > 60 ? 60 : vl), v, want);
+        return hearth_err_set(
+            err, HEARTH_E_PARSE,
+            "websocket handshake: line %d: Sec-WebSocket-Accept \"%.*s\" does not match \"%s\"",
+            line, (int)(vl > 60 ? 60 : vl), v, want);
       accept_ok = 1;
     } else if (nl_ == 24 && strncasecmp(s, "Sec-WebSocket-Extensions", 24) == 0 && vl)
-      return hearth_err_set(err, HEARTH_E_UNSUPPORTED,
-                            "websocket handshake: line %d: the server negotiated extensions \"%.*s\" that were not offered",
-                            line, (int)(vl > 60 ? 60 : vl), v);
+      return hearth_err_set(
+          err, HEARTH_E_UNSUPPORTED,
+          "websocket handshake: line %d: the server negotiated extensions \"%.*s\" that were not offered",
+          line, (int)(vl > 60 ? 60 : vl), v);
   }
   if (line == 0) return hearth_err_set(err, HEARTH_E_PARSE, "websocket handshake: empty response");
-  if (!upgrade) return hearth_err_set(err, HEARTH_E_PARSE, "websocket handshake: missing \"Upgrade: websocket\"");
-  if (!connection) return hearth_err_set(err, HEARTH_E_PARSE, "websocket handshake: missing \"Connection: Upgrade\"");
-  if (!accept_ok) return hearth_err_set(err, HEARTH_E_PARSE, "websocket handshake: missing Sec-WebSocket-Accept");
+  if (!upgrade)
+    return hearth_err_set(err, HEARTH_E_PARSE,
+                          "websocket handshake: missing \"Upgrade: websocket\"");
+  if (!connection)
+    return hearth_err_set(err, HEARTH_E_PARSE,
+                          "websocket handshake: missing \"Connection: Upgrade\"");
+  if (!accept_ok)
+    return hearth_err_set(err, HEARTH_E_PARSE, "websocket handshake: missing Sec-WebSocket-Accept");
   return HEARTH_OK;
 }
 
@@ -153,13 +166,15 @@ hearth_status hearth_ws_parse_header(const uint8_t *buf, size_t len, int allow_m
   h->opcode = b0 & 0x0f;
   h->masked = b1 >> 7;
   if (b0 & 0x70)
-    return hearth_err_set(err, HEARTH_E_PARSE, "websocket frame: reserved bits 0x%02x set (no extension was negotiated)",
+    return hearth_err_set(err, HEARTH_E_PARSE,
+                          "websocket frame: reserved bits 0x%02x set (no extension was negotiated)",
                           b0 & 0x70);
   int op = h->opcode;
   if (!(op == 0 || op == 1 || op == 2 || op == 8 || op == 9 || op == 10))
     return hearth_err_set(err, HEARTH_E_PARSE, "websocket frame: unknown opcode 0x%x", op);
   if (h->masked && !allow_masked)
-    return hearth_err_set(err, HEARTH_E_PARSE, "websocket frame: a server must not mask its frames");
+    return hearth_err_set(err, HEARTH_E_PARSE,
+                          "websocket frame: a server must not mask its frames");
   uint64_t pl = b1 & 0x7f;
   size_t hl = 2 + (pl == 126 ? 2 : pl == 127 ? 8 : 0) + (h->masked ? 4 : 0);
   if (len < hl) {
@@ -168,18 +183,25 @@ hearth_status hearth_ws_parse_header(const uint8_t *buf, size_t len, int allow_m
   }
   if (pl == 126) {
     pl = (uint64_t)buf[2] << 8 | buf[3];
-    if (pl < 126) return hearth_err_set(err, HEARTH_E_PARSE, "websocket frame: non-minimal 16-bit length %llu", (unsigned long long)pl);
+    if (pl < 126)
+      return hearth_err_set(err, HEARTH_E_PARSE, "websocket frame: non-minimal 16-bit length %llu",
+                            (unsigned long long)pl);
   } else if (pl == 127) {
     pl = 0;
     for (int i = 0; i < 8; i++) pl = pl << 8 | buf[2 + i];
-    if (pl >> 63) return hearth_err_set(err, HEARTH_E_PARSE, "websocket frame: 64-bit length with the top bit set");
-    if (pl <= 0xffff) return hearth_err_set(err, HEARTH_E_PARSE, "websocket frame: non-minimal 64-bit length %llu", (unsigned long long)pl);
+    if (pl >> 63)
+      return hearth_err_set(err, HEARTH_E_PARSE,
+                            "websocket frame: 64-bit length with the top bit set");
+    if (pl <= 0xffff)
+      return hearth_err_set(err, HEARTH_E_PARSE, "websocket frame: non-minimal 64-bit length %llu",
+                            (unsigned long long)pl);
   }
   if (op >= 8 && (!h->fin || pl > 125))
     return hearth_err_set(err, HEARTH_E_PARSE, "websocket frame: control frame 0x%x %s", op,
                           !h->fin ? "fragmented" : "longer than 125 bytes");
   if (pl > max_payload)
-    return hearth_err_set(err, HEARTH_E_LIMIT, "websocket frame: payload of %llu bytes exceeds the limit of %llu",
+    return hearth_err_set(err, HEARTH_E_LIMIT,
+                          "websocket frame: payload of %llu bytes exceeds the limit of %llu",
                           (unsigned long long)pl, (unsigned long long)max_payload);
   if (h->masked) memcpy(h->mask, buf + hl - 4, 4);
   h->payload_len = pl;
@@ -187,7 +209,8 @@ hearth_status hearth_ws_parse_header(const uint8_t *buf, size_t len, int allow_m
   return HEARTH_OK;
 }
 
-size_t hearth_ws_build_header(uint8_t out[14], int fin, int opcode, uint64_t n, const uint8_t mask[4]) {
+size_t hearth_ws_build_header(uint8_t out[14], int fin, int opcode, uint64_t n,
+                              const uint8_t mask[4]) {
   size_t k = 0;
   out[k++] = (uint8_t)((fin ? 0x80 : 0) | (opcode & 0x0f));
   uint8_t m = mask ? 0x80 : 0;

@@ -47,14 +47,16 @@ static int wait_fd(int fd, short ev, double deadline) {
   }
 }
 
-static hearth_status send_all(hearth_ws *c, const uint8_t *p, size_t n, double deadline, hearth_err *err) {
+static hearth_status send_all(hearth_ws *c, const uint8_t *p, size_t n, double deadline,
+                              hearth_err *err) {
   while (n) {
     int w = wait_fd(c->fd, POLLOUT, deadline);
     if (w == 0) return hearth_err_set(err, HEARTH_E_IO, "websocket %s: send timed out", c->host);
     ssize_t k = send(c->fd, p, n, MSG_NOSIGNAL);
     if (k < 0) {
       if (errno == EAGAIN || errno == EINTR) continue;
-      return hearth_err_set(err, HEARTH_E_IO, "websocket %s: send failed: %s", c->host, strerror(errno));
+      return hearth_err_set(err, HEARTH_E_IO, "websocket %s: send failed: %s", c->host,
+                            strerror(errno));
     }
     p += k, n -= (size_t)k;
   }
@@ -72,19 +74,23 @@ static hearth_status fill(hearth_ws *c, double deadline, double timeout_s, heart
   for (;;) {
     int w = wait_fd(c->fd, POLLIN, deadline);
     if (w == 0)
-      return hearth_err_set(err, HEARTH_E_IO, "websocket %s: no reply from the server within %.1f s",
-                            c->host, timeout_s);
-    if (w < 0) return hearth_err_set(err, HEARTH_E_IO, "websocket %s: poll: %s", c->host, strerror(errno));
+      return hearth_err_set(err, HEARTH_E_IO,
+                            "websocket %s: no reply from the server within %.1f s", c->host,
+                            timeout_s);
+    if (w < 0)
+      return hearth_err_set(err, HEARTH_E_IO, "websocket %s: poll: %s", c->host, strerror(errno));
     ssize_t k = recv(c->fd, c->rbuf + c->rlen, c->rcap - c->rlen, 0);
     if (k == 0) {
       c->closed = 1;
-      return hearth_err_set(err, HEARTH_E_IO, "websocket %s: the server closed the connection without a close frame",
+      return hearth_err_set(err, HEARTH_E_IO,
+                            "websocket %s: the server closed the connection without a close frame",
                             c->host);
     }
     if (k < 0) {
       if (errno == EAGAIN || errno == EINTR) continue;
       c->closed = 1;
-      return hearth_err_set(err, HEARTH_E_IO, "websocket %s: receive failed: %s", c->host, strerror(errno));
+      return hearth_err_set(err, HEARTH_E_IO, "websocket %s: receive failed: %s", c->host,
+                            strerror(errno));
     }
     c->rlen += (size_t)k;
     return HEARTH_OK;
@@ -96,8 +102,8 @@ static void consume(hearth_ws *c, size_t n) {
   c->rlen -= n;
 }
 
-static hearth_status send_frame(hearth_ws *c, int fin, int op, const uint8_t *p, size_t n, double deadline,
-                                hearth_err *err) {
+static hearth_status send_frame(hearth_ws *c, int fin, int op, const uint8_t *p, size_t n,
+                                double deadline, hearth_err *err) {
   uint8_t hdr[14], mask[4];
   uint64_t r = hearth_rng_u64(&c->rng);
   memcpy(mask, &r, 4);
@@ -136,10 +142,12 @@ static void with_host(hearth_err *err, const char *host) {
   snprintf(err->msg, sizeof err->msg, "websocket %s: %s", host, rest);
 }
 
-hearth_status hearth_ws_connect(const char *url, double timeout_s, hearth_ws **out, hearth_err *err) {
+hearth_status hearth_ws_connect(const char *url, double timeout_s, hearth_ws **out,
+                                hearth_err *err) {
   *out = NULL;
   if (strncmp(url, "ws://", 5) != 0)
-    return hearth_err_set(err, HEARTH_E_ARG, "websocket: \"%s\": expected ws://HOST:PORT[/PATH]", url);
+    return hearth_err_set(err, HEARTH_E_ARG, "websocket: \"%s\": expected ws://HOST:PORT[/PATH]",
+                          url);
   const char *h = url + 5;
   const char *slash = strchr(h, '/');
   size_t hl = slash ? (size_t)(slash - h) : strlen(h);
@@ -153,7 +161,8 @@ hearth_status hearth_ws_connect(const char *url, double timeout_s, hearth_ws **o
   snprintf(host, sizeof host, "%s", hostport);
   if (colon && !strchr(colon, ']')) {
     host[colon - hostport] = 0;
-    if (strlen(colon + 1) == 0 || strlen(colon + 1) >= sizeof port || strspn(colon + 1, "0123456789") != strlen(colon + 1))
+    if (strlen(colon + 1) == 0 || strlen(colon + 1) >= sizeof port ||
+        strspn(colon + 1, "0123456789") != strlen(colon + 1))
       return hearth_err_set(err, HEARTH_E_ARG, "websocket: \"%s\": bad port", url);
     snprintf(port, sizeof port, "%s", colon + 1);
   }
@@ -167,7 +176,9 @@ hearth_status hearth_ws_connect(const char *url, double timeout_s, hearth_ws **o
   struct addrinfo hints = {0}, *ai = NULL;
   hints.ai_socktype = SOCK_STREAM;
   int g = getaddrinfo(host, port, &hints, &ai);
-  if (g) return hearth_err_set(err, HEARTH_E_IO, "websocket %s: cannot resolve: %s", hostport, gai_strerror(g));
+  if (g)
+    return hearth_err_set(err, HEARTH_E_IO, "websocket %s: cannot resolve: %s", hostport,
+                          gai_strerror(g));
   hearth_ws *c = calloc(1, sizeof *c);
   if (!c) {
     freeaddrinfo(ai);
@@ -213,10 +224,11 @@ hearth_status hearth_ws_connect(const char *url, double timeout_s, hearth_ws **o
   char key[32];
   hearth_base64_encode(kb, 16, key, sizeof key);
   char req[1024];
-  int rl = snprintf(req, sizeof req,
-                    "GET %s HTTP/1.1\r\nHost: %s\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
-                    "Sec-WebSocket-Key: %s\r\nSec-WebSocket-Version: 13\r\nUser-Agent: hearth\r\n\r\n",
-                    path, hostport, key);
+  int rl =
+      snprintf(req, sizeof req,
+               "GET %s HTTP/1.1\r\nHost: %s\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+               "Sec-WebSocket-Key: %s\r\nSec-WebSocket-Version: 13\r\nUser-Agent: hearth\r\n\r\n",
+               path, hostport, key);
   if (rl < 0 || (size_t)rl >= sizeof req) {
     hearth_ws_close(c, 0);
     return hearth_err_set(err, HEARTH_E_ARG, "websocket: URL too long");
@@ -225,11 +237,13 @@ hearth_status hearth_ws_connect(const char *url, double timeout_s, hearth_ws **o
   size_t hend = 0;
   while (!st) {
     for (size_t i = 3; i < c->rlen && !hend; i++)
-      if (c->rbuf[i - 3] == '\r' && c->rbuf[i - 2] == '\n' && c->rbuf[i - 1] == '\r' && c->rbuf[i] == '\n')
+      if (c->rbuf[i - 3] == '\r' && c->rbuf[i - 2] == '\n' && c->rbuf[i - 1] == '\r' &&
+          c->rbuf[i] == '\n')
         hend = i + 1;
     if (hend) break;
     if (c->rlen > 16384) {
-      st = hearth_err_set(err, HEARTH_E_LIMIT, "websocket %s: handshake response over 16 KiB", hostport);
+      st = hearth_err_set(err, HEARTH_E_LIMIT, "websocket %s: handshake response over 16 KiB",
+                          hostport);
       break;
     }
     st = fill(c, deadline, timeout_s, err);
@@ -248,8 +262,10 @@ hearth_status hearth_ws_connect(const char *url, double timeout_s, hearth_ws **o
   return HEARTH_OK;
 }
 
-hearth_status hearth_ws_send(hearth_ws *c, int opcode, const void *data, size_t n, size_t frag, hearth_err *err) {
-  if (c->closed) return hearth_err_set(err, HEARTH_E_IO, "websocket %s: connection is closed", c->host);
+hearth_status hearth_ws_send(hearth_ws *c, int opcode, const void *data, size_t n, size_t frag,
+                             hearth_err *err) {
+  if (c->closed)
+    return hearth_err_set(err, HEARTH_E_IO, "websocket %s: connection is closed", c->host);
   double deadline = now_s() + 600;
   if (frag == 0 || frag >= n) return send_frame(c, 1, opcode, data, n, deadline, err);
   const uint8_t *p = data;
@@ -262,8 +278,8 @@ hearth_status hearth_ws_send(hearth_ws *c, int opcode, const void *data, size_t 
 }
 
 /* one frame: returns its header; payload at rbuf[header_len..) */
-static hearth_status next_frame(hearth_ws *c, hearth_ws_header *h, double deadline, double timeout_s,
-                                hearth_err *err) {
+static hearth_status next_frame(hearth_ws *c, hearth_ws_header *h, double deadline,
+                                double timeout_s, hearth_err *err) {
   for (;;) {
     size_t need = 0;
     hearth_status st = hearth_ws_parse_header(c->rbuf, c->rlen, 0, WS_MAX_MESSAGE, h, &need, err);
@@ -282,7 +298,8 @@ hearth_status hearth_ws_recv(hearth_ws *c, uint8_t **data, size_t *n, int *opcod
                              hearth_err *err) {
   *data = NULL, *n = 0;
   if (opcode) *opcode = 0;
-  if (c->closed) return hearth_err_set(err, HEARTH_E_IO, "websocket %s: connection is closed", c->host);
+  if (c->closed)
+    return hearth_err_set(err, HEARTH_E_IO, "websocket %s: connection is closed", c->host);
   double deadline = now_s() + timeout_s;
   uint8_t *msg = NULL;
   size_t mlen = 0;
@@ -308,7 +325,8 @@ hearth_status hearth_ws_recv(hearth_ws *c, uint8_t **data, size_t *n, int *opcod
       continue;
     }
     if (h.opcode == HEARTH_WS_PONG) {
-      if (c->pong_pending && pl == c->pong_len && memcmp(p, c->pong_payload, pl) == 0) c->pong_pending = 0;
+      if (c->pong_pending && pl == c->pong_len && memcmp(p, c->pong_payload, pl) == 0)
+        c->pong_pending = 0;
       consume(c, h.header_len + pl);
       if (!c->pong_pending && c->ping_wait) return HEARTH_OK;
       continue;
@@ -325,7 +343,8 @@ hearth_status hearth_ws_recv(hearth_ws *c, uint8_t **data, size_t *n, int *opcod
       if (c->close_code != 1005) send_frame(c, 1, HEARTH_WS_CLOSE, cb, 2, now_s() + 1, NULL);
       c->closed = 1;
       free(msg);
-      return hearth_err_set(err, HEARTH_E_IO, "websocket %s: the server closed the connection with code %d%s%s%s",
+      return hearth_err_set(err, HEARTH_E_IO,
+                            "websocket %s: the server closed the connection with code %d%s%s%s",
                             c->host, c->close_code, c->close_reason[0] ? " (" : "", c->close_reason,
                             c->close_reason[0] ? ")" : "");
     }
@@ -357,7 +376,9 @@ hearth_status hearth_ws_recv(hearth_ws *c, uint8_t **data, size_t *n, int *opcod
       if (c->ping_wait) {
         free(msg);
         c->closed = 1;
-        return hearth_err_set(err, HEARTH_E_PARSE, "websocket %s: a data message arrived while waiting for a pong", c->host);
+        return hearth_err_set(err, HEARTH_E_PARSE,
+                              "websocket %s: a data message arrived while waiting for a pong",
+                              c->host);
       }
       *data = msg, *n = mlen;
       if (opcode) *opcode = mop;
@@ -366,9 +387,11 @@ hearth_status hearth_ws_recv(hearth_ws *c, uint8_t **data, size_t *n, int *opcod
   }
 }
 
-hearth_status hearth_ws_ping(hearth_ws *c, const void *payload, size_t n, double timeout_s, hearth_err *err) {
+hearth_status hearth_ws_ping(hearth_ws *c, const void *payload, size_t n, double timeout_s,
+                             hearth_err *err) {
   if (n > 125) return hearth_err_set(err, HEARTH_E_ARG, "websocket: ping payload over 125 bytes");
-  if (c->closed) return hearth_err_set(err, HEARTH_E_IO, "websocket %s: connection is closed", c->host);
+  if (c->closed)
+    return hearth_err_set(err, HEARTH_E_IO, "websocket %s: connection is closed", c->host);
   memcpy(c->pong_payload, payload, n);
   c->pong_len = n;
   c->pong_pending = 1;

@@ -131,8 +131,9 @@ static int ov_hit_on_border(const ov_grid *g, const float *depth, const size_t b
 
 /* mark outline sub-pixels (silhouette and depth jumps) of the mesh seen
  * from T in s->edge; mesh (may be NULL: cast everything) bounds the cast */
-static void ov_outline(const hearth_raycaster *rc, const hearth_mesh *mesh, const hearth_camera *cam,
-                       const ov_grid *g, const hearth_rigid *T, ov_scratch *s) {
+static void ov_outline(const hearth_raycaster *rc, const hearth_mesh *mesh,
+                       const hearth_camera *cam, const ov_grid *g, const hearth_rigid *T,
+                       ov_scratch *s) {
   const size_t w = g->w, h = g->h, zoom = (size_t)g->zoom;
   float *depth = s->depth;
   uint8_t *edge = s->edge;
@@ -163,7 +164,8 @@ static void ov_outline(const hearth_raycaster *rc, const hearth_mesh *mesh, cons
         if (nx < 0 || ny < 0 || nx >= (long)w || ny >= (long)h) continue;
         float dn = depth[(size_t)ny * w + (size_t)nx];
         /* both sides of the jump, so the line is two sub-pixels wide */
-        if (!isfinite(dn) || dn > d * 1.05f) edge[y * w + x] = edge[(size_t)ny * w + (size_t)nx] = 1;
+        if (!isfinite(dn) || dn > d * 1.05f)
+          edge[y * w + x] = edge[(size_t)ny * w + (size_t)nx] = 1;
       }
     }
 }
@@ -189,7 +191,8 @@ static void ov_auto_range(const hearth_image *temps, double *vals, double *lo, d
 /* Turbo colour of every thermal pixel over [lo, hi] */
 static void ov_colours(const hearth_image *temps, double lo, double hi, uint8_t *turbo) {
   const float *t = temps->data;
-  for (size_t i = 0; i < temps->width * temps->height; i++) hearth_turbo((t[i] - lo) / (hi - lo), turbo + 3 * i);
+  for (size_t i = 0; i < temps->width * temps->height; i++)
+    hearth_turbo((t[i] - lo) / (hi - lo), turbo + 3 * i);
 }
 
 /* a new image of the colours enlarged zoom times (nearest) */
@@ -215,8 +218,10 @@ hearth_status hearth_overlay_render(const hearth_raycaster *rc, const hearth_cam
       temps->width != (size_t)cam->width || temps->height != (size_t)cam->height)
     return hearth_err_set(err, HEARTH_E_SIZE, "overlay: expected a %dx%d temperature image",
                           cam->width, cam->height);
-  if (zoom < 1 || zoom > 16) return hearth_err_set(err, HEARTH_E_ARG, "overlay: zoom %d outside 1..16", zoom);
-  size_t n = temps->width * temps->height, w = temps->width * (size_t)zoom, h = temps->height * (size_t)zoom;
+  if (zoom < 1 || zoom > 16)
+    return hearth_err_set(err, HEARTH_E_ARG, "overlay: zoom %d outside 1..16", zoom);
+  size_t n = temps->width * temps->height, w = temps->width * (size_t)zoom,
+         h = temps->height * (size_t)zoom;
   ov_scratch *s = ov_scratch_new(w * h, n);
   ov_grid g = {0};
   hearth_status st = HEARTH_OK;
@@ -224,7 +229,8 @@ hearth_status hearth_overlay_render(const hearth_raycaster *rc, const hearth_cam
   if (!(lo < hi)) ov_auto_range(temps, s->vals, &lo, &hi);
   if (!out->data) {
     ov_colours(temps, lo, hi, s->turbo);
-    if ((st = ov_background(s->turbo, temps->width, temps->height, (size_t)zoom, out, err))) goto done;
+    if ((st = ov_background(s->turbo, temps->width, temps->height, (size_t)zoom, out, err)))
+      goto done;
   } else if (out->width != w || out->height != h || out->channels != 3) {
     st = hearth_err_set(err, HEARTH_E_SIZE, "overlay: target image has the wrong size");
     goto done;
@@ -249,12 +255,12 @@ typedef struct ov_ctx {
   const hearth_manifest *man;
   const hearth_poses *before, *after; /* before: NULL when there is none */
   const char *after_path, *dir;
-  const char *rig_path;               /* the camera's document, named in size errors */
-  const ov_grid *big, *small;         /* at the job's zoom and at 1 */
-  ov_scratch **scratch;               /* per worker */
-  hearth_image (*thumbs)[2];          /* per view: the sheet's before and after cells */
-  hearth_status *st;                  /* per view */
-  hearth_err *errs;                   /* per view */
+  const char *rig_path;       /* the camera's document, named in size errors */
+  const ov_grid *big, *small; /* at the job's zoom and at 1 */
+  ov_scratch **scratch;       /* per worker */
+  hearth_image (*thumbs)[2];  /* per view: the sheet's before and after cells */
+  hearth_status *st;          /* per view */
+  hearth_err *errs;           /* per view */
 } ov_ctx;
 
 /* view k: its own file, and its two contact-sheet cells in thumbs */
@@ -266,8 +272,8 @@ static hearth_status ov_view(const ov_ctx *c, ov_scratch *s, size_t k, hearth_im
   const hearth_view_pose *pa = hearth_poses_find(c->after, state, vf->view);
   const hearth_view_pose *pb = c->before ? hearth_poses_find(c->before, state, vf->view) : NULL;
   if (!pa)
-    return hearth_err_set(err, HEARTH_E_NOT_FOUND, "%s: no pose for state '%s' view '%s'", c->after_path,
-                          state, vf->view);
+    return hearth_err_set(err, HEARTH_E_NOT_FOUND, "%s: no pose for state '%s' view '%s'",
+                          c->after_path, state, vf->view);
   char path[RF_PATH];
   size_t cw = (size_t)c->cam->width, ch = (size_t)c->cam->height;
   rf_pathf(path, "%s/instances/%s/raw/%s/%s", job->root, job->instance, state, vf->thermal);
@@ -309,7 +315,8 @@ static void ov_range(void *ctx, size_t b, size_t e, int t) {
     if ((c->st[k] = ov_view(c, c->scratch[t], k, c->thumbs[k], &c->errs[k]))) break;
 }
 
-hearth_status hearth_overlay_run(const hearth_overlay_job *job, size_t *n_written, hearth_err *err) {
+hearth_status hearth_overlay_run(const hearth_overlay_job *job, size_t *n_written,
+                                 hearth_err *err) {
   if (!job || !job->root || !job->instance || !job->state)
     return hearth_err_set(err, HEARTH_E_ARG, "overlay: root, instance and state are required");
   const char *root = job->root, *inst = job->instance, *state = job->state;
@@ -364,14 +371,16 @@ hearth_status hearth_overlay_run(const hearth_overlay_job *job, size_t *n_writte
   nt = job->threads > 0 ? job->threads : hearth_default_threads();
   if ((size_t)nt > man.n_views) nt = (int)man.n_views;
   if (nt < 1) nt = 1;
-  c = (ov_ctx){job, &mesh, rc, &rig.thermal, &man, have_before ? &before : NULL, &after, after_path, dir,
-               rig_path, &big, zoom != 1 ? &small : &big, NULL, NULL, NULL, NULL};
+  c = (ov_ctx){job,    &mesh,      rc,   &rig.thermal, &man, have_before ? &before : NULL,
+               &after, after_path, dir,  rig_path,     &big, zoom != 1 ? &small : &big,
+               NULL,   NULL,       NULL, NULL};
   c.scratch = calloc((size_t)nt, sizeof *c.scratch);
   c.thumbs = calloc(man.n_views, sizeof *c.thumbs);
   c.st = calloc(man.n_views, sizeof *c.st);
   c.errs = calloc(man.n_views, sizeof *c.errs);
   int nomem = !c.scratch || !c.thumbs || !c.st || !c.errs;
-  for (int t = 0; t < nt && !nomem; t++) nomem = !(c.scratch[t] = ov_scratch_new(big.w * big.h, cw * ch));
+  for (int t = 0; t < nt && !nomem; t++)
+    nomem = !(c.scratch[t] = ov_scratch_new(big.w * big.h, cw * ch));
   if (nomem) {
     s = hearth_err_set(err, HEARTH_E_NOMEM, "overlay: out of memory");
     goto done;
@@ -395,7 +404,8 @@ hearth_status hearth_overlay_run(const hearth_overlay_job *job, size_t *n_writte
     size_t cx = (k % cols) * (2 * cw + 8) + 4, cy = (k / cols) * (ch + label + 8) + 16;
     hearth_draw_text(&sheet, cx, cy, man.views[k].view, grey, 1);
     for (int side = 0; side < 2; side++)
-      if (c.thumbs[k][side].data) hearth_image_blit(&sheet, &c.thumbs[k][side], cx + (size_t)side * cw, cy + label);
+      if (c.thumbs[k][side].data)
+        hearth_image_blit(&sheet, &c.thumbs[k][side], cx + (size_t)side * cw, cy + label);
   }
 sheet:
   rf_pathf(path, "%s/contact_sheet.png", dir);

@@ -17,14 +17,14 @@
 #include "hearth/dataset.h"
 #include "poses/poses_internal.h"
 
-#define RF_BISECT 5           /* silhouette to 1/32 px */
-#define RF_EVAL_WINDOW 3.0    /* px: edge search window of the criterion */
-#define RF_TRUNC 1.5          /* px: truncation of the criterion */
-#define RF_HUBER 1.0          /* px */
-#define RF_STEP 0.5           /* px: profile sampling step */
-#define RF_COARSE 4           /* px: coarse grid of the hit mask */
+#define RF_BISECT 5        /* silhouette to 1/32 px */
+#define RF_EVAL_WINDOW 3.0 /* px: edge search window of the criterion */
+#define RF_TRUNC 1.5       /* px: truncation of the criterion */
+#define RF_HUBER 1.0       /* px */
+#define RF_STEP 0.5        /* px: profile sampling step */
+#define RF_COARSE 4        /* px: coarse grid of the hit mask */
 #define RF_MAX_NODES 4096
-#define RF_PRIOR_PX 0.1       /* px: see the prior in refine_one */
+#define RF_PRIOR_PX 0.1 /* px: see the prior in refine_one */
 
 void hearth_refine_opts_default(hearth_refine_opts *o) {
   memset(o, 0, sizeof *o);
@@ -51,7 +51,8 @@ int rf_mesh_box(const hearth_mesh *mesh, const hearth_camera *cam,
   double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
   int any = 0, behind = 0;
   for (size_t i = 0; i < mesh->n_vertices; i++) {
-    double X[3] = {mesh->positions[3 * i], mesh->positions[3 * i + 1], mesh->positions[3 * i + 2]}, Xc[3], uv[2];
+    double X[3] = {mesh->positions[3 * i], mesh->positions[3 * i + 1], mesh->positions[3 * i + 2]},
+           Xc[3], uv[2];
     hearth_rigid_apply(&Tcw, X, Xc);
     if (!hearth_camera_project(cam, Xc, uv, NULL)) {
       behind = 1;
@@ -80,16 +81,16 @@ int rf_mesh_box(const hearth_mesh *mesh, const hearth_camera *cam,
 /* ---- per-view machinery ------------------------------------------------------ */
 
 typedef struct rf_sample {
-  double X[3];   /* world point on the silhouette */
-  double n[2];   /* outward silhouette normal in the image at extraction */
+  double X[3]; /* world point on the silhouette */
+  double n[2]; /* outward silhouette normal in the image at extraction */
 } rf_sample;
 
 typedef struct rf_scratch {
-  uint8_t *hit;      /* per image pixel */
-  rf_sample *samp;   /* candidates */
+  uint8_t *hit;    /* per image pixel */
+  rf_sample *samp; /* candidates */
   size_t cap;
-  float *smooth;     /* smoothed image */
-  int box[4];        /* pixel box of the last extraction */
+  float *smooth; /* smoothed image */
+  int box[4];    /* pixel box of the last extraction */
 } rf_scratch;
 
 typedef struct rf_ctx {
@@ -149,14 +150,17 @@ static size_t extract_contour(const rf_ctx *c, rf_scratch *sc, const hearth_rigi
   int exact = nx >= RF_MAX_NODES - 1 || ny >= RF_MAX_NODES - 1 || nx < 2 || ny < 2;
   if (exact) { /* huge box: cast everything */
     for (int y = box[1]; y < box[3]; y++)
-      for (int x = box[0]; x < box[2]; x++) sc->hit[(size_t)y * W + (size_t)x] = cast_hit(c, T, x, y);
+      for (int x = box[0]; x < box[2]; x++)
+        sc->hit[(size_t)y * W + (size_t)x] = cast_hit(c, T, x, y);
   } else {
     for (int j = 0; j < ny; j++)
-      for (int i = 0; i < nx; i++) sc->hit[(size_t)ys[j] * W + (size_t)xs[i]] = cast_hit(c, T, xs[i], ys[j]);
+      for (int i = 0; i < nx; i++)
+        sc->hit[(size_t)ys[j] * W + (size_t)xs[i]] = cast_hit(c, T, xs[i], ys[j]);
     for (int pass = 0; pass < 2; pass++)
       for (int j = 0; j + 1 < ny; j++)
         for (int i = 0; i + 1 < nx; i++) {
-          uint8_t a = sc->hit[(size_t)ys[j] * W + (size_t)xs[i]], b = sc->hit[(size_t)ys[j] * W + (size_t)xs[i + 1]],
+          uint8_t a = sc->hit[(size_t)ys[j] * W + (size_t)xs[i]],
+                  b = sc->hit[(size_t)ys[j] * W + (size_t)xs[i + 1]],
                   cc = sc->hit[(size_t)ys[j + 1] * W + (size_t)xs[i]],
                   dd = sc->hit[(size_t)ys[j + 1] * W + (size_t)xs[i + 1]];
           int uniform = a == b && a == cc && a == dd;
@@ -210,7 +214,8 @@ static size_t extract_contour(const rf_ctx *c, rf_scratch *sc, const hearth_rigi
           s->n[0] = dx[j];
           s->n[1] = dy[j];
           const uint32_t *ix = c->mesh->indices + 3 * (size_t)hl.prim;
-          const float *p0 = c->mesh->positions + 3 * (size_t)ix[0], *p1 = c->mesh->positions + 3 * (size_t)ix[1],
+          const float *p0 = c->mesh->positions + 3 * (size_t)ix[0],
+                      *p1 = c->mesh->positions + 3 * (size_t)ix[1],
                       *p2 = c->mesh->positions + 3 * (size_t)ix[2];
           double e1[3], e2[3], nw[3];
           for (int k2 = 0; k2 < 3; k2++) {
@@ -223,11 +228,13 @@ static size_t extract_contour(const rf_ctx *c, rf_scratch *sc, const hearth_rigi
             hearth_rigid Tcw;
             hearth_rigid_inverse(T, &Tcw);
             double Xc[3], Xe[3], Xce[3], uv0[2], uv1[2];
-            double eps = 1e-3 * hearth_norm3((double[3]){X[0] - T->t[0], X[1] - T->t[1], X[2] - T->t[2]});
+            double eps =
+                1e-3 * hearth_norm3((double[3]){X[0] - T->t[0], X[1] - T->t[1], X[2] - T->t[2]});
             for (int k2 = 0; k2 < 3; k2++) Xe[k2] = X[k2] + eps * nw[k2] / nl;
             hearth_rigid_apply(&Tcw, X, Xc);
             hearth_rigid_apply(&Tcw, Xe, Xce);
-            if (hearth_camera_project(c->cam, Xc, uv0, NULL) && hearth_camera_project(c->cam, Xce, uv1, NULL)) {
+            if (hearth_camera_project(c->cam, Xc, uv0, NULL) &&
+                hearth_camera_project(c->cam, Xce, uv1, NULL)) {
               double gx = uv1[0] - uv0[0], gy = uv1[1] - uv0[1], gl = sqrt(gx * gx + gy * gy);
               if (gl > 0 && (gx * dx[j] + gy * dy[j]) / gl > 0.3) {
                 s->n[0] = gx / gl;
@@ -257,8 +264,8 @@ static double sample_img(const float *img, int w, int h, double x, double y) {
 
 /* strongest edge of polarity pol (inside - outside sign) along n from uv
  * within +-win; returns 1 and the offset, 0 if none above thr */
-static int find_edge(const float *img, int w, int h, const double uv[2], const double n[2], double pol,
-                     double win, double thr, double *off) {
+static int find_edge(const float *img, int w, int h, const double uv[2], const double n[2],
+                     double pol, double win, double thr, double *off) {
   int m = (int)ceil(win / RF_STEP);
   double best = -INFINITY, gm1 = 0, gp1 = 0;
   int bi = 0;
@@ -306,7 +313,8 @@ static void smooth3(const float *in, int w, int h, float *out) {
 
 /* median temperature of the pixels the mesh covers minus that of the
  * uncovered pixels of the box around it (robust to a start several pixels off) */
-static double contour_contrast(const rf_ctx *c, const rf_scratch *sc, size_t ns, const hearth_rigid *T) {
+static double contour_contrast(const rf_ctx *c, const rf_scratch *sc, size_t ns,
+                               const hearth_rigid *T) {
   (void)T;
   if (!ns) return 0;
   const int *b = sc->box;
@@ -330,8 +338,8 @@ static double contour_contrast(const rf_ctx *c, const rf_scratch *sc, size_t ns,
 
 /* the criterion at pose T: mean over silhouette samples of min(d^2, c^2),
  * d = distance to the edge found within the evaluation window */
-static double eval_cost(const rf_ctx *c, rf_scratch *sc, const hearth_rigid *T, double pol, double thr,
-                        size_t *n_in, size_t *n_s) {
+static double eval_cost(const rf_ctx *c, rf_scratch *sc, const hearth_rigid *T, double pol,
+                        double thr, size_t *n_in, size_t *n_s) {
   size_t ns = extract_contour(c, sc, T, c->o->max_samples);
   hearth_rigid Tcw;
   hearth_rigid_inverse(T, &Tcw);
@@ -342,7 +350,8 @@ static double eval_cost(const rf_ctx *c, rf_scratch *sc, const hearth_rigid *T, 
     hearth_rigid_apply(&Tcw, sc->samp[i].X, Xc);
     double cost = RF_TRUNC * RF_TRUNC;
     if (hearth_camera_project(c->cam, Xc, uv, NULL) &&
-        find_edge(sc->smooth, c->cam->width, c->cam->height, uv, sc->samp[i].n, pol, RF_EVAL_WINDOW, thr, &off)) {
+        find_edge(sc->smooth, c->cam->width, c->cam->height, uv, sc->samp[i].n, pol, RF_EVAL_WINDOW,
+                  thr, &off)) {
       if (off * off < cost) cost = off * off;
       if (fabs(off) < RF_HUBER) in++;
     }
@@ -402,7 +411,8 @@ static void twist_between(const hearth_rigid *a, const hearth_rigid *b, double d
   d[5] = D.t[2];
 }
 
-static void pose_change(const hearth_rigid *a, const hearth_rigid *b, double *rot_deg, double *t_mm) {
+static void pose_change(const hearth_rigid *a, const hearth_rigid *b, double *rot_deg,
+                        double *t_mm) {
   *rot_deg = hearth_rotation_angle_between(a->R, b->R) * 180.0 / M_PI;
   double d[3] = {a->t[0] - b->t[0], a->t[1] - b->t[1], a->t[2] - b->t[2]};
   *t_mm = hearth_norm3(d) * 1e3;
@@ -463,8 +473,12 @@ static void refine_one(rf_ctx *c, size_t v, int t) {
       /* d r / d Xc = n^T J_point; Xc' = R(w)^T (Xc - v) ~ Xc + Xc x w - v */
       double a[3];
       for (int k = 0; k < 3; k++) a[k] = n[0] * jac.d_point[k] + n[1] * jac.d_point[3 + k];
-      double J[6] = {a[1] * Xc[2] - a[2] * Xc[1], a[2] * Xc[0] - a[0] * Xc[2],
-                     a[0] * Xc[1] - a[1] * Xc[0], -a[0], -a[1], -a[2]};
+      double J[6] = {a[1] * Xc[2] - a[2] * Xc[1],
+                     a[2] * Xc[0] - a[0] * Xc[2],
+                     a[0] * Xc[1] - a[1] * Xc[0],
+                     -a[0],
+                     -a[1],
+                     -a[2]};
       for (int p = 0; p < 6; p++) {
         g[p] += w * J[p] * r;
         for (int q = 0; q < 6; q++) H[6 * p + q] += w * J[p] * J[q];
@@ -537,10 +551,11 @@ static void refine_one(rf_ctx *c, size_t v, int t) {
   }
   double inl = n_s ? (double)n_in / (double)n_s : 0;
   if (!(cost < res->cost_start)) {
-    snprintf(res->reason, sizeof res->reason, "kept: criterion %.4f not better than start %.4f", cost,
-             res->cost_start);
+    snprintf(res->reason, sizeof res->reason, "kept: criterion %.4f not better than start %.4f",
+             cost, res->cost_start);
   } else if (dr > o->max_rot_deg || dt > o->max_t_mm) {
-    snprintf(res->reason, sizeof res->reason, "kept: moved %.2f deg %.1f mm, beyond the limits", dr, dt);
+    snprintf(res->reason, sizeof res->reason, "kept: moved %.2f deg %.1f mm, beyond the limits", dr,
+             dt);
   } else if (n_in < 20) {
     snprintf(res->reason, sizeof res->reason, "kept: only %zu edge inliers", n_in);
   } else {
@@ -578,8 +593,8 @@ hearth_status hearth_refine_views(const hearth_mesh *mesh, const hearth_raycaste
     if (!im || im->type != HEARTH_PIX_F32 || im->channels != 1 || im->width != (size_t)cam->width ||
         im->height != (size_t)cam->height)
       return hearth_err_set(err, HEARTH_E_SIZE,
-                            "refine: view %zu: expected a %dx%d single-channel temperature image", v,
-                            cam->width, cam->height);
+                            "refine: view %zu: expected a %dx%d single-channel temperature image",
+                            v, cam->width, cam->height);
   }
   if (!n_views) return HEARTH_OK;
   hearth_raycaster *own = NULL;
@@ -664,7 +679,9 @@ hearth_status hearth_reprojection_error(const hearth_raycaster *rc, const hearth
       sum += hypot(uv[0] - x, uv[1] - y);
       n++;
     }
-  if (!n) return hearth_err_set(err, HEARTH_E_NOT_FOUND, "reprojection: the mesh is not seen from the pose");
+  if (!n)
+    return hearth_err_set(err, HEARTH_E_NOT_FOUND,
+                          "reprojection: the mesh is not seen from the pose");
   *mean_px = sum / (double)n;
   return HEARTH_OK;
 }
@@ -686,7 +703,8 @@ hearth_status hearth_pose_nudge_parse(const char *text, hearth_pose_nudge *out, 
   memset(out, 0, sizeof *out);
   const char *slash = strchr(text, '/'), *colon = strchr(text, ':');
   if (!slash || !colon || colon < slash || slash == text || colon == slash + 1 ||
-      (size_t)(slash - text) >= sizeof out->state || (size_t)(colon - slash - 1) >= sizeof out->view)
+      (size_t)(slash - text) >= sizeof out->state ||
+      (size_t)(colon - slash - 1) >= sizeof out->view)
     return hearth_err_set(err, HEARTH_E_PARSE,
                           "nudge '%s': expected STATE/VIEW:rx,ry,rz,tx,ty,tz (degrees, mm)", text);
   memcpy(out->state, text, (size_t)(slash - text));
@@ -699,7 +717,8 @@ hearth_status hearth_pose_nudge_parse(const char *text, hearth_pose_nudge *out, 
     if ((k < 5 && !e) || (k == 5 && e) || hearth_parse_double(p, len, 0, &v) != 0)
       return hearth_err_set(err, HEARTH_E_PARSE,
                             "nudge '%s': value %d: expected 6 comma-separated numbers "
-                            "rx,ry,rz (degrees), tx,ty,tz (mm)", text, k + 1);
+                            "rx,ry,rz (degrees), tx,ty,tz (mm)",
+                            text, k + 1);
     if (k < 3) out->d_rot_deg[k] = v;
     else out->d_t_mm[k - 3] = v;
     p = e ? e + 1 : p + len;

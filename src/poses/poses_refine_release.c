@@ -27,8 +27,8 @@ hearth_status hearth_pose_nudges_read(const char *path, hearth_pose_nudge **out,
   json_t *root = json_loadb((const char *)data, size, JSON_REJECT_DUPLICATES, &je);
   free(data);
   if (!root)
-    return hearth_err_set(err, HEARTH_E_PARSE, "%s: line %d, column %d: %s", path, je.line, je.column,
-                          je.text);
+    return hearth_err_set(err, HEARTH_E_PARSE, "%s: line %d, column %d: %s", path, je.line,
+                          je.column, je.text);
   json_t *views = json_is_object(root) ? json_object_get(root, "views") : NULL;
   if (!json_is_array(views)) {
     json_decref(root);
@@ -47,7 +47,8 @@ hearth_status hearth_pose_nudges_read(const char *path, hearth_pose_nudge **out,
     for (int k = 0; k < 2; k++) {
       json_t *sv = json_is_object(v) ? json_object_get(v, keys[k]) : NULL;
       if (!json_is_string(sv) || json_string_length(sv) == 0 || json_string_length(sv) >= 64) {
-        s = hearth_err_set(err, HEARTH_E_PARSE, "%s: views[%zu].%s: expected a name", path, i, keys[k]);
+        s = hearth_err_set(err, HEARTH_E_PARSE, "%s: views[%zu].%s: expected a name", path, i,
+                           keys[k]);
         goto fail;
       }
       snprintf(dst[k], 64, "%s", json_string_value(sv));
@@ -63,14 +64,15 @@ hearth_status hearth_pose_nudges_read(const char *path, hearth_pose_nudge **out,
       json_t *arr = json_object_get(v, vk[k]);
       if (!arr) continue; /* absent: no change of that kind */
       if (!json_is_array(arr) || json_array_size(arr) != 3) {
-        s = hearth_err_set(err, HEARTH_E_PARSE, "%s: views[%zu].%s: expected 3 numbers", path, i, vk[k]);
+        s = hearth_err_set(err, HEARTH_E_PARSE, "%s: views[%zu].%s: expected 3 numbers", path, i,
+                           vk[k]);
         goto fail;
       }
       for (size_t j = 0; j < 3; j++) {
         json_t *x = json_array_get(arr, j);
         if (!json_is_number(x)) {
-          s = hearth_err_set(err, HEARTH_E_PARSE, "%s: views[%zu].%s[%zu]: expected a number", path, i,
-                             vk[k], j);
+          s = hearth_err_set(err, HEARTH_E_PARSE, "%s: views[%zu].%s[%zu]: expected a number", path,
+                             i, vk[k], j);
           goto fail;
         }
         vd[k][j] = json_number_value(x);
@@ -107,7 +109,8 @@ static void perturb(hearth_rigid *T, double deg, double mm, hearth_rng *r) {
 }
 
 static json_t *view_json(const char *state, const char *view, const hearth_refine_view_result *r,
-                         int auto_ran, const hearth_pose_nudge *nudge, double reproj0, double reproj1) {
+                         int auto_ran, const hearth_pose_nudge *nudge, double reproj0,
+                         double reproj1) {
   json_t *o = json_object();
   json_object_set_new(o, "state", json_string(state));
   json_object_set_new(o, "view", json_string(view));
@@ -116,8 +119,10 @@ static json_t *view_json(const char *state, const char *view, const hearth_refin
     json_object_set_new(o, "reason", json_string(r->reason));
     json_object_set_new(o, "d_rot_deg", json_real(r->d_rot_deg));
     json_object_set_new(o, "d_t_mm", json_real(r->d_t_mm));
-    json_object_set_new(o, "cost_start_px2", json_real(isfinite(r->cost_start) ? r->cost_start : -1));
-    json_object_set_new(o, "cost_final_px2", json_real(isfinite(r->cost_final) ? r->cost_final : -1));
+    json_object_set_new(o, "cost_start_px2",
+                        json_real(isfinite(r->cost_start) ? r->cost_start : -1));
+    json_object_set_new(o, "cost_final_px2",
+                        json_real(isfinite(r->cost_final) ? r->cost_final : -1));
     json_object_set_new(o, "contrast_c", json_real(r->contrast_c));
     json_object_set_new(o, "confidence", json_real(r->confidence));
     json_object_set_new(o, "sigma_rot_deg", json_real(r->sigma_rot_deg));
@@ -204,7 +209,8 @@ hearth_status hearth_refine_run(const hearth_refine_job *job, hearth_refine_summ
   }
   for (size_t i = 0; i < start.n; i++) {
     outp.views[i] = start.views[i];
-    const hearth_view_pose *pp = hearth_poses_find(&prev, start.views[i].state, start.views[i].view);
+    const hearth_view_pose *pp =
+        hearth_poses_find(&prev, start.views[i].state, start.views[i].view);
     if (pp) outp.views[i].T_world_from_cam = pp->T_world_from_cam;
   }
   hearth_rng rng;
@@ -233,13 +239,14 @@ hearth_status hearth_refine_run(const hearth_refine_job *job, hearth_refine_summ
       const hearth_view_pose *vp = hearth_poses_find(&start, state, vf->view);
       if (!vp) {
         free(slot);
-        s = hearth_err_set(err, HEARTH_E_NOT_FOUND, "%s: no pose for state '%s' view '%s'", start_path,
-                           state, vf->view);
+        s = hearth_err_set(err, HEARTH_E_NOT_FOUND, "%s: no pose for state '%s' view '%s'",
+                           start_path, state, vf->view);
         goto done;
       }
       slot[k] = (size_t)(vp - start.views);
       rf_pathf(path, "%s/instances/%s/raw/%s/%s", root, inst, state, vf->thermal);
-      if ((s = hearth_thermal_read_csv_camera(path, copts.width, copts.height, rig_path, &imgs[k], err))) {
+      if ((s = hearth_thermal_read_csv_camera(path, copts.width, copts.height, rig_path, &imgs[k],
+                                              err))) {
         free(slot);
         goto done;
       }
@@ -265,18 +272,20 @@ hearth_status hearth_refine_run(const hearth_refine_job *job, hearth_refine_summ
       hearth_rigid T = res[k].T_world_from_cam;
       const hearth_pose_nudge *nudge = NULL;
       for (size_t j = 0; j < job->n_nudges; j++)
-        if (!strcmp(job->nudges[j].state, state) && !strcmp(job->nudges[j].view, man.views[k].view)) {
+        if (!strcmp(job->nudges[j].state, state) &&
+            !strcmp(job->nudges[j].view, man.views[k].view)) {
           hearth_pose_nudge_apply(&job->nudges[j], &T);
           nudge = &job->nudges[j];
         }
       outp.views[slot[k]].T_world_from_cam = T;
       done_flag[slot[k]] = 1;
       double e0 = -1, e1 = -1;
-      const hearth_view_pose *tp = truth.n ? hearth_poses_find(&truth, state, man.views[k].view) : NULL;
+      const hearth_view_pose *tp =
+          truth.n ? hearth_poses_find(&truth, state, man.views[k].view) : NULL;
       if (tp) {
         hearth_err e2;
-        if (!hearth_reprojection_error(rc, &rig.thermal, &tp->T_world_from_cam, &views[k].T_world_from_cam,
-                                       2, &e0, &e2) &&
+        if (!hearth_reprojection_error(rc, &rig.thermal, &tp->T_world_from_cam,
+                                       &views[k].T_world_from_cam, 2, &e0, &e2) &&
             !hearth_reprojection_error(rc, &rig.thermal, &tp->T_world_from_cam, &T, 2, &e1, &e2)) {
           rsum0 += e0;
           rsum1 += e1;
@@ -286,7 +295,8 @@ hearth_status hearth_refine_run(const hearth_refine_job *job, hearth_refine_summ
           e0 = e1 = -1;
         }
       }
-      json_array_append_new(report, view_json(state, man.views[k].view, &res[k], !job->no_auto, nudge, e0, e1));
+      json_array_append_new(report, view_json(state, man.views[k].view, &res[k], !job->no_auto,
+                                              nudge, e0, e1));
       S.n_views++;
       S.n_accepted += res[k].accepted ? 1 : 0;
       tsum += res[k].seconds;
@@ -301,8 +311,8 @@ hearth_status hearth_refine_run(const hearth_refine_job *job, hearth_refine_summ
     res = NULL;
   }
   if (!any_state) {
-    s = hearth_err_set(err, HEARTH_E_NOT_FOUND, "%s/instances/%s/instance.json: no state '%s'", root,
-                       inst, job->state ? job->state : "");
+    s = hearth_err_set(err, HEARTH_E_NOT_FOUND, "%s/instances/%s/instance.json: no state '%s'",
+                       root, inst, job->state ? job->state : "");
     goto done;
   }
   /* the outputs' folders (derived/ need not exist yet with --start/--mesh elsewhere) */
@@ -323,8 +333,9 @@ hearth_status hearth_refine_run(const hearth_refine_job *job, hearth_refine_summ
     json_object_set_new(doc, "instance", json_string(inst));
     json_object_set_new(doc, "start", json_string(hearth_path_under(root, start_path)));
     json_object_set_new(doc, "criterion",
-                        json_string("mean over silhouette samples of min(d, 1.5 px)^2, d = distance "
-                                    "to the strongest thermal edge within 3 px along the normal"));
+                        json_string(
+                            "mean over silhouette samples of min(d, 1.5 px)^2, d = distance "
+                            "to the strongest thermal edge within 3 px along the normal"));
     json_object_set_new(doc, "views", report);
     report = NULL;
     char *text = json_dumps(doc, JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(10));

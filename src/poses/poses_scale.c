@@ -27,8 +27,8 @@ void hearth_scale_opts_default(hearth_scale_opts *o) {
 
 /* one candidate pixel: measured and rendered depth */
 typedef struct zpair {
-  float zm;  /* metres */
-  float zr;  /* recon units */
+  float zm; /* metres */
+  float zr; /* recon units */
 } zpair;
 
 #define SCALE_BATCH 4096 /* rays per cast */
@@ -47,11 +47,11 @@ typedef struct scale_ctx {
   const hearth_raycaster *rc;
   const hearth_scale_view *views;
   const hearth_scale_opts *o;
-  double s;            /* current estimate (for the baseline) */
-  float **dirs;        /* per view: its camera's pixel rays (3 per sampled pixel), shared
+  double s;                /* current estimate (for the baseline) */
+  float **dirs;            /* per view: its camera's pixel rays (3 per sampled pixel), shared
                           by the views of one camera */
   scale_scratch **scratch; /* per worker */
-  zpair **pairs;       /* per view */
+  zpair **pairs;           /* per view */
   size_t *n_pairs;
   int failed;
 } scale_ctx;
@@ -84,8 +84,8 @@ static void scale_flush(const scale_ctx *c, scale_scratch *sc, size_t n, size_t 
 
 /* cast the sampled pixels of bx from T into zr, in 4 x 4 tiles so that
  * each packet of 16 rays is a tight bundle */
-static void scale_cast(const scale_ctx *c, scale_scratch *sc, const float *dirs, const hearth_rigid *T,
-                       float *zr, scale_box *bx) {
+static void scale_cast(const scale_ctx *c, scale_scratch *sc, const float *dirs,
+                       const hearth_rigid *T, float *zr, scale_box *bx) {
   const float o[3] = {(float)T->t[0], (float)T->t[1], (float)T->t[2]};
   const size_t gw = bx->gw;
   size_t n = 0;
@@ -193,7 +193,8 @@ static void grid_range(void *ctx, size_t b, size_t e, int t) {
   for (size_t i = b; i < e; i++) {
     size_t v = g->owner[i];
     const hearth_image *D = g->views[v].depth;
-    size_t gw = (D->width + g->stride - 1) / g->stride, gh = (D->height + g->stride - 1) / g->stride;
+    size_t gw = (D->width + g->stride - 1) / g->stride,
+           gh = (D->height + g->stride - 1) / g->stride;
     size_t n = gw * gh;
     if (!(g->dirs[v] = hearth_alloc_array(n ? n : 1, 3 * sizeof(float)))) {
       g->failed = 1;
@@ -207,7 +208,8 @@ static void grid_range(void *ctx, size_t b, size_t e, int t) {
 /* dirs[v] for every view; own[v] = 1 where the grid is view v's own to free */
 static hearth_status make_grids(const hearth_scale_view *views, size_t n_views, size_t stride,
                                 int threads, float **dirs, uint8_t *own) {
-  size_t *owner = hearth_alloc_array(n_views, sizeof *owner), *same = hearth_alloc_array(n_views, sizeof *same);
+  size_t *owner = hearth_alloc_array(n_views, sizeof *owner),
+         *same = hearth_alloc_array(n_views, sizeof *same);
   if (!owner || !same) {
     free(owner);
     free(same);
@@ -239,7 +241,8 @@ static void robust_fit(zpair *const *pairs, const size_t *n_pairs, size_t n_view
                        const hearth_scale_opts *o, double *tmp, hearth_scale_result *res) {
   size_t n = 0;
   for (size_t v = 0; v < n_views; v++)
-    for (size_t i = 0; i < n_pairs[v]; i++) tmp[n++] = (double)pairs[v][i].zm / (double)pairs[v][i].zr;
+    for (size_t i = 0; i < n_pairs[v]; i++)
+      tmp[n++] = (double)pairs[v][i].zm / (double)pairs[v][i].zr;
   res->n_candidates = n;
   double s = rf_quantile(tmp, n, 0.5);
   double band = 0;
@@ -297,16 +300,19 @@ hearth_status hearth_scale_estimate(const hearth_mesh *recon_mesh, const hearth_
   }
   memset(out, 0, sizeof *out);
   if (!recon_mesh || !views || !n_views)
-    return hearth_err_set(err, HEARTH_E_ARG, "scale: a mesh and at least one depth view are needed");
+    return hearth_err_set(err, HEARTH_E_ARG,
+                          "scale: a mesh and at least one depth view are needed");
   for (size_t v = 0; v < n_views; v++) {
     const hearth_image *D = views[v].depth;
     if (!D || D->type != HEARTH_PIX_U16 || D->channels != 1)
       return hearth_err_set(err, HEARTH_E_UNSUPPORTED,
                             "scale: depth view %zu: expected a 16-bit single-channel image", v);
-    if (D->width != (size_t)views[v].depth_cam.width || D->height != (size_t)views[v].depth_cam.height)
+    if (D->width != (size_t)views[v].depth_cam.width ||
+        D->height != (size_t)views[v].depth_cam.height)
       return hearth_err_set(err, HEARTH_E_SIZE,
                             "scale: depth view %zu: image is %zux%zu, its intrinsics say %dx%d", v,
-                            D->width, D->height, views[v].depth_cam.width, views[v].depth_cam.height);
+                            D->width, D->height, views[v].depth_cam.width,
+                            views[v].depth_cam.height);
   }
   hearth_raycaster *own = NULL;
   hearth_status s = HEARTH_OK;
@@ -330,7 +336,9 @@ hearth_status hearth_scale_estimate(const hearth_mesh *recon_mesh, const hearth_
   }
   size_t stride = (size_t)(opts->pixel_stride > 0 ? opts->pixel_stride : 1);
   if ((s = make_grids(views, n_views, stride, nt, dirs, own_dirs))) {
-    hearth_err_set(err, s, s == HEARTH_E_NOMEM ? "scale: out of memory" : "scale: cannot start worker threads");
+    hearth_err_set(err, s,
+                   s == HEARTH_E_NOMEM ? "scale: out of memory"
+                                       : "scale: cannot start worker threads");
     goto done;
   }
   /* first round: the baseline taken as if recon units were metres; each
@@ -356,7 +364,8 @@ hearth_status hearth_scale_estimate(const hearth_mesh *recon_mesh, const hearth_
     if (total < 10) {
       s = hearth_err_set(err, HEARTH_E_INCONSISTENT,
                          "scale: only %zu depth pixels see the mesh away from edges (expected at "
-                         "least 10): do the poses, depth frames and mesh belong together?", total);
+                         "least 10): do the poses, depth frames and mesh belong together?",
+                         total);
       goto done;
     }
     free(tmp);
@@ -406,8 +415,9 @@ static hearth_status write_scale_json(const char *path, const hearth_scale_resul
   json_object_set_new(o, "candidate_pixels", json_integer((json_int_t)r->n_candidates));
   json_object_set_new(o, "inlier_pixels", json_integer((json_int_t)r->n_inliers));
   json_object_set_new(o, "inlier_fraction", json_real(r->inlier_fraction));
-  json_object_set_new(o, "method", json_string("median of z_measured/z_rendered, then trimmed "
-                                               "least squares; edges, holes and background excluded"));
+  json_object_set_new(o, "method",
+                      json_string("median of z_measured/z_rendered, then trimmed "
+                                  "least squares; edges, holes and background excluded"));
   char *text = json_dumps(o, JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(17));
   json_decref(o);
   if (!text) return hearth_err_set(err, HEARTH_E_NOMEM, "%s: cannot encode", path);
@@ -453,8 +463,8 @@ hearth_status hearth_scale_run(const hearth_scale_job *job, hearth_scale_result 
     n_states++;
   }
   if (!n_states) {
-    s = hearth_err_set(err, HEARTH_E_NOT_FOUND, "%s/instances/%s/instance.json: no state '%s'", root,
-                       inst, job->state ? job->state : "");
+    s = hearth_err_set(err, HEARTH_E_NOT_FOUND, "%s/instances/%s/instance.json: no state '%s'",
+                       root, inst, job->state ? job->state : "");
     goto done;
   }
   depths = calloc(n_frames ? n_frames : 1, sizeof *depths);
@@ -487,7 +497,8 @@ hearth_status hearth_scale_run(const hearth_scale_job *job, hearth_scale_result 
         s = hearth_err_set(err, HEARTH_E_UNSUPPORTED, "%s: expected a 16-bit grey depth PNG", path);
         goto done;
       }
-      views[f] = (hearth_scale_view){&depths[f], di.depth, di.T_depth_from_rgb, vp->T_world_from_cam};
+      views[f] =
+          (hearth_scale_view){&depths[f], di.depth, di.T_depth_from_rgb, vp->T_world_from_cam};
     }
   if ((s = hearth_scale_estimate(&mesh, NULL, views, n_frames, &job->opts, &r, err))) {
     hearth_err_prefix(err, "%s", inst);

@@ -8,8 +8,7 @@
 
 #define PATH_SZ 4096
 
-static hearth_status joinf(char *buf, const char *fmt, ...)
-    __attribute__((format(printf, 2, 3)));
+static hearth_status joinf(char *buf, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 static hearth_status joinf(char *buf, const char *fmt, ...) {
   va_list ap;
   va_start(ap, fmt);

@@ -80,15 +80,17 @@ static char *cameras_text(const hearth_recon_cameras *c) {
     w_reals(&b, h->dist, 5);
     hearth_strbuf_printf(&b, "\n    }%s\n", i + 1 < c->n_cameras ? "," : "");
   }
-  hearth_strbuf_printf(&b, "%s],\n  \"views\": [%s", c->n_cameras ? "  " : "", c->n_views ? "\n" : "");
+  hearth_strbuf_printf(&b, "%s],\n  \"views\": [%s", c->n_cameras ? "  " : "",
+                       c->n_views ? "\n" : "");
   for (size_t i = 0; i < c->n_views; i++) {
     const hearth_recon_view_camera *v = &c->views[i];
     hearth_strbuf_printf(&b, "    {\n      \"state\": ");
     rc_json_string(&b, v->state);
     hearth_strbuf_printf(&b, ",\n      \"view\": ");
     rc_json_string(&b, v->view);
-    hearth_strbuf_printf(&b, ",\n      \"colmap_camera_id\": %u,\n      \"colmap_image_id\": %u,\n"
-                             "      \"colmap_image\": ",
+    hearth_strbuf_printf(&b,
+                         ",\n      \"colmap_camera_id\": %u,\n      \"colmap_image_id\": %u,\n"
+                         "      \"colmap_image\": ",
                          (unsigned)v->camera_id, (unsigned)v->image_id);
     rc_json_string(&b, v->image);
     hearth_strbuf_printf(&b, "\n    }%s\n", i + 1 < c->n_views ? "," : "");
@@ -125,7 +127,8 @@ static hearth_status rd_fail(rd *r, hearth_status s, const char *fmt, ...) {
   va_start(ap, fmt);
   vsnprintf(msg, sizeof msg, fmt, ap);
   va_end(ap);
-  return hearth_err_set(r->err, s, "%s: %s: %s", r->name, r->path[0] ? r->path : "(top level)", msg);
+  return hearth_err_set(r->err, s, "%s: %s: %s", r->name, r->path[0] ? r->path : "(top level)",
+                        msg);
 }
 
 static const char *type_name(const json_t *v) {
@@ -150,22 +153,26 @@ static hearth_status rd_member(rd *r, const json_t *obj, const char *prefix, con
   return HEARTH_OK;
 }
 
-static hearth_status rd_uint(rd *r, const json_t *v, json_int_t lo, json_int_t hi, json_int_t *out) {
-  if (!json_is_integer(v)) return rd_fail(r, HEARTH_E_PARSE, "expected an integer, found %s", type_name(v));
+static hearth_status rd_uint(rd *r, const json_t *v, json_int_t lo, json_int_t hi,
+                             json_int_t *out) {
+  if (!json_is_integer(v))
+    return rd_fail(r, HEARTH_E_PARSE, "expected an integer, found %s", type_name(v));
   json_int_t x = json_integer_value(v);
   if (x < lo || x > hi)
-    return rd_fail(r, HEARTH_E_RANGE, "expected an integer in %lld..%lld, found %lld", (long long)lo,
-                   (long long)hi, (long long)x);
+    return rd_fail(r, HEARTH_E_RANGE, "expected an integer in %lld..%lld, found %lld",
+                   (long long)lo, (long long)hi, (long long)x);
   *out = x;
   return HEARTH_OK;
 }
 
 static hearth_status rd_string(rd *r, const json_t *v, char *buf, size_t bufsz) {
-  if (!json_is_string(v)) return rd_fail(r, HEARTH_E_PARSE, "expected a string, found %s", type_name(v));
+  if (!json_is_string(v))
+    return rd_fail(r, HEARTH_E_PARSE, "expected a string, found %s", type_name(v));
   size_t n = json_string_length(v);
   const char *s = json_string_value(v);
   if (n >= bufsz || memchr(s, 0, n))
-    return rd_fail(r, HEARTH_E_LIMIT, "expected a string of at most %zu bytes without NUL", bufsz - 1);
+    return rd_fail(r, HEARTH_E_LIMIT, "expected a string of at most %zu bytes without NUL",
+                   bufsz - 1);
   memcpy(buf, s, n + 1);
   return HEARTH_OK;
 }
@@ -173,10 +180,12 @@ static hearth_status rd_string(rd *r, const json_t *v, char *buf, size_t bufsz) 
 /* an array of exactly n finite numbers (n_max: any count up to it, *got) */
 static hearth_status rd_reals(rd *r, const json_t *v, size_t n, size_t n_max, double *out,
                               size_t *got) {
-  if (!json_is_array(v)) return rd_fail(r, HEARTH_E_PARSE, "expected an array, found %s", type_name(v));
+  if (!json_is_array(v))
+    return rd_fail(r, HEARTH_E_PARSE, "expected an array, found %s", type_name(v));
   size_t m = json_array_size(v);
   if (n_max ? m > n_max : m != n) {
-    if (n_max) return rd_fail(r, HEARTH_E_SIZE, "expected at most %zu numbers, found %zu", n_max, m);
+    if (n_max)
+      return rd_fail(r, HEARTH_E_SIZE, "expected at most %zu numbers, found %zu", n_max, m);
     return rd_fail(r, HEARTH_E_SIZE, "expected %zu numbers, found %zu", n, m);
   }
   for (size_t i = 0; i < m; i++) {
@@ -262,12 +271,14 @@ static hearth_status rd_view(rd *r, const json_t *o, const char *at, const heart
   if ((s = rd_member(r, o, at, "state", &x)) || (s = rd_string(r, x, v->state, sizeof v->state)))
     return s;
   if (!hearth_state_valid(v->state))
-    return rd_fail(r, HEARTH_E_RANGE, "expected neutral, hot, warm, iced or used, found \"%s\"", v->state);
-  if ((s = rd_member(r, o, at, "view", &x)) || (s = rd_string(r, x, v->view, sizeof v->view))) return s;
+    return rd_fail(r, HEARTH_E_RANGE, "expected neutral, hot, warm, iced or used, found \"%s\"",
+                   v->state);
+  if ((s = rd_member(r, o, at, "view", &x)) || (s = rd_string(r, x, v->view, sizeof v->view)))
+    return s;
   char st[HEARTH_NAME_MAX], vw[HEARTH_NAME_MAX];
   if (hearth_colmap_view_of(v->view, v->state, st, vw, NULL) || strcmp(vw, v->view))
-    return rd_fail(r, HEARTH_E_RANGE, "expected a view name of letters, digits, '_' or '-', found \"%s\"",
-                   v->view);
+    return rd_fail(r, HEARTH_E_RANGE,
+                   "expected a view name of letters, digits, '_' or '-', found \"%s\"", v->view);
   if ((s = rd_member(r, o, at, "colmap_camera_id", &x)) || (s = rd_uint(r, x, 0, UINT32_MAX, &n)))
     return s;
   v->camera_id = (uint32_t)n;
@@ -277,7 +288,8 @@ static hearth_status rd_view(rd *r, const json_t *o, const char *at, const heart
   if ((s = rd_member(r, o, at, "colmap_image_id", &x)) || (s = rd_uint(r, x, 0, UINT32_MAX, &n)))
     return s;
   v->image_id = (uint32_t)n;
-  if ((s = rd_member(r, o, at, "colmap_image", &x)) || (s = rd_string(r, x, v->image, sizeof v->image)))
+  if ((s = rd_member(r, o, at, "colmap_image", &x)) ||
+      (s = rd_string(r, x, v->image, sizeof v->image)))
     return s;
   return HEARTH_OK;
 }
@@ -286,21 +298,27 @@ static hearth_status rd_doc(rd *r, const json_t *root, hearth_recon_cameras *c) 
   json_t *v;
   char conv[128];
   hearth_status s;
-  if (!json_is_object(root)) return rd_fail(r, HEARTH_E_PARSE, "expected an object, found %s", type_name(root));
-  if ((s = rd_member(r, root, "", "convention", &v)) || (s = rd_string(r, v, conv, sizeof conv))) return s;
+  if (!json_is_object(root))
+    return rd_fail(r, HEARTH_E_PARSE, "expected an object, found %s", type_name(root));
+  if ((s = rd_member(r, root, "", "convention", &v)) || (s = rd_string(r, v, conv, sizeof conv)))
+    return s;
   if (strcmp(conv, RC_CONVENTION))
     return rd_fail(r, HEARTH_E_RANGE, "expected \"%s\", found \"%s\"", RC_CONVENTION, conv);
   json_t *cams, *views;
   if ((s = rd_member(r, root, "", "cameras", &cams))) return s;
-  if (!json_is_array(cams)) return rd_fail(r, HEARTH_E_PARSE, "expected an array, found %s", type_name(cams));
+  if (!json_is_array(cams))
+    return rd_fail(r, HEARTH_E_PARSE, "expected an array, found %s", type_name(cams));
   if ((s = rd_member(r, root, "", "views", &views))) return s;
-  if (!json_is_array(views)) return rd_fail(r, HEARTH_E_PARSE, "expected an array, found %s", type_name(views));
+  if (!json_is_array(views))
+    return rd_fail(r, HEARTH_E_PARSE, "expected an array, found %s", type_name(views));
   size_t nc = json_array_size(cams), nv = json_array_size(views);
-  if (nc > RC_MAX_CAMERAS) return rd_fail(r, HEARTH_E_LIMIT, "more than %d cameras", RC_MAX_CAMERAS);
+  if (nc > RC_MAX_CAMERAS)
+    return rd_fail(r, HEARTH_E_LIMIT, "more than %d cameras", RC_MAX_CAMERAS);
   if (nv > RC_MAX_VIEWS) return rd_fail(r, HEARTH_E_LIMIT, "more than %d views", RC_MAX_VIEWS);
   c->cameras = hearth_calloc_array(nc ? nc : 1, sizeof *c->cameras);
   c->views = hearth_calloc_array(nv ? nv : 1, sizeof *c->views);
-  if (!c->cameras || !c->views) return hearth_err_set(r->err, HEARTH_E_NOMEM, "%s: out of memory", r->name);
+  if (!c->cameras || !c->views)
+    return hearth_err_set(r->err, HEARTH_E_NOMEM, "%s: out of memory", r->name);
   char at[48];
   for (size_t i = 0; i < nc; i++) {
     snprintf(at, sizeof at, "cameras[%zu]", i);
@@ -317,7 +335,8 @@ static hearth_status rd_doc(rd *r, const json_t *root, hearth_recon_cameras *c) 
     snprintf(at, sizeof at, "views[%zu]", i);
     if ((s = rd_view(r, json_array_get(views, i), at, c, &c->views[i]))) return s;
     for (size_t j = 0; j < i; j++)
-      if (!strcmp(c->views[j].state, c->views[i].state) && !strcmp(c->views[j].view, c->views[i].view)) {
+      if (!strcmp(c->views[j].state, c->views[i].state) &&
+          !strcmp(c->views[j].view, c->views[i].view)) {
         snprintf(r->path, sizeof r->path, "%s", at);
         return rd_fail(r, HEARTH_E_INCONSISTENT, "duplicate of views[%zu] (state %s, view %s)", j,
                        c->views[i].state, c->views[i].view);

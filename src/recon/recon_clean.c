@@ -303,11 +303,11 @@ static int vlist_add(vlist *l, uint32_t t) {
 
 typedef struct simp {
   hearth_mesh *m;
-  double *q;        /* 10 per vertex: a11 a12 a13 a14 a22 a23 a24 a33 a34 a44 */
-  vlist *vt;        /* triangles of each vertex (may hold dead ones) */
-  uint32_t *ver;    /* version per vertex */
+  double *q;     /* 10 per vertex: a11 a12 a13 a14 a22 a23 a24 a33 a34 a44 */
+  vlist *vt;     /* triangles of each vertex (may hold dead ones) */
+  uint32_t *ver; /* version per vertex */
   uint8_t *dead_v, *dead_t;
-  double *pos;      /* working positions, double */
+  double *pos; /* working positions, double */
 } simp;
 
 static double q_eval(const double *q, const double p[3]) {
@@ -331,11 +331,14 @@ static double best_point(const simp *S, uint32_t u, uint32_t v, double p[3]) {
   if (scale > 0 && fabs(det) > 1e-9 * scale * scale * scale) {
     double x[3];
     x[0] = (b[0] * (A[4] * A[8] - A[5] * A[7]) - A[1] * (b[1] * A[8] - A[5] * b[2]) +
-            A[2] * (b[1] * A[7] - A[4] * b[2])) / det;
+            A[2] * (b[1] * A[7] - A[4] * b[2])) /
+           det;
     x[1] = (A[0] * (b[1] * A[8] - A[5] * b[2]) - b[0] * (A[3] * A[8] - A[5] * A[6]) +
-            A[2] * (A[3] * b[2] - b[1] * A[6])) / det;
+            A[2] * (A[3] * b[2] - b[1] * A[6])) /
+           det;
     x[2] = (A[0] * (A[4] * b[2] - b[1] * A[7]) - A[1] * (A[3] * b[2] - b[1] * A[6]) +
-            b[0] * (A[3] * A[7] - A[4] * A[6])) / det;
+            b[0] * (A[3] * A[7] - A[4] * A[6])) /
+           det;
     double d2 = 0;
     for (int a = 0; a < 3; a++) {
       double mid = 0.5 * (pu[a] + pv[a]);
@@ -393,8 +396,7 @@ static int collapse_ok(const simp *S, uint32_t u, uint32_t v, const double p[3])
       uint32_t w = ix[3 * t + c];
       if (w == u) continue;
       size_t q;
-      for (q = 0; q < nu && nbr_u[q] != w; q++) {
-      }
+      for (q = 0; q < nu && nbr_u[q] != w; q++) {}
       if (q == nu) {
         if (nu == 256) return 0;
         nbr_u[nu++] = w;
@@ -411,8 +413,7 @@ static int collapse_ok(const simp *S, uint32_t u, uint32_t v, const double p[3])
       uint32_t w = ix[3 * t + c];
       if (w == v || w == u) continue;
       size_t q;
-      for (q = 0; q < ns && seen[q] != w; q++) {
-      }
+      for (q = 0; q < ns && seen[q] != w; q++) {}
       if (q < ns) continue;
       if (ns == 256) return 0;
       seen[ns++] = w;
@@ -429,8 +430,7 @@ static int collapse_ok(const simp *S, uint32_t u, uint32_t v, const double p[3])
       uint32_t t = S->vt[x].t[k];
       if (S->dead_t[t]) continue;
       const uint32_t *f = ix + 3 * t;
-      if ((f[0] == u || f[1] == u || f[2] == u) && (f[0] == v || f[1] == v || f[2] == v))
-        continue;
+      if ((f[0] == u || f[1] == u || f[2] == u) && (f[0] == v || f[1] == v || f[2] == v)) continue;
       const double *P[3], *Q[3];
       for (int c = 0; c < 3; c++) {
         P[c] = S->pos + 3 * (size_t)f[c];

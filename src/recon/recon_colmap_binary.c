@@ -157,15 +157,16 @@ static hearth_status bn_images(bn *b, const hearth_colmap_model *m, rc_vec *v, r
         return bn_fail(b, at_name, HEARTH_E_LIMIT, "image %u: name longer than %zu bytes",
                        (unsigned)im->id, sizeof im->name - 1);
       if (ch < 0x20 || ch == 0x7f)
-        return bn_fail(b, b->off - 1, HEARTH_E_PARSE, "image %u: control character in the image name",
-                       (unsigned)im->id);
+        return bn_fail(b, b->off - 1, HEARTH_E_PARSE,
+                       "image %u: control character in the image name", (unsigned)im->id);
       im->name[k++] = (char)ch;
     }
     im->name[k] = 0;
     if (!k) return bn_fail(b, at_name, HEARTH_E_PARSE, "image %u: empty name", (unsigned)im->id);
     if (!hearth_colmap_find_camera(m, im->camera_id))
-      return bn_fail(b, at_cam, HEARTH_E_INCONSISTENT, "image %u (%s): camera %u is not in the model's cameras",
-                     (unsigned)im->id, im->name, (unsigned)im->camera_id);
+      return bn_fail(b, at_cam, HEARTH_E_INCONSISTENT,
+                     "image %u (%s): camera %u is not in the model's cameras", (unsigned)im->id,
+                     im->name, (unsigned)im->camera_id);
     if (rc_image_pose(im, why, sizeof why))
       return bn_fail(b, at + 4, HEARTH_E_RANGE, "image %u: %s", (unsigned)im->id, why);
     uint64_t np;
@@ -175,7 +176,8 @@ static hearth_status bn_images(bn *b, const hearth_colmap_model *m, rc_vec *v, r
     if (np > (b->len - b->off) / 24)
       return bn_fail(b, at_np, HEARTH_E_PARSE,
                      "image %u: %llu 2-D points announced, but the %zu bytes left hold at most %zu",
-                     (unsigned)im->id, (unsigned long long)np, b->len - b->off, (b->len - b->off) / 24);
+                     (unsigned)im->id, (unsigned long long)np, b->len - b->off,
+                     (b->len - b->off) / 24);
     im->n_points2d = (size_t)np;
     const uint8_t *p = b->data + b->off;
     b->off += 24 * im->n_points2d;
@@ -223,10 +225,11 @@ static hearth_status bn_points(bn *b, const hearth_colmap_model *m, rc_vec *v, r
     snprintf(what, sizeof what, "the track length of point %llu", (unsigned long long)pt->id);
     if ((s = bn_u64(b, what, &tl))) return s;
     if (tl > (b->len - b->off) / 8)
-      return bn_fail(b, at_tl, HEARTH_E_PARSE,
-                     "point %llu: track of %llu elements announced, but the %zu bytes left hold at most %zu",
-                     (unsigned long long)pt->id, (unsigned long long)tl, b->len - b->off,
-                     (b->len - b->off) / 8);
+      return bn_fail(
+          b, at_tl, HEARTH_E_PARSE,
+          "point %llu: track of %llu elements announced, but the %zu bytes left hold at most %zu",
+          (unsigned long long)pt->id, (unsigned long long)tl, b->len - b->off,
+          (b->len - b->off) / 8);
     pt->track_length = (size_t)tl;
     const uint8_t *t = b->data + b->off;
     for (size_t j = 0; j < pt->track_length; j++)

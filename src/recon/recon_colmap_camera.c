@@ -29,8 +29,17 @@ static const colmap_model_row k_models[] = {
     /* 8 */ {"SIMPLE_RADIAL_FISHEYE", 4, 0, 0, 0, 0, 0, {0}, 0, "a fisheye model"},
     /* 9 */ {"RADIAL_FISHEYE", 5, 0, 0, 0, 0, 0, {0}, 0, "a fisheye model"},
     /* 10 */ {"THIN_PRISM_FISHEYE", 12, 0, 0, 0, 0, 0, {0}, 0, "a fisheye model with thin-prism terms"},
-    /* 11 */ {"RAD_TAN_THIN_PRISM_FISHEYE", 16, 0, 0, 0, 0, 0, {0}, 0,
-              "a fisheye model with thin-prism terms"},
+    /* 11 */
+    {"RAD_TAN_THIN_PRISM_FISHEYE",
+     16,
+     0,
+     0,
+     0,
+     0,
+     0,
+     {0},
+     0,
+     "a fisheye model with thin-prism terms"},
     /* 12 */ {"SIMPLE_DIVISION", 4, 0, 0, 0, 0, 0, {0}, 0, "the division distortion model"},
     /* 13 */ {"DIVISION", 5, 0, 0, 0, 0, 0, {0}, 0, "the division distortion model"},
     /* 14 */ {"SIMPLE_FISHEYE", 3, 0, 0, 0, 0, 0, {0}, 0, "a fisheye model"},
@@ -65,7 +74,8 @@ hearth_status hearth_colmap_camera_convert(int model_id, const double *params, s
                                            uint64_t width, uint64_t height, hearth_camera *cam,
                                            hearth_err *err) {
   const colmap_model_row *r = row_of(model_id);
-  if (!r) return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "unknown COLMAP camera model id %d", model_id);
+  if (!r)
+    return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "unknown COLMAP camera model id %d", model_id);
   if (!r->supported)
     return hearth_err_set(err, HEARTH_E_UNSUPPORTED,
                           "model %s (id %d) is %s; hearth's camera is a pinhole with "
@@ -79,8 +89,7 @@ hearth_status hearth_colmap_camera_convert(int model_id, const double *params, s
       return hearth_err_set(err, HEARTH_E_RANGE, "model %s: parameter %zu is not finite", r->name,
                             i + 1);
   if (width < 1 || width > 65536 || height < 1 || height > 65536)
-    return hearth_err_set(err, HEARTH_E_RANGE,
-                          "size %llux%llu outside 1..65536 pixels per side",
+    return hearth_err_set(err, HEARTH_E_RANGE, "size %llux%llu outside 1..65536 pixels per side",
                           (unsigned long long)width, (unsigned long long)height);
   for (int i = r->must_be_zero; i < r->n_params; i++)
     if (params[i] != 0.0)

@@ -79,8 +79,8 @@ int rc_image_pose(hearth_colmap_image *im, char *why, size_t whysz) {
     }
   double norm = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
   if (!(fabs(norm - 1.0) <= 1e-3)) {
-    snprintf(why, whysz, "quaternion (%.17g, %.17g, %.17g, %.17g) has norm %.9g, expected 1",
-             q[0], q[1], q[2], q[3], norm);
+    snprintf(why, whysz, "quaternion (%.17g, %.17g, %.17g, %.17g) has norm %.9g, expected 1", q[0],
+             q[1], q[2], q[3], norm);
     return -1;
   }
   double w = q[0] / norm, x = q[1] / norm, y = q[2] / norm, z = q[3] / norm;
@@ -136,11 +136,12 @@ hearth_status rc_finish(hearth_colmap_model *m, hearth_colmap_file which, rc_vec
     if (r < 0) s = hearth_err_set(err, HEARTH_E_NOMEM, "%s: out of memory sorting", name);
     else if (r == 0 && binary)
       s = hearth_err_set(err, HEARTH_E_INCONSISTENT,
-                         "%s: byte offset %zu: duplicate %s id %llu (also at byte offset %zu)", name,
-                         b, k_kind[which], (unsigned long long)id, a);
-    else if (r == 0)
-      s = hearth_err_set(err, HEARTH_E_INCONSISTENT, "%s:%zu: duplicate %s id %llu (also on line %zu)",
+                         "%s: byte offset %zu: duplicate %s id %llu (also at byte offset %zu)",
                          name, b, k_kind[which], (unsigned long long)id, a);
+    else if (r == 0)
+      s = hearth_err_set(err, HEARTH_E_INCONSISTENT,
+                         "%s:%zu: duplicate %s id %llu (also on line %zu)", name, b, k_kind[which],
+                         (unsigned long long)id, a);
   }
   free(w->data);
   memset(w, 0, sizeof *w);
@@ -232,7 +233,8 @@ hearth_status hearth_colmap_read(const char *dir, hearth_colmap_model *m, hearth
   } else if (have[0][0] && have[1][0] && have[2][0]) {
     binary = 0;
   } else {
-    if (!hearth_path_exists(dir)) return hearth_err_set(err, HEARTH_E_NOT_FOUND, "%s: no such folder", dir);
+    if (!hearth_path_exists(dir))
+      return hearth_err_set(err, HEARTH_E_NOT_FOUND, "%s: no such folder", dir);
     char missing[256] = "";
     int b = have[0][1] || have[1][1] || have[2][1];
     for (int f = 0; f < 3; f++)

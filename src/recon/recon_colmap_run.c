@@ -117,7 +117,8 @@ static hearth_status prepare_state(run_ctx *r, const char *state) {
   hearth_manifest man;
   if ((s = hearth_manifest_read(mpath, &man, err))) return s;
   if ((s = join(dir_img, r->images, state, err)) || (s = join(dir_mask, r->masks, state, err)) ||
-      (s = hearth_mkdirs(dir_img, err)) || (!r->job->no_masks && (s = hearth_mkdirs(dir_mask, err)))) {
+      (s = hearth_mkdirs(dir_img, err)) ||
+      (!r->job->no_masks && (s = hearth_mkdirs(dir_mask, err)))) {
     hearth_manifest_free(&man);
     return s;
   }
@@ -143,8 +144,8 @@ static hearth_status prepare_state(run_ctx *r, const char *state) {
       char cut[4096], mask[4096], mname[300];
       size_t w = 0, h = 0;
       if (image_size(abs, &w, &h)) {
-        s = hearth_err_set(err, HEARTH_E_PARSE, "%s: cannot read the image size (JPEG or PNG expected)",
-                           rgb);
+        s = hearth_err_set(err, HEARTH_E_PARSE,
+                           "%s: cannot read the image size (JPEG or PNG expected)", rgb);
         break;
       }
       snprintf(mname, sizeof mname, "%s.png", name);
@@ -186,7 +187,8 @@ static void on_line(void *ctx, const char *line) {
   unsigned a, b, c;
   if (sp->kind == STEP_EXTRACT && sscanf(line, "Processed file [%u/%u]", &a, &b) == 2) {
     if (a > sp->p.done) hearth_progress_step(&sp->p, a - sp->p.done);
-  } else if (sp->kind == STEP_MATCH && sscanf(line, "Matching block [%u/%u, %u/", &a, &b, &c) == 3) {
+  } else if (sp->kind == STEP_MATCH &&
+             sscanf(line, "Matching block [%u/%u, %u/", &a, &b, &c) == 3) {
     sp->p.total = (size_t)b * b;
     hearth_progress_step(&sp->p, 1);
   } else if (sp->kind == STEP_MAP) {
@@ -221,17 +223,18 @@ static hearth_status run_step(run_ctx *r, step_kind kind, const char *step, cons
     fputc('\n', stderr);
   }
   if (s && kind == STEP_MAP && sp.no_pair)
-    return hearth_err_set(r->err, HEARTH_E_NUMERIC,
-                          "colmap mapper made no model: no pair of views with enough matched "
-                          "features to start from (too little texture inside the cut-outs?); its log: %s",
-                          log);
+    return hearth_err_set(
+        r->err, HEARTH_E_NUMERIC,
+        "colmap mapper made no model: no pair of views with enough matched "
+        "features to start from (too little texture inside the cut-outs?); its log: %s",
+        log);
   return s;
 }
 
 /* "a,b,c" of the FULL_OPENCV parameters of hearth camera c (COLMAP pixels) */
 static char *full_opencv_params(const hearth_camera *c) {
-  double p[12] = {c->fx, c->fy, c->cx + 0.5, c->cy + 0.5, c->dist[0], c->dist[1],
-                  c->dist[2], c->dist[3], c->dist[4], 0, 0, 0};
+  double p[12] = {c->fx,      c->fy,      c->cx + 0.5, c->cy + 0.5, c->dist[0], c->dist[1],
+                  c->dist[2], c->dist[3], c->dist[4],  0,           0,          0};
   hearth_strbuf b = {0};
   for (int i = 0; i < 12; i++) {
     if (i) hearth_strbuf_printf(&b, ",");
@@ -277,10 +280,20 @@ static hearth_status run_colmap(run_ctx *r, hearth_colmap_result *res) {
       return hearth_err_set(r->err, HEARTH_E_NOMEM, "out of memory");
   }
   int calibrated = params != NULL;
-  const char *extract[32] = {r->program, "feature_extractor", "--database_path", r->db,
-                             "--image_path", r->images, "--ImageReader.single_camera", "1",
-                             "--SiftExtraction.use_gpu", "0", "--SiftExtraction.num_threads", threads,
-                             "--ImageReader.camera_model", calibrated ? "FULL_OPENCV" : "SIMPLE_RADIAL"};
+  const char *extract[32] = {r->program,
+                             "feature_extractor",
+                             "--database_path",
+                             r->db,
+                             "--image_path",
+                             r->images,
+                             "--ImageReader.single_camera",
+                             "1",
+                             "--SiftExtraction.use_gpu",
+                             "0",
+                             "--SiftExtraction.num_threads",
+                             threads,
+                             "--ImageReader.camera_model",
+                             calibrated ? "FULL_OPENCV" : "SIMPLE_RADIAL"};
   int n = 14;
   if (calibrated) {
     extract[n++] = "--ImageReader.camera_params";
@@ -294,17 +307,20 @@ static hearth_status run_colmap(run_ctx *r, hearth_colmap_result *res) {
   s = run_step(r, STEP_EXTRACT, "feature_extractor", extract, &res->seconds[0]);
   free(params);
   if (s) return s;
-  const char *match[] = {r->program, "exhaustive_matcher", "--database_path", r->db,
-                         "--SiftMatching.use_gpu", "0", "--SiftMatching.num_threads", threads, NULL};
+  const char *match[] =
+      {r->program, "exhaustive_matcher",         "--database_path", r->db, "--SiftMatching.use_gpu",
+       "0",        "--SiftMatching.num_threads", threads,           NULL};
   if ((s = run_step(r, STEP_MATCH, "exhaustive_matcher", match, &res->seconds[1]))) return s;
   if ((s = hearth_mkdirs(r->sparse, r->err))) return s;
-  const char *map[32] = {r->program, "mapper", "--database_path", r->db, "--image_path", r->images,
-                         "--output_path", r->sparse, "--Mapper.num_threads", threads};
+  const char *map[32] = {r->program,      "mapper",       "--database_path",
+                         r->db,           "--image_path", r->images,
+                         "--output_path", r->sparse,      "--Mapper.num_threads",
+                         threads};
   n = 10;
   if (calibrated) {
-    static const char *const k_fixed[] = {"--Mapper.ba_refine_focal_length", "0",
+    static const char *const k_fixed[] = {"--Mapper.ba_refine_focal_length",    "0",
                                           "--Mapper.ba_refine_principal_point", "0",
-                                          "--Mapper.ba_refine_extra_params", "0"};
+                                          "--Mapper.ba_refine_extra_params",    "0"};
     for (size_t i = 0; i < sizeof k_fixed / sizeof k_fixed[0]; i++) map[n++] = k_fixed[i];
   }
   map[n] = NULL;
@@ -320,7 +336,8 @@ static hearth_status best_model(run_ctx *r, hearth_colmap_model *best, size_t *n
   struct dirent *e;
   while ((e = readdir(d)) && n < RUN_MAX_MODELS) {
     size_t k = strspn(e->d_name, "0123456789");
-    if (k && !e->d_name[k] && k < sizeof names[0]) snprintf(names[n++], sizeof names[0], "%s", e->d_name);
+    if (k && !e->d_name[k] && k < sizeof names[0])
+      snprintf(names[n++], sizeof names[0], "%s", e->d_name);
   }
   closedir(d);
   *n_models = n;
@@ -336,8 +353,8 @@ static hearth_status best_model(run_ctx *r, hearth_colmap_model *best, size_t *n
       return s;
     }
     long idx = strtol(names[i], NULL, 10);
-    if (m.n_images > best->n_images || (m.n_images == best->n_images && best_index >= 0 && idx < best_index) ||
-        best_index < 0) {
+    if (m.n_images > best->n_images ||
+        (m.n_images == best->n_images && best_index >= 0 && idx < best_index) || best_index < 0) {
       hearth_colmap_model_free(best);
       *best = m;
       best_index = idx;
@@ -346,8 +363,8 @@ static hearth_status best_model(run_ctx *r, hearth_colmap_model *best, size_t *n
     }
   }
   if (best_index < 0 || !best->n_images)
-    return hearth_err_set(r->err, HEARTH_E_NUMERIC, "colmap mapper registered no view (%s is empty)",
-                          r->sparse);
+    return hearth_err_set(r->err, HEARTH_E_NUMERIC,
+                          "colmap mapper registered no view (%s is empty)", r->sparse);
   return HEARTH_OK;
 }
 
@@ -429,7 +446,8 @@ hearth_status hearth_colmap_run(const hearth_colmap_job *job, hearth_colmap_resu
       (s = join(r.logs, r.work, "logs", err)) || (s = hearth_mkdirs(r.logs, err)))
     return s;
   if (!job->quiet)
-    fprintf(stderr, "recon %s: preparing %zu state(s) in %s\n", job->instance, inst.n_states, r.work);
+    fprintf(stderr, "recon %s: preparing %zu state(s) in %s\n", job->instance, inst.n_states,
+            r.work);
   for (size_t i = 0; i < inst.n_states && !s; i++) s = prepare_state(&r, inst.states[i]);
   res->n_views = r.n_views;
   if (!s && !r.n_views) s = hearth_err_set(err, HEARTH_E_NOT_FOUND, "%s: no colour views", r.inst);
@@ -437,7 +455,8 @@ hearth_status hearth_colmap_run(const hearth_colmap_job *job, hearth_colmap_resu
   if (!s) s = import_model(&r, res);
   if (s) {
     hearth_err_prefix(err, "%s", job->instance);
-    if (!job->quiet) fprintf(stderr, "recon %s: workspace kept for inspection: %s\n", job->instance, r.work);
+    if (!job->quiet)
+      fprintf(stderr, "recon %s: workspace kept for inspection: %s\n", job->instance, r.work);
     return s;
   }
   if (temp) {

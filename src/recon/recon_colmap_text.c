@@ -17,7 +17,7 @@
 typedef struct tx {
   const char *p, *end; /* unread bytes */
   const char *name;
-  size_t line;         /* number of the current line (1-based) */
+  size_t line;          /* number of the current line (1-based) */
   const char *cur, *le; /* the current line's unread part, its end (trimmed) */
   locale_t c_locale;
   hearth_err *err;
@@ -85,7 +85,8 @@ static const char *tx_show(const char *s, size_t n, char *buf, size_t bufsz) {
 static hearth_status tx_u64(tx *t, const char *what, uint64_t max, uint64_t *out) {
   const char *s;
   size_t n;
-  if (!tx_token(t, &s, &n)) return tx_fail(t, HEARTH_E_PARSE, "expected %s, found the end of the line", what);
+  if (!tx_token(t, &s, &n))
+    return tx_fail(t, HEARTH_E_PARSE, "expected %s, found the end of the line", what);
   uint64_t v = 0;
   int ok = n > 0 && n <= 20;
   for (size_t i = 0; ok && i < n; i++) {
@@ -111,7 +112,8 @@ static hearth_status tx_u32(tx *t, const char *what, uint32_t *out) {
 static hearth_status tx_real(tx *t, const char *what, double *out) {
   const char *s;
   size_t n;
-  if (!tx_token(t, &s, &n)) return tx_fail(t, HEARTH_E_PARSE, "expected %s, found the end of the line", what);
+  if (!tx_token(t, &s, &n))
+    return tx_fail(t, HEARTH_E_PARSE, "expected %s, found the end of the line", what);
   char show[48], buf[80];
   double check;
   /* hearth_parse_double decides the syntax (no NaN, Inf or hex); strtod in
@@ -124,8 +126,7 @@ static hearth_status tx_real(tx *t, const char *what, double *out) {
   locale_t old = uselocale(t->c_locale);
   double v = strtod(buf, NULL);
   uselocale(old);
-  if (!isfinite(v))
-    return tx_fail(t, HEARTH_E_RANGE, "%s '%s' is out of range", what, buf);
+  if (!isfinite(v)) return tx_fail(t, HEARTH_E_RANGE, "%s '%s' is out of range", what, buf);
   *out = v;
   return HEARTH_OK;
 }
@@ -151,7 +152,8 @@ static hearth_status tx_cameras(tx *t, rc_vec *v, rc_vec *w) {
     const char *nm;
     size_t nn;
     if (!tx_token(t, &nm, &nn))
-      return tx_fail(t, HEARTH_E_PARSE, "camera %u: expected a model name, found the end of the line",
+      return tx_fail(t, HEARTH_E_PARSE,
+                     "camera %u: expected a model name, found the end of the line",
                      (unsigned)c->id);
     char model[40], show[48];
     c->model_id = -1;
@@ -161,8 +163,8 @@ static hearth_status tx_cameras(tx *t, rc_vec *v, rc_vec *w) {
       c->model_id = hearth_colmap_model_id(model);
     }
     if (c->model_id < 0)
-      return tx_fail(t, HEARTH_E_UNSUPPORTED, "camera %u: unknown camera model '%s'", (unsigned)c->id,
-                     tx_show(nm, nn, show, sizeof show));
+      return tx_fail(t, HEARTH_E_UNSUPPORTED, "camera %u: unknown camera model '%s'",
+                     (unsigned)c->id, tx_show(nm, nn, show, sizeof show));
     if ((s = tx_u64(t, "the width", UINT64_MAX, &c->width)) ||
         (s = tx_u64(t, "the height", UINT64_MAX, &c->height)))
       return s;
@@ -207,7 +209,8 @@ static hearth_status tx_images(tx *t, const hearth_colmap_model *m, rc_vec *v, r
     const char *nm;
     size_t nn;
     if (!tx_token(t, &nm, &nn))
-      return tx_fail(t, HEARTH_E_PARSE, "image %u: expected the image name, found the end of the line",
+      return tx_fail(t, HEARTH_E_PARSE,
+                     "image %u: expected the image name, found the end of the line",
                      (unsigned)im->id);
     if (nn >= sizeof im->name)
       return tx_fail(t, HEARTH_E_LIMIT, "image %u: name longer than %zu bytes", (unsigned)im->id,
@@ -220,8 +223,9 @@ static hearth_status tx_images(tx *t, const hearth_colmap_model *m, rc_vec *v, r
     im->name[nn] = 0;
     if ((s = tx_end_of_line(t, "the image name"))) return s;
     if (!hearth_colmap_find_camera(m, im->camera_id))
-      return tx_fail(t, HEARTH_E_INCONSISTENT, "image %u (%s): camera %u is not in the model's cameras",
-                     (unsigned)im->id, im->name, (unsigned)im->camera_id);
+      return tx_fail(t, HEARTH_E_INCONSISTENT,
+                     "image %u (%s): camera %u is not in the model's cameras", (unsigned)im->id,
+                     im->name, (unsigned)im->camera_id);
     if (rc_image_pose(im, why, sizeof why))
       return tx_fail(t, HEARTH_E_RANGE, "image %u: %s", (unsigned)im->id, why);
     *wh = (rc_where){im->id, t->line};
@@ -234,9 +238,11 @@ static hearth_status tx_images(tx *t, const hearth_colmap_model *m, rc_vec *v, r
                      (unsigned)im->id);
     while (tx_more(t)) {
       double x, y;
-      snprintf(what, sizeof what, "X of 2-D point %zu of image %u", im->n_points2d, (unsigned)im->id);
+      snprintf(what, sizeof what, "X of 2-D point %zu of image %u", im->n_points2d,
+               (unsigned)im->id);
       if ((s = tx_real(t, what, &x))) return s;
-      snprintf(what, sizeof what, "Y of 2-D point %zu of image %u", im->n_points2d, (unsigned)im->id);
+      snprintf(what, sizeof what, "Y of 2-D point %zu of image %u", im->n_points2d,
+               (unsigned)im->id);
       if ((s = tx_real(t, what, &y))) return s;
       const char *id;
       size_t idn;
@@ -247,8 +253,8 @@ static hearth_status tx_images(tx *t, const hearth_colmap_model *m, rc_vec *v, r
       if (!(idn == 2 && id[0] == '-' && id[1] == '1')) {
         t->cur = id; /* re-read it as an id */
         uint64_t pid;
-        snprintf(what, sizeof what, "POINT3D_ID of 2-D point %zu of image %u (or -1)", im->n_points2d,
-                 (unsigned)im->id);
+        snprintf(what, sizeof what, "POINT3D_ID of 2-D point %zu of image %u (or -1)",
+                 im->n_points2d, (unsigned)im->id);
         if ((s = tx_u64(t, what, UINT64_MAX - 1, &pid))) return s;
         im->n_observations++;
       }

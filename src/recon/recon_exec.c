@@ -26,7 +26,8 @@ int hearth_program_found(const char *program) {
     const char *colon = strchr(path, ':');
     size_t n = colon ? (size_t)(colon - path) : strlen(path);
     char full[4096];
-    if (snprintf(full, sizeof full, "%.*s/%s", (int)n, n ? path : ".", program) < (int)sizeof full) {
+    if (snprintf(full, sizeof full, "%.*s/%s", (int)n, n ? path : ".", program) <
+        (int)sizeof full) {
       struct stat st;
       if (stat(full, &st) == 0 && S_ISREG(st.st_mode) && access(full, X_OK) == 0) return 1;
     }
@@ -143,8 +144,7 @@ hearth_status hearth_exec(const char *what, const char *const *argv, const char 
   close(out[0]);
   if (log) fclose(log);
   int wstatus = 0;
-  while (waitpid(pid, &wstatus, 0) < 0 && errno == EINTR) {
-  }
+  while (waitpid(pid, &wstatus, 0) < 0 && errno == EINTR) {}
   if (got == (ssize_t)sizeof exec_errno)
     return hearth_err_set(err, HEARTH_E_NOT_FOUND, "%s: cannot run '%s': %s", what, argv[0],
                           strerror(exec_errno));
@@ -153,10 +153,12 @@ hearth_status hearth_exec(const char *what, const char *const *argv, const char 
   tail_text(&tail, tail_msg, sizeof tail_msg);
   char how[64];
   if (WIFEXITED(wstatus)) snprintf(how, sizeof how, "exit status %d", WEXITSTATUS(wstatus));
-  else if (WIFSIGNALED(wstatus)) snprintf(how, sizeof how, "killed by signal %d", WTERMSIG(wstatus));
+  else if (WIFSIGNALED(wstatus))
+    snprintf(how, sizeof how, "killed by signal %d", WTERMSIG(wstatus));
   else snprintf(how, sizeof how, "wait status %d", wstatus);
   return hearth_err_set(err, HEARTH_E_IO, "%s failed (%s)%s%s%s%s%s", what, how,
                         tail.n ? "; the last lines of its output" : "; it printed nothing",
-                        log_path && tail.n ? " (all of it in " : "", log_path && tail.n ? log_path : "",
+                        log_path && tail.n ? " (all of it in " : "",
+                        log_path && tail.n ? log_path : "",
                         log_path && tail.n ? "):" : (tail.n ? ":" : ""), tail_msg);
 }

@@ -11,9 +11,11 @@ hearth_status hearth_recon_match_instance(const char *root, const char *instance
                                           hearth_err *err) {
   memset(cov, 0, sizeof *cov);
   if (!hearth_instance_id_valid(instance))
-    return hearth_err_set(err, HEARTH_E_ARG, "'%s' is not an instance id (<category>_<NN>)", instance);
+    return hearth_err_set(err, HEARTH_E_ARG, "'%s' is not an instance id (<category>_<NN>)",
+                          instance);
   char path[4096];
-  if (snprintf(path, sizeof path, "%s/instances/%s/instance.json", root, instance) >= (int)sizeof path)
+  if (snprintf(path, sizeof path, "%s/instances/%s/instance.json", root, instance) >=
+      (int)sizeof path)
     return hearth_err_set(err, HEARTH_E_LIMIT, "%s: path too long", root);
   hearth_instance_doc inst;
   hearth_status s = hearth_instance_read(path, &inst, err);

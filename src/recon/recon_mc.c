@@ -15,7 +15,7 @@
 typedef struct edge_map {
   uint64_t *keys; /* key + 1; 0 = empty */
   uint32_t *vals;
-  size_t cap;     /* power of two */
+  size_t cap; /* power of two */
   size_t n;
 } edge_map;
 
@@ -96,8 +96,7 @@ static long vertex_on_edge(mc_out *o, const hearth_tsdf *t, const int pa[3], flo
   }
   double s = d0 / (double)(d0 - d1);
   for (int a = 0; a < 3; a++)
-    o->pos[3 * o->nv + a] =
-        (float)(t->origin[a] + t->voxel * (p0[a] + s * (p1[a] - p0[a])));
+    o->pos[3 * o->nv + a] = (float)(t->origin[a] + t->voxel * (p0[a] + s * (p1[a] - p0[a])));
   o->em.keys[sl] = key + 1;
   o->em.vals[sl] = (uint32_t)o->nv;
   o->em.n++;
@@ -135,10 +134,8 @@ static int emit(mc_out *o, long a, long b, long c, const double dir[3]) {
 static int march_tet(mc_out *o, const hearth_tsdf *t, const int p[4][3], const float d[4]) {
   int in[4], out_[4], ni = 0, no = 0;
   for (int q = 0; q < 4; q++) {
-    if (d[q] < 0)
-      in[ni++] = q;
-    else
-      out_[no++] = q;
+    if (d[q] < 0) in[ni++] = q;
+    else out_[no++] = q;
   }
   if (ni == 0 || no == 0) return 0;
   /* direction from the negative to the positive samples */
@@ -168,8 +165,7 @@ hearth_status hearth_tsdf_extract(const hearth_tsdf *t, hearth_mesh *out, hearth
   memset(out, 0, sizeof *out);
   if (!t || !t->dist) return hearth_err_set(err, HEARTH_E_ARG, "tsdf extract: no volume");
   /* the six monotone paths through the cube: corner bit orders */
-  static const int kPerm[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2},
-                                  {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+  static const int kPerm[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
   mc_out o = {0};
   int fail = 0;
   for (int k = 0; k + 1 < t->nz && !fail; k++) {

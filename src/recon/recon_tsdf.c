@@ -8,8 +8,8 @@
 #include "hearth/dataset.h"
 #include "hearth/recon_geom.h"
 
-hearth_status hearth_tsdf_init(hearth_tsdf *t, const double lo[3], const double hi[3],
-                               double voxel, double trunc, hearth_err *err) {
+hearth_status hearth_tsdf_init(hearth_tsdf *t, const double lo[3], const double hi[3], double voxel,
+                               double trunc, hearth_err *err) {
   memset(t, 0, sizeof *t);
   if (!(voxel > 0) || !(trunc > 0) || !isfinite(voxel) || !isfinite(trunc))
     return hearth_err_set(err, HEARTH_E_ARG, "tsdf: voxel %g and truncation %g must be positive",
@@ -20,8 +20,7 @@ hearth_status hearth_tsdf_init(hearth_tsdf *t, const double lo[3], const double 
     if (!isfinite(lo[a]) || !isfinite(hi[a]) || !(hi[a] >= lo[a]))
       return hearth_err_set(err, HEARTH_E_ARG, "tsdf: empty or non-finite bounds on axis %d", a);
     double c = ceil((hi[a] - lo[a]) / voxel) + 1.0;
-    if (c > 1e6)
-      return hearth_err_set(err, HEARTH_E_LIMIT, "tsdf: %g samples on axis %d", c, a);
+    if (c > 1e6) return hearth_err_set(err, HEARTH_E_LIMIT, "tsdf: %g samples on axis %d", c, a);
     n[a] = c < 2 ? 2 : (int)c;
     total *= (size_t)n[a];
     if (total > HEARTH_TSDF_MAX_SAMPLES)
@@ -53,18 +52,16 @@ void hearth_tsdf_free(hearth_tsdf *t) {
 }
 
 hearth_status hearth_tsdf_integrate(hearth_tsdf *t, const hearth_image *depth,
-                                    const hearth_camera *cam,
-                                    const hearth_rigid *T_world_from_cam, const uint8_t *mask,
-                                    hearth_err *err) {
+                                    const hearth_camera *cam, const hearth_rigid *T_world_from_cam,
+                                    const uint8_t *mask, hearth_err *err) {
   if (!t || !t->dist || !depth || !cam || !T_world_from_cam)
     return hearth_err_set(err, HEARTH_E_ARG, "tsdf integrate: missing argument");
   if (depth->type != HEARTH_PIX_U16 || depth->channels != 1)
     return hearth_err_set(err, HEARTH_E_UNSUPPORTED,
                           "tsdf integrate: depth must be 1-channel 16-bit");
   if ((size_t)cam->width != depth->width || (size_t)cam->height != depth->height)
-    return hearth_err_set(err, HEARTH_E_SIZE,
-                          "tsdf integrate: depth %zux%zu but camera %dx%d", depth->width,
-                          depth->height, cam->width, cam->height);
+    return hearth_err_set(err, HEARTH_E_SIZE, "tsdf integrate: depth %zux%zu but camera %dx%d",
+                          depth->width, depth->height, cam->width, cam->height);
   hearth_rigid Tcw;
   hearth_rigid_inverse(T_world_from_cam, &Tcw);
   const uint16_t *dp = depth->data;
@@ -167,7 +164,8 @@ static void dilate_cut(uint8_t *c, uint8_t *tmp, int W, int H) {
       uint8_t *p = &c[(size_t)y * W + x];
       if (*p == 2) continue;
       int on = 0;
-      for (int d = -r; d <= r && !on; d++) on = y + d >= 0 && y + d < H && tmp[(size_t)(y + d) * W + x];
+      for (int d = -r; d <= r && !on; d++)
+        on = y + d >= 0 && y + d < H && tmp[(size_t)(y + d) * W + x];
       *p = (uint8_t)on;
     }
 }
@@ -242,8 +240,7 @@ static hearth_status view_mask(recon_view *views, size_t nv, size_t i, const hea
 
 static hearth_status load_views(const char *root, const char *instance, const char *state,
                                 const hearth_poses *poses, const hearth_factory_calib *fac,
-                                recon_view **views, size_t *n_views, size_t *cap,
-                                hearth_err *err) {
+                                recon_view **views, size_t *n_views, size_t *cap, hearth_err *err) {
   char dir[1024], path[1400];
   snprintf(dir, sizeof dir, "%s/instances/%s/raw/%s", root, instance, state);
   snprintf(path, sizeof path, "%s/manifest.json", dir);
@@ -280,9 +277,8 @@ static hearth_status load_views(const char *root, const char *instance, const ch
     if ((s = hearth_png_read(path, &rv->depth, err))) break;
     if (rv->depth.type != HEARTH_PIX_U16 || rv->depth.channels != 1 ||
         rv->depth.width != (size_t)rv->cam.width || rv->depth.height != (size_t)rv->cam.height) {
-      s = hearth_err_set(err, HEARTH_E_SIZE,
-                         "%s: expected a %dx%d 1-channel 16-bit depth image", path,
-                         rv->cam.width, rv->cam.height);
+      s = hearth_err_set(err, HEARTH_E_SIZE, "%s: expected a %dx%d 1-channel 16-bit depth image",
+                         path, rv->cam.width, rv->cam.height);
       break;
     }
     hearth_rigid_compose(&vp->T_world_from_cam, &T_rgb_from_depth, &rv->T_world_from_depth);
@@ -299,10 +295,8 @@ static hearth_status load_views(const char *root, const char *instance, const ch
       for (size_t p = 0; p < cut.width * cut.height; p++)
         rv->cut[p] = (uint8_t)(2 * cutout_at(&cut, p));
       uint8_t *tmp = malloc(cut.width * cut.height);
-      if (!tmp)
-        s = hearth_err_set(err, HEARTH_E_NOMEM, "%s", path);
-      else
-        dilate_cut(rv->cut, tmp, (int)cut.width, (int)cut.height);
+      if (!tmp) s = hearth_err_set(err, HEARTH_E_NOMEM, "%s", path);
+      else dilate_cut(rv->cut, tmp, (int)cut.width, (int)cut.height);
       free(tmp);
     }
     hearth_image_free(&cut);
@@ -311,15 +305,12 @@ static hearth_status load_views(const char *root, const char *instance, const ch
   return s;
 }
 
-hearth_status hearth_recon_tsdf(const char *root, const char *instance,
-                                const char *const *states, size_t n_states,
-                                const hearth_recon_tsdf_opts *opts, hearth_mesh *out,
-                                hearth_err *err) {
+hearth_status hearth_recon_tsdf(const char *root, const char *instance, const char *const *states,
+                                size_t n_states, const hearth_recon_tsdf_opts *opts,
+                                hearth_mesh *out, hearth_err *err) {
   hearth_recon_tsdf_opts o;
-  if (opts)
-    o = *opts;
-  else
-    hearth_recon_tsdf_opts_default(&o);
+  if (opts) o = *opts;
+  else hearth_recon_tsdf_opts_default(&o);
   if (!(o.voxel_m > 0)) o.voxel_m = 0.002;
   if (!(o.trunc_m > 0)) o.trunc_m = 2.0 * o.voxel_m;
   memset(out, 0, sizeof *out);
@@ -338,10 +329,8 @@ hearth_status hearth_recon_tsdf(const char *root, const char *instance,
   snprintf(path, sizeof path, "%s/calibration/factory.json", root);
   if ((s = hearth_factory_read(path, &fac, err))) return s;
   hearth_poses poses = {0};
-  if (o.poses)
-    snprintf(path, sizeof path, "%s/%s", root, o.poses);
-  else
-    snprintf(path, sizeof path, "%s/ground_truth/instances/%s/poses_rgb.json", root, instance);
+  if (o.poses) snprintf(path, sizeof path, "%s/%s", root, o.poses);
+  else snprintf(path, sizeof path, "%s/ground_truth/instances/%s/poses_rgb.json", root, instance);
   if ((s = hearth_poses_read(path, &poses, err))) return s;
 
   recon_view *views = NULL;

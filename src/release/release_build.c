@@ -121,8 +121,7 @@ static uint64_t inputs_hash(const char *root, const char *params, const hearth_b
     if (stat(p, &st) == 0)
       snprintf(line, sizeof line, "%s %lld %lld.%09ld", in->paths[i], (long long)st.st_size,
                (long long)st.st_mtim.tv_sec, (long)st.st_mtim.tv_nsec);
-    else
-      snprintf(line, sizeof line, "%s missing", in->paths[i]);
+    else snprintf(line, sizeof line, "%s missing", in->paths[i]);
     h = fnv(h, line, strlen(line) + 1);
   }
   return h;
@@ -205,8 +204,9 @@ static hearth_status resolve_params(const char *root, hearth_build_opts *o, hear
       if (err) {
         char msg[sizeof err->msg];
         snprintf(msg, sizeof msg, "%s", err->msg);
-        hearth_err_set(err, s, "build: %s (the recorded parameters: delete the file to build with the defaults)",
-                       msg);
+        hearth_err_set(
+            err, s,
+            "build: %s (the recorded parameters: delete the file to build with the defaults)", msg);
       }
       return s;
     }
@@ -241,8 +241,8 @@ void hearth_build_report_free(hearth_build_report *r) {
 /* bake comes before refine and map: it rewrites derived/mesh.glb (texture only),
  * which they read, so a finished build has every later stamp taken after it */
 enum { ST_SCALE, ST_BAKE, ST_TRANSFER, ST_REFINE, ST_MAP, ST_OVERLAY, ST_COUNT };
-static const char *const k_stage_names[ST_COUNT] = {"scale", "bake", "transfer",
-                                                    "refine", "map", "overlay"};
+static const char *const k_stage_names[ST_COUNT] = {"scale",  "bake", "transfer",
+                                                    "refine", "map",  "overlay"};
 
 /* every stage is part of every build (kept as a hook for optional stages) */
 static int stage_available(int st) {
@@ -285,7 +285,9 @@ typedef struct build_ctx {
 } build_ctx;
 
 static void fusion_params(const hearth_build_opts *o, char *buf, size_t n) {
-  const char *f = o->fusion == HEARTH_FUSE_MAX ? "max" : o->fusion == HEARTH_FUSE_ROBUST ? "robust" : "mean";
+  const char *f = o->fusion == HEARTH_FUSE_MAX      ? "max"
+                  : o->fusion == HEARTH_FUSE_ROBUST ? "robust"
+                                                    : "mean";
   char mc[32];
   hearth_format_fixed(mc, sizeof mc, o->min_cos, 6);
   snprintf(buf, n, "resolution=%zu fusion=%s min_cos=%s turbo=10..60", o->resolution, f, mc);
@@ -297,8 +299,10 @@ static hearth_status stage_files(const build_ctx *c, const inst_plan *p, int st,
                                  size_t psz) {
   const char *id = p->id;
   hearth_status s = HEARTH_OK;
-#define IN(...) if (!s) s = hearth_build_files_add(in, __VA_ARGS__)
-#define OUT(...) if (!s) s = hearth_build_files_add(out, __VA_ARGS__)
+#define IN(...) \
+  if (!s) s = hearth_build_files_add(in, __VA_ARGS__)
+#define OUT(...) \
+  if (!s) s = hearth_build_files_add(out, __VA_ARGS__)
   params[0] = 0;
   switch (st) {
     case ST_SCALE:
@@ -405,8 +409,8 @@ static hearth_status stage_run(const build_ctx *c, const inst_plan *p, int st, s
       return hearth_refine_run(&j, NULL, err);
     }
     case ST_BAKE: {
-      hearth_bake_job j = {c->root, p->id, NULL, o->rgb_resolution, 2, NULL, NULL, NULL,
-                           c->stage_threads};
+      hearth_bake_job j = {c->root, p->id, NULL, o->rgb_resolution, 2,
+                           NULL,    NULL,  NULL, c->stage_threads};
       return hearth_bake_rgb_run(&j, err);
     }
     case ST_MAP: {
@@ -506,7 +510,8 @@ static int do_stage(build_ctx *c, size_t idx, int st, size_t k) {
     pthread_mutex_unlock(&c->mu);
   }
   if ((s = stage_run(c, p, st, k, &mapped, &err))) goto fail;
-  if ((s = stamp_write(c->root, stamp, k_stage_names[st], what, params, &in, &out, &err))) goto fail;
+  if ((s = stamp_write(c->root, stamp, k_stage_names[st], what, params, &in, &out, &err)))
+    goto fail;
   r->states_mapped += mapped;
   r->stages_run++;
   pthread_mutex_lock(&c->mu);
@@ -609,8 +614,8 @@ static void plan_instance(const char *root, inst_plan *p) {
 }
 
 static hearth_status run_release_stage(const char *root, const hearth_build_stage *bs,
-                                       const hearth_build_opts *o, int threads, FILE *log,
-                                       int *ran, size_t *swept, hearth_err *err) {
+                                       const hearth_build_opts *o, int threads, FILE *log, int *ran,
+                                       size_t *swept, hearth_err *err) {
   hearth_build_files in = {0}, out = {0};
   char stamp[PATH_SZ];
   snprintf(stamp, sizeof stamp, "%s/calibration/.stamps/%s.json", root, bs->name);
@@ -643,7 +648,8 @@ done:
 
 hearth_status hearth_build_release(const char *root, const hearth_build_opts *o_in,
                                    hearth_build_report *rep, hearth_err *err) {
-  if (!root || !rep) return hearth_err_set(err, HEARTH_E_ARG, "build: root and report are required");
+  if (!root || !rep)
+    return hearth_err_set(err, HEARTH_E_ARG, "build: root and report are required");
   memset(rep, 0, sizeof *rep);
   hearth_build_opts o;
   if (o_in) o = *o_in;
@@ -703,8 +709,8 @@ hearth_status hearth_build_release(const char *root, const hearth_build_opts *o_
       n++;
   if (o.only_instance && !n) {
     hearth_release_free(&rel);
-    return hearth_err_set(err, HEARTH_E_NOT_FOUND, "%s: no instance '%s' in this release (or shard)",
-                          path, o.only_instance);
+    return hearth_err_set(err, HEARTH_E_NOT_FOUND,
+                          "%s: no instance '%s' in this release (or shard)", path, o.only_instance);
   }
   build_ctx c;
   memset(&c, 0, sizeof c);
@@ -779,11 +785,14 @@ void hearth_build_report_print(const hearth_build_report *r, FILE *out) {
     states += r->instances[i].n_states;
     mapped += r->instances[i].states_mapped;
   }
-  fprintf(out, "build summary: %zu instance(s): %zu complete, %zu failed; %zu/%zu state(s) mapped; "
-          "%zu stage(s) run, %zu up to date; %.1f s\n", r->n_instances, ok, failed, mapped, states,
-          r->stages_run, r->stages_up_to_date, r->seconds);
+  fprintf(out,
+          "build summary: %zu instance(s): %zu complete, %zu failed; %zu/%zu state(s) mapped; "
+          "%zu stage(s) run, %zu up to date; %.1f s\n",
+          r->n_instances, ok, failed, mapped, states, r->stages_run, r->stages_up_to_date,
+          r->seconds);
   if (r->temps_removed)
-    fprintf(out, "  removed %zu temporary file(s)/folder(s) left by an interrupted run\n", r->temps_removed);
+    fprintf(out, "  removed %zu temporary file(s)/folder(s) left by an interrupted run\n",
+            r->temps_removed);
   if (r->release_failed) fprintf(out, "  release: FAILED: %s\n", r->release_reason);
   for (size_t i = 0; i < r->n_instances; i++)
     if (r->instances[i].failed)

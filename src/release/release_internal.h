@@ -7,10 +7,10 @@
 /* The parameters of a build that shape its outputs, as build.json at the
  * release root records them (docs/dataset.md). */
 typedef struct hb_params {
-  size_t resolution;      /* temperature maps, 2..16384 */
+  size_t resolution; /* temperature maps, 2..16384 */
   hearth_fusion fusion;
-  double min_cos;         /* [0, 1) */
-  size_t rgb_resolution;  /* baked colour texture, 16..16384 */
+  double min_cos;        /* [0, 1) */
+  size_t rgb_resolution; /* baked colour texture, 16..16384 */
   int bake_rgb, calibrate, calib_overlays;
 } hb_params;
 /* 1024, max, 0, 1024, bake, calibrate, overlays */

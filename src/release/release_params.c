@@ -25,8 +25,9 @@ void hb_params_default(hb_params *p) {
 
 int hb_params_same(const hb_params *a, const hb_params *b) {
   return a->resolution == b->resolution && a->fusion == b->fusion &&
-         !memcmp(&a->min_cos, &b->min_cos, sizeof a->min_cos) && a->rgb_resolution == b->rgb_resolution &&
-         a->bake_rgb == b->bake_rgb && a->calibrate == b->calibrate && a->calib_overlays == b->calib_overlays;
+         !memcmp(&a->min_cos, &b->min_cos, sizeof a->min_cos) &&
+         a->rgb_resolution == b->rgb_resolution && a->bake_rgb == b->bake_rgb &&
+         a->calibrate == b->calibrate && a->calib_overlays == b->calib_overlays;
 }
 
 static const char *type_name(const json_t *v) {
@@ -60,7 +61,8 @@ static hearth_status get_size(const char *name, const json_t *o, const char *key
                           type_name(v));
   long long x = json_integer_value(v);
   if (x < lo || x > hi)
-    return hearth_err_set(err, HEARTH_E_RANGE, "%s: %s: %lld outside %lld..%lld", name, key, x, lo, hi);
+    return hearth_err_set(err, HEARTH_E_RANGE, "%s: %s: %lld outside %lld..%lld", name, key, x, lo,
+                          hi);
   *out = (size_t)x;
   return HEARTH_OK;
 }
@@ -71,8 +73,8 @@ static hearth_status get_bool(const char *name, const json_t *o, const char *key
   hearth_status s = member(name, o, key, &v, err);
   if (s) return s;
   if (!json_is_boolean(v))
-    return hearth_err_set(err, HEARTH_E_PARSE, "%s: %s: expected true or false, found %s", name, key,
-                          type_name(v));
+    return hearth_err_set(err, HEARTH_E_PARSE, "%s: %s: expected true or false, found %s", name,
+                          key, type_name(v));
   *out = json_is_true(v);
   return HEARTH_OK;
 }
@@ -82,13 +84,13 @@ hearth_status hb_params_parse(const char *text, size_t len, const char *name, hb
   json_error_t je;
   json_t *o = json_loadb(text, len, JSON_REJECT_DUPLICATES, &je);
   if (!o)
-    return hearth_err_set(err, HEARTH_E_PARSE, "%s: line %d, column %d: %s", name, je.line, je.column,
-                          je.text);
+    return hearth_err_set(err, HEARTH_E_PARSE, "%s: line %d, column %d: %s", name, je.line,
+                          je.column, je.text);
   hearth_status s = HEARTH_OK;
   json_t *v;
   if (!json_is_object(o)) {
-    s = hearth_err_set(err, HEARTH_E_PARSE, "%s: expected an object at the top level, found %s", name,
-                       type_name(o));
+    s = hearth_err_set(err, HEARTH_E_PARSE, "%s: expected an object at the top level, found %s",
+                       name, type_name(o));
     goto done;
   }
   if ((s = get_size(name, o, "resolution", 2, 16384, &p->resolution, err))) goto done;
@@ -98,14 +100,16 @@ hearth_status hb_params_parse(const char *text, size_t len, const char *name, hb
   for (int i = 0; f && i < 3; i++)
     if (!strcmp(f, k_fusion_names[i])) fi = i;
   if (fi < 0) {
-    s = hearth_err_set(err, HEARTH_E_PARSE, "%s: fusion: expected \"max\", \"robust\" or \"mean\", found %s%s%s",
-                       name, f ? "\"" : type_name(v), f ? f : "", f ? "\"" : "");
+    s = hearth_err_set(err, HEARTH_E_PARSE,
+                       "%s: fusion: expected \"max\", \"robust\" or \"mean\", found %s%s%s", name,
+                       f ? "\"" : type_name(v), f ? f : "", f ? "\"" : "");
     goto done;
   }
   p->fusion = (hearth_fusion)fi;
   if ((s = member(name, o, "min_cos", &v, err))) goto done;
   if (!json_is_number(v)) {
-    s = hearth_err_set(err, HEARTH_E_PARSE, "%s: min_cos: expected a number, found %s", name, type_name(v));
+    s = hearth_err_set(err, HEARTH_E_PARSE, "%s: min_cos: expected a number, found %s", name,
+                       type_name(v));
     goto done;
   }
   p->min_cos = json_number_value(v);
@@ -148,14 +152,16 @@ static char *params_text(const hb_params *p, int prec) {
 
 hearth_status hb_params_write(const char *path, const hb_params *p, hearth_err *err) {
   if ((unsigned)p->fusion > 2)
-    return hearth_err_set(err, HEARTH_E_ARG, "%s: fusion %d: expected max, robust or mean", path, (int)p->fusion);
+    return hearth_err_set(err, HEARTH_E_ARG, "%s: fusion %d: expected max, robust or mean", path,
+                          (int)p->fusion);
   /* min_cos in the shortest of 15, 16 or 17 digits that reads back exactly */
   char *text = NULL;
   hb_params back;
   hearth_status s = HEARTH_OK;
   for (int prec = 15; prec <= 17; prec++) {
     free(text);
-    if (!(text = params_text(p, prec))) return hearth_err_set(err, HEARTH_E_NOMEM, "%s: cannot encode", path);
+    if (!(text = params_text(p, prec)))
+      return hearth_err_set(err, HEARTH_E_NOMEM, "%s: cannot encode", path);
     if ((s = hb_params_parse(text, strlen(text), path, &back, err))) break;
     if (!memcmp(&back.min_cos, &p->min_cos, sizeof back.min_cos)) break;
   }

@@ -73,11 +73,14 @@ static hearth_status report_state(const char *root, const char *out_dir, const c
   *have_truth_png = *have_overlay = 0;
   snprintf(path, sizeof path, "%s/instances/%s/derived/%s/mask.npy", root, inst, state);
   if ((s = hearth_npy_read(path, &mask, err))) return s;
-  snprintf(path, sizeof path, "%s/instances/%s/derived/%s/temperature_observed.npy", root, inst, state);
+  snprintf(path, sizeof path, "%s/instances/%s/derived/%s/temperature_observed.npy", root, inst,
+           state);
   if ((s = hearth_npy_read(path, &obs, err))) goto done;
-  if (mask.ndim != 2 || obs.ndim != 2 || mask.shape[0] != obs.shape[0] || mask.dtype != HEARTH_NPY_U8 ||
-      obs.dtype != HEARTH_NPY_F32 || mask.shape[0] != mask.shape[1]) {
-    s = hearth_err_set(err, HEARTH_E_SIZE, "%s: maps of %s/%s have inconsistent shapes", path, inst, state);
+  if (mask.ndim != 2 || obs.ndim != 2 || mask.shape[0] != obs.shape[0] ||
+      mask.dtype != HEARTH_NPY_U8 || obs.dtype != HEARTH_NPY_F32 ||
+      mask.shape[0] != mask.shape[1]) {
+    s = hearth_err_set(err, HEARTH_E_SIZE, "%s: maps of %s/%s have inconsistent shapes", path, inst,
+                       state);
     goto done;
   }
   size_t R = mask.shape[0], n = R * R;
@@ -94,10 +97,12 @@ static hearth_status report_state(const char *root, const char *out_dir, const c
   if ((s = copy_file(path, dst, err))) goto done;
 
   /* ground truth: the same UV layout at the same R */
-  snprintf(path, sizeof path, "%s/ground_truth/instances/%s/%s/temperature_true.npy", root, inst, state);
+  snprintf(path, sizeof path, "%s/ground_truth/instances/%s/%s/temperature_true.npy", root, inst,
+           state);
   if (hearth_path_exists(path)) {
     if ((s = hearth_npy_read(path, &truth, err))) goto done;
-    if (truth.ndim == 2 && truth.dtype == HEARTH_NPY_F32 && truth.shape[0] == R && truth.shape[1] == R) {
+    if (truth.ndim == 2 && truth.dtype == HEARTH_NPY_F32 && truth.shape[0] == R &&
+        truth.shape[1] == R) {
       e->has_truth = 1;
       const float *t = truth.data;
       double *ad = hearth_alloc_array(e->n_observed ? e->n_observed : 1, sizeof *ad);
@@ -141,7 +146,8 @@ static hearth_status report_state(const char *root, const char *out_dir, const c
       *have_truth_png = 1;
     }
   }
-  snprintf(path, sizeof path, "%s/instances/%s/derived/overlay/%s/contact_sheet.png", root, inst, state);
+  snprintf(path, sizeof path, "%s/instances/%s/derived/overlay/%s/contact_sheet.png", root, inst,
+           state);
   if (hearth_path_exists(path)) {
     snprintf(dst, sizeof dst, "%s/%s_%s_overlay.png", out_dir, inst, state);
     if ((s = copy_file(path, dst, err))) goto done;
@@ -179,7 +185,8 @@ hearth_status hearth_report_write(const char *root, const char *out_dir, const c
   if ((s = hearth_release_read(path, &rel, err))) return s;
   size_t cap = rel.n_instances * HEARTH_MAX_STATES;
   rep->entries = calloc(cap ? cap : 1, sizeof *rep->entries);
-  int *truth_png = calloc(cap ? cap : 1, sizeof *truth_png), *overlay = calloc(cap ? cap : 1, sizeof *overlay);
+  int *truth_png = calloc(cap ? cap : 1, sizeof *truth_png),
+      *overlay = calloc(cap ? cap : 1, sizeof *overlay);
   int *colour = calloc(rel.n_instances ? rel.n_instances : 1, sizeof *colour);
   if (!rep->entries || !truth_png || !overlay || !colour) {
     s = hearth_err_set(err, HEARTH_E_NOMEM, "report: out of memory");
@@ -216,31 +223,37 @@ hearth_status hearth_report_write(const char *root, const char *out_dir, const c
   FILE *f = af.fp;
   fputs("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>", f);
   html_escape(f, title ? title : "hearth report");
-  fputs("</title>\n<style>\n"
-        "body{font-family:sans-serif;margin:24px;background:#fafafa;color:#222}\n"
-        "table.n{border-collapse:collapse;margin:8px 0}\n"
-        "table.n td,table.n th{border:1px solid #bbb;padding:3px 8px;text-align:right}\n"
-        "table.n th{background:#eee}\n"
-        ".row{display:flex;flex-wrap:wrap;gap:12px;align-items:flex-start}\n"
-        "figure{margin:0;background:#fff;border:1px solid #ddd;padding:6px}\n"
-        "figure img{width:256px;height:256px;image-rendering:pixelated;display:block}\n"
-        "figure.wide img{width:auto;height:auto;max-width:780px}\n"
-        "figcaption{font-size:12px;color:#555;max-width:256px}\n"
-        ".bar{height:12px;width:256px;background:linear-gradient(to right,"
-        "#30123b,#4662d7,#36aaf9,#1ae4b6,#72fe5e,#c8ef34,#faba39,#f66b19,#ca2a04,#7a0403)}\n"
-        "pre{background:#fff;border:1px solid #ddd;padding:8px;white-space:pre-wrap}\n"
-        "</style></head><body>\n<h1>", f);
+  fputs(
+      "</title>\n<style>\n"
+      "body{font-family:sans-serif;margin:24px;background:#fafafa;color:#222}\n"
+      "table.n{border-collapse:collapse;margin:8px 0}\n"
+      "table.n td,table.n th{border:1px solid #bbb;padding:3px 8px;text-align:right}\n"
+      "table.n th{background:#eee}\n"
+      ".row{display:flex;flex-wrap:wrap;gap:12px;align-items:flex-start}\n"
+      "figure{margin:0;background:#fff;border:1px solid #ddd;padding:6px}\n"
+      "figure img{width:256px;height:256px;image-rendering:pixelated;display:block}\n"
+      "figure.wide img{width:auto;height:auto;max-width:780px}\n"
+      "figcaption{font-size:12px;color:#555;max-width:256px}\n"
+      ".bar{height:12px;width:256px;background:linear-gradient(to right,"
+      "#30123b,#4662d7,#36aaf9,#1ae4b6,#72fe5e,#c8ef34,#faba39,#f66b19,#ca2a04,#7a0403)}\n"
+      "pre{background:#fff;border:1px solid #ddd;padding:8px;white-space:pre-wrap}\n"
+      "</style></head><body>\n<h1>",
+      f);
   html_escape(f, title ? title : "hearth report");
   fputs("</h1>\n<p>Release: <code>", f);
   html_escape(f, root);
-  fputs("</code>. Thermal textures use the Turbo colour map over a fixed 10&ndash;60 &deg;C "
-        "(<span style=\"display:inline-block;vertical-align:middle\" class=\"bar\"></span>); "
-        "error maps show |observed &minus; true| over 0&ndash;5 &deg;C on observed texels "
-        "(grey: not observed). Every texture is in the mesh's UV layout (row 0 at v = 0), so "
-        "thermal, colour and ground truth line up texel for texel.</p>\n", f);
-  fputs("<h2>Summary</h2>\n<table class=\"n\"><tr><th>instance</th><th>state</th><th>R</th>"
-        "<th>surface texels</th><th>observed</th><th>median |err| &deg;C</th>"
-        "<th>p95 |err| &deg;C</th><th>mean err &deg;C</th></tr>\n", f);
+  fputs(
+      "</code>. Thermal textures use the Turbo colour map over a fixed 10&ndash;60 &deg;C "
+      "(<span style=\"display:inline-block;vertical-align:middle\" class=\"bar\"></span>); "
+      "error maps show |observed &minus; true| over 0&ndash;5 &deg;C on observed texels "
+      "(grey: not observed). Every texture is in the mesh's UV layout (row 0 at v = 0), so "
+      "thermal, colour and ground truth line up texel for texel.</p>\n",
+      f);
+  fputs(
+      "<h2>Summary</h2>\n<table class=\"n\"><tr><th>instance</th><th>state</th><th>R</th>"
+      "<th>surface texels</th><th>observed</th><th>median |err| &deg;C</th>"
+      "<th>p95 |err| &deg;C</th><th>mean err &deg;C</th></tr>\n",
+      f);
   for (size_t j = 0; j < rep->n; j++) {
     const hearth_report_entry *e = &rep->entries[j];
     char cov[32], med[32], p95[32], mean[32];
@@ -248,9 +261,11 @@ hearth_status hearth_report_write(const char *root, const char *out_dir, const c
     fmt2(med, sizeof med, e->median_abs_c);
     fmt2(p95, sizeof p95, e->p95_abs_c);
     fmt2(mean, sizeof mean, e->mean_signed_c);
-    fprintf(f, "<tr><td style=\"text-align:left\"><a href=\"#%s_%s\">%s</a></td><td style=\"text-align:left\">%s</td>"
-            "<td>%zu</td><td>%zu</td><td>%s %%</td><td>%s</td><td>%s</td><td>%s</td></tr>\n",
-            e->instance, e->state, e->instance, e->state, e->R, e->n_surface, cov, med, p95, mean);
+    fprintf(
+        f,
+        "<tr><td style=\"text-align:left\"><a href=\"#%s_%s\">%s</a></td><td style=\"text-align:left\">%s</td>"
+        "<td>%zu</td><td>%zu</td><td>%s %%</td><td>%s</td><td>%s</td><td>%s</td></tr>\n",
+        e->instance, e->state, e->instance, e->state, e->R, e->n_surface, cov, med, p95, mean);
   }
   fputs("</table>\n", f);
   if (validate_text) {
@@ -267,31 +282,44 @@ hearth_status hearth_report_write(const char *root, const char *out_dir, const c
       hearth_format_fixed(cov, sizeof cov, 100.0 * e->coverage, 1);
       fmt2(med, sizeof med, e->median_abs_c);
       fmt2(p95, sizeof p95, e->p95_abs_c);
-      fprintf(f, "<h2 id=\"%s_%s\">%s &mdash; %s</h2>\n<p>%s %% of the surface observed; "
-              "median |error| %s &deg;C, p95 %s &deg;C against ground truth.</p>\n<div class=\"row\">\n",
-              e->instance, e->state, e->instance, e->state, cov, med, p95);
-      fprintf(f, "<figure><img src=\"%s_%s_thermal.png\" alt=\"thermal texture\"><figcaption>thermal "
-              "texture (Turbo, 10&ndash;60 &deg;C), derived/%s/thermal_turbo.png</figcaption></figure>\n",
-              inst, e->state, e->state);
+      fprintf(
+          f,
+          "<h2 id=\"%s_%s\">%s &mdash; %s</h2>\n<p>%s %% of the surface observed; "
+          "median |error| %s &deg;C, p95 %s &deg;C against ground truth.</p>\n<div class=\"row\">\n",
+          e->instance, e->state, e->instance, e->state, cov, med, p95);
+      fprintf(
+          f,
+          "<figure><img src=\"%s_%s_thermal.png\" alt=\"thermal texture\"><figcaption>thermal "
+          "texture (Turbo, 10&ndash;60 &deg;C), derived/%s/thermal_turbo.png</figcaption></figure>\n",
+          inst, e->state, e->state);
       if (colour[i])
-        fprintf(f, "<figure><img src=\"%s_colour.png\" alt=\"colour texture\"><figcaption>colour "
-                "texture, same UV layout</figcaption></figure>\n", inst);
+        fprintf(f,
+                "<figure><img src=\"%s_colour.png\" alt=\"colour texture\"><figcaption>colour "
+                "texture, same UV layout</figcaption></figure>\n",
+                inst);
       if (truth_png[j]) {
-        fprintf(f, "<figure><img src=\"%s_%s_truth.png\" alt=\"ground truth\"><figcaption>ground "
-                "truth temperature (Turbo, 10&ndash;60 &deg;C)</figcaption></figure>\n", inst, e->state);
-        fprintf(f, "<figure><img src=\"%s_%s_error.png\" alt=\"error\"><figcaption>|observed &minus; "
-                "true| (Turbo, 0&ndash;5 &deg;C; grey not observed)</figcaption></figure>\n", inst, e->state);
+        fprintf(f,
+                "<figure><img src=\"%s_%s_truth.png\" alt=\"ground truth\"><figcaption>ground "
+                "truth temperature (Turbo, 10&ndash;60 &deg;C)</figcaption></figure>\n",
+                inst, e->state);
+        fprintf(f,
+                "<figure><img src=\"%s_%s_error.png\" alt=\"error\"><figcaption>|observed &minus; "
+                "true| (Turbo, 0&ndash;5 &deg;C; grey not observed)</figcaption></figure>\n",
+                inst, e->state);
       }
       fputs("</div>\n", f);
       if (overlay[j])
-        fprintf(f, "<div class=\"row\"><figure class=\"wide\"><img src=\"%s_%s_overlay.png\" "
-                "alt=\"overlays\"><figcaption style=\"max-width:780px\">mesh outlines on the thermal "
-                "views: before (transferred poses) and after refinement</figcaption></figure></div>\n",
-                inst, e->state);
+        fprintf(
+            f,
+            "<div class=\"row\"><figure class=\"wide\"><img src=\"%s_%s_overlay.png\" "
+            "alt=\"overlays\"><figcaption style=\"max-width:780px\">mesh outlines on the thermal "
+            "views: before (transferred poses) and after refinement</figcaption></figure></div>\n",
+            inst, e->state);
     }
   }
   fputs("<p style=\"color:#777;font-size:12px\">Made by hearth " HEARTH_VERSION
-        ". Static page: open it from disk, no server needed.</p>\n</body></html>\n", f);
+        ". Static page: open it from disk, no server needed.</p>\n</body></html>\n",
+        f);
   s = hearth_atomic_commit(&af, err);
 done:
   free(truth_png);

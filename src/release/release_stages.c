@@ -68,9 +68,10 @@ size_t hb_calib_stages(const char *root, int overlays, hearth_build_stage *stage
   char dir[4096];
   snprintf(dir, sizeof dir, "%s/calibration/captures", root);
   if (max < 2 || !hearth_path_exists(dir)) return 0;
-  stages[0] = (hearth_build_stage){"detect", overlays ? "defaults overlays=1" : "defaults overlays=0",
-                                   detect_files, detect_run,
-                                   (void *)(overlays ? &k_overlays_on : &k_overlays_off)};
+  stages[0] =
+      (hearth_build_stage){"detect", overlays ? "defaults overlays=1" : "defaults overlays=0",
+                           detect_files, detect_run,
+                           (void *)(overlays ? &k_overlays_on : &k_overlays_off)};
   stages[1] = (hearth_build_stage){"calibrate", "defaults", calib_files, calib_run, NULL};
   return 2;
 }

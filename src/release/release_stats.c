@@ -107,7 +107,8 @@ hearth_status hearth_release_stats_compute(const char *root, hearth_release_stat
         snprintf(b, sizeof b, "%s/%s", sdir, vf->thermal);
         int has_rgb = is_file(a), has_th = is_file(b);
         if (has_rgb && has_th) st->n_pairs++;
-        if (vf->elevation_index >= 0 && vf->elevation_index < 64) elev_seen |= 1ull << vf->elevation_index;
+        if (vf->elevation_index >= 0 && vf->elevation_index < 64)
+          elev_seen |= 1ull << vf->elevation_index;
         if (vf->azimuth_index >= 0 && vf->azimuth_index < 64) azi_seen |= 1ull << vf->azimuth_index;
         char dp[PATH_SZ];
         snprintf(dp, sizeof dp, "%s/%s", sdir, vf->depth);
@@ -156,8 +157,10 @@ hearth_status hearth_release_stats_compute(const char *root, hearth_release_stat
     const struct {
       const char *name;
       size_t *count;
-    } assets[] = {{"mesh.glb", &st->n_meshes},       {"rgb_texture.png", &st->n_rgb_textures},
-                  {"scale.json", &st->n_scales},     {"poses_rgb.json", &st->n_poses_rgb},
+    } assets[] = {{"mesh.glb", &st->n_meshes},
+                  {"rgb_texture.png", &st->n_rgb_textures},
+                  {"scale.json", &st->n_scales},
+                  {"poses_rgb.json", &st->n_poses_rgb},
                   {"poses_thermal.json", &st->n_poses_thermal}};
     for (size_t j = 0; j < sizeof assets / sizeof assets[0]; j++) {
       snprintf(path, sizeof path, "%s/%s", dd, assets[j].name);
@@ -197,8 +200,12 @@ static void per_category(const hearth_release_stats *st, char *buf, size_t n) {
 
 static void human_bytes(uint64_t b, char *buf, size_t n) {
   char num[32];
-  if (b >= (1ull << 30)) hearth_format_fixed(num, sizeof num, (double)b / (1ull << 30), 1), snprintf(buf, n, "%s GiB", num);
-  else if (b >= (1ull << 20)) hearth_format_fixed(num, sizeof num, (double)b / (1ull << 20), 1), snprintf(buf, n, "%s MiB", num);
+  if (b >= (1ull << 30))
+    hearth_format_fixed(num, sizeof num, (double)b / (1ull << 30), 1),
+        snprintf(buf, n, "%s GiB", num);
+  else if (b >= (1ull << 20))
+    hearth_format_fixed(num, sizeof num, (double)b / (1ull << 20), 1),
+        snprintf(buf, n, "%s MiB", num);
   else hearth_format_fixed(num, sizeof num, (double)b / 1024.0, 1), snprintf(buf, n, "%s KiB", num);
 }
 
@@ -206,12 +213,14 @@ void hearth_release_stats_print(const hearth_release_stats *st, FILE *out) {
   char buf[1024], pc[64];
   const int w = 28;
   fprintf(out, "Object dataset overview\n");
-  fprintf(out, "%.*s\n", 100, "------------------------------------------------------------"
-                                "----------------------------------------");
+  fprintf(out, "%.*s\n", 100,
+          "------------------------------------------------------------"
+          "----------------------------------------");
   size_t off = 0;
   for (int c = 0; c < 18 && off < sizeof buf; c++)
     if (st->instances_per_category[c])
-      off += (size_t)snprintf(buf + off, sizeof buf - off, "%s%s", off ? ", " : "", hearth_categories[c]);
+      off += (size_t)snprintf(buf + off, sizeof buf - off, "%s%s", off ? ", " : "",
+                              hearth_categories[c]);
   fprintf(out, "%-*s %zu (%s)\n", w, "Object categories", st->n_categories, off ? buf : "none");
   per_category(st, pc, sizeof pc);
   fprintf(out, "%-*s %zu (%s)\n", w, "Physical instances", st->n_instances, pc);
@@ -226,7 +235,8 @@ void hearth_release_stats_print(const hearth_release_stats *st, FILE *out) {
     fprintf(out, ", plus %s for %zu instances in %zu categories", buf, st->n_instances_nonneutral,
             st->n_categories_nonneutral);
   fprintf(out, " (%zu object states)\n", st->n_states);
-  if (st->views_min == st->views_max) fprintf(out, "%-*s %zu", w, "Views per object state", st->views_max);
+  if (st->views_min == st->views_max)
+    fprintf(out, "%-*s %zu", w, "Views per object state", st->views_max);
   else fprintf(out, "%-*s %zu-%zu", w, "Views per object state", st->views_min, st->views_max);
   /* a subset of the turntable grid says so, rather than implying the full grid */
   fprintf(out, " (%s%zu elevations x %zu azimuths)\n",
@@ -235,10 +245,13 @@ void hearth_release_stats_print(const hearth_release_stats *st, FILE *out) {
   fprintf(out, "%-*s %zu (%zu object states", w, "RGB-thermal pairs", st->n_pairs, st->n_states);
   if (st->views_min == st->views_max) fprintf(out, " x %zu views", st->views_max);
   fprintf(out, ")\n");
-  fprintf(out, "%-*s RGB image (%zux%zu), apparent-temperature matrix (%zux%zu, CSV), depth map "
-          "(%zux%zu); %zu depth maps\n", w, "Raw data per view", st->rgb_w, st->rgb_h,
-          st->thermal_w, st->thermal_h, st->depth_w, st->depth_h, st->n_depth);
-  fprintf(out, "%-*s mesh (GLB with UV) %zu/%zu, RGB texture %zu/%zu, metric scale %zu/%zu, "
+  fprintf(out,
+          "%-*s RGB image (%zux%zu), apparent-temperature matrix (%zux%zu, CSV), depth map "
+          "(%zux%zu); %zu depth maps\n",
+          w, "Raw data per view", st->rgb_w, st->rgb_h, st->thermal_w, st->thermal_h, st->depth_w,
+          st->depth_h, st->n_depth);
+  fprintf(out,
+          "%-*s mesh (GLB with UV) %zu/%zu, RGB texture %zu/%zu, metric scale %zu/%zu, "
           "per-view camera poses %zu/%zu;\n%-*s temperature UV map with validity mask %zu/%zu "
           "(%zux%zu), thermal texture (PNG) %zu/%zu, provenance %zu/%zu; calibration %s\n",
           w, "Derived assets", st->n_meshes, st->n_instances, st->n_rgb_textures, st->n_instances,
@@ -257,7 +270,8 @@ char *hearth_release_stats_json(const hearth_release_stats *st) {
   json_t *cats = json_object();
   for (int c = 0; c < 18; c++)
     if (st->instances_per_category[c])
-      json_object_set_new(cats, hearth_categories[c], json_integer((json_int_t)st->instances_per_category[c]));
+      json_object_set_new(cats, hearth_categories[c],
+                          json_integer((json_int_t)st->instances_per_category[c]));
   json_object_set_new(o, "categories", json_integer((json_int_t)st->n_categories));
   json_object_set_new(o, "instances_per_category", cats);
   json_object_set_new(o, "instances", json_integer((json_int_t)st->n_instances));
@@ -266,8 +280,10 @@ char *hearth_release_stats_json(const hearth_release_stats *st) {
   for (int j = 0; j < HEARTH_N_STATE_KINDS; j++)
     json_object_set_new(kinds, k_kinds[j], json_integer((json_int_t)st->states_by_kind[j]));
   json_object_set_new(o, "states_by_kind", kinds);
-  json_object_set_new(o, "instances_with_non_neutral_state", json_integer((json_int_t)st->n_instances_nonneutral));
-  json_object_set_new(o, "categories_with_non_neutral_state", json_integer((json_int_t)st->n_categories_nonneutral));
+  json_object_set_new(o, "instances_with_non_neutral_state",
+                      json_integer((json_int_t)st->n_instances_nonneutral));
+  json_object_set_new(o, "categories_with_non_neutral_state",
+                      json_integer((json_int_t)st->n_categories_nonneutral));
   json_t *v = json_object();
   json_object_set_new(v, "min", json_integer((json_int_t)st->views_min));
   json_object_set_new(v, "max", json_integer((json_int_t)st->views_max));
@@ -278,8 +294,10 @@ char *hearth_release_stats_json(const hearth_release_stats *st) {
   json_object_set_new(o, "depth_maps", json_integer((json_int_t)st->n_depth));
   json_t *raw = json_object();
   json_object_set_new(raw, "rgb", json_pack("[I,I]", (json_int_t)st->rgb_w, (json_int_t)st->rgb_h));
-  json_object_set_new(raw, "thermal", json_pack("[I,I]", (json_int_t)st->thermal_w, (json_int_t)st->thermal_h));
-  json_object_set_new(raw, "depth", json_pack("[I,I]", (json_int_t)st->depth_w, (json_int_t)st->depth_h));
+  json_object_set_new(raw, "thermal",
+                      json_pack("[I,I]", (json_int_t)st->thermal_w, (json_int_t)st->thermal_h));
+  json_object_set_new(raw, "depth",
+                      json_pack("[I,I]", (json_int_t)st->depth_w, (json_int_t)st->depth_h));
   json_object_set_new(o, "raw_per_view", raw);
   json_t *d = json_object();
   json_object_set_new(d, "meshes", json_integer((json_int_t)st->n_meshes));

@@ -52,9 +52,7 @@ static void add_err(hearth_problems *p, const char *path, const hearth_err *e) {
   hearth_problems_add(p, path, "%s", *m ? m : hearth_strerror(e->status));
 }
 
-void hearth_validate_opts_default(hearth_validate_opts *o) {
-  memset(o, 0, sizeof *o);
-}
+void hearth_validate_opts_default(hearth_validate_opts *o) { memset(o, 0, sizeof *o); }
 
 /* ---- image headers ------------------------------------------------------- */
 typedef struct img_info {
@@ -144,7 +142,8 @@ static void check_image(hearth_problems *p, const char *path, img_kind kind, siz
   }
   img_info ii = {0};
   char why[256];
-  int ok = kind == IMG_PNG ? png_info(d, n, &ii, why, sizeof why) : jpeg_info(d, n, &ii, why, sizeof why);
+  int ok = kind == IMG_PNG ? png_info(d, n, &ii, why, sizeof why)
+                           : jpeg_info(d, n, &ii, why, sizeof why);
   if (!ok) {
     hearth_problems_add(p, path, "%s", why);
   } else {
@@ -156,7 +155,9 @@ static void check_image(hearth_problems *p, const char *path, img_kind kind, siz
     }
     int cok = 0;
     for (const int *c = channels_ok; *c; c++) cok |= *c == ii.channels;
-    if (!cok) hearth_problems_add(p, path, "image has %d channel(s), which this file may not have", ii.channels);
+    if (!cok)
+      hearth_problems_add(p, path, "image has %d channel(s), which this file may not have",
+                          ii.channels);
     if (bits && ii.bits != bits)
       hearth_problems_add(p, path, "image is %d-bit, expected %d-bit", ii.bits, bits);
     /* a header that disagrees is reported without decoding what it declares */
@@ -266,10 +267,12 @@ static void check_provenance(hearth_problems *p, const char *path, const char *i
   json_t *ji = json_object_get(o, "instance"), *js = json_object_get(o, "state");
   if (!json_is_string(ji)) hearth_problems_add(p, path, "instance: expected a string");
   else if (strcmp(json_string_value(ji), inst))
-    hearth_problems_add(p, path, "instance: names '%s', expected '%s'", json_string_value(ji), inst);
+    hearth_problems_add(p, path, "instance: names '%s', expected '%s'", json_string_value(ji),
+                        inst);
   if (!json_is_string(js)) hearth_problems_add(p, path, "state: expected a string");
   else if (strcmp(json_string_value(js), sv->state))
-    hearth_problems_add(p, path, "state: names '%s', expected '%s'", json_string_value(js), sv->state);
+    hearth_problems_add(p, path, "state: names '%s', expected '%s'", json_string_value(js),
+                        sv->state);
   json_t *jv = json_object_get(o, "source_views");
   if (!json_is_array(jv)) {
     hearth_problems_add(p, path, "source_views: expected an array of view names");
@@ -299,7 +302,8 @@ static void check_provenance(hearth_problems *p, const char *path, const char *i
     hearth_problems_add(p, path, "parameters: expected an object");
   } else {
     json_t *res = json_object_get(jp, "resolution");
-    if (!json_is_integer(res)) hearth_problems_add(p, path, "parameters.resolution: expected an integer");
+    if (!json_is_integer(res))
+      hearth_problems_add(p, path, "parameters.resolution: expected an integer");
     else if (R && (size_t)json_integer_value(res) != R)
       hearth_problems_add(p, path, "parameters.resolution: %lld, but the maps are %zux%zu",
                           (long long)json_integer_value(res), R, R);
@@ -366,21 +370,27 @@ static void check_state_maps(hearth_problems *p, const char *dir, const char *in
         if (!bad_mask++) first_mask = i;
         continue;
       }
-      if (o && m[i] == 1 && !(isfinite(o[i]) && o[i] >= HEARTH_THERMAL_MIN_C && o[i] <= HEARTH_THERMAL_MAX_C))
+      if (o && m[i] == 1 &&
+          !(isfinite(o[i]) && o[i] >= HEARTH_THERMAL_MIN_C && o[i] <= HEARTH_THERMAL_MAX_C))
         if (!bad_obs++) first_obs = i;
       if (f && (m[i] == 1 || m[i] == 2) &&
           !(isfinite(f[i]) && f[i] >= HEARTH_THERMAL_MIN_C && f[i] <= HEARTH_THERMAL_MAX_C))
         if (!bad_fil++) first_fil = i;
     }
     if (bad_mask)
-      hearth_problems_add(p, path, "%zu texel(s) with a value outside {0,1,2,3}, first [%zu][%zu] = %u",
+      hearth_problems_add(p, path,
+                          "%zu texel(s) with a value outside {0,1,2,3}, first [%zu][%zu] = %u",
                           bad_mask, first_mask / R, first_mask % R, m[first_mask]);
     if (bad_obs)
-      hearth_problems_add(p, opath, "%zu observed texel(s) (mask 1) not a temperature in -50..650 degC, "
-                          "first [%zu][%zu]", bad_obs, first_obs / R, first_obs % R);
+      hearth_problems_add(p, opath,
+                          "%zu observed texel(s) (mask 1) not a temperature in -50..650 degC, "
+                          "first [%zu][%zu]",
+                          bad_obs, first_obs / R, first_obs % R);
     if (bad_fil)
-      hearth_problems_add(p, fpath, "%zu texel(s) with mask 1 or 2 not a temperature in -50..650 "
-                          "degC, first [%zu][%zu]", bad_fil, first_fil / R, first_fil % R);
+      hearth_problems_add(p, fpath,
+                          "%zu texel(s) with mask 1 or 2 not a temperature in -50..650 "
+                          "degC, first [%zu][%zu]",
+                          bad_fil, first_fil / R, first_fil % R);
   }
   static const int rgb_only[] = {3, 0};
   snprintf(path, sizeof path, "%s/thermal_turbo.png", dir);
@@ -430,8 +440,7 @@ static void check_leftovers(hearth_problems *p, const char *dir, int depth) {
     if (hearth_temp_parse(names[i], NULL, &pid)) {
       if (hearth_temp_writer_alive(pid))
         hearth_problems_add(p, path, "a temporary of process %ld, which is still writing", pid);
-      else
-        hearth_problems_add(p, path, "left by an interrupted write (hearth build removes it)");
+      else hearth_problems_add(p, path, "left by an interrupted write (hearth build removes it)");
     } else if (depth < 8 && lstat(path, &st) == 0 && S_ISDIR(st.st_mode))
       check_leftovers(p, path, depth + 1);
     free(names[i]);
@@ -471,7 +480,8 @@ static void check_instance(const char *root, const char *id, const hearth_valida
     snprintf(path, sizeof path, "%s/manifest.json", sdir);
     (*nfiles)++;
     if (!present(path)) {
-      hearth_problems_add(p, path, "missing (state '%s' is listed in instance.json)", doc.states[k]);
+      hearth_problems_add(p, path, "missing (state '%s' is listed in instance.json)",
+                          doc.states[k]);
       continue;
     }
     if (hearth_manifest_read(path, &sv[k].man, &e)) {
@@ -487,8 +497,11 @@ static void check_instance(const char *root, const char *id, const hearth_valida
       char f[PATH_SZ];
       const struct {
         const char *rel, *what;
-      } files[5] = {{vf->rgb, "rgb"}, {vf->cutout, "cutout"}, {vf->depth, "depth"},
-                    {vf->depth_intrinsics, "depth_intrinsics"}, {vf->thermal, "thermal"}};
+      } files[5] = {{vf->rgb, "rgb"},
+                    {vf->cutout, "cutout"},
+                    {vf->depth, "depth"},
+                    {vf->depth_intrinsics, "depth_intrinsics"},
+                    {vf->thermal, "thermal"}};
       int have[5];
       for (int j = 0; j < 5; j++) {
         snprintf(f, sizeof f, "%s/%s", sdir, files[j].rel);
@@ -531,7 +544,8 @@ static void check_instance(const char *root, const char *id, const hearth_valida
   /* derived/: scale, mesh, poses, per-state maps (one line if never built) */
   snprintf(path, sizeof path, "%s/derived", dir);
   if (!hearth_path_exists(path)) {
-    hearth_problems_add(p, path, "missing: the instance was never built (run `hearth build`, "
+    hearth_problems_add(p, path,
+                        "missing: the instance was never built (run `hearth build`, "
                         "or validate a capture with --raw-only)");
     goto done;
   }
@@ -583,10 +597,11 @@ static void check_calibration(const char *root, const hearth_validate_opts *o, h
     add_err(p, path, &e);
   } else if (rig.thermal.width != 256 || rig.thermal.height != 192 || rig.rgb.width != 1920 ||
              rig.rgb.height != 1080 || rig.depth.width != 640 || rig.depth.height != 576) {
-    hearth_problems_add(p, path, "camera sizes rgb %dx%d, thermal %dx%d, depth %dx%d; expected "
-                        "1920x1080, 256x192, 640x576", (int)rig.rgb.width, (int)rig.rgb.height,
-                        (int)rig.thermal.width, (int)rig.thermal.height, (int)rig.depth.width,
-                        (int)rig.depth.height);
+    hearth_problems_add(p, path,
+                        "camera sizes rgb %dx%d, thermal %dx%d, depth %dx%d; expected "
+                        "1920x1080, 256x192, 640x576",
+                        (int)rig.rgb.width, (int)rig.rgb.height, (int)rig.thermal.width,
+                        (int)rig.thermal.height, (int)rig.depth.width, (int)rig.depth.height);
   }
   snprintf(path, sizeof path, "%s/calibration/factory.json", root);
   if (present(path)) {
@@ -644,7 +659,7 @@ typedef struct vctx {
   const char *root;
   const hearth_release_doc *rel;
   const hearth_validate_opts *o;
-  hearth_problems *per;   /* one list per instance */
+  hearth_problems *per; /* one list per instance */
   size_t *nfiles;
 } vctx;
 
@@ -657,7 +672,8 @@ static void validate_range(void *ctx, size_t b, size_t e, int t) {
 hearth_status hearth_validate_release(const char *root, const hearth_validate_opts *o,
                                       hearth_problems *out, size_t *files_checked,
                                       hearth_err *err) {
-  if (!root || !out) return hearth_err_set(err, HEARTH_E_ARG, "validate: root and out are required");
+  if (!root || !out)
+    return hearth_err_set(err, HEARTH_E_ARG, "validate: root and out are required");
   hearth_validate_opts def;
   if (!o) {
     hearth_validate_opts_default(&def);

@@ -245,7 +245,8 @@ hearth_status sim_asset_load(const char *root, int use_gt, const char *category,
       st = capture_up(p, up, err);
     }
     if (!st) {
-      snprintf(p, sizeof p, "%s/ground_truth/instances/%s/%s/temperature_true.npy", root, id, state);
+      snprintf(p, sizeof p, "%s/ground_truth/instances/%s/%s/temperature_true.npy", root, id,
+               state);
       st = thermal_texture(p, &a->thermal, err);
     }
   } else {

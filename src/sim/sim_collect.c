@@ -26,8 +26,8 @@ void hearth_sim_split_path(const char *out_path, int ins, char *buf, size_t bufs
 }
 
 /* one rollout of the expert from (layout, instruction) into b */
-static hearth_status rollout(hearth_sim_env *e, uint64_t seed, uint64_t layout, int ins, sim_demo *b,
-                             int *success, hearth_err *err) {
+static hearth_status rollout(hearth_sim_env *e, uint64_t seed, uint64_t layout, int ins,
+                             sim_demo *b, int *success, hearth_err *err) {
   hearth_status st = hearth_sim_reset(e, seed, layout, ins, err);
   if (st) return st;
   b->T = 0;
@@ -73,12 +73,12 @@ static hearth_status rollout(hearth_sim_env *e, uint64_t seed, uint64_t layout, 
 typedef struct collect_run {
   const hearth_sim_collect_opts *o;
   hearth_sim_env *env;
-  int nfile;              /* 1, or 2 with split_instructions */
+  int nfile; /* 1, or 2 with split_instructions */
   char path[2][4200];
   sim_h5_out out[2];
   sim_h5_meta meta[2];
-  char *model_file;       /* the scene's MJCF, stored with every demo */
-  sim_demo demo[2];       /* instruction 0, 1 */
+  char *model_file; /* the scene's MJCF, stored with every demo */
+  sim_demo demo[2]; /* instruction 0, 1 */
 } collect_run;
 
 static void run_free(collect_run *c) {
@@ -119,7 +119,8 @@ static hearth_status run_open(collect_run *c, hearth_err *err) {
   for (int i = 0; i < c->nfile && !st; i++) {
     if (c->nfile == 2) hearth_sim_split_path(o->out_path, i, c->path[i], sizeof c->path[i]);
     else snprintf(c->path[i], sizeof c->path[i], "%s", o->out_path);
-    st = sim_h5_describe(o, c->nfile == 2 ? i : 0, c->nfile == 2 ? 1 : 2, c->env->gl, &c->meta[i], err);
+    st = sim_h5_describe(o, c->nfile == 2 ? i : 0, c->nfile == 2 ? 1 : 2, c->env->gl, &c->meta[i],
+                         err);
     if (!st) st = sim_h5_create(&c->out[i], c->path[i], err);
   }
   return st;
@@ -127,7 +128,8 @@ static hearth_status run_open(collect_run *c, hearth_err *err) {
 
 /* fill slot k: its first candidate layout where the expert succeeds on
  * both instructions (any with keep_failures), stored in every file */
-static hearth_status fill_slot(collect_run *c, int k, hearth_sim_collect_stats *stats, hearth_err *err) {
+static hearth_status fill_slot(collect_run *c, int k, hearth_sim_collect_stats *stats,
+                               hearth_err *err) {
   const hearth_sim_collect_opts *o = c->o;
   for (int j = 0; j < HEARTH_SIM_SLOT_TRIES; j++) {
     uint64_t l = (uint64_t)k + (uint64_t)j * 2u * HEARTH_SIM_MAX_LAYOUTS;
@@ -145,16 +147,18 @@ static hearth_status fill_slot(collect_run *c, int k, hearth_sim_collect_stats *
     }
     for (int ins = 0; ins < 2; ins++) {
       sim_h5_out *out = &c->out[c->nfile == 2 ? ins : 0];
-      hearth_status st = sim_h5_add_demo(out, &c->demo[ins], o->image_size,
-                                         hearth_sim_instruction_text(o->task, ins), c->model_file, err);
+      hearth_status st =
+          sim_h5_add_demo(out, &c->demo[ins], o->image_size,
+                          hearth_sim_instruction_text(o->task, ins), c->model_file, err);
       if (st) return st;
     }
     return HEARTH_OK;
   }
-  return hearth_err_set(err, HEARTH_E_NUMERIC,
-                        "sim collect %s: the expert failed on all %d candidate layouts of slot %d (layouts %d, "
-                        "%d + 200000 j ...); check the assets or pass --keep-failures",
-                        hearth_sim_task_name(o->task), HEARTH_SIM_SLOT_TRIES, k, k, k);
+  return hearth_err_set(
+      err, HEARTH_E_NUMERIC,
+      "sim collect %s: the expert failed on all %d candidate layouts of slot %d (layouts %d, "
+      "%d + 200000 j ...); check the assets or pass --keep-failures",
+      hearth_sim_task_name(o->task), HEARTH_SIM_SLOT_TRIES, k, k, k);
 }
 
 hearth_status hearth_sim_collect(const hearth_sim_collect_opts *o, hearth_sim_collect_stats *stats,
@@ -164,15 +168,19 @@ hearth_status hearth_sim_collect(const hearth_sim_collect_opts *o, hearth_sim_co
   memset(stats, 0, sizeof *stats);
   if (!o->out_path) return hearth_err_set(err, HEARTH_E_ARG, "sim collect: no output path");
   if (o->layouts < 1 || o->layouts > HEARTH_SIM_MAX_LAYOUTS)
-    return hearth_err_set(err, HEARTH_E_RANGE, "sim collect: layouts must be 1..%d, got %d", HEARTH_SIM_MAX_LAYOUTS,
-                          o->layouts);
-  int count = o->shard_count > 1 ? o->shard_count : 1, index = o->shard_count > 1 ? o->shard_index : 0;
+    return hearth_err_set(err, HEARTH_E_RANGE, "sim collect: layouts must be 1..%d, got %d",
+                          HEARTH_SIM_MAX_LAYOUTS, o->layouts);
+  int count = o->shard_count > 1 ? o->shard_count : 1,
+      index = o->shard_count > 1 ? o->shard_index : 0;
   if (index < 0 || index >= count)
-    return hearth_err_set(err, HEARTH_E_ARG, "sim collect: shard %d/%d: expected 0 <= index < count", o->shard_index,
+    return hearth_err_set(err, HEARTH_E_ARG,
+                          "sim collect: shard %d/%d: expected 0 <= index < count", o->shard_index,
                           o->shard_count);
   if (index >= o->layouts)
-    return hearth_err_set(err, HEARTH_E_ARG, "sim collect: shard %d/%d has no slot of %d layout(s): use at most %d shards",
-                          index, count, o->layouts, o->layouts);
+    return hearth_err_set(
+        err, HEARTH_E_ARG,
+        "sim collect: shard %d/%d has no slot of %d layout(s): use at most %d shards", index, count,
+        o->layouts, o->layouts);
   double t0 = hearth_now();
   collect_run c = {.o = o};
   hearth_status st = run_open(&c, err);

@@ -84,7 +84,8 @@ void sim_osc(hearth_sim_env *e) {
     }
   double Lp_in[9], Lo_in[9], Lp[9], Lo[9], L[36];
   for (int r = 0; r < 3; r++)
-    for (int c = 0; c < 3; c++) Lp_in[r * 3 + c] = Li[r * 6 + c], Lo_in[r * 3 + c] = Li[(r + 3) * 6 + c + 3];
+    for (int c = 0; c < 3; c++)
+      Lp_in[r * 3 + c] = Li[r * 6 + c], Lo_in[r * 3 + c] = Li[(r + 3) * 6 + c + 3];
   if (!inv3(Lp_in, Lp) || !inv3(Lo_in, Lo)) return;
   memcpy(L, Li, sizeof L);
   if (!invn(L, 6)) return;
@@ -99,13 +100,15 @@ void sim_osc(hearth_sim_env *e) {
   double ep[3], eo[3] = {0, 0, 0};
   for (int i = 0; i < 3; i++) ep[i] = e->goal_pos[i] - x[i];
   for (int c = 0; c < 3; c++) {
-    double rc[3] = {R[c], R[3 + c], R[6 + c]}, rd[3] = {e->goal_R[c], e->goal_R[3 + c], e->goal_R[6 + c]}, cr[3];
+    double rc[3] = {R[c], R[3 + c], R[6 + c]},
+           rd[3] = {e->goal_R[c], e->goal_R[3 + c], e->goal_R[6 + c]}, cr[3];
     hearth_cross3(rc, rd, cr);
     for (int i = 0; i < 3; i++) eo[i] += 0.5 * cr[i];
   }
   const double kp = 150.0, kv = 2.0 * sqrt(150.0);
   double fdes[3], tdes[3], w[6];
-  for (int i = 0; i < 3; i++) fdes[i] = kp * ep[i] - kv * v[i], tdes[i] = kp * eo[i] - kv * v[3 + i];
+  for (int i = 0; i < 3; i++)
+    fdes[i] = kp * ep[i] - kv * v[i], tdes[i] = kp * eo[i] - kv * v[3 + i];
   for (int i = 0; i < 3; i++) {
     w[i] = Lp[i * 3] * fdes[0] + Lp[i * 3 + 1] * fdes[1] + Lp[i * 3 + 2] * fdes[2];
     w[3 + i] = Lo[i * 3] * tdes[0] + Lo[i * 3 + 1] * tdes[1] + Lo[i * 3 + 2] * tdes[2];
@@ -119,7 +122,8 @@ void sim_osc(hearth_sim_env *e) {
    * Jbar = Mi J^T Lambda */
   const double kn = 10.0, kvn = 2.0 * sqrt(10.0);
   double pr[7], p[7], MiP[7], JMiP[6], LJ[6];
-  for (int i = 0; i < 7; i++) pr[i] = kn * (sim_robot_q_start[i] - d->qpos[e->arm_qadr[i]]) - kvn * qd[i];
+  for (int i = 0; i < 7; i++)
+    pr[i] = kn * (sim_robot_q_start[i] - d->qpos[e->arm_qadr[i]]) - kvn * qd[i];
   for (int i = 0; i < 7; i++) {
     p[i] = 0;
     for (int k = 0; k < 7; k++) p[i] += Ma[i][k] * pr[k];

@@ -52,7 +52,8 @@ hearth_status hearth_sim_env_new(const hearth_sim_opts *o, hearth_sim_env **out,
   if (!gl || !*gl) gl = "osmesa";
   if (strcmp(gl, "osmesa") != 0 && strcmp(gl, "egl") != 0) {
     free(e);
-    return hearth_err_set(err, HEARTH_E_ARG, "sim: renderer '%s' is not osmesa or egl (option gl / HEARTH_GL)", gl);
+    return hearth_err_set(err, HEARTH_E_ARG,
+                          "sim: renderer '%s' is not osmesa or egl (option gl / HEARTH_GL)", gl);
   }
   snprintf(e->gl, sizeof e->gl, "%s", gl);
   hearth_status st = HEARTH_OK;
@@ -73,7 +74,8 @@ hearth_status hearth_sim_env_new(const hearth_sim_opts *o, hearth_sim_env **out,
   const sim_task_def *td = sim_task_get(e->task);
   for (int k = 0; k < SIM_NOBJ && !st; k++) {
     const sim_task_obj *to = k < 2 ? &td->cand[k] : &td->dist[k - 2];
-    st = sim_asset_load(o->release_root, o->use_ground_truth, to->category, to->state, &e->assets[k], err);
+    st = sim_asset_load(o->release_root, o->use_ground_truth, to->category, to->state,
+                        &e->assets[k], err);
     char p[4200];
     if (!st) {
       snprintf(p, sizeof p, "%s/obj%d.obj", e->work_dir, k);
@@ -182,7 +184,8 @@ double sim_visible_frac(const hearth_sim_env *e, int k) {
     if (c[2] > -1e-6 || fabs(c[0] / -c[2]) > th * aspect || fabs(c[1] / -c[2]) > th) continue;
     int gid = -1;
     mjtNum x = mj_ray(m, d, cp, dir, groups, 1, -1, &gid);
-    if (gid < 0 || x > 1.0 - 0.01 / hearth_norm3(dir) || m->geom_bodyid[gid] == e->obj_body[k]) seen++;
+    if (gid < 0 || x > 1.0 - 0.01 / hearth_norm3(dir) || m->geom_bodyid[gid] == e->obj_body[k])
+      seen++;
   }
   return total ? (double)seen / total : 0.0;
 }
@@ -190,7 +193,8 @@ double sim_visible_frac(const hearth_sim_env *e, int k) {
 hearth_status hearth_sim_reset(hearth_sim_env *e, uint64_t seed, uint64_t layout, int instruction,
                                hearth_err *err) {
   if (instruction < 0 || instruction > 1)
-    return hearth_err_set(err, HEARTH_E_ARG, "sim reset: instruction must be 0 or 1, got %d", instruction);
+    return hearth_err_set(err, HEARTH_E_ARG, "sim reset: instruction must be 0 or 1, got %d",
+                          instruction);
   mjModel *m = e->m;
   mjData *d = e->d;
   mj_resetData(m, d);
@@ -273,7 +277,8 @@ hearth_status hearth_sim_step(hearth_sim_env *e, const double action[7], hearth_
   mj_forward(m, d);
   for (int i = 0; i < m->nq; i++)
     if (!isfinite(d->qpos[i]))
-      return hearth_err_set(err, HEARTH_E_NUMERIC, "sim step %d: the simulation diverged", e->steps);
+      return hearth_err_set(err, HEARTH_E_NUMERIC, "sim step %d: the simulation diverged",
+                            e->steps);
   e->steps++;
   return HEARTH_OK;
 }
@@ -310,7 +315,9 @@ int hearth_sim_success(const hearth_sim_env *e) {
   int k = e->target;
   const double *q = d->qpos + e->obj_qadr[k], *v = d->qvel + e->obj_dadr[k];
   double top = HEARTH_SIM_TABLE_Z + 0.002;
-  if (fabs(q[0] - sim_mat_centre[0]) > SIM_MAT_HALF || fabs(q[1] - sim_mat_centre[1]) > SIM_MAT_HALF) return 0;
+  if (fabs(q[0] - sim_mat_centre[0]) > SIM_MAT_HALF ||
+      fabs(q[1] - sim_mat_centre[1]) > SIM_MAT_HALF)
+    return 0;
   /* resting on the mat: its frame origin (bottom centre) at the mat top,
    * upright enough, slow */
   if (q[2] < top - 0.02 || q[2] > top + 0.02) return 0;

@@ -27,55 +27,57 @@ void hearth_sim_expert_action(hearth_sim_env *e, double act[7]) {
   int next = 0;
   double tol = 0.01;
   switch (e->phase) {
-  case 0: { /* above the target, high enough that the open pads pass over
+    case 0: { /* above the target, high enough that the open pads pass over
              * every other object (the kettle stands 20 cm tall) */
-    double tallest = 0;
-    for (int j = 0; j < SIM_NOBJ; j++)
-      if (j != k) tallest = fmax(tallest, e->assets[j].size[2]);
-    tgt[0] = q[0], tgt[1] = q[1];
-    tgt[2] = fmax(fmax(q[2] + h + 0.08, lift_z - 0.04), HEARTH_SIM_TABLE_Z + tallest + SIM_PAD_HALF_Z + 0.04);
-    tol = 0.015;
-    next = 1;
-    break;
-  }
-  case 1: /* down to the grasp height */
-    tgt[0] = q[0], tgt[1] = q[1], tgt[2] = q[2] + gz;
-    tol = 0.006;
-    next = 1;
-    break;
-  case 2: /* close, holding the grasp height: following the hand as the
+      double tallest = 0;
+      for (int j = 0; j < SIM_NOBJ; j++)
+        if (j != k) tallest = fmax(tallest, e->assets[j].size[2]);
+      tgt[0] = q[0], tgt[1] = q[1];
+      tgt[2] = fmax(fmax(q[2] + h + 0.08, lift_z - 0.04),
+                    HEARTH_SIM_TABLE_Z + tallest + SIM_PAD_HALF_Z + 0.04);
+      tol = 0.015;
+      next = 1;
+      break;
+    }
+    case 1: /* down to the grasp height */
+      tgt[0] = q[0], tgt[1] = q[1], tgt[2] = q[2] + gz;
+      tol = 0.006;
+      next = 1;
+      break;
+    case 2: /* close, holding the grasp height: following the hand as the
            * closing pads push it up would let them ride over thin objects */
-    tgt[0] = x[0], tgt[1] = x[1], tgt[2] = q[2] + gz;
-    grip = 1;
-    next = e->phase_steps >= 8;
-    break;
-  case 3: /* lift */
-    tgt[0] = x[0], tgt[1] = x[1], tgt[2] = lift_z;
-    grip = 1;
-    tol = 0.02;
-    next = 1;
-    break;
-  case 4: /* transport above the mat */
-    tgt[0] = sim_mat_centre[0], tgt[1] = sim_mat_centre[1], tgt[2] = lift_z;
-    grip = 1;
-    tol = 0.015;
-    next = 1;
-    break;
-  case 5: /* lower until the object is just above the mat */
-    tgt[0] = sim_mat_centre[0], tgt[1] = sim_mat_centre[1], tgt[2] = HEARTH_SIM_TABLE_Z + 0.002 + gz + 0.012;
-    grip = 1;
-    tol = 0.008;
-    next = 1;
-    break;
-  case 6: /* release */
-    tgt[0] = x[0], tgt[1] = x[1], tgt[2] = x[2];
-    grip = -1;
-    next = e->phase_steps >= 6;
-    break;
-  default: /* retreat upwards */
-    tgt[0] = x[0], tgt[1] = x[1], tgt[2] = lift_z;
-    grip = -1;
-    break;
+      tgt[0] = x[0], tgt[1] = x[1], tgt[2] = q[2] + gz;
+      grip = 1;
+      next = e->phase_steps >= 8;
+      break;
+    case 3: /* lift */
+      tgt[0] = x[0], tgt[1] = x[1], tgt[2] = lift_z;
+      grip = 1;
+      tol = 0.02;
+      next = 1;
+      break;
+    case 4: /* transport above the mat */
+      tgt[0] = sim_mat_centre[0], tgt[1] = sim_mat_centre[1], tgt[2] = lift_z;
+      grip = 1;
+      tol = 0.015;
+      next = 1;
+      break;
+    case 5: /* lower until the object is just above the mat */
+      tgt[0] = sim_mat_centre[0], tgt[1] = sim_mat_centre[1],
+      tgt[2] = HEARTH_SIM_TABLE_Z + 0.002 + gz + 0.012;
+      grip = 1;
+      tol = 0.008;
+      next = 1;
+      break;
+    case 6: /* release */
+      tgt[0] = x[0], tgt[1] = x[1], tgt[2] = x[2];
+      grip = -1;
+      next = e->phase_steps >= 6;
+      break;
+    default: /* retreat upwards */
+      tgt[0] = x[0], tgt[1] = x[1], tgt[2] = lift_z;
+      grip = -1;
+      break;
   }
   double err3[3] = {tgt[0] - x[0], tgt[1] - x[1], tgt[2] - x[2]};
   double dist = hearth_norm3(err3);

@@ -8,9 +8,11 @@
 
 #include "sim/sim_h5.h"
 
-const char *const sim_h5_key_names[SIM_H5_NKEYS] = {
-    "env_name",    "problem_info",    "env_args",       "bddl_file_name",  "bddl_file_content",
-    "macros_image_convention", "instructions", "image_row_order", "thermal_colormap"};
+const char *const sim_h5_key_names[SIM_H5_NKEYS] = {"env_name",          "problem_info",
+                                                    "env_args",          "bddl_file_name",
+                                                    "bddl_file_content", "macros_image_convention",
+                                                    "instructions",      "image_row_order",
+                                                    "thermal_colormap"};
 
 int sim_demo_grow(sim_demo *b, size_t cap) {
   if (cap <= b->cap) return 1;
@@ -83,8 +85,8 @@ static int h5_f64_array_attr(hid_t obj, const char *name, const double *v, size_
   return ok;
 }
 
-static int h5_write(hid_t g, const char *name, hid_t ftype, hid_t mtype, int rank, const hsize_t *dims,
-                    const void *data) {
+static int h5_write(hid_t g, const char *name, hid_t ftype, hid_t mtype, int rank,
+                    const hsize_t *dims, const void *data) {
   hid_t sp = H5Screate_simple(rank, dims, NULL);
   hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
   H5Pset_obj_track_times(dcpl, 0); /* same inputs, same bytes */
@@ -133,18 +135,22 @@ hearth_status sim_h5_add_demo(sim_h5_out *o, const sim_demo *b, int S, const cha
   hid_t g = h5_group(o->data, name);
   if (g < 0) return hearth_err_set(err, HEARTH_E_IO, "%s: cannot create data/%s", o->af.path, name);
   hsize_t T = b->T;
-  int ok = h5_int_attr(g, "num_samples", (long long)T) && h5_int_attr(g, "layout", (long long)b->layout) &&
+  int ok = h5_int_attr(g, "num_samples", (long long)T) &&
+           h5_int_attr(g, "layout", (long long)b->layout) &&
            h5_int_attr(g, "instruction_index", b->instruction) &&
-           h5_str_attr(g, "language_instruction", instruction) && h5_str_attr(g, "model_file", model_file);
+           h5_str_attr(g, "language_instruction", instruction) &&
+           h5_str_attr(g, "model_file", model_file);
   size_t n = T ? (size_t)T : 1;
   uint8_t *rew = calloc(n, 1), *don = calloc(n, 1);
-  double *pos = hearth_alloc_array(n * 3, sizeof(double)), *ori = hearth_alloc_array(n * 3, sizeof(double));
+  double *pos = hearth_alloc_array(n * 3, sizeof(double)),
+         *ori = hearth_alloc_array(n * 3, sizeof(double));
   if (!rew || !don || !pos || !ori) ok = 0;
   if (ok && T) {
     ok = h5_f64_array_attr(g, "init_state", b->states, b->nstate);
     rew[T - 1] = don[T - 1] = 1;
     for (size_t t = 0; t < T; t++)
-      for (int i = 0; i < 3; i++) pos[3 * t + i] = b->ee[6 * t + i], ori[3 * t + i] = b->ee[6 * t + 3 + i];
+      for (int i = 0; i < 3; i++)
+        pos[3 * t + i] = b->ee[6 * t + i], ori[3 * t + i] = b->ee[6 * t + 3 + i];
     hsize_t d7[2] = {T, 7}, dS[2] = {T, b->nstate}, dR[2] = {T, SIM_ROBOT_STATE_DIM}, d1[1] = {T},
             d2[2] = {T, 2}, d6[2] = {T, 6}, d3[2] = {T, 3}, dI[4] = {T, (hsize_t)S, (hsize_t)S, 3};
     hid_t f64 = H5T_IEEE_F64LE, nd = H5T_NATIVE_DOUBLE, u8 = H5T_STD_U8LE, nu8 = H5T_NATIVE_UINT8;
@@ -160,7 +166,8 @@ hearth_status sim_h5_add_demo(sim_h5_out *o, const sim_demo *b, int S, const cha
            h5_write(ob, "eye_in_hand_rgb", u8, nu8, 4, dI, b->wrist) &&
            h5_write(ob, "joint_states", f64, nd, 2, d7, b->joint) &&
            h5_write(ob, "gripper_states", f64, nd, 2, d2, b->grip) &&
-           h5_write(ob, "ee_states", f64, nd, 2, d6, b->ee) && h5_write(ob, "ee_pos", f64, nd, 2, d3, pos) &&
+           h5_write(ob, "ee_states", f64, nd, 2, d6, b->ee) &&
+           h5_write(ob, "ee_pos", f64, nd, 2, d3, pos) &&
            h5_write(ob, "ee_ori", f64, nd, 2, d3, ori);
     if (ob >= 0) H5Gclose(ob);
   }
@@ -182,12 +189,14 @@ void sim_h5_abort(sim_h5_out *o) {
 hearth_status sim_h5_finish(sim_h5_out *o, const sim_h5_meta *m, const sim_h5_shard *shard,
                             hearth_err *err) {
   int ok = 1;
-  for (int k = 0; k < SIM_H5_NKEYS && ok; k++) ok = h5_str_attr(o->data, sim_h5_key_names[k], m->str[k] ? m->str[k] : "");
+  for (int k = 0; k < SIM_H5_NKEYS && ok; k++)
+    ok = h5_str_attr(o->data, sim_h5_key_names[k], m->str[k] ? m->str[k] : "");
   ok = ok && h5_int_attr(o->data, "num_demos", o->ndemo) && h5_int_attr(o->data, "total", o->total);
   if (ok && shard) {
     char s[64];
     snprintf(s, sizeof s, "%d/%d", shard->index, shard->count);
-    ok = h5_str_attr(o->data, "hearth_shard", s) && h5_int_attr(o->data, "hearth_layouts", shard->layouts);
+    ok = h5_str_attr(o->data, "hearth_shard", s) &&
+         h5_int_attr(o->data, "hearth_layouts", shard->layouts);
   }
   H5Gclose(o->data);
   o->data = -1;
@@ -195,7 +204,8 @@ hearth_status sim_h5_finish(sim_h5_out *o, const sim_h5_meta *m, const sim_h5_sh
   o->f = -1;
   if (!ok) {
     hearth_atomic_abort(&o->af);
-    return hearth_err_set(err, HEARTH_E_IO, "%s: writing the attributes of data failed", o->af.path);
+    return hearth_err_set(err, HEARTH_E_IO, "%s: writing the attributes of data failed",
+                          o->af.path);
   }
   /* HDF5 wrote through its own descriptor; the atomic file's stream holds
    * nothing, and commit renames the temporary over the path */
@@ -276,14 +286,16 @@ hearth_status sim_h5_open(sim_h5_in *in, const char *path, hearth_err *err) {
   long long nd = -1;
   if (in->data < 0 || !h5_read_int(in->data, "num_demos", &nd) || nd < 0 || nd > 1000000) {
     sim_h5_close(in);
-    return hearth_err_set(err, HEARTH_E_PARSE, "%s: expected group data with attribute num_demos", path);
+    return hearth_err_set(err, HEARTH_E_PARSE, "%s: expected group data with attribute num_demos",
+                          path);
   }
   in->ndemo = (int)nd;
   for (int k = 0; k < SIM_H5_NKEYS; k++) {
     in->meta.str[k] = h5_read_str(in->data, sim_h5_key_names[k]);
     if (!in->meta.str[k]) {
       sim_h5_close(in);
-      return hearth_err_set(err, HEARTH_E_PARSE, "%s: data has no string attribute %s (not a hearth sim collect file?)",
+      return hearth_err_set(err, HEARTH_E_PARSE,
+                            "%s: data has no string attribute %s (not a hearth sim collect file?)",
                             path, sim_h5_key_names[k]);
     }
   }
@@ -292,9 +304,10 @@ hearth_status sim_h5_open(sim_h5_in *in, const char *path, hearth_err *err) {
     int i = -1, n = 0, used = 0;
     if (sscanf(sh, "%d/%d%n", &i, &n, &used) != 2 || sh[used] || n < 1 || i < 0 || i >= n ||
         !h5_read_int(in->data, "hearth_layouts", &in->shard.layouts) || in->shard.layouts < 1) {
-      hearth_status st = hearth_err_set(err, HEARTH_E_PARSE,
-                                        "%s: data@hearth_shard \"%s\": expected I/N with 0 <= I < N and data@hearth_layouts",
-                                        path, sh);
+      hearth_status st = hearth_err_set(
+          err, HEARTH_E_PARSE,
+          "%s: data@hearth_shard \"%s\": expected I/N with 0 <= I < N and data@hearth_layouts",
+          path, sh);
       free(sh);
       sim_h5_close(in);
       return st;
@@ -316,21 +329,25 @@ hearth_status sim_h5_read_demo(sim_h5_in *in, int idx, sim_demo *b, int *S, char
   long long T = -1, lay = -1, ins = -1;
   hsize_t da[2] = {0}, ds[2] = {0}, di[4] = {0};
   if (!h5_read_int(g, "num_samples", &T) || !h5_read_int(g, "layout", &lay) ||
-      !h5_read_int(g, "instruction_index", &ins) || T < 0 || T > 10000000 || lay < 0 || ins < 0 || ins > 1 ||
-      !(*instruction = h5_read_str(g, "language_instruction")) || !(*model_file = h5_read_str(g, "model_file")))
+      !h5_read_int(g, "instruction_index", &ins) || T < 0 || T > 10000000 || lay < 0 || ins < 0 ||
+      ins > 1 || !(*instruction = h5_read_str(g, "language_instruction")) ||
+      !(*model_file = h5_read_str(g, "model_file")))
     st = hearth_err_set(err, HEARTH_E_PARSE,
                         "%s: data/%s: expected attributes num_samples, layout, instruction_index, "
-                        "language_instruction and model_file", in->path, name);
+                        "language_instruction and model_file",
+                        in->path, name);
   hid_t ob = -1;
   if (!st && T > 0) {
     ob = H5Gopen2(g, "obs", H5P_DEFAULT);
     if (ob < 0 || !h5_dims(g, "actions", 2, da) || da[0] != (hsize_t)T || da[1] != 7 ||
         !h5_dims(g, "states", 2, ds) || ds[0] != (hsize_t)T || ds[1] < 1 || ds[1] > 100000 ||
-        !h5_dims(ob, "agentview_rgb", 4, di) || di[0] != (hsize_t)T || di[1] != di[2] || di[3] != 3 ||
-        di[1] < 1 || di[1] > 8192)
-      st = hearth_err_set(err, HEARTH_E_PARSE,
-                          "%s: data/%s: expected actions (T, 7), states (T, S) and obs/agentview_rgb (T, S, S, 3) "
-                          "with T = num_samples %lld", in->path, name, T);
+        !h5_dims(ob, "agentview_rgb", 4, di) || di[0] != (hsize_t)T || di[1] != di[2] ||
+        di[3] != 3 || di[1] < 1 || di[1] > 8192)
+      st = hearth_err_set(
+          err, HEARTH_E_PARSE,
+          "%s: data/%s: expected actions (T, 7), states (T, S) and obs/agentview_rgb (T, S, S, 3) "
+          "with T = num_samples %lld",
+          in->path, name, T);
   }
   if (!st) {
     if (T > 0 && (b->nstate != (size_t)ds[1] || b->img != (size_t)di[1] * di[1] * 3)) {
@@ -349,10 +366,14 @@ hearth_status sim_h5_read_demo(sim_h5_in *in, int idx, sim_demo *b, int *S, char
       size_t width; /* 2-D: columns; 0: an image (T, S, S, 3) */
       void *dst;
     } k_read[] = {
-        {g, "actions", 7, b->actions},           {g, "states", b->nstate, b->states},
-        {g, "robot_states", SIM_ROBOT_STATE_DIM, b->robot}, {ob, "joint_states", 7, b->joint},
-        {ob, "gripper_states", 2, b->grip},      {ob, "ee_states", 6, b->ee},
-        {ob, "agentview_rgb", 0, b->front},      {ob, "agentview_thermal", 0, b->thermal},
+        {g, "actions", 7, b->actions},
+        {g, "states", b->nstate, b->states},
+        {g, "robot_states", SIM_ROBOT_STATE_DIM, b->robot},
+        {ob, "joint_states", 7, b->joint},
+        {ob, "gripper_states", 2, b->grip},
+        {ob, "ee_states", 6, b->ee},
+        {ob, "agentview_rgb", 0, b->front},
+        {ob, "agentview_thermal", 0, b->thermal},
         {ob, "eye_in_hand_rgb", 0, b->wrist},
     };
     for (size_t k = 0; k < sizeof k_read / sizeof k_read[0] && !st; k++) {
@@ -362,13 +383,16 @@ hearth_status sim_h5_read_demo(sim_h5_in *in, int idx, sim_demo *b, int *S, char
                                d[1] == di[1] && d[2] == di[1] && d[3] == 3
                          : h5_dims(k_read[k].grp, k_read[k].name, 2, d) && d[0] == (hsize_t)T &&
                                d[1] == k_read[k].width;
-      if (!shape_ok || !h5_read(k_read[k].grp, k_read[k].name, img ? H5T_NATIVE_UINT8 : H5T_NATIVE_DOUBLE,
-                                k_read[k].dst)) {
+      if (!shape_ok || !h5_read(k_read[k].grp, k_read[k].name,
+                                img ? H5T_NATIVE_UINT8 : H5T_NATIVE_DOUBLE, k_read[k].dst)) {
         char want[64];
-        if (img) snprintf(want, sizeof want, "%lld, %llu, %llu, 3", T, (unsigned long long)di[1], (unsigned long long)di[1]);
+        if (img)
+          snprintf(want, sizeof want, "%lld, %llu, %llu, 3", T, (unsigned long long)di[1],
+                   (unsigned long long)di[1]);
         else snprintf(want, sizeof want, "%lld, %zu", T, k_read[k].width);
-        st = hearth_err_set(err, HEARTH_E_PARSE, "%s: data/%s/%s%s: missing, unreadable or not of shape (%s)",
-                            in->path, name, k_read[k].grp == ob ? "obs/" : "", k_read[k].name, want);
+        st = hearth_err_set(err, HEARTH_E_PARSE,
+                            "%s: data/%s/%s%s: missing, unreadable or not of shape (%s)", in->path,
+                            name, k_read[k].grp == ob ? "obs/" : "", k_read[k].name, want);
       }
     }
   }

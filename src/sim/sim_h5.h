@@ -15,17 +15,17 @@
 /* one demonstration in memory: per sample, rows of the widths below */
 #define SIM_ROBOT_STATE_DIM 9 /* gripper qpos (2), ee pos (3), ee quat x y z w (4) */
 typedef struct sim_demo {
-  size_t T, cap;      /* samples stored, samples allocated */
-  size_t nstate, img; /* state length; bytes per image (S * S * 3) */
-  double *actions;    /* T x 7 */
-  double *states;     /* T x nstate: [time, qpos, qvel] */
-  double *joint;      /* T x 7 */
-  double *grip;       /* T x 2 */
-  double *ee;         /* T x 6: ee pos, ee axis-angle */
-  double *robot;      /* T x SIM_ROBOT_STATE_DIM */
+  size_t T, cap;                    /* samples stored, samples allocated */
+  size_t nstate, img;               /* state length; bytes per image (S * S * 3) */
+  double *actions;                  /* T x 7 */
+  double *states;                   /* T x nstate: [time, qpos, qvel] */
+  double *joint;                    /* T x 7 */
+  double *grip;                     /* T x 2 */
+  double *ee;                       /* T x 6: ee pos, ee axis-angle */
+  double *robot;                    /* T x SIM_ROBOT_STATE_DIM */
   uint8_t *front, *thermal, *wrist; /* T x img each */
   uint64_t layout;
-  int instruction;    /* 0 or 1: index into the task's instructions */
+  int instruction; /* 0 or 1: index into the task's instructions */
 } sim_demo;
 /* Make room for cap samples (keeps what is stored); 0 when out of memory. */
 int sim_demo_grow(sim_demo *b, size_t cap);
@@ -60,8 +60,8 @@ void sim_h5_meta_free(sim_h5_meta *m);
  * instructions ins_first .. ins_first + ins_count - 1 (problem_info and the
  * BDDL text name ins_first), rendered with the GL back end gl ("osmesa" or
  * "egl"). m's strings are the caller's to free (sim_h5_meta_free). */
-hearth_status sim_h5_describe(const hearth_sim_collect_opts *o, int ins_first, int ins_count, const char *gl,
-                              sim_h5_meta *m, hearth_err *err);
+hearth_status sim_h5_describe(const hearth_sim_collect_opts *o, int ins_first, int ins_count,
+                              const char *gl, sim_h5_meta *m, hearth_err *err);
 
 /* A shard's place (written only in the files of a sharded collection):
  * data@hearth_shard "I/N" and data@hearth_layouts L. */
@@ -75,7 +75,7 @@ typedef struct sim_h5_out {
   hearth_atomic_file af; /* the temporary name HDF5 writes to, renamed on finish */
   hid_t f, data;
   int ndemo;
-  long long total;       /* samples over the demos */
+  long long total; /* samples over the demos */
 } sim_h5_out;
 /* Create path's temporary file and its group data. */
 hearth_status sim_h5_create(sim_h5_out *o, const char *path, hearth_err *err);
@@ -97,7 +97,7 @@ typedef struct sim_h5_in {
   char path[4096];
   hid_t f, data;
   int ndemo;
-  sim_h5_shard shard;  /* count 0: the file is not a shard */
+  sim_h5_shard shard; /* count 0: the file is not a shard */
   sim_h5_meta meta;
 } sim_h5_in;
 /* Open a collection file: its meta, num_demos and shard attributes. */

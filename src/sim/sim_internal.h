@@ -11,8 +11,8 @@
 typedef struct sim_category {
   const char *name;
   double mass, friction;
-  double max_narrow;   /* candidates: largest allowed narrow horizontal extent (gripper) */
-  double max_extent;   /* largest allowed extent of any axis */
+  double max_narrow; /* candidates: largest allowed narrow horizontal extent (gripper) */
+  double max_extent; /* largest allowed extent of any axis */
 } sim_category;
 const sim_category *sim_category_find(const char *name);
 
@@ -20,10 +20,10 @@ const sim_category *sim_category_find(const char *name);
  * horizontal axis along x), its colour texture and a thermal Turbo texture */
 typedef struct sim_asset {
   char instance[64], category[64], state[32];
-  hearth_mesh mesh;       /* no texture inside */
-  hearth_image rgb;       /* U8 RGB */
-  hearth_image thermal;   /* U8 RGB Turbo 10..60 degC */
-  double size[3];         /* bounding box extents */
+  hearth_mesh mesh;     /* no texture inside */
+  hearth_image rgb;     /* U8 RGB */
+  hearth_image thermal; /* U8 RGB Turbo 10..60 degC */
+  double size[3];       /* bounding box extents */
   double mass, friction;
 } sim_asset;
 void sim_asset_free(sim_asset *a);

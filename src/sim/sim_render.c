@@ -54,7 +54,8 @@ enum { VIEW_RGB = 0, VIEW_THERMAL = 1, VIEW_SEGMENT = 2 };
 
 static int make_current(hearth_sim_env *e) {
   sim_render *r = e->rnd;
-  if (r->egl) return r->api.make_current(r->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, r->ctx) == EGL_TRUE;
+  if (r->egl)
+    return r->api.make_current(r->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, r->ctx) == EGL_TRUE;
   return OSMesaMakeCurrent(r->gl, r->glbuf, GL_UNSIGNED_BYTE, e->width, e->height) != 0;
 }
 
@@ -64,9 +65,10 @@ static hearth_status egl_load(egl_api *a, hearth_err *err) {
     return hearth_err_set(err, HEARTH_E_UNSUPPORTED,
                           "sim: EGL renderer: libEGL.so.1 not found (Debian: libegl1 libegl-mesa0)");
   a->get_proc = (PFNEGLGETPROCADDRESSPROC)dlsym(a->lib, "eglGetProcAddress");
-  if (!a->get_proc) return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "sim: libEGL.so.1 has no eglGetProcAddress");
-#define EGL_FN(field, type, name)                                                              \
-  if (!(a->field = (type)a->get_proc(name)))                                                   \
+  if (!a->get_proc)
+    return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "sim: libEGL.so.1 has no eglGetProcAddress");
+#define EGL_FN(field, type, name)            \
+  if (!(a->field = (type)a->get_proc(name))) \
     return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "sim: EGL renderer: %s not available", name);
   EGL_FN(initialize, PFNEGLINITIALIZEPROC, "eglInitialize")
   EGL_FN(bind_api, PFNEGLBINDAPIPROC, "eglBindAPI")
@@ -100,37 +102,47 @@ static hearth_status egl_open(sim_render *r, hearth_err *err) {
         const char *ext = a->query_device_string(dev[i], EGL_EXTENSIONS);
         if (ext && strstr(ext, "EGL_MESA_device_software")) continue;
         EGLDisplay d = a->platform_display(EGL_PLATFORM_DEVICE_EXT, dev[i], NULL);
-        if (d != EGL_NO_DISPLAY && a->initialize(d, NULL, NULL) == EGL_TRUE) r->dpy = d, kind = "device";
+        if (d != EGL_NO_DISPLAY && a->initialize(d, NULL, NULL) == EGL_TRUE)
+          r->dpy = d, kind = "device";
       }
     }
   }
   if (r->dpy == EGL_NO_DISPLAY) {
     EGLDisplay d = a->platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, NULL);
-    if (d != EGL_NO_DISPLAY && a->initialize(d, NULL, NULL) == EGL_TRUE) r->dpy = d, kind = "surfaceless";
+    if (d != EGL_NO_DISPLAY && a->initialize(d, NULL, NULL) == EGL_TRUE)
+      r->dpy = d, kind = "surfaceless";
   }
   if (r->dpy == EGL_NO_DISPLAY)
-    return hearth_err_set(err, HEARTH_E_UNSUPPORTED,
-                          "sim: EGL renderer: no GPU device and no surfaceless platform (EGL error 0x%x)",
-                          (unsigned)a->get_error());
+    return hearth_err_set(
+        err, HEARTH_E_UNSUPPORTED,
+        "sim: EGL renderer: no GPU device and no surfaceless platform (EGL error 0x%x)",
+        (unsigned)a->get_error());
   const char *ext = a->query_string(r->dpy, EGL_EXTENSIONS);
   if (!ext || !strstr(ext, "EGL_KHR_surfaceless_context"))
-    return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "sim: EGL renderer: display lacks EGL_KHR_surfaceless_context");
+    return hearth_err_set(err, HEARTH_E_UNSUPPORTED,
+                          "sim: EGL renderer: display lacks EGL_KHR_surfaceless_context");
   if (a->bind_api(EGL_OPENGL_API) != EGL_TRUE)
-    return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "sim: EGL renderer: desktop OpenGL not available");
-  const EGLint want[] = {EGL_RED_SIZE, 8, EGL_GREEN_SIZE, 8, EGL_BLUE_SIZE, 8, EGL_ALPHA_SIZE, 8,
-                         EGL_DEPTH_SIZE, 24, EGL_STENCIL_SIZE, 8, EGL_SURFACE_TYPE, 0,
-                         EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
+    return hearth_err_set(err, HEARTH_E_UNSUPPORTED,
+                          "sim: EGL renderer: desktop OpenGL not available");
+  const EGLint want[] = {EGL_RED_SIZE,     8,  EGL_GREEN_SIZE,      8,
+                         EGL_BLUE_SIZE,    8,  EGL_ALPHA_SIZE,      8,
+                         EGL_DEPTH_SIZE,   24, EGL_STENCIL_SIZE,    8,
+                         EGL_SURFACE_TYPE, 0,  EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT,
+                         EGL_NONE};
   EGLConfig cfg;
   EGLint ncfg = 0;
   if (a->choose_config(r->dpy, want, &cfg, 1, &ncfg) != EGL_TRUE || ncfg < 1)
-    return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "sim: EGL renderer: no RGBA8/depth24 OpenGL config");
+    return hearth_err_set(err, HEARTH_E_UNSUPPORTED,
+                          "sim: EGL renderer: no RGBA8/depth24 OpenGL config");
   /* MuJoCo's renderer uses the compatibility profile (the default) */
   r->ctx = a->create_context(r->dpy, cfg, EGL_NO_CONTEXT, NULL);
   if (r->ctx == EGL_NO_CONTEXT)
-    return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "sim: EGL renderer: context creation failed (0x%x)",
+    return hearth_err_set(err, HEARTH_E_UNSUPPORTED,
+                          "sim: EGL renderer: context creation failed (0x%x)",
                           (unsigned)a->get_error());
   if (a->make_current(r->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, r->ctx) != EGL_TRUE)
-    return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "sim: EGL renderer: eglMakeCurrent failed (0x%x)",
+    return hearth_err_set(err, HEARTH_E_UNSUPPORTED,
+                          "sim: EGL renderer: eglMakeCurrent failed (0x%x)",
                           (unsigned)a->get_error());
   typedef const unsigned char *(*get_string_fn)(unsigned);
   get_string_fn gs = (get_string_fn)a->get_proc("glGetString");
@@ -144,19 +156,25 @@ hearth_status sim_render_init(hearth_sim_env *e, hearth_err *err) {
   if (!r) return hearth_err_set(err, HEARTH_E_NOMEM, "sim: out of memory");
   e->rnd = r;
   size_t px = (size_t)e->width * (size_t)e->height;
-  r->front = malloc(px * 3), r->thermal = malloc(px * 3), r->wrist = malloc(px * 3), r->seg = malloc(px * 3);
+  r->front = malloc(px * 3), r->thermal = malloc(px * 3), r->wrist = malloc(px * 3),
+  r->seg = malloc(px * 3);
   if (!r->front || !r->thermal || !r->wrist || !r->seg)
-    return hearth_err_set(err, HEARTH_E_NOMEM, "sim: out of memory for %dx%d images", e->width, e->height);
+    return hearth_err_set(err, HEARTH_E_NOMEM, "sim: out of memory for %dx%d images", e->width,
+                          e->height);
   r->egl = strcmp(e->gl, "egl") == 0;
   if (r->egl) {
     hearth_status st = egl_open(r, err);
     if (st) return st;
   } else {
     r->glbuf = malloc(px * 4);
-    if (!r->glbuf) return hearth_err_set(err, HEARTH_E_NOMEM, "sim: out of memory for %dx%d images", e->width, e->height);
+    if (!r->glbuf)
+      return hearth_err_set(err, HEARTH_E_NOMEM, "sim: out of memory for %dx%d images", e->width,
+                            e->height);
     r->gl = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, NULL);
-    if (!r->gl) return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "sim: OSMesa context creation failed");
-    if (!make_current(e)) return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "sim: OSMesaMakeCurrent failed");
+    if (!r->gl)
+      return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "sim: OSMesa context creation failed");
+    if (!make_current(e))
+      return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "sim: OSMesaMakeCurrent failed");
     const GLubyte *name = glGetString(GL_RENDERER);
     snprintf(r->renderer, sizeof r->renderer, "osmesa: %s", name ? (const char *)name : "?");
   }
@@ -181,7 +199,8 @@ const char *hearth_sim_renderer(const hearth_sim_env *e) {
 void sim_render_free(hearth_sim_env *e) {
   sim_render *r = e->rnd;
   if (!r) return;
-  int current = (r->egl ? r->ctx != NULL && r->ctx != EGL_NO_CONTEXT : r->gl != NULL) && make_current(e);
+  int current =
+      (r->egl ? r->ctx != NULL && r->ctx != EGL_NO_CONTEXT : r->gl != NULL) && make_current(e);
   if (current && r->have_con) mjr_freeContext(&r->con);
   if (r->have_scn) mjv_freeScene(&r->scn);
   if (r->egl) {
@@ -232,7 +251,8 @@ static void render_view(hearth_sim_env *e, int cam, int mode, int only_geom, uin
   if (only_geom >= 0) {
     int n = 0;
     for (int i = 0; i < s->ngeom; i++)
-      if (s->geoms[i].objtype == mjOBJ_GEOM && s->geoms[i].objid == only_geom) s->geoms[n++] = s->geoms[i];
+      if (s->geoms[i].objtype == mjOBJ_GEOM && s->geoms[i].objid == only_geom)
+        s->geoms[n++] = s->geoms[i];
     s->ngeom = n;
   }
   if (mode == VIEW_THERMAL) {
@@ -335,7 +355,8 @@ hearth_status hearth_sim_candidate_boxes(hearth_sim_env *e, int boxes[2][4], hea
   for (int slot = 0; slot < 2; slot++) {
     int k = slot ^ e->swap;
     if (count_geom(e, r->seg, e->obj_geom_rgb[k], boxes[slot]) == 0)
-      return hearth_err_set(err, HEARTH_E_NOT_FOUND, "sim: candidate in slot %c not visible", 'A' + slot);
+      return hearth_err_set(err, HEARTH_E_NOT_FOUND, "sim: candidate in slot %c not visible",
+                            'A' + slot);
   }
   return HEARTH_OK;
 }

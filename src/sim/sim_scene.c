@@ -5,12 +5,14 @@
 #include "sim/sim_env.h"
 
 /* flip to top-row-first and write */
-static hearth_status write_view(const char *path, const uint8_t *img, int w, int h, hearth_err *err) {
+static hearth_status write_view(const char *path, const uint8_t *img, int w, int h,
+                                hearth_err *err) {
   hearth_image im;
   hearth_status st = hearth_image_alloc(&im, (size_t)w, (size_t)h, 3, HEARTH_PIX_U8, err);
   if (st) return st;
   for (int y = 0; y < h; y++)
-    memcpy((uint8_t *)im.data + (size_t)y * w * 3, img + (size_t)(h - 1 - y) * w * 3, (size_t)w * 3);
+    memcpy((uint8_t *)im.data + (size_t)y * w * 3, img + (size_t)(h - 1 - y) * w * 3,
+           (size_t)w * 3);
   st = hearth_png_write(path, &im, err);
   hearth_image_free(&im);
   return st;

@@ -7,19 +7,24 @@
 
 /* paper, Table III */
 static const sim_task_def k_tasks[3] = {
-    {"H1", "study",
+    {"H1",
+     "study",
      {{"cup", "hot", "hot cup"}, {"cup", "neutral", "normal cup"}},
      {{"electric_kettle", "hot", "kettle"}, {"eraser", "neutral", "eraser"}}},
-    {"H2", "kitchen",
+    {"H2",
+     "kitchen",
      {{"canned_drink", "iced", "iced can"}, {"canned_drink", "neutral", "normal can"}},
      {{"orange", "iced", "orange"}, {"cup", "neutral", "cup"}}},
-    {"H3", "kitchen",
+    {"H3",
+     "kitchen",
      {{"smartphone", "hot", "hot phone"}, {"sponge", "hot", "hot sponge"}},
      {{"orange", "neutral", "orange"}, {"cup", "hot", "cup"}}},
 };
 static const char *const k_instr[3][2] = {
-    {"pick up the hot cup and place it on the mat", "pick up the normal cup and place it on the mat"},
-    {"pick up the iced can and place it on the mat", "pick up the normal can and place it on the mat"},
+    {"pick up the hot cup and place it on the mat",
+     "pick up the normal cup and place it on the mat"},
+    {"pick up the iced can and place it on the mat",
+     "pick up the normal can and place it on the mat"},
     {"pick up the hot phone and place it on the mat",
      "pick up the hot sponge and place it on the mat"},
 };
@@ -36,8 +41,20 @@ const sim_task_def *sim_task_get(hearth_sim_task t) { return &k_tasks[t - 1]; }
  * desk; the kitchen: gray ceramic tiles and yellow linen walls around a
  * light wooden table */
 static const sim_scene_look k_looks[2] = {
-    {"study", {0.62, 0.62, 0.61}, {0.57, 0.57, 0.56}, 8, {0.36, 0.24, 0.15}, {0.80, 0.79, 0.77}, 0.7433500240372424},
-    {"kitchen", {0.52, 0.52, 0.51}, {0.44, 0.44, 0.44}, 14, {0.78, 0.66, 0.48}, {0.90, 0.83, 0.60}, 0.7103500240372423},
+    {"study",
+     {0.62, 0.62, 0.61},
+     {0.57, 0.57, 0.56},
+     8,
+     {0.36, 0.24, 0.15},
+     {0.80, 0.79, 0.77},
+     0.7433500240372424},
+    {"kitchen",
+     {0.52, 0.52, 0.51},
+     {0.44, 0.44, 0.44},
+     14,
+     {0.78, 0.66, 0.48},
+     {0.90, 0.83, 0.60},
+     0.7103500240372423},
 };
 
 const sim_scene_look *sim_scene_look_get(const char *scene) {

@@ -78,10 +78,40 @@ typedef enum synth_fill {
 
 /* Albedo styles: indices of synth_materials. */
 enum {
-  S_PLAIN, S_GLAZE, S_UNGLAZED, S_CAN_LABEL, S_ALU, S_ALU_TOP, S_CLEAR, S_BOTTLE_LABEL, S_CAP,
-  S_PEEL, S_PEEL_TOP, S_SCREEN, S_FRAME, S_PHONE_BACK, S_FOAM, S_PAD, S_STEEL, S_STEEL_DARK,
-  S_BLACK, S_MOUSE_TOP, S_RUBBER, S_SLEEVE, S_LAPTOP_LID, S_LAPTOP_BASE, S_LEATHER, S_TISSUE_BOX,
-  S_TISSUE_TOP, S_CASE, S_FABRIC, S_FABRIC_CHECK, S_BAG, S_BAG_ZIP, S_CUSHION_PAD, S_GLAZE_BAND,
+  S_PLAIN,
+  S_GLAZE,
+  S_UNGLAZED,
+  S_CAN_LABEL,
+  S_ALU,
+  S_ALU_TOP,
+  S_CLEAR,
+  S_BOTTLE_LABEL,
+  S_CAP,
+  S_PEEL,
+  S_PEEL_TOP,
+  S_SCREEN,
+  S_FRAME,
+  S_PHONE_BACK,
+  S_FOAM,
+  S_PAD,
+  S_STEEL,
+  S_STEEL_DARK,
+  S_BLACK,
+  S_MOUSE_TOP,
+  S_RUBBER,
+  S_SLEEVE,
+  S_LAPTOP_LID,
+  S_LAPTOP_BASE,
+  S_LEATHER,
+  S_TISSUE_BOX,
+  S_TISSUE_TOP,
+  S_CASE,
+  S_FABRIC,
+  S_FABRIC_CHECK,
+  S_BAG,
+  S_BAG_ZIP,
+  S_CUSHION_PAD,
+  S_GLAZE_BAND,
   S_COUNT
 };
 
@@ -122,14 +152,14 @@ typedef enum synth_pattern {
 /* The colour of a surface point: base, then a band round strips, then the
  * grain (fbm noise of cell grain_size metres) added, then the pattern. */
 typedef struct synth_material {
-  int stream;         /* seeds the material's noise: texture seed + 977 * stream */
+  int stream; /* seeds the material's noise: texture seed + 977 * stream */
   synth_base base;
   double rgb[3];
   int slot;
   double mix;
-  double band[3];     /* a band of slot 0 between heights band[0] and band[1] (fractions of a
+  double band[3]; /* a band of slot 0 between heights band[0] and band[1] (fractions of a
                          strip), blended in by band[2]; band[2] = 0: none */
-  double grain;       /* amplitude; 0: none */
+  double grain;   /* amplitude; 0: none */
   double grain_size;
   int grain_octaves;
   synth_pattern pattern;
@@ -163,13 +193,28 @@ typedef struct synth_slot {
 #define SYNTH_MAX_SLOTS 8
 
 /* the slots of each shape */
-enum { VESSEL_BODY, VESSEL_BOTTOM, VESSEL_RIM, VESSEL_INNER, VESSEL_HANDLE, VESSEL_LID,
-       VESSEL_KNOB, VESSEL_SLOTS };
+enum {
+  VESSEL_BODY,
+  VESSEL_BOTTOM,
+  VESSEL_RIM,
+  VESSEL_INNER,
+  VESSEL_HANDLE,
+  VESSEL_LID,
+  VESSEL_KNOB,
+  VESSEL_SLOTS
+};
 enum { CAN_BODY, CAN_RIM, CAN_LID, CAN_DOME, CAN_FOOT, CAN_SLOTS };
 enum { BOTTLE_BODY, BOTTLE_LABEL, BOTTLE_NECK, BOTTLE_CAP, BOTTLE_BOTTOM, BOTTLE_SLOTS };
 enum { SPHEROID_PEEL, SPHEROID_STEM, SPHEROID_SLOTS };
-enum { KETTLE_BASE, KETTLE_BODY, KETTLE_LID, KETTLE_KNOB, KETTLE_HANDLE, KETTLE_SPOUT,
-       KETTLE_SLOTS };
+enum {
+  KETTLE_BASE,
+  KETTLE_BODY,
+  KETTLE_LID,
+  KETTLE_KNOB,
+  KETTLE_HANDLE,
+  KETTLE_SPOUT,
+  KETTLE_SLOTS
+};
 enum { SLAB_BOTTOM, SLAB_SIDE, SLAB_UPPER, SLAB_TOP, SLAB_SLOTS }; /* upper: side above D_ZSPLIT */
 enum { HEADSET_CUP, HEADSET_CUSHION, HEADSET_BAND, HEADSET_SLOTS };
 
@@ -186,7 +231,7 @@ typedef struct synth_vessel {
    * out D_REACH */
   int lugs;
   double mug[3], lug[2];
-  int lid;            /* a domed lid with a knob when D_VARIANT is drawn */
+  int lid; /* a domed lid with a knob when D_VARIANT is drawn */
 } synth_vessel;
 
 /* ---- temperature fields -------------------------------------------------- */
@@ -242,7 +287,7 @@ typedef struct synth_category {
   synth_slot slots[SYNTH_MAX_SLOTS]; /* indexed by the shape's slot enum */
   synth_vessel vessel;               /* SHAPE_VESSEL only */
   synth_fill fill;
-  double wrapped_fill;      /* fill level of a given mesh put under this category */
+  double wrapped_fill; /* fill level of a given mesh put under this category */
   synth_field_spec field;
 } synth_category;
 

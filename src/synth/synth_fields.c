@@ -16,7 +16,15 @@
 
 /* params layout */
 enum {
-  P_MODEL, P_STATE, P_H, P_ZF, P_RB, P_RMAX, P_NAMP, P_GRAD, P_T0 = 8, /* P_T0..P_T0+7: temps */
+  P_MODEL,
+  P_STATE,
+  P_H,
+  P_ZF,
+  P_RB,
+  P_RMAX,
+  P_NAMP,
+  P_GRAD,
+  P_T0 = 8,   /* P_T0..P_T0+7: temps */
   P_ROLE = 16 /* role of part k at P_ROLE + k */
 };
 
@@ -24,18 +32,37 @@ enum { ST_NEUTRAL, ST_HOT, ST_WARM, ST_ICED, ST_USED };
 static const char *const k_states[] = {"neutral", "hot", "warm", "iced", "used"};
 
 enum {
-  R_BODY, R_BOTTOM, R_RIM, R_INNER, R_HANDLE, R_TOP, R_NECK, R_CAP, R_BACK, R_FRAME, R_SCREEN,
-  R_FOAM, R_PAD, R_BASE, R_LID, R_SPOUT, R_CUSHION, R_BAND, R_SHELL
+  R_BODY,
+  R_BOTTOM,
+  R_RIM,
+  R_INNER,
+  R_HANDLE,
+  R_TOP,
+  R_NECK,
+  R_CAP,
+  R_BACK,
+  R_FRAME,
+  R_SCREEN,
+  R_FOAM,
+  R_PAD,
+  R_BASE,
+  R_LID,
+  R_SPOUT,
+  R_CUSHION,
+  R_BAND,
+  R_SHELL
 };
 
 static int role_of(const char *name) {
-  static const struct { const char *n; int r; } t[] = {
-      {"body", R_BODY},     {"bottom", R_BOTTOM}, {"rim", R_RIM},       {"inner", R_INNER},
-      {"handle", R_HANDLE}, {"top", R_TOP},       {"stem_end", R_TOP},  {"neck", R_NECK},
-      {"cap", R_CAP},       {"back", R_BACK},     {"frame", R_FRAME},   {"screen", R_SCREEN},
-      {"foam", R_FOAM},     {"pad", R_PAD},       {"base", R_BASE},     {"lid", R_LID},
-      {"spout", R_SPOUT},   {"cushion", R_CUSHION}, {"band", R_BAND},   {"shell", R_SHELL},
-      {"side", R_SHELL},    {"cup", R_SHELL}};
+  static const struct {
+    const char *n;
+    int r;
+  } t[] = {{"body", R_BODY},     {"bottom", R_BOTTOM},   {"rim", R_RIM},      {"inner", R_INNER},
+           {"handle", R_HANDLE}, {"top", R_TOP},         {"stem_end", R_TOP}, {"neck", R_NECK},
+           {"cap", R_CAP},       {"back", R_BACK},       {"frame", R_FRAME},  {"screen", R_SCREEN},
+           {"foam", R_FOAM},     {"pad", R_PAD},         {"base", R_BASE},    {"lid", R_LID},
+           {"spout", R_SPOUT},   {"cushion", R_CUSHION}, {"band", R_BAND},    {"shell", R_SHELL},
+           {"side", R_SHELL},    {"cup", R_SHELL}};
   if (!name) return R_BODY;
   for (size_t i = 0; i < sizeof t / sizeof t[0]; i++)
     if (strcmp(name, t[i].n) == 0) return t[i].r;
@@ -53,8 +80,7 @@ static double clamp01(double t) { return t < 0 ? 0 : t > 1 ? 1 : t; }
 static double logistic(double x) { return 1.0 / (1.0 + exp(-x)); }
 
 /* a soft rectangle: ~1 inside |x-cx| < ax, |y-cy| < ay, falling over w */
-static double soft_rect(double x, double y, double cx, double cy, double ax, double ay,
-                        double w) {
+static double soft_rect(double x, double y, double cx, double cy, double ax, double ay, double w) {
   return logistic((ax - fabs(x - cx)) / w) * logistic((ay - fabs(y - cy)) / w);
 }
 
@@ -78,8 +104,8 @@ hearth_status synth_field_make(const synth_object *obj, const char *state, uint6
                           obj->category, state ? state : "(null)");
   if (!(ambient_c > -40 && ambient_c < 60))
     return hearth_err_set(err, HEARTH_E_RANGE,
-                          "synth_field_make(%s): ambient %g degC: expected -40..60",
-                          obj->category, ambient_c);
+                          "synth_field_make(%s): ambient %g degC: expected -40..60", obj->category,
+                          ambient_c);
   if (obj->n_parts < 0 || obj->n_parts > SYNTH_MAX_PARTS)
     return hearth_err_set(err, HEARTH_E_RANGE, "synth_field_make(%s): %d parts: expected <= %d",
                           obj->category, obj->n_parts, SYNTH_MAX_PARTS);
@@ -171,75 +197,76 @@ double synth_field_eval(const synth_field *f, const synth_object *obj, uint32_t 
   if (st == ST_NEUTRAL) return amb + small + P[P_GRAD] * (zr - 0.5);
 
   switch ((synth_field_model)P[P_MODEL]) {
-  case FIELD_TOP_COOLER: return T[0] - T[1] * zr + 0.5 * small;
-  case FIELD_CUP: {
-    double hot = T[0], rim = T[1], w = T[4];
-    switch (role) {
-    case R_HANDLE: return handle_temp(T, r, rb, rmax) + 0.3 * small;
-    case R_RIM: return rim + 0.3 * small;
-    case R_INNER: return liquid_line(z, zf, H, hot + 1.5, rim + 3, w) + 0.3 * small;
-    case R_BOTTOM: return hot - T[5] * (1 - sstep(r / rb)) + 0.3 * small;
-    default: return liquid_line(z, zf, H, hot, rim, w) + 0.3 * small;
+    case FIELD_TOP_COOLER: return T[0] - T[1] * zr + 0.5 * small;
+    case FIELD_CUP: {
+      double hot = T[0], rim = T[1], w = T[4];
+      switch (role) {
+        case R_HANDLE: return handle_temp(T, r, rb, rmax) + 0.3 * small;
+        case R_RIM: return rim + 0.3 * small;
+        case R_INNER: return liquid_line(z, zf, H, hot + 1.5, rim + 3, w) + 0.3 * small;
+        case R_BOTTOM: return hot - T[5] * (1 - sstep(r / rb)) + 0.3 * small;
+        default: return liquid_line(z, zf, H, hot, rim, w) + 0.3 * small;
+      }
     }
-  }
-  case FIELD_KETTLE:
-    switch (role) {
-    case R_HANDLE: return T[3] + 0.5 * small;
-    case R_BASE: return T[4] + 2 * clamp01(z / 0.02) + 0.3 * small;
-    case R_LID: /* the plastic knob is cooler than the lid */
-      return T[2] + (amb + 12 - T[2]) * sstep((0.02 - r) / 0.008) + 0.5 * small;
-    case R_SPOUT: return T[5] + 0.5 * small;
-    default: return liquid_line(z, zf, H, T[0], T[1], T[6]) + 0.4 * small;
+    case FIELD_KETTLE:
+      switch (role) {
+        case R_HANDLE: return T[3] + 0.5 * small;
+        case R_BASE: return T[4] + 2 * clamp01(z / 0.02) + 0.3 * small;
+        case R_LID: /* the plastic knob is cooler than the lid */
+          return T[2] + (amb + 12 - T[2]) * sstep((0.02 - r) / 0.008) + 0.5 * small;
+        case R_SPOUT: return T[5] + 0.5 * small;
+        default: return liquid_line(z, zf, H, T[0], T[1], T[6]) + 0.4 * small;
+      }
+    case FIELD_POT:
+      switch (role) {
+        case R_HANDLE: return handle_temp(T, r, rb, rmax) + 0.3 * small;
+        case R_LID: return T[4] + (amb + 15 - T[4]) * sstep((0.021 - r) / 0.008) + 0.5 * small;
+        case R_RIM: return T[1] + 0.3 * small;
+        case R_INNER: return liquid_line(z, zf, H, T[0] + 2, T[1] + 3, T[5]) + 0.3 * small;
+        default: return liquid_line(z, zf, H, T[0], T[1], T[5]) + 0.4 * small;
+      }
+    case FIELD_SPONGE: {
+      double wet = synth_smooth_noise3(f->seed + 17, x / 0.03, y / 0.03, z / 0.03);
+      double t = T[0] - T[1] * sstep((wet - 0.05) / 0.5);
+      if (role == R_PAD) t -= T[2];
+      return t + 0.2 * small;
     }
-  case FIELD_POT:
-    switch (role) {
-    case R_HANDLE: return handle_temp(T, r, rb, rmax) + 0.3 * small;
-    case R_LID: return T[4] + (amb + 15 - T[4]) * sstep((0.021 - r) / 0.008) + 0.5 * small;
-    case R_RIM: return T[1] + 0.3 * small;
-    case R_INNER: return liquid_line(z, zf, H, T[0] + 2, T[1] + 3, T[5]) + 0.3 * small;
-    default: return liquid_line(z, zf, H, T[0], T[1], T[5]) + 0.4 * small;
+    case FIELD_PHONE: {
+      /* long axis along y, screen on top (+z) */
+      double edge = T[0], bat = T[1], soc = T[2], scr = T[3];
+      double ax = T[4], by = T[5];
+      double g_bat = soft_rect(x, y, 0, -0.1 * by, 0.7 * ax, 0.45 * by, 0.006);
+      double g_soc = gauss2(x, y, 0.25 * ax, 0.55 * by, 0.015);
+      double g_in = soft_rect(x, y, 0, 0, 0.8 * ax, 0.88 * by, 0.006);
+      switch (role) {
+        case R_BACK:
+          return edge + (bat - edge) * g_bat + (soc - edge) * 0.7 * g_soc * (1 - g_bat) +
+                 0.2 * small;
+        case R_SCREEN: return edge + (scr - edge) * g_in + (soc - scr) * g_soc * g_in + 0.2 * small;
+        default: return edge + 1.5 * g_soc + 0.2 * small;
+      }
     }
-  case FIELD_SPONGE: {
-    double wet = synth_smooth_noise3(f->seed + 17, x / 0.03, y / 0.03, z / 0.03);
-    double t = T[0] - T[1] * sstep((wet - 0.05) / 0.5);
-    if (role == R_PAD) t -= T[2];
-    return t + 0.2 * small;
-  }
-  case FIELD_PHONE: {
-    /* long axis along y, screen on top (+z) */
-    double edge = T[0], bat = T[1], soc = T[2], scr = T[3];
-    double ax = T[4], by = T[5];
-    double g_bat = soft_rect(x, y, 0, -0.1 * by, 0.7 * ax, 0.45 * by, 0.006);
-    double g_soc = gauss2(x, y, 0.25 * ax, 0.55 * by, 0.015);
-    double g_in = soft_rect(x, y, 0, 0, 0.8 * ax, 0.88 * by, 0.006);
-    switch (role) {
-    case R_BACK: return edge + (bat - edge) * g_bat + (soc - edge) * 0.7 * g_soc * (1 - g_bat) +
-                        0.2 * small;
-    case R_SCREEN: return edge + (scr - edge) * g_in + (soc - scr) * g_soc * g_in + 0.2 * small;
-    default: return edge + 1.5 * g_soc + 0.2 * small;
+    case FIELD_CHILLED: {
+      double t = T[0] + (T[1] - T[0]) * pow(zr, 0.8);
+      if (role == R_TOP) t += 0.5;
+      if (role == R_CAP) t += 2.0;
+      if (role == R_NECK) t += 1.0;
+      return t + 0.2 * small;
     }
-  }
-  case FIELD_CHILLED: {
-    double t = T[0] + (T[1] - T[0]) * pow(zr, 0.8);
-    if (role == R_TOP) t += 0.5;
-    if (role == R_CAP) t += 2.0;
-    if (role == R_NECK) t += 1.0;
-    return t + 0.2 * small;
-  }
-  case FIELD_CHILLED_FRUIT: return T[0] + T[1] * zr + 0.4 * small;
-  case FIELD_WARM: return amb + T[0] * (0.8 + 0.2 * (1 - zr)) + 0.4 * small;
-  case FIELD_LAPTOP:
-    if (role == R_LID) return amb + T[2] + 0.3 * small;
-    return amb + T[1] + T[0] * gauss2(x, y, 0.04, 0.03, 0.05) + 0.3 * small;
-  case FIELD_USED_CUSHION:
-    if (role == R_CUSHION) return amb + T[1] + 0.3 * small;
-    break;
-  case FIELD_USED_GRIP:
-    if (role == R_SHELL || role == R_TOP)
-      return amb + T[0] + (T[1] - T[0]) * sstep(-y / 0.05 + 0.2) + 0.3 * small;
-    break;
-  case FIELD_USED:
-  case FIELD_MODELS: break;
+    case FIELD_CHILLED_FRUIT: return T[0] + T[1] * zr + 0.4 * small;
+    case FIELD_WARM: return amb + T[0] * (0.8 + 0.2 * (1 - zr)) + 0.4 * small;
+    case FIELD_LAPTOP:
+      if (role == R_LID) return amb + T[2] + 0.3 * small;
+      return amb + T[1] + T[0] * gauss2(x, y, 0.04, 0.03, 0.05) + 0.3 * small;
+    case FIELD_USED_CUSHION:
+      if (role == R_CUSHION) return amb + T[1] + 0.3 * small;
+      break;
+    case FIELD_USED_GRIP:
+      if (role == R_SHELL || role == R_TOP)
+        return amb + T[0] + (T[1] - T[0]) * sstep(-y / 0.05 + 0.2) + 0.3 * small;
+      break;
+    case FIELD_USED:
+    case FIELD_MODELS: break;
   }
   /* used: mild warmth, more where hands, palms or heads were */
   double blob = sstep(0.5 + 0.8 * synth_smooth_noise3(f->seed + 29, x / 0.04, y / 0.04, z / 0.04));

@@ -29,20 +29,19 @@ static inline uint64_t synth_mix64(uint64_t x) {
 
 /* Value in [0,1) at lattice point (a, b, c) of stream seed; salt separates
  * lattices that share a seed. */
-static inline double synth_lattice(uint64_t seed, uint64_t salt, int64_t a, int64_t b,
-                                   int64_t c) {
-  uint64_t h = synth_mix64(seed ^ synth_mix64((uint64_t)a * 0x9E3779B97F4A7C15ULL ^
-                                              synth_mix64((uint64_t)b + 0x632BE59BD9B4E019ULL) ^
-                                              synth_mix64((uint64_t)c * 0xD6E8FEB86659FD93ULL +
-                                                          salt)));
+static inline double synth_lattice(uint64_t seed, uint64_t salt, int64_t a, int64_t b, int64_t c) {
+  uint64_t h =
+      synth_mix64(seed ^ synth_mix64((uint64_t)a * 0x9E3779B97F4A7C15ULL ^
+                                     synth_mix64((uint64_t)b + 0x632BE59BD9B4E019ULL) ^
+                                     synth_mix64((uint64_t)c * 0xD6E8FEB86659FD93ULL + salt)));
   return (double)(h >> 11) * (1.0 / 9007199254740992.0);
 }
 
 static inline double synth_fade3(double t) { return t * t * (3.0 - 2.0 * t); }
 
 /* bilinear blend over cell (ix, iy) of the lattice layer z = iz */
-static inline double synth_noise_layer(uint64_t seed, int64_t ix, int64_t iy, int64_t iz,
-                                       double tx, double ty) {
+static inline double synth_noise_layer(uint64_t seed, int64_t ix, int64_t iy, int64_t iz, double tx,
+                                       double ty) {
   double a = synth_lattice(seed, SYNTH_NOISE_SALT, ix, iy, iz);
   double b = synth_lattice(seed, SYNTH_NOISE_SALT, ix + 1, iy, iz);
   double c = synth_lattice(seed, SYNTH_NOISE_SALT, ix, iy + 1, iz);
@@ -90,8 +89,8 @@ static inline double synth_smooth_noise3(uint64_t seed, double x, double y, doub
   for (int k = 0; k < 3; k++) u[k] = u[k] * u[k] * u[k] * (u[k] * (u[k] * 6 - 15) + 10);
   double v = 0;
   for (int c = 0; c < 8; c++) {
-    double w = ((c & 1) ? u[0] : 1 - u[0]) * ((c & 2) ? u[1] : 1 - u[1]) *
-               ((c & 4) ? u[2] : 1 - u[2]);
+    double w =
+        ((c & 1) ? u[0] : 1 - u[0]) * ((c & 2) ? u[1] : 1 - u[1]) * ((c & 4) ? u[2] : 1 - u[2]);
     double corner = synth_lattice(seed, SYNTH_SMOOTH_SALT, ix + (c & 1), iy + ((c >> 1) & 1),
                                   iz + ((c >> 2) & 1));
     v += w * (2.0 * corner - 1.0);

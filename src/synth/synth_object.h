@@ -20,13 +20,13 @@
 
 typedef struct synth_object {
   char category[64];
-  hearth_mesh mesh;          /* object frame; mesh.texture unused (see albedo) */
-  uint8_t *part_of_tri;      /* n_triangles part ids, < n_parts */
+  hearth_mesh mesh;     /* object frame; mesh.texture unused (see albedo) */
+  uint8_t *part_of_tri; /* n_triangles part ids, < n_parts */
   int n_parts;
   const char *part_names[SYNTH_MAX_PARTS]; /* static strings: "body", "handle", ... */
-  hearth_image albedo;       /* RGB U8 base colour texture in the mesh's UV layout */
-  double height;             /* max z */
-  double radius;             /* max distance from the z axis */
+  hearth_image albedo;                     /* RGB U8 base colour texture in the mesh's UV layout */
+  double height;                           /* max z */
+  double radius;                           /* max distance from the z axis */
   /* for containers: height of the liquid line as a fraction of height (0 if none) */
   double fill_level;
 } synth_object;
@@ -55,8 +55,8 @@ void synth_object_free(synth_object *obj);
 /* A temperature field over an object's surface for one state. */
 typedef struct synth_field {
   char state[32];
-  double ambient_c;          /* room temperature of the capture */
-  double params[32];         /* category/state parameters drawn from seed */
+  double ambient_c;  /* room temperature of the capture */
+  double params[32]; /* category/state parameters drawn from seed */
   uint64_t seed;
 } synth_field;
 

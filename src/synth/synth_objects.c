@@ -35,7 +35,9 @@
 enum { K_STRIP, K_DISK };
 
 /* a part id and an albedo style (synth_slot once numbered) */
-typedef struct slot_use { int part, style; } slot_use;
+typedef struct slot_use {
+  int part, style;
+} slot_use;
 
 typedef struct patch {
   int part, style, kind;
@@ -50,14 +52,14 @@ typedef struct patch {
 typedef struct builder {
   int count_only;
   size_t nv, nt;
-  float *pos, *uv;  /* uv holds native coordinates until packing */
+  float *pos, *uv; /* uv holds native coordinates until packing */
   uint32_t *idx;
   uint8_t *part;
   patch patches[MAX_PATCHES];
   int np;
   const char *part_names[SYNTH_MAX_PARTS];
   int n_parts;
-  int overflow;     /* too many patches/parts: a bug in a builder */
+  int overflow; /* too many patches/parts: a bug in a builder */
 } builder;
 
 static int b_part(builder *b, const char *name) {
@@ -220,8 +222,13 @@ static int outline_rrect(outline *o, double A, double B, double rc, double h) {
   return 0;
 }
 
-typedef struct prow { double s, d, z; } prow;
-typedef struct pseg { size_t i0, i1; int part, style; } pseg;
+typedef struct prow {
+  double s, d, z;
+} prow;
+typedef struct pseg {
+  size_t i0, i1;
+  int part, style;
+} pseg;
 
 #define MAX_SEGS 24
 typedef struct profile {
@@ -389,10 +396,10 @@ static int sweep_build(builder *b, const outline *ol, const profile *pf, const d
         if (per > lt) lt = per;
         if (i > sg.i0) {
           prow q = pf->r[i - 1];
-          ltot += hypot(rw.s * (ol->c[0] + rw.d * ol->nr[0]) - q.s * (ol->c[0] + q.d * ol->nr[0]),
-                        hypot(rw.s * (ol->c[1] + rw.d * ol->nr[1]) -
-                                  q.s * (ol->c[1] + q.d * ol->nr[1]),
-                              rw.z - q.z));
+          ltot +=
+              hypot(rw.s * (ol->c[0] + rw.d * ol->nr[0]) - q.s * (ol->c[0] + q.d * ol->nr[0]),
+                    hypot(rw.s * (ol->c[1] + rw.d * ol->nr[1]) - q.s * (ol->c[1] + q.d * ol->nr[1]),
+                          rw.z - q.z));
         }
       }
       size_t nch = 1;
@@ -440,8 +447,8 @@ static int sweep_build(builder *b, const outline *ol, const profile *pf, const d
 /* a tube along a planar path: path(t) for t in [0,1], half-axes a (along
  * the plane normal bn) and c (in the plane) */
 typedef struct tube_def {
-  double p[4][3];   /* cubic Bezier control points */
-  double bn[3];     /* unit normal of the path's plane */
+  double p[4][3];        /* cubic Bezier control points */
+  double bn[3];          /* unit normal of the path's plane */
   double a0, a1, c0, c1; /* half-axes at the start and end */
 } tube_def;
 
@@ -530,10 +537,8 @@ static int tube_build(builder *b, const tube_def *td, slot_use u, double h) {
              X ? X[2 * (e * K + k) + 1] : 0);
     for (size_t k = 0; k < K; k++) {
       uint32_t j0 = rb + (uint32_t)k, j1 = rb + (uint32_t)((k + 1) % K);
-      if (e == 0)
-        b_tri(b, c, j1, j0, part);
-      else
-        b_tri(b, c, j0, j1, part);
+      if (e == 0) b_tri(b, c, j1, j0, part);
+      else b_tri(b, c, j0, j1, part);
     }
     patch_close(b, cp);
   }
@@ -587,15 +592,19 @@ static void shape_draw(shape *s, const synth_category *cat, hearth_rng *r) {
   double *d = s->d;
   for (const synth_draw *st = cat->draw; st < cat->draw + SYNTH_MAX_DRAWS && st->op; st++) {
     switch (st->op) {
-    case DRAW_RANGE: d[st->dst] = hearth_rng_range(r, st->lo, st->hi); break;
-    case DRAW_SCALED: d[st->dst] = st->k * d[st->src] * hearth_rng_range(r, st->lo, st->hi); break;
-    case DRAW_OFFSET: d[st->dst] = d[st->src] + hearth_rng_range(r, st->lo, st->hi); break;
-    case DRAW_CONST: d[st->dst] = st->k; break;
-    case DRAW_TIMES: d[st->dst] = d[st->src] * st->k; break;
-    case DRAW_MINUS: d[st->dst] = d[st->src] - st->k; break;
-    case DRAW_FLAG: d[st->dst] = hearth_rng_uniform(r) < st->k; break;
-    case DRAW_COLOUR: pick_col(r, s->col[st->dst], synth_palettes[st->src].rgb, (int)st->k); break;
-    case DRAW_END: break;
+      case DRAW_RANGE: d[st->dst] = hearth_rng_range(r, st->lo, st->hi); break;
+      case DRAW_SCALED:
+        d[st->dst] = st->k * d[st->src] * hearth_rng_range(r, st->lo, st->hi);
+        break;
+      case DRAW_OFFSET: d[st->dst] = d[st->src] + hearth_rng_range(r, st->lo, st->hi); break;
+      case DRAW_CONST: d[st->dst] = st->k; break;
+      case DRAW_TIMES: d[st->dst] = d[st->src] * st->k; break;
+      case DRAW_MINUS: d[st->dst] = d[st->src] - st->k; break;
+      case DRAW_FLAG: d[st->dst] = hearth_rng_uniform(r) < st->k; break;
+      case DRAW_COLOUR:
+        pick_col(r, s->col[st->dst], synth_palettes[st->src].rgb, (int)st->k);
+        break;
+      case DRAW_END: break;
     }
   }
 }
@@ -757,7 +766,10 @@ static int build_bottle(builder *b, const shape *s, double h) {
 }
 
 /* peel bumps: a small radial displacement from smooth 3D noise */
-typedef struct peel_disp { double zc, amp; uint64_t seed; } peel_disp;
+typedef struct peel_disp {
+  double zc, amp;
+  uint64_t seed;
+} peel_disp;
 static void peel_displace(const void *ctx, double p[3]) {
   const peel_disp *od = ctx;
   double q[3] = {p[0], p[1], p[2] - od->zc};
@@ -838,9 +850,15 @@ static int build_kettle(builder *b, const shape *s, double h) {
   if (rc) return rc;
   /* spout at the front: up and out, tapering */
   double zs = zb + Hb * 0.78, rs = R - (R - Rt) * 0.78 - 0.012;
-  tube_def sp = {{{rs, 0, zs}, {rs + 0.03, 0, zs + 0.004}, {rs + 0.04, 0, zs + 0.025},
+  tube_def sp = {{{rs, 0, zs},
+                  {rs + 0.03, 0, zs + 0.004},
+                  {rs + 0.04, 0, zs + 0.025},
                   {rs + 0.045, 0, zs + 0.04}},
-                 {0, 1, 0}, 0.014, 0.008, 0.012, 0.006};
+                 {0, 1, 0},
+                 0.014,
+                 0.008,
+                 0.012,
+                 0.006};
   return tube_build(b, &sp, sl[KETTLE_SPOUT], h);
 }
 
@@ -918,15 +936,19 @@ static int build_headset(builder *b, const shape *s, double h) {
   if (rc) return rc;
   /* band over the top, its ends inside the cups */
   double hw = 0.5 * W, zc = R, k4 = 0.5523 * 2;
-  tube_def td = {{{-hw, 0, zc}, {-hw, 0, zc + hw * k4 * 1.3}, {hw, 0, zc + hw * k4 * 1.3},
-                  {hw, 0, zc}},
-                 {0, 1, 0}, s->d[D_A], s->d[D_A], s->d[D_C], s->d[D_C]};
+  tube_def td =
+      {{{-hw, 0, zc}, {-hw, 0, zc + hw * k4 * 1.3}, {hw, 0, zc + hw * k4 * 1.3}, {hw, 0, zc}},
+       {0, 1, 0},
+       s->d[D_A],
+       s->d[D_A],
+       s->d[D_C],
+       s->d[D_C]};
   return tube_build(b, &td, sl[HEADSET_BAND], h);
 }
 
 typedef int (*shape_fn)(builder *b, const shape *s, double h);
 static const shape_fn k_shapes[SHAPE_COUNT] = {
-    [SHAPE_VESSEL] = build_vessel, [SHAPE_CAN] = build_can,         [SHAPE_BOTTLE] = build_bottle,
+    [SHAPE_VESSEL] = build_vessel,     [SHAPE_CAN] = build_can,       [SHAPE_BOTTLE] = build_bottle,
     [SHAPE_SPHEROID] = build_spheroid, [SHAPE_KETTLE] = build_kettle, [SHAPE_SLAB] = build_slab,
     [SHAPE_HEADSET] = build_headset};
 
@@ -987,10 +1009,8 @@ static void pack_islands(builder *b) {
   double lo = 0, hi = 1e4;
   for (int it = 0; it < 60; it++) {
     double mid = 0.5 * (lo + hi);
-    if (pack_try(b->patches, order, n, mid, 0))
-      lo = mid;
-    else
-      hi = mid;
+    if (pack_try(b->patches, order, n, mid, 0)) lo = mid;
+    else hi = mid;
   }
   pack_try(b->patches, order, n, lo, 1);
   for (int i = 0; i < n; i++) {
@@ -1040,133 +1060,134 @@ static void draw_pattern(const shape *s, const patch *p, const synth_material *m
   const double *d = s->d;
   double lx = x - p->ox, ly = y - p->oy;
   switch (m->pattern) {
-  case PAT_NONE: break;
-  case PAT_CAN_LABEL: {
-    double t = ly / p->h, u = lx / p->w;
-    if (t < 0.08 || t > 0.92) setc(out, 0.75, 0.76, 0.78);
-    else if (fabs(t - 0.3) < 0.04) copyc(out, s->col[1]);
-    else if (t > 0.42 && t < 0.75 && u > 0.1 && u < 0.45) {
-      /* a logo block with white lettering */
-      double q = textish(ts, lx, ly, 0.012);
-      mixc(out, s->col[0], k_white, q);
-    } else if (t > 0.45 && t < 0.65 && u > 0.6 && u < 0.9) {
-      double q = textish(ts + 5, lx, ly, 0.004);
-      mixc(out, out, (const double[3]){0.05, 0.05, 0.05}, q * 0.8);
+    case PAT_NONE: break;
+    case PAT_CAN_LABEL: {
+      double t = ly / p->h, u = lx / p->w;
+      if (t < 0.08 || t > 0.92) setc(out, 0.75, 0.76, 0.78);
+      else if (fabs(t - 0.3) < 0.04) copyc(out, s->col[1]);
+      else if (t > 0.42 && t < 0.75 && u > 0.1 && u < 0.45) {
+        /* a logo block with white lettering */
+        double q = textish(ts, lx, ly, 0.012);
+        mixc(out, s->col[0], k_white, q);
+      } else if (t > 0.45 && t < 0.65 && u > 0.6 && u < 0.9) {
+        double q = textish(ts + 5, lx, ly, 0.004);
+        mixc(out, out, (const double[3]){0.05, 0.05, 0.05}, q * 0.8);
+      }
+      break;
     }
-    break;
-  }
-  case PAT_ALU: {
-    double r = hypot(x, y);
-    double v = m->param + 0.05 * synth_noise2(ts, r / 0.0006, 0.5) + 0.02 * coarse_grain(ts, x, y);
-    setc(out, v, v + 0.005, v + 0.015);
-    if (m->alt && p->kind == K_DISK && x > 0.004 && x < 0.02 && fabs(y) < 0.006)
-      setc(out, 0.55, 0.56, 0.58);
-    break;
-  }
-  case PAT_BOTTLE_LABEL: {
-    double t = ly / p->h;
-    if (t < 0.12 || t > 0.88) setc(out, 0.95, 0.95, 0.95);
-    double q = textish(ts, lx, ly, 0.008);
-    if (t > 0.3 && t < 0.7) mixc(out, out, k_white, q);
-    break;
-  }
-  case PAT_RIBS:
-    if (p->kind == K_STRIP) {
-      double rib = 0.5 + 0.5 * sin(lx / 0.0008 * 2 * M_PI);
-      for (int k = 0; k < 3; k++) out[k] *= 0.85 + 0.15 * rib;
+    case PAT_ALU: {
+      double r = hypot(x, y);
+      double v =
+          m->param + 0.05 * synth_noise2(ts, r / 0.0006, 0.5) + 0.02 * coarse_grain(ts, x, y);
+      setc(out, v, v + 0.005, v + 0.015);
+      if (m->alt && p->kind == K_DISK && x > 0.004 && x < 0.02 && fabs(y) < 0.006)
+        setc(out, 0.55, 0.56, 0.58);
+      break;
     }
-    break;
-  case PAT_PEEL: {
-    double pores = synth_noise2(ts, x / 0.0009, y / 0.0009);
-    double k = 0.06 * coarse_grain(ts, x, y) - (pores > 0.55 ? 0.12 * (pores - 0.55) / 0.45 : 0);
-    for (int c = 0; c < 3; c++) out[c] += k * out[c] * 2;
-    double r = hypot(x, y);
-    if (m->alt && r < 0.004) mixc(out, out, (const double[3]){0.35, 0.40, 0.12}, 1 - r / 0.004);
-    break;
-  }
-  case PAT_SCREEN: {
-    double A = 0.5 * d[D_W] - d[D_E] - 0.0025, B = 0.5 * d[D_L] - d[D_E] - 0.004;
-    if (fabs(x) < A && fabs(y) < B) {
-      double g = 0.04 + 0.03 * (x / A + y / B + 2) / 4;
-      setc(out, g, g, g + 0.01);
-    } else {
-      setc(out, 0.02, 0.02, 0.02);
+    case PAT_BOTTLE_LABEL: {
+      double t = ly / p->h;
+      if (t < 0.12 || t > 0.88) setc(out, 0.95, 0.95, 0.95);
+      double q = textish(ts, lx, ly, 0.008);
+      if (t > 0.3 && t < 0.7) mixc(out, out, k_white, q);
+      break;
     }
-    if (hypot(x, y - (0.5 * d[D_L] - 0.009)) < 0.0018) setc(out, 0.10, 0.10, 0.14);
-    break;
-  }
-  case PAT_FRAME: {
-    double v = 0.55 + 0.04 * coarse_grain(ts, x, y);
-    mixc(out, s->col[0], (const double[3]){v, v, v}, 0.6);
-    break;
-  }
-  case PAT_CAMERA: {
-    double cx = -(0.5 * d[D_W] - 0.02), cy = 0.5 * d[D_L] - 0.02;
-    if (fabs(x - cx) < 0.015 && fabs(y - cy) < 0.015) {
-      mixc(out, out, (const double[3]){0.15, 0.15, 0.16}, 0.7);
-      for (int l = 0; l < 2; l++)
-        if (hypot(x - cx + 0.005, y - cy - 0.006 + 0.012 * l) < 0.0045)
-          setc(out, 0.03, 0.03, 0.05);
+    case PAT_RIBS:
+      if (p->kind == K_STRIP) {
+        double rib = 0.5 + 0.5 * sin(lx / 0.0008 * 2 * M_PI);
+        for (int k = 0; k < 3; k++) out[k] *= 0.85 + 0.15 * rib;
+      }
+      break;
+    case PAT_PEEL: {
+      double pores = synth_noise2(ts, x / 0.0009, y / 0.0009);
+      double k = 0.06 * coarse_grain(ts, x, y) - (pores > 0.55 ? 0.12 * (pores - 0.55) / 0.45 : 0);
+      for (int c = 0; c < 3; c++) out[c] += k * out[c] * 2;
+      double r = hypot(x, y);
+      if (m->alt && r < 0.004) mixc(out, out, (const double[3]){0.35, 0.40, 0.12}, 1 - r / 0.004);
+      break;
     }
-    break;
-  }
-  case PAT_PORES: {
-    double pores = synth_noise2(ts, x / 0.0007, y / 0.0007);
-    if (pores > 0.5) mixc(out, out, (const double[3]){0.75, 0.58, 0.10}, (pores - 0.5) * 1.6);
-    break;
-  }
-  case PAT_FIBRES: {
-    double f = synth_noise2(ts, x / 0.0004, y / 0.003) * 0.5 +
-               synth_noise2(ts + 9, x / 0.003, y / 0.0004) * 0.5;
-    for (int k = 0; k < 3; k++) out[k] *= 0.8 + 0.35 * f;
-    break;
-  }
-  case PAT_BRUSHED: {
-    double v = m->param + 0.06 * synth_noise2(ts, lx / 0.03, ly / 0.0004) +
-               0.03 * coarse_grain(ts, x, y);
-    if (p->kind == K_STRIP) v += 0.08 * sin(2 * M_PI * lx / p->w * 2);
-    setc(out, v, v + 0.005, v + 0.012);
-    break;
-  }
-  case PAT_MOUSE:
-    if (p->kind == K_DISK && fabs(x) < 0.0006 && y > d[D_L] * 0.1) setc(out, 0.02, 0.02, 0.02);
-    if (p->kind == K_DISK && hypot(x, y - d[D_L] * 0.3) < 0.004) setc(out, 0.2, 0.2, 0.22);
-    break;
-  case PAT_PRINT: mixc(out, out, k_white, textish(ts, lx, ly, m->param)); break;
-  case PAT_LOGO:
-    if (hypot(x, y) < 0.012) setc(out, 0.82, 0.83, 0.85);
-    break;
-  case PAT_FEET:
-    if (p->kind == K_DISK && fabs(fabs(x) - 0.5 * d[D_W] + 0.03) < 0.008 &&
-        fabs(fabs(y) - 0.5 * d[D_L] + 0.03) < 0.008)
-      setc(out, 0.1, 0.1, 0.1);
-    break;
-  case PAT_STITCHES:
-    if (p->kind == K_DISK) {
-      double dx = 0.5 * d[D_W] - d[D_E] - fabs(x), dy = 0.5 * d[D_L] - d[D_E] - fabs(y);
-      double dm = fmin(dx, dy);
-      if (dm > 0.003 && dm < 0.0038 && fmod(fabs(x + y) / 0.003, 1.0) < 0.6)
-        setc(out, 0.85, 0.78, 0.60);
+    case PAT_SCREEN: {
+      double A = 0.5 * d[D_W] - d[D_E] - 0.0025, B = 0.5 * d[D_L] - d[D_E] - 0.004;
+      if (fabs(x) < A && fabs(y) < B) {
+        double g = 0.04 + 0.03 * (x / A + y / B + 2) / 4;
+        setc(out, g, g, g + 0.01);
+      } else {
+        setc(out, 0.02, 0.02, 0.02);
+      }
+      if (hypot(x, y - (0.5 * d[D_L] - 0.009)) < 0.0018) setc(out, 0.10, 0.10, 0.14);
+      break;
     }
-    break;
-  case PAT_FLOWERS:
-    if (synth_noise2(ts, lx / 0.02, ly / 0.02) > 0.45) mixc(out, out, s->col[1], 0.7);
-    break;
-  case PAT_OPENING: {
-    double ex = x / (0.5 * d[D_W] * 0.6), ey = y / (0.5 * d[D_L] * 0.35);
-    if (ex * ex + ey * ey < 1) setc(out, 0.97, 0.97, 0.97);
-    break;
-  }
-  case PAT_WEAVE: {
-    double weave = 0.5 + 0.5 * sin(lx / 0.0012 * M_PI) * sin(ly / 0.0012 * M_PI);
-    for (int k = 0; k < 3; k++) out[k] *= 0.92 + 0.08 * weave;
-    if (m->alt && ((int)floor(lx / 0.04) + (int)floor(ly / 0.04)) % 2)
-      for (int k = 0; k < 3; k++) out[k] *= 0.75;
-    break;
-  }
-  case PAT_ZIP:
-    if (fabs(ly - 0.5 * p->h) < 0.002) copyc(out, s->col[0]);
-    break;
+    case PAT_FRAME: {
+      double v = 0.55 + 0.04 * coarse_grain(ts, x, y);
+      mixc(out, s->col[0], (const double[3]){v, v, v}, 0.6);
+      break;
+    }
+    case PAT_CAMERA: {
+      double cx = -(0.5 * d[D_W] - 0.02), cy = 0.5 * d[D_L] - 0.02;
+      if (fabs(x - cx) < 0.015 && fabs(y - cy) < 0.015) {
+        mixc(out, out, (const double[3]){0.15, 0.15, 0.16}, 0.7);
+        for (int l = 0; l < 2; l++)
+          if (hypot(x - cx + 0.005, y - cy - 0.006 + 0.012 * l) < 0.0045)
+            setc(out, 0.03, 0.03, 0.05);
+      }
+      break;
+    }
+    case PAT_PORES: {
+      double pores = synth_noise2(ts, x / 0.0007, y / 0.0007);
+      if (pores > 0.5) mixc(out, out, (const double[3]){0.75, 0.58, 0.10}, (pores - 0.5) * 1.6);
+      break;
+    }
+    case PAT_FIBRES: {
+      double f = synth_noise2(ts, x / 0.0004, y / 0.003) * 0.5 +
+                 synth_noise2(ts + 9, x / 0.003, y / 0.0004) * 0.5;
+      for (int k = 0; k < 3; k++) out[k] *= 0.8 + 0.35 * f;
+      break;
+    }
+    case PAT_BRUSHED: {
+      double v = m->param + 0.06 * synth_noise2(ts, lx / 0.03, ly / 0.0004) +
+                 0.03 * coarse_grain(ts, x, y);
+      if (p->kind == K_STRIP) v += 0.08 * sin(2 * M_PI * lx / p->w * 2);
+      setc(out, v, v + 0.005, v + 0.012);
+      break;
+    }
+    case PAT_MOUSE:
+      if (p->kind == K_DISK && fabs(x) < 0.0006 && y > d[D_L] * 0.1) setc(out, 0.02, 0.02, 0.02);
+      if (p->kind == K_DISK && hypot(x, y - d[D_L] * 0.3) < 0.004) setc(out, 0.2, 0.2, 0.22);
+      break;
+    case PAT_PRINT: mixc(out, out, k_white, textish(ts, lx, ly, m->param)); break;
+    case PAT_LOGO:
+      if (hypot(x, y) < 0.012) setc(out, 0.82, 0.83, 0.85);
+      break;
+    case PAT_FEET:
+      if (p->kind == K_DISK && fabs(fabs(x) - 0.5 * d[D_W] + 0.03) < 0.008 &&
+          fabs(fabs(y) - 0.5 * d[D_L] + 0.03) < 0.008)
+        setc(out, 0.1, 0.1, 0.1);
+      break;
+    case PAT_STITCHES:
+      if (p->kind == K_DISK) {
+        double dx = 0.5 * d[D_W] - d[D_E] - fabs(x), dy = 0.5 * d[D_L] - d[D_E] - fabs(y);
+        double dm = fmin(dx, dy);
+        if (dm > 0.003 && dm < 0.0038 && fmod(fabs(x + y) / 0.003, 1.0) < 0.6)
+          setc(out, 0.85, 0.78, 0.60);
+      }
+      break;
+    case PAT_FLOWERS:
+      if (synth_noise2(ts, lx / 0.02, ly / 0.02) > 0.45) mixc(out, out, s->col[1], 0.7);
+      break;
+    case PAT_OPENING: {
+      double ex = x / (0.5 * d[D_W] * 0.6), ey = y / (0.5 * d[D_L] * 0.35);
+      if (ex * ex + ey * ey < 1) setc(out, 0.97, 0.97, 0.97);
+      break;
+    }
+    case PAT_WEAVE: {
+      double weave = 0.5 + 0.5 * sin(lx / 0.0012 * M_PI) * sin(ly / 0.0012 * M_PI);
+      for (int k = 0; k < 3; k++) out[k] *= 0.92 + 0.08 * weave;
+      if (m->alt && ((int)floor(lx / 0.04) + (int)floor(ly / 0.04)) % 2)
+        for (int k = 0; k < 3; k++) out[k] *= 0.75;
+      break;
+    }
+    case PAT_ZIP:
+      if (fabs(ly - 0.5 * p->h) < 0.002) copyc(out, s->col[0]);
+      break;
   }
 }
 
@@ -1176,10 +1197,10 @@ static void shade(const shape *s, const patch *p, double x, double y, double out
   const synth_material *m = &synth_materials[p->style];
   uint64_t ts = s->tseed + (uint64_t)m->stream * 977;
   switch (m->base) {
-  case BASE_NONE: break;
-  case BASE_RGB: copyc(out, m->rgb); break;
-  case BASE_SLOT: copyc(out, s->col[m->slot]); break;
-  case BASE_MIX: mixc(out, s->col[m->slot], m->rgb, m->mix); break;
+    case BASE_NONE: break;
+    case BASE_RGB: copyc(out, m->rgb); break;
+    case BASE_SLOT: copyc(out, s->col[m->slot]); break;
+    case BASE_MIX: mixc(out, s->col[m->slot], m->rgb, m->mix); break;
   }
   if (m->band[2] > 0 && p->kind == K_STRIP) {
     double t = (y - p->oy) / p->h;
@@ -1299,10 +1320,8 @@ hearth_status synth_object_make(const char *category, uint64_t seed, size_t targ
       best_h = h;
       best_n = n;
     }
-    if (n > target_triangles)
-      lo = mid;
-    else
-      hi = mid;
+    if (n > target_triangles) lo = mid;
+    else hi = mid;
     if (e < 0.02 * (double)target_triangles) break;
   }
   if (fail)
@@ -1349,9 +1368,11 @@ hearth_status synth_object_make(const char *category, uint64_t seed, size_t targ
   for (int k = 0; k < b->n_parts; k++) obj->part_names[k] = b->part_names[k];
   obj_extent(obj);
   switch (sc->fill) {
-  case FILL_DRAWN: obj->fill_level = s.d[D_FILL]; break;
-  case FILL_DEPTH: obj->fill_level = s.d[D_H] * s.d[D_FILL] / obj->height; break;
-  case FILL_ABOVE_BASE: obj->fill_level = (s.d[D_T] + s.d[D_H] * s.d[D_FILL]) / obj->height; break;
+    case FILL_DRAWN: obj->fill_level = s.d[D_FILL]; break;
+    case FILL_DEPTH: obj->fill_level = s.d[D_H] * s.d[D_FILL] / obj->height; break;
+    case FILL_ABOVE_BASE:
+      obj->fill_level = (s.d[D_T] + s.d[D_H] * s.d[D_FILL]) / obj->height;
+      break;
   }
 
   st = hearth_image_alloc(&obj->albedo, texture_size, texture_size, 3, HEARTH_PIX_U8, err);

@@ -56,9 +56,9 @@ static int classify_plate(const double (*holes)[2], double x, double y) {
 
 typedef struct plate_view {
   const hearth_camera *cam;
-  hearth_rigid T;   /* camera from plate */
-  double n[3];      /* plate normal in the camera */
-  double nt;        /* n . t */
+  hearth_rigid T; /* camera from plate */
+  double n[3];    /* plate normal in the camera */
+  double nt;      /* n . t */
   /* thermal */
   double ambient, plate_dt, hole_dt;
   /* colour */
@@ -93,22 +93,22 @@ static int classify_ray(const plate_view *v, const double d[3], double p[2]) {
   /* plate coordinates: R^T q */
   p[0] = v->T.R[0] * q[0] + v->T.R[3] * q[1] + v->T.R[6] * q[2];
   p[1] = v->T.R[1] * q[0] + v->T.R[4] * q[1] + v->T.R[7] * q[2];
-  return classify_plate((const double (*)[2])v->holes, p[0], p[1]);
+  return classify_plate((const double(*)[2])v->holes, p[0], p[1]);
 }
 
 static double thermal_value(const plate_view *v, int cls, const double p[2], const double d[3]) {
   switch (cls) {
-  case C_PLATE: return v->ambient + v->plate_dt + 1.5 * (p[0] - 0.06);
-  case C_HOLE: return v->ambient + v->hole_dt + 4.0 * (p[1] - 0.036);
-  default: return v->ambient + 0.4 * d[1] + 0.2 * d[0];
+    case C_PLATE: return v->ambient + v->plate_dt + 1.5 * (p[0] - 0.06);
+    case C_HOLE: return v->ambient + v->hole_dt + 4.0 * (p[1] - 0.036);
+    default: return v->ambient + 0.4 * d[1] + 0.2 * d[0];
   }
 }
 
 static double rgb_value(const plate_view *v, int cls, const double p[2], const double d[3]) {
   switch (cls) {
-  case C_PLATE: return v->white * (1.0 - 0.3 * (p[1] - 0.036));
-  case C_HOLE: return 0.05;
-  default: return 0.36 + 0.08 * d[1] - 0.05 * d[0];
+    case C_PLATE: return v->white * (1.0 - 0.3 * (p[1] - 0.036));
+    case C_HOLE: return 0.05;
+    default: return 0.36 + 0.08 * d[1] - 0.05 * d[0];
   }
 }
 
@@ -118,7 +118,8 @@ static double rgb_value(const plate_view *v, int cls, const double p[2], const d
 static double pixel_fine(const plate_view *v, int thermal, double x, double y, int n) {
   double c[4][2];
   for (int j = 0; j < 2; j++)
-    for (int i = 0; i < 2; i++) synth_lens_unproject(v->cam, x - 0.5 + i, y - 0.5 + j, c[j * 2 + i]);
+    for (int i = 0; i < 2; i++)
+      synth_lens_unproject(v->cam, x - 0.5 + i, y - 0.5 + j, c[j * 2 + i]);
   double sum = 0;
   for (int j = 0; j < n; j++) {
     double b = ((double)j + 0.5) / n;
@@ -275,8 +276,8 @@ int synth_plate_truth(const hearth_camera *c, const hearth_rigid *T,
         double a = k * (2.0 * 3.14159265358979323846 / 12.0), uv[2];
         double R[3] = {hx + HOLE_R * cos(a), hy + HOLE_R * sin(a), 0}, S[3];
         hearth_rigid_apply(T, R, S);
-        if (!synth_lens_project(c, S, uv) || uv[0] < 0.5 || uv[1] < 0.5 ||
-            uv[0] > c->width - 1.5 || uv[1] > c->height - 1.5)
+        if (!synth_lens_project(c, S, uv) || uv[0] < 0.5 || uv[1] < 0.5 || uv[0] > c->width - 1.5 ||
+            uv[1] > c->height - 1.5)
           ok = 0;
       }
       inside += ok;
@@ -410,8 +411,8 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
     char name[16];
     snprintf(name, sizeof name, "p%03d", i);
     snprintf(path, sizeof path, "%s/%s_thermal.csv", dir_st, name);
-    st = write_thermal(path, &vt, thermal_rays, blurred ? 1.3 : 0.5, o->netd_c, &noise,
-                       o->threads, err);
+    st = write_thermal(path, &vt, thermal_rays, blurred ? 1.3 : 0.5, o->netd_c, &noise, o->threads,
+                       err);
     if (!st) {
       hearth_image img = {0};
       st = render_rgb_plate(&vc, rgb_rays, blurred ? 3.0 : 0.6, &noise, o->threads, &img, err);

@@ -98,8 +98,7 @@ hearth_status synth_instance_make(const hearth_synth_opts *o, const hearth_rig *
   }
   if (!ns) {
     synth_instance_free(inst);
-    return hearth_err_set(err, HEARTH_E_ARG, "%s: no states for category '%s'", inst->id,
-                          category);
+    return hearth_err_set(err, HEARTH_E_ARG, "%s: no states for category '%s'", inst->id, category);
   }
   inst->n_states = ns;
   inst->ambient_c = hearth_rng_range(&r, 21.0, 23.0);
@@ -259,8 +258,8 @@ typedef struct render_ctx {
 } render_ctx;
 
 static hearth_status write_contact_sheet(const char *path, hearth_image *thumbs,
-                                         hearth_image *temps, const synth_view_def *views,
-                                         size_t n, hearth_err *err) {
+                                         hearth_image *temps, const synth_view_def *views, size_t n,
+                                         hearth_err *err) {
   const size_t tw = 256, th = 192, pad = 6, lab = 18;
   size_t cols = n < 5 ? n : 5, rows = (n + cols - 1) / cols;
   size_t TW = 2 * tw + 3 * pad, TH = th + lab + 2 * pad;
@@ -316,10 +315,16 @@ static hearth_status render_state(const render_ctx *rc, const char *root, synth_
   hearth_depth_intrinsics di = {rc->rig->depth, rc->rig->T_depth_from_rgb};
   for (size_t v = 0; v < inst->n_views && !st; v++) {
     const synth_view_def *vd = &inst->views[s][v];
-    synth_view_job job = {scene, &inst->fields[s], rc->rig, rc->thermal_rays, rc->rgb_rays,
-                          rc->depth_rays, vd->T_world_from_rgb,
+    synth_view_job job = {scene,
+                          &inst->fields[s],
+                          rc->rig,
+                          rc->thermal_rays,
+                          rc->rgb_rays,
+                          rc->depth_rays,
+                          vd->T_world_from_rgb,
                           inst->seed ^ synth_hash(state) ^ ((uint64_t)vd->index * 0x100000001B3ULL),
-                          o->netd_c, rc->threads};
+                          o->netd_c,
+                          rc->threads};
     hearth_view_files *vf = &man.views[v];
     snprintf(vf->view, sizeof vf->view, "%s", vd->name);
     vf->elevation_index = vd->elevation_index;
@@ -342,8 +347,11 @@ static hearth_status render_state(const render_ctx *rc, const char *root, synth_
       jd.rgb_rays = rc->draft_rgb_rays;
       hearth_image small = {0}, small_mask = {0};
       st = synth_render_rgb(&jd, &small, &small_mask, err);
-      if (!st) st = enlarge4(&small, (size_t)rc->rig->rgb.width, (size_t)rc->rig->rgb.height, &rgb, err);
-      if (!st) st = enlarge4(&small_mask, (size_t)rc->rig->rgb.width, (size_t)rc->rig->rgb.height, &mask, err);
+      if (!st)
+        st = enlarge4(&small, (size_t)rc->rig->rgb.width, (size_t)rc->rig->rgb.height, &rgb, err);
+      if (!st)
+        st = enlarge4(&small_mask, (size_t)rc->rig->rgb.width, (size_t)rc->rig->rgb.height, &mask,
+                      err);
       hearth_image_free(&small);
       hearth_image_free(&small_mask);
     } else if (!st) {
@@ -452,8 +460,7 @@ static hearth_status write_instance(const render_ctx *rc, const char *root, synt
   doc.n_states = inst->n_states;
   for (size_t s = 0; s < inst->n_states; s++)
     snprintf(doc.states[s], HEARTH_NAME_MAX, "%s", inst->states[s]);
-  snprintf(doc.notes, sizeof doc.notes,
-           "virtual rig, seed %llu, ambient %.1f C, %zu triangles%s",
+  snprintf(doc.notes, sizeof doc.notes, "virtual rig, seed %llu, ambient %.1f C, %zu triangles%s",
            (unsigned long long)o->seed, inst->ambient_c, inst->obj.mesh.n_triangles,
            o->mesh_path ? ", mesh from a given GLB" : "");
   snprintf(p, sizeof p, "%s/instances/%s/instance.json", root, inst->id);
@@ -463,7 +470,8 @@ static hearth_status write_instance(const render_ctx *rc, const char *root, synt
   synth_scene scene;
   if ((st = synth_scene_init(&scene, &inst->obj, &inst->T_world_from_obj, inst->ambient_c, err)))
     return hearth_err_prefix(err, "%s: ", inst->id);
-  for (size_t s = 0; s < inst->n_states && !st; s++) st = render_state(rc, root, inst, &scene, s, err);
+  for (size_t s = 0; s < inst->n_states && !st; s++)
+    st = render_state(rc, root, inst, &scene, s, err);
   synth_scene_free(&scene);
   if (st) return st;
 
@@ -646,7 +654,8 @@ static hearth_status build_tree(const hearth_synth_opts *o, const char *root, he
     int nv = o->n_views <= 0 || o->n_views > 30 ? 30 : o->n_views;
     for (size_t ci = 0; ci < ncat; ci++) {
       const char *sn[HEARTH_MAX_STATES];
-      size_t nst = o->n_states ? o->n_states : synth_category_states(cats[ci], sn, HEARTH_MAX_STATES);
+      size_t nst =
+          o->n_states ? o->n_states : synth_category_states(cats[ci], sn, HEARTH_MAX_STATES);
       total_views += (size_t)per * nst * (size_t)nv;
     }
   }

@@ -130,42 +130,41 @@ static void background(const synth_scene *s, const double bd[3], const double o[
 static double background_temp(const synth_scene *s, const bg_hit *h) {
   double a = s->ambient_c;
   switch (h->kind) {
-  case BG_TURNTABLE: return a - 0.25 + 0.1 * sin(40.0 * hypot(h->p[0], h->p[1]));
-  case BG_TABLE: return a - 0.1 + 0.15 * sin(6.0 * h->p[0]) * cos(5.0 * h->p[1]);
-  case BG_BACKDROP: return a + 0.2 + 0.4 * h->p[2] + 0.1 * sin(7.0 * (h->p[0] + h->p[1]));
-  default: return a - 1.0;
+    case BG_TURNTABLE: return a - 0.25 + 0.1 * sin(40.0 * hypot(h->p[0], h->p[1]));
+    case BG_TABLE: return a - 0.1 + 0.15 * sin(6.0 * h->p[0]) * cos(5.0 * h->p[1]);
+    case BG_BACKDROP: return a + 0.2 + 0.4 * h->p[2] + 0.1 * sin(7.0 * (h->p[0] + h->p[1]));
+    default: return a - 1.0;
   }
 }
 
 static void background_rgb(const synth_scene *s, const bg_hit *h, double rgb[3]) {
   switch (h->kind) {
-  case BG_TURNTABLE:
-    rgb[0] = 0.20;
-    rgb[1] = 0.20;
-    rgb[2] = 0.21;
-    break;
-  case BG_TABLE:
-    rgb[0] = 0.55;
-    rgb[1] = 0.50;
-    rgb[2] = 0.45;
-    break;
-  case BG_BACKDROP: {
-    double g = 0.52 - 0.15 * fmin(fmax(h->p[2], -0.3), 0.6);
-    rgb[0] = g;
-    rgb[1] = g;
-    rgb[2] = g * 1.02;
-    break;
-  }
-  default:
-    rgb[0] = rgb[1] = rgb[2] = 0.3;
+    case BG_TURNTABLE:
+      rgb[0] = 0.20;
+      rgb[1] = 0.20;
+      rgb[2] = 0.21;
+      break;
+    case BG_TABLE:
+      rgb[0] = 0.55;
+      rgb[1] = 0.50;
+      rgb[2] = 0.45;
+      break;
+    case BG_BACKDROP: {
+      double g = 0.52 - 0.15 * fmin(fmax(h->p[2], -0.3), 0.6);
+      rgb[0] = g;
+      rgb[1] = g;
+      rgb[2] = g * 1.02;
+      break;
+    }
+    default: rgb[0] = rgb[1] = rgb[2] = 0.3;
   }
   (void)s;
 }
 
 /* ---- shared per-view geometry ---------------------------------------------- */
 typedef struct view_geom {
-  hearth_rigid T;  /* world from camera */
-  double bd[3];    /* backdrop direction */
+  hearth_rigid T; /* world from camera */
+  double bd[3];   /* backdrop direction */
 } view_geom;
 
 static void view_geom_make(const hearth_rigid *T_world_from_cam, view_geom *g) {
@@ -345,8 +344,8 @@ hearth_status synth_blur_f32(hearth_image *img, double sigma, hearth_err *err) {
 
 hearth_status synth_render_thermal(const synth_view_job *job, hearth_image *out, hearth_err *err) {
   const hearth_camera *cam = &job->rig->thermal;
-  hearth_status st = hearth_image_alloc(out, (size_t)cam->width, (size_t)cam->height, 1,
-                                        HEARTH_PIX_F32, err);
+  hearth_status st =
+      hearth_image_alloc(out, (size_t)cam->width, (size_t)cam->height, 1, HEARTH_PIX_F32, err);
   if (st) return st;
   thermal_ctx c = {job, {{{0}}}, out->data, 0};
   hearth_rigid T_rgb_from_th;
@@ -597,8 +596,11 @@ hearth_status synth_render_depth(const synth_view_job *job, hearth_image *out, h
   size_t W = (size_t)cam->width, H = (size_t)cam->height;
   hearth_status st = hearth_image_alloc(out, W, H, 1, HEARTH_PIX_U16, err);
   if (st) return st;
-  depth_ctx c = {job, {{{0}}}, hearth_alloc_array(W * H, sizeof(float)),
-                 hearth_alloc_array(W * H, sizeof(float)), 0};
+  depth_ctx c = {job,
+                 {{{0}}},
+                 hearth_alloc_array(W * H, sizeof(float)),
+                 hearth_alloc_array(W * H, sizeof(float)),
+                 0};
   if (!c.z_true || !c.z_meas) {
     free(c.z_true);
     free(c.z_meas);

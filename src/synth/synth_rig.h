@@ -52,8 +52,8 @@ uint64_t synth_hash(const char *s);
 typedef struct synth_scene {
   const synth_object *obj;
   hearth_rigid T_world_from_obj;
-  hearth_mesh world;        /* object mesh placed in the world (no texture) */
-  float *normals;           /* per-vertex normals, world, 3 per vertex */
+  hearth_mesh world; /* object mesh placed in the world (no texture) */
+  float *normals;    /* per-vertex normals, world, 3 per vertex */
   hearth_raycaster *rc;
   double centre[3], radius; /* bounding sphere of the object, world */
   double turntable_radius;
@@ -73,7 +73,7 @@ typedef struct synth_view_job {
   const hearth_rig *rig;
   const float *thermal_rays, *rgb_rays, *depth_rays;
   hearth_rigid T_world_from_rgb;
-  uint64_t noise_seed;   /* per view */
+  uint64_t noise_seed; /* per view */
   double netd_c;
   int threads;
 } synth_view_job;
@@ -106,7 +106,7 @@ int synth_plate_truth(const hearth_camera *c, const hearth_rigid *T_cam_from_pla
 /* One instance as the rig captures it; shared with the tests so they can
  * check the files against the scene they came from. */
 typedef struct synth_view_def {
-  char name[8];              /* "v07" */
+  char name[8]; /* "v07" */
   int index, elevation_index, azimuth_index;
   hearth_rigid T_world_from_rgb;
 } synth_view_def;

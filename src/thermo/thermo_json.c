@@ -9,8 +9,7 @@
 
 #define THERMO_FORMAT "hearth-thermal-model"
 #define THERMO_VERSION 1
-#define MAX_CONDUCTANCES \
-  (HEARTH_THERMO_MAX_REGIONS * (HEARTH_THERMO_MAX_REGIONS - 1) / 2)
+#define MAX_CONDUCTANCES (HEARTH_THERMO_MAX_REGIONS * (HEARTH_THERMO_MAX_REGIONS - 1) / 2)
 
 /* every key of obj must be one of `allowed` (NULL-terminated) */
 static hearth_status keys_only(hj_ctx *c, const json_t *obj, const char *const *allowed) {
@@ -42,17 +41,17 @@ static hearth_status get_range(hj_ctx *c, const json_t *obj, const char *key, do
   return s;
 }
 
-static const char *const k_top_keys[] = {"format", "version", "category", "T_air", "regions",
-                                         "conductances", "offsets", NULL};
-static const char *const k_region_keys[] = {"name", "C", "T", "area", "h_conv", "emissivity",
-                                            "label", NULL};
+static const char *const k_top_keys[] = {"format",  "version",      "category", "T_air",
+                                         "regions", "conductances", "offsets",  NULL};
+static const char *const k_region_keys[] = {"name",   "C",          "T",     "area",
+                                            "h_conv", "emissivity", "label", NULL};
 static const char *const k_link_keys[] = {"a", "b", "G", NULL};
 
 static hearth_status parse_region(hj_ctx *c, const json_t *o, hearth_thermo_net *net) {
   hearth_thermo_region r = {0};
   hearth_status s;
-  if (!json_is_object(o)) return hj_fail(c, HEARTH_E_PARSE, "expected an object, found %s",
-                                         hj_type_name(o));
+  if (!json_is_object(o))
+    return hj_fail(c, HEARTH_E_PARSE, "expected an object, found %s", hj_type_name(o));
   if ((s = keys_only(c, o, k_region_keys)) != HEARTH_OK) return s;
   if ((s = hj_get_string(c, o, "name", r.name, sizeof r.name)) != HEARTH_OK) return s;
   if ((s = get_range(c, o, "C", 1e-9, 1e12, &r.C)) != HEARTH_OK) return s;
@@ -73,8 +72,8 @@ static hearth_status parse_link(hj_ctx *c, const json_t *o, hearth_thermo_net *n
   double g;
   size_t ia, ib;
   hearth_status s;
-  if (!json_is_object(o)) return hj_fail(c, HEARTH_E_PARSE, "expected an object, found %s",
-                                         hj_type_name(o));
+  if (!json_is_object(o))
+    return hj_fail(c, HEARTH_E_PARSE, "expected an object, found %s", hj_type_name(o));
   if ((s = keys_only(c, o, k_link_keys)) != HEARTH_OK) return s;
   if ((s = hj_get_string(c, o, "a", a, sizeof a)) != HEARTH_OK) return s;
   if ((s = hj_get_string(c, o, "b", b, sizeof b)) != HEARTH_OK) return s;
@@ -109,8 +108,7 @@ static hearth_status parse_doc(hj_ctx *c, const json_t *root, hearth_thermo_mode
   if ((s = hj_get_string(c, root, "category", m->category, sizeof m->category)) != HEARTH_OK)
     return s;
   if ((s = get_range(c, root, "T_air", -273.0, 1e4, &m->net.T_air)) != HEARTH_OK) return s;
-  if ((s = hj_get_string(c, root, "offsets", m->offsets, sizeof m->offsets)) != HEARTH_OK)
-    return s;
+  if ((s = hj_get_string(c, root, "offsets", m->offsets, sizeof m->offsets)) != HEARTH_OK) return s;
   if (m->offsets[0] && !hj_relative_path_ok(m->offsets)) {
     size_t mk = hj_push_key(c, "offsets");
     s = hj_fail(c, HEARTH_E_RANGE, "expected a relative path without '..'");

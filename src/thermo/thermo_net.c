@@ -29,7 +29,8 @@ static hearth_status region_check(const hearth_thermo_region *r, size_t i, heart
   if (!name_ok(r->name))
     return hearth_err_set(err, HEARTH_E_ARG, "region %zu: name must be 1..31 of [A-Za-z0-9_-]", i);
   if (!isfinite(r->C) || r->C <= 0)
-    return hearth_err_set(err, HEARTH_E_RANGE, "region %s: C = %g J/K, expected > 0", r->name, r->C);
+    return hearth_err_set(err, HEARTH_E_RANGE, "region %s: C = %g J/K, expected > 0", r->name,
+                          r->C);
   if (!isfinite(r->T) || r->T <= -KELVIN)
     return hearth_err_set(err, HEARTH_E_RANGE, "region %s: T = %g degC, expected > -273.15",
                           r->name, r->T);
@@ -40,8 +41,8 @@ static hearth_status region_check(const hearth_thermo_region *r, size_t i, heart
     return hearth_err_set(err, HEARTH_E_RANGE, "region %s: h_conv = %g, expected >= 0", r->name,
                           r->h_conv);
   if (!isfinite(r->emissivity) || r->emissivity < 0 || r->emissivity > 1)
-    return hearth_err_set(err, HEARTH_E_RANGE, "region %s: emissivity = %g, expected 0..1",
-                          r->name, r->emissivity);
+    return hearth_err_set(err, HEARTH_E_RANGE, "region %s: emissivity = %g, expected 0..1", r->name,
+                          r->emissivity);
   if (!isfinite(r->power))
     return hearth_err_set(err, HEARTH_E_RANGE, "region %s: power is not finite", r->name);
   if (r->label < -1 || r->label >= HEARTH_THERMO_MAX_CLUSTERS)
@@ -69,8 +70,8 @@ hearth_status hearth_thermo_add_region(hearth_thermo_net *net, const hearth_ther
 hearth_status hearth_thermo_set_conductance(hearth_thermo_net *net, size_t i, size_t j, double g,
                                             hearth_err *err) {
   if (i >= net->n || j >= net->n || i == j)
-    return hearth_err_set(err, HEARTH_E_ARG, "conductance %zu-%zu: needs two distinct regions of %zu",
-                          i, j, net->n);
+    return hearth_err_set(err, HEARTH_E_ARG,
+                          "conductance %zu-%zu: needs two distinct regions of %zu", i, j, net->n);
   if (!isfinite(g) || g < 0)
     return hearth_err_set(err, HEARTH_E_RANGE, "conductance %s-%s = %g W/K, expected >= 0",
                           net->region[i].name, net->region[j].name, g);
@@ -118,7 +119,8 @@ hearth_status hearth_thermo_net_check(const hearth_thermo_net *net, hearth_err *
       if (!isfinite(g) || g < 0 || g != net->G[j][i] || (i == j && g != 0))
         return hearth_err_set(err, HEARTH_E_INCONSISTENT,
                               "conductance %zu-%zu: must be finite, >= 0, symmetric, 0 on the "
-                              "diagonal", i, j);
+                              "diagonal",
+                              i, j);
     }
   }
   for (size_t c = 0; c < net->n_contacts; c++) {
@@ -181,14 +183,14 @@ static int solve_dense(double (*A)[MAX_N], double *b, size_t n) {
 typedef struct step_ws {
   double A[MAX_N][MAX_N];
   double rhs[MAX_N];
-  double d_ext[MAX_N];  /* air + contact conductance of each unknown */
-  double q_ext[MAX_N];  /* sum G_c T_c + power of each unknown */
+  double d_ext[MAX_N]; /* air + contact conductance of each unknown */
+  double q_ext[MAX_N]; /* sum G_c T_c + power of each unknown */
   size_t base[HEARTH_THERMO_MAX_NETS];
 } step_ws;
 
 hearth_status hearth_thermo_step_coupled(hearth_thermo_net *const *nets, size_t n_nets,
-                                         const hearth_thermo_link *links, size_t n_links,
-                                         double dt, double *heat_in, hearth_err *err) {
+                                         const hearth_thermo_link *links, size_t n_links, double dt,
+                                         double *heat_in, hearth_err *err) {
   if (heat_in) *heat_in = 0;
   if (!(dt > 0) || !isfinite(dt))
     return hearth_err_set(err, HEARTH_E_ARG, "thermal step: dt = %g s, expected > 0", dt);

@@ -8,12 +8,12 @@
 
 static const hearth_thermo_material k_materials[] = {
     /* name               c (J/kg K)  k (W/m K)  emissivity  source */
-    {"ceramic",             920.0,     1.3,      0.90,       "ETB-c, OMEGA-eps"},
-    {"water",              4179.0,     0.613,    0.96,       "INC-A6, IDEAL-eps"},
-    {"aluminium",           903.0,   237.0,      0.09,       "INC-A1, FLIR-eps"},
-    {"aluminium_painted",   903.0,   237.0,      0.94,       "INC-A1, IDEAL-eps"},
-    {"glass",               840.0,     1.4,      0.94,       "ETB-c, INC-A3, IDEAL-eps"},
-    {"stainless_steel",     477.0,    14.9,      0.16,       "INC-A1, IDEAL-eps"},
+    {"ceramic", 920.0, 1.3, 0.90, "ETB-c, OMEGA-eps"},
+    {"water", 4179.0, 0.613, 0.96, "INC-A6, IDEAL-eps"},
+    {"aluminium", 903.0, 237.0, 0.09, "INC-A1, FLIR-eps"},
+    {"aluminium_painted", 903.0, 237.0, 0.94, "INC-A1, IDEAL-eps"},
+    {"glass", 840.0, 1.4, 0.94, "ETB-c, INC-A3, IDEAL-eps"},
+    {"stainless_steel", 477.0, 14.9, 0.16, "INC-A1, IDEAL-eps"},
 };
 
 const hearth_thermo_material *hearth_thermo_material_find(const char *name) {
@@ -28,9 +28,9 @@ const hearth_thermo_material *hearth_thermo_material_find(const char *name) {
 typedef struct region_tpl {
   const char *name;
   const char *material;
-  double mass;   /* kg */
-  double area;   /* m^2 */
-  double h;      /* W/(m^2 K) */
+  double mass; /* kg */
+  double area; /* m^2 */
+  double h;    /* W/(m^2 K) */
   int label;
 } region_tpl;
 

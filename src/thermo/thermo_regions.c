@@ -61,9 +61,8 @@ static size_t kmeans_1d(const float *sorted, size_t n, size_t k, double *centre)
 }
 
 hearth_status hearth_thermo_regions_from_map(size_t R, const uint8_t *mask, const float *observed,
-                                             const float *filled, const uint32_t *island,
-                                             size_t k, hearth_thermo_regions *out,
-                                             hearth_err *err) {
+                                             const float *filled, const uint32_t *island, size_t k,
+                                             hearth_thermo_regions *out, hearth_err *err) {
   memset(out, 0, sizeof *out);
   if (k == 0 || k > HEARTH_THERMO_MAX_CLUSTERS)
     return hearth_err_set(err, HEARTH_E_ARG, "regions: k = %zu, expected 1..%d", k,
@@ -95,10 +94,10 @@ hearth_status hearth_thermo_regions_from_map(size_t R, const uint8_t *mask, cons
   /* label every texel with a value by its nearest centre */
   for (size_t t = 0; t < n; t++) {
     float v = mask[t] == HEARTH_TEXEL_OBSERVED ? observed[t] : filled[t];
-    out->label[t] = (mask[t] == HEARTH_TEXEL_OBSERVED || mask[t] == HEARTH_TEXEL_FILLED) &&
-                            isfinite(v)
-                        ? (uint8_t)nearest(centre, kc, v)
-                        : HEARTH_THERMO_NO_LABEL;
+    out->label[t] =
+        (mask[t] == HEARTH_TEXEL_OBSERVED || mask[t] == HEARTH_TEXEL_FILLED) && isfinite(v)
+            ? (uint8_t)nearest(centre, kc, v)
+            : HEARTH_THERMO_NO_LABEL;
   }
   /* islands: every island takes the label most of its observed texels have
    * (ties to the lower label); island ids are found in a sorted id list */
@@ -197,6 +196,6 @@ void hearth_thermo_regions_texture(const hearth_thermo_regions *r, const double 
                                    float *out) {
   size_t n = r->R * r->R;
   for (size_t t = 0; t < n; t++)
-    out[t] = r->label[t] == HEARTH_THERMO_NO_LABEL ? NAN
-                                                   : (float)(T_label[r->label[t]] + r->offset[t]);
+    out[t] =
+        r->label[t] == HEARTH_THERMO_NO_LABEL ? NAN : (float)(T_label[r->label[t]] + r->offset[t]);
 }

@@ -210,10 +210,9 @@ int main(void) {
   CHECK(!exists(bad, "calibration/detections.json"));
   /* a plate never found: detection succeeds (frames reported), calibration
    * refuses naming detections.json, and no rig.json appears */
-  snprintf(
-      cmd, sizeof cmd,
-      "rm -rf '%s/calibration/captures/stereo'/* && mkdir -p '%s/calibration/captures/thermal'",
-      bad, bad);
+  snprintf(cmd, sizeof cmd,
+           "rm -rf '%s/calibration/captures/stereo'/* && mkdir -p '%s/calibration/captures/thermal'",
+           bad, bad);
   CHECK(system(cmd) == 0);
   {
     hearth_image flat = {0};

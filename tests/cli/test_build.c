@@ -25,7 +25,8 @@ static int tree_hash(const char *root, const char *out_file) {
   char cmd[4096];
   snprintf(cmd, sizeof cmd,
            "cd '%s' && find . -type f ! -path '*/.stamps/*' | sort | "
-           "xargs sha256sum > '%s'", root, out_file);
+           "xargs sha256sum > '%s'",
+           root, out_file);
   return system(cmd);
 }
 
@@ -44,11 +45,12 @@ int main(void) {
 
   /* 10 instances, 2 views per state, tiny meshes and maps; the true rig
      stands in for calibration (no captures: no release-level stages) */
-  snprintf(cmd, sizeof cmd,
-           "'%s' synth --out '%s' --draft-rgb --seed 11 --categories cup,canned_drink --instances 5 --views 2 "
-           "--triangles 600 --texture 64 --map-res 32 --no-calibration --threads 2 --quiet && "
-           "cp '%s/ground_truth/rig.json' '%s/calibration/rig.json' && cp -a '%s' '%s'",
-           HEARTH_EXE, root, root, root, root, pristine);
+  snprintf(
+      cmd, sizeof cmd,
+      "'%s' synth --out '%s' --draft-rgb --seed 11 --categories cup,canned_drink --instances 5 --views 2 "
+      "--triangles 600 --texture 64 --map-res 32 --no-calibration --threads 2 --quiet && "
+      "cp '%s/ground_truth/rig.json' '%s/calibration/rig.json' && cp -a '%s' '%s'",
+      HEARTH_EXE, root, root, root, root, pristine);
   int rc = run(cmd, out, sizeof out);
   CHECK_MSG(rc == 0, "synth: %s", out);
   const char *opts = "--resolution 32 --no-bake -j 2 --threads 2";
@@ -86,30 +88,35 @@ int main(void) {
   if (child == 0) _exit(0);
   waitpid(child, NULL, 0);
   long dead = (long)child, live = (long)getpid();
-  snprintf(cmd, sizeof cmd,
-           "cd '%s' && rm %s/hot/mask.npy && mkdir %s/hot.tmp-%ld-Qw3Er5 %s/hot.tmp-%ld-Old000 && "
-           "touch %s/hot/mask.npy.tmp-%ld-Ab12Cd %s/hot.tmp-%ld-Qw3Er5/mask.npy %s/hot.tmp-%ld-Old000/mask.npy "
-           "%s/.stamps/map-hot.json.tmp-%ld-q9Z0xY %s/notes.tmp-1234567 "
-           "%s/overlay/neutral/v00.png.tmp-%ld-Zz9y8X %s/overlay/neutral/v01.png.tmp-%ld-Zz9y8X && "
-           "'%s' build '%s' %s",
-           root, d3, d3, dead, d3, dead, d3, dead, d3, dead, d3, dead, d3, dead, d3, d3, dead, d3,
-           live, HEARTH_EXE, root, opts);
+  snprintf(
+      cmd, sizeof cmd,
+      "cd '%s' && rm %s/hot/mask.npy && mkdir %s/hot.tmp-%ld-Qw3Er5 %s/hot.tmp-%ld-Old000 && "
+      "touch %s/hot/mask.npy.tmp-%ld-Ab12Cd %s/hot.tmp-%ld-Qw3Er5/mask.npy %s/hot.tmp-%ld-Old000/mask.npy "
+      "%s/.stamps/map-hot.json.tmp-%ld-q9Z0xY %s/notes.tmp-1234567 "
+      "%s/overlay/neutral/v00.png.tmp-%ld-Zz9y8X %s/overlay/neutral/v01.png.tmp-%ld-Zz9y8X && "
+      "'%s' build '%s' %s",
+      root, d3, d3, dead, d3, dead, d3, dead, d3, dead, d3, dead, d3, dead, d3, d3, dead, d3, live,
+      HEARTH_EXE, root, opts);
   rc = run(cmd, out, sizeof out);
-  CHECK_MSG(rc == 0 && strstr(out, " 1 stage(s) run") && strstr(out, "cup_03 map hot: done"), "%s", out);
+  CHECK_MSG(rc == 0 && strstr(out, " 1 stage(s) run") && strstr(out, "cup_03 map hot: done"), "%s",
+            out);
   CHECK_MSG(strstr(out, "removed 5 temporary file(s)/folder(s)"), "%s", out);
-  snprintf(cmd, sizeof cmd,
-           "cd '%s' && test ! -e %s/hot/mask.npy.tmp-%ld-Ab12Cd && test ! -e %s/.stamps/map-hot.json.tmp-%ld-q9Z0xY "
-           "&& test ! -e %s/hot.tmp-%ld-Qw3Er5 && test ! -e %s/hot.tmp-%ld-Old000 "
-           "&& test ! -e %s/overlay/neutral/v00.png.tmp-%ld-Zz9y8X "
-           "&& test -e %s/notes.tmp-1234567 && test -e %s/overlay/neutral/v01.png.tmp-%ld-Zz9y8X",
-           root, d3, dead, d3, dead, d3, dead, d3, dead, d3, dead, d3, d3, live);
+  snprintf(
+      cmd, sizeof cmd,
+      "cd '%s' && test ! -e %s/hot/mask.npy.tmp-%ld-Ab12Cd && test ! -e %s/.stamps/map-hot.json.tmp-%ld-q9Z0xY "
+      "&& test ! -e %s/hot.tmp-%ld-Qw3Er5 && test ! -e %s/hot.tmp-%ld-Old000 "
+      "&& test ! -e %s/overlay/neutral/v00.png.tmp-%ld-Zz9y8X "
+      "&& test -e %s/notes.tmp-1234567 && test -e %s/overlay/neutral/v01.png.tmp-%ld-Zz9y8X",
+      root, d3, dead, d3, dead, d3, dead, d3, dead, d3, dead, d3, d3, live);
   CHECK_MSG(system(cmd) == 0, "stale temporaries: wrong files removed");
   /* validate names the one left (its writer still runs) */
   snprintf(cmd, sizeof cmd, "'%s' validate '%s'", HEARTH_EXE, root);
   rc = run(cmd, out, sizeof out);
   char want[256];
-  snprintf(want, sizeof want, "overlay/neutral/v01.png.tmp-%ld-Zz9y8X: a temporary of process %ld, "
-           "which is still writing", live, live);
+  snprintf(want, sizeof want,
+           "overlay/neutral/v01.png.tmp-%ld-Zz9y8X: a temporary of process %ld, "
+           "which is still writing",
+           live, live);
   CHECK_MSG(rc != 0 && strstr(out, want) && !strstr(out, "notes.tmp-1234567"), "validate: %s", out);
   snprintf(cmd, sizeof cmd, "rm '%s/%s/overlay/neutral/v01.png.tmp-%ld-Zz9y8X'", root, d3, live);
   CHECK(system(cmd) == 0);
@@ -135,10 +142,11 @@ int main(void) {
      another directory, so also: no output depends on where the release is */
   char moved[1200];
   snprintf(moved, sizeof moved, "%s/elsewhere/release", base);
-  snprintf(cmd, sizeof cmd,
-           "rm -rf '%s' '%s/elsewhere' && mkdir -p '%s/elsewhere' && cp -a '%s' '%s' && '%s' build '%s' %s --shard 0/2 && "
-           "'%s' build '%s' %s --shard 1/2", root, base, base, pristine, moved, HEARTH_EXE, moved, opts,
-           HEARTH_EXE, moved, opts);
+  snprintf(
+      cmd, sizeof cmd,
+      "rm -rf '%s' '%s/elsewhere' && mkdir -p '%s/elsewhere' && cp -a '%s' '%s' && '%s' build '%s' %s --shard 0/2 && "
+      "'%s' build '%s' %s --shard 1/2",
+      root, base, base, pristine, moved, HEARTH_EXE, moved, opts, HEARTH_EXE, moved, opts);
   rc = run(cmd, out, sizeof out);
   CHECK_MSG(rc == 0 && strstr(out, "5 instance(s): 5 complete"), "shards: %s", out);
   snprintf(b, sizeof b, "%s/hash_shards.txt", base);

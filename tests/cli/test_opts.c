@@ -105,8 +105,12 @@ static int parse_with(const cli_command *cmd, const char *line, cli_args *args) 
 
 static fixture g_f;
 static cli_opt g_grp[3], g_tab[20];
-static const cli_command g_cmd = {.name = "hearth test", .args = "ROOT", .min_args = 1,
-                                  .max_args = 1, .about = "Tests the parser.\n", .opts = g_tab,
+static const cli_command g_cmd = {.name = "hearth test",
+                                  .args = "ROOT",
+                                  .min_args = 1,
+                                  .max_args = 1,
+                                  .about = "Tests the parser.\n",
+                                  .opts = g_tab,
                                   .tail = "The end.\n"};
 
 /* parse with fresh defaults */
@@ -183,10 +187,14 @@ static void test_errors(void) {
   check_error("r --out o --ratio=0,5", "found '0,5'");
   check_error("r --out o --ratio nan", "found 'nan'");
   check_error("r --out o --mode=mean", "option --mode: expected max or robust, found 'mean'");
-  check_error("r --out o --items a,bad", "option --items: expected an item other than 'bad', found 'bad'");
-  check_error("r --out o --items a,b,c,d", "option --items: expected a comma-separated list of at most 3 items");
+  check_error("r --out o --items a,bad",
+              "option --items: expected an item other than 'bad', found 'bad'");
+  check_error("r --out o --items a,b,c,d",
+              "option --items: expected a comma-separated list of at most 3 items");
   check_error("r --out o --items ,", "option --items: expected a comma-separated list");
-  check_error("r --out o --range 2,1", "option --range: expected two comma-separated numbers, the first below the second, found '2,1'");
+  check_error(
+      "r --out o --range 2,1",
+      "option --range: expected two comma-separated numbers, the first below the second, found '2,1'");
   check_error("r --out o --range=1", "found '1'");
   check_error("r --out o --shard 3/3", "option --shard: expected I/N with 0 <= I < N, found '3/3'");
   check_error("r --out o --shard x/2", "found 'x/2'");
@@ -209,7 +217,10 @@ static void test_errors(void) {
 static void test_positional(void) {
   cli_args a;
   /* positional arguments may sit among the options; they keep their order */
-  const cli_command many = {.name = "hearth test", .args = "FILE", .min_args = 1, .max_args = -1,
+  const cli_command many = {.name = "hearth test",
+                            .args = "FILE",
+                            .min_args = 1,
+                            .max_args = -1,
                             .opts = g_tab};
   fixture_default(&g_f);
   make_table(&g_f, g_grp, g_tab);
@@ -218,7 +229,10 @@ static void test_positional(void) {
   CHECK(g_f.quiet == 1);
   CHECK(parse_with(&many, "--out o", &a) == 2 && strstr(g_err, "missing FILE"));
   /* an optional one */
-  const cli_command opt = {.name = "hearth test", .args = "DIR", .min_args = 0, .max_args = 1,
+  const cli_command opt = {.name = "hearth test",
+                           .args = "DIR",
+                           .min_args = 0,
+                           .max_args = 1,
                            .opts = g_tab};
   CHECK(parse_with(&opt, "--out o", &a) == CLI_RUN && a.n == 0);
   CHECK(parse_with(&opt, "--out o d", &a) == CLI_RUN && a.n == 1 && !strcmp(a.v[0], "d"));
@@ -226,8 +240,12 @@ static void test_positional(void) {
   const cli_command none = {.name = "hearth test", .opts = g_tab};
   CHECK(parse_with(&none, "--out o d", &a) == 2 && strstr(g_err, "unexpected argument 'd'"));
   /* a subcommand: the options end at the first positional argument */
-  const cli_command sub = {.name = "hearth test", .args = "COMMAND", .min_args = 1,
-                           .max_args = -1, .opts = g_tab, .stop_at_arg = 1};
+  const cli_command sub = {.name = "hearth test",
+                           .args = "COMMAND",
+                           .min_args = 1,
+                           .max_args = -1,
+                           .opts = g_tab,
+                           .stop_at_arg = 1};
   CHECK(parse_with(&sub, "--out o --quiet run --bogus --help", &a) == CLI_RUN);
   CHECK(a.n == 3 && !strcmp(a.v[0], "run") && !strcmp(a.v[1], "--bogus") &&
         !strcmp(a.v[2], "--help"));
@@ -248,17 +266,38 @@ static void test_help(void) {
 
   CHECK(parse("--help", &a) == 0);
   CHECK_MSG(!strncmp(g_out, "usage: hearth test ROOT --out DIR [options]\n\nTests the parser.\n",
-                     62), "%s", g_out);
+                     62),
+            "%s", g_out);
   /* every option with its metavar, help and default */
-  const char *want[] = {
-      "--quiet",        "say less",      "--level L",      "how much (default: 3)",
-      "-j, --jobs N",   "(default: one per core)",          "--resolution R", "(default: 1024)",
-      "--seed S",       "(default: 1)",  "--ratio X",      "(default: 0.5)",
-      "--name ID",      "--out DIR",     "(required)",     "--mode max|robust",
-      "(default: max)", "--items a,b",   "(default: none)", "--range LO,HI",
-      "--shard I/N",    "--word W",      "grouped options:", "--threads N",
-      "(default: all cores)", "--no-bake", "-h, --help",   "this text",
-      "The end.\n"};
+  const char *want[] = {"--quiet",
+                        "say less",
+                        "--level L",
+                        "how much (default: 3)",
+                        "-j, --jobs N",
+                        "(default: one per core)",
+                        "--resolution R",
+                        "(default: 1024)",
+                        "--seed S",
+                        "(default: 1)",
+                        "--ratio X",
+                        "(default: 0.5)",
+                        "--name ID",
+                        "--out DIR",
+                        "(required)",
+                        "--mode max|robust",
+                        "(default: max)",
+                        "--items a,b",
+                        "(default: none)",
+                        "--range LO,HI",
+                        "--shard I/N",
+                        "--word W",
+                        "grouped options:",
+                        "--threads N",
+                        "(default: all cores)",
+                        "--no-bake",
+                        "-h, --help",
+                        "this text",
+                        "The end.\n"};
   for (size_t k = 0; k < sizeof want / sizeof want[0]; k++)
     CHECK_MSG(strstr(g_out, want[k]) != NULL, "help lacks '%s':\n%s", want[k], g_out);
   /* no line is wider than 80 columns unless one word is */

@@ -68,10 +68,14 @@ int main(void) {
 
   /* bad options: usage status 2 and the option named */
   const char *bad[][2] = {
-      {"--views 31", "--views"},       {"--views x", "--views"},
-      {"--netd -1", "--netd"},         {"--bogus", "--bogus"},
-      {"--categories teapotx", "--categories"}, {"--states boiling", "--states"},
-      {"--seed", "--seed"},            {"--triangles 5", "--triangles"},
+      {"--views 31", "--views"},
+      {"--views x", "--views"},
+      {"--netd -1", "--netd"},
+      {"--bogus", "--bogus"},
+      {"--categories teapotx", "--categories"},
+      {"--states boiling", "--states"},
+      {"--seed", "--seed"},
+      {"--triangles 5", "--triangles"},
   };
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
     snprintf(cmd, sizeof cmd, "'%s' synth --out '%s/bad%zu' %s", HEARTH_EXE, base, i, bad[i][0]);

@@ -44,7 +44,8 @@ static const command_case k_cases[] = {
     {"map", 1, "--resolution", "abc",
      "--instance --state --resolution --fusion --min-cos --keep-edges --views --trace-rays "
      "--mesh --poses --rig --rgb --threads"},
-    {"overlay", 1, "--zoom", "0", "--instance --state --before --after --mesh --rig --zoom --range"},
+    {"overlay", 1, "--zoom", "0",
+     "--instance --state --before --after --mesh --rig --zoom --range"},
     {"build", 1, "--min-cos", "1",
      "-j --jobs --threads --shard --instance --resolution --fusion --min-cos --rgb-resolution "
      "--no-bake --no-overlays --force --dry-run --quiet"},

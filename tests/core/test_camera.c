@@ -223,8 +223,8 @@ int main(void) {
           double fd = (up[k] - um[k]) / (2 * h);
           double rel = fabs(fd - an[k]) / fmax(fmax(fabs(an[k]), gscale[g][k]), 1e-300);
           worst_rel = fmax(worst_rel, rel);
-          CHECK_MSG(rel < 1e-6, "%s: param %d row %d analytic %.12g fd %.12g",
-                    LENSES[li].name, p, k, an[k], fd);
+          CHECK_MSG(rel < 1e-6, "%s: param %d row %d analytic %.12g fd %.12g", LENSES[li].name, p,
+                    k, an[k], fd);
         }
       }
       /* the 2x2 distortion Jacobian */

@@ -55,12 +55,17 @@ int main(void) {
   CHECK(hearth_temp_parse("mask.npy.tmp-4711-Ab12Cd", &bl, &pid) && bl == 8 && pid == 4711);
   CHECK(hearth_temp_parse("hot.tmp-1-000000", &bl, &pid) && bl == 3 && pid == 1);
   CHECK(hearth_temp_parse("a.tmp-9-x.tmp-12-Zz9y8X", &bl, &pid) && bl == 9 && pid == 12);
-  CHECK(!hearth_temp_parse("mask.npy", NULL, NULL) && !hearth_temp_parse(".tmp-1-Ab12Cd", NULL, NULL));
-  CHECK(!hearth_temp_parse("a.tmp-1-Ab12C", NULL, NULL) && !hearth_temp_parse("a.tmp-1-Ab12Cde", NULL, NULL));
-  CHECK(!hearth_temp_parse("a.tmp-1-Ab_2Cd", NULL, NULL) && !hearth_temp_parse("a.tmp-Ab12Cd", NULL, NULL));
-  CHECK(!hearth_temp_parse("a.tmp--Ab12Cd", NULL, NULL) && !hearth_temp_parse("a.tmp-0-Ab12Cd", NULL, NULL));
+  CHECK(!hearth_temp_parse("mask.npy", NULL, NULL) &&
+        !hearth_temp_parse(".tmp-1-Ab12Cd", NULL, NULL));
+  CHECK(!hearth_temp_parse("a.tmp-1-Ab12C", NULL, NULL) &&
+        !hearth_temp_parse("a.tmp-1-Ab12Cde", NULL, NULL));
+  CHECK(!hearth_temp_parse("a.tmp-1-Ab_2Cd", NULL, NULL) &&
+        !hearth_temp_parse("a.tmp-Ab12Cd", NULL, NULL));
+  CHECK(!hearth_temp_parse("a.tmp--Ab12Cd", NULL, NULL) &&
+        !hearth_temp_parse("a.tmp-0-Ab12Cd", NULL, NULL));
   CHECK(!hearth_temp_parse("a.tmp-12345678901-Ab12Cd", NULL, NULL) &&
-        !hearth_temp_parse("a.tmp-1-Ab12Cd.png", NULL, NULL) && !hearth_temp_parse("hot.old-4242", NULL, NULL));
+        !hearth_temp_parse("a.tmp-1-Ab12Cd.png", NULL, NULL) &&
+        !hearth_temp_parse("hot.old-4242", NULL, NULL));
   /* temporaries made by the helpers have the pattern and this process's id */
   char tmp[1300];
   int fd = -1;
@@ -102,7 +107,8 @@ int main(void) {
   CHECK_OK(hearth_sweep_temps(sub, "c.png", 0, &removed, &err), &err);
   CHECK(removed == 0 && count_entries(sub) == 5);
   CHECK_OK(hearth_sweep_temps(sub, NULL, 1, &removed, &err), &err);
-  CHECK_MSG(removed == 3 && count_entries(sub) == 3, "removed %zu, %d left", removed, count_entries(sub));
+  CHECK_MSG(removed == 3 && count_entries(sub) == 3, "removed %zu, %d left", removed,
+            count_entries(sub));
   snprintf(p1, sizeof p1, "%s/deep/er/y.tmp-%ld-q9Z0xY", sub, dead);
   CHECK(hearth_path_exists(p1));
   removed = 0;
@@ -141,7 +147,8 @@ int main(void) {
   CHECK(hearth_read_file(p1, 100, &data, &n, &err) == HEARTH_E_IO);
   CHECK_MSG(strstr(err.msg, "fifo: not a regular file (a FIFO)") != NULL, "%s", err.msg);
   CHECK(hearth_check_regular(p1, &err) == HEARTH_E_IO && strstr(err.msg, "(a FIFO)"));
-  CHECK(hearth_read_file(dir, 100, &data, &n, &err) == HEARTH_E_IO && strstr(err.msg, "(a directory)"));
+  CHECK(hearth_read_file(dir, 100, &data, &n, &err) == HEARTH_E_IO &&
+        strstr(err.msg, "(a directory)"));
   CHECK(hearth_read_file("/dev/null", 100, &data, &n, &err) == HEARTH_E_IO &&
         strstr(err.msg, "(a character device)"));
   CHECK(hearth_check_regular(path, &err) == HEARTH_OK);

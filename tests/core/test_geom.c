@@ -15,11 +15,23 @@ static void axis_rotation(int axis, double a, double R[9]) {
   double c = cos(a), s = sin(a);
   for (int i = 0; i < 9; i++) R[i] = 0.0;
   if (axis == 0) {
-    R[0] = 1; R[4] = c; R[5] = -s; R[7] = s; R[8] = c;
+    R[0] = 1;
+    R[4] = c;
+    R[5] = -s;
+    R[7] = s;
+    R[8] = c;
   } else if (axis == 1) {
-    R[4] = 1; R[0] = c; R[2] = s; R[6] = -s; R[8] = c;
+    R[4] = 1;
+    R[0] = c;
+    R[2] = s;
+    R[6] = -s;
+    R[8] = c;
   } else {
-    R[8] = 1; R[0] = c; R[1] = -s; R[3] = s; R[4] = c;
+    R[8] = 1;
+    R[0] = c;
+    R[1] = -s;
+    R[3] = s;
+    R[4] = c;
   }
 }
 
@@ -135,8 +147,8 @@ int main(void) {
       hearth_rotvec_to_matrix(wm, Rm);
       for (int e = 0; e < 9; e++) {
         double fd = (Rp[e] - Rm[e]) / (2 * h);
-        CHECK_MSG(fabs(fd - dR[k * 9 + e]) < 1e-8, "dR[%d][%d] %g vs fd %g", k, e,
-                  dR[k * 9 + e], fd);
+        CHECK_MSG(fabs(fd - dR[k * 9 + e]) < 1e-8, "dR[%d][%d] %g vs fd %g", k, e, dR[k * 9 + e],
+                  fd);
       }
     }
   }

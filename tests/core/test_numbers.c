@@ -13,7 +13,8 @@ typedef struct chunk_seen {
 
 static void chunk_range(void *ctx, size_t b, size_t e, int t) {
   chunk_seen *cs = ctx;
-  if (t < 0 || t >= cs->nt || b >= e || b % cs->chunk || (e - b != cs->chunk && e != 1000)) atomic_store(&cs->bad, 1);
+  if (t < 0 || t >= cs->nt || b >= e || b % cs->chunk || (e - b != cs->chunk && e != 1000))
+    atomic_store(&cs->bad, 1);
   for (size_t i = b; i < e && i < 1000; i++) atomic_fetch_add(&cs->hits[i], 1);
 }
 

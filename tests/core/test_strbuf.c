@@ -35,7 +35,8 @@ int main(void) {
   }
   CHECK(b.len == expect && strlen(b.data) == expect && !b.failed);
   int ok = 1;
-  for (int i = 0; i < 10000 && ok; i++) ok = b.data[5001 + 2 * i] == '0' + i % 10 && b.data[5002 + 2 * i] == ';';
+  for (int i = 0; i < 10000 && ok; i++)
+    ok = b.data[5001 + 2 * i] == '0' + i % 10 && b.data[5002 + 2 * i] == ';';
   CHECK(ok);
 
   /* take hands over the text and leaves the buffer empty and reusable */

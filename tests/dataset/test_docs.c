@@ -139,7 +139,8 @@ static hearth_poses sample_poses(void) {
   for (size_t i = 0; i < p.n; i++) {
     snprintf(p.views[i].state, sizeof p.views[i].state, "%s", i < 3 ? "hot" : "iced");
     snprintf(p.views[i].view, sizeof p.views[i].view, "v%02zu", i % 3);
-    p.views[i].T_world_from_cam = rigid(0.3 * (double)i, 1.0 - 0.2 * (double)i, 0.7, 0.5 + 0.1 * (double)i);
+    p.views[i].T_world_from_cam =
+        rigid(0.3 * (double)i, 1.0 - 0.2 * (double)i, 0.7, 0.5 + 0.1 * (double)i);
   }
   return p;
 }
@@ -184,8 +185,13 @@ static void test_round_trips(void) {
   /* keys in the spec's order, 2-space indent, short numbers stay short */
   char *text = slurp(tpath("rig.json"), NULL);
   CHECK(text && strncmp(text, "{\n  \"rgb\": {\n    \"width\": 1920,", 30) == 0);
-  const char *order[] = {"\"rgb\"", "\"thermal\"", "\"depth\"", "\"T_thermal_from_rgb\"",
-                         "\"T_depth_from_rgb\"", "\"thermal_rms_px\"", "\"stereo_rms_px\""};
+  const char *order[] = {"\"rgb\"",
+                         "\"thermal\"",
+                         "\"depth\"",
+                         "\"T_thermal_from_rgb\"",
+                         "\"T_depth_from_rgb\"",
+                         "\"thermal_rms_px\"",
+                         "\"stereo_rms_px\""};
   const char *prev = text;
   for (int i = 0; i < 7 && text; i++) {
     const char *at = strstr(text, order[i]);
@@ -282,8 +288,7 @@ static void test_round_trips(void) {
   CHECK_OK(hearth_release_read(tpath("release.json"), &rel2, &err), &err);
   CHECK(rel2.n_instances == 3 && !strcmp(rel2.name, rel.name) &&
         !strcmp(rel2.version, rel.version) && !strcmp(rel2.software_version, "0.1.0"));
-  for (size_t i = 0; i < 3 && i < rel2.n_instances; i++)
-    CHECK(!strcmp(rel2.instances[i], ids[i]));
+  for (size_t i = 0; i < 3 && i < rel2.n_instances; i++) CHECK(!strcmp(rel2.instances[i], ids[i]));
   hearth_release_free(&rel2);
 
   hearth_manifest_free(&m);
@@ -294,8 +299,18 @@ static void test_round_trips(void) {
 /* awkward doubles survive a write/read bit for bit */
 static void test_exact_numbers(void) {
   hearth_err err = {0};
-  double vals[] = {0.1, 1.0 / 3.0, 2.0 / 3.0, 1e-300, 4.9e-324, 1.7976931348623157e308,
-                   123456789.123456789, -0.0, 5e-324 * 3, 0.30000000000000004, 1e22, 1e21};
+  double vals[] = {0.1,
+                   1.0 / 3.0,
+                   2.0 / 3.0,
+                   1e-300,
+                   4.9e-324,
+                   1.7976931348623157e308,
+                   123456789.123456789,
+                   -0.0,
+                   5e-324 * 3,
+                   0.30000000000000004,
+                   1e22,
+                   1e21};
   size_t n = sizeof vals / sizeof vals[0];
   hearth_detections d;
   d.n = 1;
@@ -313,8 +328,8 @@ static void test_exact_numbers(void) {
   if (d2.n == 1) {
     for (int i = 0; i < HEARTH_PLATE_HOLES; i++)
       for (int k = 0; k < 2; k++)
-        CHECK_MSG(memcmp(&d.frames[0].centres[i][k], &d2.frames[0].centres[i][k],
-                         sizeof(double)) == 0,
+        CHECK_MSG(memcmp(&d.frames[0].centres[i][k], &d2.frames[0].centres[i][k], sizeof(double)) ==
+                      0,
                   "centre %d/%d: %.17g became %.17g", i, k, d.frames[0].centres[i][k],
                   d2.frames[0].centres[i][k]);
   }
@@ -367,10 +382,11 @@ static void test_plate(void) {
 }
 
 static void test_names(void) {
-  const char *cats[18] = {"sponge", "eraser", "bottled_drink", "tissue", "headset", "storage_bag",
-                          "glasses_case", "smartphone", "canned_drink", "mouse", "pillow",
-                          "wallet", "cup", "pot", "cushion", "electric_kettle", "orange",
-                          "laptop"};
+  const char *cats[18] = {"sponge",       "eraser",      "bottled_drink", "tissue",
+                          "headset",      "storage_bag", "glasses_case",  "smartphone",
+                          "canned_drink", "mouse",       "pillow",        "wallet",
+                          "cup",          "pot",         "cushion",       "electric_kettle",
+                          "orange",       "laptop"};
   for (int i = 0; i < 18; i++) {
     CHECK(hearth_category_valid(cats[i]));
     int seen = 0;
@@ -476,8 +492,7 @@ static hearth_status rd_release(const char *p, hearth_err *e) {
 static void run_bad(const char *label, const char *valid, reader_fn rd, const bad_case *cases,
                     size_t n) {
   hearth_err err = {0};
-  CHECK_MSG(rd(tpath(valid), &err) == HEARTH_OK, "%s: valid document refused: %s", label,
-            err.msg);
+  CHECK_MSG(rd(tpath(valid), &err) == HEARTH_OK, "%s: valid document refused: %s", label, err.msg);
   for (size_t k = 0; k < n; k++) {
     const bad_case *bc = &cases[k];
     json_error_t je;
@@ -497,10 +512,8 @@ static void run_bad(const char *label, const char *valid, reader_fn rd, const ba
     }
     json_t *v = bc->value ? json_loads(bc->value, JSON_DECODE_ANY, &je) : NULL;
     CHECK_MSG(!bc->value || v, "%s: bad test value %s", label, bc->value);
-    if (is_index)
-      v ? json_array_set_new(parent, idx, v) : json_array_remove(parent, idx);
-    else
-      v ? json_object_set_new(parent, key, v) : json_object_del(parent, key);
+    if (is_index) v ? json_array_set_new(parent, idx, v) : json_array_remove(parent, idx);
+    else v ? json_object_set_new(parent, key, v) : json_object_del(parent, key);
     char name[128];
     snprintf(name, sizeof name, "bad_%s_%zu.json", label, k);
     const char *path = tpath(name);
@@ -716,8 +729,10 @@ static void test_instance_load(void) {
   CHECK_OK(hearth_instance_write(path, &in, &err), &err);
   snprintf(dir, sizeof dir, "%s/load", g_dir);
   CHECK(hearth_instance_load(dir, "cup_03", &back, &err) == HEARTH_E_INCONSISTENT);
-  CHECK_MSG(strstr(err.msg, "cup_03/instance.json: id: \"cup_04\", but the directory is "
-                            "instances/cup_03"), "%s", err.msg);
+  CHECK_MSG(strstr(err.msg,
+                   "cup_03/instance.json: id: \"cup_04\", but the directory is "
+                   "instances/cup_03"),
+            "%s", err.msg);
   snprintf(in.id, sizeof in.id, "cup_03");
   CHECK_OK(hearth_instance_write(path, &in, &err), &err);
   CHECK_OK(hearth_instance_load(dir, "cup_03", &back, &err), &err);
@@ -741,8 +756,8 @@ static void test_writer_refusals(void) {
   p.views[2].T_world_from_cam.R[4] = 3.0;
   snprintf(path, sizeof path, "%s/poses.json", sub);
   CHECK(hearth_poses_write(path, &p, &err) == HEARTH_E_RANGE);
-  CHECK_MSG(strstr(err.msg, "views[2].T_world_from_cam") && strstr(err.msg, "not a rotation"),
-            "%s", err.msg);
+  CHECK_MSG(strstr(err.msg, "views[2].T_world_from_cam") && strstr(err.msg, "not a rotation"), "%s",
+            err.msg);
   hearth_poses_free(&p);
 
   hearth_manifest m = sample_manifest();

@@ -24,7 +24,8 @@ static void make_release(void) {
   hearth_synth_opts so;
   hearth_synth_opts_default(&so);
   so.out_root = g_root;
-  const char *cats[] = {"cup", "canned_drink", "electric_kettle", "eraser", "orange", "smartphone", "sponge"};
+  const char *cats[] = {"cup",    "canned_drink", "electric_kettle", "eraser",
+                        "orange", "smartphone",   "sponge"};
   so.n_categories = 7;
   for (int i = 0; i < 7; i++) so.categories[i] = cats[i];
   so.n_states = 3;
@@ -62,7 +63,8 @@ static void test_oracle(void) {
     for (int i = 0; i < 2; i++)
       CHECK_MSG(pi[t][i] >= 0.95, "oracle H%d instruction %d: %.2f", t, i + 1, pi[t][i]);
   /* held-out layouts, both instructions on the same layout */
-  for (size_t k = 0; k < r.n; k++) CHECK(r.eps[k].layout == HEARTH_EVAL_LAYOUT_BASE + (uint64_t)r.eps[k].episode);
+  for (size_t k = 0; k < r.n; k++)
+    CHECK(r.eps[k].layout == HEARTH_EVAL_LAYOUT_BASE + (uint64_t)r.eps[k].episode);
   char *txt = hearth_eval_format_text(&r);
   CHECK(txt != NULL);
   if (txt) {
@@ -107,8 +109,8 @@ static void test_replay(const char *demo) {
   CHECK(r.n == 2);
   for (size_t k = 0; k < r.n; k++) {
     CHECK_MSG(r.eps[k].success, "replay of demo %d: %s", r.eps[k].episode, r.eps[k].reason);
-    CHECK_MSG(r.eps[k].state_diff == 0.0, "replay of demo %d: states differ by %g", r.eps[k].episode,
-              r.eps[k].state_diff);
+    CHECK_MSG(r.eps[k].state_diff == 0.0, "replay of demo %d: states differ by %g",
+              r.eps[k].episode, r.eps[k].state_diff);
     CHECK(r.eps[k].layout == 0 && r.eps[k].instruction == r.eps[k].episode);
   }
   hearth_eval_results_free(&r);
@@ -201,13 +203,15 @@ static void test_ws_demo(const char *demo) {
     CHECK_MSG(r.eps[k].success, "ws demo instr %d: %s", r.eps[k].instruction + 1, r.eps[k].reason);
     want_req += (r.eps[k].steps + 4) / 5;
   }
-  CHECK_MSG(count_lines(s.log) == want_req, "server saw %d requests, expected %d", count_lines(s.log), want_req);
+  CHECK_MSG(count_lines(s.log) == want_req, "server saw %d requests, expected %d",
+            count_lines(s.log), want_req);
   hearth_eval_results_free(&r);
   stop_server(&s);
 }
 
 /* misbehaving servers: the first connection's 2nd request goes wrong */
-static void test_ws_failure(const char *mode, const char *want, int thermal_client, int thermal_server) {
+static void test_ws_failure(const char *mode, const char *want, int thermal_client,
+                            int thermal_server) {
   server s = {0};
   char th[8];
   snprintf(th, sizeof th, "%d", thermal_server);
@@ -232,14 +236,15 @@ static void test_ws_failure(const char *mode, const char *want, int thermal_clie
                 "mode %s: episode 1 reason \"%s\", expected \"%s\"", mode, r.eps[0].reason, want);
       /* the evaluation went on with a fresh connection (a key mismatch fails every request) */
       if (strcmp(mode, "ok") == 0)
-        CHECK_MSG(r.eps[1].error && strstr(r.eps[1].reason, want), "mode %s: episode 2: %s", mode, r.eps[1].reason);
-      else
-        CHECK_MSG(!r.eps[1].error && strstr(r.eps[1].reason, "time limit"), "mode %s: episode 2: %s", mode,
+        CHECK_MSG(r.eps[1].error && strstr(r.eps[1].reason, want), "mode %s: episode 2: %s", mode,
                   r.eps[1].reason);
+      else
+        CHECK_MSG(!r.eps[1].error && strstr(r.eps[1].reason, "time limit"),
+                  "mode %s: episode 2: %s", mode, r.eps[1].reason);
     } else {
       for (int k = 0; k < 2; k++)
-        CHECK_MSG(!r.eps[k].error && strstr(r.eps[k].reason, "time limit"), "mode %s: episode %d: %s", mode, k,
-                  r.eps[k].reason);
+        CHECK_MSG(!r.eps[k].error && strstr(r.eps[k].reason, "time limit"),
+                  "mode %s: episode %d: %s", mode, k, r.eps[k].reason);
       /* 12 policy steps with replan 5: 3 requests per episode */
       CHECK(count_lines(s.log) == 6);
     }
@@ -251,7 +256,8 @@ static void test_ws_failure(const char *mode, const char *want, int thermal_clie
 /* the server's metadata held against the thermal condition: a server that
  * declares it ignores the thermal view is refused before any episode, one
  * that declares nothing is "unknown", never silently "w/" */
-static void test_ws_thermal(const char *decl, const char *keys, int thermal, hearth_status want_st, int want_used) {
+static void test_ws_thermal(const char *decl, const char *keys, int thermal, hearth_status want_st,
+                            int want_used) {
   server s = {0};
   char th[8];
   snprintf(th, sizeof th, "%d", thermal);
@@ -273,22 +279,27 @@ static void test_ws_thermal(const char *decl, const char *keys, int thermal, hea
   hearth_err err = {0};
   hearth_status st = hearth_eval_run(&o, &r, &err);
   if (want_st) {
-    CHECK_MSG(st == want_st && strstr(err.msg, "ignores the thermal view") && strstr(err.msg, "--no-thermal"),
+    CHECK_MSG(st == want_st && strstr(err.msg, "ignores the thermal view") &&
+                  strstr(err.msg, "--no-thermal"),
               "decl %s keys %s: %s", decl, keys ? keys : "-", err.msg);
     CHECK_MSG(count_lines(s.log) == 0, "the server got requests before the refusal");
   } else {
     CHECK_OK(st, &err);
-    CHECK_MSG(r.thermal_used == want_used, "decl %s keys %s thermal %d: thermal_used %d, expected %d", decl,
-              keys ? keys : "-", thermal, r.thermal_used, want_used);
+    CHECK_MSG(r.thermal_used == want_used,
+              "decl %s keys %s thermal %d: thermal_used %d, expected %d", decl, keys ? keys : "-",
+              thermal, r.thermal_used, want_used);
     char *js = hearth_eval_format_json(&r), *txt = hearth_eval_format_text(&r);
-    const char *used = want_used < 0 ? "\"thermal_used\": \"unknown\"" : want_used ? "\"thermal_used\": true"
-                                                                           : "\"thermal_used\": false";
-    CHECK_MSG(js && strstr(js, used) && strstr(js, "\"server\": \"hearth-test\"") && strstr(js, "\"render_size\": 48") &&
-                  strstr(js, "\"image_size\": 32") && strstr(js, "\"replan_steps\": 5") && strstr(js, "\"renderer\": \"osmesa"),
+    const char *used = want_used < 0 ? "\"thermal_used\": \"unknown\""
+                       : want_used   ? "\"thermal_used\": true"
+                                     : "\"thermal_used\": false";
+    CHECK_MSG(js && strstr(js, used) && strstr(js, "\"server\": \"hearth-test\"") &&
+                  strstr(js, "\"render_size\": 48") && strstr(js, "\"image_size\": 32") &&
+                  strstr(js, "\"replan_steps\": 5") && strstr(js, "\"renderer\": \"osmesa"),
               "results.json: %s", js ? js : "(null)");
     const char *label = want_used < 0 ? "H1     w/?" : thermal ? "H1     w/ " : "H1     w/o";
-    CHECK_MSG(txt && strstr(txt, label) && strstr(txt, "server metadata: {\"server\":\"hearth-test\""), "text: %s",
-              txt ? txt : "(null)");
+    CHECK_MSG(txt && strstr(txt, label) &&
+                  strstr(txt, "server metadata: {\"server\":\"hearth-test\""),
+              "text: %s", txt ? txt : "(null)");
     CHECK(want_used >= 0 || (strstr(r.warning, "unknown") && txt && strstr(txt, "warning: ")));
     free(js), free(txt);
     hearth_eval_results_free(&r);
@@ -300,16 +311,19 @@ static void test_ws_thermal(const char *decl, const char *keys, int thermal, hea
  * server, and says so; results are written all the same */
 static void test_cli_all_policy_errors(void) {
   server s = {0};
-  const char *extra[] = {"--size", "32", "--mode", "error", "--bad-at", "0", "--bad-conn", "0", NULL};
+  const char *extra[] = {"--size", "32",         "--mode", "error", "--bad-at",
+                         "0",      "--bad-conn", "0",      NULL};
   if (!start_server(&s, "allbad", extra)) return;
   char cmd[4000], out[1300];
   snprintf(out, sizeof out, "%s/cli_eval", g_dir);
-  snprintf(cmd, sizeof cmd,
-           "'%s' sim eval --policy %s --release '%s' --ground-truth --task H1 --episodes 1 --size 48 --image-size 32 "
-           "--max-steps 6 --wait 1 --timeout 5 --quiet --out '%s' > '%s.log' 2>&1",
-           HEARTH_EXE, s.url, g_root, out, out);
+  snprintf(
+      cmd, sizeof cmd,
+      "'%s' sim eval --policy %s --release '%s' --ground-truth --task H1 --episodes 1 --size 48 --image-size 32 "
+      "--max-steps 6 --wait 1 --timeout 5 --quiet --out '%s' > '%s.log' 2>&1",
+      HEARTH_EXE, s.url, g_root, out, out);
   int rc = system(cmd);
-  CHECK_MSG(WIFEXITED(rc) && WEXITSTATUS(rc) == 1, "hearth sim eval exited %d", WIFEXITED(rc) ? WEXITSTATUS(rc) : -1);
+  CHECK_MSG(WIFEXITED(rc) && WEXITSTATUS(rc) == 1, "hearth sim eval exited %d",
+            WIFEXITED(rc) ? WEXITSTATUS(rc) : -1);
   char path[1400], buf[8192] = "";
   snprintf(path, sizeof path, "%s.log", out);
   FILE *f = fopen(path, "r");
@@ -350,7 +364,8 @@ static double crop_temp(const uint8_t *img, int w, const int b[4], const uint8_t
 /* choose a slot from one view: the candidate reading hotter / colder /
  * nearer room temperature as the instruction asks; a difference under 3 degC
  * is no evidence, so slot A */
-static int select_slot(const uint8_t *view, int w, int boxes[2][4], const char *instr, const uint8_t lut[256][3]) {
+static int select_slot(const uint8_t *view, int w, int boxes[2][4], const char *instr,
+                       const uint8_t lut[256][3]) {
   double t0 = crop_temp(view, w, boxes[0], lut), t1 = crop_temp(view, w, boxes[1], lut);
   if (fabs(t0 - t1) < 3) return 0;
   if (strstr(instr, "hot")) return t1 > t0;
@@ -391,7 +406,8 @@ static void test_probe(void) {
       }
     double acc_rgb = (double)right[0] / n, acc_th = (double)right[1] / n;
     printf("probe H%d: RGB-only %.3f, thermal %.3f over %d choices\n", task, acc_rgb, acc_th, n);
-    CHECK_MSG(acc_rgb >= 0.3 && acc_rgb <= 0.7, "H%d: RGB-only selector at %.2f, expected chance", task, acc_rgb);
+    CHECK_MSG(acc_rgb >= 0.3 && acc_rgb <= 0.7, "H%d: RGB-only selector at %.2f, expected chance",
+              task, acc_rgb);
     CHECK_MSG(acc_th >= 0.95, "H%d: thermal selector at %.2f", task, acc_th);
     hearth_sim_env_free(e);
   }
@@ -423,8 +439,8 @@ int main(void) {
   test_ws_demo(demo);
   stamp("test_ws_demo(demo);");
   test_ws_failure("ok", NULL, 1, 1);
-  test_ws_failure("ok", NULL, 0, 0);                        /* the RGB-only condition */
-  test_ws_failure("ok", "observation keys", 0, 1);          /* the server checks the keys */
+  test_ws_failure("ok", NULL, 0, 0);               /* the RGB-only condition */
+  test_ws_failure("ok", "observation keys", 0, 1); /* the server checks the keys */
   test_ws_failure("error", "1011", 1, 1);
   test_ws_failure("disconnect", "closed the connection", 1, 1);
   test_ws_failure("garbage", "msgpack", 1, 1);
@@ -438,7 +454,8 @@ int main(void) {
   test_ws_thermal("none", "observation/image,observation/wrist_image", 1, HEARTH_E_ARG, 0);
   test_ws_thermal("none", NULL, 1, HEARTH_OK, -1); /* a stock server */
   test_ws_thermal("true", NULL, 1, HEARTH_OK, 1);
-  test_ws_thermal("none", "observation/image,observation/wrist_image,observation/thermal_image", 1, HEARTH_OK, 1);
+  test_ws_thermal("none", "observation/image,observation/wrist_image,observation/thermal_image", 1,
+                  HEARTH_OK, 1);
   test_ws_thermal("false", NULL, 0, HEARTH_OK, 0); /* the RGB-only condition */
   stamp("ws metadata");
   test_cli_all_policy_errors();

@@ -164,8 +164,10 @@ static void faults_run_all(const char *suite, const fault_case *cases, size_t n)
       CHECK_MSG(0, "%s: no answer within %.0f s (hang): %s", c->name, tmo, c->command);
       continue;
     }
-    if (c->expect_success) CHECK_MSG(st == 0, "%s: exit %d, expected success: %s", c->name, st, out);
-    else CHECK_MSG(st >= 1 && st < 128, "%s: exit %d, expected a clean failure: %s", c->name, st, out);
+    if (c->expect_success)
+      CHECK_MSG(st == 0, "%s: exit %d, expected success: %s", c->name, st, out);
+    else
+      CHECK_MSG(st >= 1 && st < 128, "%s: exit %d, expected a clean failure: %s", c->name, st, out);
     for (int k = 0; k < FAULT_MAX_NEEDLES && c->needles[k]; k++)
       CHECK_MSG(strstr(out, c->needles[k]) != NULL, "%s: output lacks \"%s\": %s", c->name,
                 c->needles[k], out);

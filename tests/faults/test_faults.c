@@ -92,12 +92,14 @@ static const fault_case k_cases[] = {
     {"dup_depth_build",
      COPY "sed -i 's|\"depth/v15.png\"|\"./depth/v00.png\"|' $I/raw/hot/manifest.json",
      "$HEARTH build R --resolution 32 --threads 2",
-     {"raw/hot/manifest.json: views[1].depth:", "names \"./depth/v00.png\", the file of view \"v00\""},
+     {"raw/hot/manifest.json: views[1].depth:",
+      "names \"./depth/v00.png\", the file of view \"v00\""},
      {TEMPS, STAMP_TEMPS},
      20},
     {"factory_size_calibrate",
-     COPY "sed -i '0,/\"width\": 1920/s//\"width\": 1280/' R/calibration/factory.json && "
-          "rm R/calibration/rig.json R/calibration/rig_opencv.yaml R/calibration/calibration_report.json",
+     COPY
+     "sed -i '0,/\"width\": 1920/s//\"width\": 1280/' R/calibration/factory.json && "
+     "rm R/calibration/rig.json R/calibration/rig_opencv.yaml R/calibration/calibration_report.json",
      "$HEARTH calibrate R",
      {"calibration/factory.json: the colour camera is 1280x1080, but capture",
       "captures/stereo/p000_rgb.jpg is 1920x1080"},
@@ -118,7 +120,8 @@ static const fault_case k_cases[] = {
      20},
     /* the rig is what disagrees with every CSV: blamed, not the CSV */
     {"rig_thermal_width_map",
-     COPY "sed -i '/\"thermal\"/,/\"width\"/s/\"width\": 256/\"width\": 320/' R/calibration/rig.json",
+     COPY
+     "sed -i '/\"thermal\"/,/\"width\"/s/\"width\": 256/\"width\": 320/' R/calibration/rig.json",
      "$HEARTH map R --state hot --resolution 32 --threads 2",
      {"calibration/rig.json: the thermal camera is 320x192, but",
       "thermal/v00.csv is a 256x192 matrix"},
@@ -129,8 +132,9 @@ static const fault_case k_cases[] = {
     /* the bake reads the first state's colour views: a broken one must not
        leave hot re-mapped */
     {"map_rgb_bad_bake",
-     COPY "head -c 2000 $I/raw/neutral/rgb/v15.jpg > x.jpg && mv x.jpg $I/raw/neutral/rgb/v15.jpg && "
-          "ls -i $I/derived/hot/* $I/derived/rgb_texture.png $I/derived/mesh.glb > before",
+     COPY
+     "head -c 2000 $I/raw/neutral/rgb/v15.jpg > x.jpg && mv x.jpg $I/raw/neutral/rgb/v15.jpg && "
+     "ls -i $I/derived/hot/* $I/derived/rgb_texture.png $I/derived/mesh.glb > before",
      "$HEARTH map R --rgb --state hot --resolution 32 --threads 2; rc=$?; "
      "ls -i R/instances/cup_01/derived/hot/* R/instances/cup_01/derived/rgb_texture.png "
      "R/instances/cup_01/derived/mesh.glb > after; "
@@ -140,8 +144,9 @@ static const fault_case k_cases[] = {
      30},
     /* a map that fails after a good bake must not leave the texture re-baked */
     {"map_rgb_bad_map",
-     COPY "head -c 300 $I/raw/hot/thermal/v15.csv > x.csv && mv x.csv $I/raw/hot/thermal/v15.csv && "
-          "ls -i $I/derived/hot/* $I/derived/rgb_texture.png $I/derived/mesh.glb > before",
+     COPY
+     "head -c 300 $I/raw/hot/thermal/v15.csv > x.csv && mv x.csv $I/raw/hot/thermal/v15.csv && "
+     "ls -i $I/derived/hot/* $I/derived/rgb_texture.png $I/derived/mesh.glb > before",
      "$HEARTH map R --rgb --state hot --resolution 32 --threads 2; rc=$?; "
      "ls -i R/instances/cup_01/derived/hot/* R/instances/cup_01/derived/rgb_texture.png "
      "R/instances/cup_01/derived/mesh.glb > after; "
@@ -154,14 +159,16 @@ static const fault_case k_cases[] = {
     /* an up-to-date build removes dead writers' temporaries anywhere in its
        instances and calibration/, and keeps a running writer's */
     {"leftover_build_uptodate",
-     COPY DEAD "D=$I/derived && mkdir $D/hot.tmp-$dead-Qw3Er5 && touch $D/hot.tmp-$dead-Qw3Er5/mask.npy "
-          "$D/rgb_texture.png.tmp-$dead-Ab12Cd $D/.stamps/map-hot.json.tmp-$dead-q9Z0xY "
-          "$D/overlay/hot/contact_sheet.png.tmp-$dead-Zz9y8X R/calibration/rig.json.tmp-$dead-Zz9y8X",
+     COPY DEAD
+     "D=$I/derived && mkdir $D/hot.tmp-$dead-Qw3Er5 && touch $D/hot.tmp-$dead-Qw3Er5/mask.npy "
+     "$D/rgb_texture.png.tmp-$dead-Ab12Cd $D/.stamps/map-hot.json.tmp-$dead-q9Z0xY "
+     "$D/overlay/hot/contact_sheet.png.tmp-$dead-Zz9y8X R/calibration/rig.json.tmp-$dead-Zz9y8X",
      "D=R/instances/cup_01/derived && mkdir $D/neutral.tmp-$$-AbCdEf && "
      "$HEARTH build R --resolution 32 --threads 2 && test -d $D/neutral.tmp-$$-AbCdEf && "
      "rmdir $D/neutral.tmp-$$-AbCdEf",
      {" 0 stage(s) run", "removed 5 temporary file(s)/folder(s)"},
-     {TEMPS, STAMP_TEMPS, "R/instances/cup_01/derived/overlay/hot/*.tmp-*", "R/calibration/*.tmp-*"},
+     {TEMPS, STAMP_TEMPS, "R/instances/cup_01/derived/overlay/hot/*.tmp-*",
+      "R/calibration/*.tmp-*"},
      30,
      0,
      1},
@@ -173,7 +180,7 @@ static const fault_case k_cases[] = {
      20},
     {"leftover_map_rerun",
      COPY DEAD "mkdir $I/derived/hot.tmp-$dead-Qw3Er5 $I/derived/hot.tmp-$dead-Old000 && "
-          "touch $I/derived/hot.tmp-$dead-Qw3Er5/mask.npy",
+               "touch $I/derived/hot.tmp-$dead-Qw3Er5/mask.npy",
      "$HEARTH map R --state hot --resolution 32 --threads 2",
      {"map cup_01/hot:"},
      {TEMPS},
@@ -217,7 +224,7 @@ static const fault_case k_cases[] = {
      20},
     {"glb_huge_bad_length_scale",
      COPY "printf 'glTF\\002\\000\\000\\000\\144\\000\\000\\000' > $I/recon/mesh.glb && "
-     "truncate -s 3G $I/recon/mesh.glb",
+          "truncate -s 3G $I/recon/mesh.glb",
      "$HEARTH scale R --threads 2",
      {"recon/mesh.glb: header: length field 100 does not match the file size 3221225472"},
      {TEMPS},
@@ -304,7 +311,8 @@ static int write_huge_png(const char *path) {
   put32(q, (uint32_t)crc32(0L, chunk + 4, (uInt)(4 + n)));
   free(b);
   static const uint8_t sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-  uint8_t ihdr[25] = {0, 0, 0, 13, 'I', 'H', 'D', 'R', 0, 0, 0x40, 0, 0, 0, 0x40, 0, 16, 6, 0, 0, 0};
+  uint8_t ihdr[25] = {0, 0, 0, 13,   'I', 'H', 'D', 'R', 0, 0, 0x40,
+                      0, 0, 0, 0x40, 0,   16,  6,   0,   0, 0};
   put32(ihdr + 21, (uint32_t)crc32(0L, ihdr + 4, 17));
   FILE *f = fopen(path, "wb");
   int bad = !f || fwrite(sig, 1, 8, f) != 8 || fwrite(ihdr, 1, 25, f) != 25 ||

@@ -11,12 +11,12 @@
 #include "hearth/hearth.h"
 
 static int failures = 0;
-#define EXPECT(cond)                                                        \
-  do {                                                                      \
-    if (!(cond)) {                                                          \
-      fprintf(stderr, "outside.c:%d: expected %s\n", __LINE__, #cond);      \
-      failures++;                                                           \
-    }                                                                       \
+#define EXPECT(cond)                                                   \
+  do {                                                                 \
+    if (!(cond)) {                                                     \
+      fprintf(stderr, "outside.c:%d: expected %s\n", __LINE__, #cond); \
+      failures++;                                                      \
+    }                                                                  \
   } while (0)
 
 /* core + io: a 4 x 3 thermal CSV written and read back */

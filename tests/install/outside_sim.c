@@ -11,12 +11,12 @@
 
 int main(void) {
   int failures = 0;
-#define EXPECT(cond)                                                        \
-  do {                                                                      \
-    if (!(cond)) {                                                          \
-      fprintf(stderr, "outside_sim.c:%d: expected %s\n", __LINE__, #cond);  \
-      failures++;                                                           \
-    }                                                                       \
+#define EXPECT(cond)                                                       \
+  do {                                                                     \
+    if (!(cond)) {                                                         \
+      fprintf(stderr, "outside_sim.c:%d: expected %s\n", __LINE__, #cond); \
+      failures++;                                                          \
+    }                                                                      \
   } while (0)
   EXPECT(hearth_sim_task_parse("h2") == HEARTH_SIM_H2);
   EXPECT(!strcmp(hearth_sim_task_name(HEARTH_SIM_H3), "H3"));

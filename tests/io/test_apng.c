@@ -82,8 +82,10 @@ static void check_file(const uint8_t *p, size_t n, size_t w, size_t h, int frame
     } else if (memcmp(type, "fcTL", 4) == 0) {
       CHECK(len == 26);
       if (be32(data) != seq++) bad_seq++;
-      CHECK(be32(data + 4) == w && be32(data + 8) == h && be32(data + 12) == 0 && be32(data + 16) == 0);
-      CHECK(data[20] == 0 && data[21] == 1 && data[22] == 0 && data[23] == 10 && data[24] == 0 && data[25] == 0);
+      CHECK(be32(data + 4) == w && be32(data + 8) == h && be32(data + 12) == 0 &&
+            be32(data + 16) == 0);
+      CHECK(data[20] == 0 && data[21] == 1 && data[22] == 0 && data[23] == 10 && data[24] == 0 &&
+            data[25] == 0);
       fctl++;
     } else if (memcmp(type, "IDAT", 4) == 0) {
       CHECK(fctl == 1 && fdat == 0);
@@ -95,7 +97,8 @@ static void check_file(const uint8_t *p, size_t n, size_t w, size_t h, int frame
       uint8_t *png = plain_png(ihdr, data + 4, len - 4, &pn);
       hearth_image im = {0};
       hearth_err err = {0};
-      if (hearth_png_read_mem(png, pn, "frame", &im, &err) || !same_pixels(&im, w, h, fdat + 1)) bad_frame++;
+      if (hearth_png_read_mem(png, pn, "frame", &im, &err) || !same_pixels(&im, w, h, fdat + 1))
+        bad_frame++;
       hearth_image_free(&im);
       free(png);
       fdat++;
@@ -136,8 +139,8 @@ static void check_size(size_t w, size_t h, int frames) {
 int main(void) {
   check_size(1, 1, 1);
   check_size(5, 4, 3);
-  check_size(1456, 15, 2);  /* 65535 filtered bytes: one full stored block */
-  check_size(1456, 16, 2);  /* 69904: two blocks */
+  check_size(1456, 15, 2); /* 65535 filtered bytes: one full stored block */
+  check_size(1456, 16, 2); /* 69904: two blocks */
   check_size(200, 110, 3);
 
   /* the exact bytes of a fixed input (size and CRC-32 of the whole file):
@@ -146,8 +149,8 @@ int main(void) {
   size_t n = 0;
   hearth_err err = {0};
   CHECK_OK(hearth_apng_encode(f, 48, 16, 4, 1, 10, &out, &n, &err), &err);
-  CHECK_MSG(n == 9601 && crc32(crc32(0, Z_NULL, 0), out, (uInt)n) == 0x310b1300u, "size %zu crc %08lx", n,
-            crc32(crc32(0, Z_NULL, 0), out, (uInt)n));
+  CHECK_MSG(n == 9601 && crc32(crc32(0, Z_NULL, 0), out, (uInt)n) == 0x310b1300u,
+            "size %zu crc %08lx", n, crc32(crc32(0, Z_NULL, 0), out, (uInt)n));
   free(out);
 
   /* the file on disk is the same */

@@ -92,11 +92,16 @@ static void test_variants(void) {
     const char *eol;
     int trailing;
   } v[] = {
-      {"canonical", ',', '.', 0, "\n", 0},     {"semicolon-dot", ';', '.', 0, "\n", 0},
-      {"semicolon-comma", ';', ',', 0, "\n", 0}, {"tab-dot", '\t', '.', 0, "\n", 0},
-      {"tab-comma", '\t', ',', 0, "\n", 0},     {"quoted-dot", ',', '.', 1, "\n", 0},
-      {"quoted-comma", ',', ',', 1, "\n", 0},   {"quoted-semicolon", ';', ',', 1, "\n", 0},
-      {"crlf", ',', '.', 0, "\r\n", 0},         {"trailing-sep", ',', '.', 0, "\n", 1},
+      {"canonical", ',', '.', 0, "\n", 0},
+      {"semicolon-dot", ';', '.', 0, "\n", 0},
+      {"semicolon-comma", ';', ',', 0, "\n", 0},
+      {"tab-dot", '\t', '.', 0, "\n", 0},
+      {"tab-comma", '\t', ',', 0, "\n", 0},
+      {"quoted-dot", ',', '.', 1, "\n", 0},
+      {"quoted-comma", ',', ',', 1, "\n", 0},
+      {"quoted-semicolon", ';', ',', 1, "\n", 0},
+      {"crlf", ',', '.', 0, "\r\n", 0},
+      {"trailing-sep", ',', '.', 0, "\n", 1},
       {"trailing-sep-semicolon-crlf", ';', ',', 0, "\r\n", 1},
   };
   for (size_t i = 0; i < sizeof v / sizeof v[0]; i++) {
@@ -109,10 +114,14 @@ static void test_variants(void) {
   /* BOM, header lines of several kinds, trailing empty lines */
   sbuf b = {0};
   sb_add(&b, "\xEF\xBB\xBF");
-  sb_add(&b, "Thermal export \xC2\xB0" "C, camera XYZ\r\n");
+  sb_add(&b,
+         "Thermal export \xC2\xB0"
+         "C, camera XYZ\r\n");
   sb_add(&b, "Date;2024-05-01 12:00:00\r\n");
   sb_add(&b, "Emissivity;0,95\r\n");
-  sb_add(&b, "Reflected temperature;20,0;\xC2\xB0" "C\r\n");
+  sb_add(&b,
+         "Reflected temperature;20,0;\xC2\xB0"
+         "C\r\n");
   sb_add(&b, "\r\n");
   sb_add(&b, "256;192\r\n"); /* a full numeric row of another width is a header */
   emit(&b, ';', ',', 0, "\r\n", 1);
@@ -215,9 +224,10 @@ static void test_parse_identity(void) {
         if (sign == 1 && form != 3) c[k++] = '-'; /* keep x10 values in range */
         if (sign == 2) c[k++] = '+';
         int ni = (int)(hearth_rng_u64(&r) % 3), nf = (int)(hearth_rng_u64(&r) % 19);
-        if (form == 0) ni = 0, nf = nf ? nf : 1;  /* ".5" */
-        k += snprintf(c + k, 8, "%d", ni == 0 ? 0 : (int)(hearth_rng_u64(&r) % (ni == 1 ? 10 : 49)));
-        if (form == 0) k = sign ? 1 : 0;          /* drop the 0 */
+        if (form == 0) ni = 0, nf = nf ? nf : 1; /* ".5" */
+        k +=
+            snprintf(c + k, 8, "%d", ni == 0 ? 0 : (int)(hearth_rng_u64(&r) % (ni == 1 ? 10 : 49)));
+        if (form == 0) k = sign ? 1 : 0; /* drop the 0 */
         if (form != 1) {
           c[k++] = dm;
           for (int i = 0; i < nf; i++) c[k++] = (char)('0' + hearth_rng_u64(&r) % 10);
@@ -299,8 +309,8 @@ static void test_rejections(void) {
   size_t n;
   char *t;
   /* NaN / infinity spellings at line 10, cell 5 -> column 31 */
-  const char *naninf[] = {"nan", "NaN", "-nan", "inf", "-Infinity", "+INF", "1.#INF", "-1.#IND",
-                          "\"NaN\""};
+  const char *naninf[] = {"nan",  "NaN",    "-nan",    "inf",    "-Infinity",
+                          "+INF", "1.#INF", "-1.#IND", "\"NaN\""};
   for (size_t i = 0; i < sizeof naninf / sizeof naninf[0]; i++) {
     t = with_cell(10, 5, naninf[i], &n);
     expect_reject(naninf[i], t, n, HEARTH_E_PARSE, 10, 31, "finite");
@@ -346,7 +356,9 @@ static void test_rejections(void) {
 
   /* garbage characters */
   const char *junk[] = {"20.0x", "2O.00", "20..0", "--1", "1e", "0x10", "20.00 C", "\"20.00\"x",
-                        "20\r00", "\xC2\xB0" "C",
+                        "20\r00",
+                        "\xC2\xB0"
+                        "C",
                         /* long and non-printable: the message excerpt is cut safely */
                         "\x01\x02\x03\x04\x05\x06\x07\x08\x0b\x0c\x0e\x0f\x10\x11\x12\x13\x14\x15"
                         "\x16\x17\x18\x19\x1a\x1b\x1c\x1d\x1e\x1f\x7f\x80\x81\x82"};
@@ -367,7 +379,8 @@ static void test_rejections(void) {
     sbuf b = {0};
     sb_add(&b, "\xEF\xBB\xBF");
     for (int y = 1; y <= H; y++) {
-      for (int x = 0; x < W; x++) sb_add(&b, "%s%s", x ? "," : "", y == 1 && x == 2 ? "?" : "20.00");
+      for (int x = 0; x < W; x++)
+        sb_add(&b, "%s%s", x ? "," : "", y == 1 && x == 2 ? "?" : "20.00");
       sb_add(&b, "\n");
     }
     expect_reject("bom-column", b.s, b.n, HEARTH_E_PARSE, 1, 13, NULL);
@@ -409,7 +422,8 @@ static void test_rejections(void) {
     sbuf b = {0};
     sb_add(&b, "Camera,XYZ\nEmissivity,0.95\n");
     for (int y = 1; y <= H; y++) {
-      for (int x = 0; x < W; x++) sb_add(&b, "%s%s", x ? "," : "", y == 10 && x == 3 ? "x" : "20.00");
+      for (int x = 0; x < W; x++)
+        sb_add(&b, "%s%s", x ? "," : "", y == 10 && x == 3 ? "x" : "20.00");
       sb_add(&b, "\n");
     }
     expect_reject("header-offset", b.s, b.n, HEARTH_E_PARSE, 12, 19, NULL);

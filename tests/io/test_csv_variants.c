@@ -193,7 +193,6 @@ static size_t fx_column(const char *s, size_t n, size_t line, size_t cell, char 
   return i - start + 1;
 }
 
-
 /* a metadata block from a template: '|' is the separator, '~' the decimal mark */
 static char *fx_meta(const char *tpl, char sep, char dm) {
   size_t n = strlen(tpl);
@@ -204,15 +203,18 @@ static char *fx_meta(const char *tpl, char sep, char dm) {
 
 /* metadata blocks as camera software writes them (see the module notes) */
 static const char *const k_meta_en =
-    "File: C:\\captures\\HM0001.jpg\nUnit|\xC2\xB0" "C\nEmissivity|0~95\nDistance|0~5|m\n"
+    "File: C:\\captures\\HM0001.jpg\nUnit|\xC2\xB0"
+    "C\nEmissivity|0~95\nDistance|0~5|m\n"
     "Min|18~20\nMax|45~70\nAvg|26~10\nDate|2024-05-01 12:00:00\n\n";
 static const char *const k_meta_hik =
     "\"File\"|\"C:\\HM0001.jpg\"|\"\"|\"\"\n\"Emissivity\"|\"\"|\"\"|\"0~95\"\n"
-    "\"Temperature Unit\"|\"\"|\"\"|\"\xC2\xB0" "C\"\n\"Min\"|\"\"|\"\"|\"18~2\"\n"
+    "\"Temperature Unit\"|\"\"|\"\"|\"\xC2\xB0"
+    "C\"\n\"Min\"|\"\"|\"\"|\"18~2\"\n"
     "\"Max\"|\"\"|\"\"|\"45~7\"\n\"\"|\"\"|\"\"|\"\"\n";
 static const char *const k_meta_flir =
     "File:|C:\\IR_0001.jpg\n\nParameters:|Emissivity:|0~95\n|Object distance:|1~0 m\n"
-    "|Reflected apparent temperature:|20~0 \xC2\xB0" "C\n\n";
+    "|Reflected apparent temperature:|20~0 \xC2\xB0"
+    "C\n\n";
 static const char *const k_meta_ko = /* cp949: emissivity, temperature unit, degree C */
     "\xB9\xE6\xBB\xE7\xC0\xB2|0~95\n\xBF\xC2\xB5\xB5\x20\xB4\xDC\xC0\xA7|\xA1\xC6\x43\n";
 static const char *const k_meta_zh = /* GBK */
@@ -220,7 +222,8 @@ static const char *const k_meta_zh = /* GBK */
 static const char *const k_meta_ja = /* Shift-JIS */
     "\x95\xFA\x8E\xCB\x97\xA6|0~95\n\x89\xB7\x93\x78\x92\x50\x88\xCA|\x81\x8E\n";
 static const char *const k_meta_de = /* Windows-1252 */
-    "Emissionsgrad|0~95\nTemperatureinheit|\xB0" "C\nBemerkung|\xC4nderung\n";
+    "Emissionsgrad|0~95\nTemperatureinheit|\xB0"
+    "C\nBemerkung|\xC4nderung\n";
 static const char *const k_meta_utf8 =
     "\xE6\x94\xBE\xE5\xB0\x84\xE7\x8E\x87|0~95\nEmissivity|0~95\n\xE5\x8D\x95\xE4\xBD\x8D|"
     "\xE2\x84\x83\n";
@@ -262,14 +265,13 @@ static void check_variant(const variant *v, uint64_t seed) {
                     !memcmp(img.data, ref.data, ref.width * ref.height * sizeof(float)),
                 "%s: values differ from the canonical CSV's", v->name);
       const expect *e = &v->e;
-      CHECK_MSG(!strcmp(hearth_csv_layout_name(info.layout), e->layout), "%s: layout %s",
-                v->name, hearth_csv_layout_name(info.layout));
+      CHECK_MSG(!strcmp(hearth_csv_layout_name(info.layout), e->layout), "%s: layout %s", v->name,
+                hearth_csv_layout_name(info.layout));
       CHECK_MSG(info.separator == f.sep, "%s: separator '%c'", v->name, info.separator);
       CHECK_MSG(info.decimal_mark == e->decimal, "%s: decimal mark '%c'", v->name,
                 info.decimal_mark ? info.decimal_mark : '0');
       CHECK_MSG(!strcmp(info.encoding, e->encoding), "%s: encoding %s", v->name, info.encoding);
-      CHECK_MSG(!strcmp(info.line_ends, e->line_ends), "%s: line ends %s", v->name,
-                info.line_ends);
+      CHECK_MSG(!strcmp(info.line_ends, e->line_ends), "%s: line ends %s", v->name, info.line_ends);
       CHECK_MSG(info.n_meta == e->n_meta, "%s: %zu metadata pairs", v->name, info.n_meta);
       CHECK_MSG(info.width == (size_t)f.w && info.height == (size_t)f.h, "%s: info size", v->name);
       const char *em = hearth_thermal_info_get(&info, "emissivity");
@@ -277,11 +279,12 @@ static void check_variant(const variant *v, uint64_t seed) {
                 v->name, em ? em : "(none)");
       CHECK_MSG(e->label ? info.label && !strcmp(info.label, e->label) : !info.label,
                 "%s: label '%s'", v->name, info.label ? info.label : "(none)");
-      CHECK_MSG(e->celsius ? info.unit && !strcmp(info.unit, "degC") : !info.unit,
-                "%s: unit %s", v->name, info.unit ? info.unit : "(none)");
+      CHECK_MSG(e->celsius ? info.unit && !strcmp(info.unit, "degC") : !info.unit, "%s: unit %s",
+                v->name, info.unit ? info.unit : "(none)");
       /* the matrix's lines: after the header lines, one per row (+ index row) */
       size_t rows = (size_t)f.h + (f.layout == FX_AXIS);
-      CHECK_MSG(info.last_line - info.first_line + 1 == rows && info.header_lines + 1 == info.first_line,
+      CHECK_MSG(info.last_line - info.first_line + 1 == rows &&
+                    info.header_lines + 1 == info.first_line,
                 "%s: matrix lines %zu..%zu", v->name, info.first_line, info.last_line);
     }
     hearth_thermal_info_free(&info);
@@ -293,92 +296,172 @@ static void check_variant(const variant *v, uint64_t seed) {
   hearth_image_free(&ref);
 }
 
-#define PLAIN(w, h, sep, dm, q, tr, eol) w, h, sep, dm, q, tr, eol, 0, FX_PLAIN, NULL, NULL, ENC_RAW, 0
+#define PLAIN(w, h, sep, dm, q, tr, eol) \
+  w, h, sep, dm, q, tr, eol, 0, FX_PLAIN, NULL, NULL, ENC_RAW, 0
 static void test_variants(void) {
   const variant v[] = {
       /* separators, decimal marks, quotes, line ends, trailing separators */
-      {"plain", {PLAIN(256, 192, ',', '.', 0, 0, "\n")}, NULL,
+      {"plain",
+       {PLAIN(256, 192, ',', '.', 0, 0, "\n")},
+       NULL,
        {"plain", "ascii", "LF", '.', 0, NULL, NULL, 0}},
-      {"semicolon-comma-crlf-trailing", {PLAIN(256, 192, ';', ',', 0, 1, "\r\n")}, NULL,
+      {"semicolon-comma-crlf-trailing",
+       {PLAIN(256, 192, ';', ',', 0, 1, "\r\n")},
+       NULL,
        {"plain", "ascii", "CRLF", ',', 0, NULL, NULL, 0}},
-      {"semicolon-dot", {PLAIN(256, 192, ';', '.', 0, 0, "\n")}, NULL,
+      {"semicolon-dot",
+       {PLAIN(256, 192, ';', '.', 0, 0, "\n")},
+       NULL,
        {"plain", "ascii", "LF", '.', 0, NULL, NULL, 0}},
-      {"tab-comma-cr", {PLAIN(256, 192, '\t', ',', 0, 0, "\r")}, NULL,
+      {"tab-comma-cr",
+       {PLAIN(256, 192, '\t', ',', 0, 0, "\r")},
+       NULL,
        {"plain", "ascii", "CR", ',', 0, NULL, NULL, 0}},
-      {"tab-dot-trailing", {PLAIN(256, 192, '\t', '.', 0, 1, "\n")}, NULL,
+      {"tab-dot-trailing",
+       {PLAIN(256, 192, '\t', '.', 0, 1, "\n")},
+       NULL,
        {"plain", "ascii", "LF", '.', 0, NULL, NULL, 0}},
-      {"quoted-comma-in-comma-csv", {PLAIN(256, 192, ',', ',', 1, 0, "\r\n")}, NULL,
+      {"quoted-comma-in-comma-csv",
+       {PLAIN(256, 192, ',', ',', 1, 0, "\r\n")},
+       NULL,
        {"plain", "ascii", "CRLF", ',', 0, NULL, NULL, 0}},
-      {"quoted-semicolon", {PLAIN(256, 192, ';', '.', 1, 1, "\n")}, NULL,
+      {"quoted-semicolon",
+       {PLAIN(256, 192, ';', '.', 1, 1, "\n")},
+       NULL,
        {"plain", "ascii", "LF", '.', 0, NULL, NULL, 0}},
-      {"sci-dot", {256, 192, ',', '.', 0, 0, "\n", 1, FX_PLAIN, NULL, NULL, ENC_RAW, 0}, NULL,
+      {"sci-dot",
+       {256, 192, ',', '.', 0, 0, "\n", 1, FX_PLAIN, NULL, NULL, ENC_RAW, 0},
+       NULL,
        {"plain", "ascii", "LF", '.', 0, NULL, NULL, 0}},
-      {"sci-comma-semicolon", {256, 192, ';', ',', 0, 0, "\r\n", 1, FX_PLAIN, NULL, NULL, ENC_RAW, 0},
-       NULL, {"plain", "ascii", "CRLF", ',', 0, NULL, NULL, 0}},
+      {"sci-comma-semicolon",
+       {256, 192, ';', ',', 0, 0, "\r\n", 1, FX_PLAIN, NULL, NULL, ENC_RAW, 0},
+       NULL,
+       {"plain", "ascii", "CRLF", ',', 0, NULL, NULL, 0}},
       /* sizes */
-      {"160x120", {PLAIN(160, 120, ',', '.', 0, 0, "\n")}, NULL,
+      {"160x120",
+       {PLAIN(160, 120, ',', '.', 0, 0, "\n")},
+       NULL,
        {"plain", "ascii", "LF", '.', 0, NULL, NULL, 0}},
-      {"640x512-semicolon", {PLAIN(640, 512, ';', ',', 0, 1, "\r\n")}, NULL,
+      {"640x512-semicolon",
+       {PLAIN(640, 512, ';', ',', 0, 1, "\r\n")},
+       NULL,
        {"plain", "ascii", "CRLF", ',', 0, NULL, NULL, 0}},
       /* size lines */
-      {"size-line", {256, 192, ',', '.', 0, 0, "\n", 0, FX_SIZE, NULL, NULL, ENC_RAW, 0}, NULL,
+      {"size-line",
+       {256, 192, ',', '.', 0, 0, "\n", 0, FX_SIZE, NULL, NULL, ENC_RAW, 0},
+       NULL,
        {"size-line", "ascii", "LF", '.', 0, NULL, NULL, 0}},
-      {"size-line-160x120-metadata", {160, 120, ';', ',', 0, 1, "\r\n", 0, FX_SIZE, NULL, NULL, ENC_RAW, 0},
-       k_meta_en, {"size-line", "utf-8", "CRLF", ',', 8, "0,95", NULL, 1}},
+      {"size-line-160x120-metadata",
+       {160, 120, ';', ',', 0, 1, "\r\n", 0, FX_SIZE, NULL, NULL, ENC_RAW, 0},
+       k_meta_en,
+       {"size-line", "utf-8", "CRLF", ',', 8, "0,95", NULL, 1}},
       /* axis-labelled matrices (HIKMICRO Analyzer) with corner labels of several locales */
-      {"axis-xy", {256, 192, ',', '.', 0, 0, "\n", 0, FX_AXIS, "X/Y", NULL, ENC_RAW, 0}, NULL,
+      {"axis-xy",
+       {256, 192, ',', '.', 0, 0, "\n", 0, FX_AXIS, "X/Y", NULL, ENC_RAW, 0},
+       NULL,
        {"axis-labelled", "ascii", "LF", '.', 0, NULL, "X/Y", 0}},
-      {"axis-empty-corner", {256, 192, ';', ',', 0, 1, "\r\n", 0, FX_AXIS, "", NULL, ENC_RAW, 0}, NULL,
+      {"axis-empty-corner",
+       {256, 192, ';', ',', 0, 1, "\r\n", 0, FX_AXIS, "", NULL, ENC_RAW, 0},
+       NULL,
        {"axis-labelled", "ascii", "CRLF", ',', 0, NULL, "", 0}},
-      {"axis-hikmicro-quoted", {256, 192, ',', ',', 1, 0, "\r\n", 0, FX_AXIS, "X/Y", NULL, ENC_RAW, 0},
-       k_meta_hik, {"axis-labelled", "utf-8", "CRLF", ',', 5, "0,95", "X/Y", 1}},
-      {"axis-korean-utf8-bom", {256, 192, ',', '.', 0, 0, "\r\n", 0, FX_AXIS, "\xEC\xB6\x95", NULL, ENC_UTF8_BOM, 0},
-       NULL, {"axis-labelled", "utf-8-bom", "CRLF", '.', 0, NULL, "\xEC\xB6\x95", 0}},
-      {"axis-korean-cp949", {256, 192, ';', ',', 0, 0, "\r\n", 0, FX_AXIS, "\xC3\xE0", NULL, ENC_RAW, 0},
-       k_meta_ko, {"axis-labelled", "8-bit", "CRLF", ',', 2, NULL, "\\xc3\\xe0", 1}},
-      {"axis-chinese-gbk", {256, 192, ',', '.', 0, 0, "\n", 0, FX_AXIS, "\xD6\xE1", NULL, ENC_RAW, 0},
-       k_meta_zh, {"axis-labelled", "8-bit", "LF", '.', 2, NULL, "\\xd6\\xe1", 1}},
-      {"axis-japanese-sjis", {256, 192, '\t', ',', 0, 0, "\r\n", 0, FX_AXIS, "\x8E\xB2", NULL, ENC_RAW, 0},
-       k_meta_ja, {"axis-labelled", "8-bit", "CRLF", ',', 2, NULL, "\\x8e\\xb2", 1}},
-      {"axis-german-1252", {256, 192, ';', ',', 0, 1, "\r\n", 0, FX_AXIS, "Achse", NULL, ENC_RAW, 0},
-       k_meta_de, {"axis-labelled", "8-bit", "CRLF", ',', 3, NULL, "Achse", 1}},
-      {"axis-russian-utf16le", {256, 192, ';', ',', 0, 0, "\r\n", 0, FX_AXIS, "\xD0\x9E\xD1\x81\xD1\x8C", NULL, ENC_UTF16LE, 0},
-       k_meta_utf8, {"axis-labelled", "utf-16le-bom", "CRLF", ',', 3, "0,95", "\xD0\x9E\xD1\x81\xD1\x8C", 1}},
-      {"axis-japanese-utf16be", {256, 192, '\t', '.', 0, 0, "\r\n", 0, FX_AXIS, "\xE8\xBB\xB8", NULL, ENC_UTF16BE, 0},
-       k_meta_utf8, {"axis-labelled", "utf-16be-bom", "CRLF", '.', 3, "0.95", "\xE8\xBB\xB8", 1}},
-      {"axis-160x120", {160, 120, ',', '.', 0, 0, "\n", 0, FX_AXIS, "X/Y", NULL, ENC_RAW, 0}, NULL,
+      {"axis-hikmicro-quoted",
+       {256, 192, ',', ',', 1, 0, "\r\n", 0, FX_AXIS, "X/Y", NULL, ENC_RAW, 0},
+       k_meta_hik,
+       {"axis-labelled", "utf-8", "CRLF", ',', 5, "0,95", "X/Y", 1}},
+      {"axis-korean-utf8-bom",
+       {256, 192, ',', '.', 0, 0, "\r\n", 0, FX_AXIS, "\xEC\xB6\x95", NULL, ENC_UTF8_BOM, 0},
+       NULL,
+       {"axis-labelled", "utf-8-bom", "CRLF", '.', 0, NULL, "\xEC\xB6\x95", 0}},
+      {"axis-korean-cp949",
+       {256, 192, ';', ',', 0, 0, "\r\n", 0, FX_AXIS, "\xC3\xE0", NULL, ENC_RAW, 0},
+       k_meta_ko,
+       {"axis-labelled", "8-bit", "CRLF", ',', 2, NULL, "\\xc3\\xe0", 1}},
+      {"axis-chinese-gbk",
+       {256, 192, ',', '.', 0, 0, "\n", 0, FX_AXIS, "\xD6\xE1", NULL, ENC_RAW, 0},
+       k_meta_zh,
+       {"axis-labelled", "8-bit", "LF", '.', 2, NULL, "\\xd6\\xe1", 1}},
+      {"axis-japanese-sjis",
+       {256, 192, '\t', ',', 0, 0, "\r\n", 0, FX_AXIS, "\x8E\xB2", NULL, ENC_RAW, 0},
+       k_meta_ja,
+       {"axis-labelled", "8-bit", "CRLF", ',', 2, NULL, "\\x8e\\xb2", 1}},
+      {"axis-german-1252",
+       {256, 192, ';', ',', 0, 1, "\r\n", 0, FX_AXIS, "Achse", NULL, ENC_RAW, 0},
+       k_meta_de,
+       {"axis-labelled", "8-bit", "CRLF", ',', 3, NULL, "Achse", 1}},
+      {"axis-russian-utf16le",
+       {256, 192, ';', ',', 0, 0, "\r\n", 0, FX_AXIS, "\xD0\x9E\xD1\x81\xD1\x8C", NULL, ENC_UTF16LE,
+        0},
+       k_meta_utf8,
+       {"axis-labelled", "utf-16le-bom", "CRLF", ',', 3, "0,95", "\xD0\x9E\xD1\x81\xD1\x8C", 1}},
+      {"axis-japanese-utf16be",
+       {256, 192, '\t', '.', 0, 0, "\r\n", 0, FX_AXIS, "\xE8\xBB\xB8", NULL, ENC_UTF16BE, 0},
+       k_meta_utf8,
+       {"axis-labelled", "utf-16be-bom", "CRLF", '.', 3, "0.95", "\xE8\xBB\xB8", 1}},
+      {"axis-160x120",
+       {160, 120, ',', '.', 0, 0, "\n", 0, FX_AXIS, "X/Y", NULL, ENC_RAW, 0},
+       NULL,
        {"axis-labelled", "ascii", "LF", '.', 0, NULL, "X/Y", 0}},
-      {"axis-640x512-cr", {640, 512, ';', ',', 0, 0, "\r", 0, FX_AXIS, "X/Y", NULL, ENC_RAW, 0}, NULL,
+      {"axis-640x512-cr",
+       {640, 512, ';', ',', 0, 0, "\r", 0, FX_AXIS, "X/Y", NULL, ENC_RAW, 0},
+       NULL,
        {"axis-labelled", "ascii", "CR", ',', 0, NULL, "X/Y", 0}},
-      {"axis-4x3", {4, 3, ',', '.', 0, 0, "\n", 0, FX_AXIS, "X/Y", NULL, ENC_RAW, 0}, NULL,
+      {"axis-4x3",
+       {4, 3, ',', '.', 0, 0, "\n", 0, FX_AXIS, "X/Y", NULL, ENC_RAW, 0},
+       NULL,
        {"axis-labelled", "ascii", "LF", '.', 0, NULL, "X/Y", 0}},
       /* frame-labelled matrices (FLIR) */
-      {"frame-flir-semicolon", {256, 192, ';', ',', 0, 1, "\r\n", 0, FX_FRAME, "Image 1", NULL, ENC_RAW, 0},
-       NULL, {"frame-labelled", "ascii", "CRLF", ',', 0, NULL, "Image 1", 0}},
-      {"frame-flir-metadata", {256, 192, ',', '.', 0, 0, "\n", 0, FX_FRAME, "Frame 1", NULL, ENC_RAW, 0},
-       k_meta_flir, {"frame-labelled", "utf-8", "LF", '.', 4, NULL, "Frame 1", 1}},
-      {"frame-3x2", {3, 2, ',', '.', 0, 0, "\n", 0, FX_FRAME, "Frame 1", NULL, ENC_RAW, 0}, NULL,
+      {"frame-flir-semicolon",
+       {256, 192, ';', ',', 0, 1, "\r\n", 0, FX_FRAME, "Image 1", NULL, ENC_RAW, 0},
+       NULL,
+       {"frame-labelled", "ascii", "CRLF", ',', 0, NULL, "Image 1", 0}},
+      {"frame-flir-metadata",
+       {256, 192, ',', '.', 0, 0, "\n", 0, FX_FRAME, "Frame 1", NULL, ENC_RAW, 0},
+       k_meta_flir,
+       {"frame-labelled", "utf-8", "LF", '.', 4, NULL, "Frame 1", 1}},
+      {"frame-3x2",
+       {3, 2, ',', '.', 0, 0, "\n", 0, FX_FRAME, "Frame 1", NULL, ENC_RAW, 0},
+       NULL,
        {"frame-labelled", "ascii", "LF", '.', 0, NULL, "Frame 1", 0}},
       /* metadata blocks over plain matrices, in each encoding */
-      {"meta-en-semicolon", {PLAIN(256, 192, ';', ',', 0, 1, "\r\n")}, k_meta_en,
+      {"meta-en-semicolon",
+       {PLAIN(256, 192, ';', ',', 0, 1, "\r\n")},
+       k_meta_en,
        {"plain", "utf-8", "CRLF", ',', 8, "0,95", NULL, 1}},
-      {"meta-en-comma-bom", {256, 192, ',', '.', 0, 0, "\n", 0, FX_PLAIN, NULL, NULL, ENC_UTF8_BOM, 0},
-       k_meta_en, {"plain", "utf-8-bom", "LF", '.', 8, "0.95", NULL, 1}},
-      {"meta-en-utf16le", {256, 192, '\t', ',', 0, 0, "\r\n", 0, FX_PLAIN, NULL, NULL, ENC_UTF16LE, 0},
-       k_meta_en, {"plain", "utf-16le-bom", "CRLF", ',', 8, "0,95", NULL, 1}},
-      {"meta-en-utf16be", {256, 192, ',', '.', 0, 0, "\n", 0, FX_PLAIN, NULL, NULL, ENC_UTF16BE, 0},
-       k_meta_en, {"plain", "utf-16be-bom", "LF", '.', 8, "0.95", NULL, 1}},
-      {"meta-ko-cp949", {PLAIN(256, 192, ';', ',', 0, 0, "\r\n")}, k_meta_ko,
+      {"meta-en-comma-bom",
+       {256, 192, ',', '.', 0, 0, "\n", 0, FX_PLAIN, NULL, NULL, ENC_UTF8_BOM, 0},
+       k_meta_en,
+       {"plain", "utf-8-bom", "LF", '.', 8, "0.95", NULL, 1}},
+      {"meta-en-utf16le",
+       {256, 192, '\t', ',', 0, 0, "\r\n", 0, FX_PLAIN, NULL, NULL, ENC_UTF16LE, 0},
+       k_meta_en,
+       {"plain", "utf-16le-bom", "CRLF", ',', 8, "0,95", NULL, 1}},
+      {"meta-en-utf16be",
+       {256, 192, ',', '.', 0, 0, "\n", 0, FX_PLAIN, NULL, NULL, ENC_UTF16BE, 0},
+       k_meta_en,
+       {"plain", "utf-16be-bom", "LF", '.', 8, "0.95", NULL, 1}},
+      {"meta-ko-cp949",
+       {PLAIN(256, 192, ';', ',', 0, 0, "\r\n")},
+       k_meta_ko,
        {"plain", "8-bit", "CRLF", ',', 2, NULL, NULL, 1}},
-      {"meta-zh-gbk", {PLAIN(256, 192, ',', '.', 0, 0, "\r\n")}, k_meta_zh,
+      {"meta-zh-gbk",
+       {PLAIN(256, 192, ',', '.', 0, 0, "\r\n")},
+       k_meta_zh,
        {"plain", "8-bit", "CRLF", '.', 2, NULL, NULL, 1}},
-      {"meta-ja-sjis", {PLAIN(256, 192, '\t', '.', 0, 0, "\n")}, k_meta_ja,
+      {"meta-ja-sjis",
+       {PLAIN(256, 192, '\t', '.', 0, 0, "\n")},
+       k_meta_ja,
        {"plain", "8-bit", "LF", '.', 2, NULL, NULL, 1}},
-      {"meta-de-1252-cr", {PLAIN(256, 192, ';', ',', 0, 0, "\r")}, k_meta_de,
+      {"meta-de-1252-cr",
+       {PLAIN(256, 192, ';', ',', 0, 0, "\r")},
+       k_meta_de,
        {"plain", "8-bit", "CR", ',', 3, NULL, NULL, 1}},
-      {"meta-utf8", {PLAIN(160, 120, ';', ',', 0, 0, "\n")}, k_meta_utf8,
+      {"meta-utf8",
+       {PLAIN(160, 120, ';', ',', 0, 0, "\n")},
+       k_meta_utf8,
        {"plain", "utf-8", "LF", ',', 3, "0,95", NULL, 1}},
-      {"meta-hikmicro-plain", {PLAIN(256, 192, ',', ',', 1, 0, "\r\n")}, k_meta_hik,
+      {"meta-hikmicro-plain",
+       {PLAIN(256, 192, ',', ',', 1, 0, "\r\n")},
+       k_meta_hik,
        {"plain", "utf-8", "CRLF", ',', 5, "0,95", NULL, 1}},
   };
   for (size_t i = 0; i < sizeof v / sizeof v[0]; i++) check_variant(&v[i], 100 + i);
@@ -401,7 +484,9 @@ static void test_variants(void) {
   CHECK(info.layout == HEARTH_CSV_AXIS && info.n_meta == 5 && info.meta &&
         !strcmp(info.meta[0].key, "File") && !strcmp(info.meta[0].value, "C:\\HM0001.jpg") &&
         info.meta[0].line == 1 && info.first_line == 7);
-  CHECK(!strcmp(hearth_thermal_info_get(&info, "temperature unit"), "\xC2\xB0" "C"));
+  CHECK(!strcmp(hearth_thermal_info_get(&info, "temperature unit"),
+                "\xC2\xB0"
+                "C"));
   hearth_thermal_info_free(&info);
   hearth_thermal_info_free(&info); /* freeing twice (zeroed) is fine */
   hearth_image_free(&img);
@@ -489,7 +574,8 @@ static void test_mangled(void) {
       {"index-row", &axis, 1, 100, "100", HEARTH_E_PARSE, 100, "column index '100', expected 99"},
       {"index-row-after-metadata", &axis_meta, 10, 7, "x", HEARTH_E_PARSE, 7, "column index 'x'"},
       {"index-column", &axis, 52, 0, "51", HEARTH_E_PARSE, 0, "row index '51', expected 50"},
-      {"index-column-small", &axis_small, 3, 0, "2", HEARTH_E_PARSE, 0, "row index '2', expected 1"},
+      {"index-column-small", &axis_small, 3, 0, "2", HEARTH_E_PARSE, 0,
+       "row index '2', expected 1"},
       {"index-column-decimal", &axis, 40, 0, "38.0", HEARTH_E_PARSE, 0, "row index '38.0'"},
       /* a ragged row, garbage, a second frame label */
       {"ragged-long-axis", &axis, 12, 256, "20.00,21.00", HEARTH_E_SIZE, 257,
@@ -566,15 +652,21 @@ static void test_mangled(void) {
       {"size-line-disagrees", &plain, "256,191\n", "", HEARTH_E_SIZE, 1, 1,
        "size line says 256x191, expected the 256x192"},
       /* units other than degC are refused, at the unit's column */
-      {"unit-degF", &plain, "Emissivity,0.95\nUnit,\xC2\xB0" "F\n", "", HEARTH_E_UNSUPPORTED, 2, 6,
-       "temperature unit '\\xc2\\xb0F'"},
+      {"unit-degF", &plain,
+       "Emissivity,0.95\nUnit,\xC2\xB0"
+       "F\n",
+       "", HEARTH_E_UNSUPPORTED, 2, 6, "temperature unit '\\xc2\\xb0F'"},
       {"unit-kelvin", &plain, "Temperature unit: K\n", "", HEARTH_E_UNSUPPORTED, 1, 19,
        "temperature unit 'K'"},
-      {"unit-hint-degF", &plain, "Min: 65.1 \xC2\xB0" "F\n", "", HEARTH_E_UNSUPPORTED, 1, 11,
-       "expected degC"},
+      {"unit-hint-degF", &plain,
+       "Min: 65.1 \xC2\xB0"
+       "F\n",
+       "", HEARTH_E_UNSUPPORTED, 1, 11, "expected degC"},
       /* Windows-1252 text: columns count bytes */
-      {"unit-hint-1252", &plain_semi, "\xC4nderung;x\nMax;98,6\xB0" "F\n", "", HEARTH_E_UNSUPPORTED,
-       2, 9, "expected degC"},
+      {"unit-hint-1252", &plain_semi,
+       "\xC4nderung;x\nMax;98,6\xB0"
+       "F\n",
+       "", HEARTH_E_UNSUPPORTED, 2, 9, "expected degC"},
       {"unit-unknown", &plain, "Unit,counts\n", "", HEARTH_E_UNSUPPORTED, 1, 6, "'counts'"},
   };
   for (size_t i = 0; i < sizeof added / sizeof added[0]; i++) {

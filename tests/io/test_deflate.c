@@ -77,15 +77,16 @@ int main(void) {
   size_t sizes[] = {2, 100, 65534, 65535, 65536, 131071, 131070, 200000};
   for (size_t k = 0; k < sizeof sizes / sizeof *sizes; k++) {
     CHECK_MSG(one_piece(buf, sizes[k], &packed), "noise of %zu bytes", sizes[k]);
-    CHECK_MSG(packed <= sizes[k] + 5 * (sizes[k] / 65535 + 1), "noise of %zu bytes packed into %zu", sizes[k],
-              packed);
+    CHECK_MSG(packed <= sizes[k] + 5 * (sizes[k] / 65535 + 1), "noise of %zu bytes packed into %zu",
+              sizes[k], packed);
   }
 
   /* skewed counts (doubling frequencies over 24 symbols): an unlimited
      Huffman code would need 23 bits, the limit of 15 must hold */
   size_t at = 0;
   for (int s = 0; s < 24 && at < N; s++)
-    for (size_t r = 0; r < ((size_t)1 << (s < 17 ? s : 17)) && at < N; r++) buf[at++] = (uint8_t)(3 * s + 1);
+    for (size_t r = 0; r < ((size_t)1 << (s < 17 ? s : 17)) && at < N; r++)
+      buf[at++] = (uint8_t)(3 * s + 1);
   for (size_t i = 0; i + 1 < at; i += 2) { /* break the runs: literals, not matches */
     size_t j = next_u32(&seed) % at;
     uint8_t t = buf[i];
@@ -99,7 +100,9 @@ int main(void) {
      concatenated through sync flushes */
   for (size_t i = 0; i < N; i++) {
     size_t x = i % 3073;
-    buf[i] = x == 0 ? 1 : (i / 3073) % 3 == 0 ? 0 : (uint8_t)((x / 97) % 5 + (next_u32(&seed) % 3 == 0));
+    buf[i] = x == 0                ? 1
+             : (i / 3073) % 3 == 0 ? 0
+                                   : (uint8_t)((x / 97) % 5 + (next_u32(&seed) % 3 == 0));
   }
   CHECK(one_piece(buf, N, &packed));
   CHECK_MSG(packed < N / 3, "image-like %d bytes packed into %zu", (int)N, packed);
@@ -115,7 +118,10 @@ int main(void) {
     int kind = trial % 4;
     for (size_t i = 0; i < n; i++) {
       uint32_t r = next_u32(&seed);
-      buf[i] = kind == 0 ? (uint8_t)r : kind == 1 ? (uint8_t)(r % 3) : kind == 2 ? (uint8_t)(i / 300) : (uint8_t)(r % 200 < 190 ? 0 : r);
+      buf[i] = kind == 0   ? (uint8_t)r
+               : kind == 1 ? (uint8_t)(r % 3)
+               : kind == 2 ? (uint8_t)(i / 300)
+                           : (uint8_t)(r % 200 < 190 ? 0 : r);
     }
     size_t c[4] = {0, next_u32(&seed) % (n + 1), 0, n};
     c[2] = c[1] + next_u32(&seed) % (n - c[1] + 1);

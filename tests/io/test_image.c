@@ -210,8 +210,7 @@ static void test_text(void) {
   /* all glyphs differ from one another */
   for (size_t i = 0; i < nreq; i++)
     for (size_t j = i + 1; j < nreq; j++)
-      CHECK_MSG(memcmp(masks[i], masks[j], 35) != 0, "'%c' and '%c' look the same", req[i],
-                req[j]);
+      CHECK_MSG(memcmp(masks[i], masks[j], 35) != 0, "'%c' and '%c' look the same", req[i], req[j]);
   /* lower case is drawn as upper case; space draws nothing */
   uint8_t m[35];
   glyph_mask("k", 1, m, &ink, &outside);

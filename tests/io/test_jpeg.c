@@ -191,8 +191,10 @@ static void test_expect(const char *dir) {
   hearth_image_free(&img);
   hearth_image_expect rig = {1920, 1080, 3, 0, 0, "(the colour camera of rig.json)"};
   CHECK(hearth_jpeg_read_expect(path, &rig, &back, &err) == HEARTH_E_SIZE && !back.data);
-  CHECK_MSG(strstr(err.msg, "expect.jpg: image is 64x48, expected 1920x1080 (the colour camera "
-                            "of rig.json)"), "%s", err.msg);
+  CHECK_MSG(strstr(err.msg,
+                   "expect.jpg: image is 64x48, expected 1920x1080 (the colour camera "
+                   "of rig.json)"),
+            "%s", err.msg);
   CHECK(hearth_jpeg_read_gray_expect(path, &rig, &back, &err) == HEARTH_E_SIZE);
   hearth_image_expect ok = {64, 48, 3, 0, 0, NULL};
   CHECK_OK(hearth_jpeg_read_expect(path, &ok, &back, &err), &err);

@@ -29,10 +29,10 @@ static void test_round_trip(const char *dir) {
     size_t shape[4];
     const void *data;
   } cases[] = {
-      {HEARTH_NPY_F32, 2, {4, 6}, f},       {HEARTH_NPY_F32, 3, {2, 3, 4}, f},
-      {HEARTH_NPY_U8, 2, {6, 5}, u},        {HEARTH_NPY_U8, 3, {3, 5, 2}, u},
-      {HEARTH_NPY_F32, 1, {24}, f},         {HEARTH_NPY_F32, 0, {0}, f},
-      {HEARTH_NPY_U8, 4, {1, 2, 3, 5}, u},  {HEARTH_NPY_F32, 2, {0, 7}, f},
+      {HEARTH_NPY_F32, 2, {4, 6}, f},      {HEARTH_NPY_F32, 3, {2, 3, 4}, f},
+      {HEARTH_NPY_U8, 2, {6, 5}, u},       {HEARTH_NPY_U8, 3, {3, 5, 2}, u},
+      {HEARTH_NPY_F32, 1, {24}, f},        {HEARTH_NPY_F32, 0, {0}, f},
+      {HEARTH_NPY_U8, 4, {1, 2, 3, 5}, u}, {HEARTH_NPY_F32, 2, {0, 7}, f},
   };
   for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
     snprintf(path, sizeof path, "%s/rt%zu.npy", dir, c);
@@ -78,8 +78,8 @@ static void test_exact_bytes(const char *dir) {
   memcpy(want + 10, dict, 59);
   memset(want + 69, ' ', 58);
   want[127] = '\n';
-  static const uint8_t data[24] = {0, 0, 0,    0,    0, 0, 0,    0x3F, 0, 0, 0x80, 0x3F,
-                                   0, 0, 0xC0, 0x3F, 0, 0, 0,    0x40, 0, 0, 0x20, 0x40};
+  static const uint8_t data[24] = {0, 0, 0,    0,    0, 0, 0, 0x3F, 0, 0, 0x80, 0x3F,
+                                   0, 0, 0xC0, 0x3F, 0, 0, 0, 0x40, 0, 0, 0x20, 0x40};
   memcpy(want + 128, data, 24);
 
   float v[6] = {0.0f, 0.5f, 1.0f, 1.5f, 2.0f, 2.5f};
@@ -184,14 +184,14 @@ static void test_headers(void) {
          HEARTH_NPY_F32, 2, 2, 3);
   accept("no-trailing-comma", 1, "{'descr':'|u1','fortran_order':False,'shape':(4,2)}\n", 8,
          HEARTH_NPY_U8, 2, 4, 2);
-  accept("u1", 1, "{'descr': 'u1', 'fortran_order': False, 'shape': (3,), }\n", 3,
-         HEARTH_NPY_U8, 1, 3, 0);
-  accept("<u1", 1, "{'descr': '<u1', 'fortran_order': False, 'shape': (3,), }\n", 3,
-         HEARTH_NPY_U8, 1, 3, 0);
+  accept("u1", 1, "{'descr': 'u1', 'fortran_order': False, 'shape': (3,), }\n", 3, HEARTH_NPY_U8, 1,
+         3, 0);
+  accept("<u1", 1, "{'descr': '<u1', 'fortran_order': False, 'shape': (3,), }\n", 3, HEARTH_NPY_U8,
+         1, 3, 0);
   accept("order", 1, "{\"shape\": (2,), \"fortran_order\": False, \"descr\": \"<f4\"}\n", 8,
          HEARTH_NPY_F32, 1, 2, 0);
-  accept("rank0", 1, "{'descr': '<f4', 'fortran_order': False, 'shape': (), }\n", 4,
-         HEARTH_NPY_F32, 0, 0, 0);
+  accept("rank0", 1, "{'descr': '<f4', 'fortran_order': False, 'shape': (), }\n", 4, HEARTH_NPY_F32,
+         0, 0, 0);
   accept("trailing-comma-2d", 1, "{'descr': '<f4', 'fortran_order': False, 'shape': (1, 2,), }\n",
          8, HEARTH_NPY_F32, 2, 1, 2);
   accept("py2-long", 1, "{'descr': '<f4', 'fortran_order': False, 'shape': (1L, 2L), }\n", 8,
@@ -235,8 +235,8 @@ static void test_headers(void) {
               HEARTH_E_UNSUPPORTED, NULL);
   reject_dict("structured", "{'descr': [('a', '<f4')], 'fortran_order': False, 'shape': (2,), }\n",
               8, HEARTH_E_UNSUPPORTED, "structured");
-  reject_dict("rank5", "{'descr': '|u1', 'fortran_order': False, 'shape': (1, 1, 1, 1, 1), }\n",
-              1, HEARTH_E_UNSUPPORTED, "rank");
+  reject_dict("rank5", "{'descr': '|u1', 'fortran_order': False, 'shape': (1, 1, 1, 1, 1), }\n", 1,
+              HEARTH_E_UNSUPPORTED, "rank");
   reject_dict("not-tuple", "{'descr': '<f4', 'fortran_order': False, 'shape': (5), }\n", 20,
               HEARTH_E_PARSE, "(n,)");
   reject_dict("negative", "{'descr': '<f4', 'fortran_order': False, 'shape': (-1,), }\n", 4,
@@ -247,25 +247,24 @@ static void test_headers(void) {
               "{'descr': '<f4', 'fortran_order': False, 'shape': (99999999999999999999999,), }\n",
               4, HEARTH_E_LIMIT, NULL);
   reject_dict("overflow-product",
-              "{'descr': '<f4', 'fortran_order': False, 'shape': (4294967296, 4294967296), }\n",
-              4, HEARTH_E_LIMIT, NULL);
+              "{'descr': '<f4', 'fortran_order': False, 'shape': (4294967296, 4294967296), }\n", 4,
+              HEARTH_E_LIMIT, NULL);
   reject_dict("overflow-bytes",
-              "{'descr': '<f4', 'fortran_order': False, 'shape': (4611686018427387904,), }\n",
-              4, HEARTH_E_LIMIT, NULL);
+              "{'descr': '<f4', 'fortran_order': False, 'shape': (4611686018427387904,), }\n", 4,
+              HEARTH_E_LIMIT, NULL);
   reject_dict("missing-key", "{'descr': '<f4', 'shape': (2, 3), }\n", 24, HEARTH_E_PARSE,
               "fortran_order");
-  reject_dict("extra-key",
-              "{'descr': '<f4', 'fortran_order': False, 'shape': (2, 3), 'x': 1, }\n", 24,
-              HEARTH_E_PARSE, "unknown key");
+  reject_dict("extra-key", "{'descr': '<f4', 'fortran_order': False, 'shape': (2, 3), 'x': 1, }\n",
+              24, HEARTH_E_PARSE, "unknown key");
   reject_dict("dup-key",
-              "{'descr': '<f4', 'descr': '<f4', 'fortran_order': False, 'shape': (2, 3), }\n",
-              24, HEARTH_E_PARSE, "duplicate");
-  reject_dict("no-newline", "{'descr': '<f4', 'fortran_order': False, 'shape': (2, 3), }  ",
-              24, HEARTH_E_PARSE, NULL);
-  reject_dict("junk-after", "{'descr': '<f4', 'fortran_order': False, 'shape': (2, 3), }x\n",
-              24, HEARTH_E_PARSE, NULL);
-  reject_dict("bool-typo", "{'descr': '<f4', 'fortran_order': false, 'shape': (2, 3), }\n",
-              24, HEARTH_E_PARSE, "True or False");
+              "{'descr': '<f4', 'descr': '<f4', 'fortran_order': False, 'shape': (2, 3), }\n", 24,
+              HEARTH_E_PARSE, "duplicate");
+  reject_dict("no-newline", "{'descr': '<f4', 'fortran_order': False, 'shape': (2, 3), }  ", 24,
+              HEARTH_E_PARSE, NULL);
+  reject_dict("junk-after", "{'descr': '<f4', 'fortran_order': False, 'shape': (2, 3), }x\n", 24,
+              HEARTH_E_PARSE, NULL);
+  reject_dict("bool-typo", "{'descr': '<f4', 'fortran_order': false, 'shape': (2, 3), }\n", 24,
+              HEARTH_E_PARSE, "True or False");
   reject_dict("not-dict", "['descr', '<f4']\n", 24, HEARTH_E_PARSE, "'{'");
   /* the header byte of the problem is named: 'True' starts at byte 10 + 34 */
   reject_dict("offset", "{'descr': '<f4', 'fortran_order': True, 'shape': (2, 3), }\n", 24,
@@ -355,8 +354,7 @@ static void test_numpy(const char *dir) {
   if (p) {
     CHECK(fgets(line, sizeof line, p) != NULL);
     pclose(p);
-    CHECK_MSG(strcmp(line, "uint8 (3, 2) 0 1 127 128 254 255\n") == 0, "numpy printed '%s'",
-              line);
+    CHECK_MSG(strcmp(line, "uint8 (3, 2) 0 1 127 128 254 255\n") == 0, "numpy printed '%s'", line);
   }
 
   /* numpy -> ours, format 1.0 and 2.0, several shapes */

@@ -52,9 +52,19 @@ static bytes make_png(uint32_t w, uint32_t h, int depth, int ctype, const uint8_
   bytes b = {0};
   static const uint8_t sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
   put(&b, sig, 8);
-  uint8_t ihdr[13] = {(uint8_t)(w >> 24), (uint8_t)(w >> 16), (uint8_t)(w >> 8), (uint8_t)w,
-                      (uint8_t)(h >> 24), (uint8_t)(h >> 16), (uint8_t)(h >> 8), (uint8_t)h,
-                      (uint8_t)depth, (uint8_t)ctype, 0, 0, 0};
+  uint8_t ihdr[13] = {(uint8_t)(w >> 24),
+                      (uint8_t)(w >> 16),
+                      (uint8_t)(w >> 8),
+                      (uint8_t)w,
+                      (uint8_t)(h >> 24),
+                      (uint8_t)(h >> 16),
+                      (uint8_t)(h >> 8),
+                      (uint8_t)h,
+                      (uint8_t)depth,
+                      (uint8_t)ctype,
+                      0,
+                      0,
+                      0};
   put_chunk(&b, "IHDR", ihdr, 13);
   if (plte) put_chunk(&b, "PLTE", plte, plte_n);
   if (trns) put_chunk(&b, "tRNS", trns, trns_n);
@@ -238,8 +248,8 @@ static void test_handmade_decode(void) {
   CHECK_OK(hearth_png_read_mem(b.p, b.n, "pal", &img, &err), &err);
   CHECK(img.type == HEARTH_PIX_U8 && img.channels == 4 && img.width == 4);
   if (img.data) {
-    const uint8_t want[16] = {10, 20, 30, 255, 40, 50, 60, 128, 70, 80, 90, 255,
-                              200, 210, 220, 255};
+    const uint8_t want[16] = {10, 20, 30, 255, 40,  50,  60,  128,
+                              70, 80, 90, 255, 200, 210, 220, 255};
     CHECK(memcmp(img.data, want, 16) == 0);
   }
   hearth_image_free(&img);

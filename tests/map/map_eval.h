@@ -9,10 +9,10 @@
 #include "hearth/hearth.h"
 
 typedef struct map_eval {
-  size_t n_eval;         /* observed texels seen >= 10 deg from grazing */
+  size_t n_eval; /* observed texels seen >= 10 deg from grazing */
   double median, p95, max_err;
-  double coverage;       /* observed / surface */
-  size_t cross_island;   /* filled texels whose value is not from their island */
+  double coverage;     /* observed / surface */
+  size_t cross_island; /* filled texels whose value is not from their island */
   size_t n_filled;
 } map_eval;
 
@@ -30,8 +30,8 @@ static int cmp_pair(const void *a, const void *b) {
 /* poses_path: thermal poses; rig_path: rig; mesh_path: metric mesh */
 static hearth_status map_eval_state(const char *root, const char *inst, const char *state,
                                     const char *mesh_path, const char *poses_path,
-                                    const char *rig_path, const hearth_map_opts *opts,
-                                    map_eval *ev, hearth_err *err) {
+                                    const char *rig_path, const hearth_map_opts *opts, map_eval *ev,
+                                    hearth_err *err) {
   char path[4096];
   memset(ev, 0, sizeof *ev);
   hearth_rig rig;
@@ -53,7 +53,8 @@ static hearth_status map_eval_state(const char *root, const char *inst, const ch
   imgs = calloc(man.n_views, sizeof *imgs);
   views = calloc(man.n_views, sizeof *views);
   for (size_t v = 0; v < man.n_views; v++) {
-    snprintf(path, sizeof path, "%s/instances/%s/raw/%s/%s", root, inst, state, man.views[v].thermal);
+    snprintf(path, sizeof path, "%s/instances/%s/raw/%s/%s", root, inst, state,
+             man.views[v].thermal);
     if ((s = hearth_thermal_read_csv(path, NULL, &imgs[v], err))) goto done;
     const hearth_view_pose *p = hearth_poses_find(&poses, state, man.views[v].view);
     if (!p) {
@@ -63,8 +64,10 @@ static hearth_status map_eval_state(const char *root, const char *inst, const ch
     views[v].image = &imgs[v];
     views[v].T_world_from_cam = p->T_world_from_cam;
   }
-  if ((s = hearth_map_views(&mesh, NULL, &rig.thermal, views, man.n_views, opts, &r, err))) goto done;
-  snprintf(path, sizeof path, "%s/ground_truth/instances/%s/%s/temperature_true.npy", root, inst, state);
+  if ((s = hearth_map_views(&mesh, NULL, &rig.thermal, views, man.n_views, opts, &r, err)))
+    goto done;
+  snprintf(path, sizeof path, "%s/ground_truth/instances/%s/%s/temperature_true.npy", root, inst,
+           state);
   if ((s = hearth_npy_read(path, &gt, err))) goto done;
   if (gt.ndim != 2 || gt.shape[0] != r.R || gt.shape[1] != r.R) {
     s = hearth_err_set(err, HEARTH_E_SIZE, "%s: ground truth is not %zux%zu", path, r.R, r.R);
@@ -89,7 +92,8 @@ static hearth_status map_eval_state(const char *root, const char *inst, const ch
   /* filled texels: their value must be an observed value of their own
      island (the fill copies; checked against the mesh's UV island labels) */
   {
-    uint32_t *tri = malloc(N * sizeof *tri), *isl = malloc(mesh.n_triangles * sizeof *isl), nisl = 0;
+    uint32_t *tri = malloc(N * sizeof *tri), *isl = malloc(mesh.n_triangles * sizeof *isl),
+             nisl = 0;
     hearth_uv_rasterize(&mesh, r.R, tri, NULL, NULL);
     hearth_uv_islands(&mesh, isl, &nisl, NULL);
     /* (island, value) pairs of observed texels, sorted, for exact lookups */

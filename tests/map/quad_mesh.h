@@ -7,7 +7,8 @@
  * up else -z, with UVs over [u0, u1] x [v0, v1] (v0 at y1); *nv and *nt
  * count the vertices and triangles written so far. */
 static inline void add_quad(hearth_mesh *m, size_t *nv, size_t *nt, double x0, double x1, double y0,
-                            double y1, double z, int up, double u0, double u1, double v0, double v1) {
+                            double y1, double z, int up, double u0, double u1, double v0,
+                            double v1) {
   size_t b = *nv;
   double P[4][3] = {{x0, y0, z}, {x1, y0, z}, {x1, y1, z}, {x0, y1, z}};
   double U[4][2] = {{u0, v1}, {u1, v1}, {u1, v0}, {u0, v0}};

@@ -36,7 +36,8 @@ int main(void) {
   CHECK_OK(hearth_image_alloc(&img, 256, 192, 1, HEARTH_PIX_F32, &err), &err);
   hearth_rng rng;
   hearth_rng_seed(&rng, 7);
-  for (size_t i = 0; i < 256 * 192; i++) ((float *)img.data)[i] = (float)(10.0 + 50.0 * hearth_rng_uniform(&rng));
+  for (size_t i = 0; i < 256 * 192; i++)
+    ((float *)img.data)[i] = (float)(10.0 + 50.0 * hearth_rng_uniform(&rng));
   hearth_map_view view = {&img, T};
   hearth_map_opts o;
   hearth_map_opts_default(&o);
@@ -72,16 +73,18 @@ int main(void) {
     }
     if (!match) bad++;
   }
-  printf("plate: %zu observed, %zu filled, %zu unobserved; occluder %zu/%zu/%zu; hidden %zu/%zu/%zu\n",
-         n_obs[0], n_fill[0], n_unobs[0], n_obs[1], n_fill[1], n_unobs[1], n_obs[2], n_fill[2],
-         n_unobs[2]);
+  printf(
+      "plate: %zu observed, %zu filled, %zu unobserved; occluder %zu/%zu/%zu; hidden %zu/%zu/%zu\n",
+      n_obs[0], n_fill[0], n_unobs[0], n_obs[1], n_fill[1], n_unobs[1], n_obs[2], n_fill[2],
+      n_unobs[2]);
   /* the plate is seen with a hole and cut-off sides: much to fill, around
      and inside the observed region */
   CHECK(n_obs[0] > 1000 && n_fill[0] > 1000 && n_unobs[0] == 0);
   CHECK(n_obs[1] > 100 && n_unobs[1] == 0);
   CHECK(n_obs[2] == 0 && n_fill[2] == 0 && n_unobs[2] > 100);
   CHECK(wrong_mask == 0);
-  CHECK_MSG(bad == 0, "%zu filled texels did not take the nearest observed texel of their island", bad);
+  CHECK_MSG(bad == 0, "%zu filled texels did not take the nearest observed texel of their island",
+            bad);
 
   /* the same bytes for any thread count */
   for (int th = 2; th <= 3; th++) {

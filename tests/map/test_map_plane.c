@@ -12,7 +12,8 @@ static double field(double x) { return 20.0 + 200.0 * x; }
 
 /* render the scene's temperatures the simple way: a ray per pixel centre
  * against the planes (independent of the ray caster) */
-static void render(const hearth_camera *cam, const hearth_rigid *T, double offset, hearth_image *img) {
+static void render(const hearth_camera *cam, const hearth_rigid *T, double offset,
+                   hearth_image *img) {
   hearth_err err;
   hearth_image_alloc(img, (size_t)cam->width, (size_t)cam->height, 1, HEARTH_PIX_F32, &err);
   float *px = img->data;
@@ -66,8 +67,8 @@ int main(void) {
   /* one view: observed texels match the field within the splat footprint */
   hearth_map_result r1;
   CHECK_OK(hearth_map_views(&m, NULL, &cam, views, 1, &o, &r1, &err), &err);
-  double texel_m = 0.1 / (0.4 * RES);             /* metres per texel on A and B */
-  double bound = 200.0 * 1.5 * texel_m + 1e-3;  /* |grad| x (splat reach) */
+  double texel_m = 0.1 / (0.4 * RES);          /* metres per texel on A and B */
+  double bound = 200.0 * 1.5 * texel_m + 1e-3; /* |grad| x (splat reach) */
   double worst = 0;
   size_t n_obs[4] = {0}, n_mask[4] = {0};
   for (size_t row = 0; row < RES; row++)
@@ -86,7 +87,8 @@ int main(void) {
       }
       if (r1.mask[q] == HEARTH_TEXEL_FILLED && isl < 2) {
         /* filled values come from the same island's range only */
-        double lo = isl == 0 ? field(-0.12) : field(0.02), hi = isl == 0 ? field(-0.02) : field(0.12);
+        double lo = isl == 0 ? field(-0.12) : field(0.02),
+               hi = isl == 0 ? field(-0.02) : field(0.12);
         CHECK(r1.filled[q] >= lo - bound && r1.filled[q] <= hi + bound);
       }
       if (r1.mask[q] != HEARTH_TEXEL_OBSERVED) CHECK(isnan(r1.observed[q]));
@@ -113,7 +115,8 @@ int main(void) {
       if (r2.observed[q] >= r1.observed[q] + 1.0 - 2.0 * bound) warmer++;
     }
   CHECK(both > 0);
-  CHECK_MSG(warmer > 0.95 * both, "max fusion: %zu of %zu texels took the warmer view", warmer, both);
+  CHECK_MSG(warmer > 0.95 * both, "max fusion: %zu of %zu texels took the warmer view", warmer,
+            both);
 
   /* the maximum is exactly the larger of the two views' own means (each
      view's mean does not depend on the other view), texel by texel */
@@ -126,11 +129,14 @@ int main(void) {
     if (!a && !b) continue;
     either++;
     float want = !b ? r1.observed[q] : !a ? rb.observed[q] : fmaxf(r1.observed[q], rb.observed[q]);
-    float want_cos = !b ? r1.best_cos[q] : !a ? rb.best_cos[q] : fmaxf(r1.best_cos[q], rb.best_cos[q]);
+    float want_cos = !b   ? r1.best_cos[q]
+                     : !a ? rb.best_cos[q]
+                          : fmaxf(r1.best_cos[q], rb.best_cos[q]);
     exact += r2.observed[q] == want && r2.best_cos[q] == want_cos;
   }
   CHECK(either > 0);
-  CHECK_MSG(exact == either, "max fusion: %zu of %zu texels are the larger view mean", exact, either);
+  CHECK_MSG(exact == either, "max fusion: %zu of %zu texels are the larger view mean", exact,
+            either);
   hearth_map_result_free(&rb);
 
   /* same bytes for any thread count, with or without the cosines */
@@ -148,7 +154,8 @@ int main(void) {
   CHECK(!memcmp(r2.mask, r3.mask, (size_t)RES * RES));
   CHECK(!memcmp(r2.observed, r3.observed, (size_t)RES * RES * sizeof(float)));
   CHECK(!memcmp(r2.filled, r3.filled, (size_t)RES * RES * sizeof(float)));
-  CHECK(r3.n_observed == r2.n_observed && r3.n_filled == r2.n_filled && r3.n_surface == r2.n_surface);
+  CHECK(r3.n_observed == r2.n_observed && r3.n_filled == r2.n_filled &&
+        r3.n_surface == r2.n_surface);
   hearth_map_result_free(&r3);
   o.skip_best_cos = 0;
   o.fusion = HEARTH_FUSE_MEAN;

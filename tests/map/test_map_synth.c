@@ -49,14 +49,18 @@ int main(void) {
         static map_eval fan_max;
         CHECK_OK(map_eval_state(root, inst[i], states[s], mesh, poses, rig, &o, &ev, &err), &err);
         printf("%-16s %-8s %-6s n=%6zu median=%.3f p95=%.3f max=%.2f coverage=%.3f filled=%zu\n",
-               inst[i], states[s], f == 1 ? "robust" : f ? "rays" : "max", ev.n_eval, ev.median, ev.p95,
-               ev.max_err, ev.coverage, ev.n_filled);
+               inst[i], states[s],
+               f == 1 ? "robust"
+               : f    ? "rays"
+                      : "max",
+               ev.n_eval, ev.median, ev.p95, ev.max_err, ev.coverage, ev.n_filled);
         if (f == 0) fan_max = ev;
         if (f == 2) {
-          CHECK_MSG(fabs(ev.coverage - fan_max.coverage) <= 1e-3, "coverage: rays %.4f, fan %.4f", ev.coverage,
-                    fan_max.coverage);
+          CHECK_MSG(fabs(ev.coverage - fan_max.coverage) <= 1e-3, "coverage: rays %.4f, fan %.4f",
+                    ev.coverage, fan_max.coverage);
           CHECK_MSG(fabs(ev.median - fan_max.median) <= 2e-3 && fabs(ev.p95 - fan_max.p95) <= 2e-3,
-                    "errors: rays %.4f/%.4f, fan %.4f/%.4f", ev.median, ev.p95, fan_max.median, fan_max.p95);
+                    "errors: rays %.4f/%.4f, fan %.4f/%.4f", ev.median, ev.p95, fan_max.median,
+                    fan_max.p95);
         }
         CHECK(ev.n_eval > 1000);
         CHECK_MSG(ev.median <= 0.1, "%s/%s: median %.3f", inst[i], states[s], ev.median);

@@ -70,8 +70,11 @@ int main(void) {
             if (d > rad) continue;
             size_t q = y * R + x;
             double u = hearth_rng_uniform(&rng);
-            r.mask[q] = u < 0.6 ? HEARTH_TEXEL_OBSERVED : u < 0.9 ? HEARTH_TEXEL_FILLED : HEARTH_TEXEL_UNOBSERVED;
-            if (r.mask[q] != HEARTH_TEXEL_UNOBSERVED) r.filled[q] = (float)(0 + 70 * hearth_rng_uniform(&rng));
+            r.mask[q] = u < 0.6   ? HEARTH_TEXEL_OBSERVED
+                        : u < 0.9 ? HEARTH_TEXEL_FILLED
+                                  : HEARTH_TEXEL_UNOBSERVED;
+            if (r.mask[q] != HEARTH_TEXEL_UNOBSERVED)
+              r.filled[q] = (float)(0 + 70 * hearth_rng_uniform(&rng));
           }
       }
       hearth_image tex = {0};
@@ -102,7 +105,8 @@ int main(void) {
       reference_pad(R, px, have, pad);
       size_t diff = 0;
       for (size_t i = 0; i < 3 * N; i++) diff += px[i] != tp[i];
-      CHECK_MSG(diff == 0, "R=%zu pad=%d: %zu bytes differ from the reference padding", R, pad, diff);
+      CHECK_MSG(diff == 0, "R=%zu pad=%d: %zu bytes differ from the reference padding", R, pad,
+                diff);
       free(px);
       free(have);
       hearth_image_free(&tex);

@@ -26,8 +26,12 @@ static inline void make_cube(hearth_mesh *m) {
   };
   for (int f = 0; f < 6; f++) {
     uint32_t *t = m->indices + f * 6;
-    t[0] = quads[f][0]; t[1] = quads[f][1]; t[2] = quads[f][2];
-    t[3] = quads[f][0]; t[4] = quads[f][2]; t[5] = quads[f][3];
+    t[0] = quads[f][0];
+    t[1] = quads[f][1];
+    t[2] = quads[f][2];
+    t[3] = quads[f][0];
+    t[4] = quads[f][2];
+    t[5] = quads[f][3];
   }
 }
 

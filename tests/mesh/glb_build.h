@@ -25,19 +25,19 @@
 
 typedef struct tb_glb {
   size_t nv, nt;
-  const double *pos;            /* 3 per vertex */
-  int pos_type, pos_norm;       /* componentType (0: FLOAT), normalized */
-  const double *uv[2];          /* TEXCOORD_0, TEXCOORD_1: 2 per vertex, or NULL */
+  const double *pos;      /* 3 per vertex */
+  int pos_type, pos_norm; /* componentType (0: FLOAT), normalized */
+  const double *uv[2];    /* TEXCOORD_0, TEXCOORD_1: 2 per vertex, or NULL */
   int uv_type, uv_norm;
-  const uint32_t *idx;          /* 3 per triangle */
+  const uint32_t *idx;               /* 3 per triangle */
   const double *scale, *translation; /* node TRS parts, 3 each, or NULL */
-  int texture;                  /* embed a 4x4 PNG as the base colour texture */
-  int wrap_s, wrap_t;           /* sampler wrap modes; both 0: no sampler */
-  int tex_coord;                /* textureInfo.texCoord; < 0: absent */
-  const char *transform;        /* JSON object text of KHR_texture_transform, or NULL */
-  int quantization;             /* declare KHR_mesh_quantization (used and required) */
-  int transform_required;       /* list KHR_texture_transform in extensionsRequired too */
-  const char *required_extra;   /* one more extension, used and required, or NULL */
+  int texture;                       /* embed a 4x4 PNG as the base colour texture */
+  int wrap_s, wrap_t;                /* sampler wrap modes; both 0: no sampler */
+  int tex_coord;                     /* textureInfo.texCoord; < 0: absent */
+  const char *transform;             /* JSON object text of KHR_texture_transform, or NULL */
+  int quantization;                  /* declare KHR_mesh_quantization (used and required) */
+  int transform_required;            /* list KHR_texture_transform in extensionsRequired too */
+  const char *required_extra;        /* one more extension, used and required, or NULL */
 } tb_glb;
 
 static size_t tb_csize(int t) {
@@ -46,22 +46,22 @@ static size_t tb_csize(int t) {
 
 static void tb_put(uint8_t *p, int t, double v) {
   switch (t) {
-  case TB_BYTE: *(int8_t *)p = (int8_t)lrint(v); break;
-  case TB_UBYTE: *p = (uint8_t)lrint(v); break;
-  case TB_SHORT: {
-    int16_t s = (int16_t)lrint(v);
-    memcpy(p, &s, 2);
-    break;
-  }
-  case TB_USHORT: {
-    uint16_t s = (uint16_t)lrint(v);
-    memcpy(p, &s, 2);
-    break;
-  }
-  default: {
-    float f = (float)v;
-    memcpy(p, &f, 4);
-  }
+    case TB_BYTE: *(int8_t *)p = (int8_t)lrint(v); break;
+    case TB_UBYTE: *p = (uint8_t)lrint(v); break;
+    case TB_SHORT: {
+      int16_t s = (int16_t)lrint(v);
+      memcpy(p, &s, 2);
+      break;
+    }
+    case TB_USHORT: {
+      uint16_t s = (uint16_t)lrint(v);
+      memcpy(p, &s, 2);
+      break;
+    }
+    default: {
+      float f = (float)v;
+      memcpy(p, &f, 4);
+    }
   }
 }
 
@@ -90,8 +90,10 @@ static void tb_attr(json_t *views, json_t *accs, uint8_t *bin, size_t *len, cons
   if (norm) json_object_set_new(a, "normalized", json_true());
   json_t *jl = json_array(), *jh = json_array();
   for (int k = 0; k < ncomp; k++) {
-    json_array_append_new(jl, ctype == TB_FLOAT ? json_real(lo[k]) : json_integer((json_int_t)lo[k]));
-    json_array_append_new(jh, ctype == TB_FLOAT ? json_real(hi[k]) : json_integer((json_int_t)hi[k]));
+    json_array_append_new(jl,
+                          ctype == TB_FLOAT ? json_real(lo[k]) : json_integer((json_int_t)lo[k]));
+    json_array_append_new(jh,
+                          ctype == TB_FLOAT ? json_real(hi[k]) : json_integer((json_int_t)hi[k]));
   }
   json_object_set_new(a, "min", jl);
   json_object_set_new(a, "max", jh);
@@ -131,9 +133,9 @@ static uint8_t *tb_encode(const tb_glb *g, size_t *size) {
     memcpy(bin + len, &g->idx[i], 4);
     len += 4;
   }
-  json_array_append_new(views, json_pack("{s:i,s:I,s:I,s:i}", "buffer", 0, "byteOffset",
-                                         (json_int_t)ioff, "byteLength", (json_int_t)(len - ioff),
-                                         "target", 34963));
+  json_array_append_new(views,
+                        json_pack("{s:i,s:I,s:I,s:i}", "buffer", 0, "byteOffset", (json_int_t)ioff,
+                                  "byteLength", (json_int_t)(len - ioff), "target", 34963));
   json_array_append_new(accs, json_pack("{s:I,s:i,s:I,s:s}", "bufferView",
                                         (json_int_t)json_array_size(views) - 1, "componentType",
                                         5125, "count", (json_int_t)(3 * g->nt), "type", "SCALAR"));
@@ -142,10 +144,12 @@ static uint8_t *tb_encode(const tb_glb *g, size_t *size) {
   json_t *root = json_pack("{s:{s:s},s:i,s:[{s:[i]}]}", "asset", "version", "2.0", "scene", 0,
                            "scenes", "nodes", 0);
   json_t *node = json_pack("{s:i}", "mesh", 0);
-  if (g->scale) json_object_set_new(node, "scale", json_pack("[f,f,f]", g->scale[0], g->scale[1], g->scale[2]));
+  if (g->scale)
+    json_object_set_new(node, "scale", json_pack("[f,f,f]", g->scale[0], g->scale[1], g->scale[2]));
   if (g->translation)
     json_object_set_new(node, "translation",
-                        json_pack("[f,f,f]", g->translation[0], g->translation[1], g->translation[2]));
+                        json_pack("[f,f,f]", g->translation[0], g->translation[1],
+                                  g->translation[2]));
   json_object_set_new(root, "nodes", json_pack("[o]", node));
   json_t *used = json_array(), *req = json_array();
   if (g->quantization) {
@@ -174,9 +178,9 @@ static uint8_t *tb_encode(const tb_glb *g, size_t *size) {
     json_t *tex = json_pack("{s:i}", "source", 0);
     if (g->wrap_s || g->wrap_t) {
       json_object_set_new(tex, "sampler", json_integer(0));
-      json_object_set_new(root, "samplers", json_pack("[{s:i,s:i}]", "wrapS",
-                                                      g->wrap_s ? g->wrap_s : 10497, "wrapT",
-                                                      g->wrap_t ? g->wrap_t : 10497));
+      json_object_set_new(root, "samplers",
+                          json_pack("[{s:i,s:i}]", "wrapS", g->wrap_s ? g->wrap_s : 10497, "wrapT",
+                                    g->wrap_t ? g->wrap_t : 10497));
     }
     json_object_set_new(root, "textures", json_pack("[o]", tex));
     json_object_set_new(root, "images",
@@ -242,7 +246,6 @@ static void tb_cube_init(void) {
   }
 }
 
-
 /* ---- the cube quantised --------------------------------------------------------- */
 /* A component type as KHR_mesh_quantization allows it for POSITION and
  * TEXCOORD: stored values c in [cmin, cmax], decoded c * dec. */
@@ -285,8 +288,8 @@ static void tb_quantized_cube(const tb_qtype *q, const double lo[3], const doubl
   c->us = 1.0 / (span * q->dec);
   c->uo = -q->cmin * q->dec * c->us;
   for (int i = 0; i < 2 * CUBE_NV; i++) c->uv[i] = round(q->cmin + g_uv[i] * span);
-  snprintf(c->xf, sizeof c->xf, "{\"offset\":[%.17g,%.17g],\"scale\":[%.17g,%.17g]}", c->uo,
-           c->uo, c->us, c->us);
+  snprintf(c->xf, sizeof c->xf, "{\"offset\":[%.17g,%.17g],\"scale\":[%.17g,%.17g]}", c->uo, c->uo,
+           c->us, c->us);
   memset(&c->g, 0, sizeof c->g);
   c->g.nv = CUBE_NV, c->g.nt = CUBE_NT, c->g.idx = g_idx;
   c->g.pos = c->pos, c->g.pos_type = q->ctype, c->g.pos_norm = q->norm;

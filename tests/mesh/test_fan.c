@@ -58,11 +58,16 @@ static void make_torus(hearth_mesh *m, double a, double b, size_t nu, size_t nv)
   for (size_t i = 0; i < nu; i++)
     for (size_t j = 0; j < nv; j++) {
       uint32_t p00 = (uint32_t)(i * nv + j), p10 = (uint32_t)(((i + 1) % nu) * nv + j),
-               p01 = (uint32_t)(i * nv + (j + 1) % nv), p11 = (uint32_t)(((i + 1) % nu) * nv + (j + 1) % nv);
+               p01 = (uint32_t)(i * nv + (j + 1) % nv),
+               p11 = (uint32_t)(((i + 1) % nu) * nv + (j + 1) % nv);
       /* counter-clockwise seen from outside: along u then v */
       uint32_t *ix = m->indices + 3 * t;
-      ix[0] = p00; ix[1] = p10; ix[2] = p11;
-      ix[3] = p00; ix[4] = p11; ix[5] = p01;
+      ix[0] = p00;
+      ix[1] = p10;
+      ix[2] = p11;
+      ix[3] = p00;
+      ix[4] = p11;
+      ix[5] = p01;
       t += 2;
     }
 }
@@ -88,8 +93,8 @@ typedef struct compare_stats {
 } compare_stats;
 
 /* cast the fan and the reference from T; tally the differences */
-static void compare(const hearth_mesh *m, const hearth_camera *cam, size_t stride, const hearth_rigid *T,
-                    compare_stats *st) {
+static void compare(const hearth_mesh *m, const hearth_camera *cam, size_t stride,
+                    const hearth_rigid *T, compare_stats *st) {
   hearth_err err = {0};
   hearth_ray_fan *fan = NULL;
   hearth_raycaster *rc = NULL;
@@ -98,7 +103,8 @@ static void compare(const hearth_mesh *m, const hearth_camera *cam, size_t strid
   if (!fan || !rc) return;
   size_t w, h;
   const float *dirs = hearth_ray_fan_dirs(fan, &w, &h);
-  CHECK(w == ((size_t)cam->width + stride - 1) / stride && h == ((size_t)cam->height + stride - 1) / stride);
+  CHECK(w == ((size_t)cam->width + stride - 1) / stride &&
+        h == ((size_t)cam->height + stride - 1) / stride);
   size_t ss = hearth_ray_fan_scratch_size(fan, m->n_vertices);
   unsigned char *scratch = calloc(1, ss);
   hearth_ray_hit *hits = malloc(w * h * sizeof *hits);
@@ -146,12 +152,15 @@ static void compare(const hearth_mesh *m, const hearth_camera *cam, size_t strid
 }
 
 static void check_stats(const char *what, const compare_stats *s, size_t min_hits) {
-  fprintf(stderr, "%s: %zu hits (reference %zu), hit/miss %zu, other triangle %zu, t off %zu, bary off %zu\n",
-          what, s->hits, s->ref_hits, s->hit_miss, s->other_tri, s->bad_t, s->bad_b);
+  fprintf(
+      stderr,
+      "%s: %zu hits (reference %zu), hit/miss %zu, other triangle %zu, t off %zu, bary off %zu\n",
+      what, s->hits, s->ref_hits, s->hit_miss, s->other_tri, s->bad_t, s->bad_b);
   CHECK_MSG(s->hits >= min_hits, "%s: only %zu hits", what, s->hits);
   /* rays grazing an edge or a silhouette may go either way in float: a
      handful in ten thousand */
-  CHECK_MSG(s->hit_miss * 5000 <= s->ref_hits + 5000, "%s: %zu hit/miss differences", what, s->hit_miss);
+  CHECK_MSG(s->hit_miss * 5000 <= s->ref_hits + 5000, "%s: %zu hit/miss differences", what,
+            s->hit_miss);
   CHECK_MSG(s->other_tri * 200 <= s->ref_hits + 200, "%s: %zu other triangles", what, s->other_tri);
   CHECK_MSG(s->bad_t == 0, "%s: %zu depths differ", what, s->bad_t);
   CHECK_MSG(s->bad_b == 0, "%s: %zu barycentrics differ", what, s->bad_b);
@@ -170,7 +179,8 @@ int main(void) {
     compare_stats s = {0}, s2 = {0};
     for (int k = 0; k < 8; k++) {
       double az = 2 * M_PI * k / 8.0 + 0.1, el = (k % 3 - 1) * 0.6;
-      hearth_rigid T = look_at(1.1 * cos(el) * cos(az), 1.1 * cos(el) * sin(az), 1.1 * sin(el) + 0.05);
+      hearth_rigid T =
+          look_at(1.1 * cos(el) * cos(az), 1.1 * cos(el) * sin(az), 1.1 * sin(el) + 0.05);
       compare(&torus, k % 2 ? &lens : &pin, 1, &T, &s);
       compare(&torus, &lens, 3, &T, &s2);
     }
@@ -218,11 +228,19 @@ int main(void) {
         /* facing -z (towards the camera): clockwise in x-right, y-down */
         uint32_t *ix = plane.indices + 3 * t;
         if ((i + j) % 2) {
-          ix[0] = a; ix[1] = c; ix[2] = b;
-          ix[3] = b; ix[4] = c; ix[5] = d;
+          ix[0] = a;
+          ix[1] = c;
+          ix[2] = b;
+          ix[3] = b;
+          ix[4] = c;
+          ix[5] = d;
         } else {
-          ix[0] = a; ix[1] = d; ix[2] = b;
-          ix[3] = a; ix[4] = c; ix[5] = d;
+          ix[0] = a;
+          ix[1] = d;
+          ix[2] = b;
+          ix[3] = a;
+          ix[4] = c;
+          ix[5] = d;
         }
         t += 2;
       }
@@ -244,7 +262,10 @@ int main(void) {
         inside++;
         const hearth_ray_hit *h = &hits[v * 160 + u];
         if (h->prim == UINT32_MAX) holes++;
-        else CHECK_NEAR(h->t, sqrt(1.0 + pow((u - pin.cx) / pin.fx, 2) + pow((v - pin.cy) / pin.fy, 2)), 1e-5);
+        else
+          CHECK_NEAR(h->t,
+                     sqrt(1.0 + pow((u - pin.cx) / pin.fx, 2) + pow((v - pin.cy) / pin.fy, 2)),
+                     1e-5);
       }
     CHECK_MSG(holes == 0, "%zu of %zu pixels fell through the plane", holes, inside);
 

@@ -77,8 +77,7 @@ static char *replace(const char *s, const char *a, const char *b) {
 static const float A_POS[3][3] = {{0.5f, -1.0f, 2.0f}, {1.5f, 0.25f, -1.0f}, {-2.0f, 1.0f, 0.75f}};
 static const uint16_t A_UV[3][2] = {{0, 65535}, {65535, 0}, {32768, 16384}};
 static const float B_POS[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0.5f}};
-static const float B_UV[4][2] = {
-    {0.125f, 0.25f}, {0.75f, 0.25f}, {0.125f, 0.875f}, {0.75f, 0.875f}};
+static const float B_UV[4][2] = {{0.125f, 0.25f}, {0.75f, 0.25f}, {0.125f, 0.875f}, {0.75f, 0.875f}};
 static const uint16_t B_IDX[6] = {0, 1, 2, 2, 1, 3};
 #define HAND_BIN_LEN 140
 
@@ -429,8 +428,10 @@ static void test_round_trip(const char *dir) {
     size_t iv = (size_t)json_integer_value(json_object_get(img, "bufferView"));
     CHECK(strcmp(json_string_value(json_object_get(img, "mimeType")), "image/png") == 0);
     CHECK(json_object_get(json_array_get(views, iv), "target") == NULL);
-    json_t *prim = json_array_get(
-        json_object_get(json_array_get(json_object_get(root, "meshes"), 0), "primitives"), 0);
+    json_t *prim =
+        json_array_get(json_object_get(json_array_get(json_object_get(root, "meshes"), 0),
+                                       "primitives"),
+                       0);
     json_t *accs = json_object_get(root, "accessors");
     json_t *ia = json_array_get(accs, (size_t)json_integer_value(json_object_get(prim, "indices")));
     CHECK(json_integer_value(json_object_get(ia, "componentType")) == 5125);
@@ -531,8 +532,9 @@ static void test_normals(void) {
   const uint8_t *bin = a + 28 + jl;
   json_error_t je;
   json_t *root = json_loadb((const char *)a + 20, jl, 0, &je);
-  json_t *prim = json_array_get(
-      json_object_get(json_array_get(json_object_get(root, "meshes"), 0), "primitives"), 0);
+  json_t *prim = json_array_get(json_object_get(json_array_get(json_object_get(root, "meshes"), 0),
+                                                "primitives"),
+                                0);
   CHECK(json_object_get(json_object_get(prim, "attributes"), "TEXCOORD_0") == NULL);
   size_t ai =
       (size_t)json_integer_value(json_object_get(json_object_get(prim, "attributes"), "NORMAL"));
@@ -542,14 +544,18 @@ static void test_normals(void) {
   size_t off = (size_t)json_integer_value(json_object_get(view, "byteOffset")) +
                (size_t)json_integer_value(json_object_get(acc, "byteOffset"));
   double s5 = sqrt(5.0);
-  const double want[5][3] = {
-      {0, -2 / s5, 1 / s5}, {0, -2 / s5, 1 / s5}, {0, 0, 1}, {0, -1, 0}, {0, 0, 1}};
+  const double want[5][3] = {{0, -2 / s5, 1 / s5},
+                             {0, -2 / s5, 1 / s5},
+                             {0, 0, 1},
+                             {0, -1, 0},
+                             {0, 0, 1}};
   for (int v = 0; v < 5; v++)
     for (int k = 0; k < 3; k++) CHECK_NEAR(get_f32(bin + off + 12 * v + 4 * k), want[v][k], 1e-6);
   /* POSITION min/max cover every vertex */
-  json_t *pa = json_array_get(
-      json_object_get(root, "accessors"),
-      (size_t)json_integer_value(json_object_get(json_object_get(prim, "attributes"), "POSITION")));
+  json_t *pa =
+      json_array_get(json_object_get(root, "accessors"),
+                     (size_t)json_integer_value(
+                         json_object_get(json_object_get(prim, "attributes"), "POSITION")));
   CHECK_NEAR(json_number_value(json_array_get(json_object_get(pa, "min"), 2)), -2.0, 0);
   CHECK_NEAR(json_number_value(json_array_get(json_object_get(pa, "max"), 0)), 9.0, 0);
   json_decref(root);

@@ -26,8 +26,8 @@ static uint8_t *cube_glb(const int tiles[6][2], int wrap_s, int wrap_t, size_t *
   return tb_encode(&g, n);
 }
 
-static hearth_status parse(const uint8_t *f, size_t n, int require_uvs, int keep,
-                           hearth_mesh *m, hearth_glb_report *rep, hearth_err *e) {
+static hearth_status parse(const uint8_t *f, size_t n, int require_uvs, int keep, hearth_mesh *m,
+                           hearth_glb_report *rep, hearth_err *e) {
   hearth_glb_read_opts o = {0};
   o.require_uvs = require_uvs;
   o.keep_uv_tiles = keep;
@@ -125,8 +125,9 @@ static void test_tiles_straddling(void) {
   /* an island on the border of [0,1], within the slack, stays (also under
    * CLAMP_TO_EDGE, where moving it would be refused) */
   memcpy(uv, g_uv, sizeof uv);
-  for (int v = 4; v < 8; v++) uv[2 * v] = v == 4 || v == 7 ? 1.0 - 0.25 * HEARTH_UV_TILE_SLACK
-                                                         : 1.0 + 0.25 * HEARTH_UV_TILE_SLACK;
+  for (int v = 4; v < 8; v++)
+    uv[2 * v] =
+        v == 4 || v == 7 ? 1.0 - 0.25 * HEARTH_UV_TILE_SLACK : 1.0 + 0.25 * HEARTH_UV_TILE_SLACK;
   g.texture = 1, g.wrap_s = 33071, g.wrap_t = 33071;
   f = tb_encode(&g, &n);
   CHECK_OK(parse(f, n, 1, 0, &m, &rep, &e), &e);
@@ -176,8 +177,9 @@ static void test_tiles_wrap_modes(void) {
   f = cube_glb(tv, 10497, 33071, &n);
   hearth_status s = parse(f, n, 1, 0, &m, &rep, &e);
   CHECK_MSG(s == HEARTH_E_UNSUPPORTED && strstr(e.msg, "CLAMP_TO_EDGE") &&
-                strstr(e.msg, "1 UV island (2 triangles; first: meshes[0].primitives[0] "
-                              "triangle 8"),
+                strstr(e.msg,
+                       "1 UV island (2 triangles; first: meshes[0].primitives[0] "
+                       "triangle 8"),
             "got %s: %s", hearth_status_name(s), e.msg);
   CHECK_OK(parse(f, n, 0, 0, &m, &rep, &e), &e);
   CHECK(rep.uv_islands_left == 1 && rep.uv_islands_moved == 0);
@@ -364,8 +366,8 @@ static void test_end_to_end(void) {
              "--threads 2",
              HEARTH_EXE, dir, names[c], dir, names[c], g, dir, names[c], g, dir, names[c]);
     rc = run(cmd, out, sizeof out);
-    CHECK_MSG(rc == 0 && strstr(out, "surface 0 texels") == NULL, "%s: map exit %d: %s",
-              names[c], rc, out);
+    CHECK_MSG(rc == 0 && strstr(out, "surface 0 texels") == NULL, "%s: map exit %d: %s", names[c],
+              rc, out);
   }
   /* the same ground truth and the same map, byte for byte */
   const char *files[] = {"ground_truth/instances/cup_01/hot/temperature_true.npy",

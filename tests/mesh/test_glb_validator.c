@@ -70,15 +70,18 @@ int main(void) {
   const char *src = getenv("HEARTH_SOURCE_DIR");
   if (!src || !*src) src = ".";
   if (system("node --version >/dev/null 2>&1") != 0) {
-    fprintf(stderr, "FAIL: node is not installed; run scripts/setup.sh (CI installs node and "
-                    "the gltf-validator package)\n");
+    fprintf(stderr,
+            "FAIL: node is not installed; run scripts/setup.sh (CI installs node and "
+            "the gltf-validator package)\n");
     return 1;
   }
   char pkg[4096];
   snprintf(pkg, sizeof pkg, "%s/.tools/node_modules/gltf-validator/package.json", src);
   if (!hearth_path_exists(pkg)) {
-    fprintf(stderr, "FAIL: %s is missing; run scripts/setup.sh to install the Khronos glTF "
-                    "validator (npm package gltf-validator) into %s/.tools\n", pkg, src);
+    fprintf(stderr,
+            "FAIL: %s is missing; run scripts/setup.sh to install the Khronos glTF "
+            "validator (npm package gltf-validator) into %s/.tools\n",
+            pkg, src);
     return 1;
   }
 
@@ -89,7 +92,9 @@ int main(void) {
     const char *name;
     int uvs;
     size_t tex;
-  } cases[] = {{"textured.glb", 1, 64}, {"textured_npot.glb", 1, 24}, {"untextured.glb", 1, 0},
+  } cases[] = {{"textured.glb", 1, 64},
+               {"textured_npot.glb", 1, 24},
+               {"untextured.glb", 1, 0},
                {"no_uvs.glb", 0, 0}};
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
     hearth_mesh m;

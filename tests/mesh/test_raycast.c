@@ -12,12 +12,12 @@
 /* icosphere of radius 1 with `sub` subdivisions (no vertex sharing needed) */
 static void make_icosphere(hearth_mesh *m, int sub) {
   const double p = (1.0 + sqrt(5.0)) / 2.0;
-  double v[12][3] = {{-1, p, 0}, {1, p, 0}, {-1, -p, 0}, {1, -p, 0}, {0, -1, p}, {0, 1, p},
-                     {0, -1, -p}, {0, 1, -p}, {p, 0, -1}, {p, 0, 1}, {-p, 0, -1}, {-p, 0, 1}};
-  static const int f[20][3] = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11},
-                               {1, 5, 9}, {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
-                               {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8}, {3, 8, 9},
-                               {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
+  double v[12][3] = {{-1, p, 0},  {1, p, 0},  {-1, -p, 0}, {1, -p, 0}, {0, -1, p},  {0, 1, p},
+                     {0, -1, -p}, {0, 1, -p}, {p, 0, -1},  {p, 0, 1},  {-p, 0, -1}, {-p, 0, 1}};
+  static const int f[20][3] = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                               {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                               {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                               {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
   size_t ntri = 20;
   for (int s = 0; s < sub; s++) ntri *= 4;
   double *tris = malloc(ntri * 9 * sizeof(double));
@@ -40,7 +40,8 @@ static void make_icosphere(hearth_mesh *m, int sub) {
       }
       double *mids[3] = {ab, bc, ca};
       for (int q = 0; q < 3; q++) {
-        double n = sqrt(mids[q][0] * mids[q][0] + mids[q][1] * mids[q][1] + mids[q][2] * mids[q][2]);
+        double n =
+            sqrt(mids[q][0] * mids[q][0] + mids[q][1] * mids[q][1] + mids[q][2] * mids[q][2]);
         for (int d = 0; d < 3; d++) mids[q][d] /= n;
       }
       const double *out[4][3] = {{a, ab, ca}, {ab, b, bc}, {ca, bc, c}, {ab, bc, ca}};
@@ -267,8 +268,7 @@ int main(void) {
     for (size_t i = 0; i < 37; i++) CHECK(same_hit(&hb[100 + i], &hs[i]));
     /* tfar cuts every hit */
     hearth_raycast_batch(r3, 1000, org, dir, 0.0f, 1e-3f, hs);
-    for (size_t i = 0; i < 1000; i++)
-      CHECK(hs[i].prim == UINT32_MAX || hs[i].t <= 1e-3f);
+    for (size_t i = 0; i < 1000; i++) CHECK(hs[i].prim == UINT32_MAX || hs[i].t <= 1e-3f);
     free(org);
     free(dir);
     free(hb);

@@ -9,8 +9,8 @@
 
 /* append an axis-aligned UV quad [u0,u1]x[v0,v1] as two triangles with their
  * own 4 vertices; `flip` reverses the winding */
-static void add_quad(hearth_mesh *m, size_t *nv, size_t *nt, float u0, float v0, float u1,
-                     float v1, int flip) {
+static void add_quad(hearth_mesh *m, size_t *nv, size_t *nt, float u0, float v0, float u1, float v1,
+                     int flip) {
   float uv[4][2] = {{u0, v0}, {u1, v0}, {u1, v1}, {u0, v1}};
   size_t b = *nv;
   for (int k = 0; k < 4; k++) {
@@ -22,7 +22,10 @@ static void add_quad(hearth_mesh *m, size_t *nv, size_t *nt, float u0, float v0,
   }
   uint32_t t[6] = {0, 1, 2, 0, 2, 3};
   if (flip) {
-    t[1] = 2; t[2] = 1; t[4] = 3; t[5] = 2;
+    t[1] = 2;
+    t[2] = 1;
+    t[4] = 3;
+    t[5] = 2;
   }
   for (int k = 0; k < 6; k++) m->indices[*nt * 3 + k] = (uint32_t)(b + t[k]);
   *nv += 4;
@@ -65,9 +68,12 @@ int main(void) {
     CHECK_OK(hearth_uv_islands(&w, isl, &n, &err), &err);
     CHECK(n == 1 && isl[0] == 0 && isl[1] == 0);
     /* touching at one corner only is not an edge: two islands */
-    w.uvs[3 * 2] = 0.4f; w.uvs[3 * 2 + 1] = 0.3f; /* tri 1 = (0.4,0.3),(0.7,0.3),(0.7,0.5) */
-    w.uvs[4 * 2] = 0.7f; w.uvs[4 * 2 + 1] = 0.3f;
-    w.uvs[5 * 2] = 0.7f; w.uvs[5 * 2 + 1] = 0.5f;
+    w.uvs[3 * 2] = 0.4f;
+    w.uvs[3 * 2 + 1] = 0.3f; /* tri 1 = (0.4,0.3),(0.7,0.3),(0.7,0.5) */
+    w.uvs[4 * 2] = 0.7f;
+    w.uvs[4 * 2 + 1] = 0.3f;
+    w.uvs[5 * 2] = 0.7f;
+    w.uvs[5 * 2 + 1] = 0.5f;
     CHECK_OK(hearth_uv_islands(&w, isl, &n, &err), &err);
     CHECK(n == 2 && isl[0] == 0 && isl[1] == 1);
     /* a seam: same 3-D edge but different UVs -> separate islands even with
@@ -156,7 +162,9 @@ int main(void) {
       size_t nv2 = 0, nt2 = 0;
       add_quad(&d, &nv2, &nt2, 0.05f, 0.05f, 0.95f, 0.95f, 0);
       /* use exactly representable coordinates: 0.0625 and 0.9375 on R = 16 */
-      float q[4][2] = {{0.03125f, 0.03125f}, {0.96875f, 0.03125f}, {0.96875f, 0.96875f},
+      float q[4][2] = {{0.03125f, 0.03125f},
+                       {0.96875f, 0.03125f},
+                       {0.96875f, 0.96875f},
                        {0.03125f, 0.96875f}};
       for (int k = 0; k < 4; k++) {
         d.uvs[k * 2] = q[k][0];
@@ -224,7 +232,12 @@ int main(void) {
         uint32_t a = (uint32_t)(j * (G + 1) + i), b = a + 1, c = a + (uint32_t)G + 2,
                  d = a + (uint32_t)G + 1;
         uint32_t *t = g.indices + (j * G + i) * 6;
-        t[0] = a; t[1] = b; t[2] = c; t[3] = a; t[4] = c; t[5] = d;
+        t[0] = a;
+        t[1] = b;
+        t[2] = c;
+        t[3] = a;
+        t[4] = c;
+        t[5] = d;
       }
     uint32_t *isl = malloc(nt * sizeof *isl), n = 0;
     double t0 = hearth_now();

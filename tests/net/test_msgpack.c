@@ -16,8 +16,8 @@ static int hexval(char c) { return c <= '9' ? c - '0' : c - 'a' + 10; }
 int main(void) {
   hearth_mp_writer w;
   hearth_mp_writer_init(&w);
-  int64_t ints[] = {0, 127, 128, 255, 256, 65535, 65536, 4294967296LL, -1, -32, -33, -128, -129, -32768, -32769,
-                    -2147483649LL};
+  int64_t ints[] = {0,  127, 128, 255,  256,  65535,  65536,  4294967296LL,
+                    -1, -32, -33, -128, -129, -32768, -32769, -2147483649LL};
   hearth_mp_put_array(&w, 22);
   for (int i = 0; i < 16; i++) hearth_mp_put_int(&w, ints[i]);
   hearth_mp_put_f64(&w, 1.5);
@@ -28,17 +28,21 @@ int main(void) {
   hearth_mp_put_bin(&w, "\x01", 1);
   size_t n = strlen(k_py) / 2;
   uint8_t ref[256];
-  for (size_t i = 0; i < n; i++) ref[i] = (uint8_t)(hexval(k_py[2 * i]) << 4 | hexval(k_py[2 * i + 1]));
+  for (size_t i = 0; i < n; i++)
+    ref[i] = (uint8_t)(hexval(k_py[2 * i]) << 4 | hexval(k_py[2 * i + 1]));
   CHECK(!w.failed && w.len == n && memcmp(w.buf, ref, n) == 0);
   hearth_mp_doc doc;
   hearth_err err = {0};
   CHECK_OK(hearth_mp_decode(ref, n, NULL, &doc, &err), &err);
   if (doc.root) {
     CHECK(doc.root->type == HEARTH_MP_ARRAY && doc.root->n == 22);
-    for (int i = 0; i < 16; i++) CHECK(doc.root->items[i].type == HEARTH_MP_INT && doc.root->items[i].i == ints[i]);
+    for (int i = 0; i < 16; i++)
+      CHECK(doc.root->items[i].type == HEARTH_MP_INT && doc.root->items[i].i == ints[i]);
     CHECK(doc.root->items[16].f == 1.5 && doc.root->items[17].type == HEARTH_MP_NIL);
-    CHECK(doc.root->items[18].b == 1 && doc.root->items[19].type == HEARTH_MP_BOOL && !doc.root->items[19].b);
-    CHECK(hearth_mp_str_eq(&doc.root->items[20], "hi") && doc.root->items[21].type == HEARTH_MP_BIN);
+    CHECK(doc.root->items[18].b == 1 && doc.root->items[19].type == HEARTH_MP_BOOL &&
+          !doc.root->items[19].b);
+    CHECK(hearth_mp_str_eq(&doc.root->items[20], "hi") &&
+          doc.root->items[21].type == HEARTH_MP_BIN);
   }
   hearth_mp_doc_free(&doc);
   /* ndarray round trip */
@@ -51,8 +55,11 @@ int main(void) {
   hearth_mp_put_ndarray(&w, a, sizeof a, "<f4", shape, 2);
   CHECK_OK(hearth_mp_decode(w.buf, w.len, NULL, &doc, &err), &err);
   hearth_mp_ndarray nd;
-  CHECK_OK(hearth_mp_ndarray_get(hearth_mp_map_get(doc.root, "actions", HEARTH_MP_STR), "x", &nd, &err), &err);
-  CHECK(nd.ndim == 2 && nd.shape[0] == 2 && nd.shape[1] == 3 && hearth_mp_ndarray_at(&nd, 2) == 3.5);
+  CHECK_OK(hearth_mp_ndarray_get(hearth_mp_map_get(doc.root, "actions", HEARTH_MP_STR), "x", &nd,
+                                 &err),
+           &err);
+  CHECK(nd.ndim == 2 && nd.shape[0] == 2 && nd.shape[1] == 3 &&
+        hearth_mp_ndarray_at(&nd, 2) == 3.5);
   CHECK(hearth_mp_map_get(doc.root, "actions", HEARTH_MP_BIN) == NULL);
   hearth_mp_doc_free(&doc);
   /* errors: truncation names the offset, trailing bytes, bad byte, limits */

@@ -46,7 +46,8 @@ static int fake_server(int mode, pid_t *pid) {
       hearth_ws_accept(key, acc);
       snprintf(reply, sizeof reply,
                "HTTP/1.1 101 Switching Protocols\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
-               "Sec-WebSocket-Accept: %s\r\n\r\n\xc2", acc);
+               "Sec-WebSocket-Accept: %s\r\n\r\n\xc2",
+               acc);
     }
     if (mode != 1 && write(c, reply, strlen(reply) + (mode == 2)) < 0) _exit(1);
     sleep(3);
@@ -85,13 +86,16 @@ int main(void) {
   hearth_ws_accept("dGhlIHNhbXBsZSBub25jZQ==", acc);
   CHECK(strcmp(acc, "s3pPLMBiTxaQ9kYGzzhZRbK+xOo=") == 0);
   hearth_err err = {0};
-  const char *ok = "HTTP/1.1 101 Switching Protocols\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
-                   "Sec-WebSocket-Accept: s3pPLMBiTxaQ9kYGzzhZRbK+xOo=\r\n\r\n";
+  const char *ok =
+      "HTTP/1.1 101 Switching Protocols\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+      "Sec-WebSocket-Accept: s3pPLMBiTxaQ9kYGzzhZRbK+xOo=\r\n\r\n";
   CHECK_OK(hearth_ws_check_handshake(ok, strlen(ok), "dGhlIHNhbXBsZSBub25jZQ==", &err), &err);
-  CHECK(hearth_ws_check_handshake(ok, strlen(ok), "AAAAAAAAAAAAAAAAAAAAAA==", &err) == HEARTH_E_PARSE &&
+  CHECK(hearth_ws_check_handshake(ok, strlen(ok), "AAAAAAAAAAAAAAAAAAAAAA==", &err) ==
+            HEARTH_E_PARSE &&
         strstr(err.msg, "line 4"));
   const char *nf = "HTTP/1.1 404 Not Found\r\n\r\n";
-  CHECK(hearth_ws_check_handshake(nf, strlen(nf), "x", &err) == HEARTH_E_PARSE && strstr(err.msg, "101"));
+  CHECK(hearth_ws_check_handshake(nf, strlen(nf), "x", &err) == HEARTH_E_PARSE &&
+        strstr(err.msg, "101"));
   /* RFC 6455 5.7: unmasked "Hello", masked "Hello" */
   hearth_ws_header fh;
   size_t need;
@@ -104,14 +108,17 @@ int main(void) {
   CHECK(memcmp(masked + 6, "Hello", 5) == 0);
   CHECK(hearth_ws_parse_header(masked, 11, 0, 1 << 20, &fh, &need, &err) == HEARTH_E_PARSE);
   uint8_t hdr[14], mk[4] = {0x37, 0xfa, 0x21, 0x3d};
-  CHECK(hearth_ws_build_header(hdr, 1, 1, 5, mk) == 6 && memcmp(hdr, "\x81\x85\x37\xfa\x21\x3d", 6) == 0);
-  CHECK(hearth_ws_build_header(hdr, 1, 2, 256, NULL) == 4 && hdr[1] == 126 && hdr[2] == 1 && hdr[3] == 0);
+  CHECK(hearth_ws_build_header(hdr, 1, 1, 5, mk) == 6 &&
+        memcmp(hdr, "\x81\x85\x37\xfa\x21\x3d", 6) == 0);
+  CHECK(hearth_ws_build_header(hdr, 1, 2, 256, NULL) == 4 && hdr[1] == 126 && hdr[2] == 1 &&
+        hdr[3] == 0);
   CHECK(hearth_ws_build_header(hdr, 1, 2, 65536, NULL) == 10 && hdr[1] == 127 && hdr[7] == 1);
   const uint8_t partial[] = {0x82, 0x7e, 0x01};
   CHECK_OK(hearth_ws_parse_header(partial, 3, 0, 1 << 20, &fh, &need, &err), &err);
   CHECK(need == 1);
-  const uint8_t rsv[] = {0xc2, 0x00}, bigping[] = {0x89, 0x7e, 0x00, 0x80}, fragclose[] = {0x08, 0x00},
-                badop[] = {0x83, 0x00}, nonmin[] = {0x82, 0x7e, 0x00, 0x05};
+  const uint8_t rsv[] = {0xc2, 0x00}, bigping[] = {0x89, 0x7e, 0x00, 0x80},
+                fragclose[] = {0x08, 0x00}, badop[] = {0x83, 0x00},
+                nonmin[] = {0x82, 0x7e, 0x00, 0x05};
   CHECK(hearth_ws_parse_header(rsv, 2, 0, 1 << 20, &fh, &need, &err) == HEARTH_E_PARSE);
   CHECK(hearth_ws_parse_header(bigping, 4, 0, 1 << 20, &fh, &need, &err) == HEARTH_E_PARSE);
   CHECK(hearth_ws_parse_header(fragclose, 2, 0, 1 << 20, &fh, &need, &err) == HEARTH_E_PARSE);
@@ -121,7 +128,8 @@ int main(void) {
   CHECK(hearth_ws_parse_header(big, 10, 0, 1 << 20, &fh, &need, &err) == HEARTH_E_LIMIT);
   /* a refused connection is a clear error */
   hearth_ws *c = NULL;
-  CHECK(hearth_ws_connect("ws://127.0.0.1:1", 2.0, &c, &err) == HEARTH_E_IO && strstr(err.msg, "connect"));
+  CHECK(hearth_ws_connect("ws://127.0.0.1:1", 2.0, &c, &err) == HEARTH_E_IO &&
+        strstr(err.msg, "connect"));
   CHECK(hearth_ws_connect("http://x", 2.0, &c, &err) == HEARTH_E_ARG);
   /* a server that misbehaves: each message names it once */
   for (int mode = 0; mode < 3; mode++) {

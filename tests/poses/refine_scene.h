@@ -15,14 +15,16 @@ static void scene_box_mesh(hearth_mesh *m, const double lo[3], const double hi[3
     m->positions[3 * i + 2] = (float)((i & 4) ? hi[2] : lo[2]);
   }
   /* faces -x +x -y +y -z +z, each two outward CCW triangles */
-  static const uint32_t f[12][3] = {{0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}, {0, 1, 5}, {0, 5, 4},
-                                    {2, 6, 7}, {2, 7, 3}, {0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}};
+  static const uint32_t f[12][3] = {{0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5},
+                                    {0, 1, 5}, {0, 5, 4}, {2, 6, 7}, {2, 7, 3},
+                                    {0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}};
   for (int t = 0; t < 12; t++)
     for (int k = 0; k < 3; k++) m->indices[3 * t + k] = f[t][k];
 }
 
 /* nearest positive hit distance of a ray with the box, or INFINITY */
-static double scene_ray_box(const double o[3], const double d[3], const double lo[3], const double hi[3]) {
+static double scene_ray_box(const double o[3], const double d[3], const double lo[3],
+                            const double hi[3]) {
   double t0 = 0, t1 = INFINITY;
   for (int k = 0; k < 3; k++) {
     if (fabs(d[k]) < 1e-15) {
@@ -30,7 +32,11 @@ static double scene_ray_box(const double o[3], const double d[3], const double l
       continue;
     }
     double a = (lo[k] - o[k]) / d[k], b = (hi[k] - o[k]) / d[k];
-    if (a > b) { double t = a; a = b; b = t; }
+    if (a > b) {
+      double t = a;
+      a = b;
+      b = t;
+    }
     if (a > t0) t0 = a;
     if (b < t1) t1 = b;
   }
@@ -39,12 +45,17 @@ static double scene_ray_box(const double o[3], const double d[3], const double l
 
 /* T_world_from_cam of a camera at c looking at target (y roughly down) */
 static void scene_look_at(const double c[3], const double target[3], hearth_rigid *T) {
-  double z[3] = {target[0] - c[0], target[1] - c[1], target[2] - c[2]}, up[3] = {0, 0, -1}, x[3], y[3];
+  double z[3] = {target[0] - c[0], target[1] - c[1], target[2] - c[2]}, up[3] = {0, 0, -1}, x[3],
+         y[3];
   double l = hearth_norm3(z);
   for (int k = 0; k < 3; k++) z[k] /= l;
   hearth_cross3(z, up, x);
   /* avoid a degenerate up vector */
-  if (hearth_norm3(x) < 1e-6) { up[0] = 1; up[2] = 0; hearth_cross3(z, up, x); }
+  if (hearth_norm3(x) < 1e-6) {
+    up[0] = 1;
+    up[2] = 0;
+    hearth_cross3(z, up, x);
+  }
   l = hearth_norm3(x);
   for (int k = 0; k < 3; k++) x[k] /= l;
   hearth_cross3(z, x, y);

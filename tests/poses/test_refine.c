@@ -38,7 +38,8 @@ int main(void) {
   hearth_rng rng;
   hearth_rng_seed(&rng, 3);
   for (int v = 0; v < NV; v++) {
-    double a = 0.7 + 2.0 * v, c[3] = {0.35 * cos(a), 0.35 * sin(a), 0.22}, tgt[3] = {0.005, 0.0, 0.05};
+    double a = 0.7 + 2.0 * v, c[3] = {0.35 * cos(a), 0.35 * sin(a), 0.22},
+           tgt[3] = {0.005, 0.0, 0.05};
     scene_look_at(c, tgt, &truth[v]);
     render(&cam, &truth[v], 55.0, &imgs[0][v]);
     render(&cam, &truth[v], 22.0, &imgs[1][v]); /* no contrast at all */
@@ -64,17 +65,23 @@ int main(void) {
   CHECK_OK(hearth_refine_views(&mesh, rc, &cam, views[0], NV, &o, res, &err), &err);
   for (int v = 0; v < NV; v++) {
     double e0 = 0, e1 = 0;
-    CHECK_OK(hearth_reprojection_error(rc, &cam, &truth[v], &views[0][v].T_world_from_cam, 1, &e0, &err), &err);
-    CHECK_OK(hearth_reprojection_error(rc, &cam, &truth[v], &res[v].T_world_from_cam, 1, &e1, &err), &err);
-    printf("view %d: %s, reprojection %.3f -> %.3f px, criterion %.4f -> %.4f, confidence %.2f, %.1f ms\n", v,
-           res[v].reason, e0, e1, res[v].cost_start, res[v].cost_final, res[v].confidence, 1e3 * res[v].seconds);
+    CHECK_OK(hearth_reprojection_error(rc, &cam, &truth[v], &views[0][v].T_world_from_cam, 1, &e0,
+                                       &err),
+             &err);
+    CHECK_OK(hearth_reprojection_error(rc, &cam, &truth[v], &res[v].T_world_from_cam, 1, &e1, &err),
+             &err);
+    printf(
+        "view %d: %s, reprojection %.3f -> %.3f px, criterion %.4f -> %.4f, confidence %.2f, %.1f ms\n",
+        v, res[v].reason, e0, e1, res[v].cost_start, res[v].cost_final, res[v].confidence,
+        1e3 * res[v].seconds);
     CHECK(e0 > 2.0);
     CHECK(res[v].accepted);
     CHECK(e1 < 0.3);
     CHECK(res[v].cost_final < res[v].cost_start);
     /* the criterion of the returned pose, evaluated independently */
     double cf;
-    CHECK_OK(hearth_refine_cost(&mesh, rc, &cam, &imgs[0][v], &res[v].T_world_from_cam, &cf, &err), &err);
+    CHECK_OK(hearth_refine_cost(&mesh, rc, &cam, &imgs[0][v], &res[v].T_world_from_cam, &cf, &err),
+             &err);
     CHECK_NEAR(cf, res[v].cost_final, 1e-9);
   }
   /* deterministic whatever the thread count */
@@ -108,13 +115,15 @@ int main(void) {
   const char *dir = test_tmpdir("refine_nudges");
   char path[1200];
   snprintf(path, sizeof path, "%s/n.json", dir);
-  const char *bad = "{\"views\": [{\"state\": \"hot\", \"view\": \"v01\", \"d_rot_deg\": [0, \"1\", 0]}]}";
+  const char *bad =
+      "{\"views\": [{\"state\": \"hot\", \"view\": \"v01\", \"d_rot_deg\": [0, \"1\", 0]}]}";
   CHECK_OK(hearth_write_file_atomic(path, bad, strlen(bad), &err), &err);
   hearth_pose_nudge *nn = NULL;
   size_t nn_n = 0;
   CHECK(hearth_pose_nudges_read(path, &nn, &nn_n, &err) == HEARTH_E_PARSE);
   CHECK(strstr(err.msg, "n.json") && strstr(err.msg, "views[0].d_rot_deg[1]"));
-  const char *good = "{\"views\": [{\"state\": \"hot\", \"view\": \"v01\", \"d_rot_deg\": [0, 1, 0], \"d_t_mm\": [1, 2, 3]}]}";
+  const char *good =
+      "{\"views\": [{\"state\": \"hot\", \"view\": \"v01\", \"d_rot_deg\": [0, 1, 0], \"d_t_mm\": [1, 2, 3]}]}";
   CHECK_OK(hearth_write_file_atomic(path, good, strlen(good), &err), &err);
   CHECK_OK(hearth_pose_nudges_read(path, &nn, &nn_n, &err), &err);
   CHECK(nn_n == 1 && nn && nn[0].d_rot_deg[1] == 1.0 && nn[0].d_t_mm[2] == 3.0);

@@ -58,7 +58,8 @@ static void corrupt_depths(const char *root, const char *inst, const char *const
     hearth_manifest man = {0};
     CHECK_OK(hearth_manifest_read(path, &man, &err), &err);
     for (size_t v = 0; v < man.n_views; v++) {
-      snprintf(path, sizeof path, "%s/instances/%s/raw/%s/%s", root, inst, states[s], man.views[v].depth);
+      snprintf(path, sizeof path, "%s/instances/%s/raw/%s/%s", root, inst, states[s],
+               man.views[v].depth);
       hearth_image d = {0};
       CHECK_OK(hearth_png_read(path, &d, &err), &err);
       uint16_t *z = d.data;
@@ -101,7 +102,8 @@ int main(void) {
   hearth_rng rng;
   hearth_rng_seed(&rng, 2024);
   for (int i = 0; i < NI; i++) {
-    char gdir[1400], mesh_path[1600], truth_path[1600], start_path[1600], out_path[1600], rep_path[1600];
+    char gdir[1400], mesh_path[1600], truth_path[1600], start_path[1600], out_path[1600],
+        rep_path[1600];
     snprintf(gdir, sizeof gdir, "%s/ground_truth/instances/%s", root, inst[i]);
     snprintf(mesh_path, sizeof mesh_path, "%s/mesh.glb", gdir);
     snprintf(truth_path, sizeof truth_path, "%s/poses_thermal.json", gdir);
@@ -145,10 +147,12 @@ int main(void) {
         CHECK(a && b);
         if (!a || !b) continue;
         double e0 = 0, e1 = 0;
-        CHECK_OK(hearth_reprojection_error(rc, &rig.thermal, &t->T_world_from_cam, &a->T_world_from_cam, 2,
-                                           &e0, &err), &err);
-        CHECK_OK(hearth_reprojection_error(rc, &rig.thermal, &t->T_world_from_cam, &b->T_world_from_cam, 2,
-                                           &e1, &err), &err);
+        CHECK_OK(hearth_reprojection_error(rc, &rig.thermal, &t->T_world_from_cam,
+                                           &a->T_world_from_cam, 2, &e0, &err),
+                 &err);
+        CHECK_OK(hearth_reprojection_error(rc, &rig.thermal, &t->T_world_from_cam,
+                                           &b->T_world_from_cam, 2, &e1, &err),
+                 &err);
         m0 += e0;
         m1 += e1;
         if (e1 > worst) worst = e1;
@@ -158,11 +162,12 @@ int main(void) {
       CHECK(n == 10);
       m0 /= (double)(n ? n : 1);
       m1 /= (double)(n ? n : 1);
-      printf("%-16s %-8s reprojection %.3f -> %.3f px (worst view %.3f), %zu views worse\n", inst[i],
-             states[s], m0, m1, worst, worse);
+      printf("%-16s %-8s reprojection %.3f -> %.3f px (worst view %.3f), %zu views worse\n",
+             inst[i], states[s], m0, m1, worst, worse);
       CHECK(m0 > 2.0); /* the perturbation is real */
       CHECK_MSG(worse == 0, "%s/%s: %zu views got worse", inst[i], states[s], worse);
-      if (s == 1) CHECK_MSG(m1 <= 0.3, "%s/%s: mean reprojection %.3f px > 0.3", inst[i], states[s], m1);
+      if (s == 1)
+        CHECK_MSG(m1 <= 0.3, "%s/%s: mean reprojection %.3f px > 0.3", inst[i], states[s], m1);
       /* mapping with the refined poses (true mesh and rig) */
       for (int f = 0; f < 2; f++) {
         hearth_map_opts mo;
@@ -170,12 +175,14 @@ int main(void) {
         mo.resolution = 256;
         mo.fusion = f ? HEARTH_FUSE_ROBUST : HEARTH_FUSE_MAX;
         map_eval ev;
-        CHECK_OK(map_eval_state(root, inst[i], states[s], mesh_path, out_path, rig_path, &mo, &ev, &err), &err);
+        CHECK_OK(map_eval_state(root, inst[i], states[s], mesh_path, out_path, rig_path, &mo, &ev,
+                                &err),
+                 &err);
         printf("%-16s %-8s %-6s mapping n=%zu median=%.3f p95=%.3f\n", inst[i], states[s],
                f ? "robust" : "max", ev.n_eval, ev.median, ev.p95);
         CHECK(ev.n_eval > 1000);
-        CHECK_MSG(ev.median <= 0.1 && ev.p95 <= 0.5, "%s/%s %s: median %.3f p95 %.3f", inst[i], states[s],
-                  f ? "robust" : "max", ev.median, ev.p95);
+        CHECK_MSG(ev.median <= 0.1 && ev.p95 <= 0.5, "%s/%s %s: median %.3f p95 %.3f", inst[i],
+                  states[s], f ? "robust" : "max", ev.median, ev.p95);
       }
     }
     hearth_raycaster_free(rc);
@@ -197,8 +204,8 @@ int main(void) {
     double s_true = read_scale(p);
     snprintf(p, sizeof p, "%s/instances/cup_01/derived/scale.json", root);
     double s_file = read_scale(p);
-    printf("scale with 10%% corrupted depth: %.6f (true %.6f, rel err %.2e), inliers %.3f\n", sr.scale, s_true,
-           fabs(sr.scale / s_true - 1), sr.inlier_fraction);
+    printf("scale with 10%% corrupted depth: %.6f (true %.6f, rel err %.2e), inliers %.3f\n",
+           sr.scale, s_true, fabs(sr.scale / s_true - 1), sr.inlier_fraction);
     CHECK(isfinite(s_true));
     CHECK_MSG(fabs(sr.scale / s_true - 1) <= 0.005, "scale %.6f vs true %.6f", sr.scale, s_true);
     CHECK(fabs(s_file / sr.scale - 1) < 1e-9);

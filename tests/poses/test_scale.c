@@ -7,7 +7,8 @@
 
 #define NV 6
 
-static void make_views(double s_true, double corrupt, hearth_image *imgs, hearth_scale_view *views) {
+static void make_views(double s_true, double corrupt, hearth_image *imgs,
+                       hearth_scale_view *views) {
   /* metric box; the recon mesh is this box divided by s_true */
   const double lo[3] = {-0.04, -0.03, 0.0}, hi[3] = {0.05, 0.035, 0.11};
   hearth_camera dc = {640, 576, 505.0, 504.0, 321.0, 330.0, {0.05, -0.02, 1e-4, -5e-5, 0.006}};
@@ -37,7 +38,8 @@ static void make_views(double s_true, double corrupt, hearth_image *imgs, hearth
         double zmm = isfinite(t) ? t * d[2] * 1000.0 : 900.0; /* background wall */
         D[y * 640 + x] = (uint16_t)lround(zmm);
         if (hearth_rng_uniform(&rng) < corrupt)
-          D[y * 640 + x] = hearth_rng_uniform(&rng) < 0.3 ? 0 : (uint16_t)hearth_rng_range(&rng, 200, 3000);
+          D[y * 640 + x] =
+              hearth_rng_uniform(&rng) < 0.3 ? 0 : (uint16_t)hearth_rng_range(&rng, 200, 3000);
       }
     /* recon-frame colour pose: translation divided by the true scale */
     for (int k = 0; k < 3; k++) Twr.t[k] /= s_true;
@@ -48,7 +50,8 @@ static void make_views(double s_true, double corrupt, hearth_image *imgs, hearth
 int main(void) {
   const double s_true = 0.37;
   hearth_mesh mesh = {0};
-  const double lo[3] = {-0.04 / s_true, -0.03 / s_true, 0.0}, hi[3] = {0.05 / s_true, 0.035 / s_true, 0.11 / s_true};
+  const double lo[3] = {-0.04 / s_true, -0.03 / s_true, 0.0},
+               hi[3] = {0.05 / s_true, 0.035 / s_true, 0.11 / s_true};
   scene_box_mesh(&mesh, lo, hi);
   hearth_err err = {0};
   for (int pass = 0; pass < 2; pass++) {
@@ -60,9 +63,11 @@ int main(void) {
     hearth_scale_opts_default(&o);
     hearth_scale_result r;
     CHECK_OK(hearth_scale_estimate(&mesh, NULL, views, NV, &o, &r, &err), &err);
-    printf("corrupt %.2f: scale %.6f (true %.6f, rel err %.2e), %d views, residual median %.3f mm, "
-           "inliers %.3f, rounds %d\n", corrupt, r.scale, s_true, fabs(r.scale / s_true - 1), r.views_used,
-           r.residual_median_mm, r.inlier_fraction, r.iterations);
+    printf(
+        "corrupt %.2f: scale %.6f (true %.6f, rel err %.2e), %d views, residual median %.3f mm, "
+        "inliers %.3f, rounds %d\n",
+        corrupt, r.scale, s_true, fabs(r.scale / s_true - 1), r.views_used, r.residual_median_mm,
+        r.inlier_fraction, r.iterations);
     /* mm quantisation only: the fit is essentially exact; with 10 % corrupted
        pixels it must stay well inside 0.5 % */
     CHECK(fabs(r.scale / s_true - 1) < (pass ? 1e-3 : 2e-4));

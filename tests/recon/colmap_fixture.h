@@ -60,7 +60,8 @@ static const fx_point k_fx_points[] = {
 
 /* q = (cos(a/2), sin(a/2) * axis / |axis|) */
 static inline void fx_quat(const fx_image *im, double q[4]) {
-  double n = sqrt(im->axis[0] * im->axis[0] + im->axis[1] * im->axis[1] + im->axis[2] * im->axis[2]);
+  double n =
+      sqrt(im->axis[0] * im->axis[0] + im->axis[1] * im->axis[1] + im->axis[2] * im->axis[2]);
   q[0] = cos(im->angle / 2);
   for (int k = 0; k < 3; k++) q[k + 1] = sin(im->angle / 2) * im->axis[k] / n;
 }
@@ -76,8 +77,9 @@ static inline int fx_write_text_as(const char *dir, int tabs) {
   snprintf(p, sizeof p, "%s/cameras.txt", dir);
   FILE *f = fopen(p, "wb");
   if (!f) return -1;
-  fprintf(f, "# Camera list with one line of data per camera:\n"
-             "#   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n# Number of cameras: 3\n\n");
+  fprintf(f,
+          "# Camera list with one line of data per camera:\n"
+          "#   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n# Number of cameras: 3\n\n");
   for (size_t i = 0; i < FX_N_CAMERAS; i++) {
     const fx_camera *c = &k_fx_cameras[i];
     fprintf(f, "%u %s %llu %llu", (unsigned)c->id, c->model_name, (unsigned long long)c->width,
@@ -88,9 +90,10 @@ static inline int fx_write_text_as(const char *dir, int tabs) {
   fclose(f);
   snprintf(p, sizeof p, "%s/images.txt", dir);
   if (!(f = fopen(p, "wb"))) return -1;
-  fprintf(f, "# Image list with two lines of data per image:\r\n"
-             "#   IMAGE_ID, QW, QX, QY, QZ, TX, TY, TZ, CAMERA_ID, NAME\r\n"
-             "#   POINTS2D[] as (X, Y, POINT3D_ID)\r\n\r\n");
+  fprintf(f,
+          "# Image list with two lines of data per image:\r\n"
+          "#   IMAGE_ID, QW, QX, QY, QZ, TX, TY, TZ, CAMERA_ID, NAME\r\n"
+          "#   POINTS2D[] as (X, Y, POINT3D_ID)\r\n\r\n");
   for (size_t i = 0; i < FX_N_IMAGES; i++) {
     const fx_image *im = &k_fx_images[i];
     double q[4];
@@ -105,12 +108,14 @@ static inline int fx_write_text_as(const char *dir, int tabs) {
   fclose(f);
   snprintf(p, sizeof p, "%s/points3D.txt", dir);
   if (!(f = fopen(p, "wb"))) return -1;
-  fprintf(f, "# 3D point list with one line of data per point:\n"
-             "#   POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as (IMAGE_ID, POINT2D_IDX)\n");
+  fprintf(f,
+          "# 3D point list with one line of data per point:\n"
+          "#   POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as (IMAGE_ID, POINT2D_IDX)\n");
   for (size_t i = 0; i < FX_N_POINTS; i++) {
     const fx_point *pt = &k_fx_points[i];
-    fprintf(f, "%llu%c%.17g %.17g %.17g %u %u %u %.17g", (unsigned long long)pt->id, tabs ? '\t' : ' ', pt->xyz[0],
-            pt->xyz[1], pt->xyz[2], pt->rgb[0], pt->rgb[1], pt->rgb[2], pt->error);
+    fprintf(f, "%llu%c%.17g %.17g %.17g %u %u %u %.17g", (unsigned long long)pt->id,
+            tabs ? '\t' : ' ', pt->xyz[0], pt->xyz[1], pt->xyz[2], pt->rgb[0], pt->rgb[1],
+            pt->rgb[2], pt->error);
     for (int k = 0; k < pt->track_length; k++)
       fprintf(f, " %u %u", (unsigned)pt->image[k], (unsigned)pt->point2d[k]);
     fprintf(f, "\n\n");

@@ -23,8 +23,9 @@ static inline void rr_write_instance(const char *root, const char *id, const cha
   inst.n_states = n_states;
   for (size_t s = 0; s < n_states; s++) {
     snprintf(inst.states[s], HEARTH_NAME_MAX, "%s", states[s]);
-    snprintf(path, sizeof path, "mkdir -p '%s/instances/%s/raw/%s/rgb' '%s/instances/%s/raw/%s/cutout'",
-             root, id, states[s], root, id, states[s]);
+    snprintf(path, sizeof path,
+             "mkdir -p '%s/instances/%s/raw/%s/rgb' '%s/instances/%s/raw/%s/cutout'", root, id,
+             states[s], root, id, states[s]);
     CHECK(system(path) == 0);
   }
   snprintf(path, sizeof path, "%s/instances/%s/instance.json", root, id);

@@ -104,11 +104,12 @@ static void check_model(const hearth_colmap_model *m) {
   CHECK(pin->width == 1920 && pin->height == 1080);
   CHECK(pin->fx == 1500.25 && pin->fy == 1490.5 && pin->cx == 960.0 && pin->cy == 540.0);
   for (int k = 0; k < 5; k++) CHECK(pin->dist[k] == 0);
-  CHECK(sr->width == 640 && sr->fx == 1200 && sr->fy == 1200 && sr->cx == 320.0 && sr->cy == 239.75);
+  CHECK(sr->width == 640 && sr->fx == 1200 && sr->fy == 1200 && sr->cx == 320.0 &&
+        sr->cy == 239.75);
   CHECK(sr->dist[0] == -0.0123 && sr->dist[1] == 0 && sr->dist[4] == 0);
   CHECK(cv->fx == 1510 && cv->fy == 1509 && cv->cx == 955.25 && cv->cy == 540.625);
-  CHECK(cv->dist[0] == 0.1 && cv->dist[1] == -0.05 && cv->dist[2] == 0.001 && cv->dist[3] == -0.002 &&
-        cv->dist[4] == 0);
+  CHECK(cv->dist[0] == 0.1 && cv->dist[1] == -0.05 && cv->dist[2] == 0.001 &&
+        cv->dist[3] == -0.002 && cv->dist[4] == 0);
   CHECK(m->points[0].track_length == 1 && m->points[2].track_length == 3);
   CHECK(m->points[1].rgb[0] == 255 && m->points[1].rgb[2] == 7 && m->points[1].error == 0.5);
 }
@@ -169,7 +170,8 @@ static void test_text_and_binary(void) {
   for (size_t i = 0; i < cr.n_cameras && i < ct.n_cameras; i++) {
     CHECK(cr.cameras[i].id == ct.cameras[i].id && cr.cameras[i].model_id == ct.cameras[i].model_id);
     CHECK(!memcmp(&cr.cameras[i].camera, &ct.cameras[i].camera, sizeof cr.cameras[i].camera));
-    CHECK(!memcmp(cr.cameras[i].params, ct.cameras[i].params, ct.cameras[i].n_params * sizeof(double)));
+    CHECK(!memcmp(cr.cameras[i].params, ct.cameras[i].params,
+                  ct.cameras[i].n_params * sizeof(double)));
   }
   hearth_recon_cameras_free(&cr);
   /* its reader is strict: a view naming a camera not listed */
@@ -179,7 +181,8 @@ static void test_text_and_binary(void) {
   if (at) {
     at[20] = '8';
     hearth_status s = hearth_recon_cameras_parse(doc, strlen(doc), "c.json", &cr, &err);
-    CHECK(s == HEARTH_E_INCONSISTENT && strstr(err.msg, "c.json: views[3].colmap_camera_id: camera 8"));
+    CHECK(s == HEARTH_E_INCONSISTENT &&
+          strstr(err.msg, "c.json: views[3].colmap_camera_id: camera 8"));
   }
   free(doc);
 
@@ -200,10 +203,17 @@ static void test_models(void) {
     int id;
     const char *name;
     int n;
-  } k_table[] = {{0, "SIMPLE_PINHOLE", 3}, {1, "PINHOLE", 4}, {2, "SIMPLE_RADIAL", 4},
-                 {3, "RADIAL", 5}, {4, "OPENCV", 8}, {5, "OPENCV_FISHEYE", 8},
-                 {6, "FULL_OPENCV", 12}, {7, "FOV", 5}, {8, "SIMPLE_RADIAL_FISHEYE", 4},
-                 {9, "RADIAL_FISHEYE", 5}, {10, "THIN_PRISM_FISHEYE", 12},
+  } k_table[] = {{0, "SIMPLE_PINHOLE", 3},
+                 {1, "PINHOLE", 4},
+                 {2, "SIMPLE_RADIAL", 4},
+                 {3, "RADIAL", 5},
+                 {4, "OPENCV", 8},
+                 {5, "OPENCV_FISHEYE", 8},
+                 {6, "FULL_OPENCV", 12},
+                 {7, "FOV", 5},
+                 {8, "SIMPLE_RADIAL_FISHEYE", 4},
+                 {9, "RADIAL_FISHEYE", 5},
+                 {10, "THIN_PRISM_FISHEYE", 12},
                  {11, "RAD_TAN_THIN_PRISM_FISHEYE", 16}};
   for (size_t i = 0; i < sizeof k_table / sizeof k_table[0]; i++) {
     CHECK(!strcmp(hearth_colmap_model_name(k_table[i].id), k_table[i].name));
@@ -218,7 +228,8 @@ static void test_models(void) {
   CHECK(c.fx == 800 && c.fy == 800 && c.cx == 320 && c.cy == 240);
   double rad[5] = {700, 100, 50, 0.1, -0.01};
   CHECK_OK(hearth_colmap_camera_convert(3, rad, 5, 200, 100, &c, &err), &err);
-  CHECK(c.dist[0] == 0.1 && c.dist[1] == -0.01 && c.dist[2] == 0 && c.dist[3] == 0 && c.dist[4] == 0);
+  CHECK(c.dist[0] == 0.1 && c.dist[1] == -0.01 && c.dist[2] == 0 && c.dist[3] == 0 &&
+        c.dist[4] == 0);
   double full[12] = {700, 710, 100, 50, 0.1, -0.01, 0.001, 0.002, 0.003, 0, 0, 0};
   CHECK_OK(hearth_colmap_camera_convert(6, full, 12, 200, 100, &c, &err), &err);
   CHECK(c.fy == 710 && c.dist[2] == 0.001 && c.dist[3] == 0.002 && c.dist[4] == 0.003);
@@ -245,11 +256,13 @@ static void test_models(void) {
                   "12 OPENCV 1920 1080 1 1 1 1 0 0 0 0\n");
   hearth_colmap_model m;
   CHECK(hearth_colmap_read(dir, &m, &err) == HEARTH_E_UNSUPPORTED);
-  CHECK_MSG(strstr(err.msg, "fisheye/cameras.txt:3: camera 7: model OPENCV_FISHEYE"), "%s", err.msg);
+  CHECK_MSG(strstr(err.msg, "fisheye/cameras.txt:3: camera 7: model OPENCV_FISHEYE"), "%s",
+            err.msg);
   CHECK(m.n_cameras == 0 && m.cameras == NULL);
   write_text_file(tpath("fisheye/cameras.txt"), "5 KANNALA 640 480 1 2 3\n");
   CHECK(hearth_colmap_read(dir, &m, &err) == HEARTH_E_UNSUPPORTED);
-  CHECK_MSG(strstr(err.msg, "cameras.txt:1: camera 5: unknown camera model 'KANNALA'"), "%s", err.msg);
+  CHECK_MSG(strstr(err.msg, "cameras.txt:1: camera 5: unknown camera model 'KANNALA'"), "%s",
+            err.msg);
 
   /* binary: byte offset, camera id and model */
   fx_buf b;
@@ -262,7 +275,8 @@ static void test_models(void) {
   for (int k = 0; k < 8; k++) fx_putd(&b, k < 2 ? 500 : 0.01);
   CHECK(hearth_colmap_parse(HEARTH_COLMAP_CAMERAS, HEARTH_COLMAP_BINARY, b.data, b.n, "c.bin", &m,
                             &err) == HEARTH_E_UNSUPPORTED);
-  CHECK_MSG(strstr(err.msg, "c.bin: byte offset 8: camera 44: model OPENCV_FISHEYE"), "%s", err.msg);
+  CHECK_MSG(strstr(err.msg, "c.bin: byte offset 8: camera 44: model OPENCV_FISHEYE"), "%s",
+            err.msg);
   b.data[12] = 200; /* model id 200 */
   CHECK(hearth_colmap_parse(HEARTH_COLMAP_CAMERAS, HEARTH_COLMAP_BINARY, b.data, b.n, "c.bin", &m,
                             &err) == HEARTH_E_UNSUPPORTED);
@@ -284,7 +298,8 @@ static void test_errors(void) {
   for (size_t cut = 0; cut < ims.n; cut++) {
     hearth_colmap_model_free(&m);
     CHECK_OK(hearth_colmap_parse(HEARTH_COLMAP_CAMERAS, HEARTH_COLMAP_BINARY, cams.data, cams.n,
-                                 "cameras.bin", &m, &err), &err);
+                                 "cameras.bin", &m, &err),
+             &err);
     hearth_status s = hearth_colmap_parse(HEARTH_COLMAP_IMAGES, HEARTH_COLMAP_BINARY, ims.data, cut,
                                           "images.bin", &m, &err);
     if (s != HEARTH_E_PARSE || !strstr(err.msg, "images.bin: byte offset ") || m.n_images) {
@@ -301,11 +316,12 @@ static void test_errors(void) {
   CHECK(hearth_colmap_parse(HEARTH_COLMAP_IMAGES, HEARTH_COLMAP_BINARY, two.data, image5 + 20,
                             "images.bin", &m, &err) == HEARTH_E_PARSE);
   char want[160];
-  snprintf(want, sizeof want, "images.bin: byte offset %zu: truncated: expected the pose of image 5",
-           image5 + 4);
+  snprintf(want, sizeof want,
+           "images.bin: byte offset %zu: truncated: expected the pose of image 5", image5 + 4);
   CHECK_MSG(strstr(err.msg, want), "%s (wanted %s)", err.msg, want);
   CHECK_OK(hearth_colmap_parse(HEARTH_COLMAP_IMAGES, HEARTH_COLMAP_BINARY, ims.data, ims.n,
-                               "images.bin", &m, &err), &err);
+                               "images.bin", &m, &err),
+           &err);
   for (size_t cut = 0; cut < pts.n; cut++) {
     hearth_status s = hearth_colmap_parse(HEARTH_COLMAP_POINTS3D, HEARTH_COLMAP_BINARY, pts.data,
                                           cut, "points3D.bin", &m, &err);
@@ -353,14 +369,15 @@ static void test_errors(void) {
        HEARTH_E_INCONSISTENT, "images.txt:5: duplicate image id 2 (also on line 1)"},
       {"2 1 0 0 0 0 0 0 3 a.jpg\n# a comment where the points belong\n", HEARTH_E_PARSE,
        "images.txt:2: expected the 2-D points of image 2"},
-      {"4294967296 1 0 0 0 0 0 0 3 a.jpg\n\n", HEARTH_E_PARSE, "images.txt:1: expected an image id"},
+      {"4294967296 1 0 0 0 0 0 0 3 a.jpg\n\n", HEARTH_E_PARSE,
+       "images.txt:1: expected an image id"},
       {"2 1 0 0 0 0 0 0 3 a.jpg\n1 2 nan\n", HEARTH_E_PARSE, "images.txt:2"},
       {"2 1e999 0 0 0 0 0 0 3 a.jpg\n\n", HEARTH_E_PARSE, "images.txt:1: expected QW of image 2"},
   };
   for (size_t i = 0; i < sizeof k_images / sizeof k_images[0]; i++) {
     hearth_status s = hearth_colmap_parse(HEARTH_COLMAP_IMAGES, HEARTH_COLMAP_TEXT,
-                                          (const uint8_t *)k_images[i].text, strlen(k_images[i].text),
-                                          "images.txt", &m, &err);
+                                          (const uint8_t *)k_images[i].text,
+                                          strlen(k_images[i].text), "images.txt", &m, &err);
     CHECK_MSG(s == k_images[i].status && strstr(err.msg, k_images[i].msg), "case %zu: %s: %s", i,
               hearth_status_name(s), err.msg);
     CHECK(m.n_images == 0);
@@ -368,17 +385,20 @@ static void test_errors(void) {
   /* a last image without its points line; blank lines and tabs; CR LF */
   const char *ok = "\n# c\r\n2\t1 0 0 0   0 0 0 3 a.jpg\r\n\r\n\r\n5 1 0 0 0 0 0 0 7 hot/b.jpg";
   CHECK_OK(hearth_colmap_parse(HEARTH_COLMAP_IMAGES, HEARTH_COLMAP_TEXT, (const uint8_t *)ok,
-                               strlen(ok), "images.txt", &m, &err), &err);
+                               strlen(ok), "images.txt", &m, &err),
+           &err);
   CHECK(m.n_images == 2 && m.images[1].n_points2d == 0 && !strcmp(m.images[1].name, "hot/b.jpg"));
   const char *pbad = "1 0 0 0 255 0 256 0.1\n";
   CHECK(hearth_colmap_parse(HEARTH_COLMAP_POINTS3D, HEARTH_COLMAP_TEXT, (const uint8_t *)pbad,
                             strlen(pbad), "points3D.txt", &m, &err) == HEARTH_E_PARSE);
-  CHECK_MSG(strstr(err.msg, "points3D.txt:1: expected B of point 1 (an integer in 0..255), found '256'"),
+  CHECK_MSG(strstr(err.msg,
+                   "points3D.txt:1: expected B of point 1 (an integer in 0..255), found '256'"),
             "%s", err.msg);
   const char *ptrack = "# p\n1 0 0 0 1 2 3 0.1 2 0 5 0 2\n";
   CHECK(hearth_colmap_parse(HEARTH_COLMAP_POINTS3D, HEARTH_COLMAP_TEXT, (const uint8_t *)ptrack,
                             strlen(ptrack), "points3D.txt", &m, &err) == HEARTH_E_INCONSISTENT);
-  CHECK_MSG(strstr(err.msg, "points3D.txt:2: point 1: track names 2-D point 0 of image 2, which has 0"),
+  CHECK_MSG(strstr(err.msg,
+                   "points3D.txt:2: point 1: track names 2-D point 0 of image 2, which has 0"),
             "%s", err.msg);
   const char *podd = "1 0 0 0 1 2 3 0.1 2\n";
   CHECK(hearth_colmap_parse(HEARTH_COLMAP_POINTS3D, HEARTH_COLMAP_TEXT, (const uint8_t *)podd,
@@ -427,14 +447,19 @@ static void test_names(void) {
   const char *ims = "3 1 0 0 0 0 0 0 1 neutral/v00.jpg\n\n8 1 0 0 0 0 0 1 1 neutral/x/v00.png\n\n";
   hearth_colmap_model m = {0};
   CHECK_OK(hearth_colmap_parse(HEARTH_COLMAP_CAMERAS, HEARTH_COLMAP_TEXT, (const uint8_t *)cams,
-                               strlen(cams), "cameras.txt", &m, &err), &err);
+                               strlen(cams), "cameras.txt", &m, &err),
+           &err);
   CHECK_OK(hearth_colmap_parse(HEARTH_COLMAP_IMAGES, HEARTH_COLMAP_TEXT, (const uint8_t *)ims,
-                               strlen(ims), "images.txt", &m, &err), &err);
+                               strlen(ims), "images.txt", &m, &err),
+           &err);
   hearth_poses p;
   hearth_recon_cameras c;
   CHECK(hearth_colmap_to_poses(&m, "neutral", &p, &c, &err) == HEARTH_E_INCONSISTENT);
-  CHECK_MSG(strstr(err.msg, "images 3 (\"neutral/v00.jpg\") and 8 (\"neutral/x/v00.png\") are both view v00 of state neutral"),
-            "%s", err.msg);
+  CHECK_MSG(
+      strstr(
+          err.msg,
+          "images 3 (\"neutral/v00.jpg\") and 8 (\"neutral/x/v00.png\") are both view v00 of state neutral"),
+      "%s", err.msg);
   CHECK(p.n == 0 && p.views == NULL && c.n_views == 0);
   hearth_colmap_model_free(&m);
 
@@ -451,7 +476,8 @@ static void test_names(void) {
   hearth_recon_coverage cov;
   /* v07 (no state folder, default neutral) is not a view of the instance */
   CHECK(hearth_recon_match_instance(root, "cup_01", &p, &cov, &err) == HEARTH_E_INCONSISTENT);
-  CHECK_MSG(strstr(err.msg, "state neutral, view v07: cup_01 has no such colour view"), "%s", err.msg);
+  CHECK_MSG(strstr(err.msg, "state neutral, view v07: cup_01 has no such colour view"), "%s",
+            err.msg);
   hearth_poses_free(&p);
   /* without image 40, three of the four views have poses; neutral/v02 is missing */
   m.n_images = 3;

@@ -112,9 +112,11 @@ static void make_release(void) {
         for (size_t x = 0; x < 64; x++) {
           int on = x >= 10 && x < 40 && y >= 5 && y < 30;
           for (int c = 0; c < ch; c++)
-            px[(y * 64 + x) * (size_t)ch + (size_t)c] = ch == 4 ? (c == 3 ? (on ? 200 : 0) : 77) : (on ? 1 : 0);
+            px[(y * 64 + x) * (size_t)ch + (size_t)c] =
+                ch == 4 ? (c == 3 ? (on ? 200 : 0) : 77) : (on ? 1 : 0);
         }
-      snprintf(path, sizeof path, "%s/instances/cup_01/raw/%s/cutout/v%02d.png", g_root, states[s], i);
+      snprintf(path, sizeof path, "%s/instances/cup_01/raw/%s/cutout/v%02d.png", g_root, states[s],
+               i);
       CHECK_OK(hearth_png_write(path, &cut, &err), &err);
       hearth_image_free(&rgb);
       hearth_image_free(&cut);
@@ -137,8 +139,10 @@ static void test_exec(void) {
   int lines = 0;
   CHECK_OK(hearth_exec("sh ok", ok, log, on_line, &lines, &err), &err);
   CHECK(lines == 4);
-  const char *bad[] = {"sh", "-c", "echo first; i=0; while [ $i -lt 20 ]; do echo line$i; i=$((i+1)); done; "
-                                   "echo 'the reason' >&2; exit 3", NULL};
+  const char *bad[] = {"sh", "-c",
+                       "echo first; i=0; while [ $i -lt 20 ]; do echo line$i; i=$((i+1)); done; "
+                       "echo 'the reason' >&2; exit 3",
+                       NULL};
   CHECK(hearth_exec("sh bad", bad, log, NULL, NULL, &err) == HEARTH_E_IO);
   CHECK_MSG(strstr(err.msg, "sh bad failed (exit status 3)") && strstr(err.msg, "the reason") &&
                 strstr(err.msg, "line19") && !strstr(err.msg, "first") && strstr(err.msg, log),
@@ -158,8 +162,12 @@ static void test_run(void) {
   hearth_err err = {0};
   char work[1200], path[2048];
   snprintf(work, sizeof work, "%s/work", g_dir);
-  hearth_colmap_job job = {.root = g_root, .instance = "cup_01", .work = work, .colmap = g_fake,
-                           .threads = 1, .quiet = 1};
+  hearth_colmap_job job = {.root = g_root,
+                           .instance = "cup_01",
+                           .work = work,
+                           .colmap = g_fake,
+                           .threads = 1,
+                           .quiet = 1};
   hearth_colmap_result res;
   remove(g_log);
   CHECK_OK(hearth_colmap_run(&job, &res, &err), &err);
@@ -205,8 +213,9 @@ static void test_run(void) {
   if (args) {
     CHECK(strstr(args, "--SiftExtraction.use_gpu 0") && strstr(args, "--SiftMatching.use_gpu 0"));
     CHECK(strstr(args, "--ImageReader.single_camera 1"));
-    CHECK(strstr(args, "--ImageReader.camera_model FULL_OPENCV --ImageReader.camera_params "
-                       "70.0,71.0,32.0,23.75,0.01,-0.002,0.0003,0.0004,0.005,0.0,0.0,0.0"));
+    CHECK(strstr(args,
+                 "--ImageReader.camera_model FULL_OPENCV --ImageReader.camera_params "
+                 "70.0,71.0,32.0,23.75,0.01,-0.002,0.0003,0.0004,0.005,0.0,0.0,0.0"));
     CHECK(strstr(args, "--ImageReader.mask_path"));
     CHECK(strstr(args, "--Mapper.ba_refine_focal_length 0"));
     CHECK(strstr(args, "--SiftExtraction.num_threads 1"));
@@ -236,7 +245,8 @@ static void test_run(void) {
   setenv("FAKE_FAIL_MATCH", "1", 1);
   CHECK(hearth_colmap_run(&job, &res, &err) == HEARTH_E_IO);
   CHECK_MSG(strstr(err.msg, "cup_01: colmap exhaustive_matcher failed (exit status 3)") &&
-                strstr(err.msg, "F0101 fake matcher failure") && strstr(err.msg, "exhaustive_matcher.log"),
+                strstr(err.msg, "F0101 fake matcher failure") &&
+                strstr(err.msg, "exhaustive_matcher.log"),
             "%s", err.msg);
   unsetenv("FAKE_FAIL_MATCH");
   setenv("FAKE_NO_PAIR", "1", 1);
@@ -250,7 +260,8 @@ static void test_run(void) {
   /* no program */
   job.colmap = "/nonexistent/colmap";
   CHECK(hearth_colmap_run(&job, &res, &err) == HEARTH_E_NOT_FOUND);
-  CHECK(strstr(err.msg, "'/nonexistent/colmap' not found") && strstr(err.msg, "apt-get install colmap"));
+  CHECK(strstr(err.msg, "'/nonexistent/colmap' not found") &&
+        strstr(err.msg, "apt-get install colmap"));
   job.colmap = "hearth-no-such-colmap";
   CHECK(hearth_colmap_run(&job, &res, &err) == HEARTH_E_NOT_FOUND);
   CHECK(strstr(err.msg, "not found on PATH"));
@@ -259,22 +270,28 @@ static void test_run(void) {
 static void test_cli(void) {
   char cmd[4096], out[8192], work[1200];
   snprintf(work, sizeof work, "%s/cli_work", g_dir);
-  snprintf(cmd, sizeof cmd, "'%s' recon '%s' --instance cup_01 --poses colmap --colmap '%s' "
-           "--work '%s' --force --threads 1 2>&1", HEARTH_EXE, g_root, g_fake, work);
+  snprintf(cmd, sizeof cmd,
+           "'%s' recon '%s' --instance cup_01 --poses colmap --colmap '%s' "
+           "--work '%s' --force --threads 1 2>&1",
+           HEARTH_EXE, g_root, g_fake, work);
   CHECK(run_cmd(cmd, out, sizeof out) == 0);
   CHECK_MSG(strstr(out, "recon cup_01: 3 of 4 views registered (75%)") &&
                 strstr(out, "colmap feature_extractor") && strstr(out, "4/4"),
             "%s", out);
-  snprintf(cmd, sizeof cmd, "'%s' recon import-colmap '%s/sparse/0' --root '%s' --instance cup_01 "
-           "--force 2>&1", HEARTH_EXE, work, g_root);
+  snprintf(cmd, sizeof cmd,
+           "'%s' recon import-colmap '%s/sparse/0' --root '%s' --instance cup_01 "
+           "--force 2>&1",
+           HEARTH_EXE, work, g_root);
   CHECK(run_cmd(cmd, out, sizeof out) == 0);
   CHECK_MSG(strstr(out, "(text): 1 camera(s), 3 image(s), 0 point(s)") &&
                 strstr(out, "cup_01: 3 of 4 views have a pose; without: hot/v01"),
             "%s", out);
-  snprintf(cmd, sizeof cmd, "'%s' recon import-colmap '%s/sparse/0' --root '%s' --instance cup_01 2>&1",
-           HEARTH_EXE, work, g_root);
+  snprintf(cmd, sizeof cmd,
+           "'%s' recon import-colmap '%s/sparse/0' --root '%s' --instance cup_01 2>&1", HEARTH_EXE,
+           work, g_root);
   CHECK(run_cmd(cmd, out, sizeof out) == 1 && strstr(out, "--force"));
-  snprintf(cmd, sizeof cmd, "'%s' recon import-colmap '%s/sparse/0' --out '%s/x/p.json' --state hot 2>&1",
+  snprintf(cmd, sizeof cmd,
+           "'%s' recon import-colmap '%s/sparse/0' --out '%s/x/p.json' --state hot 2>&1",
            HEARTH_EXE, work, g_dir);
   CHECK(run_cmd(cmd, out, sizeof out) == 0);
   snprintf(cmd, sizeof cmd, "%s/x/p_cameras.json", g_dir);
@@ -303,13 +320,16 @@ static void test_cli(void) {
   snprintf(cmd, sizeof cmd, "'%s' recon import-colmap /nonexistent/model --out '%s/y.json' 2>&1",
            HEARTH_EXE, g_dir);
   CHECK(run_cmd(cmd, out, sizeof out) == 1 && strstr(out, "no such folder"));
-  snprintf(cmd, sizeof cmd, "'%s' recon '%s' --instance cup_01 --poses colmap --colmap /nonexistent/colmap "
-           "--force 2>&1", HEARTH_EXE, g_root);
+  snprintf(cmd, sizeof cmd,
+           "'%s' recon '%s' --instance cup_01 --poses colmap --colmap /nonexistent/colmap "
+           "--force 2>&1",
+           HEARTH_EXE, g_root);
   CHECK(run_cmd(cmd, out, sizeof out) == 1 && strstr(out, "not found"));
   for (int h = 0; h < 2; h++) {
     snprintf(cmd, sizeof cmd, "'%s' recon %s--help 2>&1", HEARTH_EXE, h ? "import-colmap " : "");
     CHECK(run_cmd(cmd, out, sizeof out) == 0);
-    CHECK(strstr(out, h ? "usage: hearth recon import-colmap MODEL_DIR" : "usage: hearth recon ROOT"));
+    CHECK(strstr(out,
+                 h ? "usage: hearth recon import-colmap MODEL_DIR" : "usage: hearth recon ROOT"));
   }
 }
 
@@ -329,10 +349,10 @@ static void test_real_colmap(void) {
   snprintf(cmd, sizeof cmd, "mkdir -p '%s' '%s' '%s'", fx, bin, txt);
   CHECK(system(cmd) == 0);
   CHECK(fx_write_text_as(fx, 0) == 0);
-  const char *to_bin[] = {"colmap", "model_converter", "--input_path", fx, "--output_path", bin,
-                          "--output_type", "BIN", NULL};
-  const char *to_txt[] = {"colmap", "model_converter", "--input_path", bin, "--output_path", txt,
-                          "--output_type", "TXT", NULL};
+  const char *to_bin[] = {"colmap", "model_converter", "--input_path", fx,  "--output_path",
+                          bin,      "--output_type",   "BIN",          NULL};
+  const char *to_txt[] = {"colmap", "model_converter", "--input_path", bin, "--output_path",
+                          txt,      "--output_type",   "TXT",          NULL};
   CHECK_OK(hearth_exec("colmap model_converter", to_bin, NULL, NULL, NULL, &err), &err);
   CHECK_OK(hearth_exec("colmap model_converter", to_txt, NULL, NULL, NULL, &err), &err);
   const char *dirs[3] = {fx, bin, txt};

@@ -53,10 +53,8 @@ static void tri_grid_build(tri_grid *g, const hearth_mesh *m, double cell) {
         for (int j = lo[1]; j <= up[1]; j++)
           for (int i = lo[0]; i <= up[0]; i++) {
             size_t c = cell_of(g, i, j, k);
-            if (pass)
-              g->tris[g->start[c] + fill[c]++] = (uint32_t)t;
-            else
-              g->start[c + 1]++;
+            if (pass) g->tris[g->start[c] + fill[c]++] = (uint32_t)t;
+            else g->start[c + 1]++;
           }
     }
     if (!pass) {
@@ -141,8 +139,7 @@ static double tri_grid_dist(const tri_grid *g, const double p[3]) {
       for (int j = c0[1] - r; j <= c0[1] + r; j++)
         for (int i = c0[0] - r; i <= c0[0] + r; i++) {
           if (abs(i - c0[0]) != r && abs(j - c0[1]) != r && abs(k - c0[2]) != r) continue;
-          if (i < 0 || j < 0 || k < 0 || i >= g->n[0] || j >= g->n[1] || k >= g->n[2])
-            continue;
+          if (i < 0 || j < 0 || k < 0 || i >= g->n[0] || j >= g->n[1] || k >= g->n[2]) continue;
           size_t c = cell_of(g, i, j, k);
           for (size_t q = g->start[c]; q < g->start[c + 1]; q++) {
             const uint32_t *f = g->m->indices + 3 * (size_t)g->tris[q];
@@ -272,8 +269,8 @@ static void test_sphere(void) {
   CHECK_MSG(nb == 0 && nn == 0, "%zu boundary, %zu non-manifold edges", nb, nn);
   double to, from;
   sphere_stats(&m, &to, &from);
-  printf("sphere: %zu triangles, RMS mesh->sphere %.3f mm, sphere->mesh %.3f mm\n",
-         m.n_triangles, to * 1e3, from * 1e3);
+  printf("sphere: %zu triangles, RMS mesh->sphere %.3f mm, sphere->mesh %.3f mm\n", m.n_triangles,
+         to * 1e3, from * 1e3);
   CHECK_MSG(to < 0.6e-3 && from < 0.6e-3, "RMS %g %g", to, from);
   /* outward normals: the signed volume is positive and near 4/3 pi R^3 */
   double vol = 0;
@@ -283,7 +280,8 @@ static void test_sphere(void) {
     const float *c = m.positions + 3 * (size_t)m.indices[3 * t + 2];
     vol += (a[0] * ((double)b[1] * c[2] - (double)b[2] * c[1]) -
             a[1] * ((double)b[0] * c[2] - (double)b[2] * c[0]) +
-            a[2] * ((double)b[0] * c[1] - (double)b[1] * c[0])) / 6.0;
+            a[2] * ((double)b[0] * c[1] - (double)b[1] * c[0])) /
+           6.0;
   }
   double want = 4.0 / 3.0 * M_PI * SPHERE_R * SPHERE_R * SPHERE_R;
   CHECK_MSG(fabs(vol - want) < 0.03 * want, "volume %g, sphere %g", vol, want);
@@ -332,8 +330,7 @@ static void test_errors(void) {
   CHECK(hearth_tsdf_init(&vol, lo, hi, 0, 1, &err) == HEARTH_E_ARG);
   CHECK(hearth_tsdf_init(&vol, lo, hi, 1e-4, 1e-3, &err) == HEARTH_E_LIMIT);
   hearth_mesh m;
-  CHECK(hearth_recon_tsdf("/nonexistent", "cup_01", NULL, 0, NULL, &m, &err) ==
-        HEARTH_E_IO);
+  CHECK(hearth_recon_tsdf("/nonexistent", "cup_01", NULL, 0, NULL, &m, &err) == HEARTH_E_IO);
 }
 
 /* Reconstruct instance of release root and compare with its true mesh. */
@@ -363,11 +360,12 @@ static int run_release(const char *root, const char *instance, double voxel, siz
   size_t nb, nn;
   hearth_mesh_edge_stats(&m, &nb, &nn);
   CHECK_MSG(nb == 0 && nn == 0, "%s: %zu boundary, %zu non-manifold edges", instance, nb, nn);
-  printf("%s: voxel %.1f mm, %zu triangles (%zu boundary, %zu non-manifold edges), %.2f s; "
-         "RMS recon->true %.3f mm (max %.2f), true->recon %.3f mm (max %.2f)\n",
-         instance, voxel * 1e3, m.n_triangles, nb, nn,
-         (t1.tv_sec - t0.tv_sec) + 1e-9 * (t1.tv_nsec - t0.tv_nsec), *rms_a * 1e3, mx_a * 1e3,
-         *rms_b * 1e3, mx_b * 1e3);
+  printf(
+      "%s: voxel %.1f mm, %zu triangles (%zu boundary, %zu non-manifold edges), %.2f s; "
+      "RMS recon->true %.3f mm (max %.2f), true->recon %.3f mm (max %.2f)\n",
+      instance, voxel * 1e3, m.n_triangles, nb, nn,
+      (t1.tv_sec - t0.tv_sec) + 1e-9 * (t1.tv_nsec - t0.tv_nsec), *rms_a * 1e3, mx_a * 1e3,
+      *rms_b * 1e3, mx_b * 1e3);
   hearth_mesh_free(&m);
   hearth_mesh_free(&gt);
   return 0;

@@ -48,10 +48,12 @@ int main(void) {
   uint8_t *text = NULL;
   size_t len = 0;
   CHECK_OK(hearth_read_file(path, 1 << 20, &text, &len, &err), &err);
-  CHECK_MSG(text && strstr((char *)text, "\"min_cos\": 0.2,") && strstr((char *)text, "\"fusion\": \"robust\""),
+  CHECK_MSG(text && strstr((char *)text, "\"min_cos\": 0.2,") &&
+                strstr((char *)text, "\"fusion\": \"robust\""),
             "%s", text ? (char *)text : "");
   free(text);
-  const char *bad[] = {"[]", "{\"resolution\": 1024}", "{\"resolution\": \"1024\", \"fusion\": \"max\"}",
+  const char *bad[] = {"[]", "{\"resolution\": 1024}",
+                       "{\"resolution\": \"1024\", \"fusion\": \"max\"}",
                        "{\"resolution\": 1024, \"resolution\": 1024}"};
   for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
     err.msg[0] = 0;
@@ -89,8 +91,8 @@ int main(void) {
   hearth_build_report_free(&rep);
   snprintf(path, sizeof path, "%s/build.json", root);
   CHECK_OK(hb_params_read(path, &q, &err), &err);
-  CHECK(q.resolution == 32 && q.rgb_resolution == 64 && q.min_cos == 0.1 && q.fusion == HEARTH_FUSE_MAX &&
-        q.bake_rgb && q.calibrate && q.calib_overlays);
+  CHECK(q.resolution == 32 && q.rgb_resolution == 64 && q.min_cos == 0.1 &&
+        q.fusion == HEARTH_FUSE_MAX && q.bake_rgb && q.calibrate && q.calib_overlays);
   CHECK(problems_naming(root, "build.json") == 0);
 
   /* no options: the recorded ones, nothing to do */

@@ -156,7 +156,8 @@ int main(void) {
     /* rewrite the text: the writer refuses a non-rotation, so edit it by hand */
     hearth_poses_free(&ps);
     sh("python3 -c \"import json,sys; f=sys.argv[1]; d=json.load(open(f)); "
-       "d['views'][1]['T_world_from_cam'][0][0]*=1.5; json.dump(d,open(f,'w'))\" '%s'%s", p, "");
+       "d['views'][1]['T_world_from_cam'][0][0]*=1.5; json.dump(d,open(f,'w'))\" '%s'%s",
+       p, "");
     n = validate(d, "derived/poses_thermal.json", "views[1]", &hit);
     CHECK_MSG(hit, "non-rotation pose not reported");
   }
@@ -165,7 +166,8 @@ int main(void) {
     const char *d = fresh_copy("prov");
     snprintf(p, sizeof p, "%s/instances/cup_01/derived/neutral/provenance.json", d);
     sh("python3 -c \"import json,sys; f=sys.argv[1]; d=json.load(open(f)); "
-       "d['source_views'].append('v77'); json.dump(d,open(f,'w'))\" '%s'%s", p, "");
+       "d['source_views'].append('v77'); json.dump(d,open(f,'w'))\" '%s'%s",
+       p, "");
     n = validate(d, "derived/neutral/provenance.json", "'v77' does not exist", &hit);
     CHECK_MSG(hit && n == 1, "provenance v77: hit %d, %zu problem(s)", hit, n);
   }

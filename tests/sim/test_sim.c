@@ -34,7 +34,8 @@ static const char *make_release(const char *dir) {
   hearth_synth_opts so;
   hearth_synth_opts_default(&so);
   so.out_root = root;
-  const char *cats[] = {"cup", "canned_drink", "electric_kettle", "eraser", "orange", "smartphone", "sponge"};
+  const char *cats[] = {"cup",    "canned_drink", "electric_kettle", "eraser",
+                        "orange", "smartphone",   "sponge"};
   so.n_categories = 7;
   for (int i = 0; i < 7; i++) so.categories[i] = cats[i];
   so.n_states = 3;
@@ -57,7 +58,8 @@ static double box_diff(const uint8_t *a, const uint8_t *b, int w, const int bx[4
   long n = 0;
   for (int y = bx[1]; y <= bx[3]; y++)
     for (int x = bx[0]; x <= bx[2]; x++)
-      for (int c = 0; c < 3; c++, n++) s += abs((int)a[3 * (y * w + x) + c] - (int)b[3 * (y * w + x) + c]);
+      for (int c = 0; c < 3; c++, n++)
+        s += abs((int)a[3 * (y * w + x) + c] - (int)b[3 * (y * w + x) + c]);
   return n ? s / (double)n : 0.0;
 }
 
@@ -102,8 +104,10 @@ static void check_crops(hearth_sim_env *e, const char *name) {
     double dth = box_diff(th0, ob.agentview_thermal, e->width, bx);
     fprintf(stderr, "test_sim: %s slot %c crop %dx%d: RGB differs by %.2f, thermal by %.1f\n", name,
             'A' + slot, bx[2] - bx[0] + 1, bx[3] - bx[1] + 1, drgb, dth);
-    CHECK_MSG(drgb < 2.0, "%s slot %c: RGB crops of the two candidates differ by %.2f", name, 'A' + slot, drgb);
-    CHECK_MSG(dth > 20.0, "%s slot %c: thermal crops of the candidates differ by only %.1f", name, 'A' + slot, dth);
+    CHECK_MSG(drgb < 2.0, "%s slot %c: RGB crops of the two candidates differ by %.2f", name,
+              'A' + slot, drgb);
+    CHECK_MSG(dth > 20.0, "%s slot %c: thermal crops of the candidates differ by only %.1f", name,
+              'A' + slot, dth);
   }
   free(rgb0), free(th0);
 }
@@ -186,7 +190,8 @@ static int read_str_attr(hid_t f, const char *obj, const char *name, char *out, 
   hid_t a = H5Aopen_by_name(f, obj, name, H5P_DEFAULT, H5P_DEFAULT);
   hid_t t = H5Aget_type(a);
   /* every string attribute is variable-length UTF-8 (h5py reads str) */
-  int ok = H5Tget_class(t) == H5T_STRING && H5Tis_variable_str(t) && H5Tget_cset(t) == H5T_CSET_UTF8;
+  int ok =
+      H5Tget_class(t) == H5T_STRING && H5Tis_variable_str(t) && H5Tget_cset(t) == H5T_CSET_UTF8;
   char *s = NULL;
   if (ok) ok = H5Aread(a, t, &s) >= 0 && s && strlen(s) < cap;
   if (ok) snprintf(out, cap, "%s", s);
@@ -227,7 +232,8 @@ static void check_file(const char *path, int S) {
   json_error_t je;
   json_t *pi = json_loads(s, 0, &je);
   CHECK(pi && json_is_string(json_object_get(pi, "language_instruction")));
-  if (pi) CHECK(strcmp(json_string_value(json_object_get(pi, "language_instruction")), want[0]) == 0);
+  if (pi)
+    CHECK(strcmp(json_string_value(json_object_get(pi, "language_instruction")), want[0]) == 0);
   json_decref(pi);
   CHECK(read_str_attr(f, "data", "env_args", s, sizeof s));
   json_t *ea = json_loads(s, 0, &je);
@@ -236,10 +242,12 @@ static void check_file(const char *path, int S) {
   CHECK(read_str_attr(f, "data", "instructions", s, sizeof s));
   json_t *il = json_loads(s, 0, &je);
   CHECK(json_is_array(il) && json_array_size(il) == 2);
-  for (size_t i = 0; il && i < 2; i++) CHECK(strcmp(json_string_value(json_array_get(il, i)), want[i]) == 0);
+  for (size_t i = 0; il && i < 2; i++)
+    CHECK(strcmp(json_string_value(json_array_get(il, i)), want[i]) == 0);
   json_decref(il);
   CHECK(read_str_attr(f, "data", "image_row_order", s, sizeof s) && strstr(s, "bottom"));
-  CHECK(read_str_attr(f, "data", "macros_image_convention", s, sizeof s) && strcmp(s, "opengl") == 0);
+  CHECK(read_str_attr(f, "data", "macros_image_convention", s, sizeof s) &&
+        strcmp(s, "opengl") == 0);
   CHECK(read_str_attr(f, "data", "env_name", s, sizeof s) && strcmp(s, "hearth_H1") == 0);
   CHECK(read_str_attr(f, "data", "bddl_file_content", s, sizeof s) && strstr(s, "(:goal"));
   CHECK(read_int_attr(f, "data", "num_demos") == 2);
@@ -251,15 +259,22 @@ static void check_file(const char *path, int S) {
     CHECK(T > 10);
     total += T;
     CHECK(read_str_attr(f, g, "language_instruction", s, sizeof s) && strcmp(s, want[k]) == 0);
-    struct { const char *key; int rank; hsize_t d1, d2, d3; } want_ds[] = {
-        {"actions", 2, 7, 0, 0},           {"rewards", 1, 0, 0, 0},
-        {"robot_states", 2, 9, 0, 0},
-        {"dones", 1, 0, 0, 0},             {"obs/agentview_rgb", 4, (hsize_t)S, (hsize_t)S, 3},
-        {"obs/agentview_thermal", 4, (hsize_t)S, (hsize_t)S, 3},
-        {"obs/eye_in_hand_rgb", 4, (hsize_t)S, (hsize_t)S, 3},
-        {"obs/joint_states", 2, 7, 0, 0},  {"obs/gripper_states", 2, 2, 0, 0},
-        {"obs/ee_states", 2, 6, 0, 0},     {"obs/ee_pos", 2, 3, 0, 0},
-        {"obs/ee_ori", 2, 3, 0, 0}};
+    struct {
+      const char *key;
+      int rank;
+      hsize_t d1, d2, d3;
+    } want_ds[] = {{"actions", 2, 7, 0, 0},
+                   {"rewards", 1, 0, 0, 0},
+                   {"robot_states", 2, 9, 0, 0},
+                   {"dones", 1, 0, 0, 0},
+                   {"obs/agentview_rgb", 4, (hsize_t)S, (hsize_t)S, 3},
+                   {"obs/agentview_thermal", 4, (hsize_t)S, (hsize_t)S, 3},
+                   {"obs/eye_in_hand_rgb", 4, (hsize_t)S, (hsize_t)S, 3},
+                   {"obs/joint_states", 2, 7, 0, 0},
+                   {"obs/gripper_states", 2, 2, 0, 0},
+                   {"obs/ee_states", 2, 6, 0, 0},
+                   {"obs/ee_pos", 2, 3, 0, 0},
+                   {"obs/ee_ori", 2, 3, 0, 0}};
     for (size_t i = 0; i < sizeof want_ds / sizeof want_ds[0]; i++) {
       hsize_t d[4] = {0};
       snprintf(p, sizeof p, "%s/%s", g, want_ds[i].key);
@@ -327,8 +342,8 @@ static int same_file(const char *a, const char *b) {
   return same;
 }
 
-static hearth_status collect_shard(const char *root, const char *path, int layouts, int shard, int shards,
-                                   int split, hearth_err *err) {
+static hearth_status collect_shard(const char *root, const char *path, int layouts, int shard,
+                                   int shards, int split, hearth_err *err) {
   hearth_sim_collect_opts o;
   hearth_sim_collect_opts_default(&o);
   o.task = HEARTH_SIM_H1;
@@ -380,20 +395,25 @@ static void check_shards(const char *root, const char *dir) {
     const char *two[2] = {a, b};
     CHECK_OK(hearth_sim_merge(out, two, 2, &n, &err), &err);
     CHECK(n == 3);
-    CHECK_MSG(same_file(ref, out), "split instruction %d: merged shards differ from one run", ins + 1);
+    CHECK_MSG(same_file(ref, out), "split instruction %d: merged shards differ from one run",
+              ins + 1);
   }
   hearth_sim_split_path(sp[0], 0, f1, sizeof f1);
   hearth_sim_split_path(sp[1], 1, f2, sizeof f2);
   /* refusals, each naming what is wrong */
   const char *missing[2] = {part[0], part[1]};
-  CHECK(hearth_sim_merge(merged, missing, 2, NULL, &err) == HEARTH_E_ARG && strstr(err.msg, "give all 3"));
+  CHECK(hearth_sim_merge(merged, missing, 2, NULL, &err) == HEARTH_E_ARG &&
+        strstr(err.msg, "give all 3"));
   const char *twice[3] = {part[0], part[1], part[1]};
-  CHECK(hearth_sim_merge(merged, twice, 3, NULL, &err) == HEARTH_E_ARG && strstr(err.msg, "both shard 1/3"));
+  CHECK(hearth_sim_merge(merged, twice, 3, NULL, &err) == HEARTH_E_ARG &&
+        strstr(err.msg, "both shard 1/3"));
   const char *mixed[2] = {f1, f2};
-  CHECK_MSG(hearth_sim_merge(merged, mixed, 2, NULL, &err) == HEARTH_E_ARG && strstr(err.msg, "differ in data@"),
+  CHECK_MSG(hearth_sim_merge(merged, mixed, 2, NULL, &err) == HEARTH_E_ARG &&
+                strstr(err.msg, "differ in data@"),
             "%s", err.msg);
   const char *whole[1] = {one};
-  CHECK(hearth_sim_merge(merged, whole, 1, NULL, &err) == HEARTH_E_ARG && strstr(err.msg, "hearth_shard"));
+  CHECK(hearth_sim_merge(merged, whole, 1, NULL, &err) == HEARTH_E_ARG &&
+        strstr(err.msg, "hearth_shard"));
   CHECK(same_file(one, merged)); /* a refused merge leaves the output as it was */
   CHECK(collect_shard(root, one, 3, 3, 3, 0, &err) == HEARTH_E_ARG);
   CHECK(collect_shard(root, one, 2, 2, 3, 0, &err) == HEARTH_E_ARG && strstr(err.msg, "no slot"));
@@ -404,7 +424,8 @@ static void check_collect(const char *root, const char *dir) {
   const int S = 32;
   hearth_err err = {0};
   hearth_sim_collect_stats s;
-  for (int run = 0; run < 3; run++) snprintf(path[run], sizeof path[run], "%s/h1_%d.hdf5", dir, run);
+  for (int run = 0; run < 3; run++)
+    snprintf(path[run], sizeof path[run], "%s/h1_%d.hdf5", dir, run);
   /* a full collect: both instructions of one layout succeed */
   CHECK_OK(collect(root, path[0], S, 400, &s, &err), &err);
   CHECK(s.demos == 2 && s.successes[0] == 1 && s.successes[1] == 1 && s.rejected_layouts == 0);
@@ -425,17 +446,20 @@ static void check_collect(const char *root, const char *dir) {
   if (src && access("/usr/bin/python3", X_OK) == 0 &&
       system("/usr/bin/python3 -c 'import h5py' 2>/dev/null") == 0) {
     char cmd[4000];
-    snprintf(cmd, sizeof cmd, "/usr/bin/python3 '%s/bench/sim_check_hdf5.py' '%s' >&2", src, path[0]);
+    snprintf(cmd, sizeof cmd, "/usr/bin/python3 '%s/bench/sim_check_hdf5.py' '%s' >&2", src,
+             path[0]);
     CHECK_MSG(system(cmd) == 0, "h5py check of %s failed", path[0]);
     /* every LIBERO / robomimic key with its type, strings as str */
-    snprintf(cmd, sizeof cmd, "/usr/bin/python3 '%s/tests/sim/check_libero_keys.py' '%s' --size %d >&2", src,
+    snprintf(cmd, sizeof cmd,
+             "/usr/bin/python3 '%s/tests/sim/check_libero_keys.py' '%s' --size %d >&2", src,
              path[0], S);
     CHECK_MSG(system(cmd) == 0, "LIBERO key check of %s failed", path[0]);
     char split1[1200];
     snprintf(cmd, sizeof cmd, "%s/sone.hdf5", dir);
     hearth_sim_split_path(cmd, 1, split1, sizeof split1);
-    snprintf(cmd, sizeof cmd, "/usr/bin/python3 '%s/tests/sim/check_libero_keys.py' '%s' --instructions 1 >&2",
-             src, split1);
+    snprintf(cmd, sizeof cmd,
+             "/usr/bin/python3 '%s/tests/sim/check_libero_keys.py' '%s' --instructions 1 >&2", src,
+             split1);
     CHECK_MSG(system(cmd) == 0, "LIBERO key check of %s failed", split1);
   } else {
     fprintf(stderr, "test_sim: no /usr/bin/python3 with h5py: skipping the h5py check\n");

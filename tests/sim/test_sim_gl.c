@@ -37,8 +37,10 @@ static const char *make_release(const char *dir) {
 
 static int render(const char *exe, const char *root, const char *out, const char *extra) {
   char cmd[4200];
-  snprintf(cmd, sizeof cmd, "'%s' sim render --task H1 --size 96 --release '%s' --ground-truth --out '%s' %s >/dev/null",
-           exe, root, out, extra);
+  snprintf(
+      cmd, sizeof cmd,
+      "'%s' sim render --task H1 --size 96 --release '%s' --ground-truth --out '%s' %s >/dev/null",
+      exe, root, out, extra);
   return system(cmd);
 }
 
@@ -49,7 +51,8 @@ static void compare(const char *a, const char *b, double *frac, double *mad) {
   *frac = *mad = -1;
   CHECK_OK(hearth_png_read(a, &ia, &err), &err);
   CHECK_OK(hearth_png_read(b, &ib, &err), &err);
-  if (ia.data && ib.data && ia.width == ib.width && ia.height == ib.height && ia.channels == ib.channels) {
+  if (ia.data && ib.data && ia.width == ib.width && ia.height == ib.height &&
+      ia.channels == ib.channels) {
     size_t n = ia.width * ia.height * ia.channels, diff = 0;
     double s = 0;
     const uint8_t *pa = ia.data, *pb = ib.data;
@@ -86,20 +89,25 @@ int main(void) {
     snprintf(a, sizeof a, "%s/H1_%s.png", osm, views[v]);
     snprintf(b, sizeof b, "%s/H1_%s.png", egl, views[v]);
     compare(a, b, &frac, &mad);
-    fprintf(stderr, "osmesa vs egl %-8s: %.5f of bytes differ, mean |d| %.4f\n", views[v], frac, mad);
+    fprintf(stderr, "osmesa vs egl %-8s: %.5f of bytes differ, mean |d| %.4f\n", views[v], frac,
+            mad);
     CHECK_MSG(frac >= 0 && mad < 0.5, "%s: EGL and OSMesa disagree (mean |d| %.3f)", views[v], mad);
     snprintf(b, sizeof b, "%s/H1_%s.png", sh, views[v]);
     compare(a, b, &frac, &mad);
-    fprintf(stderr, "shadows off/on %-8s: %.5f of bytes differ, mean |d| %.4f\n", views[v], frac, mad);
+    fprintf(stderr, "shadows off/on %-8s: %.5f of bytes differ, mean |d| %.4f\n", views[v], frac,
+            mad);
     if (v == 1) CHECK_MSG(frac == 0, "thermal view changed with shadows (%.5f of bytes)", frac);
-    else CHECK_MSG(frac > 0.01, "%s view did not change with shadows (%.5f of bytes)", views[v], frac);
+    else
+      CHECK_MSG(frac > 0.01, "%s view did not change with shadows (%.5f of bytes)", views[v], frac);
   }
 
   /* an unknown back end: refused before anything is rendered */
   char bad[1300], cmd[4200];
   snprintf(bad, sizeof bad, "%s/bad", dir);
-  snprintf(cmd, sizeof cmd, "'%s' sim render --task H1 --size 32 --release '%s' --ground-truth --out '%s' --gl vulkan 2>'%s.err'",
-           exe, root, bad, bad);
+  snprintf(
+      cmd, sizeof cmd,
+      "'%s' sim render --task H1 --size 32 --release '%s' --ground-truth --out '%s' --gl vulkan 2>'%s.err'",
+      exe, root, bad, bad);
   CHECK(system(cmd) != 0);
   hearth_sim_opts o;
   hearth_sim_opts_default(&o);

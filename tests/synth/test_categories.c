@@ -12,30 +12,31 @@
 
 /* slots each shape fills (the vessel's last two only with a lid) */
 static const int k_slots[SHAPE_COUNT] = {
-    [SHAPE_VESSEL] = VESSEL_SLOTS,     [SHAPE_CAN] = CAN_SLOTS,
-    [SHAPE_BOTTLE] = BOTTLE_SLOTS,     [SHAPE_SPHEROID] = SPHEROID_SLOTS,
-    [SHAPE_KETTLE] = KETTLE_SLOTS,     [SHAPE_SLAB] = SLAB_SLOTS,
+    [SHAPE_VESSEL] = VESSEL_SLOTS,     [SHAPE_CAN] = CAN_SLOTS,       [SHAPE_BOTTLE] = BOTTLE_SLOTS,
+    [SHAPE_SPHEROID] = SPHEROID_SLOTS, [SHAPE_KETTLE] = KETTLE_SLOTS, [SHAPE_SLAB] = SLAB_SLOTS,
     [SHAPE_HEADSET] = HEADSET_SLOTS};
 
 /* dimensions each shape reads */
-static const synth_dim k_needs[SHAPE_COUNT][9] = {
-    [SHAPE_VESSEL] = {D_R, D_R2, D_H, D_T, D_T2, D_A, D_C, D_REACH, D_COUNT},
-    [SHAPE_CAN] = {D_R, D_H, D_COUNT},
-    [SHAPE_BOTTLE] = {D_R, D_H, D_R2, D_COUNT},
-    [SHAPE_SPHEROID] = {D_R, D_H, D_COUNT},
-    [SHAPE_KETTLE] = {D_R, D_H, D_T, D_REACH, D_COUNT},
-    [SHAPE_SLAB] = {D_W, D_L, D_H, D_RC, D_E, D_COUNT},
-    [SHAPE_HEADSET] = {D_R, D_T, D_W, D_A, D_C, D_COUNT}};
+static const synth_dim k_needs[SHAPE_COUNT][9] =
+    {[SHAPE_VESSEL] = {D_R, D_R2, D_H, D_T, D_T2, D_A, D_C, D_REACH, D_COUNT},
+     [SHAPE_CAN] = {D_R, D_H, D_COUNT},
+     [SHAPE_BOTTLE] = {D_R, D_H, D_R2, D_COUNT},
+     [SHAPE_SPHEROID] = {D_R, D_H, D_COUNT},
+     [SHAPE_KETTLE] = {D_R, D_H, D_T, D_REACH, D_COUNT},
+     [SHAPE_SLAB] = {D_W, D_L, D_H, D_RC, D_E, D_COUNT},
+     [SHAPE_HEADSET] = {D_R, D_T, D_W, D_A, D_C, D_COUNT}};
 
 /* temperatures each model draws, and the state it belongs to */
-static const struct { int n; const char *state; } k_models[FIELD_MODELS] = {
-    [FIELD_TOP_COOLER] = {2, "hot"}, [FIELD_CUP] = {6, "hot"},
-    [FIELD_KETTLE] = {7, "hot"},     [FIELD_POT] = {6, "hot"},
-    [FIELD_SPONGE] = {3, "hot"},     [FIELD_PHONE] = {4, "hot warm"},
-    [FIELD_CHILLED] = {2, "iced"},   [FIELD_CHILLED_FRUIT] = {2, "iced"},
-    [FIELD_WARM] = {1, "warm"},      [FIELD_LAPTOP] = {3, "warm"},
-    [FIELD_USED] = {2, "used"},      [FIELD_USED_CUSHION] = {2, "used"},
-    [FIELD_USED_GRIP] = {2, "used"}};
+static const struct {
+  int n;
+  const char *state;
+} k_models[FIELD_MODELS] = {[FIELD_TOP_COOLER] = {2, "hot"}, [FIELD_CUP] = {6, "hot"},
+                            [FIELD_KETTLE] = {7, "hot"},     [FIELD_POT] = {6, "hot"},
+                            [FIELD_SPONGE] = {3, "hot"},     [FIELD_PHONE] = {4, "hot warm"},
+                            [FIELD_CHILLED] = {2, "iced"},   [FIELD_CHILLED_FRUIT] = {2, "iced"},
+                            [FIELD_WARM] = {1, "warm"},      [FIELD_LAPTOP] = {3, "warm"},
+                            [FIELD_USED] = {2, "used"},      [FIELD_USED_CUSHION] = {2, "used"},
+                            [FIELD_USED_GRIP] = {2, "used"}};
 
 /* the steps' structure: ops, indices, ranges, reads after writes */
 static void check_steps(const synth_category *c, int drawn[D_COUNT]) {
@@ -48,15 +49,13 @@ static void check_steps(const synth_category *c, int drawn[D_COUNT]) {
       continue;
     }
     CHECK_MSG(!ended, "%s: step %d after the end of the list", c->name, i);
-    CHECK_MSG(st->op > DRAW_END && st->op <= DRAW_COLOUR, "%s: step %d op %d", c->name, i,
-              st->op);
+    CHECK_MSG(st->op > DRAW_END && st->op <= DRAW_COLOUR, "%s: step %d op %d", c->name, i, st->op);
     if (st->op == DRAW_COLOUR) {
       CHECK_MSG(st->dst >= 0 && st->dst < 4, "%s: colour slot %d", c->name, st->dst);
       CHECK_MSG(st->src >= 0 && st->src < PAL_COUNT, "%s: palette %d", c->name, st->src);
       if (st->src >= 0 && st->src < PAL_COUNT)
         CHECK_MSG(st->k >= 1 && st->k <= synth_palettes[st->src].n && st->k == (int)st->k,
-                  "%s: %g colours of a palette of %d", c->name, st->k,
-                  synth_palettes[st->src].n);
+                  "%s: %g colours of a palette of %d", c->name, st->k, synth_palettes[st->src].n);
       continue;
     }
     CHECK_MSG(st->dst >= 0 && st->dst < D_COUNT, "%s: step %d writes dimension %d", c->name, i,
@@ -89,26 +88,24 @@ static void sample_dims(const synth_category *c, uint64_t sample, double d[D_COU
     double f = sample == 0 ? 0 : sample == 1 ? 1 : (double)(u >> 11) / 9007199254740992.0;
     double x = st->lo + (st->hi - st->lo) * f, s = d[st->src];
     switch (st->op) {
-    case DRAW_RANGE: d[st->dst] = x; break;
-    case DRAW_SCALED: d[st->dst] = st->k * s * x; break;
-    case DRAW_OFFSET: d[st->dst] = s + x; break;
-    case DRAW_CONST: d[st->dst] = st->k; break;
-    case DRAW_TIMES: d[st->dst] = s * st->k; break;
-    case DRAW_MINUS: d[st->dst] = s - st->k; break;
-    case DRAW_FLAG: d[st->dst] = f < st->k || sample == 1; break;
-    default: break;
+      case DRAW_RANGE: d[st->dst] = x; break;
+      case DRAW_SCALED: d[st->dst] = st->k * s * x; break;
+      case DRAW_OFFSET: d[st->dst] = s + x; break;
+      case DRAW_CONST: d[st->dst] = st->k; break;
+      case DRAW_TIMES: d[st->dst] = s * st->k; break;
+      case DRAW_MINUS: d[st->dst] = s - st->k; break;
+      case DRAW_FLAG: d[st->dst] = f < st->k || sample == 1; break;
+      default: break;
     }
   }
 }
 
 /* what the shape needs of one instance's dimensions */
-static void check_dims(const synth_category *c, const double d[D_COUNT],
-                       const int drawn[D_COUNT]) {
+static void check_dims(const synth_category *c, const double d[D_COUNT], const int drawn[D_COUNT]) {
   for (int k = 0; k < D_COUNT; k++)
     CHECK_MSG(d[k] >= 0 && d[k] <= (k == D_FILL || k == D_VARIANT ? 1 : 0.6),
               "%s: dimension %d = %g", c->name, k, d[k]);
-  CHECK_MSG(!drawn[D_FILL] || (d[D_FILL] > 0 && d[D_FILL] < 1), "%s: fill %g", c->name,
-            d[D_FILL]);
+  CHECK_MSG(!drawn[D_FILL] || (d[D_FILL] > 0 && d[D_FILL] < 1), "%s: fill %g", c->name, d[D_FILL]);
   for (const synth_dim *n = k_needs[c->shape]; *n != D_COUNT; n++)
     CHECK_MSG(drawn[*n] && d[*n] > 0, "%s: dimension %d = %g", c->name, *n, d[*n]);
   if (c->shape == SHAPE_SLAB) {
@@ -156,8 +153,8 @@ static void check_entry(int ci) {
   /* slots: the shape's all named, with valid styles; none beyond */
   for (int k = 0; k < SYNTH_MAX_SLOTS; k++) {
     const synth_slot *sl = &c->slots[k];
-    int used = k < k_slots[c->shape] &&
-               !(c->shape == SHAPE_VESSEL && k >= VESSEL_LID && !c->vessel.lid);
+    int used =
+        k < k_slots[c->shape] && !(c->shape == SHAPE_VESSEL && k >= VESSEL_LID && !c->vessel.lid);
     if (!used) {
       CHECK_MSG(!sl->part, "%s: slot %d (%s) is not used by its shape", c->name, k, sl->part);
       continue;
@@ -185,8 +182,7 @@ static void check_entry(int ci) {
               k_models[t->model].n);
     for (int k = 0; k < t->n && k < SYNTH_MAX_TEMPS; k++)
       CHECK_MSG(t->range[k][0] < t->range[k][1] && t->range[k][0] > 0 && t->range[k][1] < 100,
-                "%s/%s: T%d in [%g, %g]", c->name, names[s], k, t->range[k][0],
-                t->range[k][1]);
+                "%s/%s: T%d in [%g, %g]", c->name, names[s], k, t->range[k][0], t->range[k][1]);
   }
 }
 
@@ -206,11 +202,11 @@ static void check_parts(const synth_category *c) {
     }
     /* a vessel's lid comes with its variant only */
     int lid = c->shape == SHAPE_VESSEL && c->vessel.lid;
-    CHECK_MSG(o.n_parts == n || (lid && o.n_parts == n - 1), "%s: %d parts, %d slot parts",
-              c->name, o.n_parts, n);
+    CHECK_MSG(o.n_parts == n || (lid && o.n_parts == n - 1), "%s: %d parts, %d slot parts", c->name,
+              o.n_parts, n);
     for (int k = 0; k < o.n_parts && k < n; k++)
-      CHECK_MSG(strcmp(o.part_names[k], want[k]) == 0, "%s: part %d is %s, slot part %s",
-                c->name, k, o.part_names[k], want[k]);
+      CHECK_MSG(strcmp(o.part_names[k], want[k]) == 0, "%s: part %d is %s, slot part %s", c->name,
+                k, o.part_names[k], want[k]);
     synth_object_free(&o);
   }
 }
@@ -227,8 +223,8 @@ static void check_materials(void) {
     CHECK_MSG(mt->mix >= 0 && mt->mix <= 1, "material %d: mix %g", m, mt->mix);
     CHECK_MSG(mt->band[2] == 0 || (mt->band[0] < mt->band[1] && mt->band[2] <= 1),
               "material %d: band", m);
-    CHECK_MSG(mt->grain == 0 || (mt->grain_size > 0 && mt->grain_octaves >= 1 &&
-                                 fabs(mt->grain) < 0.2),
+    CHECK_MSG(mt->grain == 0 ||
+                  (mt->grain_size > 0 && mt->grain_octaves >= 1 && fabs(mt->grain) < 0.2),
               "material %d: grain %g of %g m, %d octaves", m, mt->grain, mt->grain_size,
               mt->grain_octaves);
     CHECK_MSG(mt->pattern >= PAT_NONE && mt->pattern <= PAT_ZIP, "material %d: pattern %d", m,
@@ -254,8 +250,8 @@ int main(void) {
   for (int i = 0; i < 18; i++) {
     int hits = 0;
     for (int c = 0; c < SYNTH_N_CATEGORIES; c++)
-      hits += synth_categories[c].name &&
-              strcmp(synth_categories[c].name, hearth_categories[i]) == 0;
+      hits +=
+          synth_categories[c].name && strcmp(synth_categories[c].name, hearth_categories[i]) == 0;
     CHECK_MSG(hits == 1, "dataset category %s: %d entries", hearth_categories[i], hits);
   }
   for (int c = 0; c < SYNTH_N_CATEGORIES; c++) {

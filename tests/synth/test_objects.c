@@ -14,7 +14,10 @@
 
 /* ---- independent mesh checks ---------------------------------------------- */
 
-typedef struct vkey { float p[3]; uint32_t i; } vkey;
+typedef struct vkey {
+  float p[3];
+  uint32_t i;
+} vkey;
 
 static int cmp_vkey(const void *a, const void *b) {
   const vkey *x = a, *y = b;
@@ -75,7 +78,8 @@ static double signed_volume(const hearth_mesh *m) {
     const float *c = m->positions + 3 * m->indices[3 * t + 2];
     v += (a[0] * ((double)b[1] * c[2] - (double)b[2] * c[1]) -
           a[1] * ((double)b[0] * c[2] - (double)b[2] * c[0]) +
-          a[2] * ((double)b[0] * c[1] - (double)b[1] * c[0])) / 6.0;
+          a[2] * ((double)b[0] * c[1] - (double)b[1] * c[0])) /
+         6.0;
   }
   return v;
 }
@@ -94,8 +98,10 @@ static size_t uv_overlaps(const hearth_mesh *m, size_t R) {
     }
     double area = (u[1] - u[0]) * (v[2] - v[0]) - (u[2] - u[0]) * (v[1] - v[0]);
     if (fabs(area) < 1e-14) continue;
-    long c0 = (long)floor(fmin(u[0], fmin(u[1], u[2]))), c1 = (long)ceil(fmax(u[0], fmax(u[1], u[2])));
-    long r0 = (long)floor(fmin(v[0], fmin(v[1], v[2]))), r1 = (long)ceil(fmax(v[0], fmax(v[1], v[2])));
+    long c0 = (long)floor(fmin(u[0], fmin(u[1], u[2]))),
+         c1 = (long)ceil(fmax(u[0], fmax(u[1], u[2])));
+    long r0 = (long)floor(fmin(v[0], fmin(v[1], v[2]))),
+         r1 = (long)ceil(fmax(v[0], fmax(v[1], v[2])));
     for (long r = r0 < 0 ? 0 : r0; r <= r1 && r < (long)R; r++)
       for (long c = c0 < 0 ? 0 : c0; c <= c1 && c < (long)R; c++) {
         double px = c + 0.5, py = r + 0.5, w[3];
@@ -114,17 +120,20 @@ static size_t uv_overlaps(const hearth_mesh *m, size_t R) {
 }
 
 /* expected sizes: {height lo, hi, largest horizontal extent lo, hi} (m) */
-typedef struct size_rule { const char *cat; double hlo, hhi, wlo, whi; } size_rule;
+typedef struct size_rule {
+  const char *cat;
+  double hlo, hhi, wlo, whi;
+} size_rule;
 static const size_rule k_sizes[] = {
-    {"cup", 0.088, 0.102, 0.10, 0.14},            {"canned_drink", 0.118, 0.124, 0.064, 0.068},
-    {"bottled_drink", 0.19, 0.24, 0.058, 0.070},  {"orange", 0.063, 0.082, 0.070, 0.086},
-    {"smartphone", 0.007, 0.0095, 0.144, 0.161},  {"sponge", 0.024, 0.04, 0.099, 0.151},
-    {"electric_kettle", 0.20, 0.27, 0.19, 0.30},  {"pot", 0.09, 0.20, 0.24, 0.33},
-    {"mouse", 0.03, 0.041, 0.099, 0.121},         {"eraser", 0.009, 0.014, 0.044, 0.066},
-    {"laptop", 0.014, 0.020, 0.29, 0.35},         {"wallet", 0.011, 0.021, 0.10, 0.125},
-    {"tissue", 0.07, 0.1, 0.21, 0.25},            {"glasses_case", 0.03, 0.05, 0.15, 0.175},
-    {"pillow", 0.09, 0.15, 0.44, 0.56},           {"cushion", 0.08, 0.14, 0.37, 0.46},
-    {"storage_bag", 0.01, 0.026, 0.16, 0.28},     {"headset", 0.07, 0.2, 0.15, 0.26},
+    {"cup", 0.088, 0.102, 0.10, 0.14},           {"canned_drink", 0.118, 0.124, 0.064, 0.068},
+    {"bottled_drink", 0.19, 0.24, 0.058, 0.070}, {"orange", 0.063, 0.082, 0.070, 0.086},
+    {"smartphone", 0.007, 0.0095, 0.144, 0.161}, {"sponge", 0.024, 0.04, 0.099, 0.151},
+    {"electric_kettle", 0.20, 0.27, 0.19, 0.30}, {"pot", 0.09, 0.20, 0.24, 0.33},
+    {"mouse", 0.03, 0.041, 0.099, 0.121},        {"eraser", 0.009, 0.014, 0.044, 0.066},
+    {"laptop", 0.014, 0.020, 0.29, 0.35},        {"wallet", 0.011, 0.021, 0.10, 0.125},
+    {"tissue", 0.07, 0.1, 0.21, 0.25},           {"glasses_case", 0.03, 0.05, 0.15, 0.175},
+    {"pillow", 0.09, 0.15, 0.44, 0.56},          {"cushion", 0.08, 0.14, 0.37, 0.46},
+    {"storage_bag", 0.01, 0.026, 0.16, 0.28},    {"headset", 0.07, 0.2, 0.15, 0.26},
 };
 
 static void check_object(const char *cat, size_t target) {
@@ -135,8 +144,8 @@ static void check_object(const char *cat, size_t target) {
   const hearth_mesh *m = &o.mesh;
   CHECK_OK(hearth_mesh_validate(m, cat, &err), &err);
   double ratio = (double)m->n_triangles / (double)target;
-  CHECK_MSG(ratio > 0.75 && ratio < 1.25, "%s: %zu triangles for target %zu", cat,
-            m->n_triangles, target);
+  CHECK_MSG(ratio > 0.75 && ratio < 1.25, "%s: %zu triangles for target %zu", cat, m->n_triangles,
+            target);
   CHECK(strcmp(o.category, cat) == 0);
   CHECK(o.n_parts >= 1 && o.n_parts <= SYNTH_MAX_PARTS);
   for (size_t t = 0; t < m->n_triangles; t++)
@@ -155,7 +164,7 @@ static void check_object(const char *cat, size_t target) {
   CHECK_OK(hearth_uv_islands(m, isl, &ni, &err), &err);
   CHECK_MSG(ni > 1 && ni < 40, "%s: %u islands", cat, ni);
   if (ni > 0 && ni < 1000) {
-    double (*bb)[4] = malloc(ni * sizeof *bb);
+    double(*bb)[4] = malloc(ni * sizeof *bb);
     for (uint32_t i = 0; i < ni; i++) bb[i][0] = bb[i][1] = 2, bb[i][2] = bb[i][3] = -1;
     for (size_t t = 0; t < m->n_triangles; t++)
       for (int k = 0; k < 3; k++) {
@@ -214,8 +223,8 @@ static void check_object(const char *cat, size_t target) {
       tmin = fmin(tmin, v);
       tmax = fmax(tmax, v);
     }
-    CHECK_MSG(isfinite(tmin) && isfinite(tmax) && tmin > -5 && tmax < 100,
-              "%s/%s: range %g..%g", cat, states[s], tmin, tmax);
+    CHECK_MSG(isfinite(tmin) && isfinite(tmax) && tmin > -5 && tmax < 100, "%s/%s: range %g..%g",
+              cat, states[s], tmin, tmax);
     if (s == 0) CHECK_MSG(tmin > 21 && tmax < 23, "%s/neutral: %g..%g", cat, tmin, tmax);
   }
   synth_object_free(&o);
@@ -246,7 +255,10 @@ static int part_is(const synth_object *o, size_t t, const char *name) {
   return strcmp(o->part_names[o->part_of_tri[t]], name) == 0;
 }
 
-typedef struct zsel { const char *part; double zlo, zhi; } zsel;
+typedef struct zsel {
+  const char *part;
+  double zlo, zhi;
+} zsel;
 static int f_part_z(const synth_object *o, size_t t, const double c[3], void *ctx) {
   const zsel *z = ctx;
   return part_is(o, t, z->part) && c[2] >= z->zlo && c[2] <= z->zhi;
@@ -287,7 +299,8 @@ static void check_fields(void) {
     }
   for (double z = 0.01; z < H - 0.003; z += 0.0002) {
     double p0[3] = {0.04, 0, z}, p1[3] = {0.04, 0, z + 0.0002};
-    maxstep = fmax(maxstep, fabs(synth_field_eval(&f, &cup, tb, p1) - synth_field_eval(&f, &cup, tb, p0)));
+    maxstep = fmax(maxstep,
+                   fabs(synth_field_eval(&f, &cup, tb, p1) - synth_field_eval(&f, &cup, tb, p0)));
   }
   CHECK_MSG(maxstep < 2.0 && maxstep > 0.1, "hot cup: largest step over 0.2 mm %g", maxstep);
 

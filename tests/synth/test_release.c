@@ -71,8 +71,8 @@ static void test_lens(void) {
       worst = fmax(worst, hypot(uv[0] - u, uv[1] - v));
     }
   CHECK_MSG(worst < 1e-8, "round trip error %g px", worst);
-  double x = 0.31, y = -0.22, r2 = x * x + y * y, k1 = c->dist[0], k2 = c->dist[1],
-         p1 = c->dist[2], p2 = c->dist[3], k3 = c->dist[4], xd, yd;
+  double x = 0.31, y = -0.22, r2 = x * x + y * y, k1 = c->dist[0], k2 = c->dist[1], p1 = c->dist[2],
+         p2 = c->dist[3], k3 = c->dist[4], xd, yd;
   synth_lens_distort(c->dist, x, y, &xd, &yd);
   double rad = 1 + k1 * r2 + k2 * r2 * r2 + k3 * r2 * r2 * r2;
   CHECK_NEAR(xd, x * rad + 2 * p1 * x * y + p2 * (r2 + 2 * x * x), 1e-15);
@@ -158,8 +158,8 @@ static void check_thermal_vs_field(const char *root, const hearth_synth_opts *o,
     }
   CHECK_MSG(n_obj > 200, "only %zu smooth object pixels", n_obj);
   CHECK_MSG(n_bg > 200, "only %zu background pixels", n_bg);
-  CHECK_MSG(bad_obj == 0, "%zu of %zu object pixels off the field by > 0.3 (worst %g)",
-            bad_obj, n_obj, worst);
+  CHECK_MSG(bad_obj == 0, "%zu of %zu object pixels off the field by > 0.3 (worst %g)", bad_obj,
+            n_obj, worst);
   CHECK_MSG(bad_bg == 0, "%zu of %zu background pixels far from ambient", bad_bg, n_bg);
   synth_scene_free(&scene);
   synth_instance_free(inst);
@@ -379,13 +379,16 @@ int main(void) {
   CHECK(mkdir(b, 0777) == 0);
   small_opts(&o, b, 1);
   CHECK_OK(hearth_synth_release(&o, &err), &err);
-  const char *files[] = {
-      "instances/cup_01/raw/hot/thermal/v07.csv", "instances/cup_01/raw/neutral/rgb/v15.jpg",
-      "instances/cup_01/raw/hot/depth/v22.png", "instances/cup_01/raw/hot/cutout/v00.png",
-      "instances/cup_01/recon/poses_rgb.json", "instances/cup_01/recon/mesh.glb",
-      "ground_truth/instances/cup_01/hot/temperature_true.npy",
-      "ground_truth/calibration/detections.json", "calibration/captures/stereo/p000_rgb.jpg",
-      "calibration/captures/thermal/f002.csv"};
+  const char *files[] = {"instances/cup_01/raw/hot/thermal/v07.csv",
+                         "instances/cup_01/raw/neutral/rgb/v15.jpg",
+                         "instances/cup_01/raw/hot/depth/v22.png",
+                         "instances/cup_01/raw/hot/cutout/v00.png",
+                         "instances/cup_01/recon/poses_rgb.json",
+                         "instances/cup_01/recon/mesh.glb",
+                         "ground_truth/instances/cup_01/hot/temperature_true.npy",
+                         "ground_truth/calibration/detections.json",
+                         "calibration/captures/stereo/p000_rgb.jpg",
+                         "calibration/captures/thermal/f002.csv"};
   for (size_t i = 0; i < sizeof files / sizeof files[0]; i++)
     CHECK_MSG(same_bytes(a, b, files[i]), "%s differs between runs", files[i]);
 

@@ -10,7 +10,8 @@ static void expect_error(const char *text, hearth_status status, const char *whe
   hearth_thermo_model m;
   hearth_status s = hearth_thermo_model_parse(text, strlen(text), "thermal_model.json", &m, &err);
   CHECK_MSG(s == status, "%s: got %s (%s)", text, hearth_status_name(s), err.msg);
-  CHECK_MSG(strstr(err.msg, "thermal_model.json") && strstr(err.msg, where), "message: %s", err.msg);
+  CHECK_MSG(strstr(err.msg, "thermal_model.json") && strstr(err.msg, where), "message: %s",
+            err.msg);
 }
 
 int main(void) {
@@ -37,28 +38,39 @@ int main(void) {
     for (size_t j = 0; j < m.net.n; j++) CHECK(back.net.G[i][j] == m.net.G[i][j]);
   }
 
-  const char *head = "{\"format\": \"hearth-thermal-model\", \"version\": 1, \"category\": \"cup\", "
-                     "\"T_air\": 20, \"offsets\": \"\", ";
+  const char *head =
+      "{\"format\": \"hearth-thermal-model\", \"version\": 1, \"category\": \"cup\", "
+      "\"T_air\": 20, \"offsets\": \"\", ";
   char doc[2048];
-  snprintf(doc, sizeof doc, "%s\"regions\": [{\"name\": \"body\", \"C\": 300, \"T\": 50, \"area\": "
-           "0.02, \"h_conv\": 7, \"emissivity\": 0.9, \"label\": 0}], \"conductances\": []}", head);
+  snprintf(doc, sizeof doc,
+           "%s\"regions\": [{\"name\": \"body\", \"C\": 300, \"T\": 50, \"area\": "
+           "0.02, \"h_conv\": 7, \"emissivity\": 0.9, \"label\": 0}], \"conductances\": []}",
+           head);
   hearth_thermo_model ok;
   CHECK_OK(hearth_thermo_model_parse(doc, strlen(doc), "thermal_model.json", &ok, &err), &err);
   CHECK(ok.net.n == 1 && ok.net.region[0].C == 300);
 
-  snprintf(doc, sizeof doc, "%s\"regions\": [{\"name\": \"body\", \"C\": -3, \"T\": 50, \"area\": "
-           "0.02, \"h_conv\": 7, \"emissivity\": 0.9, \"label\": 0}], \"conductances\": []}", head);
+  snprintf(doc, sizeof doc,
+           "%s\"regions\": [{\"name\": \"body\", \"C\": -3, \"T\": 50, \"area\": "
+           "0.02, \"h_conv\": 7, \"emissivity\": 0.9, \"label\": 0}], \"conductances\": []}",
+           head);
   expect_error(doc, HEARTH_E_RANGE, "regions[0].C");
-  snprintf(doc, sizeof doc, "%s\"regions\": [{\"name\": \"body\", \"C\": 3, \"T\": 50, \"area\": "
-           "0.02, \"h_conv\": 7, \"emissivity\": 1.5, \"label\": 0}], \"conductances\": []}", head);
+  snprintf(doc, sizeof doc,
+           "%s\"regions\": [{\"name\": \"body\", \"C\": 3, \"T\": 50, \"area\": "
+           "0.02, \"h_conv\": 7, \"emissivity\": 1.5, \"label\": 0}], \"conductances\": []}",
+           head);
   expect_error(doc, HEARTH_E_RANGE, "regions[0].emissivity");
-  snprintf(doc, sizeof doc, "%s\"regions\": [{\"name\": \"body\", \"C\": 3, \"T\": 50, \"area\": "
+  snprintf(doc, sizeof doc,
+           "%s\"regions\": [{\"name\": \"body\", \"C\": 3, \"T\": 50, \"area\": "
            "0.02, \"h_conv\": 7, \"emissivity\": 0.5, \"label\": 0, \"mass\": 1}], "
-           "\"conductances\": []}", head);
+           "\"conductances\": []}",
+           head);
   expect_error(doc, HEARTH_E_PARSE, "regions[0].mass");
-  snprintf(doc, sizeof doc, "%s\"regions\": [{\"name\": \"body\", \"C\": 3, \"T\": 50, \"area\": "
+  snprintf(doc, sizeof doc,
+           "%s\"regions\": [{\"name\": \"body\", \"C\": 3, \"T\": 50, \"area\": "
            "0.02, \"h_conv\": 7, \"emissivity\": 0.5, \"label\": 0}], "
-           "\"conductances\": [{\"a\": \"body\", \"b\": \"lid\", \"G\": 1}]}", head);
+           "\"conductances\": [{\"a\": \"body\", \"b\": \"lid\", \"G\": 1}]}",
+           head);
   expect_error(doc, HEARTH_E_INCONSISTENT, "conductances[0]");
   expect_error("{\"format\": \"other\"}", HEARTH_E_UNSUPPORTED, "format");
   expect_error("[1]", HEARTH_E_PARSE, "expected a JSON object");

@@ -37,8 +37,8 @@ int main(void) {
       if (d == 1 && (minute % 2 == 0 || minute == 13))
         printf("%3d  %5.2f  %5.2f  %+5.2f\n", minute, model, ref, model - ref);
       if (minute <= 10 || minute == 13)
-        CHECK_MSG(fabs(model - ref) <= 2.0, "dt %g s, %d min: model %.2f, published %.2f",
-                  dts[d], minute, model, ref);
+        CHECK_MSG(fabs(model - ref) <= 2.0, "dt %g s, %d min: model %.2f, published %.2f", dts[d],
+                  minute, model, ref);
     }
   }
   return g_test_failures;

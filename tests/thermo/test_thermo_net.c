@@ -24,7 +24,8 @@ static void test_single_cooling(void) {
   hearth_err err;
   const double C = 1000, h = 10, A = 0.05, T0 = 80, Ta = 20, tau = C / (h * A);
   const double dts[] = {0.01 * tau, 1e-3 * tau};
-  const double tols[] = {0.2, 0.02}; /* backward Euler error ~ dt/(2 tau) * (T0-Ta) * t/tau e^-t/tau */
+  const double tols[] = {0.2,
+                         0.02}; /* backward Euler error ~ dt/(2 tau) * (T0-Ta) * t/tau e^-t/tau */
   for (int d = 0; d < 2; d++) {
     hearth_thermo_net net;
     hearth_thermo_net_init(&net);
