@@ -267,6 +267,19 @@ static const fault_case k_sim_cases[] = {
      {"eval: before the first episode: websocket 127.0.0.1:1: cannot connect"},
      {"res"},
      60},
+    /* a killed collection's temporary (dead writer) goes with the next run */
+    {"collect_leftover_rerun",
+     "$HEARTH synth --out S --draft-rgb --categories "
+     "cup,canned_drink,electric_kettle,eraser,orange,smartphone,sponge --states neutral,hot,iced "
+     "--views 1 --triangles 600 --texture 64 --map-res 32 --no-calibration --threads 2 --quiet && "
+     "dead=$(sh -c 'echo $$') && echo x > out.hdf5.tmp-$dead-abc123",
+     "$HEARTH sim collect --task H1 --layouts 1 --max-steps 2 --keep-failures --size 16 "
+     "--release S --ground-truth --quiet --out out.hdf5 && test -f out.hdf5",
+     {NULL},
+     {"out.hdf5.tmp-*"},
+     120,
+     0,
+     1},
 };
 
 /* A valid 2 MB PNG of 16384 x 16384 RGBA16 zeros (2 GiB of pixels): one
