@@ -1,32 +1,21 @@
 /* Pose transfer over a release tree: thermal poses from the colour poses
  * through the rig (see include/hearth/poses.h). */
-#include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
 #include "hearth/dataset.h"
 #include "hearth/poses.h"
-
-#define PATH_SZ 4096
-
-static hearth_status joinf(char *buf, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-static hearth_status joinf(char *buf, const char *fmt, ...) {
-  va_list ap;
-  va_start(ap, fmt);
-  int n = vsnprintf(buf, PATH_SZ, fmt, ap);
-  va_end(ap);
-  return (n < 0 || n >= PATH_SZ) ? HEARTH_E_LIMIT : HEARTH_OK;
-}
+#include "poses/poses_internal.h"
 
 hearth_status hearth_transfer_run(const hearth_transfer_job *job, hearth_err *err) {
   if (!job || !job->root || !job->instance)
     return hearth_err_set(err, HEARTH_E_ARG, "transfer: root and instance are required");
-  char rig_path[PATH_SZ], poses_path[PATH_SZ], out1[PATH_SZ], out2[PATH_SZ];
-  if (job->rig_path) snprintf(rig_path, PATH_SZ, "%s", job->rig_path);
-  else joinf(rig_path, "%s/calibration/rig.json", job->root);
-  if (job->poses_path) snprintf(poses_path, PATH_SZ, "%s", job->poses_path);
-  else joinf(poses_path, "%s/instances/%s/derived/poses_rgb.json", job->root, job->instance);
-  joinf(out1, "%s/instances/%s/derived/poses_thermal_transferred.json", job->root, job->instance);
-  joinf(out2, "%s/instances/%s/derived/poses_thermal.json", job->root, job->instance);
+  char rig_path[RF_PATH], poses_path[RF_PATH], out1[RF_PATH], out2[RF_PATH];
+  if (job->rig_path) snprintf(rig_path, RF_PATH, "%s", job->rig_path);
+  else rf_pathf(rig_path, "%s/calibration/rig.json", job->root);
+  if (job->poses_path) snprintf(poses_path, RF_PATH, "%s", job->poses_path);
+  else rf_pathf(poses_path, "%s/instances/%s/derived/poses_rgb.json", job->root, job->instance);
+  rf_pathf(out1, "%s/instances/%s/derived/poses_thermal_transferred.json", job->root, job->instance);
+  rf_pathf(out2, "%s/instances/%s/derived/poses_thermal.json", job->root, job->instance);
   hearth_rig rig;
   hearth_status s = hearth_rig_read(rig_path, &rig, err);
   if (s) return s;
@@ -38,8 +27,8 @@ hearth_status hearth_transfer_run(const hearth_transfer_job *job, hearth_err *er
   for (size_t i = 0; i < poses.n; i++)
     hearth_rigid_compose(&poses.views[i].T_world_from_cam, &T_rgb_from_th,
                          &poses.views[i].T_world_from_cam);
-  char dir[PATH_SZ];
-  joinf(dir, "%s/instances/%s/derived", job->root, job->instance);
+  char dir[RF_PATH];
+  rf_pathf(dir, "%s/instances/%s/derived", job->root, job->instance);
   if ((s = hearth_mkdirs(dir, err))) goto done;
   if ((s = hearth_poses_write(out1, &poses, err))) goto done;
   if (!(job->keep_refined && hearth_path_exists(out2))) s = hearth_poses_write(out2, &poses, err);
