@@ -14,7 +14,8 @@ hearth_status hearth_transfer_run(const hearth_transfer_job *job, hearth_err *er
   else rf_pathf(rig_path, "%s/calibration/rig.json", job->root);
   if (job->poses_path) snprintf(poses_path, RF_PATH, "%s", job->poses_path);
   else rf_pathf(poses_path, "%s/instances/%s/derived/poses_rgb.json", job->root, job->instance);
-  rf_pathf(out1, "%s/instances/%s/derived/poses_thermal_transferred.json", job->root, job->instance);
+  rf_pathf(out1, "%s/instances/%s/derived/poses_thermal_transferred.json", job->root,
+           job->instance);
   rf_pathf(out2, "%s/instances/%s/derived/poses_thermal.json", job->root, job->instance);
   hearth_rig rig;
   hearth_status s = hearth_rig_read(rig_path, &rig, err);
