@@ -18,38 +18,12 @@
 #include "hearth/sim.h"
 #include "sim/sim_env.h"
 #include "test_util.h"
+#include "test_sim_release.h"
 
 static double g_t0;
 static void stamp(const char *what) {
   fprintf(stderr, "test_sim: %-28s %6.1f s wall %6.1f s cpu\n", what, hearth_now() - g_t0,
           (double)clock() / CLOCKS_PER_SEC);
-}
-
-/* the smallest release that still has every category and state the tasks
- * use; two views per state suffice for the up direction */
-static const char *make_release(const char *dir) {
-  static char root[1200];
-  snprintf(root, sizeof root, "%s/release", dir);
-  hearth_remove_tree(root, NULL);
-  hearth_synth_opts so;
-  hearth_synth_opts_default(&so);
-  so.out_root = root;
-  const char *cats[] = {"cup",    "canned_drink", "electric_kettle", "eraser",
-                        "orange", "smartphone",   "sponge"};
-  so.n_categories = 7;
-  for (int i = 0; i < 7; i++) so.categories[i] = cats[i];
-  so.n_states = 3;
-  so.states[0] = "neutral", so.states[1] = "hot", so.states[2] = "iced";
-  so.n_views = 2;
-  so.triangles = 800;
-  so.texture_size = 64;
-  so.map_resolution = 32;
-  so.calibration = 0;
-  so.rgb_full_size = 0; /* the sim reads no raw colour frames */
-  so.quiet = 1;
-  hearth_err err = {0};
-  CHECK_OK(hearth_synth_release(&so, &err), &err);
-  return root;
 }
 
 /* mean absolute difference per channel of two images over a box */
@@ -471,7 +445,7 @@ int main(void) {
   const char *dir = test_tmpdir("sim_tasks");
   char dirbuf[1100];
   snprintf(dirbuf, sizeof dirbuf, "%s", dir);
-  const char *root = make_release(dirbuf);
+  const char *root = test_sim_release(dirbuf);
   stamp("virtual-rig release");
   check_task(root, HEARTH_SIM_H1);
   stamp("H1");
