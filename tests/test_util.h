@@ -50,6 +50,26 @@ static int g_test_failures = 0;
   } while (0)
 
 /* A fresh directory under $HEARTH_TEST_TMP (or /tmp) for this test. */
+/* The whole file, NUL-terminated (the caller frees); NULL if it cannot be
+ * opened. *len (optional) gets its size. */
+static inline char *test_slurp(const char *path, size_t *len) {
+  FILE *f = fopen(path, "rb");
+  if (!f) return NULL;
+  fseek(f, 0, SEEK_END);
+  long n = ftell(f);
+  fseek(f, 0, SEEK_SET);
+  char *b = malloc(n > 0 ? (size_t)n + 1 : 1);
+  if (!b) {
+    fclose(f);
+    return NULL;
+  }
+  size_t got = n > 0 ? fread(b, 1, (size_t)n, f) : 0;
+  fclose(f);
+  b[got] = 0;
+  if (len) *len = got;
+  return b;
+}
+
 static inline const char *test_tmpdir(const char *name) {
   static char buf[1024];
   const char *base = getenv("HEARTH_TEST_TMP");

@@ -23,20 +23,6 @@ static const char *tpath(const char *name) {
   return buf[k];
 }
 
-static char *slurp(const char *path, size_t *len) {
-  FILE *f = fopen(path, "rb");
-  if (!f) return NULL;
-  fseek(f, 0, SEEK_END);
-  long n = ftell(f);
-  fseek(f, 0, SEEK_SET);
-  char *b = malloc((size_t)n + 1);
-  size_t got = fread(b, 1, (size_t)n, f);
-  fclose(f);
-  b[got] = 0;
-  if (len) *len = got;
-  return b;
-}
-
 static void spit(const char *path, const char *text) {
   FILE *f = fopen(path, "wb");
   if (!f) {
@@ -49,7 +35,7 @@ static void spit(const char *path, const char *text) {
 
 static int same_bytes(const char *a, const char *b) {
   size_t la, lb;
-  char *x = slurp(a, &la), *y = slurp(b, &lb);
+  char *x = test_slurp(a, &la), *y = test_slurp(b, &lb);
   int same = x && y && la == lb && memcmp(x, y, la) == 0;
   free(x);
   free(y);
@@ -183,7 +169,7 @@ static void test_round_trips(void) {
   CHECK_OK(hearth_rig_write(tpath("rig_again.json"), &rig2, &err), &err);
   CHECK(same_bytes(tpath("rig.json"), tpath("rig_again.json")));
   /* keys in the spec's order, 2-space indent, short numbers stay short */
-  char *text = slurp(tpath("rig.json"), NULL);
+  char *text = test_slurp(tpath("rig.json"), NULL);
   CHECK(text && strncmp(text, "{\n  \"rgb\": {\n    \"width\": 1920,", 30) == 0);
   const char *order[] = {"\"rgb\"",
                          "\"thermal\"",
@@ -234,7 +220,7 @@ static void test_round_trips(void) {
   const hearth_view_pose *q = hearth_poses_find(&p2, "iced", "v01");
   CHECK(q && q == &p2.views[4]);
   CHECK(hearth_poses_find(&p2, "warm", "v01") == NULL);
-  text = slurp(tpath("poses_rgb.json"), NULL);
+  text = test_slurp(tpath("poses_rgb.json"), NULL);
   CHECK(text && strstr(text, "\"convention\": \"T_world_from_cam, OpenCV camera axes\""));
   CHECK(text && strstr(text, "\"units\": \"m\""));
   free(text);
@@ -333,7 +319,7 @@ static void test_exact_numbers(void) {
                   "centre %d/%d: %.17g became %.17g", i, k, d.frames[0].centres[i][k],
                   d2.frames[0].centres[i][k]);
   }
-  char *text = slurp(tpath("exact.json"), NULL);
+  char *text = test_slurp(tpath("exact.json"), NULL);
   /* shortest forms, not %.17g noise */
   CHECK(text && strstr(text, "[0.1, "));
   free(text);

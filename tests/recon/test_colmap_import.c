@@ -24,23 +24,9 @@ static const char *tpath(const char *name) {
   return buf[k];
 }
 
-static char *slurp(const char *path, size_t *len) {
-  FILE *f = fopen(path, "rb");
-  if (!f) return NULL;
-  fseek(f, 0, SEEK_END);
-  long n = ftell(f);
-  fseek(f, 0, SEEK_SET);
-  char *b = malloc((size_t)n + 1);
-  size_t got = fread(b, 1, (size_t)n, f);
-  fclose(f);
-  b[got] = 0;
-  if (len) *len = got;
-  return b;
-}
-
 static int same_file(const char *a, const char *b) {
   size_t na, nb;
-  char *x = slurp(a, &na), *y = slurp(b, &nb);
+  char *x = test_slurp(a, &na), *y = test_slurp(b, &nb);
   int same = x && y && na == nb && !memcmp(x, y, na);
   free(x);
   free(y);
@@ -175,7 +161,7 @@ static void test_text_and_binary(void) {
   }
   hearth_recon_cameras_free(&cr);
   /* its reader is strict: a view naming a camera not listed */
-  char *doc = slurp(cpt, NULL);
+  char *doc = test_slurp(cpt, NULL);
   char *at = doc ? strstr(doc, "\"colmap_camera_id\": 7,\n      \"colmap_image_id\"") : NULL;
   CHECK(at != NULL);
   if (at) {
