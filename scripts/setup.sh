@@ -47,6 +47,14 @@ if [ ! -e .tools/node_modules/@duckdb/node-api/package.json ]; then
   npm install --silent --no-audit --no-fund --prefix .tools @duckdb/node-api@1.5.6-r.1 >/dev/null 2>&1 ||
     echo "setup: warning: @duckdb/node-api could not be installed; the Parquet read-back tests will fail"
 fi
+# The Arrow Rust Parquet reader (npm parquet-wasm) with Arrow's JavaScript
+# library is the second independent reader of those files.
+if [ ! -e .tools/node_modules/parquet-wasm/package.json ] || [ ! -e .tools/node_modules/apache-arrow/package.json ]; then
+  echo "setup: installing parquet-wasm and apache-arrow (npm) into .tools/"
+  mkdir -p .tools
+  npm install --silent --no-audit --no-fund --prefix .tools parquet-wasm@0.8.0 apache-arrow@21.2.0 >/dev/null 2>&1 ||
+    echo "setup: warning: parquet-wasm could not be installed; the Parquet read-back tests will fail"
+fi
 
 type=RelWithDebInfo
 extra=""

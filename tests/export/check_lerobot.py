@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """Checks a LeRobot dataset written by `hearth sim export` against the HDF5
-collections it came from, reading the Parquet files through DuckDB's dump
-(tests/io/read_parquet.js) and everything else with numpy, h5py and OpenCV:
+collections it came from, reading the Parquet files through a reader's dump
+(DuckDB's from tests/io/read_parquet.js, or the Arrow Rust reader's from
+tests/io/read_parquet_arrow.js) and everything else with numpy, h5py and OpenCV:
 
   check_lerobot.py check DIR DUMP.json EVAL_DIR|- [--no-thermal] [--expect-flip] FILE.hdf5...
   check_lerobot.py synthetic OUT.hdf5
@@ -236,10 +237,15 @@ def check_dataset(root, dump_path, eval_dir, thermal, expect_flip, paths):
         check([c["name"] for c in pq["columns"]] == list(features), f"{rel}: columns {pq['columns']}")
         check(pq["meta"]["num_row_groups"] == (T + 99) // 100, f"{rel}: row groups of 100 rows expected")
         types = {c["name"]: c["type"] for c in pq["columns"]}
+        # the types each reader gives the columns LeRobot's writer (pyarrow via datasets) makes
+        image_t, list_t, float_t, int_t = {
+            "duckdb": ('STRUCT("bytes" BLOB, "path" VARCHAR)', "FLOAT[]", "FLOAT", "BIGINT"),
+            "arrow": ("Struct<{bytes:Binary, path:Utf8}>", "List<Float32>", "Float32", "Int64"),
+        }[pq.get("reader", "duckdb")]
         for k in image_keys:
-            check(types[k] == 'STRUCT("bytes" BLOB, "path" VARCHAR)', f"{rel}: {k} is {types[k]}")
-        check(types["state"] == "FLOAT[]" and types["actions"] == "FLOAT[]" and types["timestamp"] == "FLOAT"
-              and all(types[k] == "BIGINT" for k in ("frame_index", "episode_index", "index", "task_index")),
+            check(types[k] == image_t, f"{rel}: {k} is {types[k]}")
+        check(types["state"] == list_t and types["actions"] == list_t and types["timestamp"] == float_t
+              and all(types[k] == int_t for k in ("frame_index", "episode_index", "index", "task_index")),
               f"{rel}: column types {types}")
         task = tasks.index(d["instruction"])
         state = np.zeros((T, 8), np.float32)

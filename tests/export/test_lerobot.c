@@ -86,22 +86,25 @@ static void write_eval_frames(const char *h5, const char *eval_dir) {
   ex_source_close(&s);
 }
 
-/* DuckDB's dump of DIR's Parquet files, then check_lerobot.py */
+/* each reader's dump of DIR's Parquet files (DuckDB; the Arrow Rust reader),
+ * then check_lerobot.py on each */
 static void check_dataset(const char *ds, const char *eval_dir, const char *flags, const char *h5) {
-  char cmd[8000];
-  snprintf(cmd, sizeof cmd,
-           "node '%s/tests/io/read_parquet.js' '%s.dump.json' '%s'/data/chunk-000/*.parquet", g_src,
-           ds, ds);
-  int rc = run(cmd);
-  CHECK_MSG(rc == 0,
-            "read_parquet.js on %s: exit status %d (1: unreadable, 3: @duckdb/node-api missing)",
-            ds, rc);
-  if (rc) return;
-  snprintf(
-      cmd, sizeof cmd,
-      "/usr/bin/python3 '%s/tests/export/check_lerobot.py' check '%s' '%s.dump.json' '%s' %s '%s'",
-      g_src, ds, ds, eval_dir, flags, h5);
-  CHECK_MSG(run(cmd) == 0, "check_lerobot.py found differences in %s", ds);
+  static const char *const readers[] = {"read_parquet.js", "read_parquet_arrow.js"};
+  for (int k = 0; k < 2; k++) {
+    char cmd[8000];
+    snprintf(cmd, sizeof cmd, "node '%s/tests/io/%s' '%s.dump%d.json' '%s'/data/chunk-000/*.parquet",
+             g_src, readers[k], ds, k, ds);
+    int rc = run(cmd);
+    CHECK_MSG(rc == 0, "%s on %s: exit status %d (1: unreadable, 3: its npm packages missing)",
+              readers[k], ds, rc);
+    if (rc) continue;
+    snprintf(cmd, sizeof cmd,
+             "/usr/bin/python3 '%s/tests/export/check_lerobot.py' check '%s' '%s.dump%d.json' '%s' %s "
+             "'%s'",
+             g_src, ds, ds, k, eval_dir, flags, h5);
+    CHECK_MSG(run(cmd) == 0, "check_lerobot.py found differences in %s (read by %s)", ds,
+              readers[k]);
+  }
 }
 
 static int no_temp_left(void) {

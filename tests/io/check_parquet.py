@@ -1,7 +1,8 @@
 #!/usr/bin/python3
-"""Compares DuckDB's dump (tests/io/read_parquet.js) of the files written by
-tests/io/test_parquet.c with the values that test writes, computed here from
-the row number the same way:
+"""Compares a reader's dump (DuckDB's from tests/io/read_parquet.js or the
+Arrow Rust reader's from tests/io/read_parquet_arrow.js) of the files written
+by tests/io/test_parquet.c with the values that test writes, computed here
+from the row number the same way:
   check_parquet.py DUMP.json ROWS
 The dump holds the full file (ROWS rows) and then the empty one."""
 import base64
@@ -65,7 +66,10 @@ def main(argv):
     full, empty = files
     if full["kv"] != {"huggingface": '{"info": {}}', "second": "v\u00e4lue"}:
         fails.append(f"key-value metadata: {full['kv']}")
-    want_types = ["BIGINT", "FLOAT", "FLOAT[]", 'STRUCT("bytes" BLOB, "path" VARCHAR)']
+    want_types = {
+        "duckdb": ["BIGINT", "FLOAT", "FLOAT[]", 'STRUCT("bytes" BLOB, "path" VARCHAR)'],
+        "arrow": ["Int64", "Float32", "List<Float32>", "Struct<{bytes:Binary, path:Utf8}>"],
+    }[full.get("reader", "duckdb")]
     if [c["type"] for c in full["columns"]] != want_types or [c["name"] for c in full["columns"]] != ["n", "x", "v", "b"]:
         fails.append(f"columns: {full['columns']}")
     if full["meta"]["num_rows"] != rows or full["meta"]["num_row_groups"] != (rows + 999) // 1000:

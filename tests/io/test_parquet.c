@@ -3,10 +3,11 @@
  * need RLE runs and many bit-packed groups, a blob past the 1 MiB page
  * target, partial last row group, NaN / -0 / infinities, the int64 extremes,
  * non-ASCII paths, zero rows) are read by DuckDB (tests/io/read_parquet.js)
- * and compared value by value by tests/io/check_parquet.py, which computes
- * the same values from the row number. Also: the same rows give the same
+ * and by the Arrow Rust reader (tests/io/read_parquet_arrow.js) and compared
+ * value by value by tests/io/check_parquet.py, which computes the same values
+ * from the row number. Also: the same rows give the same
  * bytes, an aborted or failed writer leaves nothing, bad arguments are
- * refused. Missing node, DuckDB or python3 is a failure, not a skip. */
+ * refused. Missing node, a reader or python3 is a failure, not a skip. */
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -119,15 +120,19 @@ int main(void) {
   CHECK(pa && na > 12 && memcmp(pa, "PAR1", 4) == 0 && memcmp(pa + na - 4, "PAR1", 4) == 0);
   free(pa), free(pb);
 
-  snprintf(cmd, sizeof cmd, "node '%s/tests/io/read_parquet.js' '%s' '%s' '%s'", src, dump, a,
-           empty);
-  int rc = run(cmd);
-  CHECK_MSG(rc == 0, "read_parquet.js exit status %d (1: unreadable, 3: @duckdb/node-api missing)",
-            rc);
-  if (rc == 0) {
-    snprintf(cmd, sizeof cmd, "/usr/bin/python3 '%s/tests/io/check_parquet.py' '%s' %d", src, dump,
-             ROWS);
-    CHECK_MSG(run(cmd) == 0, "check_parquet.py found differences");
+  /* two readers independent of hearth and of each other: DuckDB and the Arrow Rust reader */
+  static const char *const readers[] = {"read_parquet.js", "read_parquet_arrow.js"};
+  for (int k = 0; k < 2; k++) {
+    snprintf(cmd, sizeof cmd, "node '%s/tests/io/%s' '%s' '%s' '%s'", src, readers[k], dump, a,
+             empty);
+    int rc = run(cmd);
+    CHECK_MSG(rc == 0, "%s exit status %d (1: unreadable, 3: its npm packages missing)",
+              readers[k], rc);
+    if (rc == 0) {
+      snprintf(cmd, sizeof cmd, "/usr/bin/python3 '%s/tests/io/check_parquet.py' '%s' %d", src,
+               dump, ROWS);
+      CHECK_MSG(run(cmd) == 0, "check_parquet.py found differences in what %s read", readers[k]);
+    }
   }
 
   /* an aborted writer and a refused row leave nothing behind */
