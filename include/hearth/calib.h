@@ -61,6 +61,10 @@ typedef struct hearth_calib_opts {
    * the estimated poses, and re-solve; default 1 */
   int perspective_correction;
   double hole_radius_m; /* default 0.004 */
+  /* hearth_calib_intrinsics: the lens model solved for; default
+   * HEARTH_LENS_BROWN5 (the rational model starts from the 5-parameter
+   * solution) */
+  hearth_lens_model lens_model;
 } hearth_calib_opts;
 void hearth_calib_opts_default(hearth_calib_opts *o);
 
