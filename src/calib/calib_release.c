@@ -545,6 +545,12 @@ hearth_status hearth_calib_calibrate_release(const char *root, const hearth_cali
   hearth_status st;
   if (!hearth_path_exists(pdet))
     return hearth_err_set(err, HEARTH_E_NOT_FOUND, "%s: missing (run `hearth detect` first)", pdet);
+  snprintf(path, sizeof path, "%s/calibration/captures/stereo", root);
+  if (!hearth_path_exists(pfac) && !hearth_path_exists(path))
+    return hearth_err_set(err, HEARTH_E_NOT_FOUND,
+                          "%s: missing, and no stereo captures: for thermal intrinsics alone "
+                          "use `hearth calibrate ROOT --thermal-only`",
+                          pfac);
   if ((st = hearth_detections_read(pdet, &dets, err))) return st;
   if ((st = hearth_factory_read(pfac, &fc, err)) ||
       (st = check_factory_size(root, pfac, &fc, &dets, err))) {
