@@ -334,18 +334,21 @@ hearth_status hearth_calib_pose(const hearth_camera *cam, const double (*obj)[3]
   double *plane = hearth_alloc_array(4 * n_pts, sizeof(double));
   if (!plane) return hearth_err_set(err, HEARTH_E_NOMEM, "plate pose: out of memory");
   double *norm = plane + 2 * n_pts;
-  /* homography plate -> ideal normalised coordinates gives the start */
+  /* homography plate -> ideal normalised coordinates gives the start, from
+   * the points the lens model can undistort */
+  size_t k = 0;
   for (size_t j = 0; j < n_pts; j++) {
-    plane[2 * j] = obj[j][0];
-    plane[2 * j + 1] = obj[j][1];
     double xy[2];
-    hearth_camera_undistort(cam, img[2 * j], img[2 * j + 1], xy);
-    norm[2 * j] = xy[0];
-    norm[2 * j + 1] = xy[1];
+    if (hearth_camera_undistort(cam, img[2 * j], img[2 * j + 1], xy) < 0) continue;
+    plane[2 * k] = obj[j][0];
+    plane[2 * k + 1] = obj[j][1];
+    norm[2 * k] = xy[0];
+    norm[2 * k + 1] = xy[1];
+    k++;
   }
   double Hn[9];
   hearth_rigid T;
-  int ok = calib_homography(plane, norm, n_pts, Hn) && calib_pose_from_homography(Hn, &T);
+  int ok = k >= 4 && calib_homography(plane, norm, k, Hn) && calib_pose_from_homography(Hn, &T);
   free(plane);
   if (!ok) return hearth_err_set(err, HEARTH_E_NUMERIC, "plate pose: degenerate homography");
   double p[6];

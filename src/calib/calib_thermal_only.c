@@ -354,7 +354,9 @@ static hearth_status heldout(const to_problem *p, hearth_lens_model model, const
     for (size_t i = (size_t)j; i < m; i += (size_t)folds) {
       hearth_rigid T;
       double r;
-      if ((st = hearth_calib_pose(&cam, p->obj, NP, f->pts + 2 * NP * i, &T, &r, err))) break;
+      hearth_err e2;
+      /* a frame the model cannot even place is predicted infinitely badly */
+      if (hearth_calib_pose(&cam, p->obj, NP, f->pts + 2 * NP * i, &T, &r, &e2)) r = INFINITY;
       sum += r * r * NP;
       count += NP;
     }
