@@ -341,6 +341,24 @@ static void test_frame_formats(void) {
   CHECK_OK(hearth_frame_read(p, &f, &k, &err), &err);
   CHECK(k == HEARTH_FRAME_PNG16 && f.data && ((float *)f.data)[5] == 5 * 977);
   hearth_image_free(&f);
+  /* hand-made TIFFs of the fuzz corpus: big-endian min-is-white reads as
+   * displayed (255 - stored), RGB as the mean of its channels */
+  const char *src = getenv("HEARTH_SOURCE_DIR");
+  if (src) {
+    snprintf(p, sizeof p, "%s/fuzz/corpus/frame/be_miniswhite.tif", src);
+    CHECK_OK(hearth_frame_read(p, &f, &k, &err), &err);
+    CHECK(f.width == 4 && f.height == 3 && k == HEARTH_FRAME_TIFF8);
+    for (size_t i = 0; f.data && i < 12; i++) CHECK(((float *)f.data)[i] == 255.0f - (float)i);
+    hearth_image_free(&f);
+    snprintf(p, sizeof p, "%s/fuzz/corpus/frame/rgb8.tif", src);
+    CHECK_OK(hearth_frame_read(p, &f, &k, &err), &err);
+    CHECK(f.width == 2 && f.height == 2 && f.data && ((float *)f.data)[0] == 20.0f &&
+          ((float *)f.data)[3] == 110.0f);
+    hearth_image_free(&f);
+    snprintf(p, sizeof p, "%s/fuzz/corpus/frame/truncated.tif", src);
+    CHECK(hearth_frame_read(p, &f, &k, &err) != HEARTH_OK && !f.data);
+    CHECK_MSG(strstr(err.msg, "truncated.tif"), "%s", err.msg);
+  }
   /* not an image, not a matrix: the CSV reader's place */
   const char bad[] = "1,2,3\n4,x,6\n";
   CHECK(hearth_frame_read_mem(bad, sizeof bad - 1, "bad.dat", &f, NULL, &err) != HEARTH_OK);
@@ -370,6 +388,23 @@ static void test_rig_doc(void) {
   char *text = test_slurp(p, NULL);
   CHECK(text && !strstr(text, "T_thermal_from_rgb") && !strstr(text, "\"rgb\""));
   free(text);
+  /* 6 coefficients, or the rational model for the colour camera: refused
+   * with the place */
+  static const struct {
+    const char *text, *want;
+  } bad[] = {
+      {"{\"thermal\": {\"width\": 256, \"height\": 192, \"K\": [[200,0,128],[0,200,96],[0,0,1]], "
+       "\"dist\": [0,0,0,0,0,0]}, \"thermal_rms_px\": 0.1}",
+       "thermal.dist"},
+      {"{\"thermal\": {\"width\": 256, \"height\": 192, \"K\": [[200,0,128],[0,200,96],[0,0,1]], "
+       "\"dist\": [0,0,0,0,0]}, \"thermal_rms_px\": 0.1, \"stereo_rms_px\": 0.1}",
+       "rgb"},
+  };
+  for (int i = 0; i < 2; i++) {
+    hearth_rig r2;
+    CHECK(hearth_rig_parse(bad[i].text, strlen(bad[i].text), "bad.json", &r2, &err) != HEARTH_OK);
+    CHECK_MSG(strstr(err.msg, "bad.json") && strstr(err.msg, bad[i].want), "%s", err.msg);
+  }
   CHECK(hearth_rig_require_stereo(&back, p, "mapping", &err) == HEARTH_E_UNSUPPORTED);
   CHECK_MSG(strstr(err.msg, p) && strstr(err.msg, "T_thermal_from_rgb") && strstr(err.msg, "mapping"),
             "%s", err.msg);
