@@ -410,6 +410,29 @@ static void test_rig_doc(void) {
             "%s", err.msg);
 }
 
+/* a release whose rig.json is thermal-only: the stages that need the
+ * stereo calibration stop with the reason, naming rig.json */
+static void test_pipeline_refuses(const char *thermal_root) {
+  char rel[1100], args[2400], e[4096];
+  snprintf(rel, sizeof rel, "%s/release", g_dir);
+  snprintf(args, sizeof args,
+           "synth --out '%s' --views 1 --triangles 200 --texture 16 --map-res 8 "
+           "--no-calibration --draft-rgb --quiet",
+           rel);
+  CHECK_MSG(run_tool(args, e, sizeof e) == 0, "%s", e);
+  snprintf(args, sizeof args, "cp '%s/calibration/rig.json' '%s/calibration/rig.json'",
+           thermal_root, rel);
+  CHECK(system(args) == 0);
+  static const char *const stages[] = {"transfer", "map", "refine"};
+  for (int i = 0; i < 3; i++) {
+    snprintf(args, sizeof args, "%s '%s'", stages[i], rel);
+    int rc = run_tool(args, e, sizeof e);
+    CHECK_MSG(rc != 0 && strstr(e, "rig.json: a thermal-only rig") &&
+                  strstr(e, "T_thermal_from_rgb"),
+              "%s: rc %d: %s", stages[i], rc, e);
+  }
+}
+
 int main(void) {
   snprintf(g_dir, sizeof g_dir, "%s", test_tmpdir("calib_thermal_only"));
   test_frame_formats();
@@ -417,6 +440,9 @@ int main(void) {
   test_bad_input();
   test_normal_lens();
   test_wide_lens();
+  char wide[1100];
+  snprintf(wide, sizeof wide, "%s/wide", g_dir);
+  test_pipeline_refuses(wide);
   if (g_test_failures) fprintf(stderr, "%d failures\n", g_test_failures);
   return g_test_failures ? 1 : 0;
 }
