@@ -108,6 +108,12 @@ static hearth_status list_files(const char *dir, to_file **files, size_t *n, hea
   return HEARTH_OK;
 }
 
+static const to_file *find_file(const to_file *files, size_t nf, const char *frame) {
+  for (size_t k = 0; k < nf; k++)
+    if (!strcmp(files[k].frame, frame)) return &files[k];
+  return NULL;
+}
+
 /* ---- detect -------------------------------------------------------------------------- */
 typedef struct to_job {
   char path[4096];
@@ -400,9 +406,8 @@ static hearth_status write_report(const char *path, const hearth_calib_report *r
   fputs("{\n  \"thermal_only\": true,\n  \"thermal_frames\": [", fp);
   for (size_t i = 0; i < r->n_thermal; i++) {
     const hearth_calib_frame_report *f = &r->thermal[i];
-    const char *file = "";
-    for (size_t k = 0; k < n_files; k++)
-      if (!strcmp(files[k].frame, f->frame)) file = files[k].file;
+    const to_file *tf = find_file(files, n_files, f->frame);
+    const char *file = tf ? tf->file : "";
     fprintf(fp, "%s\n    {\"frame\": \"%s\", \"file\": \"", i ? "," : "", f->frame);
     for (const char *c = file; *c; c++) {
       if (*c == '"' || *c == '\\') fputc('\\', fp);
@@ -459,18 +464,19 @@ static hearth_status write_yaml(const char *path, const hearth_camera *c, double
 }
 
 /* ---- calibrate --------------------------------------------------------------------- */
-/* the frames' size, from every found frame (all must agree) */
+/* the frames' size, from every found frame (all must agree); with stereo
+ * captures beside (a full root), thermal detections without a file in
+ * captures/thermal are the stereo pairs' halves and not used */
 static hearth_status frames_size(const char *dir, const hearth_detections *dets,
-                                 const to_file *files, size_t nf, int *w, int *h,
+                                 const to_file *files, size_t nf, int stereo, int *w, int *h,
                                  hearth_err *err) {
   char path[4096], first[4096] = "";
   *w = *h = 0;
   for (size_t i = 0; i < dets->n; i++) {
     const hearth_detection *d = &dets->frames[i];
     if (!d->found || strcmp(d->camera, "thermal")) continue;
-    const to_file *f = NULL;
-    for (size_t k = 0; k < nf && !f; k++)
-      if (!strcmp(files[k].frame, d->frame)) f = &files[k];
+    const to_file *f = find_file(files, nf, d->frame);
+    if (!f && stereo) continue;
     if (!f)
       return hearth_err_set(err, HEARTH_E_NOT_FOUND,
                             "%s: no file for frame \"%s\" of detections.json (run `hearth "
@@ -532,8 +538,10 @@ hearth_status hearth_calib_thermal_only_release(const char *root, const hearth_c
     return hearth_err_set(err, HEARTH_E_NOT_FOUND, "%s: missing (run `hearth detect` first)", pdet);
   if ((st = hearth_detections_read(pdet, &dets, err))) return st;
   int width, height;
+  snprintf(path, sizeof path, "%s/calibration/captures/stereo", root);
+  int stereo = hearth_path_exists(path);
   if ((st = list_files(dir, &files, &nf, err)) ||
-      (st = frames_size(dir, &dets, files, nf, &width, &height, err)))
+      (st = frames_size(dir, &dets, files, nf, stereo, &width, &height, err)))
     goto done;
   size_t n = dets.n;
   img = hearth_alloc_array(n * NP * 2 + 1, sizeof(double));
@@ -546,7 +554,7 @@ hearth_status hearth_calib_thermal_only_release(const char *root, const hearth_c
   size_t nt = 0;
   for (size_t i = 0; i < n; i++) {
     const hearth_detection *d = &dets.frames[i];
-    if (strcmp(d->camera, "thermal")) continue;
+    if (strcmp(d->camera, "thermal") || (stereo && !find_file(files, nf, d->frame))) continue;
     hearth_calib_frame_report *fr = &rep->thermal[rep->n_thermal++];
     snprintf(fr->frame, sizeof fr->frame, "%s", d->frame);
     fr->rms_px = NAN;
