@@ -238,6 +238,21 @@ static void test_wide_lens(void) {
   json_decref(r);
   check_camera(root, 1.0, 1.0, 0.2);
   cv_check(root, HEARTH_LENS_RATIONAL8);
+  /* --lens forces a model, and says so */
+  snprintf(args, sizeof args, "calibrate --thermal-only --lens brown5 '%s'", root);
+  CHECK_MSG(run_tool(args, e, sizeof e) == 0, "%s", e);
+  r = load_report(root);
+  json_t *lc = json_object_get(r, "lens_choice");
+  CHECK(!strcmp(json_string_value(json_object_get(r, "lens_model")), "brown5") &&
+        json_is_true(json_object_get(lc, "forced")));
+  json_decref(r);
+  hearth_rig rig;
+  hearth_err err = {0};
+  snprintf(args, sizeof args, "%s/calibration/rig.json", root);
+  CHECK_OK(hearth_rig_read(args, &rig, &err), &err);
+  CHECK(rig.thermal.model == HEARTH_LENS_BROWN5);
+  snprintf(args, sizeof args, "calibrate --lens rational8 '%s'", root);
+  CHECK(run_tool(args, e, sizeof e) == 2 && strstr(e, "--thermal-only"));
 }
 
 /* ---- bad input ------------------------------------------------------------------------- */
