@@ -198,8 +198,8 @@ hearth_status calib_detect_thermal_only(const char *root, const hearth_detect_jo
       st = hearth_err_set(err, HEARTH_E_INCONSISTENT,
                           "%s: %zux%zu, but %s (the first frame) is %zux%zu: one camera's frames "
                           "have one size",
-                          jobs[i].path, jobs[i].width, jobs[i].height, jobs[0].path,
-                          jobs[0].width, jobs[0].height);
+                          jobs[i].path, jobs[i].width, jobs[i].height, jobs[0].path, jobs[0].width,
+                          jobs[0].height);
       goto done;
     }
   if (run->overlays) {
@@ -271,8 +271,8 @@ static hearth_status solve(const to_problem *p, hearth_lens_model model, const d
                            hearth_rigid *poses, hearth_err *err) {
   hearth_calib_opts o = *p->o;
   o.lens_model = model;
-  return hearth_calib_intrinsics(p->obj, NP, pts, m, p->width, p->height, &o, cam, rms, frms,
-                                 poses, err);
+  return hearth_calib_intrinsics(p->obj, NP, pts, m, p->width, p->height, &o, cam, rms, frms, poses,
+                                 err);
 }
 
 /* outlier rounds (frames far above the median residual dropped, the solve

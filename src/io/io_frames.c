@@ -20,8 +20,8 @@ const char *hearth_frame_kind_name(hearth_frame_kind k) {
 /* ---- images to one plane ------------------------------------------------------ */
 /* U8/U16 image (1..4 channels) -> F32 plane: grey as stored, colour as the
  * mean of R, G and B (a grey palette saved as RGB), alpha ignored */
-static hearth_status plane_from_image(const hearth_image *img, const char *name,
-                                      hearth_image *out, hearth_err *err) {
+static hearth_status plane_from_image(const hearth_image *img, const char *name, hearth_image *out,
+                                      hearth_err *err) {
   hearth_status st = hearth_image_alloc(out, img->width, img->height, 1, HEARTH_PIX_F32, err);
   if (st) return st;
   size_t n = img->width * img->height, ch = (size_t)img->channels;
@@ -328,8 +328,9 @@ hearth_status hearth_tiff_write(const char *path, const hearth_image *img,
   if (ok) ok = TIFFWriteDirectory(t);
   TIFFClose(t);
   hearth_status st;
-  if (!ok || m.failed) st = hearth_err_set(err, HEARTH_E_IO, "%s: TIFF encoding failed: %s", path,
-                                           m.failed ? "out of memory" : m.msg);
+  if (!ok || m.failed)
+    st = hearth_err_set(err, HEARTH_E_IO, "%s: TIFF encoding failed: %s", path,
+                        m.failed ? "out of memory" : m.msg);
   else st = hearth_write_file_atomic(path, m.data, m.size, err);
   free(m.data);
   return st;

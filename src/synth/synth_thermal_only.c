@@ -39,9 +39,9 @@ typedef enum fmt_kind {
 } fmt_kind;
 static const struct {
   const char *name, *ext;
-} k_fmt[] = {{"csv", "csv"},        {"png8", "png"},          {"png8-dark", "png"},
-             {"png16", "png"},      {"png-rgb", "png"},       {"tiff8", "tif"},
-             {"tiff16", "tiff"},    {"tiff-lzw", "tiff"},     {"tiff-deflate", "tif"},
+} k_fmt[] = {{"csv", "csv"},          {"png8", "png"},      {"png8-dark", "png"},
+             {"png16", "png"},        {"png-rgb", "png"},   {"tiff8", "tif"},
+             {"tiff16", "tiff"},      {"tiff-lzw", "tiff"}, {"tiff-deflate", "tif"},
              {"tiff-packbits", "tif"}};
 #define N_FMT (sizeof k_fmt / sizeof k_fmt[0])
 
@@ -53,8 +53,7 @@ static hearth_status parse_formats(const char *s, int *out, size_t *n, hearth_er
     size_t k = 0;
     while (k < N_FMT && (strlen(k_fmt[k].name) != len || strncmp(k_fmt[k].name, s, len))) k++;
     if (k == N_FMT || *n >= 64)
-      return hearth_err_set(err, HEARTH_E_ARG, "synth: unknown frame format \"%.*s\"", (int)len,
-                            s);
+      return hearth_err_set(err, HEARTH_E_ARG, "synth: unknown frame format \"%.*s\"", (int)len, s);
     out[(*n)++] = (int)k;
     s = e ? e + 1 : NULL;
   }
@@ -130,8 +129,8 @@ static hearth_status write_frame(const char *path, const hearth_image *T, fmt_ki
   return st;
 }
 
-static hearth_status build(const hearth_synth_thermal_opts *o, const char *root,
-                           const int *fmts, size_t nfmt, hearth_err *err) {
+static hearth_status build(const hearth_synth_thermal_opts *o, const char *root, const int *fmts,
+                           size_t nfmt, hearth_err *err) {
   char dir[4096], gt[4096], path[4096];
   snprintf(dir, sizeof dir, "%s/calibration/captures/thermal", root);
   snprintf(gt, sizeof gt, "%s/ground_truth/calibration", root);
@@ -200,8 +199,8 @@ static hearth_status build(const hearth_synth_thermal_opts *o, const char *root,
 
 hearth_status hearth_synth_thermal_only(const hearth_synth_thermal_opts *o, hearth_err *err) {
   if (!o || !o->out_root) return hearth_err_set(err, HEARTH_E_ARG, "synth: no output root");
-  if (o->n_frames < 1 || o->n_frames > 1000 || o->width < 32 || o->height < 32 ||
-      o->width > 4096 || o->height > 4096)
+  if (o->n_frames < 1 || o->n_frames > 1000 || o->width < 32 || o->height < 32 || o->width > 4096 ||
+      o->height > 4096)
     return hearth_err_set(err, HEARTH_E_ARG, "synth: %d frames of %dx%d (1..1000, 32..4096)",
                           o->n_frames, o->width, o->height);
   int fmts[64];

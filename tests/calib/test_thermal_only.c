@@ -112,8 +112,8 @@ static void check_camera(const char *root, double tol_f, double tol_c, double to
   CHECK_OK(hearth_rig_read(p, &truth, &err), &err);
   CHECK(rig.thermal_only && truth.thermal_only);
   const hearth_camera *c = &rig.thermal, *g = &truth.thermal;
-  fprintf(stderr, "  fx %.4f (%.4f) fy %.4f (%.4f) cx %.4f (%.4f) cy %.4f (%.4f)\n", c->fx,
-          g->fx, c->fy, g->fy, c->cx, g->cx, c->cy, g->cy);
+  fprintf(stderr, "  fx %.4f (%.4f) fy %.4f (%.4f) cx %.4f (%.4f) cy %.4f (%.4f)\n", c->fx, g->fx,
+          c->fy, g->fy, c->cx, g->cx, c->cy, g->cy);
   CHECK(c->width == g->width && c->height == g->height);
   CHECK_NEAR(c->fx, g->fx, tol_f);
   CHECK_NEAR(c->fy, g->fy, tol_f);
@@ -200,8 +200,8 @@ static void cv_check(const char *root, hearth_lens_model model) {
 static void test_normal_lens(void) {
   char root[1100], e[4096], args[2400];
   make_root("normal", 0, 15,
-            "csv,png8,png16,tiff8,tiff16,png8-dark,tiff-lzw,png-rgb,tiff-deflate,tiff-packbits",
-            3, root, sizeof root);
+            "csv,png8,png16,tiff8,tiff16,png8-dark,tiff-lzw,png-rgb,tiff-deflate,tiff-packbits", 3,
+            root, sizeof root);
   snprintf(args, sizeof args, "detect --no-overlays '%s'", root);
   CHECK_MSG(run_tool(args, e, sizeof e) == 0, "%s", e);
   check_detections(root, 0.15);
@@ -267,8 +267,8 @@ static void expect_fail(const char *root, const char *needle, int calibrate_only
   }
   snprintf(args, sizeof args, "calibrate --detect --no-overlays --thermal-only '%s'", root);
   int rc = run_tool(args, e, sizeof e);
-  CHECK_MSG(rc != 0 && strstr(e, needle), "calibrate %s: rc %d, stderr: %s (want %s)", root, rc,
-            e, needle);
+  CHECK_MSG(rc != 0 && strstr(e, needle), "calibrate %s: rc %d, stderr: %s (want %s)", root, rc, e,
+            needle);
   CHECK(!file_exists(root, "calibration/rig.json"));
   CHECK(!file_exists(root, "calibration/rig_opencv.yaml"));
 }
@@ -421,7 +421,8 @@ static void test_rig_doc(void) {
     CHECK_MSG(strstr(err.msg, "bad.json") && strstr(err.msg, bad[i].want), "%s", err.msg);
   }
   CHECK(hearth_rig_require_stereo(&back, p, "mapping", &err) == HEARTH_E_UNSUPPORTED);
-  CHECK_MSG(strstr(err.msg, p) && strstr(err.msg, "T_thermal_from_rgb") && strstr(err.msg, "mapping"),
+  CHECK_MSG(strstr(err.msg, p) && strstr(err.msg, "T_thermal_from_rgb") &&
+                strstr(err.msg, "mapping"),
             "%s", err.msg);
 }
 
