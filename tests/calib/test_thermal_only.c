@@ -20,10 +20,14 @@
 
 static char g_dir[1024];
 
+static int g_width = 256, g_height = 192; /* the next root's frame size */
+
 static void make_root(const char *name, int wide, int n, const char *formats, uint64_t seed,
                       char *root, size_t rs) {
   hearth_synth_thermal_opts o;
   hearth_synth_thermal_opts_default(&o);
+  o.width = g_width;
+  o.height = g_height;
   snprintf(root, rs, "%s/%s", g_dir, name);
   o.out_root = root;
   o.seed = seed;
@@ -255,6 +259,20 @@ static void test_wide_lens(void) {
   CHECK(run_tool(args, e, sizeof e) == 2 && strstr(e, "--thermal-only"));
 }
 
+/* another sensor size: the size comes from the frames */
+static void test_other_size(void) {
+  char root[1100], e[4096], args[2400];
+  g_width = 384;
+  g_height = 288;
+  make_root("size384", 0, 10, "png16,csv,tiff8", 4, root, sizeof root);
+  g_width = 256;
+  g_height = 192;
+  snprintf(args, sizeof args, "calibrate --detect --no-overlays --thermal-only '%s'", root);
+  CHECK_MSG(run_tool(args, e, sizeof e) == 0, "%s", e);
+  check_detections(root, 0.15);
+  check_camera(root, 0.5, 0.5, 0.15);
+}
+
 /* ---- bad input ------------------------------------------------------------------------- */
 /* detect (and calibrate) must fail, naming `needle`, and leave no rig.json */
 static void expect_fail(const char *root, const char *needle, int calibrate_only) {
@@ -456,6 +474,7 @@ int main(void) {
   test_bad_input();
   test_normal_lens();
   test_wide_lens();
+  test_other_size();
   char wide[1100];
   snprintf(wide, sizeof wide, "%s/wide", g_dir);
   test_pipeline_refuses(wide);
