@@ -61,6 +61,10 @@ typedef struct hearth_calib_opts {
    * the estimated poses, and re-solve; default 1 */
   int perspective_correction;
   double hole_radius_m; /* default 0.004 */
+  /* hearth_calib_intrinsics: the lens model solved for; default
+   * HEARTH_LENS_BROWN5 (the rational model starts from the 5-parameter
+   * solution) */
+  hearth_lens_model lens_model;
 } hearth_calib_opts;
 void hearth_calib_opts_default(hearth_calib_opts *o);
 
@@ -120,12 +124,35 @@ typedef struct hearth_calib_frame_report {
   char note[96];
 } hearth_calib_frame_report;
 
+/* The thermal-only calibration's lens models, compared on held-out frames:
+ * frames are dealt round-robin into `folds` folds; each fold's frames are
+ * predicted (pose fitted, intrinsics and distortion fixed) by a calibration
+ * on the other folds. The rational model is chosen only when its held-out
+ * RMS is at least HEARTH_LENS_MARGIN_REL below the 5-parameter model's and
+ * lower by HEARTH_LENS_MARGIN_PX or more. */
+#define HEARTH_LENS_MARGIN_REL 0.10
+#define HEARTH_LENS_MARGIN_PX 0.005
+#define HEARTH_LENS_MIN_FRAMES 6 /* fewer used frames: no comparison, 5-parameter */
+typedef struct hearth_lens_fit {
+  hearth_camera cam;     /* the fit on every used frame */
+  double train_rms_px;   /* its RMS over those frames */
+  double heldout_rms_px; /* RMS of the held-out predictions; NAN if not compared */
+} hearth_lens_fit;
+typedef struct hearth_lens_choice {
+  hearth_lens_fit fit[2];   /* indexed by hearth_lens_model */
+  hearth_lens_model chosen; /* the model written to rig.json */
+  int folds;                /* 0: not compared */
+  int forced;               /* chosen by the caller, not by the rule */
+  char reason[200];
+} hearth_lens_choice;
+
 typedef struct hearth_calib_report {
   size_t n_thermal, n_pairs;
   hearth_calib_frame_report *thermal; /* owned */
   hearth_calib_frame_report *pairs;   /* owned */
   hearth_rig rig;
   double t_calib_s; /* seconds spent reading, solving (not writing) */
+  hearth_lens_choice lens; /* thermal-only calibration only */
 } hearth_calib_report;
 /* Frees the frame lists and zeroes r; accepts a zeroed report. */
 void hearth_calib_report_free(hearth_calib_report *r);
@@ -137,6 +164,21 @@ void hearth_calib_report_free(hearth_calib_report *r);
  * hearth_calib_report_free. */
 hearth_status hearth_calib_calibrate_release(const char *root, const hearth_calib_opts *o,
                                              hearth_calib_report *rep, hearth_err *err);
+
+/* Thermal-only calibration of a root holding calibration/captures/thermal
+ * (frames of any name: CSV, PNG or TIFF, see hearth_frame_read) and
+ * calibration/detections.json from `detect` (which finds such a root by
+ * the absence of captures/stereo). Every found frame is re-read for its
+ * size (all must agree). Fits both lens models with outlier rejection and
+ * perspective correction, compares them on held-out frames
+ * (hearth_lens_choice), and writes a thermal-only calibration/rig.json,
+ * calibration/rig_opencv.yaml (OpenCV's camera_matrix and
+ * distortion_coefficients, 1x5 or 1x8) and calibration_report.json; no
+ * output is written unless all inputs are good. force_model: -1 = choose
+ * by the rule, else that hearth_lens_model. */
+hearth_status hearth_calib_thermal_only_release(const char *root, const hearth_calib_opts *o,
+                                                int force_model, hearth_calib_report *rep,
+                                                hearth_err *err);
 
 /* An OpenCV FileStorage YAML of the rig (cv2.FileStorage reads it). */
 hearth_status hearth_calib_write_opencv_yaml(const char *path, const hearth_rig *rig,

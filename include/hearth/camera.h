@@ -1,6 +1,7 @@
 /* hearth/camera.h - area core (src/core/core_camera.c): the pinhole camera
- * with 5-parameter Brown-Conrady distortion, in OpenCV's conventions. A
- * camera is a plain value; nothing here allocates.
+ * with 5-parameter Brown-Conrady distortion or OpenCV's 8-parameter
+ * rational model, in OpenCV's conventions. A camera is a plain value;
+ * nothing here allocates.
  *
  * Camera axes: +x right, +y down, +z forward. Pixel (0,0) is the centre of
  * the top-left pixel. Distortion order [k1, k2, p1, p2, k3]:
@@ -9,6 +10,9 @@
  *   xd = x radial + 2 p1 x y + p2 (r2 + 2 x^2)
  *   yd = y radial + p1 (r2 + 2 y^2) + 2 p2 x y
  *   u = fx xd + cx,  v = fy yd + cy
+ * The rational model (HEARTH_LENS_RATIONAL8, OpenCV's CALIB_RATIONAL_MODEL)
+ * has order [k1, k2, p1, p2, k3, k4, k5, k6] and divides the radial term:
+ *   radial = (1 + k1 r2 + k2 r2^2 + k3 r2^3) / (1 + k4 r2 + k5 r2^2 + k6 r2^3)
  * See docs/conventions.md. */
 #ifndef HEARTH_CAMERA_H
 #define HEARTH_CAMERA_H
@@ -20,10 +24,22 @@
 extern "C" {
 #endif
 
+/* Lens models; a zeroed camera is HEARTH_LENS_BROWN5. */
+typedef enum hearth_lens_model {
+  HEARTH_LENS_BROWN5 = 0,   /* k1 k2 p1 p2 k3 (dist[5..7] unused, kept 0) */
+  HEARTH_LENS_RATIONAL8 = 1 /* k1 k2 p1 p2 k3 k4 k5 k6 */
+} hearth_lens_model;
+/* Number of coefficients of a model (5 or 8), its stable name ("brown5",
+ * "rational8") and the model of a name (-1 if unknown). */
+int hearth_lens_n_coeffs(hearth_lens_model m);
+const char *hearth_lens_name(hearth_lens_model m);
+int hearth_lens_from_name(const char *name);
+
 typedef struct hearth_camera {
-  int width, height;     /* pixels */
-  double fx, fy, cx, cy; /* pixels */
-  double dist[5];        /* k1 k2 p1 p2 k3 */
+  int width, height;       /* pixels */
+  double fx, fy, cx, cy;   /* pixels */
+  double dist[8];          /* k1 k2 p1 p2 k3 [k4 k5 k6] */
+  hearth_lens_model model; /* which of dist is used */
 } hearth_camera;
 
 /* Jacobians filled by hearth_camera_project when the pointers are non-NULL
@@ -32,6 +48,7 @@ typedef struct hearth_project_jac {
   double d_point[6]; /* d(u,v) / d(X,Y,Z) in the camera frame */
   double d_intr[8];  /* d(u,v) / d(fx, fy, cx, cy) */
   double d_dist[10]; /* d(u,v) / d(k1, k2, p1, p2, k3) */
+  double d_rat[6];   /* d(u,v) / d(k4, k5, k6); rational model only */
 } hearth_project_jac;
 
 /* The distortion polynomial above, (x, y) -> (xd, yd), inline for loops
@@ -58,6 +75,9 @@ static inline void hearth_distort_xyf(const float dist[5], float x, float y, flo
 /* Distort normalised coordinates (x, y) -> (xd, yd), optionally with the
  * 2x2 Jacobian d(xd,yd)/d(x,y) (row-major). */
 void hearth_distort(const double dist[5], double x, double y, double *xd, double *yd, double J[4]);
+/* The same for the camera's own model (5-parameter: hearth_distort). */
+void hearth_camera_distort(const hearth_camera *cam, double x, double y, double *xd, double *yd,
+                           double J[4]);
 
 /* Project a point in the camera frame to pixels. Returns 0 if Z <= 0
  * (u, v untouched), 1 otherwise. */

@@ -31,17 +31,25 @@ extern "C" {
 /* ---- rig.json ------------------------------------------------------------ */
 /* The calibrated rig: the three cameras, the thermal and depth cameras'
  * transforms from the colour camera, and the calibration's RMS errors
- * (pixels). */
+ * (pixels). A thermal-only rig (thermal_only = 1, from `hearth calibrate
+ * --thermal-only`) has only the thermal camera (5- or 8-coefficient lens)
+ * and thermal_rms_px; its other fields are zero. */
 typedef struct hearth_rig {
   hearth_camera rgb, thermal, depth;
   hearth_rigid T_thermal_from_rgb;
   hearth_rigid T_depth_from_rgb;
   double thermal_rms_px, stereo_rms_px;
+  int thermal_only;
 } hearth_rig;
 hearth_status hearth_rig_read(const char *path, hearth_rig *rig, hearth_err *err);
 hearth_status hearth_rig_parse(const char *text, size_t len, const char *name, hearth_rig *rig,
                                hearth_err *err);
 hearth_status hearth_rig_write(const char *path, const hearth_rig *rig, hearth_err *err);
+/* HEARTH_OK for a rig with the stereo calibration; for a thermal-only rig
+ * an error (HEARTH_E_UNSUPPORTED) naming path and saying that `stage`
+ * needs T_thermal_from_rgb. */
+hearth_status hearth_rig_require_stereo(const hearth_rig *rig, const char *path,
+                                        const char *stage, hearth_err *err);
 
 /* ---- depth/vNN.json: per-frame depth intrinsics ------------------------- */
 typedef struct hearth_depth_intrinsics {

@@ -13,6 +13,7 @@
 #include <stddef.h>
 #include <stdint.h>
 #include "hearth/core.h"
+#include "hearth/camera.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -56,6 +57,33 @@ void hearth_synth_opts_default(hearth_synth_opts *o);
 /* Write a complete release tree (atomically: built under a temporary name
  * beside out_root, renamed at the end; removed on failure). */
 hearth_status hearth_synth_release(const hearth_synth_opts *o, hearth_err *err);
+
+/* A thermal-only calibration root (docs/dataset.md, "Thermal-only
+ * calibration"): out_root/calibration/captures/thermal/IR_NNNN.<ext> and
+ * ground_truth/rig.json (thermal-only, the true camera) and
+ * ground_truth/calibration/detections.json (true centres). Written under a
+ * temporary name and renamed; out_root must not exist. */
+typedef struct hearth_synth_thermal_opts {
+  uint64_t seed;        /* default 1 */
+  const char *out_root; /* borrowed */
+  int n_frames;         /* default 18 */
+  int width, height;    /* default 256 x 192 */
+  /* 0: the rig's drawn thermal lens (5-parameter); 1: a ~100 degree lens
+   * with strong barrel distortion in OpenCV's rational model */
+  int wide_angle;
+  /* frame formats, used in turn: csv (degC), png8 (tone-mapped over the
+   * frame's range), png8-dark (the same inverted: holes dark), png16 (raw
+   * centikelvin counts), png-rgb (8-bit grey as RGB), tiff8, tiff16,
+   * tiff-lzw (16-bit), tiff-deflate (8-bit), tiff-packbits (8-bit); comma
+   * separated; default "csv,png8,png16,tiff8,tiff16" */
+  const char *formats;
+  double netd_c; /* default 0.05 degC */
+  int threads;   /* 0 = hearth_default_threads() */
+} hearth_synth_thermal_opts;
+void hearth_synth_thermal_opts_default(hearth_synth_thermal_opts *o);
+hearth_status hearth_synth_thermal_only(const hearth_synth_thermal_opts *o, hearth_err *err);
+/* The true camera hearth_synth_thermal_only renders with. */
+void hearth_synth_thermal_camera(const hearth_synth_thermal_opts *o, hearth_camera *c);
 
 /* Names of the procedural categories available (static strings) into
  * names[0..max); returns how many there are (18), which may exceed max. */

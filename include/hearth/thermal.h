@@ -80,6 +80,42 @@ hearth_status hearth_thermal_read_csv_camera(const char *path, size_t width, siz
 hearth_status hearth_thermal_write_csv(const char *path, const hearth_image *temps, int decimals,
                                        hearth_err *err);
 
+/* ---- calibration frames of any camera (src/io/io_frames.c) ----------------- */
+/* A thermal calibration frame is a temperature CSV (any layout the CSV
+ * reader recognises, any consistent size) or, from cameras without a
+ * radiometric export, an 8-/16-bit PNG (grey, grey+alpha, RGB or RGBA) or
+ * TIFF (grey or RGB, 8/16-bit unsigned, strips, uncompressed or any
+ * compression libtiff decodes). The format is recognised from the first
+ * bytes, never the name. Images are not radiometric: their values are kept
+ * as stored (colour: the mean of R, G, B; TIFF min-is-white inverted to
+ * displayed brightness), so only their pattern means anything. */
+typedef enum hearth_frame_kind {
+  HEARTH_FRAME_CSV = 0,
+  HEARTH_FRAME_PNG8,
+  HEARTH_FRAME_PNG16,
+  HEARTH_FRAME_TIFF8,
+  HEARTH_FRAME_TIFF16
+} hearth_frame_kind;
+/* "csv", "png8", "png16", "tiff8", "tiff16"; never NULL. */
+const char *hearth_frame_kind_name(hearth_frame_kind k);
+/* Read a frame into a new 1-channel F32 image (degC for CSV, stored values
+ * for images); kind (may be NULL) says which format it was. Errors name
+ * the file and, for CSV, the line and column; for TIFF the row. */
+hearth_status hearth_frame_read(const char *path, hearth_image *out, hearth_frame_kind *kind,
+                                hearth_err *err);
+hearth_status hearth_frame_read_mem(const void *data, size_t size, const char *name,
+                                    hearth_image *out, hearth_frame_kind *kind, hearth_err *err);
+
+typedef enum hearth_tiff_compression {
+  HEARTH_TIFF_NONE = 0,
+  HEARTH_TIFF_LZW,
+  HEARTH_TIFF_DEFLATE,
+  HEARTH_TIFF_PACKBITS
+} hearth_tiff_compression;
+/* Write a 1-channel U8 or U16 image as a grey TIFF (atomically). */
+hearth_status hearth_tiff_write(const char *path, const hearth_image *img,
+                                hearth_tiff_compression comp, hearth_err *err);
+
 /* ---- what the reader recognised ------------------------------------------- */
 typedef enum hearth_csv_layout {
   HEARTH_CSV_PLAIN = 0, /* rows of values only */

@@ -4,6 +4,8 @@
 #define HEARTH_CALIB_INTERNAL_H
 
 #include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
 #include "hearth/calib.h"
 
 /* Solve A x = b for a symmetric positive definite n x n A (row-major, n <= 16)
@@ -46,5 +48,20 @@ int calib_project_pose(const hearth_camera *cam, const double R[9], const double
  * centre, for circles of `radius` (metres) around obj on the plate plane. */
 void calib_circle_bias(const hearth_camera *cam, const hearth_rigid *T, const double (*obj)[3],
                        size_t n, double radius, double *bias);
+
+/* ---- shared by the release stages (calib_release.c) and the thermal-only
+ * calibration (calib_thermal_only.c) ---- */
+/* The overlay of a detection (as `detect` draws it), PNG-encoded into *png
+ * (malloc'ed, the caller frees). */
+hearth_status calib_overlay_encode(const hearth_image *img, int thermal,
+                                   const hearth_detection *det, uint8_t **png, size_t *size,
+                                   hearth_err *err);
+/* OpenCV FileStorage YAML pieces: a number (locale-free, 16 digits) and a
+ * !!opencv-matrix of doubles. */
+void calib_yaml_num(FILE *fp, double x);
+void calib_yaml_mat(FILE *fp, const char *name, int rows, int cols, const double *v);
+/* `detect` on a root without calibration/captures/stereo. */
+hearth_status calib_detect_thermal_only(const char *root, const hearth_detect_job *run,
+                                        hearth_detections *out, hearth_err *err);
 
 #endif

@@ -1,7 +1,8 @@
 /* Levenberg-Marquardt for single-camera calibration: intrinsics (fx, fy,
- * cx, cy), 5-parameter distortion and one pose per frame, solved through the
- * Schur complement of the per-frame pose blocks (9 x 9 reduced system), and
- * the 6-parameter pose of a plate seen by a calibrated camera. */
+ * cx, cy), 5- or 8-parameter distortion and one pose per frame, solved
+ * through the Schur complement of the per-frame pose blocks (9 x 9 or
+ * 12 x 12 reduced system), and the 6-parameter pose of a plate seen by a
+ * calibrated camera. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -16,15 +17,16 @@ void hearth_calib_opts_default(hearth_calib_opts *o) {
   o->hole_radius_m = 0.004;
 }
 
-#define NI 9 /* fx fy cx cy k1 k2 p1 p2 k3 */
+#define NI_MAX 12 /* fx fy cx cy k1 k2 p1 p2 k3 [k4 k5 k6] */
 
+/* base carries the size and the lens model (how many of q are distortion) */
 static void cam_from_params(const hearth_camera *base, const double *q, hearth_camera *c) {
   *c = *base;
   c->fx = q[0];
   c->fy = q[1];
   c->cx = q[2];
   c->cy = q[3];
-  for (int k = 0; k < 5; k++) c->dist[k] = q[4 + k];
+  for (int k = 0; k < hearth_lens_n_coeffs(base->model); k++) c->dist[k] = q[4 + k];
 }
 
 /* sum of squared residuals; per-frame sums into fsum if non-NULL; returns
@@ -51,17 +53,19 @@ static double intr_cost(const hearth_camera *cam, const double (*obj)[3], size_t
 }
 
 /* accumulate the normal equations: U (NI x NI), V (6x6 per frame),
- * W (NI x 6 per frame), gi (NI), gf (6 per frame); g = -J^T r */
+ * W (NI x 6 per frame), gi (NI), gf (6 per frame); g = -J^T r; NI = 4 +
+ * the model's coefficients */
 static int intr_normal(const hearth_camera *cam, const double (*obj)[3], size_t n_pts,
                        const double *img, size_t n_frames, const double *poses, double *U,
                        double *V, double *W, double *gi, double *gf) {
+  const int NI = 4 + hearth_lens_n_coeffs(cam->model);
   memset(U, 0, sizeof(double) * NI * NI);
   memset(gi, 0, sizeof(double) * NI);
   for (size_t f = 0; f < n_frames; f++) {
     double R[9], dR[27];
     const double *p = poses + 6 * f;
     hearth_rotvec_to_matrix_jac(p, R, dR);
-    double *Vf = V + 36 * f, *Wf = W + NI * 6 * f, *g = gf + 6 * f;
+    double *Vf = V + 36 * f, *Wf = W + NI_MAX * 6 * f, *g = gf + 6 * f;
     memset(Vf, 0, sizeof(double) * 36);
     memset(Wf, 0, sizeof(double) * NI * 6);
     memset(g, 0, sizeof(double) * 6);
@@ -72,12 +76,13 @@ static int intr_normal(const hearth_camera *cam, const double (*obj)[3], size_t 
       const double *m = img + 2 * (f * n_pts + j);
       double r[2] = {uv[0] - m[0], uv[1] - m[1]};
       for (int row = 0; row < 2; row++) {
-        double ji[NI];
+        double ji[NI_MAX];
         ji[0] = jac.d_intr[4 * row + 0];
         ji[1] = jac.d_intr[4 * row + 1];
         ji[2] = jac.d_intr[4 * row + 2];
         ji[3] = jac.d_intr[4 * row + 3];
         for (int k = 0; k < 5; k++) ji[4 + k] = jac.d_dist[5 * row + k];
+        for (int k = 9; k < NI; k++) ji[k] = jac.d_rat[3 * row + k - 9];
         const double *jp = dp + 6 * row;
         for (int a = 0; a < NI; a++) {
           for (int b = a; b < NI; b++) U[a * NI + b] += ji[a] * ji[b];
@@ -125,7 +130,7 @@ hearth_status hearth_calib_intrinsics(const double (*obj)[3], size_t n_pts, cons
   double *trial = hearth_alloc_array(6 * n_frames, sizeof(double));
   double *V = hearth_alloc_array(36 * n_frames, sizeof(double));
   double *Vi = hearth_alloc_array(36 * n_frames, sizeof(double));
-  double *W = hearth_alloc_array(NI * 6 * n_frames, sizeof(double));
+  double *W = hearth_alloc_array(NI_MAX * 6 * n_frames, sizeof(double));
   double *gf = hearth_alloc_array(6 * n_frames, sizeof(double));
   double *fsum = hearth_alloc_array(n_frames, sizeof(double));
   double *plane = hearth_alloc_array(2 * n_pts, sizeof(double));
@@ -162,11 +167,35 @@ hearth_status hearth_calib_intrinsics(const double (*obj)[3], size_t n_pts, cons
     }
     calib_params_from_rigid(&T, poses + 6 * f);
   }
-  double q[NI] = {fx, fy, cx, cy, 0, 0, 0, 0, 0};
+  double q[NI_MAX] = {fx, fy, cx, cy, 0, 0, 0, 0, 0, 0, 0, 0};
   hearth_camera base;
   memset(&base, 0, sizeof base);
   base.width = width;
   base.height = height;
+  const int NI = o->lens_model == HEARTH_LENS_RATIONAL8 ? 12 : 9;
+  if (NI == 12) {
+    /* the rational model starts from the 5-parameter solution (its
+     * k1 k2 p1 p2 k3, k4 k5 k6 = 0: the same lens) */
+    hearth_calib_opts o5 = *o;
+    o5.lens_model = HEARTH_LENS_BROWN5;
+    hearth_camera c5;
+    hearth_rigid *T5 = hearth_alloc_array(n_frames, sizeof(hearth_rigid));
+    if (!T5) {
+      st = hearth_err_set(err, HEARTH_E_NOMEM, "intrinsic calibration: out of memory");
+      goto done;
+    }
+    st = hearth_calib_intrinsics(obj, n_pts, img, n_frames, width, height, &o5, &c5, NULL, NULL,
+                                 T5, err);
+    for (size_t f = 0; !st && f < n_frames; f++) calib_params_from_rigid(&T5[f], poses + 6 * f);
+    free(T5);
+    if (st) goto done;
+    q[0] = c5.fx;
+    q[1] = c5.fy;
+    q[2] = c5.cx;
+    q[3] = c5.cy;
+    for (int k = 0; k < 5; k++) q[4 + k] = c5.dist[k];
+    base.model = HEARTH_LENS_RATIONAL8;
+  }
   hearth_camera c;
   cam_from_params(&base, q, &c);
   double cost = intr_cost(&c, obj, n_pts, img, n_frames, poses, NULL);
@@ -178,17 +207,17 @@ hearth_status hearth_calib_intrinsics(const double (*obj)[3], size_t n_pts, cons
   /* Levenberg-Marquardt with Marquardt's diagonal scaling */
   double lambda = 1e-3;
   for (int it = 0; it < o->max_iterations; it++) {
-    double U[NI * NI], gi[NI];
+    double U[NI_MAX * NI_MAX], gi[NI_MAX];
     if (!intr_normal(&c, obj, n_pts, img, n_frames, poses, U, V, W, gi, gf)) {
       st = hearth_err_set(err, HEARTH_E_NUMERIC, "intrinsic calibration: point behind camera");
       goto done;
     }
     int improved = 0;
     for (int tries = 0; tries < 12 && !improved; tries++) {
-      double S[NI * NI], rhs[NI];
-      memcpy(S, U, sizeof S);
+      double S[NI_MAX * NI_MAX], rhs[NI_MAX];
+      memcpy(S, U, sizeof(double) * NI * NI);
       for (int a = 0; a < NI; a++) S[a * NI + a] *= 1.0 + lambda;
-      memcpy(rhs, gi, sizeof rhs);
+      memcpy(rhs, gi, sizeof(double) * NI);
       int ok = 1;
       for (size_t f = 0; f < n_frames && ok; f++) {
         double *Vd = Vi + 36 * f;
@@ -199,8 +228,8 @@ hearth_status hearth_calib_intrinsics(const double (*obj)[3], size_t n_pts, cons
           break;
         }
         /* S -= W Vd^-1 W^T, rhs -= W Vd^-1 gf */
-        const double *Wf = W + NI * 6 * f;
-        double WV[NI * 6];
+        const double *Wf = W + NI_MAX * 6 * f;
+        double WV[NI_MAX * 6];
         for (int a = 0; a < NI; a++)
           for (int b = 0; b < 6; b++) {
             double s = 0;
@@ -223,10 +252,10 @@ hearth_status hearth_calib_intrinsics(const double (*obj)[3], size_t n_pts, cons
         lambda *= 10;
         continue;
       }
-      double qn[NI];
+      double qn[NI_MAX];
       for (int a = 0; a < NI; a++) qn[a] = q[a] + rhs[a];
       for (size_t f = 0; f < n_frames; f++) {
-        const double *Vd = Vi + 36 * f, *Wf = W + NI * 6 * f;
+        const double *Vd = Vi + 36 * f, *Wf = W + NI_MAX * 6 * f;
         double r6[6];
         for (int b = 0; b < 6; b++) {
           double s = gf[6 * f + b];
@@ -244,7 +273,7 @@ hearth_status hearth_calib_intrinsics(const double (*obj)[3], size_t n_pts, cons
       double cn_cost = intr_cost(&cn, obj, n_pts, img, n_frames, trial, NULL);
       if (cn_cost < cost) {
         double rel = (cost - cn_cost) / (cost > 0 ? cost : 1);
-        memcpy(q, qn, sizeof q);
+        memcpy(q, qn, sizeof(double) * NI);
         memcpy(poses, trial, sizeof(double) * 6 * n_frames);
         c = cn;
         cost = cn_cost;
@@ -305,18 +334,21 @@ hearth_status hearth_calib_pose(const hearth_camera *cam, const double (*obj)[3]
   double *plane = hearth_alloc_array(4 * n_pts, sizeof(double));
   if (!plane) return hearth_err_set(err, HEARTH_E_NOMEM, "plate pose: out of memory");
   double *norm = plane + 2 * n_pts;
-  /* homography plate -> ideal normalised coordinates gives the start */
+  /* homography plate -> ideal normalised coordinates gives the start, from
+   * the points the lens model can undistort */
+  size_t k = 0;
   for (size_t j = 0; j < n_pts; j++) {
-    plane[2 * j] = obj[j][0];
-    plane[2 * j + 1] = obj[j][1];
     double xy[2];
-    hearth_camera_undistort(cam, img[2 * j], img[2 * j + 1], xy);
-    norm[2 * j] = xy[0];
-    norm[2 * j + 1] = xy[1];
+    if (hearth_camera_undistort(cam, img[2 * j], img[2 * j + 1], xy) < 0) continue;
+    plane[2 * k] = obj[j][0];
+    plane[2 * k + 1] = obj[j][1];
+    norm[2 * k] = xy[0];
+    norm[2 * k + 1] = xy[1];
+    k++;
   }
   double Hn[9];
   hearth_rigid T;
-  int ok = calib_homography(plane, norm, n_pts, Hn) && calib_pose_from_homography(Hn, &T);
+  int ok = k >= 4 && calib_homography(plane, norm, k, Hn) && calib_pose_from_homography(Hn, &T);
   free(plane);
   if (!ok) return hearth_err_set(err, HEARTH_E_NUMERIC, "plate pose: degenerate homography");
   double p[6];

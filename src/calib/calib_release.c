@@ -219,6 +219,20 @@ static hearth_status draw_overlay(det_job *j, const hearth_image *img, hearth_er
   return st;
 }
 
+hearth_status calib_overlay_encode(const hearth_image *img, int thermal,
+                                   const hearth_detection *det, uint8_t **png, size_t *size,
+                                   hearth_err *err) {
+  det_job *j = calloc(1, sizeof *j);
+  if (!j) return hearth_err_set(err, HEARTH_E_NOMEM, "overlay: out of memory");
+  j->thermal = thermal;
+  j->det = *det;
+  hearth_status st = draw_overlay(j, img, err);
+  *png = j->png;
+  *size = j->png_size;
+  free(j);
+  return st;
+}
+
 static void det_range(void *vctx, size_t b, size_t e, int ti) {
   det_ctx *c = vctx;
   (void)ti;
@@ -265,6 +279,8 @@ hearth_status hearth_calib_detect_release(const char *root, const hearth_detect_
   char dth[4096], dst[4096], path[4096];
   snprintf(dth, sizeof dth, "%s/calibration/captures/thermal", root);
   snprintf(dst, sizeof dst, "%s/calibration/captures/stereo", root);
+  /* no stereo folder: a thermal-only root (frames of any name and format) */
+  if (!hearth_path_exists(dst)) return calib_detect_thermal_only(root, run, out, err);
   hearth_status st = HEARTH_OK;
   char(*fnames)[HEARTH_NAME_MAX] = malloc(sizeof(*fnames) * MAX_FRAMES);
   char(*pnames)[HEARTH_NAME_MAX] = malloc(sizeof(*pnames) * MAX_FRAMES);
@@ -409,6 +425,12 @@ static void yaml_mat(FILE *fp, const char *name, int rows, int cols, const doubl
   fputs(" ]\n", fp);
 }
 
+void calib_yaml_num(FILE *fp, double x) { yaml_num(fp, x); }
+
+void calib_yaml_mat(FILE *fp, const char *name, int rows, int cols, const double *v) {
+  yaml_mat(fp, name, rows, cols, v);
+}
+
 static void yaml_cam(FILE *fp, const char *name, const hearth_camera *c) {
   char key[64];
   double K[9];
@@ -523,6 +545,12 @@ hearth_status hearth_calib_calibrate_release(const char *root, const hearth_cali
   hearth_status st;
   if (!hearth_path_exists(pdet))
     return hearth_err_set(err, HEARTH_E_NOT_FOUND, "%s: missing (run `hearth detect` first)", pdet);
+  snprintf(path, sizeof path, "%s/calibration/captures/stereo", root);
+  if (!hearth_path_exists(pfac) && !hearth_path_exists(path))
+    return hearth_err_set(err, HEARTH_E_NOT_FOUND,
+                          "%s: missing, and no stereo captures: for thermal intrinsics alone "
+                          "use `hearth calibrate ROOT --thermal-only`",
+                          pfac);
   if ((st = hearth_detections_read(pdet, &dets, err))) return st;
   if ((st = hearth_factory_read(pfac, &fc, err)) ||
       (st = check_factory_size(root, pfac, &fc, &dets, err))) {

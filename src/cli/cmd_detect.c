@@ -14,6 +14,12 @@ static const char *k_about =
     "plate's rows (11/10 pattern), the same hole index in every frame and camera;\n"
     "partial, blurred or missing plates are reported and marked found=false.\n"
     "\n"
+    "A root without captures/stereo is thermal-only: every file of\n"
+    "ROOT/calibration/captures/thermal (sorted by name) is a frame, a CSV matrix or\n"
+    "an 8-/16-bit PNG or TIFF image (recognised from its content), its frame name\n"
+    "the file name without extension; holes may be brighter or darker than the\n"
+    "plate. All frames must have one size.\n"
+    "\n"
     "Writes ROOT/calibration/detections.json and overlay images\n"
     "ROOT/calibration/overlays/<frame>_<camera>.png (centres joined row by row).\n";
 

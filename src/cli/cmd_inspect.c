@@ -38,9 +38,12 @@ static const char *guess_kind(const char *path) {
 }
 
 static void print_cam(const char *name, const hearth_camera *c) {
-  printf("  %-8s %dx%d fx %.3f fy %.3f cx %.3f cy %.3f dist [%.5f %.5f %.5f %.5f %.5f]\n", name,
+  printf("  %-8s %dx%d fx %.3f fy %.3f cx %.3f cy %.3f dist [%.5f %.5f %.5f %.5f %.5f", name,
          c->width, c->height, c->fx, c->fy, c->cx, c->cy, c->dist[0], c->dist[1], c->dist[2],
          c->dist[3], c->dist[4]);
+  if (c->model == HEARTH_LENS_RATIONAL8)
+    printf(" %.5f %.5f %.5f] (rational)\n", c->dist[5], c->dist[6], c->dist[7]);
+  else printf("]\n");
 }
 
 /* a thermal CSV: its statistics, the layout the reader recognised, its metadata */
@@ -130,6 +133,12 @@ static hearth_status inspect_one(const char *path, const char *kind, hearth_err 
   } else if (!strcmp(kind, "rig")) {
     hearth_rig r;
     if ((s = hearth_rig_read(path, &r, err))) return s;
+    if (r.thermal_only) {
+      printf("%s: thermal-only rig (no colour camera, no T_thermal_from_rgb)\n", path);
+      print_cam("thermal", &r.thermal);
+      printf("  thermal rms %.3f px\n", r.thermal_rms_px);
+      return HEARTH_OK;
+    }
     printf("%s: rig\n", path);
     print_cam("rgb", &r.rgb);
     print_cam("thermal", &r.thermal);

@@ -27,6 +27,8 @@ int hearth_cmd_synth(int argc, char **argv) {
   hearth_synth_opts o;
   hearth_synth_opts_default(&o);
   cli_list cats = {0}, states = {0};
+  int thermal_only = 0, wide_angle = 0;
+  const char *formats = NULL;
   const cli_opt opts[] = {
       CLI_STR("--out", "DIR", &o.out_root, "release root to create", .flags = CLI_REQUIRED),
       CLI_U64("--seed", "N", &o.seed, "random seed; same seed, same bytes"),
@@ -58,6 +60,16 @@ int hearth_cmd_synth(int argc, char **argv) {
       CLI_INT("--threads", "N", &o.threads, 1, 1024, "worker threads",
               .def = "HEARTH_THREADS or all cores"),
       CLI_FLAG("--quiet", &o.quiet, 1, "no progress output"),
+      CLI_FLAG("--thermal-only", &thermal_only, 1,
+               "only a thermal-only calibration root: --thermal-frames plate frames of the "
+               "thermal camera alone (calibration/captures/thermal/IR_NNNN.*), no instances"),
+      CLI_FLAG("--wide-angle", &wide_angle, 1,
+               "with --thermal-only: a ~100 degree lens with strong barrel distortion (OpenCV's "
+               "rational model) instead of the rig's"),
+      CLI_STR("--frame-formats", "LIST", &formats,
+              "with --thermal-only: frame formats used in turn, of csv, png8, png8-dark, png16, "
+              "png-rgb, tiff8, tiff16, tiff-lzw, tiff-deflate, tiff-packbits",
+              .def = "csv,png8,png16,tiff8,tiff16"),
       CLI_END,
   };
   const cli_command cmd = {.name = "hearth synth",
@@ -86,6 +98,24 @@ int hearth_cmd_synth(int argc, char **argv) {
                            o.mesh_category);
   hearth_err err = {0};
   double t0 = hearth_now();
+  if ((wide_angle || formats) && !thermal_only)
+    return cli_usage_error(&cmd, "options --wide-angle and --frame-formats need --thermal-only");
+  if (thermal_only) {
+    hearth_synth_thermal_opts t;
+    hearth_synth_thermal_opts_default(&t);
+    t.seed = o.seed;
+    t.out_root = o.out_root;
+    t.n_frames = o.n_thermal_frames;
+    t.wide_angle = wide_angle;
+    if (formats) t.formats = formats;
+    t.netd_c = o.netd_c;
+    t.threads = o.threads;
+    if (hearth_synth_thermal_only(&t, &err) != HEARTH_OK) return cli_fail("synth", &err);
+    if (!o.quiet)
+      fprintf(stderr, "hearth synth: wrote %s (thermal-only) in %.1f s\n", o.out_root,
+              hearth_now() - t0);
+    return 0;
+  }
   if (hearth_synth_release(&o, &err) != HEARTH_OK) return cli_fail("synth", &err);
   if (!o.quiet)
     fprintf(stderr, "hearth synth: wrote %s in %.1f s\n", o.out_root, hearth_now() - t0);

@@ -1,7 +1,29 @@
-/* Pinhole camera with 5-parameter Brown-Conrady distortion (OpenCV order). */
+/* Pinhole camera with 5-parameter Brown-Conrady or 8-parameter rational
+ * distortion (OpenCV order). */
 #include <math.h>
 #include <stddef.h>
+#include <string.h>
 #include "hearth/camera.h"
+
+/* the lens models: coefficient count and stable name, by enum value */
+static const struct {
+  int n_coeffs;
+  const char *name;
+} k_lens[] = {{5, "brown5"}, {8, "rational8"}};
+
+int hearth_lens_n_coeffs(hearth_lens_model m) {
+  return (unsigned)m < sizeof k_lens / sizeof k_lens[0] ? k_lens[m].n_coeffs : 0;
+}
+
+const char *hearth_lens_name(hearth_lens_model m) {
+  return (unsigned)m < sizeof k_lens / sizeof k_lens[0] ? k_lens[m].name : "unknown";
+}
+
+int hearth_lens_from_name(const char *name) {
+  for (size_t i = 0; name && i < sizeof k_lens / sizeof k_lens[0]; i++)
+    if (!strcmp(name, k_lens[i].name)) return (int)i;
+  return -1;
+}
 
 void hearth_camera_K(const hearth_camera *cam, double K[9]) {
   K[0] = cam->fx;
@@ -30,12 +52,42 @@ void hearth_distort(const double dist[5], double x, double y, double *xd, double
   }
 }
 
+/* The rational model: N / D radial term, (N, D, dN/dr2, dD/dr2) into q */
+static void rational_terms(const double d[8], double r2, double q[4]) {
+  q[0] = 1.0 + r2 * (d[0] + r2 * (d[1] + r2 * d[4]));
+  q[1] = 1.0 + r2 * (d[5] + r2 * (d[6] + r2 * d[7]));
+  q[2] = d[0] + r2 * (2.0 * d[1] + 3.0 * d[4] * r2);
+  q[3] = d[5] + r2 * (2.0 * d[6] + 3.0 * d[7] * r2);
+}
+
+void hearth_camera_distort(const hearth_camera *cam, double x, double y, double *xd, double *yd,
+                           double J[4]) {
+  if (cam->model != HEARTH_LENS_RATIONAL8) {
+    hearth_distort(cam->dist, x, y, xd, yd, J);
+    return;
+  }
+  const double *d = cam->dist;
+  const double p1 = d[2], p2 = d[3];
+  double x2 = x * x, y2 = y * y, xy = x * y, r2 = x2 + y2, q[4];
+  rational_terms(d, r2, q);
+  double radial = q[0] / q[1];
+  *xd = x * radial + 2.0 * p1 * xy + p2 * (r2 + 2.0 * x2);
+  *yd = y * radial + p1 * (r2 + 2.0 * y2) + 2.0 * p2 * xy;
+  if (J) {
+    double dr = (q[2] * q[1] - q[0] * q[3]) / (q[1] * q[1]); /* d radial / d r2 */
+    J[0] = radial + 2.0 * x2 * dr + 2.0 * p1 * y + 6.0 * p2 * x;
+    J[1] = 2.0 * xy * dr + 2.0 * p1 * x + 2.0 * p2 * y;
+    J[2] = J[1];
+    J[3] = radial + 2.0 * y2 * dr + 6.0 * p1 * y + 2.0 * p2 * x;
+  }
+}
+
 int hearth_camera_project(const hearth_camera *cam, const double Xc[3], double uv[2],
                           hearth_project_jac *jac) {
   double Z = Xc[2];
   if (!(Z > 0.0)) return 0;
   double iz = 1.0 / Z, x = Xc[0] * iz, y = Xc[1] * iz, xd, yd, J[4];
-  hearth_distort(cam->dist, x, y, &xd, &yd, jac ? J : NULL);
+  hearth_camera_distort(cam, x, y, &xd, &yd, jac ? J : NULL);
   uv[0] = cam->fx * xd + cam->cx;
   uv[1] = cam->fy * yd + cam->cy;
   if (jac) {
@@ -66,6 +118,19 @@ int hearth_camera_project(const hearth_camera *cam, const double Xc[3], double u
     dd[7] = cam->fy * (r2 + 2.0 * y * y);
     dd[8] = cam->fy * 2.0 * xy;
     dd[9] = cam->fy * y * r6;
+    if (cam->model == HEARTH_LENS_RATIONAL8) {
+      /* k1..k3 act through N / D; k4..k6 through -N r2^k / D^2 */
+      double q[4];
+      rational_terms(cam->dist, r2, q);
+      double iD = 1.0 / q[1], nD2 = q[0] * iD * iD;
+      for (int k = 0; k < 10; k++)
+        if (k % 5 != 2 && k % 5 != 3) dd[k] *= iD;
+      const double rp[3] = {r2, r4, r6};
+      for (int k = 0; k < 3; k++) {
+        jac->d_rat[k] = -cam->fx * x * nD2 * rp[k];
+        jac->d_rat[3 + k] = -cam->fy * y * nD2 * rp[k];
+      }
+    }
   }
   return 1;
 }
@@ -74,7 +139,7 @@ int hearth_camera_project(const hearth_camera *cam, const double Xc[3], double u
 static double reproj_residual(const hearth_camera *cam, double x, double y, double tu, double tv,
                               double *ex, double *ey) {
   double xd, yd;
-  hearth_distort(cam->dist, x, y, &xd, &yd, NULL);
+  hearth_camera_distort(cam, x, y, &xd, &yd, NULL);
   /* residual in distorted normalised coordinates, scored in pixels */
   *ex = xd - tu;
   *ey = yd - tv;
@@ -90,7 +155,7 @@ static double undistort_from(const hearth_camera *cam, double tu, double tv, dou
   double res = reproj_residual(cam, x, y, tu, tv, &ex, &ey);
   for (int it = 0; it < 100 && res > tol; it++) {
     double xd, yd, J[4];
-    hearth_distort(cam->dist, x, y, &xd, &yd, J);
+    hearth_camera_distort(cam, x, y, &xd, &yd, J);
     double det = J[0] * J[3] - J[1] * J[2];
     if (!(fabs(det) > 1e-300) || !isfinite(det)) return -1.0;
     double dx = -(J[3] * ex - J[1] * ey) / det;
@@ -131,9 +196,15 @@ static double undistort_from(const hearth_camera *cam, double tu, double tv, dou
    * factor is not positive (the model has turned the point through the
    * centre: det can be positive again beyond the fold) */
   double xd, yd, J[4], r2 = x * x + y * y;
-  hearth_distort(cam->dist, x, y, &xd, &yd, J);
+  hearth_camera_distort(cam, x, y, &xd, &yd, J);
   if (!(J[0] * J[3] - J[1] * J[2] > 0.0)) return -1.0;
-  if (!(1.0 + r2 * (cam->dist[0] + r2 * (cam->dist[1] + r2 * cam->dist[4])) > 0.0)) return -1.0;
+  if (cam->model == HEARTH_LENS_RATIONAL8) {
+    double q[4];
+    rational_terms(cam->dist, r2, q);
+    if (!(q[0] > 0.0) || !(q[1] > 0.0)) return -1.0;
+  } else if (!(1.0 + r2 * (cam->dist[0] + r2 * (cam->dist[1] + r2 * cam->dist[4])) > 0.0)) {
+    return -1.0;
+  }
   xy[0] = x;
   xy[1] = y;
   return res;

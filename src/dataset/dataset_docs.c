@@ -80,13 +80,45 @@ static hearth_status get_nonneg(hj_ctx *c, const json_t *obj, const char *key, d
   return s;
 }
 
+/* the colour and depth cameras keep the 5-parameter model (only the
+ * thermal calibration chooses a wide-angle model); key NULL: the camera
+ * fields sit at the top level */
+static hearth_status brown5_only(hj_ctx *c, const char *key, const hearth_camera *cam) {
+  if (cam->model == HEARTH_LENS_BROWN5) return HEARTH_OK;
+  size_t m = key ? hj_push_key(c, key) : 0;
+  size_t m2 = hj_push_key(c, "dist");
+  hearth_status s = hj_fail(c, HEARTH_E_UNSUPPORTED,
+                            "8 coefficients (the rational model) are only supported for the "
+                            "thermal camera; expected 5 (k1 k2 p1 p2 k3)");
+  hj_pop(c, key ? m : m2);
+  return s;
+}
+
+/* the keys a rig.json with the stereo calibration has beyond a
+ * thermal-only one */
+static const char *const k_stereo_keys[] = {"rgb", "depth", "T_thermal_from_rgb",
+                                            "T_depth_from_rgb", "stereo_rms_px"};
+
 static hearth_status rig_from_json(hj_ctx *c, const json_t *root, void *out) {
   hearth_rig r;
   memset(&r, 0, sizeof r);
   hearth_status s;
-  if ((s = hj_get_camera(c, root, "rgb", &r.rgb))) return s;
+  int stereo = 0;
+  for (size_t i = 0; i < sizeof k_stereo_keys / sizeof k_stereo_keys[0]; i++)
+    stereo |= json_object_get(root, k_stereo_keys[i]) != NULL;
+  if (!stereo) {
+    /* thermal-only (hearth calibrate --thermal-only): the thermal camera
+     * and its RMS, nothing else */
+    if ((s = hj_get_camera(c, root, "thermal", &r.thermal))) return s;
+    if ((s = get_nonneg(c, root, "thermal_rms_px", &r.thermal_rms_px))) return s;
+    r.thermal_only = 1;
+    *(hearth_rig *)out = r;
+    return HEARTH_OK;
+  }
+  if ((s = hj_get_camera(c, root, "rgb", &r.rgb)) || (s = brown5_only(c, "rgb", &r.rgb))) return s;
   if ((s = hj_get_camera(c, root, "thermal", &r.thermal))) return s;
-  if ((s = hj_get_camera(c, root, "depth", &r.depth))) return s;
+  if ((s = hj_get_camera(c, root, "depth", &r.depth)) || (s = brown5_only(c, "depth", &r.depth)))
+    return s;
   if ((s = hj_get_rigid(c, root, "T_thermal_from_rgb", &r.T_thermal_from_rgb))) return s;
   if ((s = hj_get_rigid(c, root, "T_depth_from_rgb", &r.T_depth_from_rgb))) return s;
   if ((s = get_nonneg(c, root, "thermal_rms_px", &r.thermal_rms_px))) return s;
@@ -109,8 +141,27 @@ static hearth_status rig_validate(const char *text, size_t len, const char *name
   return hearth_rig_parse(text, len, name, &r, err);
 }
 
+hearth_status hearth_rig_require_stereo(const hearth_rig *rig, const char *path,
+                                        const char *stage, hearth_err *err) {
+  if (!rig->thermal_only) return HEARTH_OK;
+  return hearth_err_set(err, HEARTH_E_UNSUPPORTED,
+                        "%s: a thermal-only rig (hearth calibrate --thermal-only) has no colour "
+                        "camera and no T_thermal_from_rgb, which %s needs; calibrate with the "
+                        "stereo pairs and factory.json",
+                        path ? path : "rig.json", stage ? stage : "this stage");
+}
+
 hearth_status hearth_rig_write(const char *path, const hearth_rig *rig, hearth_err *err) {
   json_t *o = json_object();
+  if (rig->thermal_only) {
+    int ok = hj_set(o, "thermal", hj_camera_new(&rig->thermal)) &&
+             hj_set(o, "thermal_rms_px", hj_real(rig->thermal_rms_px));
+    if (!ok) {
+      json_decref(o);
+      o = NULL;
+    }
+    return hj_write_doc(path, o, rig_validate, err);
+  }
   int ok = hj_set(o, "rgb", hj_camera_new(&rig->rgb)) &&
            hj_set(o, "thermal", hj_camera_new(&rig->thermal)) &&
            hj_set(o, "depth", hj_camera_new(&rig->depth)) &&
@@ -131,8 +182,9 @@ static hearth_status factory_from_json(hj_ctx *c, const json_t *root, void *out)
   hearth_factory_calib f;
   memset(&f, 0, sizeof f);
   hearth_status s;
-  if ((s = hj_get_camera(c, root, "rgb", &f.rgb))) return s;
-  if ((s = hj_get_camera(c, root, "depth", &f.depth))) return s;
+  if ((s = hj_get_camera(c, root, "rgb", &f.rgb)) || (s = brown5_only(c, "rgb", &f.rgb))) return s;
+  if ((s = hj_get_camera(c, root, "depth", &f.depth)) || (s = brown5_only(c, "depth", &f.depth)))
+    return s;
   if ((s = hj_get_rigid(c, root, "T_depth_from_rgb", &f.T_depth_from_rgb))) return s;
   *(hearth_factory_calib *)out = f;
   return HEARTH_OK;
@@ -173,7 +225,7 @@ static hearth_status depth_from_json(hj_ctx *c, const json_t *root, void *out) {
   memset(&d, 0, sizeof d);
   hearth_status s;
   /* the camera fields sit at the top level, beside T_depth_from_rgb */
-  if ((s = hj_camera(c, root, &d.depth))) return s;
+  if ((s = hj_camera(c, root, &d.depth)) || (s = brown5_only(c, NULL, &d.depth))) return s;
   if ((s = hj_get_rigid(c, root, "T_depth_from_rgb", &d.T_depth_from_rgb))) return s;
   *(hearth_depth_intrinsics *)out = d;
   return HEARTH_OK;

@@ -240,7 +240,17 @@ hearth_status hj_camera(hj_ctx *c, const json_t *obj, hearth_camera *cam) {
   json_t *dv;
   if ((s = hj_member(c, obj, "dist", &dv))) return s;
   m = hj_push_key(c, "dist");
-  if ((s = hj_vec(c, dv, 5, cam->dist))) return s;
+  /* 5 coefficients: Brown-Conrady; 8: OpenCV's rational model */
+  size_t nd;
+  if ((s = hj_array(c, dv, 5, 8, &nd))) return s;
+  if (nd != 5 && nd != 8)
+    return hj_fail(c, HEARTH_E_SIZE,
+                   "expected 5 coefficients (k1 k2 p1 p2 k3) or 8 (k1 k2 p1 p2 k3 k4 k5 k6, the "
+                   "rational model), found %zu",
+                   nd);
+  memset(cam->dist, 0, sizeof cam->dist);
+  if ((s = hj_vec(c, dv, nd, cam->dist))) return s;
+  cam->model = nd == 8 ? HEARTH_LENS_RATIONAL8 : HEARTH_LENS_BROWN5;
   hj_pop(c, m);
   return HEARTH_OK;
 }
@@ -439,7 +449,7 @@ json_t *hj_camera_new(const hearth_camera *cam) {
   double K[9] = {cam->fx, 0, cam->cx, 0, cam->fy, cam->cy, 0, 0, 1};
   int ok = hj_set(o, "width", json_integer(cam->width)) &&
            hj_set(o, "height", json_integer(cam->height)) && hj_set(o, "K", hj_mat_new(K, 3, 3)) &&
-           hj_set(o, "dist", hj_vec_new(cam->dist, 5));
+           hj_set(o, "dist", hj_vec_new(cam->dist, (size_t)hearth_lens_n_coeffs(cam->model)));
   if (!ok) {
     json_decref(o);
     return NULL;

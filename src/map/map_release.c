@@ -282,7 +282,9 @@ hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats
   pthread_t lb_tid;
   int lb_started = 0;
   hearth_status s;
-  if ((s = hearth_rig_read(rig_path, &rig, err))) goto done;
+  if ((s = hearth_rig_read(rig_path, &rig, err)) ||
+      (s = hearth_rig_require_stereo(&rig, rig_path, "mapping", err)))
+    goto done;
   if ((s = hearth_manifest_read(man_path, &man, err))) goto done;
   if (strcmp(man.instance, inst) || strcmp(man.state, job->state)) {
     s = hearth_err_set(err, HEARTH_E_INCONSISTENT,
@@ -521,7 +523,9 @@ hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err) {
   hearth_map_view *views = NULL;
   hearth_map_result r = {0};
   bake_grid grid = {0};
-  if ((s = hearth_rig_read(rig_path, &rig, err))) goto done;
+  if ((s = hearth_rig_read(rig_path, &rig, err)) ||
+      (s = hearth_rig_require_stereo(&rig, rig_path, "mapping", err)))
+    goto done;
   if ((s = hearth_manifest_read(man_path, &man, err))) goto done;
   if ((s = hearth_poses_read(poses_path, &poses, err))) goto done;
   hearth_glb_read_opts gopts = {.require_uvs = 1};

@@ -93,6 +93,11 @@ hearth_status hearth_ray_fan_new(const hearth_camera *cam, size_t stride, hearth
   if (stride < 1) stride = 1;
   if (cam->width <= 0 || cam->height <= 0 || !(cam->fx > 0.0) || !(cam->fy > 0.0))
     return hearth_err_set(err, HEARTH_E_ARG, "ray fan: the camera has no size or focal length");
+  if (cam->model != HEARTH_LENS_BROWN5)
+    return hearth_err_set(err, HEARTH_E_UNSUPPORTED,
+                          "ray fan: the %s lens model is not supported (the fan's error bound "
+                          "is derived for the 5-parameter model)",
+                          hearth_lens_name(cam->model));
   size_t pw = ((size_t)cam->width + stride - 1) / stride,
          ph = ((size_t)cam->height + stride - 1) / stride;
   if (pw > (size_t)INT32_MAX / 2 || ph > (size_t)INT32_MAX / 2 || pw * ph > (size_t)UINT32_MAX / 2)

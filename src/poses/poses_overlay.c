@@ -342,7 +342,9 @@ hearth_status hearth_overlay_run(const hearth_overlay_job *job, size_t *n_writte
   int nt = 0;
   size_t written = 0;
   hearth_status s;
-  if ((s = hearth_rig_read(rig_path, &rig, err))) goto done;
+  if ((s = hearth_rig_read(rig_path, &rig, err)) ||
+      (s = hearth_rig_require_stereo(&rig, rig_path, "the pose overlay", err)))
+    goto done;
   int have_before = hearth_path_exists(before_path);
   if (have_before && (s = hearth_poses_read(before_path, &before, err))) goto done;
   if ((s = hearth_poses_read(after_path, &after, err))) goto done;

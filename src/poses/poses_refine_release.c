@@ -183,7 +183,9 @@ hearth_status hearth_refine_run(const hearth_refine_job *job, hearth_refine_summ
   double rsum0 = 0, rsum1 = 0, tsum = 0;
   size_t rn = 0;
   hearth_status s;
-  if ((s = hearth_rig_read(rig_path, &rig, err))) goto done;
+  if ((s = hearth_rig_read(rig_path, &rig, err)) ||
+      (s = hearth_rig_require_stereo(&rig, rig_path, "pose refinement", err)))
+    goto done;
   if ((s = hearth_poses_read(start_path, &start, err))) goto done;
   if (hearth_path_exists(out_path) && (s = hearth_poses_read(out_path, &prev, err))) goto done;
   if (job->truth_path && (s = hearth_poses_read(job->truth_path, &truth, err))) goto done;

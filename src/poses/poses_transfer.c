@@ -19,6 +19,7 @@ hearth_status hearth_transfer_run(const hearth_transfer_job *job, hearth_err *er
   rf_pathf(out2, "%s/instances/%s/derived/poses_thermal.json", job->root, job->instance);
   hearth_rig rig;
   hearth_status s = hearth_rig_read(rig_path, &rig, err);
+  if (!s) s = hearth_rig_require_stereo(&rig, rig_path, "the thermal pose transfer", err);
   if (s) return s;
   hearth_poses poses = {0};
   if ((s = hearth_poses_read(poses_path, &poses, err))) return s;

@@ -249,7 +249,10 @@ static hearth_status colour_camera(run_ctx *r, hearth_camera *cam) {
   if ((s = join(path, r->job->root, "calibration/rig.json", r->err))) return s;
   if (hearth_path_exists(path)) {
     hearth_rig rig;
-    if ((s = hearth_rig_read(path, &rig, r->err))) return s;
+    if ((s = hearth_rig_read(path, &rig, r->err)) ||
+        (s = hearth_rig_require_stereo(&rig, path, "the reconstruction (its colour camera)",
+                                       r->err)))
+      return s;
     *cam = rig.rgb;
     return HEARTH_OK;
   }

@@ -595,6 +595,10 @@ static void check_calibration(const char *root, const hearth_validate_opts *o, h
     if (!o->raw_only) hearth_problems_add(p, path, "missing");
   } else if (hearth_rig_read(path, &rig, &e)) {
     add_err(p, path, &e);
+  } else if (rig.thermal_only) {
+    hearth_problems_add(p, path,
+                        "a thermal-only rig (hearth calibrate --thermal-only): a release needs "
+                        "the stereo calibration (the colour camera and T_thermal_from_rgb)");
   } else if (rig.thermal.width != 256 || rig.thermal.height != 192 || rig.rgb.width != 1920 ||
              rig.rgb.height != 1080 || rig.depth.width != 640 || rig.depth.height != 576) {
     hearth_problems_add(p, path,

@@ -432,3 +432,23 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
   hearth_detections_free(&dets);
   return st;
 }
+
+/* ---- for the thermal-only captures (synth_thermal_only.c) ------------------------------ */
+void synth_plate_pose(hearth_rng *r, double d, double ox, double oy, hearth_rigid *T) {
+  plate_pose(r, d, ox, oy, T);
+}
+
+hearth_status synth_plate_thermal_frame(const hearth_camera *cam, const hearth_rigid *T,
+                                        const float *rays, double ambient, double plate_dt,
+                                        double hole_dt, double blur, double netd,
+                                        uint64_t noise_seed, int threads, hearth_image *out,
+                                        hearth_err *err) {
+  plate_view v;
+  plate_view_init(&v, cam, T);
+  v.ambient = ambient;
+  v.plate_dt = plate_dt;
+  v.hole_dt = hole_dt;
+  hearth_rng noise;
+  hearth_rng_seed(&noise, noise_seed);
+  return render_thermal_plate(&v, rays, blur, netd, &noise, threads, out, err);
+}

@@ -16,17 +16,52 @@ void synth_lens_distort(const double d[5], double x, double y, double *xd, doubl
   *yd = y * radial + d[2] * (r2 + 2.0 * y * y) + 2.0 * d[3] * x * y;
 }
 
+/* OpenCV's rational model (k1 k2 p1 p2 k3 k4 k5 k6): the radial factor is
+ * a ratio of two cubics in r^2 */
+static void rational_distort(const double d[8], double x, double y, double *xd, double *yd) {
+  double r2 = x * x + y * y, r4 = r2 * r2, r6 = r4 * r2;
+  double radial = (1.0 + d[0] * r2 + d[1] * r4 + d[4] * r6) / (1.0 + d[5] * r2 + d[6] * r4 + d[7] * r6);
+  *xd = x * radial + 2.0 * d[2] * x * y + d[3] * (r2 + 2.0 * x * x);
+  *yd = y * radial + d[2] * (r2 + 2.0 * y * y) + 2.0 * d[3] * x * y;
+}
+
+void synth_lens_distort_cam(const hearth_camera *c, double x, double y, double *xd, double *yd) {
+  if (c->model == HEARTH_LENS_RATIONAL8) rational_distort(c->dist, x, y, xd, yd);
+  else synth_lens_distort(c->dist, x, y, xd, yd);
+}
+
 int synth_lens_project(const hearth_camera *c, const double X[3], double uv[2]) {
   if (!(X[2] > 0.0)) return 0;
   double xd, yd;
-  synth_lens_distort(c->dist, X[0] / X[2], X[1] / X[2], &xd, &yd);
+  synth_lens_distort_cam(c, X[0] / X[2], X[1] / X[2], &xd, &yd);
   uv[0] = c->fx * xd + c->cx;
   uv[1] = c->fy * yd + c->cy;
   return 1;
 }
 
-/* distortion and its 2x2 Jacobian, for the Newton inversion */
-static void lens_jac(const double d[5], double x, double y, double f[2], double J[4]) {
+/* distortion and its 2x2 Jacobian, for the Newton inversion; the rational
+ * model's by central differences (kept apart from the pipeline's
+ * analytic Jacobian) */
+static void lens_jac5(const double d[5], double x, double y, double f[2], double J[4]);
+static void lens_jac(const hearth_camera *c, double x, double y, double f[2], double J[4]) {
+  if (c->model != HEARTH_LENS_RATIONAL8) {
+    lens_jac5(c->dist, x, y, f, J);
+    return;
+  }
+  const double h = 1e-7;
+  double a[2], b[2];
+  rational_distort(c->dist, x, y, &f[0], &f[1]);
+  rational_distort(c->dist, x + h, y, &a[0], &a[1]);
+  rational_distort(c->dist, x - h, y, &b[0], &b[1]);
+  J[0] = (a[0] - b[0]) / (2 * h);
+  J[2] = (a[1] - b[1]) / (2 * h);
+  rational_distort(c->dist, x, y + h, &a[0], &a[1]);
+  rational_distort(c->dist, x, y - h, &b[0], &b[1]);
+  J[1] = (a[0] - b[0]) / (2 * h);
+  J[3] = (a[1] - b[1]) / (2 * h);
+}
+
+static void lens_jac5(const double d[5], double x, double y, double f[2], double J[4]) {
   double r2 = x * x + y * y;
   double radial = 1.0 + r2 * (d[0] + r2 * (d[1] + r2 * d[4]));
   double drad = d[0] + r2 * (2.0 * d[1] + 3.0 * d[4] * r2); /* d radial / d r2 */
@@ -44,7 +79,7 @@ double synth_lens_unproject(const hearth_camera *c, double u, double v, double x
    * rig's ranges are monotonic over the image so this converges quickly */
   double x = tx, y = ty, f[2], J[4];
   for (int it = 0; it < 40; it++) {
-    lens_jac(c->dist, x, y, f, J);
+    lens_jac(c, x, y, f, J);
     double ex = tx - f[0], ey = ty - f[1];
     double det = J[0] * J[3] - J[1] * J[2];
     if (fabs(det) < 1e-12) break;
@@ -53,7 +88,7 @@ double synth_lens_unproject(const hearth_camera *c, double u, double v, double x
     y += dy;
     if (fabs(dx) + fabs(dy) < 1e-15) break;
   }
-  lens_jac(c->dist, x, y, f, J);
+  lens_jac(c, x, y, f, J);
   xy[0] = x;
   xy[1] = y;
   return hypot((f[0] - tx) * c->fx, (f[1] - ty) * c->fy);

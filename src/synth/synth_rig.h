@@ -21,6 +21,8 @@
 /* ---- lens (synth_rig.c) --------------------------------------------------- */
 /* Brown-Conrady [k1 k2 p1 p2 k3] on normalised coordinates. */
 void synth_lens_distort(const double dist[5], double x, double y, double *xd, double *yd);
+/* The camera's own model: the above, or OpenCV's rational model. */
+void synth_lens_distort_cam(const hearth_camera *c, double x, double y, double *xd, double *yd);
 /* Camera-frame point -> pixel; 0 if behind the camera. */
 int synth_lens_project(const hearth_camera *c, const double Xc[3], double uv[2]);
 /* Pixel -> ideal normalised (x, y); returns the residual in pixels. */
@@ -101,6 +103,18 @@ void synth_plate_centre(double c[3]);
  * how many are wholly inside the image. */
 int synth_plate_truth(const hearth_camera *c, const hearth_rigid *T_cam_from_plate,
                       double centres[HEARTH_PLATE_HOLES][2]);
+
+/* One thermal-only frame of the plate at T_cam_from_plate (1-channel F32,
+ * degC): plate ambient + plate_dt, holes ambient + hole_dt, Gaussian blur,
+ * noise netd (seeded by noise_seed); rays from synth_ray_table(cam, 4). */
+hearth_status synth_plate_thermal_frame(const hearth_camera *cam, const hearth_rigid *T,
+                                        const float *rays, double ambient, double plate_dt,
+                                        double hole_dt, double blur, double netd,
+                                        uint64_t noise_seed, int threads, hearth_image *out,
+                                        hearth_err *err);
+/* A plausible plate pose (as for the rig's own captures): plate centre at
+ * distance d, normalised offset (ox, oy), tilted 5..40 degrees, small roll. */
+void synth_plate_pose(hearth_rng *r, double d, double ox, double oy, hearth_rigid *T);
 
 /* ---- instances (synth_release.c) ---------------------------------------------- */
 /* One instance as the rig captures it; shared with the tests so they can
