@@ -164,7 +164,8 @@ int hearth_target_row_holes(const hearth_target *t, int r);
 void hearth_target_points(const hearth_target *t, double (*xyz)[3]);
 /* 1 if t is the paper's plate (same lattice, rows, cols, pitch, hole). */
 int hearth_target_is_default(const hearth_target *t);
-/* Checks: rows and cols 3..64, at most HEARTH_TARGET_MAX_HOLES holes, pitch
+/* Checks: rows and cols 3..64 (hex-alternating cols 4..64: every target
+ * then has a hole with all its lattice neighbours), at most HEARTH_TARGET_MAX_HOLES holes, pitch
  * 1 mm..1 m, 0 < hole diameter <= 0.8 pitch. name names the source. */
 hearth_status hearth_target_check(const hearth_target *t, const char *name, hearth_err *err);
 /* Strict reader of calibration/target.json: exactly the keys lattice, rows,

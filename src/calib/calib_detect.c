@@ -489,24 +489,30 @@ static hearth_status detect_multi(const uint8_t *U, size_t W, size_t H, double s
     for (; i < n; i++) h4[0][U[i]]++;
     for (int k = 0; k < 256; k++) hist[k] = (size_t)h4[0][k] + h4[1][k] + h4[2][k] + h4[3][k];
   }
-  int med = 0, p995 = 255;
+  int med = 0, p995 = 255, p01 = 0, p99 = 255;
   size_t acc = 0;
   for (int i = 0; i < 256; i++) {
     acc += hist[i];
     if (acc * 2 <= n) med = i + 1;
     if (acc * 1000 < n * 995) p995 = i + 1;
+    if (acc * 100 < n) p01 = i + 1;
+    if (acc * 100 < n * 99) p99 = i + 1;
   }
-  /* the last fractions catch low-contrast holes below a bright distractor
-   * (a person, a window) that sets the 99.5th percentile */
-  enum { NT = 13 };
+  /* then a sweep of the levels between the 1st and 99th percentiles, for
+   * holes of low contrast beside a distractor (a person, a window) that
+   * sets the percentiles, or level with the background */
+  enum { NFIX = 9, NT = NFIX + 64 };
   int thr[NT] = {otsu(hist)};
-  static const int frac[NT - 1] = {50, 35, 65, 75, 85, 25, 45, 55, 18, 12, 7, 4};
-  for (int k = 1; k < NT; k++) thr[k] = med + (p995 - med) * frac[k - 1] / 100;
+  static const int frac[NFIX - 1] = {50, 35, 65, 75, 85, 25, 45, 55};
+  for (int k = 1; k < NFIX; k++) thr[k] = med + (p995 - med) * frac[k - 1] / 100;
+  for (int k = NFIX; k < NT; k++) thr[k] = -1;
+  for (int k = NFIX, t = p01 + 3; k < NT && t < p99; k++, t += 4) thr[k] = t;
   char first_reason[256] = "";
   for (int k = 0; k < NT; k++) {
     int dup = 0;
     for (int q = 0; q < k; q++) dup |= thr[q] == thr[k];
-    if (dup || thr[k] < 0 || thr[k] >= 255) continue;
+    if (thr[k] < 0) break;
+    if (dup || thr[k] >= 255) continue;
     blob *bl = NULL;
     size_t nb = 0;
     hearth_status st = find_blobs(U, W, H, thr[k], scale, &bl, &nb, err);

@@ -83,6 +83,11 @@ hearth_status hearth_target_check(const hearth_target *t, const char *name, hear
   if (t->cols < 3 || t->cols > 64)
     return hearth_err_set(err, HEARTH_E_RANGE, "%s: cols: expected 3..64, found %d", name,
                           t->cols);
+  if (t->lattice == HEARTH_LATTICE_HEX_ALTERNATING && t->cols < 4)
+    return hearth_err_set(err, HEARTH_E_RANGE,
+                          "%s: cols: expected 4..64 for hex-alternating (rows of C and C-1), "
+                          "found %d",
+                          name, t->cols);
   size_t n = hearth_target_holes(t);
   if (n > HEARTH_TARGET_MAX_HOLES)
     return hearth_err_set(err, HEARTH_E_LIMIT, "%s: %d x %d: %zu holes, at most %d handled", name,
@@ -126,6 +131,11 @@ static hearth_status target_from_json(hj_ctx *c, const json_t *root, void *out) 
       (s = hj_get_number(c, root, "pitch_m", &t.pitch_m)) ||
       (s = hj_get_number(c, root, "hole_diameter_m", &t.hole_diameter_m)))
     return s;
+  if (t.lattice == HEARTH_LATTICE_HEX_ALTERNATING && t.cols < 4) {
+    hj_push_key(c, "cols");
+    return hj_fail(c, HEARTH_E_RANGE,
+                   "expected 4..64 for hex-alternating (rows of C and C-1), found %d", t.cols);
+  }
   if (hearth_target_holes(&t) > HEARTH_TARGET_MAX_HOLES) {
     hj_push_key(c, "rows");
     return hj_fail(c, HEARTH_E_LIMIT, "%d x %d: %zu holes, at most %d handled", t.rows, t.cols,

@@ -180,8 +180,10 @@ static int present(const char *path) {
   return stat(path, &st) == 0;
 }
 
-static void check_csv(hearth_problems *p, const char *path, size_t *nfiles) {
-  hearth_csv_opts co = {256, 192};
+/* tw x th: the thermal camera's size (0 x 0: any consistent rectangle) */
+static void check_csv(hearth_problems *p, const char *path, size_t tw, size_t th,
+                      size_t *nfiles) {
+  hearth_csv_opts co = {tw, th};
   hearth_image img = {0};
   hearth_err e = {0};
   (*nfiles)++;
@@ -449,7 +451,7 @@ static void check_leftovers(hearth_problems *p, const char *dir, int depth) {
 }
 
 static void check_instance(const char *root, const char *id, const hearth_validate_opts *o,
-                           hearth_problems *p, size_t *nfiles) {
+                           const size_t tsize[2], hearth_problems *p, size_t *nfiles) {
   char path[PATH_SZ], dir[PATH_SZ];
   hearth_err e = {0};
   snprintf(dir, sizeof dir, "%s/instances/%s", root, id);
@@ -535,7 +537,7 @@ static void check_instance(const char *root, const char *id, const hearth_valida
       }
       if (have[4]) {
         snprintf(f, sizeof f, "%s/%s", sdir, vf->thermal);
-        check_csv(p, f, nfiles);
+        check_csv(p, f, tsize[0], tsize[1], nfiles);
       }
     }
   }
@@ -582,8 +584,10 @@ done:
 }
 
 /* ---- release level --------------------------------------------------------- */
+/* The thermal camera's size into tsize: rig.json's when it reads, else the
+ * first thermal capture's, else 0 x 0 (any). */
 static void check_calibration(const char *root, const hearth_validate_opts *o, hearth_problems *p,
-                              size_t *nfiles) {
+                              size_t tsize[2], size_t *nfiles) {
   char path[PATH_SZ];
   hearth_err e = {0};
   hearth_rig rig;
@@ -595,13 +599,41 @@ static void check_calibration(const char *root, const hearth_validate_opts *o, h
     if (!o->raw_only) hearth_problems_add(p, path, "missing");
   } else if (hearth_rig_read(path, &rig, &e)) {
     add_err(p, path, &e);
-  } else if (rig.thermal.width != 256 || rig.thermal.height != 192 || rig.rgb.width != 1920 ||
-             rig.rgb.height != 1080 || rig.depth.width != 640 || rig.depth.height != 576) {
+  } else if (rig.rgb.width != 1920 || rig.rgb.height != 1080 || rig.depth.width != 640 ||
+             rig.depth.height != 576) {
     hearth_problems_add(p, path,
-                        "camera sizes rgb %dx%d, thermal %dx%d, depth %dx%d; expected "
-                        "1920x1080, 256x192, 640x576",
-                        (int)rig.rgb.width, (int)rig.rgb.height, (int)rig.thermal.width,
-                        (int)rig.thermal.height, (int)rig.depth.width, (int)rig.depth.height);
+                        "camera sizes rgb %dx%d, depth %dx%d; expected 1920x1080, 640x576",
+                        (int)rig.rgb.width, (int)rig.rgb.height, (int)rig.depth.width,
+                        (int)rig.depth.height);
+  } else {
+    tsize[0] = (size_t)rig.thermal.width;
+    tsize[1] = (size_t)rig.thermal.height;
+  }
+  if (!tsize[0]) {
+    /* no usable rig.json: the size of the first thermal capture */
+    const char *first[2] = {"thermal", "stereo"};
+    for (int j = 0; j < 2 && !tsize[0]; j++) {
+      char dir[PATH_SZ];
+      snprintf(dir, sizeof dir, "%s/calibration/captures/%s", root, first[j]);
+      struct dirent **ents = NULL;
+      int n = scandir(dir, &ents, NULL, alphasort);
+      for (int i = 0; i < n; i++) {
+        size_t L = strlen(ents[i]->d_name);
+        if (!tsize[0] && L > 4 && !strcmp(ents[i]->d_name + L - 4, ".csv")) {
+          char f[PATH_SZ];
+          hearth_csv_opts any = {0, 0};
+          hearth_image img = {0};
+          snprintf(f, sizeof f, "%s/%s", dir, ents[i]->d_name);
+          if (!hearth_thermal_read_csv(f, &any, &img, NULL)) {
+            tsize[0] = img.width;
+            tsize[1] = img.height;
+          }
+          hearth_image_free(&img);
+        }
+        free(ents[i]);
+      }
+      free(ents);
+    }
   }
   snprintf(path, sizeof path, "%s/calibration/factory.json", root);
   if (present(path)) {
@@ -628,7 +660,7 @@ static void check_calibration(const char *root, const hearth_validate_opts *o, h
       const char *nm = ents[i]->d_name;
       size_t L = strlen(nm);
       snprintf(path, sizeof path, "%s/%s", dir, nm);
-      if (L > 4 && !strcmp(nm + L - 4, ".csv")) check_csv(p, path, nfiles);
+      if (L > 4 && !strcmp(nm + L - 4, ".csv")) check_csv(p, path, tsize[0], tsize[1], nfiles);
       else if (L > 4 && !strcmp(nm + L - 4, ".jpg"))
         check_image(p, path, IMG_JPEG, 1920, 1080, rgb3, 8, o->decode_images, nfiles);
       free(ents[i]);
@@ -656,6 +688,7 @@ static void check_ground_truth(const char *root, const hearth_release_doc *rel, 
 }
 
 typedef struct vctx {
+  size_t tsize[2]; /* the thermal camera's size */
   const char *root;
   const hearth_release_doc *rel;
   const hearth_validate_opts *o;
@@ -666,7 +699,7 @@ typedef struct vctx {
 static void validate_range(void *ctx, size_t b, size_t e, int t) {
   vctx *c = ctx;
   for (size_t i = b; i < e; i++)
-    check_instance(c->root, c->rel->instances[i], c->o, &c->per[i], &c->nfiles[i]);
+    check_instance(c->root, c->rel->instances[i], c->o, c->tsize, &c->per[i], &c->nfiles[i]);
 }
 
 hearth_status hearth_validate_release(const char *root, const hearth_validate_opts *o,
@@ -698,7 +731,8 @@ hearth_status hearth_validate_release(const char *root, const hearth_validate_op
     nfiles++;
     if (hb_params_read(path, &bp, &e)) add_err(out, path, &e);
   }
-  check_calibration(root, o, out, &nfiles);
+  size_t tsize[2] = {0, 0};
+  check_calibration(root, o, out, tsize, &nfiles);
 
   /* directories under instances/ that release.json does not list */
   snprintf(path, sizeof path, "%s/instances", root);
@@ -725,7 +759,7 @@ hearth_status hearth_validate_release(const char *root, const hearth_validate_op
     hearth_release_free(&rel);
     return hearth_err_set(err, HEARTH_E_NOMEM, "validate: out of memory");
   }
-  vctx c = {root, &rel, o, per, nf};
+  vctx c = {{tsize[0], tsize[1]}, root, &rel, o, per, nf};
   int nt = o->threads > 0 ? o->threads : hearth_default_threads();
   if ((size_t)nt > rel.n_instances) nt = rel.n_instances ? (int)rel.n_instances : 1;
   hearth_status s = hearth_parallel_for(rel.n_instances, nt, validate_range, &c);
