@@ -68,7 +68,8 @@ typedef struct det_job {
   char path[4096];
   int thermal;
   hearth_detection det;
-  uint8_t *png; /* the encoded overlay (with overlays) */
+  size_t width, height; /* of the capture */
+  uint8_t *png;         /* the encoded overlay (with overlays) */
   size_t png_size;
   hearth_status st;
   hearth_err err;
@@ -229,7 +230,9 @@ static void det_range(void *vctx, size_t b, size_t e, int ti) {
     det_job *j = &c->jobs[i];
     hearth_image img = {0};
     if (j->thermal) {
-      j->st = hearth_thermal_read_csv(j->path, NULL, &img, &j->err);
+      /* any size: the captures tell the thermal camera's (all must agree) */
+      const hearth_csv_opts any = {0, 0};
+      j->st = hearth_thermal_read_csv(j->path, &any, &img, &j->err);
       if (!j->st) j->st = hearth_detect_plate_thermal(&img, &c->run->detect, &j->det, &j->err);
     } else {
       /* detection reads the luma plane only (no chroma work); the overlay,
@@ -250,6 +253,8 @@ static void det_range(void *vctx, size_t b, size_t e, int ti) {
         j->st = hearth_jpeg_read(j->path, &img, &j->err);
       }
     }
+    j->width = img.width;
+    j->height = img.height;
     if (!j->st && c->run->overlays) j->st = draw_overlay(j, &img, &j->err);
     hearth_image_free(&img);
     /* every error names its file */
@@ -352,6 +357,18 @@ hearth_status hearth_calib_detect_release(const char *root, const hearth_detect_
       if (err) *err = jobs[i].err;
       goto done;
     }
+  /* one thermal camera: every thermal capture of one size */
+  for (size_t i = 0, first = nj; i < nj; i++) {
+    if (!jobs[i].thermal) continue;
+    if (first == nj) first = i;
+    else if (jobs[i].width != jobs[first].width || jobs[i].height != jobs[first].height) {
+      st = hearth_err_set(err, HEARTH_E_INCONSISTENT,
+                          "%s: a %zux%zu matrix, but %s is %zux%zu (one thermal camera)",
+                          jobs[i].path, jobs[i].width, jobs[i].height, jobs[first].path,
+                          jobs[first].width, jobs[first].height);
+      goto done;
+    }
+  }
   /* outputs: overlays, then detections.json */
   if (run->overlays) {
     snprintf(path, sizeof path, "%s/calibration/overlays", root);
