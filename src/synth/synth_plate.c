@@ -516,7 +516,9 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
   }
   synth_plate_geom_init(g, &o->target);
   const size_t NH = g->n;
-  const double ds = distance_scale(g, &rig->thermal);
+  const double ds = distance_scale(g, &rig->thermal) * (o->thermal_wide ? 0.7 : 1.0);
+  /* a wide lens sees about twice as far to the side */
+  const double os = o->thermal_wide ? 2.0 : 1.0;
   synth_plate_look look = {o->calib_clutter, o->calib_low_contrast, o->calib_invert};
   const synth_plate_look *lk = (look.clutter || look.low_contrast || look.invert) ? &look : NULL;
   int nf = o->n_thermal_frames, np = o->n_stereo_pairs;
@@ -546,8 +548,9 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
     hearth_rigid T;
     for (int tries = 0; tries < 200; tries++) {
       double d = hearth_rng_range(&r, 0.22, 0.40) * ds;
-      double ox = hearth_rng_range(&r, -0.24, 0.24), oy = hearth_rng_range(&r, -0.16, 0.16);
-      if (partial) ox = (hearth_rng_uniform(&r) < 0.5 ? -1 : 1) * hearth_rng_range(&r, 0.38, 0.5);
+      double ox = hearth_rng_range(&r, -0.24, 0.24) * os, oy = hearth_rng_range(&r, -0.16, 0.16) * os;
+      if (partial)
+        ox = (hearth_rng_uniform(&r) < 0.5 ? -1 : 1) * hearth_rng_range(&r, 0.38, 0.5) * os;
       synth_plate_pose(g, &r, d, ox, oy, &T);
       size_t n = (size_t)synth_plate_truth(&rig->thermal, g, &T, c);
       if (partial ? (n >= 20 && n < NH) : n == NH) break;
@@ -576,8 +579,9 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
     hearth_rigid T_th, T_rgb;
     for (int tries = 0; tries < 200; tries++) {
       double d = hearth_rng_range(&r, 0.27, 0.45) * ds;
-      double ox = hearth_rng_range(&r, -0.14, 0.14), oy = hearth_rng_range(&r, -0.08, 0.08);
-      if (partial) ox = (hearth_rng_uniform(&r) < 0.5 ? -1 : 1) * hearth_rng_range(&r, 0.38, 0.5);
+      double ox = hearth_rng_range(&r, -0.14, 0.14) * os, oy = hearth_rng_range(&r, -0.08, 0.08) * os;
+      if (partial)
+        ox = (hearth_rng_uniform(&r) < 0.5 ? -1 : 1) * hearth_rng_range(&r, 0.38, 0.5) * os;
       synth_plate_pose(g, &r, d, ox, oy, &T_th);
       hearth_rigid_compose(&T_rgb_from_th, &T_th, &T_rgb);
       size_t n = (size_t)synth_plate_truth(&rig->thermal, g, &T_th, c);
