@@ -6,13 +6,16 @@
 #include "hearth/calib.h"
 
 static const char *k_about =
-    "Finds the 84 hole centres of the calibration plate in every capture under\n"
-    "ROOT/calibration/captures (thermal/fNNN.csv, stereo/pNNN_rgb.jpg +\n"
-    "pNNN_thermal.csv). Colour: dark blobs. Thermal: per-frame percentile clip,\n"
-    "8-bit, upsampled, blob detection, then an intensity-weighted centroid on the\n"
-    "raw matrix (never altered), in native pixels. Centres are ordered by the\n"
-    "plate's rows (11/10 pattern), the same hole index in every frame and camera;\n"
-    "partial, blurred or missing plates are reported and marked found=false.\n"
+    "Finds the hole centres of the calibration target (ROOT/calibration/target.json;\n"
+    "absent: the paper's 84-hole plate) in every capture under\n"
+    "ROOT/calibration/captures (thermal/fNNN.csv of any size, stereo/pNNN_rgb.jpg +\n"
+    "pNNN_thermal.csv). Holes bright or dark in either camera. Colour: blobs at\n"
+    "half size. Thermal: per-frame percentile clip, 8-bit, upsampled, blob\n"
+    "detection, then an intensity-weighted centroid on the raw matrix (never\n"
+    "altered), in native pixels. Centres are ordered by the target's lattice, the\n"
+    "same hole index in every frame and camera (a symmetric target by the image,\n"
+    "docs/dataset.md); partial, blurred, ambiguous or missing targets are reported\n"
+    "and marked found=false.\n"
     "\n"
     "Writes ROOT/calibration/detections.json and overlay images\n"
     "ROOT/calibration/overlays/<frame>_<camera>.png (centres joined row by row).\n";
