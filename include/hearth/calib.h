@@ -107,7 +107,9 @@ hearth_status hearth_calib_stereo(const hearth_camera *cam_a, const hearth_camer
                                   int *pair_used, hearth_err *err);
 
 /* ---- release stages ----------------------------------------------------------- */
-/* Detect the plate in every capture under <root>/calibration/captures and
+/* Detect the target of <root>/calibration/target.json (absent: the paper's
+ * plate) in every capture under <root>/calibration/captures (thermal
+ * captures of any one size) and
  * write <root>/calibration/detections.json and, if overlays, the
  * calibration/overlays/<frame>_<camera>.png images. Frames are listed
  * thermal fNNN first, then each stereo pair pNNN (rgb, thermal). out (may
@@ -141,7 +143,10 @@ typedef struct hearth_calib_report {
 /* Frees the frame lists and zeroes r; accepts a zeroed report. */
 void hearth_calib_report_free(hearth_calib_report *r);
 
-/* Read calibration/detections.json and calibration/factory.json, calibrate,
+/* Read calibration/detections.json, calibration/factory.json and
+ * calibration/target.json (absent: the paper's plate; it must be the target
+ * the detections were made for), take the thermal camera's size from its
+ * first thermal capture present, calibrate,
  * write calibration/rig.json, calibration/rig_opencv.yaml and
  * calibration/calibration_report.json (all atomically, all or nothing).
  * rep (required) is filled; the caller frees it with
