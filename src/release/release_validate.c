@@ -641,11 +641,33 @@ static void check_calibration(const char *root, const hearth_validate_opts *o, h
     (*nfiles)++;
     if (hearth_factory_read(path, &f, &e)) add_err(p, path, &e);
   }
+  /* the target (optional) and the detections made for it */
+  hearth_target target = hearth_target_default();
+  int target_ok = 1;
+  snprintf(path, sizeof path, "%s/calibration/target.json", root);
+  if (present(path)) {
+    (*nfiles)++;
+    if (hearth_target_read(path, &target, &e)) {
+      add_err(p, path, &e);
+      target_ok = 0;
+    }
+  }
   snprintf(path, sizeof path, "%s/calibration/detections.json", root);
   if (present(path)) {
     hearth_detections d = {0};
     (*nfiles)++;
-    if (hearth_detections_read(path, &d, &e)) add_err(p, path, &e);
+    if (hearth_detections_read(path, &d, &e)) {
+      add_err(p, path, &e);
+    } else {
+      hearth_target td;
+      const hearth_target *dt = hearth_target_or_default(&d.target, &td);
+      if (target_ok && (dt->lattice != target.lattice || dt->rows != target.rows ||
+                        dt->cols != target.cols))
+        hearth_problems_add(p, path,
+                            "made for a %s %d x %d target, calibration/target.json says %s %d x %d",
+                            hearth_lattice_name(dt->lattice), dt->rows, dt->cols,
+                            hearth_lattice_name(target.lattice), target.rows, target.cols);
+    }
     hearth_detections_free(&d);
   }
   /* capture frames: thermal CSVs and stereo JPEGs */

@@ -150,5 +150,10 @@ int main(void) {
   snprintf(cmd, sizeof cmd, "'%s' calibrate '%s'", HEARTH_EXE, root);
   rc = run(cmd, out, sizeof out);
   CHECK_MSG(rc != 0 && strstr(out, "target.json") && strstr(out, "hex 6 x 8"), "%s", out);
+  /* and validate says so */
+  snprintf(cmd, sizeof cmd, "'%s' validate '%s'", HEARTH_EXE, root);
+  rc = run(cmd, out, sizeof out);
+  CHECK_MSG(rc != 0 && strstr(out, "made for a hex 6 x 8 target, calibration/target.json says grid 6 x 8"),
+            "%s", out);
   TEST_MAIN_END();
 }
