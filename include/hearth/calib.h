@@ -1,14 +1,18 @@
-/* hearth/calib.h - area calib (src/calib/): the 84-hole plate: hole-centre
- * detection in colour and thermal images, thermal intrinsics (Zhang +
+/* hearth/calib.h - area calib (src/calib/): hole targets (hearth_target of
+ * dataset.h: the paper's 84-hole plate or any hex / grid target of
+ * calibration/target.json): hole-centre detection in colour and thermal images, thermal intrinsics (Zhang +
  * Levenberg-Marquardt) and the RGB-thermal stereo transform, plus the
  * release-level `detect` and `calibrate` stages.
  *
  * Detection never alters its input: thermal enhancement (percentile clip,
  * 8-bit, upsampling) works on a private copy and the final centres are
  * intensity-weighted centroids on the raw matrix, in native pixels.
- * Centres come out in plate order (hearth_plate_hole), so index i is the same
- * hole in every frame and camera; a frame that cannot be ordered with
- * certainty is reported found = 0 with a reason, never guessed. */
+ * Centres come out in target order (hearth_target_points), so index i is the
+ * same hole in every frame and camera; a frame that cannot be ordered with
+ * certainty is reported found = 0 with a reason, never guessed. Holes may be
+ * brighter or darker than the plate in either camera: detection tries the
+ * usual polarity first (thermal: warm holes; colour: dark holes), then the
+ * other. */
 #ifndef HEARTH_CALIB_H
 #define HEARTH_CALIB_H
 
@@ -32,22 +36,29 @@ typedef struct hearth_detect_opts {
                            fraction of the hole radius; default 0.4 (the
                            estimate reads low: 2.5 px blur on 3 px holes gives 0.28,
                            the virtual rig 1.3 px blurred frames up to 0.28) */
+  hearth_target target; /* the target to find; zeroed (the default): the paper's plate */
 } hearth_detect_opts;
 void hearth_detect_opts_default(hearth_detect_opts *o);
 
-/* Thermal matrix (1-channel F32, degC), holes warmer than the plate. Fills
+/* Thermal matrix (1-channel F32, degC), holes warmer or cooler than the plate. Fills
  * det->found, det->reason, det->centres (native pixels); det->frame and
  * det->camera are left to the caller. Errors only for invalid arguments.
  * o may be NULL (the defaults); temps is only read. */
 hearth_status hearth_detect_plate_thermal(const hearth_image *temps, const hearth_detect_opts *o,
                                           hearth_detection *det, hearth_err *err);
-/* Colour or gray U8 image (1, 3 or 4 channels), holes darker than the plate. */
+/* Colour or gray U8 image (1, 3 or 4 channels; an 8-bit tone-mapped thermal
+ * frame too), holes darker or brighter than the plate. */
 hearth_status hearth_detect_plate_color(const hearth_image *img, const hearth_detect_opts *o,
                                         hearth_detection *det, hearth_err *err);
 
 /* Order n candidate centres (pixels, any order, possibly with outliers) by
- * the plate's lattice and row structure. Returns 1 and fills centres[84] if
- * exactly the plate's 84 holes were identified, else 0 with a reason. */
+ * the target's lattice and row structure. Returns 1 and fills
+ * centres[0..hearth_target_holes(t)) if exactly the target's holes were
+ * identified in an unambiguous order, else 0 with a reason. t may be NULL
+ * or zeroed (the paper's plate). */
+int hearth_target_order(const hearth_target *t, const double (*pts)[2], size_t n,
+                        double (*centres)[2], char *reason, size_t reason_size);
+/* hearth_target_order for the paper's plate. */
 int hearth_plate_order(const double (*pts)[2], size_t n, double centres[HEARTH_PLATE_HOLES][2],
                        char *reason, size_t reason_size);
 
@@ -60,7 +71,7 @@ typedef struct hearth_calib_opts {
    * centroid of a tilted hole's image is not the image of its centre) from
    * the estimated poses, and re-solve; default 1 */
   int perspective_correction;
-  double hole_radius_m; /* default 0.004 */
+  double hole_radius_m; /* default 0.004; the release stage takes the target's */
   /* hearth_calib_intrinsics: the lens model solved for; default
    * HEARTH_LENS_BROWN5 (the rational model starts from the 5-parameter
    * solution) */
@@ -100,7 +111,9 @@ hearth_status hearth_calib_stereo(const hearth_camera *cam_a, const hearth_camer
                                   int *pair_used, hearth_err *err);
 
 /* ---- release stages ----------------------------------------------------------- */
-/* Detect the plate in every capture under <root>/calibration/captures and
+/* Detect the target of <root>/calibration/target.json (absent: the paper's
+ * plate) in every capture under <root>/calibration/captures (thermal
+ * captures of any one size) and
  * write <root>/calibration/detections.json and, if overlays, the
  * calibration/overlays/<frame>_<camera>.png images. Frames are listed
  * thermal fNNN first, then each stereo pair pNNN (rgb, thermal). out (may
@@ -157,7 +170,10 @@ typedef struct hearth_calib_report {
 /* Frees the frame lists and zeroes r; accepts a zeroed report. */
 void hearth_calib_report_free(hearth_calib_report *r);
 
-/* Read calibration/detections.json and calibration/factory.json, calibrate,
+/* Read calibration/detections.json, calibration/factory.json and
+ * calibration/target.json (absent: the paper's plate; it must be the target
+ * the detections were made for), take the thermal camera's size from its
+ * first thermal capture present, calibrate,
  * write calibration/rig.json, calibration/rig_opencv.yaml and
  * calibration/calibration_report.json (all atomically, all or nothing).
  * rep (required) is filled; the caller frees it with

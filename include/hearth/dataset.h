@@ -117,28 +117,88 @@ hearth_status hearth_poses_write(const char *path, const hearth_poses *p, hearth
 const hearth_view_pose *hearth_poses_find(const hearth_poses *p, const char *state,
                                           const char *view);
 
-/* ---- detections.json -------------------------------------------------------- */
+/* ---- calibration/target.json: the hole target ------------------------------- */
 #define HEARTH_PLATE_ROWS 8
 #define HEARTH_PLATE_HOLES 84
 #define HEARTH_PLATE_PITCH_M 0.012
 #define HEARTH_PLATE_ROW_STEP_M 0.0103923
-/* The calibration plate: 84 holes in 8 rows of alternately 11 and 10,
- * HEARTH_PLATE_PITCH_M apart in a row, rows HEARTH_PLATE_ROW_STEP_M apart,
- * odd rows shifted by half a pitch. Plate coordinates (metres, z = 0) of
- * hole i in row-by-row order. */
+/* The paper's calibration plate: 84 holes in 8 rows of alternately 11 and
+ * 10, HEARTH_PLATE_PITCH_M apart in a row, rows HEARTH_PLATE_ROW_STEP_M
+ * apart, odd rows shifted by half a pitch. Plate coordinates (metres, z = 0)
+ * of hole i in row-by-row order. */
 void hearth_plate_hole(int i, double xyz[3]);
 
+/* A target of holes on a plane. Lattices:
+ *   hex-alternating  rows of C and C-1 holes (even rows C), odd rows shifted
+ *                    by P/2: the paper's plate (8 x 11, P = 12 mm, 8 mm holes)
+ *   hex              C holes in every row, odd rows shifted by P/2 (OpenCV's
+ *                    asymmetric circle grid)
+ *   grid             R x C holes, P apart both ways
+ * Hex rows are P*sqrt(3)/2 apart, rounded to 0.1 um (the paper plate's
+ * 10.3923 mm). Holes are numbered row by row from row 0, each row by
+ * increasing x; plate x along a row, y across rows, z = 0 on the plate.
+ * A zeroed hearth_target (rows == 0) stands for the paper's plate wherever a
+ * target is taken. How the order is fixed in an image (symmetric targets
+ * included): docs/dataset.md. */
+typedef enum hearth_lattice {
+  HEARTH_LATTICE_HEX_ALTERNATING = 0,
+  HEARTH_LATTICE_HEX,
+  HEARTH_LATTICE_GRID
+} hearth_lattice;
+
+typedef struct hearth_target {
+  hearth_lattice lattice;
+  int rows, cols;
+  double pitch_m, hole_diameter_m;
+} hearth_target;
+
+#define HEARTH_TARGET_MAX_HOLES 512
+
+/* The paper's plate: hex-alternating, 8 x 11, 12 mm pitch, 8 mm holes. */
+hearth_target hearth_target_default(void);
+/* t itself, or the default for a zeroed target (rows == 0); never NULL. */
+const hearth_target *hearth_target_or_default(const hearth_target *t, hearth_target *scratch);
+/* "hex-alternating", "hex", "grid"; "?" for another value. */
+const char *hearth_lattice_name(hearth_lattice l);
+/* Parse a lattice name; returns 0 if unknown. */
+int hearth_lattice_parse(const char *name, hearth_lattice *out);
+/* Holes of the target (0 if it is not valid). */
+size_t hearth_target_holes(const hearth_target *t);
+/* Rows between hex rows / grid rows (metres). */
+double hearth_target_row_step(const hearth_target *t);
+/* Number of holes in row r. */
+int hearth_target_row_holes(const hearth_target *t, int r);
+/* Plate coordinates of the holes in order into xyz[0..holes) (z = 0). */
+void hearth_target_points(const hearth_target *t, double (*xyz)[3]);
+/* 1 if t is the paper's plate (same lattice, rows, cols, pitch, hole). */
+int hearth_target_is_default(const hearth_target *t);
+/* Checks: rows and cols 3..64 (hex-alternating cols 4..64: every target
+ * then has a hole with all its lattice neighbours), at most HEARTH_TARGET_MAX_HOLES holes, pitch
+ * 1 mm..1 m, 0 < hole diameter <= 0.8 pitch. name names the source. */
+hearth_status hearth_target_check(const hearth_target *t, const char *name, hearth_err *err);
+/* Strict reader of calibration/target.json: exactly the keys lattice, rows,
+ * cols, pitch_m, hole_diameter_m; errors name the file and the key. A path
+ * that does not exist gives the default target (HEARTH_OK). */
+hearth_status hearth_target_read(const char *path, hearth_target *t, hearth_err *err);
+hearth_status hearth_target_parse(const char *text, size_t len, const char *name, hearth_target *t,
+                                  hearth_err *err);
+hearth_status hearth_target_write(const char *path, const hearth_target *t, hearth_err *err);
+
+/* ---- detections.json -------------------------------------------------------- */
 typedef struct hearth_detection {
   char frame[HEARTH_NAME_MAX]; /* "f000", "p003" */
   char camera[16];             /* "thermal" | "rgb" */
   int found;
-  char reason[256];                      /* when !found */
-  double centres[HEARTH_PLATE_HOLES][2]; /* (u, v) pixels in plate order, when found */
+  char reason[256]; /* when !found */
+  /* (u, v) pixels in target order, when found: the first
+     hearth_target_holes(target) entries */
+  double centres[HEARTH_TARGET_MAX_HOLES][2];
 } hearth_detection;
 
 typedef struct hearth_detections {
   size_t n;
   hearth_detection *frames; /* owned */
+  hearth_target target;     /* the target detected; zeroed: the paper's plate */
 } hearth_detections;
 void hearth_detections_free(hearth_detections *d);
 hearth_status hearth_detections_read(const char *path, hearth_detections *d, hearth_err *err);

@@ -49,7 +49,8 @@ void hearth_validate_opts_default(hearth_validate_opts *o);
 
 /* Check the release at root against docs/dataset.md: release.json and its
  * instances, instance.json, every manifest and the files it lists (sizes and
- * types of images, thermal CSVs 256x192 within -50..650 degC, depth
+ * types of images, thermal CSVs of the thermal camera's size (rig.json; without it,
+ * the first thermal capture's) within -50..650 degC, depth
  * intrinsics), calibration documents, and (unless raw_only) derived/: scale,
  * mesh, pose files (rotations, names of existing views, a pose per view),
  * per-state maps (R x R shapes and dtypes, mask values 0..3, observed finite

@@ -14,6 +14,7 @@
 #include <stdint.h>
 #include "hearth/core.h"
 #include "hearth/camera.h"
+#include "hearth/dataset.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -49,6 +50,16 @@ typedef struct hearth_synth_opts {
   const char *mesh_category; /* whose states to use; default "cup" */
   int contact_sheet;         /* write instances/<id>/raw/<state>/contact_sheet.png */
   double netd_c;             /* thermal noise, default 0.05 degC */
+  /* the calibration target; zeroed (the default): the paper's plate and no
+     calibration/target.json; set: that target, written to target.json */
+  hearth_target target;
+  size_t thermal_width, thermal_height; /* thermal sensor; 0 (default): 256 x 192 */
+  int thermal_wide;                     /* a ~90 degree thermal lens, strong barrel distortion */
+  /* calibration captures made to look like real ones (all 0 by default):
+     clutter behind the plate (a window grid, a desk edge, a warm person in
+     thermal), low contrast (holes a few degC / grey levels off the plate),
+     inverted polarity (holes cooler in thermal, brighter in colour) */
+  int calib_clutter, calib_low_contrast, calib_invert;
   int threads;               /* 0 = hearth_default_threads() */
   int quiet;                 /* no progress output */
 } hearth_synth_opts;

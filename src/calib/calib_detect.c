@@ -1,9 +1,12 @@
-/* Hole-centre detection on the 84-hole plate.
+/* Hole-centre detection on a hole target (the paper's 84-hole plate by
+ * default).
  *
- * Colour: the holes are dark blobs on the white plate. Thermal: the holes
- * show the warmed backing; the matrix is percentile-clipped, scaled to 8
- * bits and upsampled (a private copy) so blob detection has smooth shapes to
- * work with. Either way the blobs are ordered by the plate lattice
+ * Colour: the holes are usually dark blobs on the white plate. Thermal: the
+ * holes usually show the warmed backing; the matrix is percentile-clipped,
+ * scaled to 8 bits and upsampled (a private copy) so blob detection has
+ * smooth shapes to work with. When the usual polarity finds no target the
+ * inverted image is tried (holes brighter in colour, cooler in thermal).
+ * Either way the blobs are ordered by the target lattice
  * (calib_order.c) and each centre is then refined as an intensity-weighted
  * centroid on the raw values (thermal: the untouched matrix, native pixels)
  * inside an elliptical window shaped by the blob's own second moments. */
@@ -408,20 +411,25 @@ static hearth_status finish(blob *bl, size_t nb, const pixsrc *raw, size_t w, si
     pts[i][0] = bl[i].cx;
     pts[i][1] = bl[i].cy;
   }
-  double ord[HEARTH_PLATE_HOLES][2];
-  if (!hearth_plate_order((const double(*)[2])pts, nb, ord, det->reason, sizeof det->reason)) {
-    free(pts);
-    return HEARTH_OK;
-  }
-  /* match ordered points back to their blobs for the window shapes */
-  double scratch[4096];
-  double blur[HEARTH_PLATE_HOLES];
+  hearth_target tdef;
+  const size_t holes = hearth_target_holes(hearth_target_or_default(&o->target, &tdef));
+  double(*ord)[2] = malloc(sizeof(*ord) * (holes ? holes : 1));
+  double *blur = malloc(sizeof(double) * (holes ? holes : 1));
   float *row = malloc(sizeof(float) * w);
-  if (!row) {
+  if (!ord || !blur || !row) {
     free(pts);
+    free(ord);
+    free(blur);
+    free(row);
     return hearth_err_set(err, HEARTH_E_NOMEM, "detection: out of memory");
   }
-  for (int i = 0; i < HEARTH_PLATE_HOLES; i++) {
+  hearth_status st = HEARTH_OK;
+  if (!hearth_target_order(&o->target, (const double(*)[2])pts, nb, ord, det->reason,
+                           sizeof det->reason))
+    goto done;
+  /* match ordered points back to their blobs for the window shapes */
+  double scratch[4096];
+  for (size_t i = 0; i < holes; i++) {
     size_t bi = 0;
     for (size_t j = 0; j < nb; j++)
       if (pts[j][0] == ord[i][0] && pts[j][1] == ord[i][1]) {
@@ -433,27 +441,28 @@ static hearth_status finish(blob *bl, size_t nb, const pixsrc *raw, size_t w, si
     blur[i] = refine_centre(raw, w, h, sign, S, c, scratch, 4096, row);
     if (isnan(blur[i])) {
       snprintf(det->reason, sizeof det->reason,
-               "hole %d at (%.1f, %.1f) could not be refined (too close to the edge)", i, ord[i][0],
-               ord[i][1]);
-      free(pts);
-      free(row);
-      return HEARTH_OK;
+               "hole %zu at (%.1f, %.1f) could not be refined (too close to the edge)", i,
+               ord[i][0], ord[i][1]);
+      goto done;
     }
     det->centres[i][0] = c[0];
     det->centres[i][1] = c[1];
   }
-  free(pts);
-  free(row);
-  qsort(blur, HEARTH_PLATE_HOLES, sizeof(double), cmp_double);
-  double med_blur = 0.5 * (blur[41] + blur[42]);
+  qsort(blur, holes, sizeof(double), cmp_double);
+  double med_blur = holes % 2 ? blur[holes / 2] : 0.5 * (blur[holes / 2 - 1] + blur[holes / 2]);
   if (med_blur > o->max_blur_frac) {
     snprintf(det->reason, sizeof det->reason,
              "blurred: edge spread %.2f of the hole radius (limit %.2f)", med_blur,
              o->max_blur_frac);
-    return HEARTH_OK;
+    goto done;
   }
   det->found = 1;
-  return HEARTH_OK;
+done:
+  free(pts);
+  free(ord);
+  free(blur);
+  free(row);
+  return st;
 }
 
 /* blob detection at a few thresholds: Otsu first, then fixed fractions
@@ -480,22 +489,30 @@ static hearth_status detect_multi(const uint8_t *U, size_t W, size_t H, double s
     for (; i < n; i++) h4[0][U[i]]++;
     for (int k = 0; k < 256; k++) hist[k] = (size_t)h4[0][k] + h4[1][k] + h4[2][k] + h4[3][k];
   }
-  int med = 0, p995 = 255;
+  int med = 0, p995 = 255, p01 = 0, p99 = 255;
   size_t acc = 0;
   for (int i = 0; i < 256; i++) {
     acc += hist[i];
     if (acc * 2 <= n) med = i + 1;
     if (acc * 1000 < n * 995) p995 = i + 1;
+    if (acc * 100 < n) p01 = i + 1;
+    if (acc * 100 < n * 99) p99 = i + 1;
   }
-  enum { NT = 9 };
+  /* then a sweep of the levels between the 1st and 99th percentiles, for
+   * holes of low contrast beside a distractor (a person, a window) that
+   * sets the percentiles, or level with the background */
+  enum { NFIX = 9, NT = NFIX + 64 };
   int thr[NT] = {otsu(hist)};
-  static const int frac[NT - 1] = {50, 35, 65, 75, 85, 25, 45, 55};
-  for (int k = 1; k < NT; k++) thr[k] = med + (p995 - med) * frac[k - 1] / 100;
+  static const int frac[NFIX - 1] = {50, 35, 65, 75, 85, 25, 45, 55};
+  for (int k = 1; k < NFIX; k++) thr[k] = med + (p995 - med) * frac[k - 1] / 100;
+  for (int k = NFIX; k < NT; k++) thr[k] = -1;
+  for (int k = NFIX, t = p01 + 3; k < NT && t < p99; k++, t += 4) thr[k] = t;
   char first_reason[256] = "";
   for (int k = 0; k < NT; k++) {
     int dup = 0;
     for (int q = 0; q < k; q++) dup |= thr[q] == thr[k];
-    if (dup || thr[k] < 0 || thr[k] >= 255) continue;
+    if (thr[k] < 0) break;
+    if (dup || thr[k] >= 255) continue;
     blob *bl = NULL;
     size_t nb = 0;
     hearth_status st = find_blobs(U, W, H, thr[k], scale, &bl, &nb, err);
@@ -508,6 +525,24 @@ static hearth_status detect_multi(const uint8_t *U, size_t W, size_t H, double s
     if (!first_reason[0]) snprintf(first_reason, sizeof first_reason, "%s", det->reason);
   }
   snprintf(det->reason, sizeof det->reason, "%s", first_reason);
+  return HEARTH_OK;
+}
+
+/* detect_multi with the usual polarity, then (not found, not blurred) on
+ * the inverted image with the opposite sign; U is inverted in place. The
+ * reason kept for a frame found in neither is the usual polarity's. */
+static hearth_status detect_polarities(uint8_t *U, size_t W, size_t H, double scale,
+                                       const pixsrc *raw, size_t w, size_t h, double sign,
+                                       const hearth_detect_opts *o, hearth_detection *det,
+                                       hearth_err *err) {
+  hearth_status st = detect_multi(U, W, H, scale, raw, w, h, sign, o, det, err);
+  if (st || det->found || !strncmp(det->reason, "blurred", 7)) return st;
+  char first[256];
+  snprintf(first, sizeof first, "%s", det->reason);
+  for (size_t i = 0; i < W * H; i++) U[i] = (uint8_t)(255 - U[i]);
+  st = detect_multi(U, W, H, scale, raw, w, h, -sign, o, det, err);
+  if (st || det->found || !strncmp(det->reason, "blurred", 7)) return st;
+  snprintf(det->reason, sizeof det->reason, "%s", first);
   return HEARTH_OK;
 }
 
@@ -630,7 +665,7 @@ hearth_status hearth_detect_plate_thermal(const hearth_image *temps, const heart
     free(hx);
   }
   pixsrc src = {T, NULL, 1};
-  st = detect_multi(U, W, H, 1.0 / up, &src, w, h, +1.0, o, det, err);
+  st = detect_polarities(U, W, H, 1.0 / up, &src, w, h, +1.0, o, det, err);
 done:
   free(g8);
   free(U);
@@ -652,6 +687,21 @@ hearth_status hearth_detect_plate_color(const hearth_image *img, const hearth_de
   size_t w = img->width, h = img->height;
   if (w < 16 || h < 16 || w > HEARTH_IMAGE_MAX_DIM || h > HEARTH_IMAGE_MAX_DIM)
     return hearth_err_set(err, HEARTH_E_SIZE, "colour detection: %zux%zu image", w, h);
+  /* a small frame (an 8-bit thermal image): its luma as a matrix through
+   * the thermal path, upsampled rather than halved */
+  if (w < 800 && h < 800) {
+    hearth_image f = {0};
+    hearth_status st = hearth_image_alloc(&f, w, h, 1, HEARTH_PIX_F32, err);
+    if (st) return st;
+    const uint8_t *q = img->data;
+    float *fv = f.data;
+    int c = img->channels;
+    for (size_t i = 0; i < w * h; i++, q += c)
+      fv[i] = c >= 3 ? (float)(0.299 * q[0] + 0.587 * q[1] + 0.114 * q[2]) : (float)q[0];
+    st = hearth_detect_plate_thermal(&f, o, det, err);
+    hearth_image_free(&f);
+    return st;
+  }
   /* blobs are found at half resolution (2 x 2 mean of the luma, inverted so
    * the dark holes are bright); centres are refined at full resolution */
   hearth_status st = HEARTH_OK;
@@ -685,7 +735,7 @@ hearth_status hearth_detect_plate_color(const hearth_image *img, const hearth_de
   }
   pixsrc src = {NULL, p, ch};
   /* half-res pixel j sits at full-res 2 j + 0.5: up = 1/2 in find_blobs terms */
-  st = detect_multi(inv, hw, hh, 2.0, &src, w, h, -1.0, o, det, err);
+  st = detect_polarities(inv, hw, hh, 2.0, &src, w, h, -1.0, o, det, err);
   free(inv);
   return st;
 }

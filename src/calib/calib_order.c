@@ -1,13 +1,17 @@
-/* Ordering candidate hole centres by the plate's triangular lattice.
+/* Ordering candidate hole centres by the target's lattice.
  *
- * Every hole has six lattice neighbours that come in opposite pairs; that is
- * affine invariant, so a seed hole and its neighbours fix a local lattice
- * basis (up to the six lattice rotations). A breadth-first walk predicts each
- * neighbour with a locally refitted affine map, so perspective and lens
- * distortion only need to be locally mild. The labelled set must then be
- * exactly the plate's 84 positions under one of the six rotations: the 11/10
- * row pattern admits only one, which fixes the orientation. Anything else is
- * a reasoned failure, never a guess. */
+ * On a hex lattice every hole has six neighbours, on a grid four, in
+ * opposite pairs; that is affine invariant, so a seed hole and its
+ * neighbours fix a local lattice basis (up to the lattice rotations). A
+ * breadth-first walk predicts each neighbour with a locally refitted affine
+ * map, so perspective and lens distortion only need to be locally mild. The
+ * labelled set must then be exactly the target's holes under one
+ * orientation-preserving lattice map. The paper's 11/10 row pattern admits
+ * only one; a grid or an even-rowed hex target also matches turned by 180
+ * degrees (a square grid by 90), and then the image fixes the order: the
+ * target's x axis must point to the right in the image, well away from the
+ * turn where the choice would flip (docs/dataset.md). Anything else is a
+ * reasoned failure, never a guess. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -15,14 +19,18 @@
 #include "calib/calib_internal.h"
 
 #define KNN 8
-#define LAB_HALF 48
+#define LAB_HALF 80
 #define LAB_SIDE (2 * LAB_HALF + 1)
 #define MAX_CAND 4000
 
-/* lattice offsets of the six neighbours in increasing image angle */
-static const int NB[6][2] = {{1, 0}, {0, 1}, {-1, 1}, {-1, 0}, {0, -1}, {1, -1}};
+/* lattice offsets of the neighbours in increasing image angle: six on a hex
+ * lattice (basis (1, 0) and (1/2, sqrt(3)/2) pitches), four on a grid */
+static const int NB6[6][2] = {{1, 0}, {0, 1}, {-1, 1}, {-1, 0}, {0, -1}, {1, -1}};
+static const int NB4[4][2] = {{1, 0}, {0, 1}, {-1, 0}, {0, -1}};
 
 typedef struct order_ctx {
+  const int (*nb)[2];
+  int nnb;
   const double (*p)[2];
   size_t n;
   int (*knn)[KNN];
@@ -85,27 +93,28 @@ static int fit_affine(const int (*l)[2], const double (*v)[2], int m, double A[4
   return ax * by - bx * ay > 0; /* orientation preserving */
 }
 
-/* is point i the centre of a clean hexagon of its six nearest neighbours? */
+/* is point i the centre of a clean hexagon (grid: cross) of its nearest
+ * neighbours? */
 static int seed_basis(const order_ctx *c, size_t i, double A[4], int nb_idx[6]) {
   const double *p = c->p[i];
-  int idx[6];
+  int k6 = c->nnb, idx[6];
   double ang[6], v[6][2];
-  for (int k = 0; k < 6; k++) {
+  for (int k = 0; k < k6; k++) {
     idx[k] = c->knn[i][k];
     if (idx[k] < 0) return 0;
   }
-  /* sixth and seventh neighbours must be clearly separated */
-  if (c->knn[i][6] >= 0) {
-    double d6 = dist2(p, c->p[c->knn[i][5]]), d7 = dist2(p, c->p[c->knn[i][6]]);
+  /* the last neighbour and the next one must be clearly separated */
+  if (c->knn[i][k6] >= 0) {
+    double d6 = dist2(p, c->p[c->knn[i][k6 - 1]]), d7 = dist2(p, c->p[c->knn[i][k6]]);
     if (d7 < d6 * 1.1) return 0;
   }
-  for (int k = 0; k < 6; k++) {
+  for (int k = 0; k < k6; k++) {
     v[k][0] = c->p[idx[k]][0] - p[0];
     v[k][1] = c->p[idx[k]][1] - p[1];
     ang[k] = atan2(v[k][1], v[k][0]);
   }
   /* sort by angle */
-  for (int a = 1; a < 6; a++)
+  for (int a = 1; a < k6; a++)
     for (int b = a; b > 0 && ang[b - 1] > ang[b]; b--) {
       double t = ang[b];
       ang[b] = ang[b - 1];
@@ -119,19 +128,21 @@ static int seed_basis(const order_ctx *c, size_t i, double A[4], int nb_idx[6]) 
       v[b - 1][0] = tv[0];
       v[b - 1][1] = tv[1];
     }
-  /* opposite pairs cancel and v1 = v0 + v2 (hexagon relations) */
+  /* opposite pairs cancel; on a hexagon also v1 = v0 + v2 */
   double scale = 0;
-  for (int k = 0; k < 6; k++) scale += hypot(v[k][0], v[k][1]);
-  scale /= 6;
+  for (int k = 0; k < k6; k++) scale += hypot(v[k][0], v[k][1]);
+  scale /= k6;
   double tol = 0.15 * scale;
-  for (int k = 0; k < 3; k++)
-    if (hypot(v[k][0] + v[k + 3][0], v[k][1] + v[k + 3][1]) > tol) return 0;
-  for (int k = 0; k < 6; k++) {
-    int a = k, b = (k + 1) % 6, d = (k + 2) % 6;
-    if (hypot(v[a][0] + v[d][0] - v[b][0], v[a][1] + v[d][1] - v[b][1]) > tol) return 0;
-  }
-  if (!fit_affine(NB, (const double(*)[2])v, 6, A)) return 0;
-  for (int k = 0; k < 6; k++) nb_idx[k] = idx[k];
+  int half = k6 / 2;
+  for (int k = 0; k < half; k++)
+    if (hypot(v[k][0] + v[k + half][0], v[k][1] + v[k + half][1]) > tol) return 0;
+  if (k6 == 6)
+    for (int k = 0; k < 6; k++) {
+      int a = k, b = (k + 1) % 6, d = (k + 2) % 6;
+      if (hypot(v[a][0] + v[d][0] - v[b][0], v[a][1] + v[d][1] - v[b][1]) > tol) return 0;
+    }
+  if (!fit_affine(c->nb, (const double(*)[2])v, k6, A)) return 0;
+  for (int k = 0; k < k6; k++) nb_idx[k] = idx[k];
   return 1;
 }
 
@@ -145,11 +156,11 @@ static void refit_local(order_ctx *c, int i) {
   int l[6][2];
   double v[6][2];
   int m = 0;
-  for (int k = 0; k < 6; k++) {
-    int *g = grid_at(c, c->lab_a[i] + NB[k][0], c->lab_b[i] + NB[k][1]);
+  for (int k = 0; k < c->nnb; k++) {
+    int *g = grid_at(c, c->lab_a[i] + c->nb[k][0], c->lab_b[i] + c->nb[k][1]);
     if (!g || *g < 0) continue;
-    l[m][0] = NB[k][0];
-    l[m][1] = NB[k][1];
+    l[m][0] = c->nb[k][0];
+    l[m][1] = c->nb[k][1];
     v[m][0] = c->p[*g][0] - c->p[i][0];
     v[m][1] = c->p[*g][1] - c->p[i][1];
     m++;
@@ -178,11 +189,12 @@ static int walk(order_ctx *c, int seed, const double A0[4], char *reason, size_t
     int i = queue[head++];
     refit_local(c, i);
     const double *A = c->A[i];
-    for (int k = 0; k < 6; k++) {
-      int a = c->lab_a[i] + NB[k][0], b = c->lab_b[i] + NB[k][1];
-      double pred[2] = {c->p[i][0] + A[0] * NB[k][0] + A[1] * NB[k][1],
-                        c->p[i][1] + A[2] * NB[k][0] + A[3] * NB[k][1]};
-      double step = hypot(A[0] * NB[k][0] + A[1] * NB[k][1], A[2] * NB[k][0] + A[3] * NB[k][1]);
+    for (int k = 0; k < c->nnb; k++) {
+      const int *nk = c->nb[k];
+      int a = c->lab_a[i] + nk[0], b = c->lab_b[i] + nk[1];
+      double pred[2] = {c->p[i][0] + A[0] * nk[0] + A[1] * nk[1],
+                        c->p[i][1] + A[2] * nk[0] + A[3] * nk[1]};
+      double step = hypot(A[0] * nk[0] + A[1] * nk[1], A[2] * nk[0] + A[3] * nk[1]);
       /* nearest candidate to the prediction among i's neighbours */
       int best = -1;
       double bd = INFINITY;
@@ -228,24 +240,70 @@ static int walk(order_ctx *c, int seed, const double A0[4], char *reason, size_t
   return count;
 }
 
-/* plate index of lattice label (a, b) (b = row), or -1 */
-static int plate_index(int a, int b) {
-  if (b < 0 || b >= HEARTH_PLATE_ROWS) return -1;
-  int c = a + b / 2;
-  int ncol = (b & 1) ? 10 : 11;
-  if (c < 0 || c >= ncol) return -1;
-  return (b / 2) * 21 + ((b & 1) ? 11 : 0) + c;
+/* target index of lattice label (a, b) (b = row), or -1; row_start[r] is
+ * the index of row r's first hole */
+static int target_index(const hearth_target *t, const int *row_start, int a, int b) {
+  if (b < 0 || b >= t->rows) return -1;
+  int c = t->lattice == HEARTH_LATTICE_GRID ? a : a + b / 2;
+  if (c < 0 || c >= hearth_target_row_holes(t, b)) return -1;
+  return row_start[b] + c;
 }
 
-int hearth_plate_order(const double (*pts)[2], size_t n, double centres[HEARTH_PLATE_HOLES][2],
-                       char *reason, size_t rs) {
+/* angle (radians) of the image direction of the target's x axis: the x
+ * column of the least-squares affine map from plate to image coordinates */
+static double x_axis_angle(const double (*obj)[3], const double (*img)[2], size_t n) {
+  double mx = 0, my = 0, mu = 0, mv = 0;
+  for (size_t i = 0; i < n; i++) {
+    mx += obj[i][0];
+    my += obj[i][1];
+    mu += img[i][0];
+    mv += img[i][1];
+  }
+  mx /= (double)n;
+  my /= (double)n;
+  mu /= (double)n;
+  mv /= (double)n;
+  double sxx = 0, sxy = 0, syy = 0, sxu = 0, syu = 0, sxv = 0, syv = 0;
+  for (size_t i = 0; i < n; i++) {
+    double x = obj[i][0] - mx, y = obj[i][1] - my, u = img[i][0] - mu, v = img[i][1] - mv;
+    sxx += x * x;
+    sxy += x * y;
+    syy += y * y;
+    sxu += x * u;
+    syu += y * u;
+    sxv += x * v;
+    syv += y * v;
+  }
+  double det = sxx * syy - sxy * sxy;
+  /* u = a x + b y: a = (syy sxu - sxy syu) / det */
+  double au = (syy * sxu - sxy * syu) / det, av = (syy * sxv - sxy * syv) / det;
+  return atan2(av, au);
+}
+
+#define MAX_MATCH 8
+/* a symmetric target's order is taken only with its x axis this far (degrees)
+ * inside the half-turn (square grid: quarter-turn) the choice covers */
+#define SYMMETRY_MARGIN_DEG 15.0
+
+int hearth_target_order(const hearth_target *target, const double (*pts)[2], size_t n,
+                        double (*centres)[2], char *reason, size_t rs) {
   char dummy[8];
   if (!reason) {
     reason = dummy;
     rs = sizeof dummy;
   }
   reason[0] = 0;
-  if (n < HEARTH_PLATE_HOLES) {
+  hearth_target tdef;
+  const hearth_target *t = hearth_target_or_default(target, &tdef);
+  const size_t holes = hearth_target_holes(t);
+  if (holes == 0 || holes > HEARTH_TARGET_MAX_HOLES) {
+    snprintf(reason, rs, "invalid target");
+    return 0;
+  }
+  int row_start[65];
+  row_start[0] = 0;
+  for (int r = 0; r < t->rows; r++) row_start[r + 1] = row_start[r] + hearth_target_row_holes(t, r);
+  if (n < holes) {
     snprintf(reason, rs, "only %zu holes visible", n);
     return 0;
   }
@@ -253,8 +311,11 @@ int hearth_plate_order(const double (*pts)[2], size_t n, double centres[HEARTH_P
     snprintf(reason, rs, "%zu blob candidates (clutter), at most %d handled", n, MAX_CAND);
     return 0;
   }
+  double(*obj)[3] = malloc(sizeof(*obj) * holes);
   order_ctx c;
   memset(&c, 0, sizeof c);
+  c.nb = t->lattice == HEARTH_LATTICE_GRID ? NB4 : NB6;
+  c.nnb = t->lattice == HEARTH_LATTICE_GRID ? 4 : 6;
   c.p = pts;
   c.n = n;
   c.knn = malloc(sizeof(*c.knn) * n);
@@ -263,13 +324,15 @@ int hearth_plate_order(const double (*pts)[2], size_t n, double centres[HEARTH_P
   c.has = malloc(sizeof(int) * n);
   c.A = malloc(sizeof(*c.A) * n);
   c.grid = malloc(sizeof(int) * LAB_SIDE * LAB_SIDE);
+  double(*cand)[2] = malloc(sizeof(*cand) * holes);
   int ok = 0;
-  if (!c.knn || !c.lab_a || !c.lab_b || !c.has || !c.A || !c.grid) {
+  if (!obj || !cand || !c.knn || !c.lab_a || !c.lab_b || !c.has || !c.A || !c.grid) {
     snprintf(reason, rs, "out of memory");
     goto done;
   }
+  hearth_target_points(t, obj);
   build_knn(&c);
-  /* seeds: clean hexagon centres, most central first */
+  /* seeds: clean hexagon (cross) centres, most central first */
   double mx = 0, my = 0;
   for (size_t i = 0; i < n; i++) {
     mx += pts[i][0];
@@ -277,8 +340,8 @@ int hearth_plate_order(const double (*pts)[2], size_t n, double centres[HEARTH_P
   }
   mx /= (double)n;
   my /= (double)n;
-  int best_count = 0, tried = 0;
-  char why[256] = "no hole with six lattice neighbours (plate not found)";
+  char why[256];
+  snprintf(why, sizeof why, "no hole with %d lattice neighbours (target not found)", c.nnb);
   for (int attempt = 0; attempt < 5 && !ok; attempt++) {
     int seed = -1;
     double sd = INFINITY, A0[4];
@@ -295,25 +358,22 @@ int hearth_plate_order(const double (*pts)[2], size_t n, double centres[HEARTH_P
       memcpy(A0, A, sizeof A);
     }
     if (seed < 0) break;
-    tried++;
     int cnt = walk(&c, seed, A0, why, sizeof why);
     if (cnt < 0) continue;
-    if (cnt > best_count) best_count = cnt;
-    if (cnt < HEARTH_PLATE_HOLES) {
+    if ((size_t)cnt < holes) {
       snprintf(why, sizeof why, "only %d holes visible on the lattice", cnt);
       continue;
     }
-    if (cnt > HEARTH_PLATE_HOLES) {
-      snprintf(why, sizeof why, "%d blobs on the lattice, the plate has %d", cnt,
-               HEARTH_PLATE_HOLES);
+    if ((size_t)cnt > holes) {
+      snprintf(why, sizeof why, "%d blobs on the lattice, the target has %zu", cnt, holes);
       continue;
     }
-    /* the labels are the plate's up to an orientation-preserving lattice
-     * map: one of the six rotations, or, when foreshortening made a
-     * second-shell hole look nearer than a first-shell one, a sheared basis.
-     * Try every unimodular M with small entries; the 11/10 row pattern
-     * admits exactly one. */
-    int matches = 0, mm[4] = {0}, match_da = 0, match_db = 0;
+    /* the labels are the target's up to an orientation-preserving lattice
+     * map: a rotation, or, when foreshortening made a second-shell hole
+     * look nearer than a first-shell one, a sheared basis. Try every
+     * unimodular M with small entries and keep those that land every label
+     * on a distinct hole. */
+    int matches = 0, mm[MAX_MATCH][4], mda[MAX_MATCH], mdb[MAX_MATCH];
     for (int m0 = -2; m0 <= 2; m0++)
       for (int m1 = -2; m1 <= 2; m1++)
         for (int m2 = -2; m2 <= 2; m2++)
@@ -331,40 +391,78 @@ int hearth_plate_order(const double (*pts)[2], size_t n, double centres[HEARTH_P
               if (b == minb && a < mina) mina = a;
             }
             int good = 1;
-            unsigned char seen[HEARTH_PLATE_HOLES] = {0};
+            unsigned char seen[HEARTH_TARGET_MAX_HOLES] = {0};
             for (size_t i = 0; i < n && good; i++) {
               if (!c.has[i]) continue;
               int a = m0 * c.lab_a[i] + m1 * c.lab_b[i], b = m2 * c.lab_a[i] + m3 * c.lab_b[i];
-              int pi = plate_index(a - mina, b - minb);
+              int pi = target_index(t, row_start, a - mina, b - minb);
               if (pi < 0 || seen[pi]) good = 0;
               else seen[pi] = 1;
             }
-            if (good) {
-              matches++;
-              mm[0] = m0;
-              mm[1] = m1;
-              mm[2] = m2;
-              mm[3] = m3;
-              match_da = -mina;
-              match_db = -minb;
+            if (good && matches < MAX_MATCH) {
+              mm[matches][0] = m0;
+              mm[matches][1] = m1;
+              mm[matches][2] = m2;
+              mm[matches][3] = m3;
+              mda[matches] = -mina;
+              mdb[matches] = -minb;
             }
+            if (good) matches++;
           }
-    if (matches != 1) {
-      snprintf(why, sizeof why, "84 lattice holes do not form the 11/10 row pattern");
+    /* the paper plate is asymmetric: exactly one */
+    if (matches < 1 || matches > 4 || (matches > 1 && hearth_target_is_default(t))) {
+      if (hearth_target_is_default(t))
+        snprintf(why, sizeof why, "84 lattice holes do not form the 11/10 row pattern");
+      else
+        snprintf(why, sizeof why, "%zu lattice holes do not form the %s %d x %d pattern", holes,
+                 hearth_lattice_name(t->lattice), t->rows, t->cols);
       continue;
     }
-    for (size_t i = 0; i < n; i++) {
-      if (!c.has[i]) continue;
-      int a = mm[0] * c.lab_a[i] + mm[1] * c.lab_b[i], b = mm[2] * c.lab_a[i] + mm[3] * c.lab_b[i];
-      int pi = plate_index(a + match_da, b + match_db);
-      centres[pi][0] = pts[i][0];
-      centres[pi][1] = pts[i][1];
+    /* each match's order; several: the target is symmetric, the one whose x
+     * axis points most nearly along +u wins, if it is clear of the turn */
+    int pick = 0;
+    double best = INFINITY;
+    for (int k = 0; k < matches; k++) {
+      for (size_t i = 0; i < n; i++) {
+        if (!c.has[i]) continue;
+        int a = mm[k][0] * c.lab_a[i] + mm[k][1] * c.lab_b[i];
+        int b = mm[k][2] * c.lab_a[i] + mm[k][3] * c.lab_b[i];
+        int pi = target_index(t, row_start, a + mda[k], b + mdb[k]);
+        cand[pi][0] = pts[i][0];
+        cand[pi][1] = pts[i][1];
+      }
+      if (matches == 1) break;
+      double ang = fabs(x_axis_angle((const double(*)[3])obj, (const double(*)[2])cand, holes));
+      if (ang < best) {
+        best = ang;
+        pick = k;
+      }
     }
+    if (matches > 1) {
+      double limit = 180.0 / matches - SYMMETRY_MARGIN_DEG;
+      if (best * 180.0 / 3.14159265358979323846 > limit) {
+        snprintf(why, sizeof why,
+                 "symmetric target turned %.0f degrees in the image (order fixed only within "
+                 "%.0f of upright)",
+                 best * 180.0 / 3.14159265358979323846, limit);
+        break;
+      }
+      for (size_t i = 0; i < n; i++) {
+        if (!c.has[i]) continue;
+        int a = mm[pick][0] * c.lab_a[i] + mm[pick][1] * c.lab_b[i];
+        int b = mm[pick][2] * c.lab_a[i] + mm[pick][3] * c.lab_b[i];
+        int pi = target_index(t, row_start, a + mda[pick], b + mdb[pick]);
+        cand[pi][0] = pts[i][0];
+        cand[pi][1] = pts[i][1];
+      }
+    }
+    memcpy(centres, cand, sizeof(*cand) * holes);
     ok = 1;
   }
   if (!ok) snprintf(reason, rs, "%s", why);
-  (void)tried;
 done:
+  free(obj);
+  free(cand);
   free(c.knn);
   free(c.lab_a);
   free(c.lab_b);
@@ -372,4 +470,10 @@ done:
   free(c.A);
   free(c.grid);
   return ok;
+}
+
+int hearth_plate_order(const double (*pts)[2], size_t n, double centres[HEARTH_PLATE_HOLES][2],
+                       char *reason, size_t rs) {
+  hearth_target t = hearth_target_default();
+  return hearth_target_order(&t, pts, n, centres, reason, rs);
 }

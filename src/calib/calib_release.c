@@ -64,10 +64,12 @@ static hearth_status list_frames(const char *dir, char prefix, const char *suffi
 /* One frame: detected on a worker, which also draws and encodes its
  * overlay; the files are written after every frame has been read. */
 typedef struct det_job {
+  const hearth_target *target;
   char path[4096];
   int thermal;
   hearth_detection det;
-  uint8_t *png; /* the encoded overlay (with overlays) */
+  size_t width, height; /* of the capture */
+  uint8_t *png;         /* the encoded overlay (with overlays) */
   size_t png_size;
   hearth_status st;
   hearth_err err;
@@ -197,15 +199,17 @@ static hearth_status draw_overlay(det_job *j, const hearth_image *img, hearth_er
                                           {160, 0, 255}, {255, 0, 255}};
     const uint8_t white[3] = {255, 255, 255};
     /* pixel centre convention: native u -> (u + 0.5) s - 0.5 */
-    for (int i = 0; i < HEARTH_PLATE_HOLES; i++) {
-      int r = (i / 21) * 2 + (i % 21 >= 11);
+    const int holes = (int)hearth_target_holes(j->target);
+    for (int i = 0, r = 0, next = hearth_target_row_holes(j->target, 0); i < holes; i++) {
+      if (i == next) next += hearth_target_row_holes(j->target, ++r);
       double x = (j->det.centres[i][0] + 0.5) * s - 0.5, y = (j->det.centres[i][1] + 0.5) * s - 0.5;
-      if (i + 1 < HEARTH_PLATE_HOLES) {
+      const uint8_t *rc = row_rgb[r & 7]; /* eight row colours, repeated */
+      if (i + 1 < holes) {
         double x1 = (j->det.centres[i + 1][0] + 0.5) * s - 0.5;
         double y1 = (j->det.centres[i + 1][1] + 0.5) * s - 0.5;
-        hearth_draw_line(&big, x, y, x1, y1, row_rgb[r], 2);
+        hearth_draw_line(&big, x, y, x1, y1, rc, 2);
       }
-      hearth_draw_circle(&big, x, y, 4, i == 0 ? white : row_rgb[r]);
+      hearth_draw_circle(&big, x, y, 4, i == 0 ? white : rc);
     }
     hearth_draw_text(&big, 8, 8, j->det.frame, white, 2);
   } else {
@@ -240,7 +244,9 @@ static void det_range(void *vctx, size_t b, size_t e, int ti) {
     det_job *j = &c->jobs[i];
     hearth_image img = {0};
     if (j->thermal) {
-      j->st = hearth_thermal_read_csv(j->path, NULL, &img, &j->err);
+      /* any size: the captures tell the thermal camera's (all must agree) */
+      const hearth_csv_opts any = {0, 0};
+      j->st = hearth_thermal_read_csv(j->path, &any, &img, &j->err);
       if (!j->st) j->st = hearth_detect_plate_thermal(&img, &c->run->detect, &j->det, &j->err);
     } else {
       /* detection reads the luma plane only (no chroma work); the overlay,
@@ -261,6 +267,8 @@ static void det_range(void *vctx, size_t b, size_t e, int ti) {
         j->st = hearth_jpeg_read(j->path, &img, &j->err);
       }
     }
+    j->width = img.width;
+    j->height = img.height;
     if (!j->st && c->run->overlays) j->st = draw_overlay(j, &img, &j->err);
     hearth_image_free(&img);
     /* every error names its file */
@@ -313,9 +321,13 @@ hearth_status hearth_calib_detect_release(const char *root, const hearth_detect_
         hearth_err_set(err, HEARTH_E_NOT_FOUND, "%s/calibration/captures: no capture frames", root);
     goto done;
   }
+  /* the target (calibration/target.json; absent: the paper's plate) */
+  hearth_detect_job job = *run;
+  snprintf(path, sizeof path, "%s/calibration/target.json", root);
+  if ((st = hearth_target_read(path, &job.detect.target, err))) goto done;
   det_ctx ctx;
   memset(&ctx, 0, sizeof ctx);
-  ctx.run = run;
+  ctx.run = &job;
   snprintf(path, sizeof path, "%s/calibration/factory.json", root);
   if (hearth_path_exists(path)) {
     hearth_factory_calib fc;
@@ -329,6 +341,7 @@ hearth_status hearth_calib_detect_release(const char *root, const hearth_detect_
     st = hearth_err_set(err, HEARTH_E_NOMEM, "detect: out of memory");
     goto done;
   }
+  for (size_t i = 0; i < nj; i++) jobs[i].target = &job.detect.target;
   for (size_t i = 0; i < nf; i++) {
     det_job *j = &jobs[i];
     snprintf(j->path, sizeof j->path, "%s/%s.csv", dth, fnames[i]);
@@ -360,6 +373,18 @@ hearth_status hearth_calib_detect_release(const char *root, const hearth_detect_
       if (err) *err = jobs[i].err;
       goto done;
     }
+  /* one thermal camera: every thermal capture of one size */
+  for (size_t i = 0, first = nj; i < nj; i++) {
+    if (!jobs[i].thermal) continue;
+    if (first == nj) first = i;
+    else if (jobs[i].width != jobs[first].width || jobs[i].height != jobs[first].height) {
+      st = hearth_err_set(err, HEARTH_E_INCONSISTENT,
+                          "%s: a %zux%zu matrix, but %s is %zux%zu (one thermal camera)",
+                          jobs[i].path, jobs[i].width, jobs[i].height, jobs[first].path,
+                          jobs[first].width, jobs[first].height);
+      goto done;
+    }
+  }
   /* outputs: overlays, then detections.json */
   if (run->overlays) {
     snprintf(path, sizeof path, "%s/calibration/overlays", root);
@@ -371,6 +396,8 @@ hearth_status hearth_calib_detect_release(const char *root, const hearth_detect_
     }
   }
   hearth_detections dets;
+  memset(&dets, 0, sizeof dets);
+  dets.target = job.detect.target;
   dets.n = nj;
   dets.frames = hearth_calloc_array(nj, sizeof(hearth_detection));
   if (!dets.frames) {
@@ -527,6 +554,42 @@ static hearth_status check_factory_size(const char *root, const char *pfac,
   return HEARTH_OK;
 }
 
+/* the default of hearth_calib_opts.hole_radius_m: left at it, the target's
+ * hole is used */
+static double def_hole_radius(void) {
+  hearth_calib_opts d;
+  hearth_calib_opts_default(&d);
+  return d.hole_radius_m;
+}
+
+/* The thermal camera's size, from the first thermal capture present
+ * (thermal frames, then the thermal halves of the pairs) of a frame in the
+ * detections. */
+static hearth_status thermal_capture_size(const char *root, const hearth_detections *dets, int *w,
+                                          int *h, hearth_err *err) {
+  for (int pass = 0; pass < 2; pass++)
+    for (size_t i = 0; i < dets->n; i++) {
+      const hearth_detection *d = &dets->frames[i];
+      if (strcmp(d->camera, "thermal") || (d->frame[0] == 'p') != pass) continue;
+      char path[4096];
+      snprintf(path, sizeof path, "%s/calibration/captures/%s/%s%s.csv", root,
+               pass ? "stereo" : "thermal", d->frame, pass ? "_thermal" : "");
+      if (!hearth_path_exists(path)) continue;
+      hearth_csv_opts any = {0, 0};
+      hearth_image img = {0};
+      hearth_status st = hearth_thermal_read_csv(path, &any, &img, err);
+      if (st) return st;
+      *w = (int)img.width;
+      *h = (int)img.height;
+      hearth_image_free(&img);
+      return HEARTH_OK;
+    }
+  return hearth_err_set(err, HEARTH_E_NOT_FOUND,
+                        "%s/calibration/captures: no thermal capture of the detected frames (the "
+                        "thermal camera's size comes from them)",
+                        root);
+}
+
 hearth_status hearth_calib_calibrate_release(const char *root, const hearth_calib_opts *o,
                                              hearth_calib_report *rep, hearth_err *err) {
   hearth_calib_opts def;
@@ -557,12 +620,43 @@ hearth_status hearth_calib_calibrate_release(const char *root, const hearth_cali
     hearth_detections_free(&dets);
     return st;
   }
-  double obj[HEARTH_PLATE_HOLES][3];
-  calib_plate_points(obj);
+  /* the target of target.json must be the one detection ordered by */
+  hearth_target target;
+  snprintf(path, sizeof path, "%s/calibration/target.json", root);
+  if ((st = hearth_target_read(path, &target, err))) {
+    hearth_detections_free(&dets);
+    return st;
+  }
+  {
+    hearth_target tdef;
+    const hearth_target *dt = hearth_target_or_default(&dets.target, &tdef);
+    if (dt->lattice != target.lattice || dt->rows != target.rows || dt->cols != target.cols ||
+        fabs(dt->pitch_m - target.pitch_m) > 1e-9) {
+      hearth_detections_free(&dets);
+      return hearth_err_set(err, HEARTH_E_INCONSISTENT,
+                            "%s: made for a %s %d x %d target of pitch %.6g m, but %s describes "
+                            "a %s %d x %d target of pitch %.6g m (run `hearth detect` again)",
+                            pdet, hearth_lattice_name(dt->lattice), dt->rows, dt->cols,
+                            dt->pitch_m, path, hearth_lattice_name(target.lattice), target.rows,
+                            target.cols, target.pitch_m);
+    }
+  }
+  /* the thermal camera's size: that of its captures */
+  int tw = 0, th_h = 0;
+  if ((st = thermal_capture_size(root, &dets, &tw, &th_h, err))) {
+    hearth_detections_free(&dets);
+    return st;
+  }
+  const size_t NH = hearth_target_holes(&target);
+  const double hole_r =
+      o->hole_radius_m != def_hole_radius() ? o->hole_radius_m : 0.5 * target.hole_diameter_m;
   size_t n = dets.n;
-  double *img_t = hearth_alloc_array(n * HEARTH_PLATE_HOLES * 2, sizeof(double));
-  double *img_a = hearth_alloc_array(n * HEARTH_PLATE_HOLES * 2, sizeof(double));
-  double *img_b = hearth_alloc_array(n * HEARTH_PLATE_HOLES * 2, sizeof(double));
+  double(*obj)[3] = hearth_alloc_array(NH, sizeof *obj);
+  double *bias = hearth_alloc_array(2 * NH, sizeof(double));
+  double *raw = hearth_alloc_array(2 * NH, sizeof(double));
+  double *img_t = hearth_alloc_array(n * NH * 2, sizeof(double));
+  double *img_a = hearth_alloc_array(n * NH * 2, sizeof(double));
+  double *img_b = hearth_alloc_array(n * NH * 2, sizeof(double));
   double *frms = hearth_alloc_array(n + 1, sizeof(double));
   double *tmp = hearth_alloc_array(n + 1, sizeof(double));
   int *used = hearth_calloc_array(n + 1, sizeof(int));
@@ -571,11 +665,12 @@ hearth_status hearth_calib_calibrate_release(const char *root, const hearth_cali
   hearth_rigid *poses = hearth_alloc_array(n + 1, sizeof(hearth_rigid));
   rep->thermal = hearth_calloc_array(n + 1, sizeof(hearth_calib_frame_report));
   rep->pairs = hearth_calloc_array(n + 1, sizeof(hearth_calib_frame_report));
-  if (!img_t || !img_a || !img_b || !frms || !tmp || !used || !tidx || !pidx || !poses ||
-      !rep->thermal || !rep->pairs) {
+  if (!obj || !bias || !raw || !img_t || !img_a || !img_b || !frms || !tmp || !used || !tidx ||
+      !pidx || !poses || !rep->thermal || !rep->pairs) {
     st = hearth_err_set(err, HEARTH_E_NOMEM, "calibrate: out of memory");
     goto done;
   }
+  hearth_target_points(&target, obj);
   /* thermal-only frames (fNNN) */
   size_t nt = 0;
   for (size_t i = 0; i < n; i++) {
@@ -590,7 +685,7 @@ hearth_status hearth_calib_calibrate_release(const char *root, const hearth_cali
     }
     fr->used = 1;
     tidx[nt] = rep->n_thermal - 1;
-    memcpy(img_t + nt * HEARTH_PLATE_HOLES * 2, d->centres, sizeof d->centres);
+    memcpy(img_t + nt * NH * 2, d->centres, sizeof(double) * 2 * NH);
     nt++;
   }
   if (nt < 3) {
@@ -609,9 +704,9 @@ hearth_status hearth_calib_calibrate_release(const char *root, const hearth_cali
     double *pts = img_b; /* scratch: the used frames packed */
     for (size_t i = 0; i < nt; i++)
       if (used[i])
-        memcpy(pts + 2 * HEARTH_PLATE_HOLES * m++, img_t + 2 * HEARTH_PLATE_HOLES * i,
-               sizeof(double) * 2 * HEARTH_PLATE_HOLES);
-    if ((st = hearth_calib_intrinsics((const double(*)[3])obj, HEARTH_PLATE_HOLES, pts, m, 256, 192,
+        memcpy(pts + 2 * NH * m++, img_t + 2 * NH * i,
+               sizeof(double) * 2 * NH);
+    if ((st = hearth_calib_intrinsics((const double(*)[3])obj, NH, pts, m, tw, th_h,
                                       o, &th, &trms, tmp, NULL, err))) {
       hearth_err_prefix(err, "%s", pdet);
       goto done;
@@ -620,8 +715,8 @@ hearth_status hearth_calib_calibrate_release(const char *root, const hearth_cali
     for (size_t i = 0; i < nt; i++) {
       hearth_rigid T;
       hearth_err e2;
-      if (hearth_calib_pose(&th, (const double(*)[3])obj, HEARTH_PLATE_HOLES,
-                            img_t + 2 * HEARTH_PLATE_HOLES * i, &T, &frms[i], &e2))
+      if (hearth_calib_pose(&th, (const double(*)[3])obj, NH,
+                            img_t + 2 * NH * i, &T, &frms[i], &e2))
         frms[i] = INFINITY;
     }
     size_t k = 0;
@@ -652,17 +747,16 @@ hearth_status hearth_calib_calibrate_release(const char *root, const hearth_cali
       size_t m = 0;
       for (size_t i = 0; i < nt; i++)
         if (used[i])
-          memcpy(pts + 2 * HEARTH_PLATE_HOLES * m++, img_t + 2 * HEARTH_PLATE_HOLES * i,
-                 sizeof(double) * 2 * HEARTH_PLATE_HOLES);
+          memcpy(pts + 2 * NH * m++, img_t + 2 * NH * i,
+                 sizeof(double) * 2 * NH);
       for (size_t k = 0; pass > 0 && k < m; k++) {
-        double bias[2 * HEARTH_PLATE_HOLES];
-        calib_circle_bias(&th, &poses[k], (const double(*)[3])obj, HEARTH_PLATE_HOLES,
-                          o->hole_radius_m, bias);
-        for (int q = 0; q < 2 * HEARTH_PLATE_HOLES; q++)
-          pts[2 * HEARTH_PLATE_HOLES * k + q] -= bias[q];
+        calib_circle_bias(&th, &poses[k], (const double(*)[3])obj, NH,
+                          hole_r, bias);
+        for (size_t q = 0; q < 2 * NH; q++)
+          pts[2 * NH * k + q] -= bias[q];
       }
-      if ((st = hearth_calib_intrinsics((const double(*)[3])obj, HEARTH_PLATE_HOLES, pts, m, 256,
-                                        192, o, &th, &trms, tmp, poses, err))) {
+      if ((st = hearth_calib_intrinsics((const double(*)[3])obj, NH, pts, m, tw,
+                                        th_h, o, &th, &trms, tmp, poses, err))) {
         hearth_err_prefix(err, "%s", pdet);
         goto done;
       }
@@ -675,16 +769,15 @@ hearth_status hearth_calib_calibrate_release(const char *root, const hearth_cali
     size_t m = 0;
     for (size_t i = 0; i < nt; i++)
       if (used[i])
-        memcpy(pts + 2 * HEARTH_PLATE_HOLES * m++, img_t + 2 * HEARTH_PLATE_HOLES * i,
-               sizeof(double) * 2 * HEARTH_PLATE_HOLES);
+        memcpy(pts + 2 * NH * m++, img_t + 2 * NH * i,
+               sizeof(double) * 2 * NH);
     for (size_t k = 0; k < m; k++) {
-      double bias[2 * HEARTH_PLATE_HOLES];
-      calib_circle_bias(&th, &poses[k], (const double(*)[3])obj, HEARTH_PLATE_HOLES,
-                        o->hole_radius_m, bias);
-      for (int q = 0; q < 2 * HEARTH_PLATE_HOLES; q++)
-        pts[2 * HEARTH_PLATE_HOLES * k + q] -= bias[q];
+      calib_circle_bias(&th, &poses[k], (const double(*)[3])obj, NH,
+                        hole_r, bias);
+      for (size_t q = 0; q < 2 * NH; q++)
+        pts[2 * NH * k + q] -= bias[q];
     }
-    if ((st = hearth_calib_intrinsics((const double(*)[3])obj, HEARTH_PLATE_HOLES, pts, m, 256, 192,
+    if ((st = hearth_calib_intrinsics((const double(*)[3])obj, NH, pts, m, tw, th_h,
                                       o, &th, &trms, tmp, poses, err))) {
       hearth_err_prefix(err, "%s", pdet);
       goto done;
@@ -720,8 +813,8 @@ hearth_status hearth_calib_calibrate_release(const char *root, const hearth_cali
       continue;
     }
     pidx[npair] = rep->n_pairs - 1;
-    memcpy(img_a + npair * HEARTH_PLATE_HOLES * 2, d->centres, sizeof d->centres);
-    memcpy(img_b + npair * HEARTH_PLATE_HOLES * 2, t->centres, sizeof t->centres);
+    memcpy(img_a + npair * NH * 2, d->centres, sizeof(double) * 2 * NH);
+    memcpy(img_b + npair * NH * 2, t->centres, sizeof(double) * 2 * NH);
     npair++;
   }
   if (npair < 1) {
@@ -734,24 +827,23 @@ hearth_status hearth_calib_calibrate_release(const char *root, const hearth_cali
     for (size_t i = 0; i < npair; i++) {
       for (int c = 0; c < 2; c++) {
         const hearth_camera *cc = c ? &th : &fc.rgb;
-        double *p = (c ? img_b : img_a) + 2 * HEARTH_PLATE_HOLES * i;
-        double raw[2 * HEARTH_PLATE_HOLES], bias[2 * HEARTH_PLATE_HOLES];
-        memcpy(raw, p, sizeof raw);
+        double *p = (c ? img_b : img_a) + 2 * NH * i;
+        memcpy(raw, p, sizeof(double) * 2 * NH);
         for (int pass = 0; pass < 2; pass++) {
           hearth_rigid T;
           hearth_err e2;
-          if (hearth_calib_pose(cc, (const double(*)[3])obj, HEARTH_PLATE_HOLES, p, &T, NULL, &e2))
+          if (hearth_calib_pose(cc, (const double(*)[3])obj, NH, p, &T, NULL, &e2))
             break;
-          calib_circle_bias(cc, &T, (const double(*)[3])obj, HEARTH_PLATE_HOLES, o->hole_radius_m,
+          calib_circle_bias(cc, &T, (const double(*)[3])obj, NH, hole_r,
                             bias);
-          for (int q = 0; q < 2 * HEARTH_PLATE_HOLES; q++) p[q] = raw[q] - bias[q];
+          for (size_t q = 0; q < 2 * NH; q++) p[q] = raw[q] - bias[q];
         }
       }
     }
   }
   hearth_rigid Tth;
   double srms;
-  if ((st = hearth_calib_stereo(&fc.rgb, &th, (const double(*)[3])obj, HEARTH_PLATE_HOLES, img_a,
+  if ((st = hearth_calib_stereo(&fc.rgb, &th, (const double(*)[3])obj, NH, img_a,
                                 img_b, npair, o, &Tth, &srms, frms, used, err))) {
     hearth_err_prefix(err, "%s", pdet);
     goto done;
@@ -780,6 +872,9 @@ hearth_status hearth_calib_calibrate_release(const char *root, const hearth_cali
   st = hearth_rig_write(path, rig, err);
 done:
   hearth_detections_free(&dets);
+  free(obj);
+  free(bias);
+  free(raw);
   free(img_t);
   free(img_a);
   free(img_b);

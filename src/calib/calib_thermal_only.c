@@ -15,7 +15,6 @@
 #include "hearth/thermal.h"
 
 #define TO_MAX_FRAMES 4096
-#define NP HEARTH_PLATE_HOLES
 
 /* ---- the frames of captures/thermal ---------------------------------------------- */
 /* One frame file: its name in the folder and its frame name in
@@ -164,11 +163,16 @@ static void to_range(void *vctx, size_t b, size_t e, int ti) {
 hearth_status calib_detect_thermal_only(const char *root, const hearth_detect_job *run,
                                         hearth_detections *out, hearth_err *err) {
   char dir[4096], path[4096];
+  /* the target of calibration/target.json (absent: the paper's plate) */
+  hearth_detect_job job = *run;
+  snprintf(path, sizeof path, "%s/calibration/target.json", root);
+  hearth_status st = hearth_target_read(path, &job.detect.target, err);
+  if (st) return st;
+  run = &job;
   snprintf(dir, sizeof dir, "%s/calibration/captures/thermal", root);
   to_file *files = NULL;
   size_t n = 0;
-  hearth_status st = list_files(dir, &files, &n, err);
-  if (st) return st;
+  if ((st = list_files(dir, &files, &n, err))) return st;
   to_job *jobs = hearth_calloc_array(n, sizeof *jobs);
   hearth_detections dets = {0, NULL};
   if (!jobs) {
@@ -218,6 +222,7 @@ hearth_status calib_detect_thermal_only(const char *root, const hearth_detect_jo
     goto done;
   }
   for (size_t i = 0; i < n; i++) dets.frames[i] = jobs[i].det;
+  dets.target = job.detect.target;
   snprintf(path, sizeof path, "%s/calibration/detections.json", root);
   if ((st = hearth_detections_write(path, &dets, err))) goto done;
   if (out) {
@@ -239,9 +244,10 @@ static int cmp_double(const void *a, const void *b) {
   return x < y ? -1 : x > y;
 }
 
-/* The problem: nt frames of NP centres (img), the plate, the image size. */
+/* The problem: nt frames of np centres (img), the target, the image size. */
 typedef struct to_problem {
   const double (*obj)[3];
+  size_t np; /* holes of the target */
   const double *img;
   size_t nt;
   int width, height;
@@ -256,14 +262,14 @@ typedef struct to_fit {
   double rms;
   double *frms; /* nt */
   int *used;    /* nt */
-  double *pts;  /* nt * NP * 2: the used frames' corrected centres, packed */
+  double *pts;  /* nt * np * 2: the used frames' corrected centres, packed */
   size_t m;     /* used frames */
 } to_fit;
 
 static void pack_used(const to_problem *p, const int *used, double *pts, size_t *m) {
   *m = 0;
   for (size_t i = 0; i < p->nt; i++)
-    if (used[i]) memcpy(pts + 2 * NP * (*m)++, p->img + 2 * NP * i, sizeof(double) * 2 * NP);
+    if (used[i]) memcpy(pts + 2 * p->np * (*m)++, p->img + 2 * p->np * i, sizeof(double) * 2 * p->np);
 }
 
 static hearth_status solve(const to_problem *p, hearth_lens_model model, const double *pts,
@@ -271,7 +277,7 @@ static hearth_status solve(const to_problem *p, hearth_lens_model model, const d
                            hearth_rigid *poses, hearth_err *err) {
   hearth_calib_opts o = *p->o;
   o.lens_model = model;
-  return hearth_calib_intrinsics(p->obj, NP, pts, m, p->width, p->height, &o, cam, rms, frms, poses,
+  return hearth_calib_intrinsics(p->obj, p->np, pts, m, p->width, p->height, &o, cam, rms, frms, poses,
                                  err);
 }
 
@@ -295,7 +301,7 @@ static hearth_status robust_fit(const to_problem *p, hearth_lens_model model, to
     for (size_t i = 0; i < nt; i++) {
       hearth_rigid T;
       hearth_err e2;
-      if (hearth_calib_pose(&f->cam, p->obj, NP, p->img + 2 * NP * i, &T, &f->frms[i], &e2))
+      if (hearth_calib_pose(&f->cam, p->obj, p->np, p->img + 2 * p->np * i, &T, &f->frms[i], &e2))
         f->frms[i] = INFINITY;
     }
     size_t k = 0;
@@ -322,9 +328,9 @@ static hearth_status robust_fit(const to_problem *p, hearth_lens_model model, to
   for (int pass = 0; p->o->perspective_correction && pass < 3; pass++) {
     pack_used(p, f->used, f->pts, &f->m);
     for (size_t k = 0; k < f->m; k++) {
-      double bias[2 * NP];
-      calib_circle_bias(&f->cam, &poses[k], p->obj, NP, p->o->hole_radius_m, bias);
-      for (int q = 0; q < 2 * NP; q++) f->pts[2 * NP * k + q] -= bias[q];
+      double bias[2 * HEARTH_TARGET_MAX_HOLES];
+      calib_circle_bias(&f->cam, &poses[k], p->obj, p->np, p->o->hole_radius_m, bias);
+      for (size_t q = 0; q < 2 * p->np; q++) f->pts[2 * p->np * k + q] -= bias[q];
     }
     if ((st = solve(p, model, f->pts, f->m, &f->cam, &f->rms, tmp, poses, err))) goto done;
   }
@@ -342,7 +348,7 @@ done:
 static hearth_status heldout(const to_problem *p, hearth_lens_model model, const to_fit *f,
                              int folds, double *rms, hearth_err *err) {
   size_t m = f->m;
-  double *train = hearth_alloc_array(m * 2 * NP, sizeof(double));
+  double *train = hearth_alloc_array(m * 2 * p->np, sizeof(double));
   if (!train) return hearth_err_set(err, HEARTH_E_NOMEM, "calibrate: out of memory");
   double sum = 0;
   size_t count = 0;
@@ -351,7 +357,7 @@ static hearth_status heldout(const to_problem *p, hearth_lens_model model, const
     size_t mt = 0;
     for (size_t i = 0; i < m; i++)
       if ((int)(i % (size_t)folds) != j)
-        memcpy(train + 2 * NP * mt++, f->pts + 2 * NP * i, sizeof(double) * 2 * NP);
+        memcpy(train + 2 * p->np * mt++, f->pts + 2 * p->np * i, sizeof(double) * 2 * p->np);
     hearth_camera cam;
     if ((st = solve(p, model, train, mt, &cam, NULL, NULL, NULL, err))) {
       hearth_err_prefix(err, "held-out fold %d of %d", j + 1, folds);
@@ -362,9 +368,9 @@ static hearth_status heldout(const to_problem *p, hearth_lens_model model, const
       double r;
       hearth_err e2;
       /* a frame the model cannot even place is predicted infinitely badly */
-      if (hearth_calib_pose(&cam, p->obj, NP, f->pts + 2 * NP * i, &T, &r, &e2)) r = INFINITY;
-      sum += r * r * NP;
-      count += NP;
+      if (hearth_calib_pose(&cam, p->obj, p->np, f->pts + 2 * p->np * i, &T, &r, &e2)) r = INFINITY;
+      sum += r * r * (double)p->np;
+      count += p->np;
     }
   }
   free(train);
@@ -530,13 +536,42 @@ hearth_status hearth_calib_thermal_only_release(const char *root, const hearth_c
   hearth_status st;
   to_fit fits[2];
   memset(fits, 0, sizeof fits);
-  double obj[NP][3];
-  calib_plate_points(obj);
+  static const size_t MAXH = HEARTH_TARGET_MAX_HOLES;
+  double(*obj)[3] = hearth_alloc_array(MAXH, sizeof(*obj));
+  hearth_target target;
+  size_t nh = 0;
   double *img = NULL;
   size_t *tidx = NULL;
   if (!hearth_path_exists(pdet))
     return hearth_err_set(err, HEARTH_E_NOT_FOUND, "%s: missing (run `hearth detect` first)", pdet);
-  if ((st = hearth_detections_read(pdet, &dets, err))) return st;
+  if (!obj) return hearth_err_set(err, HEARTH_E_NOMEM, "calibrate: out of memory");
+  if ((st = hearth_detections_read(pdet, &dets, err))) {
+    free(obj);
+    return st;
+  }
+  /* the target of target.json (absent: the paper's plate), the one detection ordered by */
+  snprintf(path, sizeof path, "%s/calibration/target.json", root);
+  if ((st = hearth_target_read(path, &target, err))) goto done;
+  {
+    hearth_target tdef;
+    const hearth_target *dt = hearth_target_or_default(&dets.target, &tdef);
+    if (dt->lattice != target.lattice || dt->rows != target.rows || dt->cols != target.cols ||
+        fabs(dt->pitch_m - target.pitch_m) > 1e-9) {
+      st = hearth_err_set(err, HEARTH_E_INCONSISTENT,
+                          "%s: made for a %s %d x %d target, but %s describes a %s %d x %d "
+                          "target (run `hearth detect` again)",
+                          pdet, hearth_lattice_name(dt->lattice), dt->rows, dt->cols, path,
+                          hearth_lattice_name(target.lattice), target.rows, target.cols);
+      goto done;
+    }
+  }
+  nh = hearth_target_holes(&target);
+  hearth_target_points(&target, obj);
+  hearth_calib_opts ot = *o, odef;
+  hearth_calib_opts_default(&odef);
+  /* left at its default, the hole radius is the target's */
+  if (ot.hole_radius_m == odef.hole_radius_m) ot.hole_radius_m = 0.5 * target.hole_diameter_m;
+  o = &ot;
   int width, height;
   snprintf(path, sizeof path, "%s/calibration/captures/stereo", root);
   int stereo = hearth_path_exists(path);
@@ -544,7 +579,7 @@ hearth_status hearth_calib_thermal_only_release(const char *root, const hearth_c
       (st = frames_size(dir, &dets, files, nf, stereo, &width, &height, err)))
     goto done;
   size_t n = dets.n;
-  img = hearth_alloc_array(n * NP * 2 + 1, sizeof(double));
+  img = hearth_alloc_array(n * nh * 2 + 1, sizeof(double));
   tidx = hearth_alloc_array(n + 1, sizeof(size_t));
   rep->thermal = hearth_calloc_array(n + 1, sizeof(hearth_calib_frame_report));
   if (!img || !tidx || !rep->thermal) {
@@ -564,7 +599,7 @@ hearth_status hearth_calib_thermal_only_release(const char *root, const hearth_c
     }
     fr->used = 1;
     tidx[nt] = rep->n_thermal - 1;
-    memcpy(img + nt * NP * 2, d->centres, sizeof d->centres);
+    memcpy(img + nt * nh * 2, d->centres, sizeof(double) * 2 * nh);
     nt++;
   }
   if (nt < 3) {
@@ -574,12 +609,12 @@ hearth_status hearth_calib_thermal_only_release(const char *root, const hearth_c
                         pdet, nt, rep->n_thermal, HEARTH_LENS_MIN_FRAMES);
     goto done;
   }
-  to_problem prob = {(const double(*)[3])obj, img, nt, width, height, o};
+  to_problem prob = {(const double(*)[3])obj, nh, img, nt, width, height, o};
   hearth_lens_choice *lc = &rep->lens;
   for (int m = 0; m < 2; m++) {
     fits[m].frms = hearth_alloc_array(nt, sizeof(double));
     fits[m].used = hearth_calloc_array(nt, sizeof(int));
-    fits[m].pts = hearth_alloc_array(nt * NP * 2, sizeof(double));
+    fits[m].pts = hearth_alloc_array(nt * nh * 2, sizeof(double));
     if (!fits[m].frms || !fits[m].used || !fits[m].pts) {
       st = hearth_err_set(err, HEARTH_E_NOMEM, "calibrate: out of memory");
       goto done;
@@ -649,6 +684,7 @@ done:
   free(tidx);
   fit_free(&fits[0]);
   fit_free(&fits[1]);
+  free(obj);
   if (st) hearth_calib_report_free(rep);
   return st;
 }

@@ -20,6 +20,54 @@ static void list_categories(FILE *out) {
   fprintf(out, "\n");
 }
 
+/* --target LATTICE[:RxC] into a target (pitch and hole from the lattice's
+ * defaults until --target-pitch / --target-hole) */
+static int parse_target(void *dst, const char *value, char *why, size_t whysz) {
+  hearth_target *t = dst;
+  char name[32];
+  const char *colon = strchr(value, ':');
+  size_t nl = colon ? (size_t)(colon - value) : strlen(value);
+  if (nl >= sizeof name) nl = sizeof name - 1;
+  memcpy(name, value, nl);
+  name[nl] = 0;
+  hearth_lattice l;
+  if (!hearth_lattice_parse(name, &l)) {
+    snprintf(why, whysz, "unknown lattice '%s'", name);
+    return 1;
+  }
+  /* defaults: the paper's plate; a 6 x 8 hex target; a 7 x 7 grid */
+  static const int def_rc[3][2] = {{8, 11}, {6, 8}, {7, 7}};
+  static const double def_pitch[3] = {0.012, 0.012, 0.015};
+  t->lattice = l;
+  t->rows = def_rc[l][0];
+  t->cols = def_rc[l][1];
+  t->pitch_m = def_pitch[l];
+  t->hole_diameter_m = 0.008;
+  if (colon) {
+    int r, c, used = 0;
+    if (sscanf(colon + 1, "%dx%d%n", &r, &c, &used) != 2 || colon[1 + used] != 0) {
+      snprintf(why, whysz, "expected LATTICE:RxC, e.g. grid:7x7");
+      return 1;
+    }
+    t->rows = r;
+    t->cols = c;
+  }
+  return 0;
+}
+
+static int parse_size(void *dst, const char *value, char *why, size_t whysz) {
+  size_t *wh = dst;
+  unsigned w, h;
+  int used = 0;
+  if (sscanf(value, "%ux%u%n", &w, &h, &used) != 2 || value[used] != 0) {
+    snprintf(why, whysz, "expected WxH, e.g. 160x120");
+    return 1;
+  }
+  wh[0] = w;
+  wh[1] = h;
+  return 0;
+}
+
 static int category_or_all(const char *s) { return !strcmp(s, "all") || hearth_category_valid(s); }
 static int state_ok(const char *s) { return hearth_state_valid(s); }
 
@@ -29,6 +77,8 @@ int hearth_cmd_synth(int argc, char **argv) {
   cli_list cats = {0}, states = {0};
   int thermal_only = 0, wide_angle = 0;
   const char *formats = NULL;
+  double pitch = 0, hole = 0;
+  size_t tsize[2] = {0, 0};
   const cli_opt opts[] = {
       CLI_STR("--out", "DIR", &o.out_root, "release root to create", .flags = CLI_REQUIRED),
       CLI_U64("--seed", "N", &o.seed, "random seed; same seed, same bytes"),
@@ -57,6 +107,28 @@ int hearth_cmd_synth(int argc, char **argv) {
                "render object colour views at a quarter size, enlarged 4x to 1920x1080 (16x "
                "faster colour; for tests and quick looks)"),
       CLI_NUM("--netd", "C", &o.netd_c, 0, 5, "thermal noise in degC"),
+      CLI_CALL("--target", "LATTICE[:RxC]", &o.target, parse_target,
+               "hex-alternating, hex or grid, optionally with rows x cols",
+               "calibration target, written to calibration/target.json: hex-alternating (the "
+               "paper's plate, 8x11), hex (C holes every row, odd rows shifted; 6x8) or grid "
+               "(RxC; 7x7)",
+               .def = "the paper's plate, no target.json"),
+      CLI_NUM("--target-pitch", "M", &pitch, 0.001, 1.0,
+              "hole spacing of --target in metres", .def = "hex 0.012, grid 0.015"),
+      CLI_NUM("--target-hole", "M", &hole, 0.0005, 0.8,
+              "hole diameter of --target in metres", .def = "0.008"),
+      CLI_CALL("--thermal-size", "WxH", tsize, parse_size, "WxH pixels, e.g. 160x120",
+               "thermal sensor size (64..1280 x 48..1024), e.g. 160x120, 382x288, 640x512",
+               .def = "256x192"),
+      CLI_FLAG("--thermal-wide", &o.thermal_wide, 1,
+               "a ~90 degree thermal lens with strong barrel distortion"),
+      CLI_FLAG("--calib-clutter", &o.calib_clutter, 1,
+               "calibration frames with a room behind the plate: a window grid, a desk edge, a "
+               "warm person, hole-sized spots"),
+      CLI_FLAG("--calib-low-contrast", &o.calib_low_contrast, 1,
+               "calibration holes only 2-4 degC (colour ~0.2) off the plate"),
+      CLI_FLAG("--calib-invert", &o.calib_invert, 1,
+               "calibration holes cooler than the plate in thermal, brighter in colour"),
       CLI_INT("--threads", "N", &o.threads, 1, 1024, "worker threads",
               .def = "HEARTH_THREADS or all cores"),
       CLI_FLAG("--quiet", &o.quiet, 1, "no progress output"),
@@ -91,6 +163,12 @@ int hearth_cmd_synth(int argc, char **argv) {
     o.n_states = states.n;
     for (size_t i = 0; i < states.n; i++) o.states[i] = states.items[i];
   }
+  if ((pitch || hole) && !o.target.rows)
+    return cli_usage_error(&cmd, "options --target-pitch and --target-hole need --target");
+  if (pitch) o.target.pitch_m = pitch;
+  if (hole) o.target.hole_diameter_m = hole;
+  o.thermal_width = tsize[0];
+  o.thermal_height = tsize[1];
   if (o.mesh_path && !hearth_category_valid(o.mesh_category))
     return cli_usage_error(&cmd,
                            "option --mesh-category: expected one of the paper's 18 "

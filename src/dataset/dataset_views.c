@@ -367,12 +367,36 @@ static void key_detections(const void *ctx, size_t i, const char **a, const char
 
 static int camera_name_ok(const char *s) { return !strcmp(s, "thermal") || !strcmp(s, "rgb"); }
 
-/* the plate block must describe the plate hearth knows (release.h constants) */
-static hearth_status pattern_from_json(hj_ctx *c, const json_t *root) {
+/* the pattern block: the paper's plate in its original form (rows,
+ * cols_even, cols_odd, pitch_m, row_step_m; only that plate), or any target
+ * as target.json describes it (a "lattice" key, then rows, cols, pitch_m,
+ * hole_diameter_m) */
+static hearth_status pattern_from_json(hj_ctx *c, const json_t *root, hearth_target *t) {
   json_t *pv;
   hearth_status s = hj_get_object(c, root, "pattern", &pv);
   if (s) return s;
   size_t m = hj_push_key(c, "pattern");
+  if (json_object_get(pv, "lattice")) {
+    char name[32];
+    memset(t, 0, sizeof *t);
+    if ((s = hj_get_string(c, pv, "lattice", name, sizeof name))) return s;
+    if (!hearth_lattice_parse(name, &t->lattice)) {
+      hj_push_key(c, "lattice");
+      return hj_fail(c, HEARTH_E_UNSUPPORTED,
+                     "expected \"hex-alternating\", \"hex\" or \"grid\", found \"%s\"", name);
+    }
+    if ((s = hj_get_int(c, pv, "rows", 3, 64, &t->rows)) ||
+        (s = hj_get_int(c, pv, "cols", 3, 64, &t->cols)) ||
+        (s = hj_get_number(c, pv, "pitch_m", &t->pitch_m)) ||
+        (s = hj_get_number(c, pv, "hole_diameter_m", &t->hole_diameter_m)))
+      return s;
+    hearth_err e2;
+    if (hearth_target_check(t, "target", &e2))
+      return hj_fail(c, e2.status, "%s", e2.msg + strlen("target: "));
+    hj_pop(c, m);
+    return HEARTH_OK;
+  }
+  *t = hearth_target_default();
   static const struct {
     const char *key;
     int want;
@@ -407,8 +431,9 @@ static hearth_status pattern_from_json(hj_ctx *c, const json_t *root) {
   return HEARTH_OK;
 }
 
-static hearth_status detection_from_json(hj_ctx *c, const json_t *v, void *elem) {
-  hearth_detection *f = elem;
+/* one frame; a found frame has `holes` centres */
+static hearth_status detection_from_json(hj_ctx *c, const json_t *v, size_t holes,
+                                         hearth_detection *f) {
   if (!json_is_object(v))
     return hj_fail(c, HEARTH_E_PARSE, "expected an object, found %s", hj_type_name(v));
   hearth_status s;
@@ -427,7 +452,7 @@ static hearth_status detection_from_json(hj_ctx *c, const json_t *v, void *elem)
     json_t *cv;
     if ((s = hj_member(c, v, "centres", &cv))) return s;
     m = hj_push_key(c, "centres");
-    if ((s = hj_mat(c, cv, HEARTH_PLATE_HOLES, 2, &f->centres[0][0]))) return s;
+    if ((s = hj_mat(c, cv, holes, 2, &f->centres[0][0]))) return s;
     hj_pop(c, m);
   } else {
     /* a frame without a detection says why; partial centres are not read */
@@ -437,16 +462,26 @@ static hearth_status detection_from_json(hj_ctx *c, const json_t *v, void *elem)
 }
 
 static hearth_status detections_from_json(hj_ctx *c, const json_t *root, void *out) {
-  hearth_detections d = {0, NULL};
+  hearth_detections d;
+  memset(&d, 0, sizeof d);
   hearth_status s;
-  if ((s = pattern_from_json(c, root))) return s;
-  size_t mk, n;
-  void *items = NULL;
-  if ((s = records_from_json(c, root, "frames", 0, HR_MAX_FRAMES, sizeof *d.frames, "frames",
-                             detection_from_json, &items, &n, &mk)))
-    return s;
-  d.frames = items;
+  if ((s = pattern_from_json(c, root, &d.target))) return s;
+  size_t holes = hearth_target_holes(&d.target), n;
+  json_t *arr;
+  if ((s = hj_member(c, root, "frames", &arr))) return s;
+  size_t mk = hj_push_key(c, "frames");
+  if ((s = hj_array(c, arr, 0, HR_MAX_FRAMES, &n))) return s;
+  d.frames = hearth_calloc_array(n ? n : 1, sizeof *d.frames);
+  if (!d.frames) return hj_fail(c, HEARTH_E_NOMEM, "cannot allocate %zu frames", n);
   d.n = n;
+  for (size_t i = 0; i < n; i++) {
+    size_t m2 = hj_push_index(c, i);
+    if ((s = detection_from_json(c, json_array_get(arr, i), holes, &d.frames[i]))) {
+      free(d.frames);
+      return s;
+    }
+    hj_pop(c, m2);
+  }
   size_t first, second;
   if (hr_find_duplicate(n, key_detections, &d, &first, &second)) {
     hj_push_index(c, second);
@@ -487,17 +522,26 @@ hearth_status hearth_detections_write(const char *path, const hearth_detections 
   json_t *pat = json_object();
   json_t *fv = json_array();
   int ok = o && pat && fv;
-  ok = ok && hj_set(pat, "rows", json_integer(HEARTH_PLATE_ROWS)) &&
-       hj_set(pat, "cols_even", json_integer(11)) && hj_set(pat, "cols_odd", json_integer(10)) &&
-       hj_set(pat, "pitch_m", json_real(HEARTH_PLATE_PITCH_M)) &&
-       hj_set(pat, "row_step_m", json_real(HEARTH_PLATE_ROW_STEP_M));
+  hearth_target tdef;
+  const hearth_target *t = hearth_target_or_default(&d->target, &tdef);
+  size_t holes = hearth_target_holes(t);
+  if (hearth_target_is_default(t))
+    ok = ok && hj_set(pat, "rows", json_integer(HEARTH_PLATE_ROWS)) &&
+         hj_set(pat, "cols_even", json_integer(11)) && hj_set(pat, "cols_odd", json_integer(10)) &&
+         hj_set(pat, "pitch_m", json_real(HEARTH_PLATE_PITCH_M)) &&
+         hj_set(pat, "row_step_m", json_real(HEARTH_PLATE_ROW_STEP_M));
+  else
+    ok = ok && hj_set(pat, "lattice", json_string(hearth_lattice_name(t->lattice))) &&
+         hj_set(pat, "rows", json_integer(t->rows)) && hj_set(pat, "cols", json_integer(t->cols)) &&
+         hj_set(pat, "pitch_m", hj_real(t->pitch_m)) &&
+         hj_set(pat, "hole_diameter_m", hj_real(t->hole_diameter_m));
   for (size_t i = 0; ok && i < d->n; i++) {
     const hearth_detection *f = &d->frames[i];
     json_t *v = json_object();
     ok = hj_set(v, "frame", hj_str(f->frame)) && hj_set(v, "camera", hj_str(f->camera)) &&
          hj_set(v, "found", json_boolean(f->found));
     if (ok && f->found)
-      ok = hj_set(v, "centres", hj_mat_new(&f->centres[0][0], HEARTH_PLATE_HOLES, 2));
+      ok = hj_set(v, "centres", hj_mat_new(&f->centres[0][0], holes, 2));
     else if (ok) ok = hj_set(v, "reason", hj_str(f->reason));
     if (!ok || json_array_append_new(fv, v) != 0) {
       if (ok) ok = 0;

@@ -6,7 +6,7 @@
 #include <stddef.h>
 #include "hearth/thermal.h"
 
-/* input larger than this is refused: a 256x192 matrix is ~0.4 MB */
+/* input larger than this is refused: a 256x192 matrix is ~0.4 MB, 640x512 ~2.5 MB */
 #define CSV_MAX_BYTES ((size_t)64 << 20)
 /* metadata pairs kept in a hearth_thermal_info, and bytes per key or value */
 #define CSV_MAX_META 256

@@ -180,8 +180,10 @@ static int present(const char *path) {
   return stat(path, &st) == 0;
 }
 
-static void check_csv(hearth_problems *p, const char *path, size_t *nfiles) {
-  hearth_csv_opts co = {256, 192};
+/* tw x th: the thermal camera's size (0 x 0: any consistent rectangle) */
+static void check_csv(hearth_problems *p, const char *path, size_t tw, size_t th,
+                      size_t *nfiles) {
+  hearth_csv_opts co = {tw, th};
   hearth_image img = {0};
   hearth_err e = {0};
   (*nfiles)++;
@@ -449,7 +451,7 @@ static void check_leftovers(hearth_problems *p, const char *dir, int depth) {
 }
 
 static void check_instance(const char *root, const char *id, const hearth_validate_opts *o,
-                           hearth_problems *p, size_t *nfiles) {
+                           const size_t tsize[2], hearth_problems *p, size_t *nfiles) {
   char path[PATH_SZ], dir[PATH_SZ];
   hearth_err e = {0};
   snprintf(dir, sizeof dir, "%s/instances/%s", root, id);
@@ -535,7 +537,7 @@ static void check_instance(const char *root, const char *id, const hearth_valida
       }
       if (have[4]) {
         snprintf(f, sizeof f, "%s/%s", sdir, vf->thermal);
-        check_csv(p, f, nfiles);
+        check_csv(p, f, tsize[0], tsize[1], nfiles);
       }
     }
   }
@@ -582,8 +584,10 @@ done:
 }
 
 /* ---- release level --------------------------------------------------------- */
+/* The thermal camera's size into tsize: rig.json's when it reads, else the
+ * first thermal capture's, else 0 x 0 (any). */
 static void check_calibration(const char *root, const hearth_validate_opts *o, hearth_problems *p,
-                              size_t *nfiles) {
+                              size_t tsize[2], size_t *nfiles) {
   char path[PATH_SZ];
   hearth_err e = {0};
   hearth_rig rig;
@@ -599,13 +603,41 @@ static void check_calibration(const char *root, const hearth_validate_opts *o, h
     hearth_problems_add(p, path,
                         "a thermal-only rig (hearth calibrate --thermal-only): a release needs "
                         "the stereo calibration (the colour camera and T_thermal_from_rgb)");
-  } else if (rig.thermal.width != 256 || rig.thermal.height != 192 || rig.rgb.width != 1920 ||
-             rig.rgb.height != 1080 || rig.depth.width != 640 || rig.depth.height != 576) {
+  } else if (rig.rgb.width != 1920 || rig.rgb.height != 1080 || rig.depth.width != 640 ||
+             rig.depth.height != 576) {
     hearth_problems_add(p, path,
-                        "camera sizes rgb %dx%d, thermal %dx%d, depth %dx%d; expected "
-                        "1920x1080, 256x192, 640x576",
-                        (int)rig.rgb.width, (int)rig.rgb.height, (int)rig.thermal.width,
-                        (int)rig.thermal.height, (int)rig.depth.width, (int)rig.depth.height);
+                        "camera sizes rgb %dx%d, depth %dx%d; expected 1920x1080, 640x576",
+                        (int)rig.rgb.width, (int)rig.rgb.height, (int)rig.depth.width,
+                        (int)rig.depth.height);
+  } else {
+    tsize[0] = (size_t)rig.thermal.width;
+    tsize[1] = (size_t)rig.thermal.height;
+  }
+  if (!tsize[0]) {
+    /* no usable rig.json: the size of the first thermal capture */
+    const char *first[2] = {"thermal", "stereo"};
+    for (int j = 0; j < 2 && !tsize[0]; j++) {
+      char dir[PATH_SZ];
+      snprintf(dir, sizeof dir, "%s/calibration/captures/%s", root, first[j]);
+      struct dirent **ents = NULL;
+      int n = scandir(dir, &ents, NULL, alphasort);
+      for (int i = 0; i < n; i++) {
+        size_t L = strlen(ents[i]->d_name);
+        if (!tsize[0] && L > 4 && !strcmp(ents[i]->d_name + L - 4, ".csv")) {
+          char f[PATH_SZ];
+          hearth_csv_opts any = {0, 0};
+          hearth_image img = {0};
+          snprintf(f, sizeof f, "%s/%s", dir, ents[i]->d_name);
+          if (!hearth_thermal_read_csv(f, &any, &img, NULL)) {
+            tsize[0] = img.width;
+            tsize[1] = img.height;
+          }
+          hearth_image_free(&img);
+        }
+        free(ents[i]);
+      }
+      free(ents);
+    }
   }
   snprintf(path, sizeof path, "%s/calibration/factory.json", root);
   if (present(path)) {
@@ -613,11 +645,33 @@ static void check_calibration(const char *root, const hearth_validate_opts *o, h
     (*nfiles)++;
     if (hearth_factory_read(path, &f, &e)) add_err(p, path, &e);
   }
+  /* the target (optional) and the detections made for it */
+  hearth_target target = hearth_target_default();
+  int target_ok = 1;
+  snprintf(path, sizeof path, "%s/calibration/target.json", root);
+  if (present(path)) {
+    (*nfiles)++;
+    if (hearth_target_read(path, &target, &e)) {
+      add_err(p, path, &e);
+      target_ok = 0;
+    }
+  }
   snprintf(path, sizeof path, "%s/calibration/detections.json", root);
   if (present(path)) {
     hearth_detections d = {0};
     (*nfiles)++;
-    if (hearth_detections_read(path, &d, &e)) add_err(p, path, &e);
+    if (hearth_detections_read(path, &d, &e)) {
+      add_err(p, path, &e);
+    } else {
+      hearth_target td;
+      const hearth_target *dt = hearth_target_or_default(&d.target, &td);
+      if (target_ok && (dt->lattice != target.lattice || dt->rows != target.rows ||
+                        dt->cols != target.cols))
+        hearth_problems_add(p, path,
+                            "made for a %s %d x %d target, calibration/target.json says %s %d x %d",
+                            hearth_lattice_name(dt->lattice), dt->rows, dt->cols,
+                            hearth_lattice_name(target.lattice), target.rows, target.cols);
+    }
     hearth_detections_free(&d);
   }
   /* capture frames: thermal CSVs and stereo JPEGs */
@@ -632,7 +686,7 @@ static void check_calibration(const char *root, const hearth_validate_opts *o, h
       const char *nm = ents[i]->d_name;
       size_t L = strlen(nm);
       snprintf(path, sizeof path, "%s/%s", dir, nm);
-      if (L > 4 && !strcmp(nm + L - 4, ".csv")) check_csv(p, path, nfiles);
+      if (L > 4 && !strcmp(nm + L - 4, ".csv")) check_csv(p, path, tsize[0], tsize[1], nfiles);
       else if (L > 4 && !strcmp(nm + L - 4, ".jpg"))
         check_image(p, path, IMG_JPEG, 1920, 1080, rgb3, 8, o->decode_images, nfiles);
       free(ents[i]);
@@ -660,6 +714,7 @@ static void check_ground_truth(const char *root, const hearth_release_doc *rel, 
 }
 
 typedef struct vctx {
+  size_t tsize[2]; /* the thermal camera's size */
   const char *root;
   const hearth_release_doc *rel;
   const hearth_validate_opts *o;
@@ -670,7 +725,7 @@ typedef struct vctx {
 static void validate_range(void *ctx, size_t b, size_t e, int t) {
   vctx *c = ctx;
   for (size_t i = b; i < e; i++)
-    check_instance(c->root, c->rel->instances[i], c->o, &c->per[i], &c->nfiles[i]);
+    check_instance(c->root, c->rel->instances[i], c->o, c->tsize, &c->per[i], &c->nfiles[i]);
 }
 
 hearth_status hearth_validate_release(const char *root, const hearth_validate_opts *o,
@@ -702,7 +757,8 @@ hearth_status hearth_validate_release(const char *root, const hearth_validate_op
     nfiles++;
     if (hb_params_read(path, &bp, &e)) add_err(out, path, &e);
   }
-  check_calibration(root, o, out, &nfiles);
+  size_t tsize[2] = {0, 0};
+  check_calibration(root, o, out, tsize, &nfiles);
 
   /* directories under instances/ that release.json does not list */
   snprintf(path, sizeof path, "%s/instances", root);
@@ -729,7 +785,7 @@ hearth_status hearth_validate_release(const char *root, const hearth_validate_op
     hearth_release_free(&rel);
     return hearth_err_set(err, HEARTH_E_NOMEM, "validate: out of memory");
   }
-  vctx c = {root, &rel, o, per, nf};
+  vctx c = {{tsize[0], tsize[1]}, root, &rel, o, per, nf};
   int nt = o->threads > 0 ? o->threads : hearth_default_threads();
   if ((size_t)nt > rel.n_instances) nt = rel.n_instances ? (int)rel.n_instances : 1;
   hearth_status s = hearth_parallel_for(rel.n_instances, nt, validate_range, &c);

@@ -12,75 +12,154 @@
 #include "synth/synth_rig.h"
 
 #define DEG (3.14159265358979323846 / 180.0)
-#define PLATE_W 0.200
-#define PLATE_H 0.150
-#define HOLE_R 0.004
 
 enum { C_OUT = 0, C_PLATE = 1, C_HOLE = 2 };
 
-void synth_plate_centre(double c[3]) {
-  c[0] = 5.0 * HEARTH_PLATE_PITCH_M;
-  c[1] = 3.5 * HEARTH_PLATE_ROW_STEP_M;
+void synth_plate_geom_init(synth_plate_geom *g, const hearth_target *target) {
+  hearth_target tdef;
+  const hearth_target *t = hearth_target_or_default(target, &tdef);
+  memset(g, 0, sizeof *g);
+  g->t = *t;
+  g->n = hearth_target_holes(t);
+  g->step = hearth_target_row_step(t);
+  g->r = 0.5 * t->hole_diameter_m;
+  g->row_start[0] = 0;
+  for (int r = 0; r < t->rows; r++) g->row_start[r + 1] = g->row_start[r] + hearth_target_row_holes(t, r);
+  double xyz[HEARTH_TARGET_MAX_HOLES][3];
+  hearth_target_points(t, xyz);
+  for (size_t i = 0; i < g->n; i++) {
+    g->holes[i][0] = xyz[i][0];
+    g->holes[i][1] = xyz[i][1];
+  }
+  int shifted = t->lattice == HEARTH_LATTICE_HEX && t->rows > 1;
+  g->ext_x = (t->cols - 1) * t->pitch_m + (shifted ? 0.5 * t->pitch_m : 0.0);
+  g->ext_y = (t->rows - 1) * g->step;
+  g->cx = 0.5 * g->ext_x;
+  g->cy = 0.5 * g->ext_y;
+  if (hearth_target_is_default(t)) {
+    /* the paper's plate: 200 x 150 mm */
+    g->half_w = 0.5 * 0.200;
+    g->half_h = 0.5 * 0.150;
+  } else {
+    /* other targets: 40 mm of plate around the outer holes' centres */
+    g->half_w = g->cx + 0.040;
+    g->half_h = g->cy + 0.040;
+  }
+}
+
+void synth_plate_centre(const synth_plate_geom *g, double c[3]) {
+  c[0] = g->cx;
+  c[1] = g->cy;
   c[2] = 0.0;
 }
 
-/* hole (r, c) through the shared pattern definition (rows of 11 and 10) */
-static void hole_xy(int r, int c, double *x, double *y) {
-  double p[3];
-  hearth_plate_hole((r / 2) * 21 + ((r & 1) ? 11 : 0) + c, p);
-  *x = p[0];
-  *y = p[1];
-}
-
-static int classify_plate(const double (*holes)[2], double x, double y) {
-  const double cx = 5.0 * HEARTH_PLATE_PITCH_M, cy = 3.5 * HEARTH_PLATE_ROW_STEP_M;
-  if (fabs(x - cx) > 0.5 * PLATE_W || fabs(y - cy) > 0.5 * PLATE_H) return C_OUT;
+static int classify_plate(const synth_plate_geom *g, double x, double y) {
+  if (fabs(x - g->cx) > g->half_w || fabs(y - g->cy) > g->half_h) return C_OUT;
+  const double R = g->r, P = g->t.pitch_m;
   /* quick accept of the margin around the pattern */
-  if (x < -HOLE_R || y < -HOLE_R || x > 10 * HEARTH_PLATE_PITCH_M + HOLE_R ||
-      y > 7 * HEARTH_PLATE_ROW_STEP_M + HOLE_R)
-    return C_PLATE;
-  int r0 = (int)lrint(y / HEARTH_PLATE_ROW_STEP_M);
+  if (x < -R || y < -R || x > g->ext_x + R || y > g->ext_y + R) return C_PLATE;
+  int r0 = (int)lrint(y / g->step);
   for (int r = r0 - 1; r <= r0 + 1; r++) {
-    if (r < 0 || r >= HEARTH_PLATE_ROWS) continue;
-    int ncol = (r & 1) ? 10 : 11;
-    double off = (r & 1) ? 0.5 * HEARTH_PLATE_PITCH_M : 0.0;
-    int c0 = (int)lrint((x - off) / HEARTH_PLATE_PITCH_M);
+    if (r < 0 || r >= g->t.rows) continue;
+    int ncol = hearth_target_row_holes(&g->t, r);
+    double off = (g->t.lattice != HEARTH_LATTICE_GRID && (r & 1)) ? 0.5 * P : 0.0;
+    int c0 = (int)lrint((x - off) / P);
     for (int cc = c0 - 1; cc <= c0 + 1; cc++) {
       if (cc < 0 || cc >= ncol) continue;
-      const double *h = holes[(r / 2) * 21 + ((r & 1) ? 11 : 0) + cc];
-      if ((x - h[0]) * (x - h[0]) + (y - h[1]) * (y - h[1]) < HOLE_R * HOLE_R) return C_HOLE;
+      const double *h = g->holes[g->row_start[r] + cc];
+      if ((x - h[0]) * (x - h[0]) + (y - h[1]) * (y - h[1]) < R * R) return C_HOLE;
     }
   }
   return C_PLATE;
 }
 
+/* what lies behind the plate, in normalised image coordinates of the
+ * camera (x = d0 / d2, y = d1 / d2): a window of panes, a desk edge, a
+ * person, a few small round spots (screws, LEDs) the size of a hole */
+typedef struct clutter {
+  int on;
+  double wx0, wx1, wy0, wy1; /* window */
+  int wnx, wny;
+  double mull;              /* mullion half width (normalised) */
+  double desk_y, desk_slope; /* below the line: desk */
+  double px, py, prx, pry;  /* person ellipse */
+  int n_spots;
+  double spots[8][3]; /* x, y, radius */
+} clutter;
+
 typedef struct plate_view {
   const hearth_camera *cam;
+  const synth_plate_geom *g;
   hearth_rigid T; /* camera from plate */
   double n[3];    /* plate normal in the camera */
   double nt;      /* n . t */
   /* thermal */
   double ambient, plate_dt, hole_dt;
   /* colour */
-  double white;
-  double holes[HEARTH_PLATE_HOLES][2]; /* plate coordinates of the holes */
+  double white, hole_grey;
+  clutter cl;
 } plate_view;
 
 static inline double dot3(const double a[3], const double b[3]) {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
-static void plate_view_init(plate_view *v, const hearth_camera *cam, const hearth_rigid *T) {
+static void plate_view_init(plate_view *v, const hearth_camera *cam, const synth_plate_geom *g,
+                            const hearth_rigid *T) {
+  memset(v, 0, sizeof *v);
   v->cam = cam;
+  v->g = g;
   v->T = *T;
   for (int i = 0; i < 3; i++) v->n[i] = T->R[i * 3 + 2];
   v->nt = dot3(v->n, T->t);
-  for (int i = 0; i < HEARTH_PLATE_HOLES; i++) {
-    double p[3];
-    hearth_plate_hole(i, p);
-    v->holes[i][0] = p[0];
-    v->holes[i][1] = p[1];
+  v->hole_grey = 0.05;
+}
+
+/* clutter drawn for one frame (its own stream, so frames without clutter
+ * draw nothing from the frame's streams) */
+static void clutter_draw(clutter *cl, hearth_rng *r) {
+  cl->on = 1;
+  cl->wx0 = hearth_rng_range(r, -0.9, -0.1);
+  cl->wx1 = cl->wx0 + hearth_rng_range(r, 0.4, 0.9);
+  cl->wy0 = hearth_rng_range(r, -0.8, -0.3);
+  cl->wy1 = cl->wy0 + hearth_rng_range(r, 0.3, 0.6);
+  cl->wnx = 2 + (int)(hearth_rng_uniform(r) * 3);
+  cl->wny = 2 + (int)(hearth_rng_uniform(r) * 2);
+  cl->mull = hearth_rng_range(r, 0.006, 0.015);
+  cl->desk_y = hearth_rng_range(r, 0.25, 0.55);
+  cl->desk_slope = hearth_rng_range(r, -0.15, 0.15);
+  cl->px = hearth_rng_range(r, -0.7, 0.7);
+  cl->py = hearth_rng_range(r, -0.4, 0.2);
+  cl->prx = hearth_rng_range(r, 0.12, 0.22);
+  cl->pry = cl->prx * hearth_rng_range(r, 1.8, 2.6);
+  cl->n_spots = 3 + (int)(hearth_rng_uniform(r) * 5);
+  for (int i = 0; i < cl->n_spots; i++) {
+    cl->spots[i][0] = hearth_rng_range(r, -0.8, 0.8);
+    cl->spots[i][1] = hearth_rng_range(r, -0.6, 0.6);
+    cl->spots[i][2] = hearth_rng_range(r, 0.006, 0.02);
   }
+}
+
+/* the background at ray d: 0 plain, 1 window pane, 2 mullion, 3 desk,
+ * 4 person, 5 spot */
+static int clutter_at(const clutter *cl, const double d[3]) {
+  if (!cl->on || d[2] <= 0) return 0;
+  double x = d[0] / d[2], y = d[1] / d[2];
+  for (int i = 0; i < cl->n_spots; i++) {
+    double dx = x - cl->spots[i][0], dy = y - cl->spots[i][1];
+    if (dx * dx + dy * dy < cl->spots[i][2] * cl->spots[i][2]) return 5;
+  }
+  double ex = (x - cl->px) / cl->prx, ey = (y - cl->py) / cl->pry;
+  if (ex * ex + ey * ey < 1) return 4;
+  if (y > cl->desk_y + cl->desk_slope * x) return 3;
+  if (x > cl->wx0 && x < cl->wx1 && y > cl->wy0 && y < cl->wy1) {
+    double fx = (x - cl->wx0) / (cl->wx1 - cl->wx0) * cl->wnx;
+    double fy = (y - cl->wy0) / (cl->wy1 - cl->wy0) * cl->wny;
+    double mx = fabs(fx - lrint(fx)) * (cl->wx1 - cl->wx0) / cl->wnx;
+    double my = fabs(fy - lrint(fy)) * (cl->wy1 - cl->wy0) / cl->wny;
+    return (mx < cl->mull || my < cl->mull) ? 2 : 1;
+  }
+  return 0;
 }
 
 /* class of the ray d (camera frame) and the plate point it meets */
@@ -93,13 +172,21 @@ static int classify_ray(const plate_view *v, const double d[3], double p[2]) {
   /* plate coordinates: R^T q */
   p[0] = v->T.R[0] * q[0] + v->T.R[3] * q[1] + v->T.R[6] * q[2];
   p[1] = v->T.R[1] * q[0] + v->T.R[4] * q[1] + v->T.R[7] * q[2];
-  return classify_plate((const double(*)[2])v->holes, p[0], p[1]);
+  return classify_plate(v->g, p[0], p[1]);
 }
 
 static double thermal_value(const plate_view *v, int cls, const double p[2], const double d[3]) {
   switch (cls) {
     case C_PLATE: return v->ambient + v->plate_dt + 1.5 * (p[0] - 0.06);
     case C_HOLE: return v->ambient + v->hole_dt + 4.0 * (p[1] - 0.036);
+    default: break;
+  }
+  switch (clutter_at(&v->cl, d)) {
+    case 1: return v->ambient - 6.0 + 0.5 * d[1]; /* glass: the cold sky */
+    case 2: return v->ambient - 1.0;
+    case 3: return v->ambient + 1.2 + 0.3 * d[0];
+    case 4: return 33.5 - 2.0 * fabs(d[0]); /* a person */
+    case 5: return v->ambient + v->hole_dt; /* a warm spot the size of a hole */
     default: return v->ambient + 0.4 * d[1] + 0.2 * d[0];
   }
 }
@@ -107,7 +194,15 @@ static double thermal_value(const plate_view *v, int cls, const double p[2], con
 static double rgb_value(const plate_view *v, int cls, const double p[2], const double d[3]) {
   switch (cls) {
     case C_PLATE: return v->white * (1.0 - 0.3 * (p[1] - 0.036));
-    case C_HOLE: return 0.05;
+    case C_HOLE: return v->hole_grey;
+    default: break;
+  }
+  switch (clutter_at(&v->cl, d)) {
+    case 1: return 0.95; /* daylight through the window */
+    case 2: return 0.15;
+    case 3: return 0.50 + 0.05 * sin(40.0 * d[0]); /* wood */
+    case 4: return 0.22; /* dark clothes */
+    case 5: return v->hole_grey;
     default: return 0.36 + 0.08 * d[1] - 0.05 * d[0];
   }
 }
@@ -257,37 +352,34 @@ static hearth_status render_rgb_plate(const plate_view *v, const float *rays, do
 }
 
 /* ---- truth ----------------------------------------------------------------------- */
-int synth_plate_truth(const hearth_camera *c, const hearth_rigid *T,
-                      double centres[HEARTH_PLATE_HOLES][2]) {
-  int inside = 0, i = 0;
-  for (int r = 0; r < HEARTH_PLATE_ROWS; r++)
-    for (int cc = 0; cc < ((r & 1) ? 10 : 11); cc++, i++) {
-      double hx, hy;
-      hole_xy(r, cc, &hx, &hy);
-      double P[3] = {hx, hy, 0}, Q[3];
-      hearth_rigid_apply(T, P, Q);
-      if (!synth_lens_project(c, Q, centres[i])) {
-        centres[i][0] = centres[i][1] = -1e9;
-        continue;
-      }
-      /* the whole rim must be inside the image */
-      int ok = 1;
-      for (int k = 0; k < 12 && ok; k++) {
-        double a = k * (2.0 * 3.14159265358979323846 / 12.0), uv[2];
-        double R[3] = {hx + HOLE_R * cos(a), hy + HOLE_R * sin(a), 0}, S[3];
-        hearth_rigid_apply(T, R, S);
-        if (!synth_lens_project(c, S, uv) || uv[0] < 0.5 || uv[1] < 0.5 || uv[0] > c->width - 1.5 ||
-            uv[1] > c->height - 1.5)
-          ok = 0;
-      }
-      inside += ok;
+int synth_plate_truth(const hearth_camera *c, const synth_plate_geom *g, const hearth_rigid *T,
+                      double (*centres)[2]) {
+  int inside = 0;
+  for (size_t i = 0; i < g->n; i++) {
+    double hx = g->holes[i][0], hy = g->holes[i][1];
+    double P[3] = {hx, hy, 0}, Q[3];
+    hearth_rigid_apply(T, P, Q);
+    if (!synth_lens_project(c, Q, centres[i])) {
+      centres[i][0] = centres[i][1] = -1e9;
+      continue;
     }
+    /* the whole rim must be inside the image */
+    int ok = 1;
+    for (int k = 0; k < 12 && ok; k++) {
+      double a = k * (2.0 * 3.14159265358979323846 / 12.0), uv[2];
+      double R[3] = {hx + g->r * cos(a), hy + g->r * sin(a), 0}, S[3];
+      hearth_rigid_apply(T, R, S);
+      if (!synth_lens_project(c, S, uv) || uv[0] < 0.5 || uv[1] < 0.5 || uv[0] > c->width - 1.5 ||
+          uv[1] > c->height - 1.5)
+        ok = 0;
+    }
+    inside += ok;
+  }
   return inside;
 }
 
-/* a plausible plate pose in front of a camera: distance d, plate centre at
- * normalised offset (ox, oy), tilted up to ~40 degrees, small roll */
-static void plate_pose(hearth_rng *r, double d, double ox, double oy, hearth_rigid *T) {
+void synth_plate_pose(const synth_plate_geom *g, hearth_rng *r, double d, double ox, double oy,
+                      hearth_rigid *T) {
   double phi = hearth_rng_range(r, 0, 2 * 3.14159265358979323846);
   double tilt = hearth_rng_range(r, 5.0, 40.0) * DEG, roll = hearth_rng_range(r, -12, 12) * DEG;
   double w1[3] = {cos(phi) * tilt, sin(phi) * tilt, 0}, w2[3] = {0, 0, roll}, R1[9], R2[9];
@@ -295,23 +387,30 @@ static void plate_pose(hearth_rng *r, double d, double ox, double oy, hearth_rig
   hearth_rotvec_to_matrix(w2, R2);
   hearth_mat3_mul(R1, R2, T->R);
   double pc[3], Rpc[3];
-  synth_plate_centre(pc);
+  synth_plate_centre(g, pc);
   hearth_rigid_rotate(T, pc, Rpc);
   double C[3] = {d * ox, d * oy, d};
   for (int k = 0; k < 3; k++) T->t[k] = C[k] - Rpc[k];
 }
 
+/* how far the plate is held: the paper plate's distances, scaled with the
+ * plate's size, and nearer for a sensor narrower than 256 pixels */
+static double distance_scale(const synth_plate_geom *g, const hearth_camera *thermal) {
+  double s = hearth_target_is_default(&g->t) ? 1.0 : g->half_w / 0.100;
+  if (thermal->width < 256) s *= sqrt(thermal->width / 256.0);
+  return s;
+}
+
 static void det_fill(hearth_detection *det, const char *frame, const char *camera,
-                     const hearth_camera *cam, const hearth_rigid *T) {
+                     const hearth_camera *cam, const synth_plate_geom *g, const hearth_rigid *T) {
   memset(det, 0, sizeof *det);
   snprintf(det->frame, sizeof det->frame, "%s", frame);
   snprintf(det->camera, sizeof det->camera, "%s", camera);
-  double c[HEARTH_PLATE_HOLES][2];
-  int n = synth_plate_truth(cam, T, c);
-  if (n == HEARTH_PLATE_HOLES) {
+  int n = synth_plate_truth(cam, g, T, det->centres);
+  if ((size_t)n == g->n) {
     det->found = 1;
-    memcpy(det->centres, c, sizeof c);
   } else {
+    memset(det->centres, 0, sizeof det->centres);
     det->found = 0;
     snprintf(det->reason, sizeof det->reason, "only %d holes visible", n);
   }
@@ -327,6 +426,75 @@ static hearth_status write_thermal(const char *path, const plate_view *v, const 
   return st;
 }
 
+/* the frame's look: contrast, polarity and clutter of the options (each
+ * with its own stream, so the paper's look draws nothing extra) */
+static void apply_look(plate_view *v, int thermal, const synth_plate_look *look, uint64_t seed) {
+  if (!look) return;
+  hearth_rng r;
+  hearth_rng_seed(&r, seed);
+  if (thermal) {
+    if (look->low_contrast) {
+      v->hole_dt = hearth_rng_range(&r, 2.0, 4.0);
+      v->plate_dt = hearth_rng_range(&r, 0.2, 0.6);
+    }
+    if (look->invert) {
+      double t = v->hole_dt;
+      v->hole_dt = v->plate_dt;
+      v->plate_dt = t;
+    }
+  } else {
+    if (look->low_contrast) {
+      v->white = hearth_rng_range(&r, 0.50, 0.60);
+      v->hole_grey = v->white - hearth_rng_range(&r, 0.15, 0.22);
+    }
+    if (look->invert) {
+      double w = v->white;
+      v->white = v->hole_grey > 0.1 ? v->hole_grey : 0.12;
+      v->hole_grey = w;
+    }
+  }
+  if (look->clutter) clutter_draw(&v->cl, &r);
+}
+
+hearth_status synth_plate_frame(const hearth_camera *cam, const synth_plate_geom *g,
+                                const hearth_rigid *T, int thermal, const synth_plate_look *look,
+                                uint64_t seed, int threads, hearth_image *out, hearth_err *err) {
+  memset(out, 0, sizeof *out);
+  float *rays = synth_ray_table(cam, thermal ? 4 : 1, threads);
+  if (!rays) return hearth_err_set(err, HEARTH_E_NOMEM, "plate frame: out of memory");
+  plate_view v;
+  plate_view_init(&v, cam, g, T);
+  hearth_rng r, noise;
+  hearth_rng_seed(&r, seed);
+  hearth_rng_fork(&r, 1, &noise);
+  v.ambient = hearth_rng_range(&r, 20.0, 24.0);
+  v.plate_dt = hearth_rng_range(&r, 0.5, 1.5);
+  v.hole_dt = hearth_rng_range(&r, 15.0, 25.0);
+  v.white = hearth_rng_range(&r, 0.80, 0.90) * (0.85 + 0.15 * fabs(v.n[2]));
+  apply_look(&v, thermal, look, seed ^ 0x9e3779b97f4a7c15ULL);
+  hearth_status st = thermal ? render_thermal_plate(&v, rays, 0.5, 0.05, &noise, threads, out, err)
+                             : render_rgb_plate(&v, rays, 0.6, &noise, threads, out, err);
+  free(rays);
+  return st;
+}
+
+hearth_status synth_tone_map8(const hearth_image *temps, hearth_image *out, hearth_err *err) {
+  size_t n = temps->width * temps->height;
+  const float *T = temps->data;
+  float lo = T[0], hi = T[0];
+  for (size_t i = 0; i < n; i++) {
+    lo = fminf(lo, T[i]);
+    hi = fmaxf(hi, T[i]);
+  }
+  hearth_status st = hearth_image_alloc(out, temps->width, temps->height, 1, HEARTH_PIX_U8, err);
+  if (st) return st;
+  uint8_t *q = out->data;
+  double span = hi > lo ? (double)hi - lo : 1.0;
+  /* a camera's automatic gain: min..max to 0..255 with a display gamma */
+  for (size_t i = 0; i < n; i++) q[i] = (uint8_t)lrint(255.0 * pow(((double)T[i] - lo) / span, 1 / 1.4));
+  return HEARTH_OK;
+}
+
 hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
                                       const hearth_synth_opts *o, uint64_t seed,
                                       const float *thermal_rays, const float *rgb_rays,
@@ -339,10 +507,30 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
   if ((st = hearth_mkdirs(dir_th, err)) || (st = hearth_mkdirs(dir_st, err)) ||
       (st = hearth_mkdirs(dir_gt, err)))
     return st;
+  synth_plate_geom *g = malloc(sizeof *g);
+  double(*c)[2] = hearth_alloc_array(HEARTH_TARGET_MAX_HOLES, sizeof *c);
+  if (!g || !c) {
+    free(g);
+    free(c);
+    return hearth_err_set(err, HEARTH_E_NOMEM, "calibration captures: out of memory");
+  }
+  synth_plate_geom_init(g, &o->target);
+  const size_t NH = g->n;
+  const double ds = distance_scale(g, &rig->thermal) * (o->thermal_wide ? 0.7 : 1.0);
+  /* a wide lens sees about twice as far to the side */
+  const double os = o->thermal_wide ? 2.0 : 1.0;
+  synth_plate_look look = {o->calib_clutter, o->calib_low_contrast, o->calib_invert};
+  const synth_plate_look *lk = (look.clutter || look.low_contrast || look.invert) ? &look : NULL;
   int nf = o->n_thermal_frames, np = o->n_stereo_pairs;
-  hearth_detections dets = {0, NULL};
+  hearth_detections dets;
+  memset(&dets, 0, sizeof dets);
+  dets.target = g->t;
   dets.frames = hearth_calloc_array((size_t)nf + 2 * (size_t)np + 1, sizeof(hearth_detection));
-  if (!dets.frames) return hearth_err_set(err, HEARTH_E_NOMEM, "detections: out of memory");
+  if (!dets.frames) {
+    free(g);
+    free(c);
+    return hearth_err_set(err, HEARTH_E_NOMEM, "detections: out of memory");
+  }
   hearth_rng base;
   hearth_rng_seed(&base, seed);
   hearth_progress prog;
@@ -358,26 +546,27 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
     hearth_rng_fork(&base, 5000 + (uint64_t)i, &noise);
     int partial = (i % 9) == 4, blurred = (i % 9) == 7;
     hearth_rigid T;
-    double c[HEARTH_PLATE_HOLES][2];
     for (int tries = 0; tries < 200; tries++) {
-      double d = hearth_rng_range(&r, 0.22, 0.40);
-      double ox = hearth_rng_range(&r, -0.24, 0.24), oy = hearth_rng_range(&r, -0.16, 0.16);
-      if (partial) ox = (hearth_rng_uniform(&r) < 0.5 ? -1 : 1) * hearth_rng_range(&r, 0.38, 0.5);
-      plate_pose(&r, d, ox, oy, &T);
-      int n = synth_plate_truth(&rig->thermal, &T, c);
-      if (partial ? (n >= 20 && n < HEARTH_PLATE_HOLES) : n == HEARTH_PLATE_HOLES) break;
+      double d = hearth_rng_range(&r, 0.22, 0.40) * ds;
+      double ox = hearth_rng_range(&r, -0.24, 0.24) * os, oy = hearth_rng_range(&r, -0.16, 0.16) * os;
+      if (partial)
+        ox = (hearth_rng_uniform(&r) < 0.5 ? -1 : 1) * hearth_rng_range(&r, 0.38, 0.5) * os;
+      synth_plate_pose(g, &r, d, ox, oy, &T);
+      size_t n = (size_t)synth_plate_truth(&rig->thermal, g, &T, c);
+      if (partial ? (n >= 20 && n < NH) : n == NH) break;
     }
     plate_view v;
-    plate_view_init(&v, &rig->thermal, &T);
+    plate_view_init(&v, &rig->thermal, g, &T);
     v.ambient = ambient_c + hearth_rng_range(&r, -0.3, 0.3);
     v.plate_dt = hearth_rng_range(&r, 0.5, 1.5);
     v.hole_dt = hearth_rng_range(&r, 15.0, 25.0);
+    if (lk) apply_look(&v, 1, lk, hearth_rng_u64(&noise) ^ (uint64_t)i);
     char name[16];
     snprintf(name, sizeof name, "f%03d", i);
     snprintf(path, sizeof path, "%s/%s.csv", dir_th, name);
     st = write_thermal(path, &v, thermal_rays, blurred ? 1.3 : 0.5, o->netd_c, &noise, o->threads,
                        err);
-    det_fill(&dets.frames[dets.n++], name, "thermal", &rig->thermal, &T);
+    det_fill(&dets.frames[dets.n++], name, "thermal", &rig->thermal, g, &T);
     hearth_progress_step(&prog, 1);
   }
 
@@ -388,26 +577,31 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
     hearth_rng_fork(&base, 6000 + (uint64_t)i, &noise);
     int partial = (i % 8) == 3, blurred = (i % 8) == 6;
     hearth_rigid T_th, T_rgb;
-    double c[HEARTH_PLATE_HOLES][2];
     for (int tries = 0; tries < 200; tries++) {
-      double d = hearth_rng_range(&r, 0.27, 0.45);
-      double ox = hearth_rng_range(&r, -0.14, 0.14), oy = hearth_rng_range(&r, -0.08, 0.08);
-      if (partial) ox = (hearth_rng_uniform(&r) < 0.5 ? -1 : 1) * hearth_rng_range(&r, 0.38, 0.5);
-      plate_pose(&r, d, ox, oy, &T_th);
+      double d = hearth_rng_range(&r, 0.27, 0.45) * ds;
+      double ox = hearth_rng_range(&r, -0.14, 0.14) * os, oy = hearth_rng_range(&r, -0.08, 0.08) * os;
+      if (partial)
+        ox = (hearth_rng_uniform(&r) < 0.5 ? -1 : 1) * hearth_rng_range(&r, 0.38, 0.5) * os;
+      synth_plate_pose(g, &r, d, ox, oy, &T_th);
       hearth_rigid_compose(&T_rgb_from_th, &T_th, &T_rgb);
-      int n = synth_plate_truth(&rig->thermal, &T_th, c);
-      int m = synth_plate_truth(&rig->rgb, &T_rgb, c);
-      if (partial ? (n >= 20 && n < HEARTH_PLATE_HOLES)
-                  : (n == HEARTH_PLATE_HOLES && m == HEARTH_PLATE_HOLES))
-        break;
+      size_t n = (size_t)synth_plate_truth(&rig->thermal, g, &T_th, c);
+      size_t m = (size_t)synth_plate_truth(&rig->rgb, g, &T_rgb, c);
+      if (partial ? (n >= 20 && n < NH) : (n == NH && m == NH)) break;
     }
     plate_view vt, vc;
-    plate_view_init(&vt, &rig->thermal, &T_th);
-    plate_view_init(&vc, &rig->rgb, &T_rgb);
+    plate_view_init(&vt, &rig->thermal, g, &T_th);
+    plate_view_init(&vc, &rig->rgb, g, &T_rgb);
     vt.ambient = ambient_c + hearth_rng_range(&r, -0.3, 0.3);
     vt.plate_dt = hearth_rng_range(&r, 0.5, 1.5);
     vt.hole_dt = hearth_rng_range(&r, 15.0, 25.0);
     vc.white = hearth_rng_range(&r, 0.80, 0.90) * (0.85 + 0.15 * fabs(vc.n[2]));
+    if (lk) {
+      uint64_t ls = hearth_rng_u64(&noise) ^ (uint64_t)i;
+      apply_look(&vt, 1, lk, ls);
+      apply_look(&vc, 0, lk, ls + 1);
+      /* the same room behind the plate in both cameras is not modelled:
+       * each camera gets its own clutter */
+    }
     char name[16];
     snprintf(name, sizeof name, "p%03d", i);
     snprintf(path, sizeof path, "%s/%s_thermal.csv", dir_st, name);
@@ -420,8 +614,8 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
       if (!st) st = hearth_jpeg_write(path, &img, 92, err);
       hearth_image_free(&img);
     }
-    det_fill(&dets.frames[dets.n++], name, "thermal", &rig->thermal, &T_th);
-    det_fill(&dets.frames[dets.n++], name, "rgb", &rig->rgb, &T_rgb);
+    det_fill(&dets.frames[dets.n++], name, "thermal", &rig->thermal, g, &T_th);
+    det_fill(&dets.frames[dets.n++], name, "rgb", &rig->rgb, g, &T_rgb);
     hearth_progress_step(&prog, 1);
   }
   hearth_progress_end(&prog);
@@ -430,21 +624,20 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
     st = hearth_detections_write(path, &dets, err);
   }
   hearth_detections_free(&dets);
+  free(g);
+  free(c);
   return st;
 }
 
 /* ---- for the thermal-only captures (synth_thermal_only.c) ------------------------------ */
-void synth_plate_pose(hearth_rng *r, double d, double ox, double oy, hearth_rigid *T) {
-  plate_pose(r, d, ox, oy, T);
-}
-
-hearth_status synth_plate_thermal_frame(const hearth_camera *cam, const hearth_rigid *T,
+hearth_status synth_plate_thermal_frame(const hearth_camera *cam, const synth_plate_geom *g,
+                                        const hearth_rigid *T,
                                         const float *rays, double ambient, double plate_dt,
                                         double hole_dt, double blur, double netd,
                                         uint64_t noise_seed, int threads, hearth_image *out,
                                         hearth_err *err) {
   plate_view v;
-  plate_view_init(&v, cam, T);
+  plate_view_init(&v, cam, g, T);
   v.ambient = ambient;
   v.plate_dt = plate_dt;
   v.hole_dt = hole_dt;

@@ -260,9 +260,12 @@ typedef struct render_ctx {
 static hearth_status write_contact_sheet(const char *path, hearth_image *thumbs,
                                          hearth_image *temps, const synth_view_def *views, size_t n,
                                          hearth_err *err) {
-  const size_t tw = 256, th = 192, pad = 6, lab = 18;
+  /* cells: a 256-wide colour thumbnail beside the thermal frame at its size */
+  const size_t tw = 256, pad = 6, lab = 18;
+  size_t th = n ? temps[0].height : 192, ttw = n ? temps[0].width : 256;
+  if (th < 144) th = 144;
   size_t cols = n < 5 ? n : 5, rows = (n + cols - 1) / cols;
-  size_t TW = 2 * tw + 3 * pad, TH = th + lab + 2 * pad;
+  size_t TW = tw + ttw + 3 * pad, TH = th + lab + 2 * pad;
   hearth_image sheet = {0};
   hearth_status st = hearth_image_alloc(&sheet, cols * TW, rows * TH, 3, HEARTH_PIX_U8, err);
   if (st) return st;
@@ -582,6 +585,16 @@ static hearth_status check_opts(const hearth_synth_opts *o, hearth_err *err) {
     return hearth_err_set(err, HEARTH_E_RANGE, "synth: calibration frame counts must be 0..999");
   if (!(o->netd_c >= 0 && o->netd_c <= 5))
     return hearth_err_set(err, HEARTH_E_RANGE, "synth: NETD must be 0..5 degC");
+  if ((o->thermal_width || o->thermal_height) &&
+      (o->thermal_width < 64 || o->thermal_width > 1280 || o->thermal_height < 48 ||
+       o->thermal_height > 1024))
+    return hearth_err_set(err, HEARTH_E_RANGE,
+                          "synth: thermal size %zux%zu: expected 64..1280 x 48..1024",
+                          o->thermal_width, o->thermal_height);
+  if (o->target.rows) {
+    hearth_status ts = hearth_target_check(&o->target, "synth: target", err);
+    if (ts) return ts;
+  }
   for (size_t i = 0; i < o->n_categories; i++)
     if (!o->categories[i] || !hearth_category_valid(o->categories[i]))
       return hearth_err_set(err, HEARTH_E_ARG, "synth: unknown category '%s'",
@@ -597,7 +610,8 @@ static hearth_status check_opts(const hearth_synth_opts *o, hearth_err *err) {
 
 static hearth_status build_tree(const hearth_synth_opts *o, const char *root, hearth_err *err) {
   hearth_rig rig;
-  synth_rig_draw(o->seed, &rig);
+  synth_rig_draw_thermal(o->seed, o->thermal_width ? (int)o->thermal_width : 256,
+                         o->thermal_height ? (int)o->thermal_height : 192, o->thermal_wide, &rig);
   int threads = o->threads > 0 ? o->threads : hearth_default_threads();
   hearth_status st;
   if ((st = mkdirf(err, "%s/calibration", root)) || (st = mkdirf(err, "%s/ground_truth", root)) ||
@@ -623,6 +637,10 @@ static hearth_status build_tree(const hearth_synth_opts *o, const char *root, he
   hearth_rng base, r;
   hearth_rng_seed(&base, o->seed);
   hearth_rng_fork(&base, synth_hash("calibration"), &r);
+  if (o->calibration && o->target.rows) {
+    snprintf(p, sizeof p, "%s/calibration/target.json", root);
+    if ((st = hearth_target_write(p, &o->target, err))) goto done;
+  }
   if (o->calibration) {
     st = synth_calibration_write(root, &rig, o, hearth_rng_u64(&r), trays, crays,
                                  hearth_rng_range(&r, 21.0, 23.0), err);

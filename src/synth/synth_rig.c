@@ -142,6 +142,11 @@ static void axis_angle(double ax, double ay, double az, double ang, double R[9])
 }
 
 void synth_rig_draw(uint64_t seed, hearth_rig *rig) {
+  synth_rig_draw_thermal(seed, 256, 192, 0, rig);
+}
+
+void synth_rig_draw_thermal(uint64_t seed, int thermal_w, int thermal_h, int wide,
+                            hearth_rig *rig) {
   hearth_rng base, r;
   hearth_rng_seed(&base, seed);
   hearth_rng_fork(&base, synth_hash("rig"), &r);
@@ -175,22 +180,32 @@ void synth_rig_draw(uint64_t seed, hearth_rig *rig) {
   c->dist[3] = hearth_rng_range(&r, -2e-4, 2e-4);
   c->dist[4] = hearth_rng_range(&r, 0.0, 0.01);
 
-  /* thermal: 256x192, ~50 x 37 degrees through a barrel lens with real
-   * tangential terms; fx chosen so the image edge sees the drawn half angle */
+  /* thermal: 256x192 by default, ~50 degrees across through a barrel lens
+   * with real tangential terms; fx chosen so the image edge sees the drawn
+   * half angle. Other sizes scale the principal point jitter with the
+   * width. The wide-angle lens: ~90 degrees across with strong barrel
+   * distortion (still monotonic out to the corners). */
   c = &rig->thermal;
-  c->width = 256;
-  c->height = 192;
-  c->dist[0] = hearth_rng_range(&r, -0.35, -0.15);
-  c->dist[1] = hearth_rng_range(&r, 0.05, 0.2);
+  c->width = thermal_w;
+  c->height = thermal_h;
+  const double sw = thermal_w / 256.0;
+  if (wide) {
+    c->dist[0] = hearth_rng_range(&r, -0.40, -0.32);
+    c->dist[1] = hearth_rng_range(&r, 0.10, 0.16);
+  } else {
+    c->dist[0] = hearth_rng_range(&r, -0.35, -0.15);
+    c->dist[1] = hearth_rng_range(&r, 0.05, 0.2);
+  }
   c->dist[2] = hearth_rng_range(&r, -0.002, 0.002);
   c->dist[3] = hearth_rng_range(&r, -0.002, 0.002);
-  c->dist[4] = hearth_rng_range(&r, -0.02, 0.02);
-  double half = 0.5 * hearth_rng_range(&r, 48.5, 51.5) * DEG, xe = tan(half), x2 = xe * xe;
+  c->dist[4] = wide ? hearth_rng_range(&r, -0.005, 0.0) : hearth_rng_range(&r, -0.02, 0.02);
+  double fov = wide ? hearth_rng_range(&r, 86.0, 92.0) : hearth_rng_range(&r, 48.5, 51.5);
+  double half = 0.5 * fov * DEG, xe = tan(half), x2 = xe * xe;
   double xd_edge = xe * (1.0 + x2 * (c->dist[0] + x2 * (c->dist[1] + x2 * c->dist[4])));
-  c->fx = 128.0 / xd_edge;
+  c->fx = 0.5 * thermal_w / xd_edge;
   c->fy = c->fx * (1.0 + hearth_rng_range(&r, -0.004, 0.004));
-  c->cx = 127.5 + hearth_rng_range(&r, -2.5, 2.5);
-  c->cy = 95.5 + hearth_rng_range(&r, -2.5, 2.5);
+  c->cx = 0.5 * (thermal_w - 1) + hearth_rng_range(&r, -2.5 * sw, 2.5 * sw);
+  c->cy = 0.5 * (thermal_h - 1) + hearth_rng_range(&r, -2.5 * sw, 2.5 * sw);
 
   /* thermal from colour: thermal sits ~5 cm above the colour camera with a
    * degree-level misalignment: x_th = R (x_rgb - b) */

@@ -36,6 +36,11 @@ float *synth_ray_table(const hearth_camera *c, int ss, int threads);
 
 /* The rig drawn from a seed (realistic Femto Bolt + Mini2 ranges). */
 void synth_rig_draw(uint64_t seed, hearth_rig *rig);
+/* The same with a thermal sensor of thermal_w x thermal_h pixels and, if
+ * wide, a ~90 degree lens with strong barrel distortion; 256, 192, 0 give
+ * synth_rig_draw's rig exactly. */
+void synth_rig_draw_thermal(uint64_t seed, int thermal_w, int thermal_h, int wide,
+                            hearth_rig *rig);
 /* OpenCV-axes camera at eye looking at target, world z up. */
 void synth_look_at(const double eye[3], const double target[3], hearth_rigid *T_world_from_cam);
 /* Cheap approximately normal noise (sum of four 16-bit uniforms, unit
@@ -91,30 +96,61 @@ hearth_status synth_render_depth(const synth_view_job *job, hearth_image *out, h
 hearth_status synth_blur_f32(hearth_image *img, double sigma, hearth_err *err);
 
 /* ---- calibration captures (synth_plate.c) ------------------------------------ */
+/* The target as the renderer uses it: hole centres in plate coordinates,
+ * row starts, the pattern's extent and centre, the plate's half size. */
+typedef struct synth_plate_geom {
+  hearth_target t;
+  size_t n;
+  double step, r; /* row step, hole radius */
+  int row_start[65];
+  double holes[HEARTH_TARGET_MAX_HOLES][2];
+  double ext_x, ext_y, cx, cy, half_w, half_h;
+} synth_plate_geom;
+/* target may be NULL or zeroed (the paper's plate, 200 x 150 mm). */
+void synth_plate_geom_init(synth_plate_geom *g, const hearth_target *target);
+/* Plate coordinates of the pattern centre (metres). */
+void synth_plate_centre(const synth_plate_geom *g, double c[3]);
+
+/* How real a calibration frame looks (all 0: the virtual rig's clean plate). */
+typedef struct synth_plate_look {
+  int clutter;      /* a window of panes, a desk edge, a person, hole-sized spots */
+  int low_contrast; /* holes 2-4 degC above the plate; colour contrast ~0.2 */
+  int invert;       /* holes cooler than the plate (thermal), brighter (colour) */
+} synth_plate_look;
+
 /* Write calibration/captures/... and ground_truth/calibration/detections.json
  * under root for the rig. */
 hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
                                       const hearth_synth_opts *o, uint64_t seed,
                                       const float *thermal_rays, const float *rgb_rays,
                                       double ambient_c, hearth_err *err);
-/* Plate coordinates of the pattern centre (metres). */
-void synth_plate_centre(double c[3]);
-/* True centres of the 84 holes in camera c for T_cam_from_plate; returns
- * how many are wholly inside the image. */
-int synth_plate_truth(const hearth_camera *c, const hearth_rigid *T_cam_from_plate,
-                      double centres[HEARTH_PLATE_HOLES][2]);
+/* True centres of the target's holes in camera c for T_cam_from_plate into
+ * centres[0..g->n); returns how many are wholly inside the image. */
+int synth_plate_truth(const hearth_camera *c, const synth_plate_geom *g,
+                      const hearth_rigid *T_cam_from_plate, double (*centres)[2]);
+/* A plausible plate pose: pattern centre at distance d and normalised
+ * offset (ox, oy), tilted 5..40 degrees, rolled up to 12. */
+void synth_plate_pose(const synth_plate_geom *g, hearth_rng *r, double d, double ox, double oy,
+                      hearth_rigid *T_cam_from_plate);
+/* One calibration frame of the target at pose T in camera cam: thermal (F32
+ * degC, 0.05 degC noise) or colour (U8 RGB), with the look (NULL: clean),
+ * deterministic in seed. out is allocated (hearth_image_free). */
+hearth_status synth_plate_frame(const hearth_camera *cam, const synth_plate_geom *g,
+                                const hearth_rigid *T, int thermal, const synth_plate_look *look,
+                                uint64_t seed, int threads, hearth_image *out, hearth_err *err);
+/* A thermal frame as an 8-bit tone-mapped image (min..max, gamma 1/1.4),
+ * the way cameras without a radiometric export save it. */
+hearth_status synth_tone_map8(const hearth_image *temps, hearth_image *out, hearth_err *err);
 
-/* One thermal-only frame of the plate at T_cam_from_plate (1-channel F32,
+/* One thermal-only frame of the target g at T_cam_from_plate (1-channel F32,
  * degC): plate ambient + plate_dt, holes ambient + hole_dt, Gaussian blur,
  * noise netd (seeded by noise_seed); rays from synth_ray_table(cam, 4). */
-hearth_status synth_plate_thermal_frame(const hearth_camera *cam, const hearth_rigid *T,
+hearth_status synth_plate_thermal_frame(const hearth_camera *cam, const synth_plate_geom *g,
+                                        const hearth_rigid *T,
                                         const float *rays, double ambient, double plate_dt,
                                         double hole_dt, double blur, double netd,
                                         uint64_t noise_seed, int threads, hearth_image *out,
                                         hearth_err *err);
-/* A plausible plate pose (as for the rig's own captures): plate centre at
- * distance d, normalised offset (ox, oy), tilted 5..40 degrees, small roll. */
-void synth_plate_pose(hearth_rng *r, double d, double ox, double oy, hearth_rigid *T);
 
 /* ---- instances (synth_release.c) ---------------------------------------------- */
 /* One instance as the rig captures it; shared with the tests so they can

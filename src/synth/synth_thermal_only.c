@@ -152,6 +152,15 @@ static hearth_status build(const hearth_synth_thermal_opts *o, const char *root,
     free(dets.frames);
     return hearth_err_set(err, HEARTH_E_NOMEM, "synth: out of memory");
   }
+  /* the paper's plate */
+  synth_plate_geom *g = malloc(sizeof *g);
+  if (!g) {
+    free(rays);
+    free(dets.frames);
+    return hearth_err_set(err, HEARTH_E_NOMEM, "synth: out of memory");
+  }
+  synth_plate_geom_init(g, NULL);
+  const int nh = (int)g->n;
   hearth_rng base;
   hearth_rng_seed(&base, o->seed);
   /* plate distance and offsets that keep the whole plate in view and
@@ -162,17 +171,17 @@ static hearth_status build(const hearth_synth_thermal_opts *o, const char *root,
     hearth_rng r;
     hearth_rng_fork(&base, 7000 + (uint64_t)i, &r);
     hearth_rigid T;
-    double c[HEARTH_PLATE_HOLES][2];
+    double c[HEARTH_TARGET_MAX_HOLES][2];
     int n = 0;
-    for (int tries = 0; tries < 400 && n != HEARTH_PLATE_HOLES; tries++) {
+    for (int tries = 0; tries < 400 && n != nh; tries++) {
       double d = hearth_rng_range(&r, dmin, dmax);
       double ox = hearth_rng_range(&r, -oxm, oxm), oy = hearth_rng_range(&r, -oym, oym);
-      synth_plate_pose(&r, d, ox, oy, &T);
-      n = synth_plate_truth(cam, &T, c);
+      synth_plate_pose(g, &r, d, ox, oy, &T);
+      n = synth_plate_truth(cam, g, &T, c);
     }
     hearth_image img = {0};
     double ambient = hearth_rng_range(&r, 21.0, 23.0);
-    st = synth_plate_thermal_frame(cam, &T, rays, ambient, hearth_rng_range(&r, 0.5, 1.5),
+    st = synth_plate_thermal_frame(cam, g, &T, rays, ambient, hearth_rng_range(&r, 0.5, 1.5),
                                    hearth_rng_range(&r, 15.0, 25.0), 0.5, o->netd_c,
                                    hearth_rng_u64(&r), threads, &img, err);
     fmt_kind f = (fmt_kind)fmts[(size_t)i % nfmt];
@@ -184,8 +193,8 @@ static hearth_status build(const hearth_synth_thermal_opts *o, const char *root,
     hearth_detection *det = &dets.frames[dets.n++];
     snprintf(det->frame, sizeof det->frame, "%s", name);
     snprintf(det->camera, sizeof det->camera, "thermal");
-    det->found = n == HEARTH_PLATE_HOLES;
-    if (det->found) memcpy(det->centres, c, sizeof c);
+    det->found = n == nh;
+    if (det->found) memcpy(det->centres, c, sizeof(double) * 2 * (size_t)nh);
     else snprintf(det->reason, sizeof det->reason, "only %d holes visible", n);
   }
   if (!st) {
@@ -194,6 +203,7 @@ static hearth_status build(const hearth_synth_thermal_opts *o, const char *root,
   }
   hearth_detections_free(&dets);
   free(rays);
+  free(g);
   return st;
 }
 
