@@ -42,6 +42,8 @@ struct sim_render {
   int kind; /* SIM_RENDER_SOFT, _GL or _NONE */
   sim_soft *sw;
   unsigned char *th_geom; /* ngeom flags: the assets' thermal geoms */
+  int *twin_tex;          /* ngeom: thermal texture of each colour mesh geom, else -1 */
+  int twin_ok;            /* thermal view drawn in the RGB view's pass */
   int *ids;               /* width*height geom ids of a segmentation render */
   int egl;
   OSMesaContext gl;
@@ -159,6 +161,30 @@ static hearth_status egl_open(sim_render *r, hearth_err *err) {
   return HEARTH_OK;
 }
 
+/* whether the thermal view can come from the RGB view's pass: the
+ * colour meshes (group 2) and thermal meshes (group 3) are exactly the
+ * assets' pairs, each pair the same mesh at the same pose */
+static void twin_setup(hearth_sim_env *e) {
+  sim_render *r = e->rnd;
+  const mjModel *m = e->m;
+  int ok = 1, n2 = 0, n3 = 0;
+  for (int g = 0; g < m->ngeom; g++) {
+    r->twin_tex[g] = -1;
+    n2 += m->geom_group[g] == 2, n3 += m->geom_group[g] == 3;
+  }
+  for (int k = 0; k < SIM_NOBJ && ok; k++) {
+    int a = e->obj_geom_rgb[k], b = e->obj_geom_th[k];
+    ok = a >= 0 && b >= 0 && m->geom_group[a] == 2 && m->geom_group[b] == 3 &&
+         m->geom_type[a] == m->geom_type[b] && m->geom_dataid[a] == m->geom_dataid[b] &&
+         m->geom_bodyid[a] == m->geom_bodyid[b] &&
+         memcmp(m->geom_pos + 3 * a, m->geom_pos + 3 * b, 3 * sizeof(mjtNum)) == 0 &&
+         memcmp(m->geom_quat + 4 * a, m->geom_quat + 4 * b, 4 * sizeof(mjtNum)) == 0 &&
+         m->geom_matid[b] >= 0 && m->mat_texid[m->geom_matid[b]] >= 0;
+    if (ok) r->twin_tex[a] = m->mat_texid[m->geom_matid[b]];
+  }
+  r->twin_ok = ok && n2 == SIM_NOBJ && n3 == SIM_NOBJ;
+}
+
 hearth_status sim_render_init(hearth_sim_env *e, hearth_err *err) {
   sim_render *r = calloc(1, sizeof *r);
   if (!r) return hearth_err_set(err, HEARTH_E_NOMEM, "sim: out of memory");
@@ -168,7 +194,8 @@ hearth_status sim_render_init(hearth_sim_env *e, hearth_err *err) {
   r->front = malloc(px * 3), r->thermal = malloc(px * 3), r->wrist = malloc(px * 3),
   r->seg = malloc(px * 3), r->ids = malloc(px * sizeof(int));
   r->th_geom = calloc((size_t)e->m->ngeom + 1, 1);
-  if (!r->front || !r->thermal || !r->wrist || !r->seg || !r->ids || !r->th_geom)
+  r->twin_tex = malloc(sizeof(int) * ((size_t)e->m->ngeom + 1));
+  if (!r->front || !r->thermal || !r->wrist || !r->seg || !r->ids || !r->th_geom || !r->twin_tex)
     return hearth_err_set(err, HEARTH_E_NOMEM, "sim: out of memory for %dx%d images", e->width,
                           e->height);
   for (int k = 0; k < SIM_NOBJ; k++)
@@ -178,6 +205,7 @@ hearth_status sim_render_init(hearth_sim_env *e, hearth_err *err) {
     return HEARTH_OK;
   }
   if (r->kind == SIM_RENDER_SOFT) {
+    twin_setup(e);
     if (!(r->sw = sim_soft_new(e->m, e->width, e->height)))
       return hearth_err_set(err, HEARTH_E_NOMEM, "sim: out of memory for the software renderer");
     snprintf(r->renderer, sizeof r->renderer, "soft: hearth rasteriser %s", SIM_SOFT_VERSION);
@@ -222,7 +250,7 @@ void sim_render_free(hearth_sim_env *e) {
   sim_render *r = e->rnd;
   if (!r) return;
   sim_soft_free(r->sw);
-  free(r->th_geom), free(r->ids);
+  free(r->th_geom), free(r->ids), free(r->twin_tex);
   if (r->kind != SIM_RENDER_GL) {
     free(r->front), free(r->thermal), free(r->wrist), free(r->seg);
     free(r);
@@ -281,7 +309,7 @@ static void soft_view(hearth_sim_env *e, int cam, int mode, int only_geom, uint8
   v.groups[2] = mode != VIEW_THERMAL;
   v.groups[3] = mode == VIEW_THERMAL;
   room_shown(v.flat_rgb);
-  sim_soft_render(r->sw, e->m, e->d, &v, out, ids);
+  sim_soft_render(r->sw, e->m, e->d, &v, out, NULL, ids);
 }
 
 /* render one camera; `only_geom` >= 0 keeps just that model geom */
@@ -357,7 +385,15 @@ hearth_status hearth_sim_observe(hearth_sim_env *e, hearth_sim_obs *o, hearth_er
   sim_render *r = e->rnd;
   memset(o, 0, sizeof *o);
   o->width = e->width, o->height = e->height;
-  if (r->kind != SIM_RENDER_NONE) {
+  if (r->kind == SIM_RENDER_SOFT && r->twin_ok) {
+    /* one pass draws the front RGB view and, from the same surfaces, the
+     * thermal one */
+    sim_soft_view v = {.cam = e->cam_front, .mode = SIM_SOFT_LIT, .only_geom = -1,
+                       .twin_tex = r->twin_tex, .groups = {1, 1, 1, 0, 0, 0}};
+    room_shown(v.flat_rgb);
+    sim_soft_render(r->sw, e->m, e->d, &v, r->front, r->thermal, NULL);
+    o->agentview_rgb = r->front, o->agentview_thermal = r->thermal;
+  } else if (r->kind != SIM_RENDER_NONE) {
     render_view(e, e->cam_front, VIEW_RGB, -1, r->front);
     render_view(e, e->cam_front, VIEW_THERMAL, -1, r->thermal);
     o->agentview_rgb = r->front, o->agentview_thermal = r->thermal;

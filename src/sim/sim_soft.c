@@ -11,11 +11,67 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* x^e for x in [0, 1] tabulated at 1/SOFT_POWN steps, interpolated */
+#define SOFT_POWN 1024
+#define SOFT_NPOW 16
+typedef struct soft_pow {
+  float e, t[SOFT_POWN + 2];
+} soft_pow;
+
+/* ---- arithmetic of its own: libm picks per-CPU variants (FMA or not) at
+ * run time, so the renderer computes its powers and angles itself ---- */
+
+/* sine and cosine of a (|a| up to a few turns): quadrant reduction, then
+ * Taylor series on [-pi/4, pi/4] (error below 1e-16) */
+static void soft_sincos(double a, double *sn, double *cs) {
+  double k = floor(a / (0.5 * M_PI) + 0.5), r = a - k * (0.5 * M_PI), r2 = r * r;
+  double s = r, c = 1.0, ts = r, tc = 1.0;
+  for (int i = 1; i <= 10; i++) {
+    ts *= -r2 / ((2.0 * i) * (2.0 * i + 1.0));
+    tc *= -r2 / ((2.0 * i - 1.0) * (2.0 * i));
+    s += ts, c += tc;
+  }
+  long q = (long)k % 4;
+  if (q < 0) q += 4;
+  *sn = q == 0 ? s : q == 1 ? c : q == 2 ? -s : -c;
+  *cs = q == 0 ? c : q == 1 ? -s : q == 2 ? -c : s;
+}
+
+/* x^e for x in [0, 1], e >= 0, to about 1e-7: integer exponents by
+ * squaring, others as 2^(e log2 x) with series of their own */
+static float soft_powf(float x, float e) {
+  if (x <= 0.0f) return e == 0.0f ? 1.0f : 0.0f;
+  if (x >= 1.0f || e == 0.0f) return 1.0f;
+  if (e == floorf(e) && e <= 256.0f) {
+    float r = 1.0f, b = x;
+    for (unsigned n = (unsigned)e; n; n >>= 1, b *= b)
+      if (n & 1) r *= b;
+    return r;
+  }
+  /* log2 x = ex + log2 m, m in [sqrt(1/2), sqrt(2)): 2 atanh((m-1)/(m+1)) / ln 2 */
+  int ex;
+  double m = frexp((double)x, &ex);
+  if (m < M_SQRT1_2) m *= 2.0, ex--;
+  double z = (m - 1.0) / (m + 1.0), z2 = z * z, t = z, sum = 0.0;
+  for (int i = 0; i < 8; i++, t *= z2) sum += t / (2 * i + 1);
+  double y = (double)e * ((double)ex + 2.0 * sum / M_LN2);
+  if (y < -126.0) return 0.0f;
+  /* 2^y = 2^n 2^f, f in [-0.5, 0.5] */
+  double n = floor(y + 0.5), f = (y - n) * M_LN2, term = 1.0, ef = 1.0;
+  for (int i = 1; i <= 10; i++) term *= f / i, ef += term;
+  return (float)ldexp(ef, (int)n);
+}
+
+#define SOFT_MIN3(p, q, r) ((p) < (q) ? ((p) < (r) ? (p) : (r)) : ((q) < (r) ? (q) : (r)))
+#define SOFT_MAX3(p, q, r) ((p) > (q) ? ((p) > (r) ? (p) : (r)) : ((q) > (r) ? (q) : (r)))
+
 /* one geom's triangles in its own frame, sizes applied */
 typedef struct soft_shape {
   int nv, nt;
   float *pos, *nrm, *uv; /* nv x 3, nv x 3, nv x 2 (uv NULL: no texture coordinates) */
   int *tri;              /* nt x 3, counter-clockwise seen from outside */
+  float *plane;          /* nt x 4: face normal n (unnormalised), n . corner 0 */
+  int np, *pid;          /* distinct positions; each vertex's position index */
 } soft_shape;
 
 /* a 2D texture and its mip levels, RGB U8, row 0 at t = 0 (as GL uploads it) */
@@ -39,23 +95,56 @@ typedef struct soft_svtx {
 
 /* a light in the camera frame */
 typedef struct soft_light {
+  const soft_pow *spot_pow;
   int directional;
   float pos[3], dir[3]; /* dir: unit, the way the light shines */
   float amb[3], dif[3], spc[3], att[3], cos_cut, expo;
 } soft_light;
 
 struct sim_soft {
+  soft_pow pw[SOFT_NPOW];
+  int npw;
   int w, h, ngeom, ntex;
   soft_shape *shape;
   soft_tex *tex;
   float *depth; /* 1/w of the nearest surface; 0: nothing */
-  soft_vtx *vtx;
+  int *order;    /* ngeom: drawing order of a view */
+  double *key;   /* ngeom: its sort keys */
+  soft_vtx *vtx; /* per vertex of the geom at hand: camera frame, */
+  soft_svtx *sv; /* on screen (in front of the near plane only), */
+  unsigned char *lit; /* 1 once placed, 2 once lit */
+  float *pcam;        /* per distinct position: camera frame x y z, then */
+  double *pscr;       /* screen x y and 1/w (in front of the near plane) */
+  unsigned char *pdone;
   int vcap;
 };
+
+/* the table of exponent e (made on first use), NULL when all are taken */
+static const soft_pow *pow_table(sim_soft *s, float e) {
+  for (int i = 0; i < s->npw; i++)
+    if (s->pw[i].e == e) return &s->pw[i];
+  if (s->npw == SOFT_NPOW) return NULL;
+  soft_pow *p = &s->pw[s->npw++];
+  p->e = e;
+  for (int i = 0; i <= SOFT_POWN; i++) p->t[i] = soft_powf((float)i / SOFT_POWN, e);
+  p->t[SOFT_POWN + 1] = 1.0f;
+  return p;
+}
+
+static float pow_lookup(const soft_pow *p, float e, float x) {
+  if (!p) return soft_powf(x, e);
+  if (x <= 0.0f) return p->t[0];
+  if (x >= 1.0f) return 1.0f;
+  float f = x * SOFT_POWN;
+  int i = (int)f;
+  float t = f - (float)i;
+  return p->t[i] + t * (p->t[i + 1] - p->t[i]);
+}
 
 /* ---- tessellation ---------------------------------------------------------- */
 static int shape_alloc(soft_shape *s, int nv, int nt, int with_uv) {
   s->nv = nv, s->nt = nt;
+  s->plane = NULL, s->pid = NULL, s->np = 0;
   s->pos = malloc(sizeof(float) * 3 * (size_t)nv);
   s->nrm = malloc(sizeof(float) * 3 * (size_t)nv);
   s->uv = with_uv ? malloc(sizeof(float) * 2 * (size_t)nv) : NULL;
@@ -63,8 +152,57 @@ static int shape_alloc(soft_shape *s, int nv, int nt, int with_uv) {
   return s->pos && s->nrm && s->tri && (!with_uv || s->uv);
 }
 
+/* the triangles' planes, for culling back faces before any vertex work */
+static int shape_planes(soft_shape *s) {
+  s->plane = malloc(sizeof(float) * 4 * (size_t)(s->nt > 0 ? s->nt : 1));
+  if (!s->plane) return 0;
+  for (int t = 0; t < s->nt; t++) {
+    const float *a = s->pos + 3 * s->tri[3 * t], *b = s->pos + 3 * s->tri[3 * t + 1],
+                *c = s->pos + 3 * s->tri[3 * t + 2];
+    float u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    float *p = s->plane + 4 * t;
+    p[0] = u[1] * v[2] - u[2] * v[1], p[1] = u[2] * v[0] - u[0] * v[2], p[2] = u[0] * v[1] - u[1] * v[0];
+    p[3] = p[0] * a[0] + p[1] * a[1] + p[2] * a[2];
+  }
+  return 1;
+}
+
+/* the distinct positions of a shape (vertices repeat them where normals
+ * or texture coordinates differ): each is moved to the camera once */
+static int shape_positions(soft_shape *s) {
+  size_t cap = 16;
+  while (cap < 2 * (size_t)s->nv) cap *= 2;
+  int *slot = malloc(sizeof(int) * cap);
+  s->pid = malloc(sizeof(int) * (size_t)(s->nv > 0 ? s->nv : 1));
+  if (!slot || !s->pid) return free(slot), 0;
+  for (size_t i = 0; i < cap; i++) slot[i] = -1;
+  s->np = 0;
+  for (int i = 0; i < s->nv; i++) {
+    const float *p = s->pos + 3 * i;
+    uint64_t h = 1469598103934665603ull;
+    const unsigned char *kb = (const unsigned char *)p;
+    for (size_t b = 0; b < 3 * sizeof(float); b++) h = (h ^ kb[b]) * 1099511628211ull;
+    size_t at = (size_t)h & (cap - 1);
+    for (;;) {
+      int j = slot[at];
+      if (j < 0) {
+        slot[at] = i;
+        s->pid[i] = s->np++;
+        break;
+      }
+      if (memcmp(s->pos + 3 * j, p, 3 * sizeof(float)) == 0) {
+        s->pid[i] = s->pid[j];
+        break;
+      }
+      at = (at + 1) & (cap - 1);
+    }
+  }
+  free(slot);
+  return 1;
+}
+
 static void shape_free(soft_shape *s) {
-  free(s->pos), free(s->nrm), free(s->uv), free(s->tri);
+  free(s->pos), free(s->nrm), free(s->uv), free(s->tri), free(s->plane), free(s->pid);
   memset(s, 0, sizeof *s);
 }
 
@@ -114,7 +252,8 @@ static int make_rings(soft_shape *s, int nring, const double *z, const double *r
   int nv = 0, nt = 0;
   for (int k = 0; k < nring; k++)
     for (int j = 0; j <= sl; j++) {
-      double az = 2.0 * M_PI * j / sl, ca = cos(az), sa = sin(az);
+      double az = 2.0 * M_PI * j / sl, ca, sa;
+      soft_sincos(az, &sa, &ca);
       s->pos[3 * nv] = (float)(r[k] * ca), s->pos[3 * nv + 1] = (float)(r[k] * sa);
       s->pos[3 * nv + 2] = (float)z[k];
       s->nrm[3 * nv] = (float)(nr[k] * ca), s->nrm[3 * nv + 1] = (float)(nr[k] * sa);
@@ -140,7 +279,7 @@ static int make_round(soft_shape *s, double rad, double h, int sl, int st) {
   for (int k = 0; k < n; k++) {
     int top = k <= half;
     double el = top ? 0.5 * M_PI * k / half : 0.5 * M_PI * (1.0 + (double)(k - half - 1) / half);
-    nr[k] = sin(el), nz[k] = cos(el);
+    soft_sincos(el, &nr[k], &nz[k]);
     r[k] = rad * nr[k];
     z[k] = rad * nz[k] + (top ? h : -h);
   }
@@ -166,7 +305,9 @@ static int make_cylinder(soft_shape *s, double rad, double h, int sl) {
     for (int j = -1; j <= sl; j++) {
       double az = 2.0 * M_PI * (j < 0 ? 0 : j) / sl;
       double rr = j < 0 ? 0.0 : rad;
-      s->pos[3 * v] = (float)(rr * cos(az)), s->pos[3 * v + 1] = (float)(rr * sin(az));
+      double sa, ca;
+      soft_sincos(az, &sa, &ca);
+      s->pos[3 * v] = (float)(rr * ca), s->pos[3 * v + 1] = (float)(rr * sa);
       s->pos[3 * v + 2] = (float)zc;
       s->nrm[3 * v] = 0, s->nrm[3 * v + 1] = 0, s->nrm[3 * v + 2] = n;
       v++;
@@ -180,15 +321,54 @@ static int make_cylinder(soft_shape *s, double rad, double h, int sl) {
   return 1;
 }
 
-/* the model's mesh: vertices, normals, texture coordinates as stored */
+/* the model's mesh: vertices, normals, texture coordinates as stored,
+ * with vertices that agree in all three merged (MuJoCo keeps one per
+ * face corner; merging changes no pixel and lights each corner once) */
 static int make_mesh(soft_shape *s, const mjModel *m, int id) {
   int va = m->mesh_vertadr[id], nv = m->mesh_vertnum[id], fa = m->mesh_faceadr[id],
       nf = m->mesh_facenum[id], ta = m->mesh_texcoordadr[id];
   if (!shape_alloc(s, nv, nf, ta >= 0)) return 0;
-  memcpy(s->pos, m->mesh_vert + 3 * (size_t)va, sizeof(float) * 3 * (size_t)nv);
-  memcpy(s->nrm, m->mesh_normal + 3 * (size_t)va, sizeof(float) * 3 * (size_t)nv);
-  if (ta >= 0) memcpy(s->uv, m->mesh_texcoord + 2 * (size_t)ta, sizeof(float) * 2 * (size_t)nv);
-  memcpy(s->tri, m->mesh_face + 3 * (size_t)fa, sizeof(int) * 3 * (size_t)nf);
+  size_t cap = 16;
+  while (cap < 2 * (size_t)nv) cap *= 2;
+  int *slot = malloc(sizeof(int) * cap), *remap = malloc(sizeof(int) * (size_t)(nv > 0 ? nv : 1));
+  if (!slot || !remap) return free(slot), free(remap), 0;
+  for (size_t i = 0; i < cap; i++) slot[i] = -1;
+  int n = 0;
+  for (int i = 0; i < nv; i++) {
+    float key[8];
+    memcpy(key, m->mesh_vert + 3 * (size_t)(va + i), sizeof(float) * 3);
+    memcpy(key + 3, m->mesh_normal + 3 * (size_t)(va + i), sizeof(float) * 3);
+    key[6] = key[7] = 0;
+    if (ta >= 0) memcpy(key + 6, m->mesh_texcoord + 2 * (size_t)(ta + i), sizeof(float) * 2);
+    uint64_t h = 1469598103934665603ull;
+    const unsigned char *kb = (const unsigned char *)key;
+    for (size_t b = 0; b < sizeof key; b++) h = (h ^ kb[b]) * 1099511628211ull;
+    size_t at = (size_t)h & (cap - 1);
+    for (;;) {
+      int j = slot[at];
+      if (j < 0) {
+        slot[at] = n;
+        memcpy(s->pos + 3 * n, key, sizeof(float) * 3);
+        memcpy(s->nrm + 3 * n, key + 3, sizeof(float) * 3);
+        if (s->uv) memcpy(s->uv + 2 * n, key + 6, sizeof(float) * 2);
+        remap[i] = n++;
+        break;
+      }
+      if (memcmp(s->pos + 3 * j, key, sizeof(float) * 3) == 0 &&
+          memcmp(s->nrm + 3 * j, key + 3, sizeof(float) * 3) == 0 &&
+          (!s->uv || memcmp(s->uv + 2 * j, key + 6, sizeof(float) * 2) == 0)) {
+        remap[i] = j;
+        break;
+      }
+      at = (at + 1) & (cap - 1);
+    }
+  }
+  s->nv = n;
+  for (int t = 0; t < 3 * nf; t++) {
+    int k = m->mesh_face[3 * (size_t)fa + t];
+    s->tri[t] = k >= 0 && k < nv ? remap[k] : 0;
+  }
+  free(slot), free(remap);
   return 1;
 }
 
@@ -262,9 +442,14 @@ static void tex_sample(const soft_tex *t, int l, float u, float v, float c[3]) {
   float fu = u * (float)w - 0.5f, fv = v * (float)h - 0.5f;
   float x0f = floorf(fu), y0f = floorf(fv), ax = fu - x0f, ay = fv - y0f;
   /* wrap: the coordinates stay within a few repeats of the texture */
-  long x0 = (long)x0f % w, y0 = (long)y0f % h;
-  if (x0 < 0) x0 += w;
-  if (y0 < 0) y0 += h;
+  long x0, y0;
+  if (((w & (w - 1)) | (h & (h - 1))) == 0) {
+    x0 = (long)x0f & (w - 1), y0 = (long)y0f & (h - 1);
+  } else {
+    x0 = (long)x0f % w, y0 = (long)y0f % h;
+    if (x0 < 0) x0 += w;
+    if (y0 < 0) y0 += h;
+  }
   long x1 = x0 + 1 < w ? x0 + 1 : 0, y1 = y0 + 1 < h ? y0 + 1 : 0;
   const uint8_t *a = p + 3 * (y0 * w + x0), *b = p + 3 * (y0 * w + x1), *cc = p + 3 * (y1 * w + x0),
                 *d = p + 3 * (y1 * w + x1);
@@ -280,7 +465,9 @@ void sim_soft_free(sim_soft *s) {
   if (!s) return;
   for (int g = 0; g < s->ngeom && s->shape; g++) shape_free(&s->shape[g]);
   for (int t = 0; t < s->ntex && s->tex; t++) free(s->tex[t].rgb);
-  free(s->shape), free(s->tex), free(s->depth), free(s->vtx);
+  free(s->order), free(s->key);
+  free(s->shape), free(s->tex), free(s->depth), free(s->vtx), free(s->sv), free(s->lit);
+  free(s->pcam), free(s->pscr), free(s->pdone);
   free(s);
 }
 
@@ -291,13 +478,23 @@ sim_soft *sim_soft_new(const mjModel *m, int w, int h) {
   s->shape = calloc((size_t)(m->ngeom > 0 ? m->ngeom : 1), sizeof *s->shape);
   s->tex = calloc((size_t)(m->ntex > 0 ? m->ntex : 1), sizeof *s->tex);
   s->depth = malloc(sizeof(float) * (size_t)w * (size_t)h);
-  int ok = s->shape && s->tex && s->depth;
+  s->order = malloc(sizeof(int) * (size_t)(m->ngeom > 0 ? m->ngeom : 1));
+  s->key = malloc(sizeof(double) * (size_t)(m->ngeom > 0 ? m->ngeom : 1));
+  int ok = s->shape && s->tex && s->depth && s->order && s->key;
   for (int g = 0; g < m->ngeom && ok; g++) {
-    ok = make_shape(&s->shape[g], m, g);
+    ok = make_shape(&s->shape[g], m, g) && shape_planes(&s->shape[g]) &&
+         shape_positions(&s->shape[g]);
     if (s->shape[g].nv > s->vcap) s->vcap = s->shape[g].nv;
   }
   for (int t = 0; t < m->ntex && ok; t++) ok = make_tex(&s->tex[t], m, t);
-  if (ok) ok = (s->vtx = malloc(sizeof(soft_vtx) * (size_t)(s->vcap > 0 ? s->vcap : 1))) != NULL;
+  size_t nv = (size_t)(s->vcap > 0 ? s->vcap : 1);
+  if (ok) {
+    s->vtx = malloc(sizeof(soft_vtx) * nv), s->sv = malloc(sizeof(soft_svtx) * nv);
+    s->lit = malloc(nv);
+    s->pcam = malloc(sizeof(float) * 3 * nv), s->pscr = malloc(sizeof(double) * 3 * nv);
+    s->pdone = malloc(nv);
+    ok = s->vtx && s->sv && s->lit && s->pcam && s->pscr && s->pdone;
+  }
   if (!ok) {
     sim_soft_free(s);
     return NULL;
@@ -315,9 +512,13 @@ typedef struct soft_cam {
 /* what one geom draws with: material, texture, level chooser */
 typedef struct soft_mat {
   float rgba[4], spec, shin, emis;
+  const soft_pow *shin_pow;
   const soft_tex *tex;
   int unlit;
   float flat[3];
+  uint8_t *twin;         /* LIT with a twin image: its buffer, */
+  const soft_tex *tex2;  /* the texture it shows (NULL: flat2) */
+  uint8_t flat2[3];
   int id;
 } soft_mat;
 
@@ -342,7 +543,7 @@ static void light_vertex(const soft_light *L, int nl, const soft_mat *mt, const 
       att = 1.0f / (l->att[0] + l->att[1] * dist + l->att[2] * dist * dist);
       float cs = -(Ld[0] * l->dir[0] + Ld[1] * l->dir[1] + Ld[2] * l->dir[2]);
       if (cs < l->cos_cut) continue;
-      spot = powf(cs, l->expo);
+      spot = pow_lookup(l->spot_pow, l->expo, cs);
     }
     float ndl = n[0] * Ld[0] + n[1] * Ld[1] + n[2] * Ld[2];
     float s = 0.0f;
@@ -350,7 +551,7 @@ static void light_vertex(const soft_light *L, int nl, const soft_mat *mt, const 
       float hx = Ld[0] + V[0], hy = Ld[1] + V[1], hz = Ld[2] + V[2];
       float hl = sqrtf(hx * hx + hy * hy + hz * hz);
       float ndh = hl > 0 ? (n[0] * hx + n[1] * hy + n[2] * hz) / hl : 0.0f;
-      if (ndh > 0) s = powf(ndh, mt->shin) * mt->spec;
+      if (ndh > 0) s = pow_lookup(mt->shin_pow, mt->shin, ndh) * mt->spec;
     } else {
       ndl = 0;
     }
@@ -363,22 +564,31 @@ static void light_vertex(const soft_light *L, int nl, const soft_mat *mt, const 
 
 static int edge_owns(double A, double B) { return A > 0 || (A == 0 && B < 0); }
 
-/* one screen triangle (counter-clockwise, y up) into the buffers */
-static void raster(sim_soft *s, const soft_svtx *a, const soft_svtx *b, const soft_svtx *c,
-                   const soft_mat *mt, int level, uint8_t *rgb, int *ids) {
-  double area = (b->sx - a->sx) * (c->sy - a->sy) - (b->sy - a->sy) * (c->sx - a->sx);
-  if (!(area > 0)) return;
-  double minx = fmin(a->sx, fmin(b->sx, c->sx)), maxx = fmax(a->sx, fmax(b->sx, c->sx));
-  double miny = fmin(a->sy, fmin(b->sy, c->sy)), maxy = fmax(a->sy, fmax(b->sy, c->sy));
-  /* pixels whose centres (x + 0.5, y + 0.5) may be inside */
-  double fx0 = ceil(minx - 0.5), fx1 = floor(maxx - 0.5), fy0 = ceil(miny - 0.5),
-         fy1 = floor(maxy - 0.5);
+/* the pixels whose centres (x + 0.5, y + 0.5) may be inside a screen
+ * triangle, clipped to the image: box = x0 x1 y0 y1; 0 when none */
+static int tri_box(const sim_soft *s, const soft_svtx *a, const soft_svtx *b, const soft_svtx *c,
+                   int box[4]) {
+  double fx0 = ceil(SOFT_MIN3(a->sx, b->sx, c->sx) - 0.5),
+         fx1 = floor(SOFT_MAX3(a->sx, b->sx, c->sx) - 0.5),
+         fy0 = ceil(SOFT_MIN3(a->sy, b->sy, c->sy) - 0.5),
+         fy1 = floor(SOFT_MAX3(a->sy, b->sy, c->sy) - 0.5);
   if (fx0 < 0) fx0 = 0;
   if (fy0 < 0) fy0 = 0;
   if (fx1 > s->w - 1) fx1 = s->w - 1;
   if (fy1 > s->h - 1) fy1 = s->h - 1;
-  if (fx0 > fx1 || fy0 > fy1) return;
-  int x0 = (int)fx0, x1 = (int)fx1, y0 = (int)fy0, y1 = (int)fy1;
+  if (fx0 > fx1 || fy0 > fy1) return 0;
+  box[0] = (int)fx0, box[1] = (int)fx1, box[2] = (int)fy0, box[3] = (int)fy1;
+  return 1;
+}
+
+/* one screen triangle (counter-clockwise, y up) into the buffers */
+static void raster(sim_soft *s, const soft_svtx *a, const soft_svtx *b, const soft_svtx *c,
+                   const soft_mat *mt, const int level[2], uint8_t *rgb, int *ids) {
+  double area = (b->sx - a->sx) * (c->sy - a->sy) - (b->sy - a->sy) * (c->sx - a->sx);
+  if (!(area > 0)) return;
+  int box[4];
+  if (!tri_box(s, a, b, c, box)) return;
+  int x0 = box[0], x1 = box[1], y0 = box[2], y1 = box[3];
   /* edge i opposite vertex i: E(p) = A x + B y + C, positive inside */
   const soft_svtx *v[3] = {a, b, c};
   double A[3], B[3], C[3];
@@ -393,7 +603,26 @@ static void raster(sim_soft *s, const soft_svtx *a, const soft_svtx *b, const so
     double yc = y + 0.5, row[3];
     for (int i = 0; i < 3; i++) row[i] = B[i] * yc + C[i];
     size_t line = (size_t)y * (size_t)s->w;
-    for (int x = x0; x <= x1; x++) {
+    /* the row's span from the edges' roots, a pixel wider on each side:
+     * every pixel in it still takes the exact test */
+    int lo = x0, hi = x1;
+    for (int i = 0; i < 3 && lo <= hi; i++) {
+      if (A[i] == 0) {
+        if (row[i] < 0 || (row[i] == 0 && !own[i])) hi = lo - 1;
+        continue;
+      }
+      double r = -row[i] / A[i] - 0.5;
+      if (r < x0 - 1) r = x0 - 1;
+      if (r > x1 + 1) r = x1 + 1;
+      if (A[i] > 0) {
+        int k = (int)floor(r);
+        if (k > lo) lo = k;
+      } else {
+        int k = (int)ceil(r);
+        if (k < hi) hi = k;
+      }
+    }
+    for (int x = lo; x <= hi; x++) {
       double xc = x + 0.5, e[3];
       int in = 1;
       for (int i = 0; i < 3 && in; i++) {
@@ -414,7 +643,7 @@ static void raster(sim_soft *s, const soft_svtx *a, const soft_svtx *b, const so
       if (mt->unlit && !mt->tex) col[0] = mt->flat[0], col[1] = mt->flat[1], col[2] = mt->flat[2];
       if (mt->tex) {
         float tc[3];
-        tex_sample(mt->tex, level, at[3], at[4], tc);
+        tex_sample(mt->tex, level[0], at[3], at[4], tc);
         for (int k = 0; k < 3; k++) col[k] = mt->unlit ? tc[k] : col[k] * tc[k];
       }
       uint8_t *o = rgb + 3 * px;
@@ -422,18 +651,36 @@ static void raster(sim_soft *s, const soft_svtx *a, const soft_svtx *b, const so
         float cl = col[k] < 0 ? 0 : col[k] > 1 ? 1 : col[k];
         o[k] = (uint8_t)(cl * 255.0f + 0.5f);
       }
+      if (mt->twin) {
+        uint8_t *o2 = mt->twin + 3 * px;
+        if (mt->tex2) {
+          float tc[3];
+          tex_sample(mt->tex2, level[1], at[3], at[4], tc);
+          for (int k = 0; k < 3; k++) o2[k] = (uint8_t)(tc[k] * 255.0f + 0.5f);
+        } else {
+          o2[0] = mt->flat2[0], o2[1] = mt->flat2[1], o2[2] = mt->flat2[2];
+        }
+      }
     }
   }
 }
 
-static void project(const sim_soft *s, const soft_cam *cam, const soft_vtx *p, soft_svtx *o) {
+static void project_pos(const sim_soft *s, const soft_cam *cam, const soft_vtx *p, soft_svtx *o) {
   double iw = 1.0 / -(double)p->z;
   o->sx = 0.5 * s->w + cam->f * (double)p->x * iw;
   o->sy = 0.5 * s->h + cam->f * (double)p->y * iw;
   o->iw = (float)iw;
+}
+
+static void project_attr(const soft_vtx *p, soft_svtx *o) {
   float fiw = o->iw;
   o->a[0] = p->r * fiw, o->a[1] = p->g * fiw, o->a[2] = p->b * fiw;
   o->a[3] = p->u * fiw, o->a[4] = p->v * fiw;
+}
+
+static void project(const sim_soft *s, const soft_cam *cam, const soft_vtx *p, soft_svtx *o) {
+  project_pos(s, cam, p, o);
+  project_attr(p, o);
 }
 
 static soft_vtx lerp_vtx(const soft_vtx *p, const soft_vtx *q, float t) {
@@ -483,7 +730,8 @@ static void draw_tri(sim_soft *s, const soft_cam *cam, const soft_vtx *p0, const
   for (int i = 1; i + 1 < n; i++) {
     const soft_vtx *tp[3] = {&poly[0], &poly[i], &poly[i + 1]};
     soft_svtx ts[3] = {sv[0], sv[i], sv[i + 1]};
-    raster(s, &ts[0], &ts[1], &ts[2], mt, tri_level(mt->tex, tp, ts), rgb, ids);
+    int lv[2] = {tri_level(mt->tex, tp, ts), tri_level(mt->tex2, tp, ts)};
+    raster(s, &ts[0], &ts[1], &ts[2], mt, lv, rgb, ids);
   }
 }
 
@@ -498,7 +746,7 @@ static int culled(const soft_cam *cam, const double c[3], double r) {
 }
 
 static void geom_material(const mjModel *m, sim_soft *s, int g, const sim_soft_view *v,
-                          soft_mat *mt) {
+                          uint8_t *twin, soft_mat *mt) {
   memset(mt, 0, sizeof *mt);
   int mat = m->geom_matid[g];
   const float *gr = m->geom_rgba + 4 * g;
@@ -508,6 +756,7 @@ static void geom_material(const mjModel *m, sim_soft *s, int g, const sim_soft_v
   mt->spec = mat >= 0 ? m->mat_specular[mat] : 0.5f;
   mt->shin = (mat >= 0 ? m->mat_shininess[mat] : 0.5f) * 128.0f;
   mt->emis = mat >= 0 ? m->mat_emission[mat] : 0.0f;
+  mt->shin_pow = v->mode == SIM_SOFT_LIT ? pow_table(s, mt->shin) : NULL;
   int tid = mat >= 0 ? m->mat_texid[mat] : -1;
   mt->tex = tid >= 0 && s->tex[tid].rgb ? &s->tex[tid] : NULL;
   mt->unlit = v->mode != SIM_SOFT_LIT;
@@ -516,20 +765,92 @@ static void geom_material(const mjModel *m, sim_soft *s, int g, const sim_soft_v
     if (!(v->tex_geom && v->tex_geom[g])) mt->tex = NULL;
     for (int k = 0; k < 3; k++) mt->flat[k] = v->flat_rgb[k] / 255.0f;
   }
+  if (v->mode == SIM_SOFT_LIT && twin) {
+    int t2 = v->twin_tex ? v->twin_tex[g] : -1;
+    mt->twin = twin;
+    mt->tex2 = t2 >= 0 && t2 < s->ntex && s->tex[t2].rgb ? &s->tex[t2] : NULL;
+    memcpy(mt->flat2, v->flat_rgb, 3);
+  }
+}
+
+/* what the vertices of one geom are lit with */
+typedef struct geom_pass {
+  sim_soft *s;
+  const soft_cam *cam;
+  const soft_shape *sh;
+  const soft_mat *mt;
+  const soft_light *L;
+  int nl;
+  sim_soft_mode mode;
+  const float *M; /* camera from geom rotation, row-major */
+} geom_pass;
+
+/* vertex i's colour (once per geom and view), and its attributes over w
+ * when it is in front of the near plane */
+static void light_at(const geom_pass *g, int i) {
+  sim_soft *s = g->s;
+  if (s->lit[i] == 2) return;
+  s->lit[i] = 2;
+  soft_vtx *o = &s->vtx[i];
+  if (g->mode == SIM_SOFT_LIT) {
+    const float *n = g->sh->nrm + 3 * i, *M = g->M;
+    float nn[3], q[3] = {o->x, o->y, o->z}, col[3];
+    for (int r = 0; r < 3; r++) nn[r] = M[3 * r] * n[0] + M[3 * r + 1] * n[1] + M[3 * r + 2] * n[2];
+    float len = sqrtf(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
+    if (len > 0) nn[0] /= len, nn[1] /= len, nn[2] /= len;
+    light_vertex(g->L, g->nl, g->mt, q, nn, col);
+    o->r = col[0], o->g = col[1], o->b = col[2];
+  } else {
+    o->r = o->g = o->b = 1.0f;
+  }
+  if (o->z <= (float)-g->cam->znear) project_attr(o, &s->sv[i]);
+}
+
+/* vertex i in the camera frame (once per geom and view) */
+static void place_at(const geom_pass *g, int i, const float t[3]) {
+  sim_soft *s = g->s;
+  if (s->lit[i]) return;
+  int pi = g->sh->pid[i];
+  float *q = s->pcam + 3 * pi;
+  double *sc = s->pscr + 3 * pi;
+  float zn = (float)-g->cam->znear;
+  if (!s->pdone[pi]) {
+    const float *p = g->sh->pos + 3 * i, *M = g->M;
+    q[0] = M[0] * p[0] + M[1] * p[1] + M[2] * p[2] + t[0];
+    q[1] = M[3] * p[0] + M[4] * p[1] + M[5] * p[2] + t[1];
+    q[2] = M[6] * p[0] + M[7] * p[1] + M[8] * p[2] + t[2];
+    if (q[2] <= zn) {
+      soft_vtx tmp = {.x = q[0], .y = q[1], .z = q[2]};
+      soft_svtx sv;
+      project_pos(s, g->cam, &tmp, &sv);
+      sc[0] = sv.sx, sc[1] = sv.sy, sc[2] = sv.iw;
+    }
+    s->pdone[pi] = 1;
+  }
+  soft_vtx *o = &s->vtx[i];
+  o->x = q[0], o->y = q[1], o->z = q[2];
+  o->u = g->sh->uv ? g->sh->uv[2 * i] : 0.0f, o->v = g->sh->uv ? g->sh->uv[2 * i + 1] : 0.0f;
+  o->r = o->g = o->b = 0.0f;
+  s->lit[i] = 1;
+  if (o->z <= zn) s->sv[i].sx = sc[0], s->sv[i].sy = sc[1], s->sv[i].iw = (float)sc[2];
 }
 
 void sim_soft_render(sim_soft *s, const mjModel *m, const mjData *d, const sim_soft_view *v,
-                     uint8_t *rgb, int *ids) {
+                     uint8_t *rgb, uint8_t *twin, int *ids) {
   size_t npx = (size_t)s->w * (size_t)s->h;
   memset(s->depth, 0, sizeof(float) * npx);
   if (rgb) memset(rgb, 0, 3 * npx);
+  if (twin && rgb && v->mode == SIM_SOFT_LIT) memset(twin, 0, 3 * npx);
+  else twin = NULL;
   if (ids)
     for (size_t i = 0; i < npx; i++) ids[i] = -1;
   soft_cam cam;
   for (int k = 0; k < 9; k++) cam.R[k] = d->cam_xmat[9 * v->cam + k];
   for (int k = 0; k < 3; k++) cam.p[k] = d->cam_xpos[3 * v->cam + k];
   cam.znear = m->vis.map.znear * m->stat.extent;
-  cam.tany = tan(0.5 * m->cam_fovy[v->cam] * M_PI / 180.0);
+  double hs, hc;
+  soft_sincos(0.5 * m->cam_fovy[v->cam] * M_PI / 180.0, &hs, &hc);
+  cam.tany = hs / hc;
   cam.tanx = cam.tany * s->w / s->h;
   cam.f = 0.5 * s->h / cam.tany;
   /* lights in the camera frame: the headlight (shining along the view),
@@ -562,18 +883,32 @@ void sim_soft_render(sim_soft *s, const mjModel *m, const mjData *d, const sim_s
       for (int k = 0; k < 3; k++)
         l->amb[k] = m->light_ambient[3 * i + k], l->dif[k] = m->light_diffuse[3 * i + k],
         l->spc[k] = m->light_specular[3 * i + k], l->att[k] = m->light_attenuation[3 * i + k];
-      l->cos_cut = (float)cos(m->light_cutoff[i] * M_PI / 180.0);
+      double cs, cc;
+      soft_sincos(m->light_cutoff[i] * M_PI / 180.0, &cs, &cc);
+      l->cos_cut = (float)cc;
       l->expo = m->light_exponent[i];
       if (l->directional) l->att[0] = 1, l->att[1] = l->att[2] = 0, l->cos_cut = -2, l->expo = 0;
+      l->spot_pow = pow_table(s, l->expo);
     }
   }
+  /* nearest geoms first (their centres' depth), so hidden surfaces fail
+   * the depth test before any shading */
   for (int g = 0; g < m->ngeom; g++) {
+    const double *xg = d->geom_xpos + 3 * g;
+    double z = 0;
+    for (int r = 0; r < 3; r++) z += cam.R[3 * r + 2] * (xg[r] - cam.p[r]);
+    int k = g;
+    while (k > 0 && s->key[k - 1] < z) s->order[k] = s->order[k - 1], s->key[k] = s->key[k - 1], k--;
+    s->order[k] = g, s->key[k] = z;
+  }
+  for (int gi = 0; gi < m->ngeom; gi++) {
+    int g = s->order[gi];
     const soft_shape *sh = &s->shape[g];
     int grp = m->geom_group[g];
     if (sh->nt == 0 || grp < 0 || grp >= 6 || !v->groups[grp]) continue;
     if (v->only_geom >= 0 && g != v->only_geom) continue;
     soft_mat mt;
-    geom_material(m, s, g, v, &mt);
+    geom_material(m, s, g, v, twin, &mt);
     if (mt.rgba[3] == 0) continue;
     /* camera from geom: M = R_c^T R_g, t = R_c^T (x_g - p_c) */
     const double *Rg = d->geom_xmat + 9 * g, *xg = d->geom_xpos + 3 * g;
@@ -587,30 +922,40 @@ void sim_soft_render(sim_soft *s, const mjModel *m, const mjData *d, const sim_s
     float Mf[9], tf[3];
     for (int k = 0; k < 9; k++) Mf[k] = (float)M[k];
     for (int k = 0; k < 3; k++) tf[k] = (float)t[k];
-    for (int i = 0; i < sh->nv; i++) {
-      const float *p = sh->pos + 3 * i, *n = sh->nrm + 3 * i;
-      soft_vtx *o = &s->vtx[i];
-      float q[3], nn[3];
-      for (int r = 0; r < 3; r++) {
-        q[r] = Mf[3 * r] * p[0] + Mf[3 * r + 1] * p[1] + Mf[3 * r + 2] * p[2] + tf[r];
-        nn[r] = Mf[3 * r] * n[0] + Mf[3 * r + 1] * n[1] + Mf[3 * r + 2] * n[2];
-      }
-      o->x = q[0], o->y = q[1], o->z = q[2];
-      o->u = sh->uv ? sh->uv[2 * i] : 0.0f, o->v = sh->uv ? sh->uv[2 * i + 1] : 0.0f;
-      if (v->mode == SIM_SOFT_LIT) {
-        float nl2 = sqrtf(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]), col[3];
-        if (nl2 > 0) nn[0] /= nl2, nn[1] /= nl2, nn[2] /= nl2;
-        light_vertex(L, nl, &mt, q, nn, col);
-        o->r = col[0], o->g = col[1], o->b = col[2];
-      } else {
-        o->r = o->g = o->b = 1.0f;
-      }
-    }
-    if (!sh->uv) mt.tex = NULL;
+    geom_pass gp = {s, &cam, sh, &mt, L, nl, v->mode, Mf};
+    float zn = (float)-cam.znear;
+    memset(s->lit, 0, (size_t)sh->nv);
+    memset(s->pdone, 0, (size_t)sh->np);
+    /* the camera in the geom's frame: R_g^T (p_c - x_g) */
+    float eye[3];
+    for (int c = 0; c < 3; c++)
+      eye[c] = (float)(Rg[c] * -dx[0] + Rg[3 + c] * -dx[1] + Rg[6 + c] * -dx[2]);
+    if (!sh->uv) mt.tex = NULL, mt.tex2 = NULL;
+    uint8_t *out = v->mode == SIM_SOFT_SEGMENT ? NULL : rgb;
     for (int i = 0; i < sh->nt; i++) {
       const int *tr = sh->tri + 3 * i;
-      draw_tri(s, &cam, &s->vtx[tr[0]], &s->vtx[tr[1]], &s->vtx[tr[2]], &mt,
-               v->mode == SIM_SOFT_SEGMENT ? NULL : rgb, ids);
+      const float *pl = sh->plane + 4 * i;
+      if (pl[0] * eye[0] + pl[1] * eye[1] + pl[2] * eye[2] <= pl[3]) continue; /* back face */
+      for (int k = 0; k < 3; k++) place_at(&gp, tr[k], tf);
+      const soft_vtx *p0 = &s->vtx[tr[0]], *p1 = &s->vtx[tr[1]], *p2 = &s->vtx[tr[2]];
+      int in = (p0->z <= zn) + (p1->z <= zn) + (p2->z <= zn);
+      if (in == 0) continue;
+      if (in < 3) {
+        for (int k = 0; k < 3; k++) light_at(&gp, tr[k]);
+        draw_tri(s, &cam, p0, p1, p2, &mt, out, ids);
+        continue;
+      }
+      /* wholly in front: back faces and triangles off the image go before
+       * any lighting */
+      const soft_svtx *a = &s->sv[tr[0]], *b = &s->sv[tr[1]], *c = &s->sv[tr[2]];
+      double area = (b->sx - a->sx) * (c->sy - a->sy) - (b->sy - a->sy) * (c->sx - a->sx);
+      int box[4];
+      if (!(area > 0) || !tri_box(s, a, b, c, box)) continue;
+      for (int k = 0; k < 3; k++) light_at(&gp, tr[k]);
+      const soft_vtx *tp[3] = {p0, p1, p2};
+      soft_svtx ts[3] = {*a, *b, *c};
+      int lv[2] = {tri_level(mt.tex, tp, ts), tri_level(mt.tex2, tp, ts)};
+      raster(s, a, b, c, &mt, lv, out, ids);
     }
   }
 }

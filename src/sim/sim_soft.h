@@ -40,7 +40,10 @@ typedef struct sim_soft_view {
   unsigned char groups[6];  /* geom groups drawn (mjNGROUP) */
   int only_geom;            /* >= 0: draw just this geom */
   const unsigned char *tex_geom; /* UNLIT: ngeom flags, 1 = show its texture */
-  uint8_t flat_rgb[3];      /* UNLIT: the colour of every other geom */
+  uint8_t flat_rgb[3];      /* UNLIT, twin: the colour of every other geom */
+  const int *twin_tex;      /* LIT with a twin image: ngeom texture ids, the
+                             * texture geom g shows there unlit at its own
+                             * texture coordinates (-1: flat_rgb) */
 } sim_soft_view;
 
 /* A context for w x h images of model m: the geoms' triangles in their own
@@ -50,8 +53,12 @@ sim_soft *sim_soft_new(const mjModel *m, int w, int h);
 void sim_soft_free(sim_soft *s);
 
 /* Render view v of (m, d) into rgb (w*h*3; may be NULL in SEGMENT mode)
- * and, when ids is not NULL, the geom id of each pixel (-1: background). */
+ * and, when ids is not NULL, the geom id of each pixel (-1: background).
+ * In LIT mode a non-NULL twin (w*h*3) receives, from the same pass, the
+ * unlit image of v->twin_tex: what an UNLIT render shows when geoms with
+ * the same mesh and pose carry those textures (one geometry pass for the
+ * front RGB and thermal views). */
 void sim_soft_render(sim_soft *s, const mjModel *m, const mjData *d, const sim_soft_view *v,
-                     uint8_t *rgb, int *ids);
+                     uint8_t *rgb, uint8_t *twin, int *ids);
 
 #endif
