@@ -529,7 +529,10 @@ static void light_vertex(const soft_light *L, int nl, const soft_mat *mt, const 
   for (int k = 0; k < 3; k++) c[k] = mt->emis * mt->rgba[k];
   float vl = sqrtf(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
   float V[3] = {0, 0, 1};
-  if (vl > 0) V[0] = -p[0] / vl, V[1] = -p[1] / vl, V[2] = -p[2] / vl;
+  if (vl > 0) {
+    float iv = 1.0f / vl;
+    V[0] = -p[0] * iv, V[1] = -p[1] * iv, V[2] = -p[2] * iv;
+  }
   for (int i = 0; i < nl; i++) {
     const soft_light *l = &L[i];
     float Ld[3], att = 1.0f, spot = 1.0f;
@@ -539,8 +542,10 @@ static void light_vertex(const soft_light *L, int nl, const soft_mat *mt, const 
       float dx = l->pos[0] - p[0], dy = l->pos[1] - p[1], dz = l->pos[2] - p[2];
       float dist = sqrtf(dx * dx + dy * dy + dz * dz);
       if (dist <= 0) continue;
-      Ld[0] = dx / dist, Ld[1] = dy / dist, Ld[2] = dz / dist;
-      att = 1.0f / (l->att[0] + l->att[1] * dist + l->att[2] * dist * dist);
+      float id = 1.0f / dist;
+      Ld[0] = dx * id, Ld[1] = dy * id, Ld[2] = dz * id;
+      if (l->att[0] != 1.0f || l->att[1] != 0.0f || l->att[2] != 0.0f)
+        att = 1.0f / (l->att[0] + l->att[1] * dist + l->att[2] * dist * dist);
       float cs = -(Ld[0] * l->dir[0] + Ld[1] * l->dir[1] + Ld[2] * l->dir[2]);
       if (cs < l->cos_cut) continue;
       spot = pow_lookup(l->spot_pow, l->expo, cs);
@@ -797,7 +802,10 @@ static void light_at(const geom_pass *g, int i) {
     float nn[3], q[3] = {o->x, o->y, o->z}, col[3];
     for (int r = 0; r < 3; r++) nn[r] = M[3 * r] * n[0] + M[3 * r + 1] * n[1] + M[3 * r + 2] * n[2];
     float len = sqrtf(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
-    if (len > 0) nn[0] /= len, nn[1] /= len, nn[2] /= len;
+    if (len > 0) {
+      float il = 1.0f / len;
+      nn[0] *= il, nn[1] *= il, nn[2] *= il;
+    }
     light_vertex(g->L, g->nl, g->mt, q, nn, col);
     o->r = col[0], o->g = col[1], o->b = col[2];
   } else {
@@ -951,8 +959,26 @@ void sim_soft_render(sim_soft *s, const mjModel *m, const mjData *d, const sim_s
       double area = (b->sx - a->sx) * (c->sy - a->sy) - (b->sy - a->sy) * (c->sx - a->sx);
       int box[4];
       if (!(area > 0) || !tri_box(s, a, b, c, box)) continue;
-      for (int k = 0; k < 3; k++) light_at(&gp, tr[k]);
       const soft_vtx *tp[3] = {p0, p1, p2};
+      const float *n0 = sh->nrm + 3 * tr[0];
+      if ((box[1] - box[0] + 1) * (box[3] - box[2] + 1) <= 2 &&
+          memcmp(n0, sh->nrm + 3 * tr[1], 3 * sizeof(float)) == 0 &&
+          memcmp(n0, sh->nrm + 3 * tr[2], 3 * sizeof(float)) == 0) {
+        /* a flat triangle over at most two pixel centres: lit once, at its
+         * first corner (across it the light changes by far less than a
+         * grey level) */
+        light_at(&gp, tr[0]);
+        soft_svtx ts[3] = {*a, *b, *c};
+        for (int k = 1; k < 3; k++) {
+          float iw = ts[k].iw;
+          ts[k].a[0] = p0->r * iw, ts[k].a[1] = p0->g * iw, ts[k].a[2] = p0->b * iw;
+          ts[k].a[3] = tp[k]->u * iw, ts[k].a[4] = tp[k]->v * iw;
+        }
+        int lv[2] = {tri_level(mt.tex, tp, ts), tri_level(mt.tex2, tp, ts)};
+        raster(s, &ts[0], &ts[1], &ts[2], &mt, lv, out, ids);
+        continue;
+      }
+      for (int k = 0; k < 3; k++) light_at(&gp, tr[k]);
       soft_svtx ts[3] = {*a, *b, *c};
       int lv[2] = {tri_level(mt.tex, tp, ts), tri_level(mt.tex2, tp, ts)};
       raster(s, a, b, c, &mt, lv, out, ids);
