@@ -526,7 +526,10 @@ typedef struct soft_mat {
 static void light_vertex(const soft_light *L, int nl, const soft_mat *mt, const float p[3],
                          const float n[3], float out[3]) {
   float c[3];
-  for (int k = 0; k < 3; k++) c[k] = mt->emis * mt->rgba[k];
+  /* OpenGL's global ambient: 0.3 when there is no light at all (as
+   * MuJoCo sets it), else none */
+  float amb = nl == 0 ? 0.3f : 0.0f;
+  for (int k = 0; k < 3; k++) c[k] = mt->emis * mt->rgba[k] + amb * mt->rgba[k];
   float vl = sqrtf(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
   float V[3] = {0, 0, 1};
   if (vl > 0) {
