@@ -440,6 +440,10 @@ static void tex_sample(const soft_tex *t, int l, float u, float v, float c[3]) {
   int w = t->w[l], h = t->h[l];
   const uint8_t *p = t->rgb + t->off[l];
   float fu = u * (float)w - 0.5f, fv = v * (float)h - 0.5f;
+  /* coordinates far outside the texture's repeats (or not numbers): its
+   * first texel rather than an overflowing conversion */
+  if (!(fabsf(fu) < 1e7f)) fu = 0.0f;
+  if (!(fabsf(fv) < 1e7f)) fv = 0.0f;
   float x0f = floorf(fu), y0f = floorf(fv), ax = fu - x0f, ay = fv - y0f;
   /* wrap: the coordinates stay within a few repeats of the texture */
   long x0, y0;
@@ -607,6 +611,7 @@ static void raster(sim_soft *s, const soft_svtx *a, const soft_svtx *b, const so
     own[i] = edge_owns(A[i], B[i]);
   }
   double inv = 1.0 / area;
+  int k0 = mt->unlit ? 3 : 0, k1 = mt->tex || mt->tex2 ? 5 : 3;
   for (int y = y0; y <= y1; y++) {
     double yc = y + 0.5, row[3];
     for (int i = 0; i < 3; i++) row[i] = B[i] * yc + C[i];
@@ -645,8 +650,9 @@ static void raster(sim_soft *s, const soft_svtx *a, const soft_svtx *b, const so
       s->depth[px] = iw;
       if (ids) ids[px] = mt->id;
       if (!rgb) continue;
-      float wgt = 1.0f / iw, at[5];
-      for (int k = 0; k < 5; k++) at[k] = (l0 * a->a[k] + l1 * b->a[k] + l2 * c->a[k]) * wgt;
+      /* only the attributes this triangle uses */
+      float wgt = 1.0f / iw, at[5] = {1.0f, 1.0f, 1.0f, 0.0f, 0.0f};
+      for (int k = k0; k < k1; k++) at[k] = (l0 * a->a[k] + l1 * b->a[k] + l2 * c->a[k]) * wgt;
       float col[3] = {at[0], at[1], at[2]};
       if (mt->unlit && !mt->tex) col[0] = mt->flat[0], col[1] = mt->flat[1], col[2] = mt->flat[2];
       if (mt->tex) {
