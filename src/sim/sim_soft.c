@@ -65,6 +65,17 @@ static float soft_powf(float x, float e) {
 #define SOFT_MIN3(p, q, r) ((p) < (q) ? ((p) < (r) ? (p) : (r)) : ((q) < (r) ? (q) : (r)))
 #define SOFT_MAX3(p, q, r) ((p) > (q) ? ((p) > (r) ? (p) : (r)) : ((q) > (r) ? (q) : (r)))
 
+/* floor and ceiling of values well inside the int range, exact, without
+ * a libm call (x86-64's baseline has no rounding instruction) */
+static inline int soft_floor(double x) {
+  int k = (int)x;
+  return (double)k > x ? k - 1 : k;
+}
+static inline int soft_ceil(double x) {
+  int k = (int)x;
+  return (double)k < x ? k + 1 : k;
+}
+
 /* one geom's triangles in its own frame, sizes applied */
 typedef struct soft_shape {
   int nv, nt;
@@ -444,7 +455,7 @@ static void tex_sample(const soft_tex *t, int l, float u, float v, float c[3]) {
    * first texel rather than an overflowing conversion */
   if (!(fabsf(fu) < 1e7f)) fu = 0.0f;
   if (!(fabsf(fv) < 1e7f)) fv = 0.0f;
-  float x0f = floorf(fu), y0f = floorf(fv), ax = fu - x0f, ay = fv - y0f;
+  float x0f = (float)soft_floor(fu), y0f = (float)soft_floor(fv), ax = fu - x0f, ay = fv - y0f;
   /* wrap: the coordinates stay within a few repeats of the texture */
   long x0, y0;
   if (((w & (w - 1)) | (h & (h - 1))) == 0) {
@@ -580,16 +591,17 @@ static int edge_owns(double A, double B) { return A > 0 || (A == 0 && B < 0); }
  * triangle, clipped to the image: box = x0 x1 y0 y1; 0 when none */
 static int tri_box(const sim_soft *s, const soft_svtx *a, const soft_svtx *b, const soft_svtx *c,
                    int box[4]) {
-  double fx0 = ceil(SOFT_MIN3(a->sx, b->sx, c->sx) - 0.5),
-         fx1 = floor(SOFT_MAX3(a->sx, b->sx, c->sx) - 0.5),
-         fy0 = ceil(SOFT_MIN3(a->sy, b->sy, c->sy) - 0.5),
-         fy1 = floor(SOFT_MAX3(a->sy, b->sy, c->sy) - 0.5);
-  if (fx0 < 0) fx0 = 0;
-  if (fy0 < 0) fy0 = 0;
-  if (fx1 > s->w - 1) fx1 = s->w - 1;
-  if (fy1 > s->h - 1) fy1 = s->h - 1;
-  if (fx0 > fx1 || fy0 > fy1) return 0;
-  box[0] = (int)fx0, box[1] = (int)fx1, box[2] = (int)fy0, box[3] = (int)fy1;
+  double lo[2] = {SOFT_MIN3(a->sx, b->sx, c->sx) - 0.5, SOFT_MIN3(a->sy, b->sy, c->sy) - 0.5},
+         hi[2] = {SOFT_MAX3(a->sx, b->sx, c->sx) - 0.5, SOFT_MAX3(a->sy, b->sy, c->sy) - 0.5};
+  int n[2] = {s->w, s->h};
+  for (int k = 0; k < 2; k++) {
+    if (!(hi[k] >= 0 && lo[k] <= n[k] - 1)) return 0; /* off the image (or not a number) */
+    int i0 = soft_ceil(lo[k] < -1 ? -1 : lo[k]), i1 = soft_floor(hi[k] > n[k] ? n[k] : hi[k]);
+    if (i0 < 0) i0 = 0;
+    if (i1 > n[k] - 1) i1 = n[k] - 1;
+    if (i0 > i1) return 0;
+    box[2 * k] = i0, box[2 * k + 1] = i1;
+  }
   return 1;
 }
 
@@ -628,10 +640,10 @@ static void raster(sim_soft *s, const soft_svtx *a, const soft_svtx *b, const so
       if (r < x0 - 1) r = x0 - 1;
       if (r > x1 + 1) r = x1 + 1;
       if (A[i] > 0) {
-        int k = (int)floor(r);
+        int k = soft_floor(r);
         if (k > lo) lo = k;
       } else {
-        int k = (int)ceil(r);
+        int k = soft_ceil(r);
         if (k < hi) hi = k;
       }
     }
