@@ -130,16 +130,21 @@ struct sim_soft {
   int vcap;
 };
 
-/* the table of exponent e (made on first use), NULL when all are taken */
-static const soft_pow *pow_table(sim_soft *s, float e) {
+/* the table of exponent e, NULL when there is none (then soft_powf) */
+static const soft_pow *pow_table(const sim_soft *s, float e) {
   for (int i = 0; i < s->npw; i++)
     if (s->pw[i].e == e) return &s->pw[i];
-  if (s->npw == SOFT_NPOW) return NULL;
+  return NULL;
+}
+
+/* a table for exponent e, made when the context is (so which exponents
+ * have one depends on the model alone, never on what was rendered) */
+static void pow_add(sim_soft *s, float e) {
+  if (pow_table(s, e) || s->npw == SOFT_NPOW) return;
   soft_pow *p = &s->pw[s->npw++];
   p->e = e;
   for (int i = 0; i <= SOFT_POWN; i++) p->t[i] = soft_powf((float)i / SOFT_POWN, e);
   p->t[SOFT_POWN + 1] = 1.0f;
-  return p;
 }
 
 static float pow_lookup(const soft_pow *p, float e, float x) {
@@ -502,6 +507,11 @@ sim_soft *sim_soft_new(const mjModel *m, int w, int h) {
     if (s->shape[g].nv > s->vcap) s->vcap = s->shape[g].nv;
   }
   for (int t = 0; t < m->ntex && ok; t++) ok = make_tex(&s->tex[t], m, t);
+  /* the exponents: specular (shininess x 128; 0.5 without a material)
+   * and spot lights */
+  pow_add(s, 0.5f * 128.0f);
+  for (int i = 0; i < m->nmat; i++) pow_add(s, m->mat_shininess[i] * 128.0f);
+  for (int i = 0; i < m->nlight; i++) pow_add(s, m->light_directional[i] ? 0.0f : m->light_exponent[i]);
   size_t nv = (size_t)(s->vcap > 0 ? s->vcap : 1);
   if (ok) {
     s->vtx = malloc(sizeof(soft_vtx) * nv), s->sv = malloc(sizeof(soft_svtx) * nv);
