@@ -58,6 +58,9 @@ typedef struct hearth_eval_opts {
   int use_ground_truth;
   int render_size;       /* sim view side; default 256 (as collection stores) */
   int shadows;           /* as hearth_sim_opts.shadows; default 0 */
+  const char *renderer;  /* as hearth_sim_opts.renderer: the same default as
+                          * hearth_sim_collect, so evaluation sees the images
+                          * training saw */
   const char *gl;        /* as hearth_sim_opts.gl */
   int image_size;        /* policy image side; default 224 (openpi's model input) */
   int max_steps;         /* 0 = hearth_eval_time_limit(task) */

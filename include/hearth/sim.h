@@ -65,9 +65,18 @@ typedef struct hearth_sim_opts {
   int shadows;          /* shadow-mapped light in the RGB views; default 0
                           * (a shadow-map pass per lit view, costly on the
                           * CPU; the thermal view is unlit either way) */
-  const char *gl;       /* "osmesa" (CPU, default) or "egl" (GPU through
-                          * EGL's device platform, else Mesa's surfaceless
-                          * platform); NULL: $HEARTH_GL, else "osmesa" */
+  const char *renderer; /* "soft": hearth's software rasteriser (the
+                          * default: the same bytes on every machine, no
+                          * shadows); "gl": MuJoCo's OpenGL renderer
+                          * through the back end `gl` (shadows, large
+                          * images); "none": no images (observe leaves
+                          * the image pointers NULL; physics and control
+                          * alone). NULL: $HEARTH_RENDERER, else "gl" with
+                          * shadows and "soft" without */
+  const char *gl;       /* GL back end of renderer "gl": "osmesa" (CPU,
+                          * default) or "egl" (GPU through EGL's device
+                          * platform, else Mesa's surfaceless platform);
+                          * NULL: $HEARTH_GL, else "osmesa" */
   const char *work_dir; /* scratch for the MJCF/mesh files; NULL = a fresh dir under
                           * $TMPDIR (else /tmp), removed with the env */
 } hearth_sim_opts;
@@ -80,8 +89,9 @@ typedef struct hearth_sim_env hearth_sim_env;
  * (NULL is fine). Use an env from one thread at a time. */
 hearth_status hearth_sim_env_new(const hearth_sim_opts *o, hearth_sim_env **out, hearth_err *err);
 void hearth_sim_env_free(hearth_sim_env *env);
-/* The GL back end and renderer in use, e.g. "osmesa: llvmpipe (...)" or
- * "egl device: NVIDIA H100 ..."; owned by the env. */
+/* The renderer in use, e.g. "soft: hearth rasteriser 1", "osmesa:
+ * llvmpipe (...)", "egl device: NVIDIA H100 ..." or "none"; owned by the
+ * env. */
 const char *hearth_sim_renderer(const hearth_sim_env *env);
 
 /* Start an episode: layout `layout` of the stream `seed` (object positions
@@ -149,6 +159,8 @@ typedef struct hearth_sim_collect_opts {
   int keep_failures;            /* store failed demos too (default 0: retry the slot with its next
                          * candidate layout) */
   int shadows;                  /* as hearth_sim_opts.shadows; default 0 */
+  const char *renderer;         /* as hearth_sim_opts.renderer; "none" stores no
+                         * image datasets (a physics-and-control timing run) */
   const char *gl;               /* as hearth_sim_opts.gl */
   int shard_index, shard_count; /* this process fills the slots k with k % count == index;
                          * count 0 or 1: all of them. The files of a shard are merged

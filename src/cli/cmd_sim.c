@@ -50,7 +50,7 @@ static const char *const k_task_names[] = {"H1", "H2", "H3", NULL};
 static const int k_task_values[] = {HEARTH_SIM_H1, HEARTH_SIM_H2, HEARTH_SIM_H3};
 
 int hearth_cmd_sim_render(int argc, char **argv) {
-  const char *out = NULL, *release = NULL, *gl = NULL;
+  const char *out = NULL, *release = NULL, *gl = NULL, *renderer = NULL;
   int only = 0, size = 256, gt = 0, shadows = 0;
   uint64_t seed = 1;
   const cli_opt opts[] = {
@@ -66,6 +66,10 @@ int hearth_cmd_sim_render(int argc, char **argv) {
       CLI_INT("--size", "N", &size, 16, 4096, "image side in pixels"),
       CLI_U64("--seed", "N", &seed, "layout seed"),
       CLI_FLAG("--shadows", &shadows, 1, "shadow-mapped light in the RGB views (off by default)"),
+      CLI_STR("--renderer", "soft|gl", &renderer,
+              "soft: hearth's deterministic software rasteriser; gl: MuJoCo's OpenGL renderer "
+              "(needed for --shadows)",
+              .def = "$HEARTH_RENDERER, else gl with --shadows and soft without"),
       CLI_STR("--gl", "osmesa|egl", &gl,
               "GL back end: osmesa: CPU; egl: a GPU through EGL, else Mesa's surfaceless platform",
               .def = "$HEARTH_GL, else osmesa"),
@@ -90,6 +94,7 @@ int hearth_cmd_sim_render(int argc, char **argv) {
     o.width = o.height = size;
     o.shadows = shadows;
     o.gl = gl;
+    o.renderer = renderer;
     char prefix[4200];
     snprintf(prefix, sizeof prefix, "%s/%s", out, hearth_sim_task_name(o.task));
     if (hearth_sim_render_scene(&o, seed, prefix, &err)) rc = cli_fail("sim render", &err);
@@ -123,7 +128,13 @@ int hearth_cmd_sim_collect(int argc, char **argv) {
                "with --release: a virtual-rig release's ground_truth/ assets"),
       CLI_FLAG("--keep-failures", &o.keep_failures, 1, "also store episodes that did not succeed"),
       CLI_FLAG("--shadows", &o.shadows, 1, "shadow-mapped light in the RGB views (off by default)"),
-      CLI_STR("--gl", "osmesa|egl", &o.gl, "GL back end", .def = "$HEARTH_GL, else osmesa"),
+      CLI_STR("--renderer", "soft|gl|none", &o.renderer,
+              "soft: hearth's deterministic software rasteriser; gl: MuJoCo's OpenGL renderer "
+              "(needed for --shadows); none: no images (times physics, control and the expert "
+              "alone; the file has no obs image datasets)",
+              .def = "$HEARTH_RENDERER, else gl with --shadows and soft without"),
+      CLI_STR("--gl", "osmesa|egl", &o.gl, "GL back end of --renderer gl",
+              .def = "$HEARTH_GL, else osmesa"),
       CLI_SHARD("--shard", "I/N", &o.shard_index, &o.shard_count,
                 "collect only the slots k with k % N == I (merge the N files with sim merge)",
                 .def = "0/1"),

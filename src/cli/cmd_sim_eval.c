@@ -91,7 +91,12 @@ int hearth_cmd_sim_eval(int argc, char **argv) {
               "rendered view side (as sim collect stores)"),
       CLI_FLAG("--shadows", &o.shadows, 1,
                "shadow-mapped light in the RGB views (as at collection)"),
-      CLI_STR("--gl", "osmesa|egl", &o.gl, "GL back end", .def = "$HEARTH_GL, else osmesa"),
+      CLI_STR("--renderer", "soft|gl", &o.renderer,
+              "soft: hearth's deterministic software rasteriser; gl: MuJoCo's OpenGL renderer "
+              "(needed for --shadows); the same default as sim collect",
+              .def = "$HEARTH_RENDERER, else gl with --shadows and soft without"),
+      CLI_STR("--gl", "osmesa|egl", &o.gl, "GL back end of --renderer gl",
+              .def = "$HEARTH_GL, else osmesa"),
       CLI_INT("--image-size", "N", &o.image_size, 8, 1024, "policy image side"),
       CLI_INT("--max-steps", "N", &o.max_steps, 1, 100000, "time limit in control steps",
               .def = "280"),

@@ -41,9 +41,11 @@ static hearth_status rollout(hearth_sim_env *e, uint64_t seed, uint64_t layout, 
     if (!sim_demo_grow(b, b->T + 1 > b->cap ? b->cap * 2 + 64 : b->cap))
       return hearth_err_set(err, HEARTH_E_NOMEM, "sim collect: out of memory");
     size_t i = b->T;
-    memcpy(b->front + i * px, ob.agentview_rgb, px);
-    memcpy(b->thermal + i * px, ob.agentview_thermal, px);
-    memcpy(b->wrist + i * px, ob.eye_in_hand_rgb, px);
+    if (px) {
+      memcpy(b->front + i * px, ob.agentview_rgb, px);
+      memcpy(b->thermal + i * px, ob.agentview_thermal, px);
+      memcpy(b->wrist + i * px, ob.eye_in_hand_rgb, px);
+    }
     memcpy(b->joint + 7 * i, ob.joint_states, sizeof ob.joint_states);
     memcpy(b->grip + 2 * i, ob.gripper_states, sizeof ob.gripper_states);
     memcpy(b->ee + 6 * i, ob.ee_pos, sizeof ob.ee_pos);
@@ -103,6 +105,7 @@ static hearth_status run_open(collect_run *c, hearth_err *err) {
   so.width = so.height = o->image_size;
   so.max_steps = o->max_steps;
   so.shadows = o->shadows;
+  so.renderer = o->renderer;
   so.gl = o->gl;
   hearth_status st = hearth_sim_env_new(&so, &c->env, err);
   if (st) return st;
@@ -114,12 +117,17 @@ static hearth_status run_open(collect_run *c, hearth_err *err) {
   c->nfile = o->split_instructions ? 2 : 1;
   for (int i = 0; i < 2; i++) {
     c->demo[i].nstate = hearth_sim_state(c->env, NULL, 0);
-    c->demo[i].img = (size_t)o->image_size * (size_t)o->image_size * 3;
+    /* renderer none: no images to keep */
+    c->demo[i].img = c->env->render_kind == SIM_RENDER_NONE
+                         ? 0
+                         : (size_t)o->image_size * (size_t)o->image_size * 3;
   }
   for (int i = 0; i < c->nfile && !st; i++) {
     if (c->nfile == 2) hearth_sim_split_path(o->out_path, i, c->path[i], sizeof c->path[i]);
     else snprintf(c->path[i], sizeof c->path[i], "%s", o->out_path);
-    st = sim_h5_describe(o, c->nfile == 2 ? i : 0, c->nfile == 2 ? 1 : 2, c->env->gl, &c->meta[i],
+    st = sim_h5_describe(o, c->nfile == 2 ? i : 0, c->nfile == 2 ? 1 : 2,
+                         c->env->render_kind == SIM_RENDER_GL ? c->env->gl : c->env->render_name,
+                         &c->meta[i],
                          err);
     if (!st) st = sim_h5_create(&c->out[i], c->path[i], err);
   }

@@ -56,6 +56,25 @@ hearth_status hearth_sim_env_new(const hearth_sim_opts *o, hearth_sim_env **out,
                           "sim: renderer '%s' is not osmesa or egl (option gl / HEARTH_GL)", gl);
   }
   snprintf(e->gl, sizeof e->gl, "%s", gl);
+  /* the renderer: soft unless shadows are asked for without naming one */
+  const char *rn = o->renderer && *o->renderer ? o->renderer : getenv("HEARTH_RENDERER");
+  if (!rn || !*rn) rn = o->shadows ? "gl" : "soft";
+  if (strcmp(rn, "soft") == 0) e->render_kind = SIM_RENDER_SOFT;
+  else if (strcmp(rn, "gl") == 0) e->render_kind = SIM_RENDER_GL;
+  else if (strcmp(rn, "none") == 0) e->render_kind = SIM_RENDER_NONE;
+  else {
+    free(e);
+    return hearth_err_set(err, HEARTH_E_ARG,
+                          "sim: renderer '%s' is not soft, gl or none (option renderer / "
+                          "HEARTH_RENDERER)",
+                          rn);
+  }
+  if (e->render_kind == SIM_RENDER_SOFT && o->shadows) {
+    free(e);
+    return hearth_err_set(err, HEARTH_E_UNSUPPORTED,
+                          "sim: the soft renderer draws no shadows: use renderer gl with shadows");
+  }
+  snprintf(e->render_name, sizeof e->render_name, "%s", rn);
   hearth_status st = HEARTH_OK;
   if (o->work_dir) {
     snprintf(e->work_dir, sizeof e->work_dir, "%s", o->work_dir);

@@ -10,10 +10,15 @@
 
 typedef struct sim_render sim_render;
 
+/* which renderer an env draws its views with */
+enum { SIM_RENDER_SOFT = 0, SIM_RENDER_GL = 1, SIM_RENDER_NONE = 2 };
+
 struct hearth_sim_env {
   hearth_sim_task task;
   int width, height, max_steps, render_wrist, shadows;
   char gl[16];
+  int render_kind;    /* SIM_RENDER_* */
+  char render_name[8]; /* "soft", "gl", "none" */
   char work_dir[4096];
   int own_work_dir;
   sim_asset assets[SIM_NOBJ]; /* 0, 1: candidates (instruction i targets i); 2, 3: distractors */

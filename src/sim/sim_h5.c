@@ -26,7 +26,7 @@ int sim_demo_grow(sim_demo *b, size_t cap) {
     *dp[i] = q;
   }
   uint8_t **ip[] = {&b->front, &b->thermal, &b->wrist};
-  for (int i = 0; i < 3; i++) {
+  for (int i = 0; i < 3 && b->img; i++) {
     void *q = hearth_alloc_array(cap, b->img);
     if (!q) return 0;
     if (*ip[i]) memcpy(q, *ip[i], b->T * b->img);
@@ -161,9 +161,9 @@ hearth_status sim_h5_add_demo(sim_h5_out *o, const sim_demo *b, int S, const cha
     hid_t ob = ok ? h5_group(g, "obs") : -1;
     if (ob < 0) ok = 0;
     if (ok)
-      ok = h5_write(ob, "agentview_rgb", u8, nu8, 4, dI, b->front) &&
-           h5_write(ob, "agentview_thermal", u8, nu8, 4, dI, b->thermal) &&
-           h5_write(ob, "eye_in_hand_rgb", u8, nu8, 4, dI, b->wrist) &&
+      ok = (b->img == 0 || (h5_write(ob, "agentview_rgb", u8, nu8, 4, dI, b->front) &&
+                            h5_write(ob, "agentview_thermal", u8, nu8, 4, dI, b->thermal) &&
+                            h5_write(ob, "eye_in_hand_rgb", u8, nu8, 4, dI, b->wrist))) &&
            h5_write(ob, "joint_states", f64, nd, 2, d7, b->joint) &&
            h5_write(ob, "gripper_states", f64, nd, 2, d2, b->grip) &&
            h5_write(ob, "ee_states", f64, nd, 2, d6, b->ee) &&

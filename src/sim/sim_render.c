@@ -1,6 +1,9 @@
-/* off-screen rendering of the three views with MuJoCo's OpenGL renderer:
- * front RGB, front thermal (object-attached Turbo textures, unlit;
- * everything else at room temperature), wrist RGB. Two GL back ends: an
+/* off-screen rendering of the three views: front RGB, front thermal
+ * (object-attached Turbo textures, unlit; everything else at room
+ * temperature), wrist RGB, and the segmentation renders of the audits.
+ * Two renderers: hearth's own software rasteriser (sim_soft.c, the
+ * default: deterministic bytes, no GL) and MuJoCo's OpenGL renderer
+ * (shadows, large images). Two GL back ends: an
  * OSMesa context (CPU, linked) and EGL (a GPU through the device platform,
  * else Mesa's surfaceless platform), loaded at run time so that machines
  * without libEGL still run the CPU path. MuJoCo resolves GL entry points
@@ -17,6 +20,7 @@
 
 #include "hearth/geom.h"
 #include "sim/sim_env.h"
+#include "sim/sim_soft.h"
 
 typedef struct egl_api {
   void *lib;
@@ -35,6 +39,12 @@ typedef struct egl_api {
 } egl_api;
 
 struct sim_render {
+  int kind; /* SIM_RENDER_SOFT, _GL or _NONE */
+  sim_soft *sw;
+  unsigned char *th_geom; /* ngeom flags: the assets' thermal geoms */
+  int *twin_tex;          /* ngeom: thermal texture of each colour mesh geom, else -1 */
+  int twin_ok;            /* thermal view drawn in the RGB view's pass */
+  int *ids;               /* width*height geom ids of a segmentation render */
   int egl;
   OSMesaContext gl;
   unsigned char *glbuf;
@@ -151,16 +161,56 @@ static hearth_status egl_open(sim_render *r, hearth_err *err) {
   return HEARTH_OK;
 }
 
+/* whether the thermal view can come from the RGB view's pass: the
+ * colour meshes (group 2) and thermal meshes (group 3) are exactly the
+ * assets' pairs, each pair the same mesh at the same pose */
+static void twin_setup(hearth_sim_env *e) {
+  sim_render *r = e->rnd;
+  const mjModel *m = e->m;
+  int ok = 1, n2 = 0, n3 = 0;
+  for (int g = 0; g < m->ngeom; g++) {
+    r->twin_tex[g] = -1;
+    n2 += m->geom_group[g] == 2, n3 += m->geom_group[g] == 3;
+  }
+  for (int k = 0; k < SIM_NOBJ && ok; k++) {
+    int a = e->obj_geom_rgb[k], b = e->obj_geom_th[k];
+    ok = a >= 0 && b >= 0 && m->geom_group[a] == 2 && m->geom_group[b] == 3 &&
+         m->geom_type[a] == m->geom_type[b] && m->geom_dataid[a] == m->geom_dataid[b] &&
+         m->geom_bodyid[a] == m->geom_bodyid[b] &&
+         memcmp(m->geom_pos + 3 * a, m->geom_pos + 3 * b, 3 * sizeof(mjtNum)) == 0 &&
+         memcmp(m->geom_quat + 4 * a, m->geom_quat + 4 * b, 4 * sizeof(mjtNum)) == 0 &&
+         m->geom_matid[b] >= 0 && m->mat_texid[m->geom_matid[b]] >= 0;
+    if (ok) r->twin_tex[a] = m->mat_texid[m->geom_matid[b]];
+  }
+  r->twin_ok = ok && n2 == SIM_NOBJ && n3 == SIM_NOBJ;
+}
+
 hearth_status sim_render_init(hearth_sim_env *e, hearth_err *err) {
   sim_render *r = calloc(1, sizeof *r);
   if (!r) return hearth_err_set(err, HEARTH_E_NOMEM, "sim: out of memory");
   e->rnd = r;
+  r->kind = e->render_kind;
   size_t px = (size_t)e->width * (size_t)e->height;
   r->front = malloc(px * 3), r->thermal = malloc(px * 3), r->wrist = malloc(px * 3),
-  r->seg = malloc(px * 3);
-  if (!r->front || !r->thermal || !r->wrist || !r->seg)
+  r->seg = malloc(px * 3), r->ids = malloc(px * sizeof(int));
+  r->th_geom = calloc((size_t)e->m->ngeom + 1, 1);
+  r->twin_tex = malloc(sizeof(int) * ((size_t)e->m->ngeom + 1));
+  if (!r->front || !r->thermal || !r->wrist || !r->seg || !r->ids || !r->th_geom || !r->twin_tex)
     return hearth_err_set(err, HEARTH_E_NOMEM, "sim: out of memory for %dx%d images", e->width,
                           e->height);
+  for (int k = 0; k < SIM_NOBJ; k++)
+    if (e->obj_geom_th[k] >= 0) r->th_geom[e->obj_geom_th[k]] = 1;
+  if (r->kind == SIM_RENDER_NONE) {
+    snprintf(r->renderer, sizeof r->renderer, "none");
+    return HEARTH_OK;
+  }
+  if (r->kind == SIM_RENDER_SOFT) {
+    twin_setup(e);
+    if (!(r->sw = sim_soft_new(e->m, e->width, e->height)))
+      return hearth_err_set(err, HEARTH_E_NOMEM, "sim: out of memory for the software renderer");
+    snprintf(r->renderer, sizeof r->renderer, "soft: hearth rasteriser %s", SIM_SOFT_VERSION);
+    return HEARTH_OK;
+  }
   r->egl = strcmp(e->gl, "egl") == 0;
   if (r->egl) {
     hearth_status st = egl_open(r, err);
@@ -199,6 +249,14 @@ const char *hearth_sim_renderer(const hearth_sim_env *e) {
 void sim_render_free(hearth_sim_env *e) {
   sim_render *r = e->rnd;
   if (!r) return;
+  sim_soft_free(r->sw);
+  free(r->th_geom), free(r->ids), free(r->twin_tex);
+  if (r->kind != SIM_RENDER_GL) {
+    free(r->front), free(r->thermal), free(r->wrist), free(r->seg);
+    free(r);
+    e->rnd = NULL;
+    return;
+  }
   int current =
       (r->egl ? r->ctx != NULL && r->ctx != EGL_NO_CONTEXT : r->gl != NULL) && make_current(e);
   if (current && r->have_con) mjr_freeContext(&r->con);
@@ -227,10 +285,41 @@ static int is_obj_geom(const hearth_sim_env *e, int g, const int *list) {
   return 0;
 }
 
+/* the thermal view's colour of everything but the assets: the room
+ * colour as MuJoCo's GL path shows an emissive (1) unlit surface with
+ * no light in the scene, which adds its 0.3 global ambient */
+static void room_shown(uint8_t out[3]) {
+  uint8_t room[3];
+  sim_room_rgb(room);
+  for (int c = 0; c < 3; c++) {
+    float v = 1.3f * (room[c] / 255.0f);
+    out[c] = (uint8_t)((v > 1 ? 1 : v) * 255.0f + 0.5f);
+  }
+}
+
+/* one camera with the software renderer; ids (may be NULL) gets geom ids */
+static void soft_view(hearth_sim_env *e, int cam, int mode, int only_geom, uint8_t *out,
+                      int *ids) {
+  sim_render *r = e->rnd;
+  sim_soft_view v = {.cam = cam, .only_geom = only_geom, .tex_geom = r->th_geom};
+  v.mode = mode == VIEW_RGB ? SIM_SOFT_LIT : mode == VIEW_THERMAL ? SIM_SOFT_UNLIT : SIM_SOFT_SEGMENT;
+  /* MuJoCo's default groups 0-2; the thermal view swaps group 2 (colour
+   * meshes) for 3 (thermal meshes) */
+  v.groups[0] = v.groups[1] = 1;
+  v.groups[2] = mode != VIEW_THERMAL;
+  v.groups[3] = mode == VIEW_THERMAL;
+  room_shown(v.flat_rgb);
+  sim_soft_render(r->sw, e->m, e->d, &v, out, NULL, ids);
+}
+
 /* render one camera; `only_geom` >= 0 keeps just that model geom */
 static void render_view(hearth_sim_env *e, int cam, int mode, int only_geom, uint8_t *out) {
   sim_render *r = e->rnd;
   mjModel *m = e->m;
+  if (r->kind == SIM_RENDER_SOFT) {
+    soft_view(e, cam, mode, only_geom, out, NULL);
+    return;
+  }
   make_current(e);
   r->cam.type = mjCAMERA_FIXED;
   r->cam.fixedcamid = cam;
@@ -296,10 +385,20 @@ hearth_status hearth_sim_observe(hearth_sim_env *e, hearth_sim_obs *o, hearth_er
   sim_render *r = e->rnd;
   memset(o, 0, sizeof *o);
   o->width = e->width, o->height = e->height;
-  render_view(e, e->cam_front, VIEW_RGB, -1, r->front);
-  render_view(e, e->cam_front, VIEW_THERMAL, -1, r->thermal);
-  o->agentview_rgb = r->front, o->agentview_thermal = r->thermal;
-  if (e->render_wrist) {
+  if (r->kind == SIM_RENDER_SOFT && r->twin_ok) {
+    /* one pass draws the front RGB view and, from the same surfaces, the
+     * thermal one */
+    sim_soft_view v = {.cam = e->cam_front, .mode = SIM_SOFT_LIT, .only_geom = -1,
+                       .twin_tex = r->twin_tex, .groups = {1, 1, 1, 0, 0, 0}};
+    room_shown(v.flat_rgb);
+    sim_soft_render(r->sw, e->m, e->d, &v, r->front, r->thermal, NULL);
+    o->agentview_rgb = r->front, o->agentview_thermal = r->thermal;
+  } else if (r->kind != SIM_RENDER_NONE) {
+    render_view(e, e->cam_front, VIEW_RGB, -1, r->front);
+    render_view(e, e->cam_front, VIEW_THERMAL, -1, r->thermal);
+    o->agentview_rgb = r->front, o->agentview_thermal = r->thermal;
+  }
+  if (e->render_wrist && r->kind != SIM_RENDER_NONE) {
     render_view(e, e->cam_wrist, VIEW_RGB, -1, r->wrist);
     o->eye_in_hand_rgb = r->wrist;
   }
@@ -313,12 +412,30 @@ hearth_status hearth_sim_observe(hearth_sim_env *e, hearth_sim_obs *o, hearth_er
   return HEARTH_OK;
 }
 
-static long count_geom(const hearth_sim_env *e, const uint8_t *img, int geom, int box[4]) {
+/* a segmentation render of the front camera into r->ids: the model geom
+ * of every pixel, -1 for background; `only_geom` >= 0 draws just it */
+static hearth_status render_ids(hearth_sim_env *e, int only_geom, hearth_err *err) {
+  sim_render *r = e->rnd;
+  if (r->kind == SIM_RENDER_NONE)
+    return hearth_err_set(err, HEARTH_E_UNSUPPORTED,
+                          "sim: segmentation needs a renderer (this env renders none)");
+  if (r->kind == SIM_RENDER_SOFT) {
+    soft_view(e, e->cam_front, VIEW_SEGMENT, only_geom, NULL, r->ids);
+    return HEARTH_OK;
+  }
+  render_view(e, e->cam_front, VIEW_SEGMENT, only_geom, r->seg);
+  size_t n = (size_t)e->width * (size_t)e->height;
+  for (size_t i = 0; i < n; i++) r->ids[i] = seg_geom(e, r->seg + 3 * i);
+  return HEARTH_OK;
+}
+
+static long count_geom(const hearth_sim_env *e, int geom, int box[4]) {
+  const int *ids = e->rnd->ids;
   long n = 0;
   if (box) box[0] = box[1] = 1 << 30, box[2] = box[3] = -1;
   for (int y = 0; y < e->height; y++)
     for (int x = 0; x < e->width; x++)
-      if (seg_geom(e, img + 3 * ((size_t)y * e->width + x)) == geom) {
+      if (ids[(size_t)y * e->width + x] == geom) {
         n++;
         if (box) {
           if (x < box[0]) box[0] = x;
@@ -331,17 +448,17 @@ static long count_geom(const hearth_sim_env *e, const uint8_t *img, int geom, in
 }
 
 hearth_status hearth_sim_visibility(hearth_sim_env *e, double *tf, double *of, hearth_err *err) {
-  sim_render *r = e->rnd;
   double frac[2];
   long vis[2];
   /* pixels seen in the whole scene, then each candidate rendered alone */
-  render_view(e, e->cam_front, VIEW_SEGMENT, -1, r->seg);
+  hearth_status st = render_ids(e, -1, err);
+  if (st) return st;
   for (int c = 0; c < 2; c++)
-    vis[c] = count_geom(e, r->seg, e->obj_geom_rgb[c == 0 ? e->target : 1 - e->target], NULL);
+    vis[c] = count_geom(e, e->obj_geom_rgb[c == 0 ? e->target : 1 - e->target], NULL);
   for (int c = 0; c < 2; c++) {
     int g = e->obj_geom_rgb[c == 0 ? e->target : 1 - e->target];
-    render_view(e, e->cam_front, VIEW_SEGMENT, g, r->seg);
-    long all = count_geom(e, r->seg, g, NULL);
+    if ((st = render_ids(e, g, err))) return st;
+    long all = count_geom(e, g, NULL);
     frac[c] = all > 0 ? (double)vis[c] / (double)all : 0.0;
   }
   if (tf) *tf = frac[0];
@@ -350,11 +467,11 @@ hearth_status hearth_sim_visibility(hearth_sim_env *e, double *tf, double *of, h
 }
 
 hearth_status hearth_sim_candidate_boxes(hearth_sim_env *e, int boxes[2][4], hearth_err *err) {
-  sim_render *r = e->rnd;
-  render_view(e, e->cam_front, VIEW_SEGMENT, -1, r->seg);
+  hearth_status st = render_ids(e, -1, err);
+  if (st) return st;
   for (int slot = 0; slot < 2; slot++) {
     int k = slot ^ e->swap;
-    if (count_geom(e, r->seg, e->obj_geom_rgb[k], boxes[slot]) == 0)
+    if (count_geom(e, e->obj_geom_rgb[k], boxes[slot]) == 0)
       return hearth_err_set(err, HEARTH_E_NOT_FOUND, "sim: candidate in slot %c not visible",
                             'A' + slot);
   }

@@ -26,6 +26,8 @@ hearth_status hearth_sim_render_scene(const hearth_sim_opts *o, uint64_t seed, c
   hearth_sim_obs ob;
   st = hearth_sim_reset(e, seed, 0, 0, err);
   if (!st) st = hearth_sim_observe(e, &ob, err);
+  if (!st && !ob.agentview_rgb)
+    st = hearth_err_set(err, HEARTH_E_ARG, "sim render: renderer none draws no images");
   char p[4200];
   if (!st) {
     snprintf(p, sizeof p, "%s_rgb.png", prefix);

@@ -53,12 +53,12 @@ static const command_case k_cases[] = {
     {"stats", 1, "--format", "yaml", "--json --format"},
     {"demo", 0, "--resolution", "8", "--threads --views --resolution --quiet"},
     {"sim render", 0, "--size", "8",
-     "--out --task --release --ground-truth --size --seed --shadows --gl"},
+     "--out --task --release --ground-truth --size --seed --shadows --renderer --gl"},
     {"sim collect", 0, "--layouts", "0",
      "--task --out --layouts --seed --size --max-steps --release --ground-truth "
-     "--keep-failures --shadows --gl --quiet"},
+     "--keep-failures --shadows --renderer --gl --quiet"},
     {"sim eval", 0, "--task", "H4",
-     "--policy --task --episodes --no-thermal --seed --release --size --shadows --gl "
+     "--policy --task --episodes --no-thermal --seed --release --size --shadows --renderer --gl "
      "--image-size --max-steps --replan --wait --timeout --out --video --video-every --quiet"},
 };
 

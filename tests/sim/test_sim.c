@@ -212,6 +212,10 @@ static void check_file(const char *path, int S) {
   CHECK(read_str_attr(f, "data", "env_args", s, sizeof s));
   json_t *ea = json_loads(s, 0, &je);
   CHECK(json_is_object(ea));
+  /* collected with the default renderer, the one sim eval uses by default */
+  json_t *kw = json_object_get(ea, "env_kwargs");
+  const char *rn = json_string_value(json_object_get(kw, "renderer"));
+  CHECK_MSG(rn && strcmp(rn, "soft") == 0, "env_args renderer %s", rn ? rn : "(none)");
   json_decref(ea);
   CHECK(read_str_attr(f, "data", "instructions", s, sizeof s));
   json_t *il = json_loads(s, 0, &je);
@@ -292,10 +296,13 @@ static long file_bytes(const char *path, uint8_t **out) {
   return n;
 }
 
+static const char *g_renderer; /* NULL: the default */
+
 static hearth_status collect(const char *root, const char *path, int S, int max_steps,
                              hearth_sim_collect_stats *s, hearth_err *err) {
   hearth_sim_collect_opts o;
   hearth_sim_collect_opts_default(&o);
+  o.renderer = g_renderer;
   o.task = HEARTH_SIM_H1;
   o.release_root = root;
   o.layouts = 1;
@@ -415,6 +422,39 @@ static void check_collect(const char *root, const char *dir) {
   long na = file_bytes(path[1], &a), nb = file_bytes(path[2], &b);
   CHECK(na > 0 && na == nb && a && b && memcmp(a, b, (size_t)na) == 0);
   free(a), free(b);
+  /* renderer none: the same episodes (the expert reads the state), no
+   * image datasets */
+  char none[1200];
+  snprintf(none, sizeof none, "%s/h1_none.hdf5", dir);
+  g_renderer = "none";
+  CHECK_OK(collect(root, none, S, 30, &s, &err), &err);
+  g_renderer = NULL;
+  hid_t fa = H5Fopen(path[1], H5F_ACC_RDONLY, H5P_DEFAULT),
+        fn = H5Fopen(none, H5F_ACC_RDONLY, H5P_DEFAULT);
+  CHECK(fa >= 0 && fn >= 0);
+  if (fa >= 0 && fn >= 0) {
+    for (int dm = 0; dm < 2; dm++) {
+      char ds[64];
+      snprintf(ds, sizeof ds, "data/demo_%d/actions", dm);
+      hsize_t da[4] = {0}, dn[4] = {0};
+      CHECK(dims_of(fa, ds, da) == 2 && dims_of(fn, ds, dn) == 2 && da[0] == dn[0]);
+      if (da[0] == dn[0] && da[0] > 0) {
+        double *xa = malloc(sizeof(double) * da[0] * 7), *xn = malloc(sizeof(double) * da[0] * 7);
+        hid_t a1 = H5Dopen2(fa, ds, H5P_DEFAULT), a2 = H5Dopen2(fn, ds, H5P_DEFAULT);
+        CHECK(H5Dread(a1, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, xa) >= 0 &&
+              H5Dread(a2, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, xn) >= 0);
+        CHECK_MSG(memcmp(xa, xn, sizeof(double) * da[0] * 7) == 0,
+                  "renderer none: demo %d took other actions", dm);
+        H5Dclose(a1), H5Dclose(a2);
+        free(xa), free(xn);
+      }
+      snprintf(ds, sizeof ds, "data/demo_%d/obs/agentview_rgb", dm);
+      CHECK_MSG(H5Lexists(fa, ds, H5P_DEFAULT) > 0 && H5Lexists(fn, ds, H5P_DEFAULT) == 0,
+                "renderer none: %s should exist only in the rendered file", ds);
+    }
+  }
+  if (fa >= 0) H5Fclose(fa);
+  if (fn >= 0) H5Fclose(fn);
   /* h5py (Debian python3-h5py), when present, reads it with LIBERO's keys */
   const char *src = getenv("HEARTH_SOURCE_DIR");
   if (src && access("/usr/bin/python3", X_OK) == 0 &&
