@@ -129,7 +129,7 @@ hearth_status hearth_recon_tsdf(const char *root, const char *instance, const ch
  * all views of all states (pairs of views looking from within
  * max_pair_deg of each other, projective association in the target's
  * depth image, Huber weights, a shrinking distance gate; view 0 holds the
- * gauge) and, with the colour option, the colour detail. The frame of the result: metres, +z up the axis, the turntable
+ * gauge), with the turntable's azimuths as a prior. The frame of the result: metres, +z up the axis, the turntable
  * top at z = 0, view 0's azimuth at its nominal value. A surface of
  * revolution leaves the angle about its own axis unobserved by geometry:
  * those views keep their nominal azimuth (damped steps). */
@@ -142,13 +142,9 @@ typedef struct hearth_turntable_opts {
   size_t max_points;       /* ICP samples per view and pair; default 3000 */
   double max_pair_deg;     /* default 65 */
   double erode_px;         /* colour pixels a point must lie inside the cut-out; default 8 */
-  int colour;              /* 1: then turn each view about the axis (fitted to the
-                              camera centres) to match its neighbours' colour
-                              detail (NCC of high-passed grey over the points both
-                              see, pairwise turns solved in least squares), and
-                              refine the positions again with the turns held;
-                              default 0 (on the virtual rig it does not yet
-                              beat the geometry alone) */
+  double azimuth_prior;    /* weight (m^2/rad^2) pulling each angle towards the
+                              turntable's: (depth noise / azimuth spread)^2;
+                              default 3e-3 (0.8 mm, 0.9 degrees) */
   int threads;             /* 0: hearth_default_threads() */
   int quiet;               /* 1: no progress on stderr */
 } hearth_turntable_opts;
@@ -171,8 +167,7 @@ typedef struct hearth_turntable_result {
   size_t n_views;
   hearth_turntable_view *views; /* owned, in the poses' order; free with
                                    hearth_turntable_result_free */
-  size_t n_pairs;        /* ordered view pairs of the ICP */
-  size_t n_colour_pairs; /* ordered pairs whose colour fixed a relative azimuth */
+  size_t n_pairs; /* ordered view pairs of the ICP */
   int iterations;
   double icp_rms_start_mm, icp_rms_mm; /* over all matches, first and last iteration */
   double icp_median_mm;                /* |distance| median at the end */

@@ -159,8 +159,6 @@ int hearth_cmd_recon(int argc, char **argv) {
               "turntable: azimuth added per elevation index", .def = "12"),
       CLI_FLAG("--clockwise", &tj.poses.direction, -1,
                "turntable: azimuth grows clockwise seen from above"),
-      CLI_FLAG("--colour-azimuths", &tj.poses.colour, 1,
-               "turntable: also turn views about the axis to match colour detail"),
       CLI_NUM("--voxel", "M", &tj.geometry.voxel_m, 0.0002, 0.05,
               "turntable: TSDF voxel of the mesh (metres)", .def = "0.002"),
       CLI_SIZE("--triangles", "N", &tj.geometry.target_triangles, 0, 10000000,

@@ -63,8 +63,7 @@ static hearth_status write_report(const char *path, const char *instance,
   rc_json_string(&b, instance);
   hearth_strbuf_printf(&b, ",\n  \"route\": \"turntable\",\n  \"views\": %zu,\n  \"pairs\": %zu,\n",
                        r->n_views, r->n_pairs);
-  hearth_strbuf_printf(&b, "  \"colour_pairs\": %zu,\n  \"iterations\": %d,\n",
-                       r->n_colour_pairs, r->iterations);
+  hearth_strbuf_printf(&b, "  \"iterations\": %d,\n", r->iterations);
   const struct {
     const char *k;
     double v;

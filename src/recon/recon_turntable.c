@@ -22,6 +22,8 @@
 /* RANSAC for the table plane */
 #define TT_RANSAC_ITER 300
 #define TT_PLANE_TOL_M 0.004
+/* table-plane points each view keeps for the ICP's plane term */
+#define TT_PLANE_SAMPLES 1500
 /* Huber threshold of the ICP distances */
 #define TT_HUBER_M 0.0015
 /* correspondences must have normals within this angle */
@@ -36,6 +38,7 @@ void hearth_turntable_opts_default(hearth_turntable_opts *o) {
   o->max_points = 3000;
   o->max_pair_deg = 65.0;
   o->erode_px = 8.0;
+  o->azimuth_prior = 3e-3;
 }
 
 void hearth_turntable_result_free(hearth_turntable_result *r) {
@@ -61,16 +64,15 @@ typedef struct tt_view {
   double height; /* camera above the plane, metres */
   size_t n_plane;
   double plane_rms;
+  size_t npl;
+  float *pl; /* 3 * npl: table-plane inliers (a subsample), colour frame */
   /* pose parameters: T_world_from_cam = (Rz(psi) L, (x, y, height)) */
   double psi, psi0, x, y;
   hearth_rigid T; /* current pose */
-  hearth_image grey; /* the colour image as 8-bit grey */
-  float *pg;         /* n: grey of each point in its own image, NaN: none */
 } tt_view;
 
 static void tt_view_free(tt_view *v) {
-  hearth_image_free(&v->grey);
-  free(v->pg);
+  free(v->pl);
   free(v->index);
   free(v->p);
   free(v->nrm);
@@ -205,8 +207,16 @@ static int table_plane(tt_view *v, const float *bg, size_t nb, uint64_t seed) {
     }
     v->plane_rms = sqrt(ss / (double)m);
   }
+  if (m >= TT_MIN_PLANE) {
+    size_t step = m > TT_PLANE_SAMPLES ? (m + TT_PLANE_SAMPLES - 1) / TT_PLANE_SAMPLES : 1;
+    v->pl = malloc((m / step + 1) * 3 * sizeof(float));
+    for (size_t i = 0; v->pl && i < m; i += step) {
+      for (int a = 0; a < 3; a++) v->pl[3 * v->npl + a] = bg[3 * idx[i] + a];
+      v->npl++;
+    }
+  }
   free(idx);
-  if (m < TT_MIN_PLANE) return 0;
+  if (m < TT_MIN_PLANE || !v->pl) return 0;
   v->n_plane = m;
   v->height = d;
   /* levelling: forward = the optical axis made horizontal, up = n */
@@ -232,73 +242,6 @@ static void tt_pose(tt_view *v) {
   v->T.t[0] = v->x;
   v->T.t[1] = v->y;
   v->T.t[2] = v->height;
-}
-
-/* an 8-bit grey copy of a U8 image of 1..4 channels (alpha ignored) */
-static hearth_status to_grey(const hearth_image *c, hearth_image *g, const char *path,
-                             hearth_err *err) {
-  if (c->type != HEARTH_PIX_U8)
-    return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "%s: expected an 8-bit colour image", path);
-  hearth_status s = hearth_image_alloc(g, c->width, c->height, 1, HEARTH_PIX_U8, err);
-  if (s) return s;
-  const uint8_t *src = c->data;
-  uint8_t *dst = g->data;
-  int ch = c->channels, nc = ch >= 3 ? 3 : 1;
-  for (size_t p = 0; p < c->width * c->height; p++) {
-    int sum = 0;
-    for (int k = 0; k < nc; k++) sum += src[(size_t)ch * p + k];
-    dst[p] = (uint8_t)(sum / nc);
-  }
-  return HEARTH_OK;
-}
-
-/* The grey image less its local mean (a box of TT_HP_R pixels, by an
- * integral image), 128 + 2 * difference clamped to 0..255: the shading of
- * the lights changes slowly across the surface and from view to view, the
- * albedo's detail does not. */
-#define TT_HP_R 6
-static hearth_status high_pass(hearth_image *g, const char *path, hearth_err *err) {
-  const size_t W = g->width, H = g->height;
-  uint32_t *I = malloc((W + 1) * (H + 1) * sizeof *I);
-  if (!I) return hearth_err_set(err, HEARTH_E_NOMEM, "%s", path);
-  uint8_t *d = g->data;
-  for (size_t x = 0; x <= W; x++) I[x] = 0;
-  for (size_t y = 1; y <= H; y++) {
-    uint32_t row = 0;
-    I[y * (W + 1)] = 0;
-    for (size_t x = 1; x <= W; x++) {
-      row += d[(y - 1) * W + x - 1];
-      I[y * (W + 1) + x] = I[(y - 1) * (W + 1) + x] + row;
-    }
-  }
-  const long R = TT_HP_R;
-  for (long y = 0; y < (long)H; y++)
-    for (long x = 0; x < (long)W; x++) {
-      long x0 = x - R < 0 ? 0 : x - R, x1 = x + R + 1 > (long)W ? (long)W : x + R + 1;
-      long y0 = y - R < 0 ? 0 : y - R, y1 = y + R + 1 > (long)H ? (long)H : y + R + 1;
-      uint32_t sum = I[y1 * (W + 1) + x1] - I[y0 * (W + 1) + x1] - I[y1 * (W + 1) + x0] +
-                     I[y0 * (W + 1) + x0];
-      double mean = (double)sum / (double)((x1 - x0) * (y1 - y0));
-      double v = 128.0 + 2.0 * (d[y * W + x] - mean);
-      d[y * W + x] = (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : lround(v));
-    }
-  free(I);
-  return HEARTH_OK;
-}
-
-/* bilinear grey of view v's colour image at camera-frame point pc, NaN
- * outside it */
-static float grey_at(const tt_view *v, const hearth_camera *rgb, const double pc[3]) {
-  double uv[2];
-  if (!hearth_camera_project(rgb, pc, uv, NULL)) return NAN;
-  double u = uv[0], w = uv[1];
-  if (!(u >= 0) || !(w >= 0) || u > rgb->width - 1.001 || w > rgb->height - 1.001) return NAN;
-  int x = (int)u, y = (int)w;
-  double fx = u - x, fy = w - y;
-  const uint8_t *g = v->grey.data;
-  size_t W = v->grey.width, p = (size_t)y * W + x;
-  return (float)((1 - fy) * ((1 - fx) * g[p] + fx * g[p + 1]) +
-                 fy * ((1 - fx) * g[p + W] + fx * g[p + W + 1]));
 }
 
 /* Load one view: depth, its intrinsics, the cut-out; object points (inside
@@ -498,33 +441,6 @@ static hearth_status load_view(tt_view *v, const char *dir, const hearth_view_fi
     goto done;
   }
   for (int a = 0; a < 3; a++) v->centroid[a] = csum[a] / (double)v->n;
-  /* the colour image as grey, and each point's grey in it */
-  snprintf(path, sizeof path, "%s/%s", dir, vf->rgb);
-  size_t ln = strlen(path);
-  int is_png = ln > 4 && !strcmp(path + ln - 4, ".png");
-  if (is_png) {
-    hearth_image c3 = {0};
-    if ((s = hearth_png_read(path, &c3, err))) goto done;
-    s = to_grey(&c3, &v->grey, path, err);
-    hearth_image_free(&c3);
-  } else {
-    s = hearth_jpeg_read_gray(path, &v->grey, err);
-  }
-  if (s) goto done;
-  if (v->grey.width != (size_t)CW || v->grey.height != (size_t)CH) {
-    s = hearth_err_set(err, HEARTH_E_SIZE, "%s: %zux%zu, the colour camera is %dx%d", path,
-                       v->grey.width, v->grey.height, CW, CH);
-    goto done;
-  }
-  if ((s = high_pass(&v->grey, path, err))) goto done;
-  if (!(v->pg = malloc(v->n * sizeof *v->pg))) {
-    s = hearth_err_set(err, HEARTH_E_NOMEM, "%s", path);
-    goto done;
-  }
-  for (size_t k = 0; k < v->n; k++) {
-    double pc[3] = {v->p[3 * k], v->p[3 * k + 1], v->p[3 * k + 2]};
-    v->pg[k] = grey_at(v, rgb, pc);
-  }
 done:
   free(on);
   free(dirs);
@@ -538,8 +454,9 @@ done:
 /* ---- joint ICP ------------------------------------------------------------ */
 typedef struct tt_pair {
   size_t i, j;
-  /* this iteration's normal equations in (psi_i, x_i, y_i, psi_j, x_j, y_j) */
-  double H[36], g[6];
+  /* this iteration's normal equations in (w_i, t_i, w_j, t_j): each view's
+   * small rotation (world frame) and translation */
+  double H[144], g[12];
   double ss, ss_all; /* weighted squared distances, squared distances */
   size_t m;
   float *r; /* |distance| of each match (for the median), m of them */
@@ -584,20 +501,22 @@ static void pair_system(const tt_ctx *c, tt_pair *pr) {
     double r = hearth_dot3(nw, e);
     if (fabs(r) > c->gate || hearth_norm3(e) > 2.0 * c->gate) continue;
     double wgt = fabs(r) <= TT_HUBER_M ? 1.0 : TT_HUBER_M / fabs(r);
-    /* d q / d psi = ez x (q - t); d n / d psi_j = ez x n */
-    double qa_rel[3] = {q[0] - a->T.t[0], q[1] - a->T.t[1], 0};
-    double qb_rel[3] = {qb[0] - b->T.t[0], qb[1] - b->T.t[1], 0};
-    double J[6];
-    J[0] = nw[0] * -qa_rel[1] + nw[1] * qa_rel[0];
-    J[1] = nw[0];
-    J[2] = nw[1];
-    double dn[3] = {-nw[1], nw[0], 0};
-    J[3] = hearth_dot3(dn, e) - (nw[0] * -qb_rel[1] + nw[1] * qb_rel[0]);
-    J[4] = -nw[0];
-    J[5] = -nw[1];
-    for (int x = 0; x < 6; x++) {
+    /* q moves by w_i x (q - t_i) + d_i; the target point and normal turn
+     * with view j: d r / d w_j = -(q - t_j) x n, d r / d t_j = -n */
+    double qa_rel[3] = {q[0] - a->T.t[0], q[1] - a->T.t[1], q[2] - a->T.t[2]};
+    double qj_rel[3] = {q[0] - b->T.t[0], q[1] - b->T.t[1], q[2] - b->T.t[2]};
+    double J[12], ci[3], cj[3];
+    hearth_cross3(qa_rel, nw, ci);
+    hearth_cross3(qj_rel, nw, cj);
+    for (int x = 0; x < 3; x++) {
+      J[x] = ci[x];
+      J[3 + x] = nw[x];
+      J[6 + x] = -cj[x];
+      J[9 + x] = -nw[x];
+    }
+    for (int x = 0; x < 12; x++) {
       pr->g[x] += wgt * J[x] * r;
-      for (int y = 0; y < 6; y++) pr->H[6 * x + y] += wgt * J[x] * J[y];
+      for (int y = 0; y < 12; y++) pr->H[12 * x + y] += wgt * J[x] * J[y];
     }
     pr->ss += wgt * r * r;
     pr->ss_all += r * r;
@@ -645,16 +564,19 @@ static int cmp_float(const void *a, const void *b) {
   return (x > y) - (x < y);
 }
 
-/* viewing direction of view v from the axis (unit, world) */
+/* the direction of view v's optical axis about the vertical (psi of the
+ * start) */
+static double heading(const tt_view *v) { return atan2(v->T.R[5], v->T.R[2]); }
+
+/* view v's optical axis (unit, world) */
 static void view_dir(const tt_view *v, double d[3]) {
-  double c[3] = {v->T.t[0], v->T.t[1], v->T.t[2]};
-  double l = hearth_norm3(c);
-  for (int a = 0; a < 3; a++) d[a] = l > 0 ? c[a] / l : 0;
+  for (int a = 0; a < 3; a++) d[a] = v->T.R[3 * a + 2];
 }
 
 static hearth_status run_icp(tt_view *v, size_t nv, const hearth_turntable_opts *o,
-                             int iterations, int hold_psi, double gate0,
                              hearth_turntable_result *res, hearth_err *err) {
+  const int iterations = o->iterations;
+  const double gate0 = 0.025;
   /* pairs: views looking from within max_pair_deg */
   size_t np = 0;
   tt_pair *pairs = calloc(nv * nv, sizeof *pairs);
@@ -671,7 +593,7 @@ static hearth_status run_icp(tt_view *v, size_t nv, const hearth_turntable_opts 
       pairs[np].j = j;
       np++;
     }
-  const size_t nu = 3 * (nv - 1);
+  const size_t nu = 6 * (nv - 1);
   double *A = malloc(nu * nu * sizeof *A), *b = malloc(nu * sizeof *b);
   if (!A || !b) {
     free(A);
@@ -680,8 +602,7 @@ static hearth_status run_icp(tt_view *v, size_t nv, const hearth_turntable_opts 
     return hearth_err_set(err, HEARTH_E_NOMEM, "turntable: normal equations");
   }
   hearth_progress prog;
-  hearth_progress_begin(&prog, hold_psi ? "recon: ICP (positions)" : "recon: ICP",
-                        (size_t)iterations, o->quiet);
+  hearth_progress_begin(&prog, "recon: ICP", (size_t)iterations, o->quiet);
   tt_ctx c = {v, pairs, o->max_points, 0.02};
   hearth_status s = HEARTH_OK;
   double rms = 0;
@@ -703,33 +624,59 @@ static hearth_status run_icp(tt_view *v, size_t nv, const hearth_turntable_opts 
       ss += pr->ss_all;
       m += pr->m;
       size_t ix[2] = {pr->i, pr->j};
-      for (int x = 0; x < 6; x++) {
-        size_t vx = ix[x / 3];
+      for (int x = 0; x < 12; x++) {
+        size_t vx = ix[x / 6];
         if (vx == 0) continue;
-        size_t gx = 3 * (vx - 1) + (size_t)(x % 3);
+        size_t gx = 6 * (vx - 1) + (size_t)(x % 6);
         b[gx] -= pr->g[x];
-        for (int y = 0; y < 6; y++) {
-          size_t vy = ix[y / 3];
+        for (int y = 0; y < 12; y++) {
+          size_t vy = ix[y / 6];
           if (vy == 0) continue;
-          A[gx * nu + 3 * (vy - 1) + (size_t)(y % 3)] += pr->H[6 * x + y];
+          A[gx * nu + 6 * (vy - 1) + (size_t)(y % 6)] += pr->H[12 * x + y];
         }
       }
     }
     rms = m ? sqrt(ss / (double)m) : 0;
     if (it == 0 && res->iterations == 0) res->icp_rms_start_mm = 1000.0 * rms;
-    /* damping: a scaled Levenberg term plus a floor that holds directions
-     * no match constrains (an azimuth about a surface of revolution) */
-    for (size_t d = 0; d < nu; d++)
-      A[d * nu + d] = A[d * nu + d] * 1.01 + (hold_psi && d % 3 == 0 ? 1e12 : 1e-2);
+    for (size_t vi = 1; vi < nv; vi++) {
+      const tt_view *tv = &v[vi];
+      double *Av = A + 6 * (vi - 1) * nu + 6 * (vi - 1), *bv = b + 6 * (vi - 1);
+      /* the plane term: each table point at z = 0, weighted as many
+       * matches as it has points */
+      double wp = (double)(m / (nv ? nv : 1) + 1) / (double)(tv->npl ? tv->npl : 1);
+      for (size_t k = 0; k < tv->npl; k++) {
+        double p[3] = {tv->pl[3 * k], tv->pl[3 * k + 1], tv->pl[3 * k + 2]}, q[3];
+        hearth_rigid_apply(&tv->T, p, q);
+        double r = q[2], qr[3] = {q[0] - tv->T.t[0], q[1] - tv->T.t[1], q[2] - tv->T.t[2]};
+        double w = wp * (fabs(r) <= TT_HUBER_M ? 1.0 : TT_HUBER_M / fabs(r));
+        double J[6] = {qr[1], -qr[0], 0, 0, 0, 1}; /* (q - t) x ez, ez */
+        for (int x = 0; x < 6; x++) {
+          bv[x] -= w * J[x] * r;
+          for (int y = 0; y < 6; y++) Av[x * nu + y] += w * J[x] * J[y];
+        }
+      }
+      /* the turntable's azimuth as a prior on the heading (weight: the
+       * squared ratio of the depth noise to the azimuth's spread), so an
+       * angle no match constrains (about a surface of revolution) stays
+       * at the turntable's */
+      double dh = remainder(heading(tv) - tv->psi0, 2 * TT_PI);
+      Av[2 * nu + 2] += o->azimuth_prior;
+      bv[2] -= o->azimuth_prior * dh;
+    }
+    /* a scaled Levenberg term and a small floor */
+    for (size_t d = 0; d < nu; d++) A[d * nu + d] = A[d * nu + d] * 1.01 + 1e-6;
     if (!chol_solve(A, b, nu)) {
       s = hearth_err_set(err, HEARTH_E_NUMERIC, "turntable: ICP normal equations not definite");
       break;
     }
     for (size_t vi = 1; vi < nv; vi++) {
-      v[vi].psi += b[3 * (vi - 1)];
-      v[vi].x += b[3 * (vi - 1) + 1];
-      v[vi].y += b[3 * (vi - 1) + 2];
-      tt_pose(&v[vi]);
+      const double *d = b + 6 * (vi - 1);
+      double dR[9], R[9];
+      hearth_rotvec_to_matrix(d, dR);
+      hearth_mat3_mul(dR, v[vi].T.R, R);
+      hearth_orthonormalize(R);
+      memcpy(v[vi].T.R, R, sizeof R);
+      for (int a = 0; a < 3; a++) v[vi].T.t[a] += d[3 + a];
     }
     if (last && res->views) {
       memset(res->views, 0, nv * sizeof *res->views);
@@ -771,232 +718,6 @@ static hearth_status run_icp(tt_view *v, size_t nv, const hearth_turntable_opts 
   return s;
 }
 
-
-/* ---- the turntable axis and the azimuths from colour ------------------------- */
-/* The axis (x, y) as the centre the camera centres circle round: least
- * squares of 2 a.c + k_e = |c|^2 over the horizontal centres c, one k_e
- * (= r_e^2 - |a|^2) per elevation ring. 0 when singular. */
-static int fit_axis(const tt_view *v, size_t nv, double axis[2]) {
-  enum { MAXR = 16 };
-  int ring[MAXR], nr = 0;
-  size_t nu = 2;
-  for (size_t i = 0; i < nv; i++) {
-    int e = v[i].elevation_index, f = -1;
-    for (int k = 0; k < nr; k++)
-      if (ring[k] == e) f = k;
-    if (f < 0) {
-      if (nr == MAXR) return 0;
-      ring[nr++] = e;
-    }
-  }
-  nu += (size_t)nr;
-  double A[(2 + MAXR) * (2 + MAXR)] = {0}, b[2 + MAXR] = {0};
-  for (size_t i = 0; i < nv; i++) {
-    double J[2 + MAXR] = {0};
-    J[0] = 2 * v[i].T.t[0];
-    J[1] = 2 * v[i].T.t[1];
-    for (int k = 0; k < nr; k++)
-      if (ring[k] == v[i].elevation_index) J[2 + k] = 1;
-    double y = v[i].T.t[0] * v[i].T.t[0] + v[i].T.t[1] * v[i].T.t[1];
-    for (size_t x = 0; x < nu; x++) {
-      b[x] += J[x] * y;
-      for (size_t z = 0; z < nu; z++) A[x * nu + z] += J[x] * J[z];
-    }
-  }
-  if (!chol_solve(A, b, nu)) return 0;
-  axis[0] = b[0];
-  axis[1] = b[1];
-  return 1;
-}
-
-/* rotate view v's camera by d about the vertical axis through axis */
-static void turn_view(tt_view *v, const double axis[2], double d) {
-  double c = cos(d), s = sin(d), x = v->x - axis[0], y = v->y - axis[1];
-  v->x = axis[0] + c * x - s * y;
-  v->y = axis[1] + s * x + c * y;
-  v->psi += d;
-  tt_pose(v);
-}
-
-typedef struct tt_cpair {
-  size_t i, j;
-  size_t m;      /* points of i seen by j */
-  size_t *idx;   /* their indices */
-  double delta;  /* the turn of i about the axis that best matches j */
-  double ncc;    /* the match there */
-  int ok;
-} tt_cpair;
-
-typedef struct tt_cctx {
-  tt_view *v;
-  tt_cpair *pairs;
-  const hearth_camera *rgb;
-  double axis[2];
-  size_t max_points;
-} tt_cctx;
-
-/* NCC of view i's point greys against view j's image with i turned by d */
-static double pair_ncc(const tt_cctx *c, const tt_cpair *pr, double d) {
-  const tt_view *a = &c->v[pr->i], *b = &c->v[pr->j];
-  hearth_rigid Tb_inv;
-  hearth_rigid_inverse(&b->T, &Tb_inv);
-  double cs = cos(d), sn = sin(d);
-  double s1 = 0, s2 = 0, s11 = 0, s22 = 0, s12 = 0;
-  size_t m = 0;
-  for (size_t q = 0; q < pr->m; q++) {
-    size_t k = pr->idx[q];
-    double pa[3] = {a->p[3 * k], a->p[3 * k + 1], a->p[3 * k + 2]}, w[3], pb[3];
-    hearth_rigid_apply(&a->T, pa, w);
-    double x = w[0] - c->axis[0], y = w[1] - c->axis[1];
-    w[0] = c->axis[0] + cs * x - sn * y;
-    w[1] = c->axis[1] + sn * x + cs * y;
-    hearth_rigid_apply(&Tb_inv, w, pb);
-    float gb = grey_at(b, c->rgb, pb);
-    if (!isfinite(gb)) continue;
-    double ga = a->pg[k];
-    s1 += ga;
-    s2 += gb;
-    s11 += ga * ga;
-    s22 += (double)gb * gb;
-    s12 += ga * gb;
-    m++;
-  }
-  if (m < 50) return -1;
-  double n = (double)m;
-  double va = s11 - s1 * s1 / n, vb = s22 - s2 * s2 / n, cab = s12 - s1 * s2 / n;
-  if (!(va > 1e-9) || !(vb > 1e-9)) return -1;
-  return cab / sqrt(va * vb);
-}
-
-/* the points of view i that view j sees (depth association within 3 mm,
- * normals agreeing and facing j) and the turn that matches their greys */
-static void colour_pair(const tt_cctx *c, tt_cpair *pr) {
-  const tt_view *a = &c->v[pr->i], *b = &c->v[pr->j];
-  pr->ok = 0;
-  pr->m = 0;
-  hearth_rigid Tb_inv, T_depth_from_world;
-  hearth_rigid_inverse(&b->T, &Tb_inv);
-  hearth_rigid_compose(&b->T_depth_from_rgb, &Tb_inv, &T_depth_from_world);
-  size_t step = a->n > c->max_points ? (a->n + c->max_points - 1) / c->max_points : 1;
-  for (size_t k = 0; k < a->n; k += step) {
-    if (!isfinite(a->pg[k])) continue;
-    double pa[3] = {a->p[3 * k], a->p[3 * k + 1], a->p[3 * k + 2]}, q[3], qd[3], uv[2];
-    hearth_rigid_apply(&a->T, pa, q);
-    hearth_rigid_apply(&T_depth_from_world, q, qd);
-    if (!hearth_camera_project(&b->dcam, qd, uv, NULL)) continue;
-    long u = lround(uv[0]) - b->x0, w = lround(uv[1]) - b->y0;
-    if (u < 0 || w < 0 || u >= b->cw || w >= b->ch) continue;
-    int32_t t = b->index[(size_t)w * b->cw + u];
-    if (t < 0) continue;
-    double pb[3] = {b->p[3 * t], b->p[3 * t + 1], b->p[3 * t + 2]}, qb[3];
-    hearth_rigid_apply(&b->T, pb, qb);
-    double e[3] = {q[0] - qb[0], q[1] - qb[1], q[2] - qb[2]};
-    if (hearth_norm3(e) > 0.003) continue;
-    pr->idx[pr->m++] = k;
-  }
-  if (pr->m < 200) return;
-  const double D = TT_DEG;
-  double best = -2, bd = 0;
-  for (int s = -16; s <= 16; s++) {
-    double r = pair_ncc(c, pr, 0.25 * s * D);
-    if (r > best) {
-      best = r;
-      bd = 0.25 * s * D;
-    }
-  }
-  if (fabs(bd) > 3.9 * D) return;
-  double fb = -2, fd = bd;
-  double val[25];
-  for (int s = -12; s <= 12; s++) {
-    double d = bd + 0.025 * s * D;
-    val[s + 12] = pair_ncc(c, pr, d);
-    if (val[s + 12] > fb) {
-      fb = val[s + 12];
-      fd = d;
-    }
-  }
-  int k = (int)lround((fd - bd) / (0.025 * D)) + 12;
-  if (k > 0 && k < 24) {
-    double y0 = val[k - 1], y1 = val[k], y2 = val[k + 1], den = y0 - 2 * y1 + y2;
-    if (den < 0) fd += 0.025 * D * 0.5 * (y0 - y2) / den;
-  }
-  pr->delta = fd;
-  pr->ncc = fb;
-  pr->ok = fb > 0.3;
-}
-
-static void cpairs_range(void *vctx, size_t b, size_t e, int ti) {
-  (void)ti;
-  const tt_cctx *c = vctx;
-  for (size_t k = b; k < e; k++) colour_pair(c, &c->pairs[k]);
-}
-
-/* Each view's turn about the axis from the colour of its neighbours: per
- * ordered pair (i, j) the turn of i that best matches j's image, then the
- * turns d_i (d_0 = 0) in least squares over d_i - d_j = delta_ij. */
-static hearth_status colour_azimuths(tt_view *v, size_t nv, const hearth_camera *rgb,
-                                     const hearth_turntable_opts *o, size_t *n_used,
-                                     hearth_err *err) {
-  tt_cctx c = {v, NULL, rgb, {0, 0}, o->max_points};
-  if (!fit_axis(v, nv, c.axis))
-    return hearth_err_set(err, HEARTH_E_NUMERIC, "turntable: the camera centres fix no axis");
-  double cmax = cos(o->max_pair_deg * TT_DEG);
-  tt_cpair *pairs = calloc(nv * nv, sizeof *pairs);
-  if (!pairs) return hearth_err_set(err, HEARTH_E_NOMEM, "turntable: colour pairs");
-  size_t np = 0;
-  hearth_status s = HEARTH_OK;
-  for (size_t i = 0; i < nv && !s; i++)
-    for (size_t j = 0; j < nv && !s; j++) {
-      if (i == j) continue;
-      double di[3], dj[3];
-      view_dir(&v[i], di);
-      view_dir(&v[j], dj);
-      if (hearth_dot3(di, dj) < cmax) continue;
-      pairs[np].i = i;
-      pairs[np].j = j;
-      if (!(pairs[np].idx = malloc((o->max_points + 1) * sizeof(size_t))))
-        s = hearth_err_set(err, HEARTH_E_NOMEM, "turntable: colour pairs");
-      np++;
-    }
-  c.pairs = pairs;
-  if (!s) s = hearth_parallel_for(np, o->threads, cpairs_range, &c);
-  const size_t nu = nv - 1;
-  double *A = s ? NULL : calloc(nu * nu, sizeof *A), *b = s ? NULL : calloc(nu, sizeof *b);
-  if (!s && (!A || !b)) s = hearth_err_set(err, HEARTH_E_NOMEM, "turntable: colour system");
-  size_t used = 0;
-  for (size_t k = 0; k < np && !s; k++) {
-    const tt_cpair *pr = &pairs[k];
-    if (!pr->ok) continue;
-    used++;
-    double w = pr->ncc * pr->ncc;
-    long ii = (long)pr->i - 1, jj = (long)pr->j - 1;
-    if (ii >= 0) {
-      A[ii * nu + ii] += w;
-      b[ii] += w * pr->delta;
-    }
-    if (jj >= 0) {
-      A[jj * nu + jj] += w;
-      b[jj] -= w * pr->delta;
-    }
-    if (ii >= 0 && jj >= 0) {
-      A[ii * nu + jj] -= w;
-      A[jj * nu + ii] -= w;
-    }
-  }
-  if (!s) {
-    for (size_t d = 0; d < nu; d++) A[d * nu + d] += 1e-6;
-    if (!chol_solve(A, b, nu))
-      s = hearth_err_set(err, HEARTH_E_NUMERIC, "turntable: colour azimuths not determined");
-  }
-  if (!s)
-    for (size_t i = 1; i < nv; i++) turn_view(&v[i], c.axis, b[i - 1]);
-  *n_used = used;
-  for (size_t k = 0; k < np; k++) free(pairs[k].idx);
-  free(pairs);
-  free(A);
-  free(b);
-  return s;
-}
 
 /* ---- the job ---------------------------------------------------------------- */
 hearth_status hearth_recon_turntable(const char *root, const char *instance,
@@ -1078,13 +799,7 @@ hearth_status hearth_recon_turntable(const char *root, const char *instance,
       tv->y = -cw[1];
       tt_pose(tv);
     }
-    s = run_icp(v, nv, &o, o.iterations, 0, 0.025, &res, err);
-    for (int round = 0; round < (o.colour ? 2 : 0) && !s; round++) {
-      size_t used = 0;
-      s = colour_azimuths(v, nv, &fac.rgb, &o, &used, err);
-      if (!s) s = run_icp(v, nv, &o, 8, 1, 0.006, &res, err);
-      res.n_colour_pairs = used;
-    }
+    s = run_icp(v, nv, &o, &res, err);
   }
   if (!s) {
     out->views = calloc(nv, sizeof *out->views);
@@ -1107,7 +822,7 @@ hearth_status hearth_recon_turntable(const char *root, const char *instance,
       rv->height_m = v[i].height;
       /* the optical axis (third column of R) against the horizon */
       rv->elevation_deg = -asin(fmax(-1.0, fmin(1.0, v[i].T.R[8]))) / TT_DEG;
-      double da = remainder(v[i].psi - v[i].psi0, 2 * TT_PI);
+      double da = remainder(heading(&v[i]) - v[i].psi0, 2 * TT_PI);
       rv->d_azimuth_deg = da / TT_DEG;
     }
   }

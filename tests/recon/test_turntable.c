@@ -3,14 +3,17 @@
  * poses after the best similarity; bad input (a missing depth map, an
  * empty cut-out) named in the error.
  *
- * With arguments ROOT INSTANCE it only estimates that instance's poses of
- * an existing release and prints the errors (bench/recon_turntable.sh). */
+ * With arguments ROOT INSTANCE [mesh] it only estimates that instance's
+ * poses of an existing release and prints the errors, and with `mesh` also
+ * the surface errors of the mesh fused with them (bench/recon_turntable.sh;
+ * RECON_TT_VERBOSE=1 prints every view). */
 #include <sys/wait.h>
 #include "hearth/dataset.h"
 #include "hearth/image.h"
 #include "hearth/recon.h"
 #include "hearth/recon_geom.h"
 #include "../test_util.h"
+#include "recon/mesh_distance.h"
 
 /* estimate, align to the truth, print; -1 if the estimate failed */
 static int run_release(const char *root, const char *instance, hearth_pose_alignment *al,
@@ -20,6 +23,8 @@ static int run_release(const char *root, const char *instance, hearth_pose_align
   hearth_turntable_opts o;
   hearth_turntable_opts_default(&o);
   o.quiet = 1;
+  if (getenv("RECON_TT_ITERS")) o.iterations = atoi(getenv("RECON_TT_ITERS"));
+  if (getenv("RECON_TT_PRIOR")) o.azimuth_prior = atof(getenv("RECON_TT_PRIOR"));
   hearth_poses est, gt;
   hearth_turntable_result res;
   hearth_status s = hearth_recon_turntable(root, instance, NULL, 0, &o, &est, &res, &err);
@@ -70,6 +75,12 @@ static int run_release(const char *root, const char *instance, hearth_pose_align
         up_est[a] = est.views[i].T_world_from_cam.R[6 + a];
       }
       printf("  tilt err %.3f deg; ", acos(fmin(1.0, hearth_dot3(up_gt, up_est))) * 57.29578);
+      /* signed error about the axis: R_gt^T R (in world: R R_gt^T) */
+      double Rg_t[9], Rd[9], w[3];
+      hearth_mat3_transpose(g->T_world_from_cam.R, Rg_t);
+      hearth_mat3_mul(R, Rg_t, Rd);
+      hearth_matrix_to_rotvec(Rd, w);
+      printf("  yaw %.3f;", hearth_dot3(w, up_al) * 57.29578);
       printf("  err rot %.3f deg pos %.2f mm\n",
              hearth_rotation_angle_between(R, g->T_world_from_cam.R) * 57.29578,
              hearth_norm3(e) * 1e3);
@@ -82,6 +93,47 @@ static int run_release(const char *root, const char *instance, hearth_pose_align
   hearth_poses_free(&est);
   hearth_poses_free(&gt);
   return 0;
+}
+
+/* bench: the mesh fused with the estimated poses, taken to the truth's
+ * frame by the poses' best similarity, against the true mesh */
+static void bench_mesh(const char *root, const char *instance, const hearth_pose_alignment *al) {
+  hearth_err err = {0};
+  hearth_turntable_opts o;
+  hearth_turntable_opts_default(&o);
+  o.quiet = 1;
+  hearth_poses est;
+  if (hearth_recon_turntable(root, instance, NULL, 0, &o, &est, NULL, &err)) return;
+  char rel[600], path[1400];
+  snprintf(rel, sizeof rel, "bench_poses_%s.json", instance);
+  snprintf(path, sizeof path, "%s/%s", root, rel);
+  CHECK_OK(hearth_poses_write(path, &est, &err), &err);
+  hearth_poses_free(&est);
+  hearth_recon_tsdf_opts go;
+  hearth_recon_tsdf_opts_default(&go);
+  go.poses = rel;
+  const char *vox = getenv("RECON_TT_VOXEL");
+  if (vox) go.voxel_m = atof(vox);
+  go.target_triangles = 40000;
+  hearth_mesh m, gt;
+  CHECK_OK(hearth_recon_tsdf(root, instance, NULL, 0, &go, &m, &err), &err);
+  for (size_t i = 0; i < m.n_vertices; i++) {
+    double x[3], y[3];
+    for (int a = 0; a < 3; a++) x[a] = m.positions[3 * i + a];
+    hearth_rigid_rotate(&al->ref_from_est.T, x, y);
+    for (int a = 0; a < 3; a++)
+      m.positions[3 * i + a] = (float)(al->ref_from_est.s * y[a] + al->ref_from_est.T.t[a]);
+  }
+  snprintf(path, sizeof path, "%s/ground_truth/instances/%s/mesh.glb", root, instance);
+  CHECK_OK(hearth_glb_read(path, NULL, &gt, &err), &err);
+  double ra, rb, ma, mb;
+  mesh_to_mesh(&m, &gt, &ra, &ma);
+  mesh_to_mesh(&gt, &m, &rb, &mb);
+  printf("%s: mesh (turntable poses, voxel %.1f mm) %zu triangles; RMS recon->true %.3f mm "
+         "(max %.2f), true->recon %.3f mm (max %.2f)\n",
+         instance, go.voxel_m * 1e3, m.n_triangles, ra * 1e3, ma * 1e3, rb * 1e3, mb * 1e3);
+  hearth_mesh_free(&m);
+  hearth_mesh_free(&gt);
 }
 
 static void run_cmd_expect(const char *cmd, int want_rc, const char *want) {
@@ -178,6 +230,7 @@ int main(int argc, char **argv) {
     double tilt, icp;
     int r = run_release(argv[1], argv[2], &al, &tilt, &icp);
     printf("%s: tilt max %.3f deg\n", argv[2], tilt);
+    if (!r && argc >= 4 && !strcmp(argv[3], "mesh")) bench_mesh(argv[1], argv[2], &al);
     return r ? 1 : g_test_failures;
   }
   test_release();
