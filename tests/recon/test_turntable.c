@@ -152,9 +152,12 @@ static void test_release(void) {
   snprintf(root, sizeof root, "%s/rel", dir);
   snprintf(cmd, sizeof cmd,
            "%s synth --out '%s' --categories cup --states neutral --views 10 --no-calibration "
-           "--draft-rgb --texture 256 --map-res 64 --quiet",
+           "--draft-rgb --texture 256 --map-res 64 --recon none --quiet",
            HEARTH_EXE, root);
   CHECK(system(cmd) == 0);
+  /* --recon none: no stand-in */
+  snprintf(path, sizeof path, "%s/instances/cup_01/recon", root);
+  CHECK(!hearth_path_exists(path));
   hearth_pose_alignment al;
   double tilt, icp;
   if (run_release(root, "cup_01", &al, &tilt, &icp) == 0) {
@@ -169,8 +172,10 @@ static void test_release(void) {
     CHECK_MSG(al.rot_median_deg < 3 && al.pos_median < 0.015, "rotation %g deg, centre %g m",
               al.rot_median_deg, al.pos_median);
   }
-  /* hearth recon ROOT: refuses the stand-in's recon/ without --force, then
-   * writes poses, cameras, mesh and report */
+  /* hearth recon ROOT: refuses another tool's recon/mesh.glb without
+   * --force, then removes it and writes poses, cameras, mesh and report */
+  snprintf(cmd, sizeof cmd, "mkdir -p '%s' && echo x > '%s/mesh.glb'", path, path);
+  CHECK(system(cmd) == 0);
   snprintf(cmd, sizeof cmd, "'%s' recon '%s' --quiet 2>&1", HEARTH_EXE, root);
   run_cmd_expect(cmd, 1, "--force");
   snprintf(cmd, sizeof cmd, "'%s' recon '%s' --quiet --force --triangles 4000 2>&1", HEARTH_EXE,
