@@ -247,9 +247,25 @@ static void tt_pose(tt_view *v) {
 /* Load one view: depth, its intrinsics, the cut-out; object points (inside
  * the cut-out by erode_px colour pixels, off depth edges) with normals from
  * a window fit, background points for the table plane. */
+/* The depth rays of the last camera asked for, kept while views share
+ * their intrinsics (undistorting every pixel is most of a view's load). */
+typedef struct tt_rays {
+  hearth_camera cam;
+  float *dirs; /* 3 * width * height, or NULL */
+} tt_rays;
+
+static const float *rays_for(tt_rays *r, const hearth_camera *cam) {
+  if (r->dirs && !memcmp(&r->cam, cam, sizeof *cam)) return r->dirs;
+  free(r->dirs);
+  r->cam = *cam;
+  r->dirs = malloc((size_t)cam->width * cam->height * 3 * sizeof(float));
+  if (r->dirs) hearth_camera_ray_grid(cam, 1, r->dirs);
+  return r->dirs;
+}
+
 static hearth_status load_view(tt_view *v, const char *dir, const hearth_view_files *vf,
                                const hearth_camera *rgb, double erode_px, uint64_t seed,
-                               hearth_err *err) {
+                               tt_rays *rays, hearth_err *err) {
   char path[1400];
   hearth_depth_intrinsics di;
   snprintf(path, sizeof path, "%s/%s", dir, vf->depth_intrinsics);
@@ -287,10 +303,11 @@ static hearth_status load_view(tt_view *v, const char *dir, const hearth_view_fi
   }
   const int CW = rgb->width, CH = rgb->height;
   uint8_t *on = malloc((size_t)CW * CH);
-  float *dirs = malloc((size_t)W * H * 3 * sizeof(float));
+  const float *rd = rays_for(rays, &v->dcam);
+  float *dirs = malloc((size_t)W * H * 3 * sizeof(float)); /* background points */
   float *pts = malloc((size_t)W * H * 3 * sizeof(float)); /* colour frame, NaN: none */
   uint8_t *cls = calloc((size_t)W * H, 1);                /* 1 object, 2 background */
-  if (!on || !dirs || !pts || !cls) {
+  if (!on || !rd || !dirs || !pts || !cls) {
     s = hearth_err_set(err, HEARTH_E_NOMEM, "%s", v->depth_path);
     goto done;
   }
@@ -300,7 +317,6 @@ static hearth_status load_view(tt_view *v, const char *dir, const hearth_view_fi
     s = hearth_err_set(err, HEARTH_E_INCONSISTENT, "%s: the cut-out is empty", path);
     goto done;
   }
-  hearth_camera_ray_grid(&v->dcam, 1, dirs);
   hearth_rigid T_rgb_from_depth;
   hearth_rigid_inverse(&v->T_depth_from_rgb, &T_rgb_from_depth);
   const uint16_t *dp = depth.data;
@@ -310,7 +326,7 @@ static hearth_status load_view(tt_view *v, const char *dir, const hearth_view_fi
     for (int x = 0; x < W; x++) {
       size_t p = (size_t)y * W + x;
       pts[3 * p] = NAN;
-      const float *d = dirs + 3 * p;
+      const float *d = rd + 3 * p;
       if (!dp[p] || !isfinite(d[0]) || d[2] <= 0) continue;
       double z = dp[p] * 0.001;
       double pd[3] = {d[0] / d[2] * z, d[1] / d[2] * z, z}, pr[3], uv[2];
@@ -766,6 +782,7 @@ hearth_status hearth_recon_turntable(const char *root, const char *instance,
   hearth_progress prog;
   hearth_progress_begin(&prog, "recon: depth views", nv, o.quiet);
   size_t k = 0;
+  tt_rays rays = {0};
   for (size_t i = 0; i < n_states && !s; i++) {
     char dir[1100];
     snprintf(dir, sizeof dir, "%s/instances/%s/raw/%s", root, instance, states[i]);
@@ -776,11 +793,12 @@ hearth_status hearth_recon_turntable(const char *root, const char *instance,
       snprintf(tv->view, sizeof tv->view, "%s", vf->view);
       tv->elevation_index = vf->elevation_index;
       tv->azimuth_index = vf->azimuth_index;
-      s = load_view(tv, dir, vf, &fac.rgb, o.erode_px, 0x7475726eULL + k, err);
+      s = load_view(tv, dir, vf, &fac.rgb, o.erode_px, 0x7475726eULL + k, &rays, err);
       hearth_progress_step(&prog, 1);
     }
   }
   hearth_progress_end(&prog);
+  free(rays.dirs);
   if (!s && !(res.views = calloc(nv, sizeof *res.views)))
     s = hearth_err_set(err, HEARTH_E_NOMEM, "turntable: report");
   if (!s) {
