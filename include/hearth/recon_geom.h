@@ -119,20 +119,21 @@ hearth_status hearth_recon_tsdf(const char *root, const char *instance, const ch
  *  - the turntable/table plane (RANSAC and least squares on the depth
  *    pixels off the cut-out whose plane faces up in the image): the
  *    turntable axis's direction and the camera's height above the top,
- *    which fix two rotation angles and one translation of its pose;
+ *    which start two rotation angles and one translation of its pose;
  *  - the object's points and normals (depth pixels whose point lands well
  *    inside the cut-out, away from depth edges).
  * The turntable geometry starts the rest: azimuth (index a, ring e)
  * direction * (a * azimuth_step + e * ring_shift) about the axis, the
- * object's centroid on the axis. Point-to-plane ICP then refines each
- * view's angle about the axis and its horizontal position, jointly over
- * all views of all states (pairs of views looking from within
- * max_pair_deg of each other, projective association in the target's
- * depth image, Huber weights, a shrinking distance gate; view 0 holds the
- * gauge), with the turntable's azimuths as a prior. The frame of the result: metres, +z up the axis, the turntable
- * top at z = 0, view 0's azimuth at its nominal value. A surface of
- * revolution leaves the angle about its own axis unobserved by geometry:
- * those views keep their nominal azimuth (damped steps). */
+ * object's centroid on the axis. Point-to-plane ICP then refines all six
+ * degrees of every view jointly over all views of all states (pairs of
+ * views whose optical axes are within max_pair_deg, projective association
+ * in the target's depth image, Huber weights, a shrinking distance gate;
+ * view 0 holds the gauge), with each view's table points held at z = 0 and
+ * the turntable's azimuth as a weak prior. The frame of the result: metres,
+ * +z up the axis, the turntable top at z = 0, view 0's azimuth at its
+ * nominal value. A surface of revolution without azimuthal detail leaves
+ * the angle about its own axis unobserved by its depth: those views keep
+ * (about) their turntable azimuth. */
 typedef struct hearth_turntable_opts {
   double azimuth_step_deg; /* between azimuth indices; default 36 */
   double ring_shift_deg;   /* added per elevation index; default 12 */
