@@ -112,7 +112,6 @@ hearth_status hearth_recon_tsdf(const char *root, const char *instance, const ch
                                 size_t n_states, const hearth_recon_tsdf_opts *opts,
                                 hearth_mesh *out, hearth_err *err);
 
-
 /* ---- colour poses from a turntable capture (recon_turntable.c) ----------- */
 /* The embedded pose route: no outside tool. Each view's depth map gives,
  * in the colour camera's frame (through the factory T_depth_from_rgb),
@@ -153,22 +152,22 @@ void hearth_turntable_opts_default(hearth_turntable_opts *o);
 
 typedef struct hearth_turntable_view {
   char state[HEARTH_NAME_MAX], view[HEARTH_NAME_MAX];
-  size_t n_points;        /* object points of its depth map */
-  size_t n_plane;         /* table-plane inliers */
-  double plane_rms_mm;    /* their distance to the plane */
-  double height_m;        /* camera centre above the turntable top */
-  double elevation_deg;   /* of the optical axis below the horizon */
-  size_t n_pairs;         /* views it was registered with */
-  size_t n_matches;       /* ICP correspondences at the end (as source) */
-  double icp_rms_mm;      /* their point-to-plane distances at the end */
-  double d_azimuth_deg;   /* ICP's change of its azimuth from the nominal one */
+  size_t n_points;      /* object points of its depth map */
+  size_t n_plane;       /* table-plane inliers */
+  double plane_rms_mm;  /* their distance to the plane */
+  double height_m;      /* camera centre above the turntable top */
+  double elevation_deg; /* of the optical axis below the horizon */
+  size_t n_pairs;       /* views it was registered with */
+  size_t n_matches;     /* ICP correspondences at the end (as source) */
+  double icp_rms_mm;    /* their point-to-plane distances at the end */
+  double d_azimuth_deg; /* ICP's change of its azimuth from the nominal one */
 } hearth_turntable_view;
 
 typedef struct hearth_turntable_result {
   size_t n_views;
   hearth_turntable_view *views; /* owned, in the poses' order; free with
                                    hearth_turntable_result_free */
-  size_t n_pairs; /* ordered view pairs of the ICP */
+  size_t n_pairs;               /* ordered view pairs of the ICP */
   int iterations;
   double icp_rms_start_mm, icp_rms_mm; /* over all matches, first and last iteration */
   double icp_median_mm;                /* |distance| median at the end */

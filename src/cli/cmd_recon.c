@@ -151,8 +151,7 @@ int hearth_cmd_recon(int argc, char **argv) {
   const cli_opt opts[] = {
       CLI_STR("--instance", "ID", &job.instance, "the instance",
               .def = "every instance of release.json (turntable)"),
-      CLI_CHOICE("--poses", &poses, k_poses, NULL, "where the poses come from",
-                 .def = "turntable"),
+      CLI_CHOICE("--poses", &poses, k_poses, NULL, "where the poses come from", .def = "turntable"),
       CLI_NUM("--azimuth-step", "DEG", &tj.poses.azimuth_step_deg, 1, 180,
               "turntable: degrees between azimuth indices", .def = "36"),
       CLI_NUM("--ring-shift", "DEG", &tj.poses.ring_shift_deg, -180, 180,

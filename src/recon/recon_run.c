@@ -35,9 +35,18 @@ static hearth_status cameras_of(const hearth_camera *rgb, const hearth_poses *p,
   k->id = 1;
   k->model_id = hearth_colmap_model_id("FULL_OPENCV");
   k->n_params = 12;
-  const double par[12] = {rgb->fx,      rgb->fy,      rgb->cx + 0.5, rgb->cy + 0.5,
-                          rgb->dist[0], rgb->dist[1], rgb->dist[2],  rgb->dist[3],
-                          rgb->dist[4], 0,            0,             0};
+  const double par[12] = {rgb->fx,
+                          rgb->fy,
+                          rgb->cx + 0.5,
+                          rgb->cy + 0.5,
+                          rgb->dist[0],
+                          rgb->dist[1],
+                          rgb->dist[2],
+                          rgb->dist[3],
+                          rgb->dist[4],
+                          0,
+                          0,
+                          0};
   memcpy(k->params, par, sizeof par);
   k->width = (uint64_t)rgb->width;
   k->height = (uint64_t)rgb->height;
@@ -137,8 +146,7 @@ hearth_status hearth_recon_run(const hearth_recon_job *job, hearth_recon_summary
       return hearth_err_set(err, HEARTH_E_ARG,
                             "%s exists (another reconstruction's frame); --force replaces it",
                             path);
-    if (remove(path) != 0)
-      return hearth_err_set(err, HEARTH_E_IO, "%s: cannot remove it", path);
+    if (remove(path) != 0) return hearth_err_set(err, HEARTH_E_IO, "%s: cannot remove it", path);
   }
   hearth_factory_calib fac;
   snprintf(path, sizeof path, "%s/calibration/factory.json", job->root);

@@ -152,8 +152,7 @@ static int table_plane(tt_view *v, const float *bg, size_t nb, uint64_t seed) {
   double best_n[3] = {0}, best_d = 0;
   size_t best = 0;
   for (int it = 0; it < TT_RANSAC_ITER; it++) {
-    size_t i0 = hearth_rng_u64(&r) % nb, i1 = hearth_rng_u64(&r) % nb,
-           i2 = hearth_rng_u64(&r) % nb;
+    size_t i0 = hearth_rng_u64(&r) % nb, i1 = hearth_rng_u64(&r) % nb, i2 = hearth_rng_u64(&r) % nb;
     double a[3], b[3], n[3];
     for (int k = 0; k < 3; k++) {
       a[k] = bg[3 * i1 + k] - bg[3 * i0 + k];
@@ -305,8 +304,8 @@ static hearth_status load_view(tt_view *v, const char *dir, const hearth_view_fi
   uint8_t *on = malloc((size_t)CW * CH);
   const float *rd = rays_for(rays, &v->dcam);
   float *dirs = malloc((size_t)W * H * 3 * sizeof(float)); /* background points */
-  float *pts = malloc((size_t)W * H * 3 * sizeof(float)); /* colour frame, NaN: none */
-  uint8_t *cls = calloc((size_t)W * H, 1);                /* 1 object, 2 background */
+  float *pts = malloc((size_t)W * H * 3 * sizeof(float));  /* colour frame, NaN: none */
+  uint8_t *cls = calloc((size_t)W * H, 1);                 /* 1 object, 2 background */
   if (!on || !rd || !dirs || !pts || !cls) {
     s = hearth_err_set(err, HEARTH_E_NOMEM, "%s", v->depth_path);
     goto done;
@@ -734,7 +733,6 @@ static hearth_status run_icp(tt_view *v, size_t nv, const hearth_turntable_opts 
   return s;
 }
 
-
 /* ---- the job ---------------------------------------------------------------- */
 hearth_status hearth_recon_turntable(const char *root, const char *instance,
                                      const char *const *states, size_t n_states,
@@ -805,9 +803,10 @@ hearth_status hearth_recon_turntable(const char *root, const char *instance,
     /* the start: nominal azimuths, the object's centroid on the axis */
     for (size_t i = 0; i < nv; i++) {
       tt_view *tv = &v[i];
-      double phi = o.direction * (tv->azimuth_index * o.azimuth_step_deg +
-                                  tv->elevation_index * o.ring_shift_deg) *
-                   TT_DEG;
+      double phi =
+          o.direction *
+          (tv->azimuth_index * o.azimuth_step_deg + tv->elevation_index * o.ring_shift_deg) *
+          TT_DEG;
       tv->psi = tv->psi0 = phi + TT_PI; /* forward points at the axis */
       tv->x = tv->y = 0;
       tt_pose(tv);

@@ -84,10 +84,11 @@ static int run_release(const char *root, const char *instance, hearth_pose_align
       printf("  err rot %.3f deg pos %.2f mm\n",
              hearth_rotation_angle_between(R, g->T_world_from_cam.R) * 57.29578,
              hearth_norm3(e) * 1e3);
-      printf("  %s/%s: %zu points, plane %zu (rms %.2f mm), height %.3f m, elevation %.2f deg, "
-             "%zu pairs, %zu matches, rms %.3f mm, d_azimuth %.2f deg\n",
-             v->state, v->view, v->n_points, v->n_plane, v->plane_rms_mm, v->height_m,
-             v->elevation_deg, v->n_pairs, v->n_matches, v->icp_rms_mm, v->d_azimuth_deg);
+      printf(
+          "  %s/%s: %zu points, plane %zu (rms %.2f mm), height %.3f m, elevation %.2f deg, "
+          "%zu pairs, %zu matches, rms %.3f mm, d_azimuth %.2f deg\n",
+          v->state, v->view, v->n_points, v->n_plane, v->plane_rms_mm, v->height_m,
+          v->elevation_deg, v->n_pairs, v->n_matches, v->icp_rms_mm, v->d_azimuth_deg);
     }
   hearth_turntable_result_free(&res);
   hearth_poses_free(&est);
@@ -129,9 +130,10 @@ static void bench_mesh(const char *root, const char *instance, const hearth_pose
   double ra, rb, ma, mb;
   mesh_to_mesh(&m, &gt, &ra, &ma);
   mesh_to_mesh(&gt, &m, &rb, &mb);
-  printf("%s: mesh (turntable poses, voxel %.1f mm) %zu triangles; RMS recon->true %.3f mm "
-         "(max %.2f), true->recon %.3f mm (max %.2f)\n",
-         instance, go.voxel_m * 1e3, m.n_triangles, ra * 1e3, ma * 1e3, rb * 1e3, mb * 1e3);
+  printf(
+      "%s: mesh (turntable poses, voxel %.1f mm) %zu triangles; RMS recon->true %.3f mm "
+      "(max %.2f), true->recon %.3f mm (max %.2f)\n",
+      instance, go.voxel_m * 1e3, m.n_triangles, ra * 1e3, ma * 1e3, rb * 1e3, mb * 1e3);
   hearth_mesh_free(&m);
   hearth_mesh_free(&gt);
 }
@@ -206,8 +208,8 @@ static void test_release(void) {
   free(rep);
 
   /* bad input names the file: a missing depth map, an empty cut-out */
-  snprintf(cmd, sizeof cmd, "mv '%s/instances/cup_01/raw/neutral/depth/v03.png' '%s/v03.png'",
-           root, dir);
+  snprintf(cmd, sizeof cmd, "mv '%s/instances/cup_01/raw/neutral/depth/v03.png' '%s/v03.png'", root,
+           dir);
   CHECK(system(cmd) == 0);
   hearth_poses est;
   hearth_status s = hearth_recon_turntable(root, "cup_01", NULL, 0, NULL, &est, NULL, &err);
