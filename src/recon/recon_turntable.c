@@ -24,6 +24,8 @@
 #define TT_PLANE_TOL_M 0.004
 /* table-plane points each view keeps for the ICP's plane term */
 #define TT_PLANE_SAMPLES 1500
+/* table planes fitting within this rms get the full weight */
+#define TT_PLANE_GOOD_M 0.0004
 /* Huber threshold of the ICP distances */
 #define TT_HUBER_M 0.0015
 /* correspondences must have normals within this angle */
@@ -657,8 +659,10 @@ static hearth_status run_icp(tt_view *v, size_t nv, const hearth_turntable_opts 
       const tt_view *tv = &v[vi];
       double *Av = A + 6 * (vi - 1) * nu + 6 * (vi - 1), *bv = b + 6 * (vi - 1);
       /* the plane term: each table point at z = 0, weighted as many
-       * matches as it has points */
-      double wp = (double)(m / (nv ? nv : 1) + 1) / (double)(tv->npl ? tv->npl : 1);
+       * matches as it has points, less where the plane fits worse than
+       * TT_PLANE_GOOD_M (a table seen at grazing incidence) */
+      double pq = TT_PLANE_GOOD_M / fmax(tv->plane_rms, TT_PLANE_GOOD_M);
+      double wp = pq * pq * (double)(m / (nv ? nv : 1) + 1) / (double)(tv->npl ? tv->npl : 1);
       for (size_t k = 0; k < tv->npl; k++) {
         double p[3] = {tv->pl[3 * k], tv->pl[3 * k + 1], tv->pl[3 * k + 2]}, q[3];
         hearth_rigid_apply(&tv->T, p, q);
