@@ -16,6 +16,7 @@
 #include <stdint.h>
 #include "hearth/camera.h"
 #include "hearth/core.h"
+#include "hearth/dataset.h"
 #include "hearth/geom.h"
 #include "hearth/image.h"
 #include "hearth/mesh.h"
@@ -110,6 +111,115 @@ void hearth_recon_tsdf_opts_default(hearth_recon_tsdf_opts *o);
 hearth_status hearth_recon_tsdf(const char *root, const char *instance, const char *const *states,
                                 size_t n_states, const hearth_recon_tsdf_opts *opts,
                                 hearth_mesh *out, hearth_err *err);
+
+/* ---- colour poses from a turntable capture (recon_turntable.c) ----------- */
+/* The embedded pose route: no outside tool. Each view's depth map gives,
+ * in the colour camera's frame (through the factory T_depth_from_rgb),
+ *  - the turntable/table plane (RANSAC and least squares on the depth
+ *    pixels off the cut-out whose plane faces up in the image): the
+ *    turntable axis's direction and the camera's height above the top,
+ *    which start two rotation angles and one translation of its pose;
+ *  - the object's points and normals (depth pixels whose point lands well
+ *    inside the cut-out, away from depth edges).
+ * The turntable geometry starts the rest: azimuth (index a, ring e)
+ * direction * (a * azimuth_step + e * ring_shift) about the axis, the
+ * object's centroid on the axis. Point-to-plane ICP then refines all six
+ * degrees of every view jointly over all views of all states (pairs of
+ * views whose optical axes are within max_pair_deg, projective association
+ * in the target's depth image, Huber weights, a shrinking distance gate;
+ * view 0 holds the gauge), with each view's table points held at z = 0 and
+ * the turntable's azimuth as a weak prior. The frame of the result: metres,
+ * +z up the axis, the turntable top at z = 0, view 0's azimuth at its
+ * nominal value. A surface of revolution without azimuthal detail leaves
+ * the angle about its own axis unobserved by its depth: those views keep
+ * (about) their turntable azimuth. */
+typedef struct hearth_turntable_opts {
+  double azimuth_step_deg; /* between azimuth indices; default 36 */
+  double ring_shift_deg;   /* added per elevation index; default 12 */
+  int direction;           /* +1 (default): azimuth grows counter-clockwise seen
+                              from above; -1 the other way */
+  int iterations;          /* Gauss-Newton iterations; default 30 */
+  size_t max_points;       /* ICP samples per view and pair; default 3000 */
+  double max_pair_deg;     /* default 65 */
+  double erode_px;         /* colour pixels a point must lie inside the cut-out; default 8 */
+  double azimuth_prior;    /* weight (m^2/rad^2) pulling each angle towards the
+                              turntable's: (depth noise / azimuth spread)^2;
+                              default 3e-3 (0.8 mm, 0.9 degrees) */
+  int threads;             /* 0: hearth_default_threads() */
+  int quiet;               /* 1: no progress on stderr */
+} hearth_turntable_opts;
+void hearth_turntable_opts_default(hearth_turntable_opts *o);
+
+typedef struct hearth_turntable_view {
+  char state[HEARTH_NAME_MAX], view[HEARTH_NAME_MAX];
+  size_t n_points;      /* object points of its depth map */
+  size_t n_plane;       /* table-plane inliers */
+  double plane_rms_mm;  /* their distance to the plane */
+  double height_m;      /* camera centre above the turntable top */
+  double elevation_deg; /* of the optical axis below the horizon */
+  size_t n_pairs;       /* views it was registered with */
+  size_t n_matches;     /* ICP correspondences at the end (as source) */
+  double icp_rms_mm;    /* their point-to-plane distances at the end */
+  double d_azimuth_deg; /* ICP's change of its azimuth from the nominal one */
+} hearth_turntable_view;
+
+typedef struct hearth_turntable_result {
+  size_t n_views;
+  hearth_turntable_view *views; /* owned, in the poses' order; free with
+                                   hearth_turntable_result_free */
+  size_t n_pairs;               /* ordered view pairs of the ICP */
+  int iterations;
+  double icp_rms_start_mm, icp_rms_mm; /* over all matches, first and last iteration */
+  double icp_median_mm;                /* |distance| median at the end */
+  double seconds;
+} hearth_turntable_result;
+void hearth_turntable_result_free(hearth_turntable_result *r); /* accepts a zeroed one */
+
+/* Colour poses of every view of the states (NULL/0: every state of
+ * instance.json) of `instance` under `root`, sorted by state (instance.json
+ * order) and view (manifest order). A view without a depth map, an empty
+ * cut-out, a depth map with too few object points or no table plane is an
+ * error naming the file. res may be NULL. */
+hearth_status hearth_recon_turntable(const char *root, const char *instance,
+                                     const char *const *states, size_t n_states,
+                                     const hearth_turntable_opts *opts, hearth_poses *out,
+                                     hearth_turntable_result *res, hearth_err *err);
+
+/* ---- hearth recon ROOT (recon_run.c) -------------------------------------- */
+/* The embedded route over one instance: colour poses by
+ * hearth_recon_turntable, written as recon/poses_rgb.json with the factory
+ * colour camera beside it (recon/poses_rgb_cameras.json, as the COLMAP
+ * route writes), then the metric mesh from the depth maps with those poses
+ * (hearth_recon_tsdf) as recon/mesh_geometry.glb (no UVs yet: the atlas
+ * and texture are not made here), and recon/report.json:
+ *   {"instance", "route": "turntable", "views": N, "pairs", "iterations",
+ *    "icp_rms_start_mm", "icp_rms_mm", "icp_median_mm", "seconds",
+ *    "mesh": {"vertices", "triangles", "voxel_m"},
+ *    "per_view": [{"state", "view", "points", "plane_inliers",
+ *                  "plane_rms_mm", "height_m", "elevation_deg", "pairs",
+ *                  "matches", "icp_rms_mm", "d_azimuth_deg"}]}
+ * Every file is written atomically; an existing recon/poses_rgb.json is
+ * kept (HEARTH_E_ARG, as the COLMAP route does) unless force; so are a
+ * recon/mesh.glb and recon/rgb_texture.png another tool handed over (in
+ * its frame), which force removes. */
+typedef struct hearth_recon_job {
+  const char *root, *instance;
+  hearth_turntable_opts poses;
+  hearth_recon_tsdf_opts geometry; /* .poses is set by the job */
+  int no_mesh;                     /* 1: poses and report only */
+  int force;
+  int quiet;
+} hearth_recon_job;
+void hearth_recon_job_default(hearth_recon_job *job);
+
+typedef struct hearth_recon_summary {
+  hearth_turntable_result poses; /* owned: hearth_recon_summary_free */
+  size_t mesh_vertices, mesh_triangles;
+  char poses_path[1400], mesh_path[1400], report_path[1400];
+} hearth_recon_summary;
+void hearth_recon_summary_free(hearth_recon_summary *s);
+hearth_status hearth_recon_run(const hearth_recon_job *job, hearth_recon_summary *sum,
+                               hearth_err *err);
 
 #ifdef __cplusplus
 }

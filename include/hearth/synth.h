@@ -49,6 +49,8 @@ typedef struct hearth_synth_opts {
   double mesh_size_m;        /* largest extent after scaling; default 0.12 */
   const char *mesh_category; /* whose states to use; default "cup" */
   int contact_sheet;         /* write instances/<id>/raw/<state>/contact_sheet.png */
+  int no_recon;              /* 1: no recon/ stand-in (a release for `hearth recon`);
+                                ground_truth/ is written as always */
   double netd_c;             /* thermal noise, default 0.05 degC */
   /* the calibration target; zeroed (the default): the paper's plate and no
      calibration/target.json; set: that target, written to target.json */

@@ -1,10 +1,12 @@
-/* hearth recon: camera poses from COLMAP, either by running it over an
- * instance (`hearth recon ROOT --instance ID --poses colmap`) or by importing
- * a sparse model it made (`hearth recon import-colmap MODEL_DIR ...`). */
+/* hearth recon: camera poses (and geometry) of an instance, by the embedded
+ * turntable route (`hearth recon ROOT`), by running COLMAP over it
+ * (`--poses colmap`) or by importing a sparse model COLMAP made
+ * (`hearth recon import-colmap MODEL_DIR ...`). */
 #include <stdio.h>
 #include <string.h>
 #include "cli/cli.h"
 #include "hearth/recon.h"
+#include "hearth/recon_geom.h"
 
 static const char *const k_states[] = {"neutral", "hot", "warm", "iced", "used", NULL};
 
@@ -97,7 +99,15 @@ static int cmd_import(int argc, char **argv) {
 }
 
 static const char *k_about =
-    "Camera poses of an instance's colour views from a structure-from-motion tool.\n"
+    "Camera poses (and geometry) of an instance's colour views.\n"
+    "--poses turntable (default, no outside tool): each depth map's turntable plane fixes\n"
+    "its camera's tilt and height; the turntable geometry (azimuth index x --azimuth-step,\n"
+    "plus --ring-shift per elevation index) starts the angle about the axis; joint\n"
+    "point-to-plane ICP on the cut-out depth of all views of all states refines the angles\n"
+    "and horizontal positions. Writes recon/poses_rgb.json (metres, +z up the axis, the\n"
+    "turntable top at z = 0), recon/poses_rgb_cameras.json (the factory colour camera),\n"
+    "recon/mesh_geometry.glb (the depth maps fused with those poses; no UVs yet) and\n"
+    "recon/report.json (views, ICP residuals, per-view plane and match figures).\n"
     "--poses colmap runs COLMAP (Debian's `colmap`, CPU only): feature_extractor with the\n"
     "cut-outs as masks and one camera shared by all views, exhaustive_matcher and mapper\n"
     "over every view of every state, then imports the model with the most registered\n"
@@ -109,29 +119,63 @@ static const char *k_tail =
     "Import a model made elsewhere: hearth recon import-colmap MODEL_DIR --out FILE.json\n"
     "(see hearth recon import-colmap --help).\n";
 
+/* the embedded route over one instance */
+static int run_turntable(const char *root, const char *instance, const hearth_recon_job *base) {
+  hearth_recon_job job = *base;
+  job.root = root;
+  job.instance = instance;
+  hearth_recon_summary sum;
+  hearth_err err = {0};
+  if (hearth_recon_run(&job, &sum, &err)) return cli_fail("recon", &err);
+  const hearth_turntable_result *r = &sum.poses;
+  printf("recon %s: %zu views, %zu pairs, ICP rms %.3f -> %.3f mm (median %.3f), %.1f s -> %s\n",
+         instance, r->n_views, r->n_pairs, r->icp_rms_start_mm, r->icp_rms_mm, r->icp_median_mm,
+         r->seconds, sum.poses_path);
+  if (!job.no_mesh)
+    printf("recon %s: mesh %zu vertices, %zu triangles -> %s\n", instance, sum.mesh_vertices,
+           sum.mesh_triangles, sum.mesh_path);
+  hearth_recon_summary_free(&sum);
+  return 0;
+}
+
 int hearth_cmd_recon(int argc, char **argv) {
   if (argc >= 2 && !strcmp(argv[1], "import-colmap")) return cmd_import(argc - 1, argv + 1);
-  static const char *const k_poses[] = {"colmap", NULL};
+  static const char *const k_poses[] = {"turntable", "colmap", NULL};
   static const char *const k_intr[] = {"calibration", "estimate", NULL};
   static const int k_intr_values[] = {HEARTH_COLMAP_INTR_CALIBRATION, HEARTH_COLMAP_INTR_ESTIMATE};
-  int poses = -1;
+  int poses = 0;
   int intr = HEARTH_COLMAP_INTR_CALIBRATION;
   hearth_colmap_job job = {0};
+  hearth_recon_job tj;
+  hearth_recon_job_default(&tj);
   const cli_opt opts[] = {
-      CLI_STR("--instance", "ID", &job.instance, "the instance", .flags = CLI_REQUIRED),
-      CLI_CHOICE("--poses", &poses, k_poses, NULL, "where the poses come from",
-                 .flags = CLI_REQUIRED),
+      CLI_STR("--instance", "ID", &job.instance, "the instance",
+              .def = "every instance of release.json (turntable)"),
+      CLI_CHOICE("--poses", &poses, k_poses, NULL, "where the poses come from", .def = "turntable"),
+      CLI_NUM("--azimuth-step", "DEG", &tj.poses.azimuth_step_deg, 1, 180,
+              "turntable: degrees between azimuth indices", .def = "36"),
+      CLI_NUM("--ring-shift", "DEG", &tj.poses.ring_shift_deg, -180, 180,
+              "turntable: azimuth added per elevation index", .def = "12"),
+      CLI_FLAG("--clockwise", &tj.poses.direction, -1,
+               "turntable: azimuth grows clockwise seen from above"),
+      CLI_NUM("--voxel", "M", &tj.geometry.voxel_m, 0.0002, 0.05,
+              "turntable: TSDF voxel of the mesh (metres)", .def = "0.002"),
+      CLI_SIZE("--triangles", "N", &tj.geometry.target_triangles, 0, 10000000,
+               "turntable: simplify the mesh to this many triangles (0: not)", .def = "20000"),
+      CLI_FLAG("--no-mesh", &tj.no_mesh, 1, "turntable: poses and report only"),
       CLI_CHOICE("--intrinsics", &intr, k_intr, k_intr_values,
-                 "calibration: the colour camera of calibration/rig.json (else factory.json), "
-                 "held fixed; estimate: COLMAP's self-calibration"),
-      CLI_STR("--out", "FILE.json", &job.out, "poses file to write",
+                 "colmap: calibration: the colour camera of calibration/rig.json (else "
+                 "factory.json), held fixed; estimate: COLMAP's self-calibration"),
+      CLI_STR("--out", "FILE.json", &job.out, "colmap: poses file to write",
               .def = "ROOT/instances/ID/recon/poses_rgb.json"),
-      CLI_STR("--work", "DIR", &job.work, "keep COLMAP's workspace (database, model, logs) here",
+      CLI_STR("--work", "DIR", &job.work,
+              "colmap: keep COLMAP's workspace (database, model, logs) here",
               .def = "a temporary folder, removed after success"),
-      CLI_STR("--colmap", "PROGRAM", &job.colmap, "the COLMAP program", .def = "colmap on PATH"),
+      CLI_STR("--colmap", "PROGRAM", &job.colmap, "colmap: the COLMAP program",
+              .def = "colmap on PATH"),
       CLI_FLAG("--no-masks", &job.no_masks, 1,
-               "features from the whole image, not only the cut-out"),
-      CLI_INT("--threads", "N", &job.threads, 1, 1024, "threads COLMAP may use",
+               "colmap: features from the whole image, not only the cut-out"),
+      CLI_INT("--threads", "N", &job.threads, 1, 1024, "threads to use",
               .def = "HEARTH_THREADS or all cores"),
       CLI_FLAG("--force", &job.force, 1, "replace an existing poses file"),
       CLI_FLAG("--quiet", &job.quiet, 1, "no progress output"),
@@ -148,8 +192,27 @@ int hearth_cmd_recon(int argc, char **argv) {
   cli_args args;
   int rc = cli_parse(&cmd, argc, argv, &args);
   if (rc != CLI_RUN) return rc;
-  (void)poses; /* one route so far */
   job.root = args.v[0];
+  if (poses == 0) {
+    tj.force = job.force;
+    tj.quiet = job.quiet;
+    tj.poses.threads = job.threads;
+    if (job.out || job.work || job.colmap || job.no_masks)
+      return cli_usage_error(&cmd, "--out, --work, --colmap and --no-masks go with --poses colmap");
+    if (job.instance) return run_turntable(job.root, job.instance, &tj);
+    char path[4096];
+    if (snprintf(path, sizeof path, "%s/release.json", job.root) >= (int)sizeof path)
+      return cli_usage_error(&cmd, "ROOT: path too long");
+    hearth_release_doc rel;
+    hearth_err err = {0};
+    if (hearth_release_read(path, &rel, &err)) return cli_fail("recon", &err);
+    int out = 0;
+    for (size_t i = 0; i < rel.n_instances && !out; i++)
+      out = run_turntable(job.root, rel.instances[i], &tj);
+    hearth_release_free(&rel);
+    return out;
+  }
+  if (!job.instance) return cli_usage_error(&cmd, "--poses colmap needs --instance ID");
   job.intrinsics = (hearth_colmap_intrinsics)intr;
   hearth_colmap_result res;
   hearth_err err = {0};

@@ -79,6 +79,7 @@ int hearth_cmd_synth(int argc, char **argv) {
   const char *formats = NULL;
   double pitch = 0, hole = 0;
   size_t tsize[2] = {0, 0};
+  static const char *const k_recon[] = {"stand-in", "none", NULL};
   const cli_opt opts[] = {
       CLI_STR("--out", "DIR", &o.out_root, "release root to create", .flags = CLI_REQUIRED),
       CLI_U64("--seed", "N", &o.seed, "random seed; same seed, same bytes"),
@@ -103,6 +104,10 @@ int hearth_cmd_synth(int argc, char **argv) {
               .flags = CLI_LO_OPEN | CLI_HI_OPEN),
       CLI_STR("--mesh-category", "C", &o.mesh_category, "whose temperature states it gets"),
       CLI_FLAG("--contact-sheet", &o.contact_sheet, 1, "also write raw/<state>/contact_sheet.png"),
+      CLI_CHOICE("--recon", &o.no_recon, k_recon, NULL,
+                 "stand-in: recon/ as an outside tool would hand it over (the true mesh "
+                 "under a similarity); none: no recon/ (for `hearth recon`)",
+                 .def = "stand-in"),
       CLI_FLAG("--draft-rgb", &o.rgb_full_size, 0,
                "render object colour views at a quarter size, enlarged 4x to 1920x1080 (16x "
                "faster colour; for tests and quick looks)"),

@@ -6,6 +6,7 @@
 #include <stddef.h>
 #include <stdint.h>
 #include "hearth/core.h"
+#include "hearth/image.h"
 #include "hearth/recon.h"
 
 /* A growing array of records of `size` bytes; zeroed to start. */
@@ -54,6 +55,11 @@ hearth_status rc_parse_binary(hearth_colmap_file which, const uint8_t *data, siz
  * image `image_id` is in m and has a 2-D point `point2d`, else -1 with why. */
 int rc_track_check(const hearth_colmap_model *m, uint32_t image_id, uint32_t point2d, char *why,
                    size_t whysz);
+
+/* ---- cut-outs ------------------------------------------------------------- */
+/* 1 if pixel p (index into width * height) of cut-out image c is the
+ * object: the alpha channel when there is one, any non-zero channel else. */
+int rc_cutout_at(const hearth_image *c, size_t p);
 
 /* ---- JSON text (cameras document) ----------------------------------------- */
 /* x in the shortest of %.15g/%.16g/%.17g that reads back to the same

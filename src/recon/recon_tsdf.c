@@ -7,6 +7,7 @@
 #include <string.h>
 #include "hearth/dataset.h"
 #include "hearth/recon_geom.h"
+#include "recon_internal.h"
 
 hearth_status hearth_tsdf_init(hearth_tsdf *t, const double lo[3], const double hi[3], double voxel,
                                double trunc, hearth_err *err) {
@@ -136,7 +137,7 @@ typedef struct recon_view {
 /* The cut-outs are dilated by this many colour pixels for that test. */
 #define RECON_SILHOUETTE_DILATE 3
 
-static int cutout_at(const hearth_image *c, size_t p) {
+int rc_cutout_at(const hearth_image *c, size_t p) {
   p *= (size_t)c->channels;
   if (c->type == HEARTH_PIX_U16) {
     const uint16_t *d = c->data;
@@ -293,7 +294,7 @@ static hearth_status load_views(const char *root, const char *instance, const ch
       s = hearth_err_set(err, HEARTH_E_NOMEM, "%s", path);
     } else {
       for (size_t p = 0; p < cut.width * cut.height; p++)
-        rv->cut[p] = (uint8_t)(2 * cutout_at(&cut, p));
+        rv->cut[p] = (uint8_t)(2 * rc_cutout_at(&cut, p));
       uint8_t *tmp = malloc(cut.width * cut.height);
       if (!tmp) s = hearth_err_set(err, HEARTH_E_NOMEM, "%s", path);
       else dilate_cut(rv->cut, tmp, (int)cut.width, (int)cut.height);

@@ -452,7 +452,9 @@ static hearth_status write_instance(const render_ctx *rc, const char *root, synt
   char p[4096], gt[4096];
   snprintf(gt, sizeof gt, "%s/ground_truth/instances/%s", root, inst->id);
   hearth_status st;
-  if ((st = mkdirf(err, "%s/instances/%s/recon", root, inst->id)) || (st = hearth_mkdirs(gt, err)))
+  if ((st = mkdirf(err, o->no_recon ? "%s/instances/%s" : "%s/instances/%s/recon", root,
+                   inst->id)) ||
+      (st = hearth_mkdirs(gt, err)))
     return st;
 
   /* instance.json */
@@ -488,8 +490,8 @@ static hearth_status write_instance(const render_ctx *rc, const char *root, synt
   hearth_mesh_transform(&m, 1.0 / inst->scale, T_do.R, t_s);
   m.texture = inst->obj.albedo; /* borrowed for writing */
   snprintf(p, sizeof p, "%s/instances/%s/recon/mesh.glb", root, inst->id);
-  st = hearth_glb_write(p, &m, err);
-  if (!st) {
+  st = o->no_recon ? HEARTH_OK : hearth_glb_write(p, &m, err);
+  if (!st && !o->no_recon) {
     snprintf(p, sizeof p, "%s/instances/%s/recon/rgb_texture.png", root, inst->id);
     st = hearth_png_write(p, &inst->obj.albedo, err);
   }
@@ -505,7 +507,7 @@ static hearth_status write_instance(const render_ctx *rc, const char *root, synt
   if (st) return st;
 
   snprintf(p, sizeof p, "%s/instances/%s/recon/poses_rgb.json", root, inst->id);
-  if ((st = write_poses(p, inst, rc->rig, 0, 1, err))) return st;
+  if (!o->no_recon && (st = write_poses(p, inst, rc->rig, 0, 1, err))) return st;
   snprintf(p, sizeof p, "%s/poses_rgb.json", gt);
   if ((st = write_poses(p, inst, rc->rig, 0, 0, err))) return st;
   snprintf(p, sizeof p, "%s/poses_thermal.json", gt);

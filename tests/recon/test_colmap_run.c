@@ -301,7 +301,8 @@ static void test_cli(void) {
     const char *args, *want;
   } k_usage[] = {
       {"recon", "ROOT"},
-      {"recon /nonexistent --instance cup_01", "--poses"},
+      {"recon /nonexistent --poses colmap", "--instance"},
+      {"recon /nonexistent --instance cup_01 --work /w", "--poses colmap"},
       {"recon /nonexistent --instance cup_01 --poses sfm", "sfm"},
       {"recon /a /b --instance cup_01 --poses colmap", "/b"},
       {"recon /a --instance cup_01 --poses colmap --threads 0", "--threads"},

@@ -1,0 +1,863 @@
+/* recon_turntable.c - colour poses from a turntable capture without an
+ * outside tool: each view's table plane and object points from its depth
+ * map, the turntable geometry as the start, then joint point-to-plane ICP
+ * over the views' angles about the axis and horizontal positions. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "hearth/dataset.h"
+#include "hearth/recon_geom.h"
+#include "recon_internal.h"
+
+#define TT_PI 3.14159265358979323846
+#define TT_DEG (TT_PI / 180.0)
+/* depth step (mm) between 4-neighbours taken as a depth edge */
+#define TT_EDGE_MM 8
+/* half window (depth pixels) of the normal fit */
+#define TT_NORMAL_R 3
+/* fewest object points / plane inliers a view must have */
+#define TT_MIN_POINTS 200
+#define TT_MIN_PLANE 300
+/* RANSAC for the table plane */
+#define TT_RANSAC_ITER 300
+#define TT_PLANE_TOL_M 0.004
+/* table-plane points each view keeps for the ICP's plane term */
+#define TT_PLANE_SAMPLES 1500
+/* table planes fitting within this rms get the full weight */
+#define TT_PLANE_GOOD_M 0.0004
+/* Huber threshold of the ICP distances */
+#define TT_HUBER_M 0.0015
+/* correspondences must have normals within this angle */
+#define TT_NORMAL_COS 0.7
+
+void hearth_turntable_opts_default(hearth_turntable_opts *o) {
+  memset(o, 0, sizeof *o);
+  o->azimuth_step_deg = 36.0;
+  o->ring_shift_deg = 12.0;
+  o->direction = 1;
+  o->iterations = 30;
+  o->max_points = 3000;
+  o->max_pair_deg = 65.0;
+  o->erode_px = 8.0;
+  o->azimuth_prior = 3e-3;
+}
+
+void hearth_turntable_result_free(hearth_turntable_result *r) {
+  if (!r) return;
+  free(r->views);
+  memset(r, 0, sizeof *r);
+}
+
+/* One view: object points and normals in its colour camera's frame, the
+ * crop of its depth image that indexes them, its levelling and pose. */
+typedef struct tt_view {
+  char state[HEARTH_NAME_MAX], view[HEARTH_NAME_MAX];
+  char depth_path[1400];
+  int elevation_index, azimuth_index;
+  hearth_camera dcam;
+  hearth_rigid T_depth_from_rgb;
+  int x0, y0, cw, ch; /* crop of the depth image */
+  int32_t *index;     /* cw * ch: point index or -1 */
+  size_t n;
+  float *p, *nrm; /* 3 * n each, colour camera frame */
+  double centroid[3];
+  double L[9];   /* R_level_from_cam: rows forward, side, up */
+  double height; /* camera above the plane, metres */
+  size_t n_plane;
+  double plane_rms;
+  size_t npl;
+  float *pl; /* 3 * npl: table-plane inliers (a subsample), colour frame */
+  /* pose parameters: T_world_from_cam = (Rz(psi) L, (x, y, height)) */
+  double psi, psi0, x, y;
+  hearth_rigid T; /* current pose */
+} tt_view;
+
+static void tt_view_free(tt_view *v) {
+  free(v->pl);
+  free(v->index);
+  free(v->p);
+  free(v->nrm);
+}
+
+/* eigen decomposition of a symmetric 3x3 (cyclic Jacobi); eigenvalues in
+ * w, eigenvectors in the columns of V */
+static void sym3_eigen(const double A[9], double w[3], double V[9]) {
+  double a[9];
+  memcpy(a, A, sizeof a);
+  for (int i = 0; i < 9; i++) V[i] = i % 4 == 0;
+  for (int sweep = 0; sweep < 30; sweep++) {
+    double off = fabs(a[1]) + fabs(a[2]) + fabs(a[5]);
+    if (off < 1e-300) break;
+    for (int p = 0; p < 2; p++)
+      for (int q = p + 1; q < 3; q++) {
+        double apq = a[3 * p + q];
+        if (fabs(apq) < 1e-300) continue;
+        double th = 0.5 * (a[3 * q + q] - a[3 * p + p]) / apq;
+        double t = (th >= 0 ? 1.0 : -1.0) / (fabs(th) + sqrt(th * th + 1.0));
+        double c = 1.0 / sqrt(t * t + 1.0), s = t * c;
+        for (int k = 0; k < 3; k++) { /* columns p, q */
+          double akp = a[3 * k + p], akq = a[3 * k + q];
+          a[3 * k + p] = c * akp - s * akq;
+          a[3 * k + q] = s * akp + c * akq;
+        }
+        for (int k = 0; k < 3; k++) { /* rows p, q */
+          double apk = a[3 * p + k], aqk = a[3 * q + k];
+          a[3 * p + k] = c * apk - s * aqk;
+          a[3 * q + k] = s * apk + c * aqk;
+        }
+        for (int k = 0; k < 3; k++) {
+          double vkp = V[3 * k + p], vkq = V[3 * k + q];
+          V[3 * k + p] = c * vkp - s * vkq;
+          V[3 * k + q] = s * vkp + c * vkq;
+        }
+      }
+  }
+  for (int i = 0; i < 3; i++) w[i] = a[4 * i];
+}
+
+/* the unit normal (eigenvector of the smallest eigenvalue) of points'
+ * covariance C about their mean */
+static void smallest_axis(const double C[9], double n[3]) {
+  double w[3], V[9];
+  sym3_eigen(C, w, V);
+  int k = 0;
+  for (int i = 1; i < 3; i++)
+    if (w[i] < w[k]) k = i;
+  for (int i = 0; i < 3; i++) n[i] = V[3 * i + k];
+}
+
+/* least-squares plane n.x + d = 0 through pts[idx[0..m)] */
+static void fit_plane(const float *pts, const size_t *idx, size_t m, double n[3], double *d) {
+  double mu[3] = {0, 0, 0}, C[9] = {0};
+  for (size_t i = 0; i < m; i++)
+    for (int a = 0; a < 3; a++) mu[a] += pts[3 * idx[i] + a];
+  for (int a = 0; a < 3; a++) mu[a] /= (double)m;
+  for (size_t i = 0; i < m; i++) {
+    double q[3];
+    for (int a = 0; a < 3; a++) q[a] = pts[3 * idx[i] + a] - mu[a];
+    for (int a = 0; a < 3; a++)
+      for (int b = 0; b < 3; b++) C[3 * a + b] += q[a] * q[b];
+  }
+  smallest_axis(C, n);
+  *d = -hearth_dot3(n, mu);
+}
+
+/* The table plane among the background points bg[0..nb) (colour frame):
+ * the RANSAC plane facing up in the image (normal towards the camera with
+ * -y > 0.3) with the most inliers, refit to its inliers. Fills v's plane
+ * fields and levelling; 0 when none is found. */
+static int table_plane(tt_view *v, const float *bg, size_t nb, uint64_t seed) {
+  if (nb < TT_MIN_PLANE) return 0;
+  hearth_rng r;
+  hearth_rng_seed(&r, seed);
+  double best_n[3] = {0}, best_d = 0;
+  size_t best = 0;
+  for (int it = 0; it < TT_RANSAC_ITER; it++) {
+    size_t i0 = hearth_rng_u64(&r) % nb, i1 = hearth_rng_u64(&r) % nb, i2 = hearth_rng_u64(&r) % nb;
+    double a[3], b[3], n[3];
+    for (int k = 0; k < 3; k++) {
+      a[k] = bg[3 * i1 + k] - bg[3 * i0 + k];
+      b[k] = bg[3 * i2 + k] - bg[3 * i0 + k];
+    }
+    hearth_cross3(a, b, n);
+    double ln = hearth_norm3(n);
+    if (ln < 1e-9) continue;
+    for (int k = 0; k < 3; k++) n[k] /= ln;
+    double p0[3] = {bg[3 * i0], bg[3 * i0 + 1], bg[3 * i0 + 2]};
+    double d = -hearth_dot3(n, p0);
+    if (d < 0) { /* the camera (origin) on the positive side */
+      for (int k = 0; k < 3; k++) n[k] = -n[k];
+      d = -d;
+    }
+    if (-n[1] < 0.3) continue;
+    size_t cnt = 0;
+    for (size_t i = 0; i < nb; i += 2) {
+      double q[3] = {bg[3 * i], bg[3 * i + 1], bg[3 * i + 2]};
+      if (fabs(hearth_dot3(n, q) + d) < TT_PLANE_TOL_M) cnt++;
+    }
+    if (cnt > best) {
+      best = cnt;
+      memcpy(best_n, n, sizeof best_n);
+      best_d = d;
+    }
+  }
+  if (2 * best < TT_MIN_PLANE) return 0;
+  size_t *idx = malloc(nb * sizeof *idx);
+  if (!idx) return 0;
+  double n[3] = {best_n[0], best_n[1], best_n[2]}, d = best_d;
+  size_t m = 0;
+  for (int pass = 0; pass < 3; pass++) {
+    double tol = pass == 0 ? TT_PLANE_TOL_M : 2.5 * (v->plane_rms > 5e-4 ? v->plane_rms : 5e-4);
+    m = 0;
+    for (size_t i = 0; i < nb; i++) {
+      double q[3] = {bg[3 * i], bg[3 * i + 1], bg[3 * i + 2]};
+      if (fabs(hearth_dot3(n, q) + d) < tol) idx[m++] = i;
+    }
+    if (m < TT_MIN_PLANE) break;
+    fit_plane(bg, idx, m, n, &d);
+    if (d < 0) {
+      for (int k = 0; k < 3; k++) n[k] = -n[k];
+      d = -d;
+    }
+    double ss = 0;
+    for (size_t i = 0; i < m; i++) {
+      double q[3] = {bg[3 * idx[i]], bg[3 * idx[i] + 1], bg[3 * idx[i] + 2]};
+      double e = hearth_dot3(n, q) + d;
+      ss += e * e;
+    }
+    v->plane_rms = sqrt(ss / (double)m);
+  }
+  if (m >= TT_MIN_PLANE) {
+    size_t step = m > TT_PLANE_SAMPLES ? (m + TT_PLANE_SAMPLES - 1) / TT_PLANE_SAMPLES : 1;
+    v->pl = malloc((m / step + 1) * 3 * sizeof(float));
+    for (size_t i = 0; v->pl && i < m; i += step) {
+      for (int a = 0; a < 3; a++) v->pl[3 * v->npl + a] = bg[3 * idx[i] + a];
+      v->npl++;
+    }
+  }
+  free(idx);
+  if (m < TT_MIN_PLANE || !v->pl) return 0;
+  v->n_plane = m;
+  v->height = d;
+  /* levelling: forward = the optical axis made horizontal, up = n */
+  double z[3] = {0, 0, 1}, f[3], s[3];
+  double zn = hearth_dot3(z, n);
+  for (int k = 0; k < 3; k++) f[k] = z[k] - zn * n[k];
+  double lf = hearth_norm3(f);
+  for (int k = 0; k < 3; k++) f[k] /= lf;
+  hearth_cross3(n, f, s);
+  for (int k = 0; k < 3; k++) {
+    v->L[k] = f[k];
+    v->L[3 + k] = s[k];
+    v->L[6 + k] = n[k];
+  }
+  return 1;
+}
+
+/* pose from the parameters */
+static void tt_pose(tt_view *v) {
+  double c = cos(v->psi), s = sin(v->psi);
+  double Rz[9] = {c, -s, 0, s, c, 0, 0, 0, 1};
+  hearth_mat3_mul(Rz, v->L, v->T.R);
+  v->T.t[0] = v->x;
+  v->T.t[1] = v->y;
+  v->T.t[2] = v->height;
+}
+
+/* Load one view: depth, its intrinsics, the cut-out; object points (inside
+ * the cut-out by erode_px colour pixels, off depth edges) with normals from
+ * a window fit, background points for the table plane. */
+/* The depth rays of the last camera asked for, kept while views share
+ * their intrinsics (undistorting every pixel is most of a view's load). */
+typedef struct tt_rays {
+  hearth_camera cam;
+  float *dirs; /* 3 * width * height, or NULL */
+} tt_rays;
+
+static const float *rays_for(tt_rays *r, const hearth_camera *cam) {
+  if (r->dirs && !memcmp(&r->cam, cam, sizeof *cam)) return r->dirs;
+  free(r->dirs);
+  r->cam = *cam;
+  r->dirs = malloc((size_t)cam->width * cam->height * 3 * sizeof(float));
+  if (r->dirs) hearth_camera_ray_grid(cam, 1, r->dirs);
+  return r->dirs;
+}
+
+static hearth_status load_view(tt_view *v, const char *dir, const hearth_view_files *vf,
+                               const hearth_camera *rgb, double erode_px, uint64_t seed,
+                               tt_rays *rays, hearth_err *err) {
+  char path[1400];
+  hearth_depth_intrinsics di;
+  snprintf(path, sizeof path, "%s/%s", dir, vf->depth_intrinsics);
+  if (!hearth_path_exists(path))
+    return hearth_err_set(err, HEARTH_E_NOT_FOUND, "%s: view %s has no depth intrinsics", path,
+                          vf->view);
+  hearth_status s = hearth_depth_intrinsics_read(path, &di, err);
+  if (s) return s;
+  v->dcam = di.depth;
+  v->T_depth_from_rgb = di.T_depth_from_rgb;
+  snprintf(v->depth_path, sizeof v->depth_path, "%s/%s", dir, vf->depth);
+  if (!hearth_path_exists(v->depth_path))
+    return hearth_err_set(err, HEARTH_E_NOT_FOUND, "%s: view %s has no depth map", v->depth_path,
+                          vf->view);
+  hearth_image depth = {0}, cut = {0};
+  if ((s = hearth_png_read(v->depth_path, &depth, err))) return s;
+  const int W = v->dcam.width, H = v->dcam.height;
+  if (depth.type != HEARTH_PIX_U16 || depth.channels != 1 || depth.width != (size_t)W ||
+      depth.height != (size_t)H) {
+    hearth_image_free(&depth);
+    return hearth_err_set(err, HEARTH_E_SIZE, "%s: expected a %dx%d 1-channel 16-bit depth image",
+                          v->depth_path, W, H);
+  }
+  snprintf(path, sizeof path, "%s/%s", dir, vf->cutout);
+  if ((s = hearth_png_read(path, &cut, err))) {
+    hearth_image_free(&depth);
+    return s;
+  }
+  if (cut.width != (size_t)rgb->width || cut.height != (size_t)rgb->height) {
+    s = hearth_err_set(err, HEARTH_E_SIZE, "%s: %zux%zu, the colour camera is %dx%d", path,
+                       cut.width, cut.height, rgb->width, rgb->height);
+    hearth_image_free(&depth);
+    hearth_image_free(&cut);
+    return s;
+  }
+  const int CW = rgb->width, CH = rgb->height;
+  uint8_t *on = malloc((size_t)CW * CH);
+  const float *rd = rays_for(rays, &v->dcam);
+  float *dirs = malloc((size_t)W * H * 3 * sizeof(float)); /* background points */
+  float *pts = malloc((size_t)W * H * 3 * sizeof(float));  /* colour frame, NaN: none */
+  uint8_t *cls = calloc((size_t)W * H, 1);                 /* 1 object, 2 background */
+  if (!on || !rd || !dirs || !pts || !cls) {
+    s = hearth_err_set(err, HEARTH_E_NOMEM, "%s", v->depth_path);
+    goto done;
+  }
+  size_t n_cut = 0;
+  for (size_t p = 0; p < (size_t)CW * CH; p++) n_cut += on[p] = (uint8_t)rc_cutout_at(&cut, p);
+  if (!n_cut) {
+    s = hearth_err_set(err, HEARTH_E_INCONSISTENT, "%s: the cut-out is empty", path);
+    goto done;
+  }
+  hearth_rigid T_rgb_from_depth;
+  hearth_rigid_inverse(&v->T_depth_from_rgb, &T_rgb_from_depth);
+  const uint16_t *dp = depth.data;
+  const int E = (int)ceil(erode_px);
+  int bx0 = W, by0 = H, bx1 = -1, by1 = -1;
+  for (int y = 0; y < H; y++)
+    for (int x = 0; x < W; x++) {
+      size_t p = (size_t)y * W + x;
+      pts[3 * p] = NAN;
+      const float *d = rd + 3 * p;
+      if (!dp[p] || !isfinite(d[0]) || d[2] <= 0) continue;
+      double z = dp[p] * 0.001;
+      double pd[3] = {d[0] / d[2] * z, d[1] / d[2] * z, z}, pr[3], uv[2];
+      hearth_rigid_apply(&T_rgb_from_depth, pd, pr);
+      for (int a = 0; a < 3; a++) pts[3 * p + a] = (float)pr[a];
+      int edge = x == 0 || y == 0 || x == W - 1 || y == H - 1;
+      for (int q = 0; q < 4 && !edge; q++) {
+        size_t pn = q == 0 ? p - 1 : q == 1 ? p + 1 : q == 2 ? p - W : p + W;
+        int dd = (int)dp[pn] - (int)dp[p];
+        edge = !dp[pn] || dd > TT_EDGE_MM || dd < -TT_EDGE_MM;
+      }
+      int in = 0, near = 0;
+      if (hearth_camera_project(rgb, pr, uv, NULL)) {
+        long u = lround(uv[0]), w = lround(uv[1]);
+        if (u >= 0 && w >= 0 && u < CW && w < CH && on[(size_t)w * CW + u]) {
+          near = 1;
+          in = 1;
+          const int off[4][2] = {{E, 0}, {-E, 0}, {0, E}, {0, -E}};
+          for (int k = 0; k < 4 && in; k++) {
+            long uu = u + off[k][0], ww = w + off[k][1];
+            in = uu >= 0 && ww >= 0 && uu < CW && ww < CH && on[(size_t)ww * CW + uu];
+          }
+        } else if (u >= 0 && w >= 0 && u < CW && w < CH) {
+          /* background unless within 3 E of the cut-out */
+          const int off[4][2] = {{3 * E, 0}, {-3 * E, 0}, {0, 3 * E}, {0, -3 * E}};
+          for (int k = 0; k < 4 && !near; k++) {
+            long uu = u + off[k][0], ww = w + off[k][1];
+            near = uu >= 0 && ww >= 0 && uu < CW && ww < CH && on[(size_t)ww * CW + uu];
+          }
+        } else {
+          near = 1;
+        }
+      }
+      if (in && !edge) {
+        cls[p] = 1;
+        if (x < bx0) bx0 = x;
+        if (y < by0) by0 = y;
+        if (x > bx1) bx1 = x;
+        if (y > by1) by1 = y;
+      } else if (!near && !edge && (x % 2 == 0) && (y % 2 == 0)) {
+        cls[p] = 2;
+      }
+    }
+  /* background points for the plane */
+  size_t nb = 0;
+  for (size_t p = 0; p < (size_t)W * H; p++)
+    if (cls[p] == 2) {
+      for (int a = 0; a < 3; a++) dirs[3 * nb + a] = pts[3 * p + a];
+      nb++;
+    }
+  if (!table_plane(v, dirs, nb, seed)) {
+    s = hearth_err_set(err, HEARTH_E_NUMERIC,
+                       "%s: no turntable plane found (%zu depth pixels off the cut-out)",
+                       v->depth_path, nb);
+    goto done;
+  }
+  if (bx1 < 0) {
+    s = hearth_err_set(err, HEARTH_E_NOT_FOUND,
+                       "%s: no depth pixel lies inside the cut-out %s (of view %s)", v->depth_path,
+                       path, vf->view);
+    goto done;
+  }
+  v->x0 = bx0;
+  v->y0 = by0;
+  v->cw = bx1 - bx0 + 1;
+  v->ch = by1 - by0 + 1;
+  v->index = malloc((size_t)v->cw * v->ch * sizeof *v->index);
+  size_t cnt = 0;
+  for (size_t p = 0; p < (size_t)W * H; p++) cnt += cls[p] == 1;
+  v->p = malloc(cnt * 3 * sizeof(float));
+  v->nrm = malloc(cnt * 3 * sizeof(float));
+  if (!v->index || !v->p || !v->nrm) {
+    s = hearth_err_set(err, HEARTH_E_NOMEM, "%s", v->depth_path);
+    goto done;
+  }
+  double csum[3] = {0, 0, 0};
+  for (int y = by0; y <= by1; y++)
+    for (int x = bx0; x <= bx1; x++) {
+      size_t p = (size_t)y * W + x;
+      int32_t *ix = &v->index[(size_t)(y - by0) * v->cw + (x - bx0)];
+      *ix = -1;
+      if (cls[p] != 1) continue;
+      /* normal: the window's points within 2 * TT_EDGE_MM of the centre */
+      double mu[3] = {0, 0, 0}, C[9] = {0};
+      int m = 0;
+      for (int dy = -TT_NORMAL_R; dy <= TT_NORMAL_R; dy++)
+        for (int dx = -TT_NORMAL_R; dx <= TT_NORMAL_R; dx++) {
+          int xx = x + dx, yy = y + dy;
+          if (xx < 0 || yy < 0 || xx >= W || yy >= H) continue;
+          size_t q = (size_t)yy * W + xx;
+          if (!dp[q] || abs((int)dp[q] - (int)dp[p]) > 2 * TT_EDGE_MM || !isfinite(pts[3 * q]))
+            continue;
+          for (int a = 0; a < 3; a++) mu[a] += pts[3 * q + a];
+          m++;
+        }
+      if (m < 12) continue;
+      for (int a = 0; a < 3; a++) mu[a] /= m;
+      for (int dy = -TT_NORMAL_R; dy <= TT_NORMAL_R; dy++)
+        for (int dx = -TT_NORMAL_R; dx <= TT_NORMAL_R; dx++) {
+          int xx = x + dx, yy = y + dy;
+          if (xx < 0 || yy < 0 || xx >= W || yy >= H) continue;
+          size_t q = (size_t)yy * W + xx;
+          if (!dp[q] || abs((int)dp[q] - (int)dp[p]) > 2 * TT_EDGE_MM || !isfinite(pts[3 * q]))
+            continue;
+          double e[3];
+          for (int a = 0; a < 3; a++) e[a] = pts[3 * q + a] - mu[a];
+          for (int a = 0; a < 3; a++)
+            for (int b = 0; b < 3; b++) C[3 * a + b] += e[a] * e[b];
+        }
+      double n[3], pc[3] = {pts[3 * p], pts[3 * p + 1], pts[3 * p + 2]};
+      smallest_axis(C, n);
+      if (hearth_dot3(n, pc) > 0)
+        for (int a = 0; a < 3; a++) n[a] = -n[a];
+      /* grazing points are noisy: keep those facing the camera */
+      if (-hearth_dot3(n, pc) < 0.2 * hearth_norm3(pc)) continue;
+      *ix = (int32_t)v->n;
+      for (int a = 0; a < 3; a++) {
+        v->p[3 * v->n + a] = (float)pc[a];
+        v->nrm[3 * v->n + a] = (float)n[a];
+        csum[a] += pc[a];
+      }
+      v->n++;
+    }
+  if (v->n < TT_MIN_POINTS) {
+    s = hearth_err_set(err, HEARTH_E_NOT_FOUND,
+                       "%s: only %zu depth pixels inside the cut-out %s (at least %d needed)",
+                       v->depth_path, v->n, path, TT_MIN_POINTS);
+    goto done;
+  }
+  for (int a = 0; a < 3; a++) v->centroid[a] = csum[a] / (double)v->n;
+done:
+  free(on);
+  free(dirs);
+  free(pts);
+  free(cls);
+  hearth_image_free(&depth);
+  hearth_image_free(&cut);
+  return s;
+}
+
+/* ---- joint ICP ------------------------------------------------------------ */
+typedef struct tt_pair {
+  size_t i, j;
+  /* this iteration's normal equations in (w_i, t_i, w_j, t_j): each view's
+   * small rotation (world frame) and translation */
+  double H[144], g[12];
+  double ss, ss_all; /* weighted squared distances, squared distances */
+  size_t m;
+  float *r; /* |distance| of each match (for the median), m of them */
+} tt_pair;
+
+typedef struct tt_ctx {
+  tt_view *v;
+  tt_pair *pairs;
+  size_t max_points;
+  double gate;
+} tt_ctx;
+
+/* matches of view i's points in view j's depth image, accumulated */
+static void pair_system(const tt_ctx *c, tt_pair *pr) {
+  const tt_view *a = &c->v[pr->i], *b = &c->v[pr->j];
+  memset(pr->H, 0, sizeof pr->H);
+  memset(pr->g, 0, sizeof pr->g);
+  pr->ss = pr->ss_all = 0;
+  pr->m = 0;
+  hearth_rigid Tb_inv, T_depth_from_world;
+  hearth_rigid_inverse(&b->T, &Tb_inv);
+  hearth_rigid_compose(&b->T_depth_from_rgb, &Tb_inv, &T_depth_from_world);
+  size_t step = a->n > c->max_points ? (a->n + c->max_points - 1) / c->max_points : 1;
+  for (size_t k = 0; k < a->n; k += step) {
+    double pa[3] = {a->p[3 * k], a->p[3 * k + 1], a->p[3 * k + 2]}, q[3], qd[3], uv[2];
+    hearth_rigid_apply(&a->T, pa, q);
+    hearth_rigid_apply(&T_depth_from_world, q, qd);
+    if (!hearth_camera_project(&b->dcam, qd, uv, NULL)) continue;
+    long u = lround(uv[0]) - b->x0, w = lround(uv[1]) - b->y0;
+    if (u < 0 || w < 0 || u >= b->cw || w >= b->ch) continue;
+    int32_t t = b->index[(size_t)w * b->cw + u];
+    if (t < 0) continue;
+    double pb[3] = {b->p[3 * t], b->p[3 * t + 1], b->p[3 * t + 2]};
+    double nb[3] = {b->nrm[3 * t], b->nrm[3 * t + 1], b->nrm[3 * t + 2]};
+    double na[3] = {a->nrm[3 * k], a->nrm[3 * k + 1], a->nrm[3 * k + 2]};
+    double qb[3], nw[3], naw[3];
+    hearth_rigid_apply(&b->T, pb, qb);
+    hearth_rigid_rotate(&b->T, nb, nw);
+    hearth_rigid_rotate(&a->T, na, naw);
+    if (hearth_dot3(nw, naw) < TT_NORMAL_COS) continue;
+    double e[3] = {q[0] - qb[0], q[1] - qb[1], q[2] - qb[2]};
+    double r = hearth_dot3(nw, e);
+    if (fabs(r) > c->gate || hearth_norm3(e) > 2.0 * c->gate) continue;
+    double wgt = fabs(r) <= TT_HUBER_M ? 1.0 : TT_HUBER_M / fabs(r);
+    /* q moves by w_i x (q - t_i) + d_i; the target point and normal turn
+     * with view j: d r / d w_j = -(q - t_j) x n, d r / d t_j = -n */
+    double qa_rel[3] = {q[0] - a->T.t[0], q[1] - a->T.t[1], q[2] - a->T.t[2]};
+    double qj_rel[3] = {q[0] - b->T.t[0], q[1] - b->T.t[1], q[2] - b->T.t[2]};
+    double J[12], ci[3], cj[3];
+    hearth_cross3(qa_rel, nw, ci);
+    hearth_cross3(qj_rel, nw, cj);
+    for (int x = 0; x < 3; x++) {
+      J[x] = ci[x];
+      J[3 + x] = nw[x];
+      J[6 + x] = -cj[x];
+      J[9 + x] = -nw[x];
+    }
+    for (int x = 0; x < 12; x++) {
+      pr->g[x] += wgt * J[x] * r;
+      for (int y = 0; y < 12; y++) pr->H[12 * x + y] += wgt * J[x] * J[y];
+    }
+    pr->ss += wgt * r * r;
+    pr->ss_all += r * r;
+    if (pr->r) pr->r[pr->m] = (float)fabs(r);
+    pr->m++;
+  }
+}
+
+static void pairs_range(void *vctx, size_t b, size_t e, int ti) {
+  (void)ti;
+  const tt_ctx *c = vctx;
+  for (size_t k = b; k < e; k++) pair_system(c, &c->pairs[k]);
+}
+
+/* Cholesky solve of the n x n system A x = b in place (A overwritten);
+ * 0 when A is not positive definite */
+static int chol_solve(double *A, double *b, size_t n) {
+  for (size_t j = 0; j < n; j++) {
+    double s = A[j * n + j];
+    for (size_t k = 0; k < j; k++) s -= A[j * n + k] * A[j * n + k];
+    if (!(s > 0)) return 0;
+    double d = sqrt(s);
+    A[j * n + j] = d;
+    for (size_t i = j + 1; i < n; i++) {
+      double t = A[i * n + j];
+      for (size_t k = 0; k < j; k++) t -= A[i * n + k] * A[j * n + k];
+      A[i * n + j] = t / d;
+    }
+  }
+  for (size_t i = 0; i < n; i++) {
+    double t = b[i];
+    for (size_t k = 0; k < i; k++) t -= A[i * n + k] * b[k];
+    b[i] = t / A[i * n + i];
+  }
+  for (size_t i = n; i-- > 0;) {
+    double t = b[i];
+    for (size_t k = i + 1; k < n; k++) t -= A[k * n + i] * b[k];
+    b[i] = t / A[i * n + i];
+  }
+  return 1;
+}
+
+static int cmp_float(const void *a, const void *b) {
+  float x = *(const float *)a, y = *(const float *)b;
+  return (x > y) - (x < y);
+}
+
+/* the direction of view v's optical axis about the vertical (psi of the
+ * start) */
+static double heading(const tt_view *v) { return atan2(v->T.R[5], v->T.R[2]); }
+
+/* view v's optical axis (unit, world) */
+static void view_dir(const tt_view *v, double d[3]) {
+  for (int a = 0; a < 3; a++) d[a] = v->T.R[3 * a + 2];
+}
+
+static hearth_status run_icp(tt_view *v, size_t nv, const hearth_turntable_opts *o,
+                             hearth_turntable_result *res, hearth_err *err) {
+  const int iterations = o->iterations;
+  const double gate0 = 0.025;
+  /* pairs: views looking from within max_pair_deg */
+  size_t np = 0;
+  tt_pair *pairs = calloc(nv * nv, sizeof *pairs);
+  if (!pairs) return hearth_err_set(err, HEARTH_E_NOMEM, "turntable: pairs");
+  double cmax = cos(o->max_pair_deg * TT_DEG);
+  for (size_t i = 0; i < nv; i++)
+    for (size_t j = 0; j < nv; j++) {
+      if (i == j) continue;
+      double di[3], dj[3];
+      view_dir(&v[i], di);
+      view_dir(&v[j], dj);
+      if (hearth_dot3(di, dj) < cmax) continue;
+      pairs[np].i = i;
+      pairs[np].j = j;
+      np++;
+    }
+  const size_t nu = 6 * (nv - 1);
+  double *A = malloc(nu * nu * sizeof *A), *b = malloc(nu * sizeof *b);
+  if (!A || !b) {
+    free(A);
+    free(b);
+    free(pairs);
+    return hearth_err_set(err, HEARTH_E_NOMEM, "turntable: normal equations");
+  }
+  hearth_progress prog;
+  hearth_progress_begin(&prog, "recon: ICP", (size_t)iterations, o->quiet);
+  tt_ctx c = {v, pairs, o->max_points, 0.02};
+  hearth_status s = HEARTH_OK;
+  double rms = 0;
+  for (int it = 0; it < iterations && !s; it++) {
+    c.gate = fmax(0.003, gate0 * pow(0.75, it));
+    int last = it == iterations - 1;
+    if (last)
+      for (size_t k = 0; k < np && !s; k++)
+        if (!(pairs[k].r = malloc((o->max_points + 1) * sizeof(float))))
+          s = hearth_err_set(err, HEARTH_E_NOMEM, "turntable: distances");
+    if (s) break;
+    if ((s = hearth_parallel_for(np, o->threads, pairs_range, &c))) break;
+    memset(A, 0, nu * nu * sizeof *A);
+    memset(b, 0, nu * sizeof *b);
+    double ss = 0;
+    size_t m = 0;
+    for (size_t k = 0; k < np; k++) {
+      const tt_pair *pr = &pairs[k];
+      ss += pr->ss_all;
+      m += pr->m;
+      size_t ix[2] = {pr->i, pr->j};
+      for (int x = 0; x < 12; x++) {
+        size_t vx = ix[x / 6];
+        if (vx == 0) continue;
+        size_t gx = 6 * (vx - 1) + (size_t)(x % 6);
+        b[gx] -= pr->g[x];
+        for (int y = 0; y < 12; y++) {
+          size_t vy = ix[y / 6];
+          if (vy == 0) continue;
+          A[gx * nu + 6 * (vy - 1) + (size_t)(y % 6)] += pr->H[12 * x + y];
+        }
+      }
+    }
+    rms = m ? sqrt(ss / (double)m) : 0;
+    if (it == 0 && res->iterations == 0) res->icp_rms_start_mm = 1000.0 * rms;
+    for (size_t vi = 1; vi < nv; vi++) {
+      const tt_view *tv = &v[vi];
+      double *Av = A + 6 * (vi - 1) * nu + 6 * (vi - 1), *bv = b + 6 * (vi - 1);
+      /* the plane term: each table point at z = 0, weighted as many
+       * matches as it has points, less where the plane fits worse than
+       * TT_PLANE_GOOD_M (a table seen at grazing incidence) */
+      double pq = TT_PLANE_GOOD_M / fmax(tv->plane_rms, TT_PLANE_GOOD_M);
+      double wp = pq * pq * (double)(m / (nv ? nv : 1) + 1) / (double)(tv->npl ? tv->npl : 1);
+      for (size_t k = 0; k < tv->npl; k++) {
+        double p[3] = {tv->pl[3 * k], tv->pl[3 * k + 1], tv->pl[3 * k + 2]}, q[3];
+        hearth_rigid_apply(&tv->T, p, q);
+        double r = q[2], qr[3] = {q[0] - tv->T.t[0], q[1] - tv->T.t[1], q[2] - tv->T.t[2]};
+        double w = wp * (fabs(r) <= TT_HUBER_M ? 1.0 : TT_HUBER_M / fabs(r));
+        double J[6] = {qr[1], -qr[0], 0, 0, 0, 1}; /* (q - t) x ez, ez */
+        for (int x = 0; x < 6; x++) {
+          bv[x] -= w * J[x] * r;
+          for (int y = 0; y < 6; y++) Av[x * nu + y] += w * J[x] * J[y];
+        }
+      }
+      /* the turntable's azimuth as a prior on the heading (weight: the
+       * squared ratio of the depth noise to the azimuth's spread), so an
+       * angle no match constrains (about a surface of revolution) stays
+       * at the turntable's */
+      double dh = remainder(heading(tv) - tv->psi0, 2 * TT_PI);
+      Av[2 * nu + 2] += o->azimuth_prior;
+      bv[2] -= o->azimuth_prior * dh;
+    }
+    /* a scaled Levenberg term and a small floor */
+    for (size_t d = 0; d < nu; d++) A[d * nu + d] = A[d * nu + d] * 1.01 + 1e-6;
+    if (!chol_solve(A, b, nu)) {
+      s = hearth_err_set(err, HEARTH_E_NUMERIC, "turntable: ICP normal equations not definite");
+      break;
+    }
+    for (size_t vi = 1; vi < nv; vi++) {
+      const double *d = b + 6 * (vi - 1);
+      double dR[9], R[9];
+      hearth_rotvec_to_matrix(d, dR);
+      hearth_mat3_mul(dR, v[vi].T.R, R);
+      hearth_orthonormalize(R);
+      memcpy(v[vi].T.R, R, sizeof R);
+      for (int a = 0; a < 3; a++) v[vi].T.t[a] += d[3 + a];
+    }
+    if (last && res->views) {
+      memset(res->views, 0, nv * sizeof *res->views);
+      /* statistics of the final matches (before this step's update) */
+      size_t tot = 0;
+      for (size_t k = 0; k < np; k++) tot += pairs[k].m;
+      float *all = malloc((tot + 1) * sizeof *all);
+      size_t off = 0;
+      for (size_t k = 0; k < np; k++) {
+        tt_pair *pr = &pairs[k];
+        res->views[pr->i].n_pairs++;
+        res->views[pr->i].n_matches += pr->m;
+        double s2 = 0;
+        for (size_t q = 0; q < pr->m; q++) s2 += (double)pr->r[q] * pr->r[q];
+        res->views[pr->i].icp_rms_mm += s2; /* sum for now */
+        if (all) memcpy(all + off, pr->r, pr->m * sizeof *all);
+        off += pr->m;
+      }
+      if (all && tot) {
+        qsort(all, tot, sizeof *all, cmp_float);
+        res->icp_median_mm = 1000.0 * all[tot / 2];
+      }
+      free(all);
+      for (size_t i = 0; i < nv; i++) {
+        hearth_turntable_view *rv = &res->views[i];
+        rv->icp_rms_mm = rv->n_matches ? 1000.0 * sqrt(rv->icp_rms_mm / (double)rv->n_matches) : 0;
+      }
+      res->icp_rms_mm = 1000.0 * rms;
+    }
+    hearth_progress_step(&prog, 1);
+  }
+  hearth_progress_end(&prog);
+  res->n_pairs = np;
+  res->iterations += iterations;
+  for (size_t k = 0; k < np; k++) free(pairs[k].r);
+  free(pairs);
+  free(A);
+  free(b);
+  return s;
+}
+
+/* ---- the job ---------------------------------------------------------------- */
+hearth_status hearth_recon_turntable(const char *root, const char *instance,
+                                     const char *const *states, size_t n_states,
+                                     const hearth_turntable_opts *opts, hearth_poses *out,
+                                     hearth_turntable_result *res_out, hearth_err *err) {
+  hearth_turntable_opts o;
+  if (opts) o = *opts;
+  else hearth_turntable_opts_default(&o);
+  if (o.iterations < 1) o.iterations = 30;
+  if (!o.max_points) o.max_points = 3000;
+  if (!(o.max_pair_deg > 0)) o.max_pair_deg = 65;
+  if (o.direction != -1) o.direction = 1;
+  if (!o.threads) o.threads = hearth_default_threads();
+  memset(out, 0, sizeof *out);
+  hearth_turntable_result res = {0};
+  double t0 = hearth_now();
+  char path[1400];
+  hearth_instance_doc inst;
+  snprintf(path, sizeof path, "%s/instances/%s/instance.json", root, instance);
+  hearth_status s = hearth_instance_read(path, &inst, err);
+  if (s) return s;
+  const char *own[HEARTH_MAX_STATES];
+  if (!states || !n_states) {
+    for (size_t i = 0; i < inst.n_states; i++) own[i] = inst.states[i];
+    states = own;
+    n_states = inst.n_states;
+  }
+  hearth_factory_calib fac;
+  snprintf(path, sizeof path, "%s/calibration/factory.json", root);
+  if ((s = hearth_factory_read(path, &fac, err))) return s;
+
+  /* every view of every state */
+  hearth_manifest *man = calloc(n_states, sizeof *man);
+  if (!man) return hearth_err_set(err, HEARTH_E_NOMEM, "turntable: manifests");
+  size_t nv = 0;
+  for (size_t i = 0; i < n_states && !s; i++) {
+    snprintf(path, sizeof path, "%s/instances/%s/raw/%s/manifest.json", root, instance, states[i]);
+    if (!(s = hearth_manifest_read(path, &man[i], err))) nv += man[i].n_views;
+  }
+  tt_view *v = s ? NULL : calloc(nv ? nv : 1, sizeof *v);
+  if (!s && !v) s = hearth_err_set(err, HEARTH_E_NOMEM, "turntable: views");
+  if (!s && nv < 2)
+    s = hearth_err_set(err, HEARTH_E_NOT_FOUND, "recon %s: %zu view(s), at least 2 needed",
+                       instance, nv);
+  hearth_progress prog;
+  hearth_progress_begin(&prog, "recon: depth views", nv, o.quiet);
+  size_t k = 0;
+  tt_rays rays = {0};
+  for (size_t i = 0; i < n_states && !s; i++) {
+    char dir[1100];
+    snprintf(dir, sizeof dir, "%s/instances/%s/raw/%s", root, instance, states[i]);
+    for (size_t j = 0; j < man[i].n_views && !s; j++, k++) {
+      const hearth_view_files *vf = &man[i].views[j];
+      tt_view *tv = &v[k];
+      snprintf(tv->state, sizeof tv->state, "%s", states[i]);
+      snprintf(tv->view, sizeof tv->view, "%s", vf->view);
+      tv->elevation_index = vf->elevation_index;
+      tv->azimuth_index = vf->azimuth_index;
+      s = load_view(tv, dir, vf, &fac.rgb, o.erode_px, 0x7475726eULL + k, &rays, err);
+      hearth_progress_step(&prog, 1);
+    }
+  }
+  hearth_progress_end(&prog);
+  free(rays.dirs);
+  if (!s && !(res.views = calloc(nv, sizeof *res.views)))
+    s = hearth_err_set(err, HEARTH_E_NOMEM, "turntable: report");
+  if (!s) {
+    /* the start: nominal azimuths, the object's centroid on the axis */
+    for (size_t i = 0; i < nv; i++) {
+      tt_view *tv = &v[i];
+      double phi =
+          o.direction *
+          (tv->azimuth_index * o.azimuth_step_deg + tv->elevation_index * o.ring_shift_deg) *
+          TT_DEG;
+      tv->psi = tv->psi0 = phi + TT_PI; /* forward points at the axis */
+      tv->x = tv->y = 0;
+      tt_pose(tv);
+      double cw[3];
+      hearth_rigid_rotate(&tv->T, tv->centroid, cw);
+      tv->x = -cw[0];
+      tv->y = -cw[1];
+      tt_pose(tv);
+    }
+    s = run_icp(v, nv, &o, &res, err);
+  }
+  if (!s) {
+    out->views = calloc(nv, sizeof *out->views);
+    if (!out->views) s = hearth_err_set(err, HEARTH_E_NOMEM, "turntable: poses");
+  }
+  if (!s) {
+    out->n = nv;
+    res.n_views = nv;
+    for (size_t i = 0; i < nv; i++) {
+      hearth_view_pose *vp = &out->views[i];
+      snprintf(vp->state, sizeof vp->state, "%s", v[i].state);
+      snprintf(vp->view, sizeof vp->view, "%s", v[i].view);
+      vp->T_world_from_cam = v[i].T;
+      hearth_turntable_view *rv = &res.views[i];
+      snprintf(rv->state, sizeof rv->state, "%s", v[i].state);
+      snprintf(rv->view, sizeof rv->view, "%s", v[i].view);
+      rv->n_points = v[i].n;
+      rv->n_plane = v[i].n_plane;
+      rv->plane_rms_mm = 1000.0 * v[i].plane_rms;
+      rv->height_m = v[i].height;
+      /* the optical axis (third column of R) against the horizon */
+      rv->elevation_deg = -asin(fmax(-1.0, fmin(1.0, v[i].T.R[8]))) / TT_DEG;
+      double da = remainder(heading(&v[i]) - v[i].psi0, 2 * TT_PI);
+      rv->d_azimuth_deg = da / TT_DEG;
+    }
+  }
+  for (size_t i = 0; v && i < nv; i++) tt_view_free(&v[i]);
+  free(v);
+  for (size_t i = 0; i < n_states; i++) hearth_manifest_free(&man[i]);
+  free(man);
+  res.seconds = hearth_now() - t0;
+  if (s) {
+    hearth_poses_free(out);
+    hearth_turntable_result_free(&res);
+    return hearth_err_prefix(err, "recon %s", instance);
+  }
+  if (res_out) *res_out = res;
+  else hearth_turntable_result_free(&res);
+  return HEARTH_OK;
+}
