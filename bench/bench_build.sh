@@ -59,6 +59,36 @@ timed "$h" map "$work/rel" > "$work/map.log"
 map_wall=$wall map_cpu=$cpu
 echo "  $(grep -c '^map ' "$work/map.log") state(s)"
 
+echo "== each stage alone, one thread (CPU s; ratio: to hearth map of all states, one thread)"
+# on a copy of the built release, each stage's command as the build runs it
+# (overlay at the build's zoom 2; bake = map --rgb less the maps it also does)
+rm -rf "$work/stages"
+cp -a "$work/rel" "$work/stages"
+st="$work/stages"
+stage_cpu() { HEARTH_THREADS=1 timed "$@" > /dev/null; echo "$cpu"; }
+insts=$(ls "$st/instances")
+c_map1=$(stage_cpu "$h" map "$st")
+c_detect=$(stage_cpu "$h" detect "$st")
+c_calib=$(stage_cpu "$h" calibrate "$st")
+c_scale=0 c_refine=0 c_bake=0
+for i in $insts; do
+  c_scale=$(awk -v a="$c_scale" -v b="$(stage_cpu "$h" scale "$st" --instance "$i")" 'BEGIN{print a + b}')
+  c_refine=$(awk -v a="$c_refine" -v b="$(stage_cpu "$h" refine "$st" --instance "$i")" 'BEGIN{print a + b}')
+  rgb=$(stage_cpu "$h" map "$st" --instance "$i" --rgb)
+  m=$(stage_cpu "$h" map "$st" --instance "$i")
+  c_bake=$(awk -v a="$c_bake" -v b="$rgb" -v c="$m" 'BEGIN{print a + b - c}')
+done
+c_overlay=$(stage_cpu "$h" overlay "$st" --zoom 2)
+stages_table=$(awk -v m="$c_map1" -v d="$c_detect" -v ca="$c_calib" -v sc="$c_scale" \
+  -v r="$c_refine" -v b="$c_bake" -v o="$c_overlay" 'BEGIN {
+  n = split("detect calibrate scale bake refine map overlay", k, " ")
+  v["detect"] = d; v["calibrate"] = ca; v["scale"] = sc; v["bake"] = b
+  v["refine"] = r; v["map"] = m; v["overlay"] = o
+  for (i = 1; i <= n; i++) { t += v[k[i]]
+    printf "  %-10s %6.2f s CPU %5.1fx\n", k[i], v[k[i]], (m > 0 ? v[k[i]] / m : 0) }
+  printf "  %-10s %6.2f s CPU %5.1fx\n", "all", t, (m > 0 ? t / m : 0) }')
+echo "$stages_table"
+
 echo "== hearth demo, then hearth build of its release"
 rm -rf "$work/demo"
 "$h" demo "$work/demo" --quiet > "$work/demo.log" 2>&1 || { cat "$work/demo.log"; exit 1; }

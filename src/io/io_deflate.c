@@ -7,12 +7,21 @@
  * length code (at most 15 bits), the only distance code (distance 1) gets
  * one bit, and the block is written behind its header: the two codes'
  * lengths, run-length coded with symbols 16-18 and themselves Huffman coded
- * (at most 7 bits). Bits go out least significant first through a 64-bit
- * buffer. */
+ * (at most 7 bits). The block's size in bits follows from the counts and
+ * the code lengths, so where it would be larger than the stored form
+ * the piece is stored without being coded. Bits go out least significant
+ * first through a 64-bit buffer, whole bytes at a time.
+ *
+ * Cutting into tokens looks, sixteen bytes at a time where SSE2 is there,
+ * for the next byte that starts a match (it, the byte before it and the two
+ * after it all equal); the bytes before it are literals. */
 #include "io_deflate.h"
 
 #include <stdlib.h>
 #include <string.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 /* RFC 1951: match lengths 3..258 by length code 257..285 */
 static const uint16_t k_len_base[29] = {3,  4,  5,  6,   7,   8,   9,   10,  11, 13,
@@ -35,40 +44,32 @@ size_t hearth_deflate_bound(size_t n) {
 
 /* ---- bits ---------------------------------------------------------------------- */
 
+/* The output is sized beforehand (the block's exact size plus 8 bytes), so
+ * the writer never checks for room: after every bits_flush fewer than 8
+ * bits wait in buf, so up to 56 more can be put before the next flush. */
 typedef struct bit_out {
-  uint8_t *p, *end;
+  uint8_t *p;
   uint64_t buf;
-  int n;       /* bits in buf, < 32 between calls */
-  int overrun; /* the output would pass end */
+  unsigned n; /* bits in buf */
 } bit_out;
 
-static inline void put_bits(bit_out *w, uint32_t v, int nb) {
-  w->buf |= (uint64_t)v << w->n;
+static inline void put_bits(bit_out *w, uint64_t v, unsigned nb) {
+  w->buf |= v << w->n;
   w->n += nb;
-  if (w->n >= 32) {
-    if (w->end - w->p >= 4) {
-      w->p[0] = (uint8_t)w->buf;
-      w->p[1] = (uint8_t)(w->buf >> 8);
-      w->p[2] = (uint8_t)(w->buf >> 16);
-      w->p[3] = (uint8_t)(w->buf >> 24);
-      w->p += 4;
-    } else {
-      w->overrun = 1;
-    }
-    w->buf >>= 32;
-    w->n -= 32;
-  }
 }
 
-/* out to the next byte boundary */
-static void flush_bits(bit_out *w) {
-  while (w->n > 0) {
-    if (w->p < w->end) *w->p++ = (uint8_t)w->buf;
-    else w->overrun = 1;
-    w->buf >>= 8;
-    w->n = w->n > 8 ? w->n - 8 : 0;
-  }
-  w->buf = 0;
+/* the whole bytes of buf out (all 8 bytes are stored; p moves past the
+   whole ones) */
+static inline void bits_flush(bit_out *w) {
+  uint64_t b = w->buf;
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+  memcpy(w->p, &b, 8); /* least significant byte first, as below */
+#else
+  for (int k = 0; k < 8; k++) w->p[k] = (uint8_t)(b >> (8 * k));
+#endif
+  w->p += w->n >> 3;
+  w->buf >>= w->n & ~7u;
+  w->n &= 7u;
 }
 
 /* ---- Huffman codes ------------------------------------------------------------- */
@@ -179,19 +180,51 @@ static size_t write_stored(const uint8_t *in, size_t n, int final, uint8_t *out)
   return (size_t)(o - out);
 }
 
-int hearth_deflate_rle(const uint8_t *in, size_t n, int final, uint8_t *out, size_t *out_len) {
-  *out_len = 0;
-  /* tokens: a literal byte b as b, a match of length L as 256 + L */
-  uint16_t *tok = malloc((n ? n : 1) * sizeof *tok);
-  if (!tok) return 0;
-  uint8_t len_sym[MAX_RUN + 1]; /* match length -> index of its length code */
-  for (int c = 0, L = MIN_RUN; L <= MAX_RUN; L++) {
-    while (c < 28 && L >= k_len_base[c + 1]) c++;
-    len_sym[L] = (uint8_t)c;
-  }
-  uint32_t freq[N_LL] = {0};
+/* the tokens of in[0..n) into tok (n + 16 entries: the vector path
+   stores 16 at a time), their literal / length symbol counts into freq;
+   returns the number of tokens */
+static size_t tokenize(const uint8_t *in, size_t n, const uint8_t *len_sym, uint16_t *tok,
+                       uint32_t *freq) {
   size_t nt = 0;
+#if defined(__SSE2__)
+  /* the vector path's literal counts in four tables, so that equal bytes in
+     a row do not wait on each other's increments */
+  uint32_t lit[4][256];
+  memset(lit, 0, sizeof lit);
+#endif
   for (size_t i = 0; i < n;) {
+#if defined(__SSE2__)
+    /* sixteen positions at a time while in[i - 1 .. i + 17] can be read:
+       the first that starts a match ends the literals */
+    unsigned m = 0;
+    while (i >= 1 && i + 18 <= n) {
+      const __m128i a = _mm_loadu_si128((const __m128i *)(const void *)(in + i - 1)),
+                    b = _mm_loadu_si128((const __m128i *)(const void *)(in + i)),
+                    c = _mm_loadu_si128((const __m128i *)(const void *)(in + i + 1)),
+                    d = _mm_loadu_si128((const __m128i *)(const void *)(in + i + 2));
+      const __m128i e = _mm_and_si128(_mm_and_si128(_mm_cmpeq_epi8(a, b), _mm_cmpeq_epi8(b, c)),
+                                      _mm_cmpeq_epi8(c, d));
+      m = (unsigned)_mm_movemask_epi8(e);
+      const unsigned k = m ? (unsigned)__builtin_ctz(m) : 16u;
+      const __m128i z = _mm_setzero_si128();
+      _mm_storeu_si128((__m128i *)(void *)(tok + nt), _mm_unpacklo_epi8(b, z));
+      _mm_storeu_si128((__m128i *)(void *)(tok + nt + 8), _mm_unpackhi_epi8(b, z));
+      if (k == 16) {
+        for (unsigned j = 0; j < 16; j += 4) {
+          lit[0][in[i + j]]++;
+          lit[1][in[i + j + 1]]++;
+          lit[2][in[i + j + 2]]++;
+          lit[3][in[i + j + 3]]++;
+        }
+      } else {
+        for (unsigned j = 0; j < k; j++) lit[j & 3][in[i + j]]++;
+      }
+      nt += k;
+      i += k;
+      if (m) break;
+    }
+    if (i >= n) break;
+#endif
     if (i > 0 && in[i] == in[i - 1]) {
       const uint8_t b = in[i - 1];
       size_t L = 1, lim = n - i < MAX_RUN ? n - i : MAX_RUN;
@@ -213,6 +246,24 @@ int hearth_deflate_rle(const uint8_t *in, size_t n, int final, uint8_t *out, siz
     freq[in[i]]++;
     i++;
   }
+#if defined(__SSE2__)
+  for (int b = 0; b < 256; b++) freq[b] += lit[0][b] + lit[1][b] + lit[2][b] + lit[3][b];
+#endif
+  return nt;
+}
+
+int hearth_deflate_rle(const uint8_t *in, size_t n, int final, uint8_t *out, size_t *out_len) {
+  *out_len = 0;
+  /* tokens: a literal byte b as b, a match of length L as 256 + L */
+  uint16_t *tok = malloc((n + 16) * sizeof *tok);
+  if (!tok) return 0;
+  uint8_t len_sym[MAX_RUN + 1]; /* match length -> index of its length code */
+  for (int c = 0, L = MIN_RUN; L <= MAX_RUN; L++) {
+    while (c < 28 && L >= k_len_base[c + 1]) c++;
+    len_sym[L] = (uint8_t)c;
+  }
+  uint32_t freq[N_LL] = {0};
+  size_t nt = tokenize(in, n, len_sym, tok, freq);
   freq[END_OF_BLOCK] = 1;
   if (!nt) freq[0] = 1; /* an unused literal: two codes, a complete code */
 
@@ -269,47 +320,80 @@ int hearth_deflate_rle(const uint8_t *in, size_t n, int final, uint8_t *out, siz
   int hclen = N_CL;
   while (hclen > 4 && !cl_len[k_cl_order[hclen - 1]]) hclen--;
 
-  /* the block, into out as far as the stored form's size (it is kept only
-     if smaller) */
+  /* the block's size: header, the two codes' lengths, the tokens (a match
+     also sends its extra bits and the one-bit distance code), the end of
+     block and, unless final, the empty stored block's 3 header bits; then
+     the sync flush's 4 bytes. It is coded only if no larger than the
+     stored form. */
+  static const uint8_t cl_extra_bits[3] = {2, 3, 7};
+  uint64_t bits = 3 + 5 + 5 + 4 + 3 * (uint64_t)hclen;
+  for (int i = 0; i < ncl; i++)
+    bits += cl_len[cl_sym[i]] + (cl_sym[i] >= 16 ? cl_extra_bits[cl_sym[i] - 16] : 0);
+  if (nt)
+    for (int sym = 0; sym < 256; sym++) bits += (uint64_t)freq[sym] * ll_len[sym];
+  for (int c = 0; c < 29; c++)
+    bits += (uint64_t)freq[257 + c] * (ll_len[257 + c] + k_len_extra[c] + 1u);
+  bits += ll_len[END_OF_BLOCK] + (final ? 0 : 3);
+  size_t coded = (size_t)((bits + 7) / 8) + (final ? 0 : 4);
   size_t stored = n + 5 * (n / 65535 + 1) + (final ? 0 : 5);
-  bit_out w = {out, out + stored, 0, 0, 0};
+  if (coded > stored) {
+    free(tok);
+    *out_len = write_stored(in, n, final, out);
+    return 1;
+  }
+
+  /* every token's bits as one value: the code, and for a match its extra
+     bits and the distance code (0, one bit) */
+  uint32_t tcode[256 + MAX_RUN + 1];
+  uint8_t tlen[256 + MAX_RUN + 1];
+  for (int t = 0; t < 256; t++) tcode[t] = ll_code[t], tlen[t] = ll_len[t];
+  for (int L = MIN_RUN; L <= MAX_RUN; L++) {
+    int c = len_sym[L], sym = 257 + c;
+    tcode[256 + L] = ll_code[sym] | (uint32_t)(L - k_len_base[c]) << ll_len[sym];
+    tlen[256 + L] = (uint8_t)(ll_len[sym] + k_len_extra[c] + 1);
+  }
+  /* room: the block's bytes plus the 8 that the last flush stores
+     (hearth_deflate_bound leaves 11 beyond the stored form) */
+  bit_out w = {out, 0, 0};
   put_bits(&w, final ? 1u : 0u, 1);
   put_bits(&w, 2, 2); /* dynamic Huffman */
   put_bits(&w, (uint32_t)(hlit - 257), 5);
   put_bits(&w, 0, 5); /* one distance code */
   put_bits(&w, (uint32_t)(hclen - 4), 4);
-  for (int i = 0; i < hclen; i++) put_bits(&w, cl_len[k_cl_order[i]], 3);
-  static const uint8_t cl_extra_bits[3] = {2, 3, 7};
-  for (int i = 0; i < ncl; i++) {
-    int s = cl_sym[i];
-    put_bits(&w, cl_code[s], cl_len[s]);
-    if (s >= 16) put_bits(&w, cl_extra[i], cl_extra_bits[s - 16]);
+  bits_flush(&w);
+  for (int i = 0; i < hclen; i++) {
+    put_bits(&w, cl_len[k_cl_order[i]], 3);
+    bits_flush(&w);
   }
-  for (size_t i = 0; i < nt && !w.overrun; i++) {
-    unsigned t = tok[i];
-    if (t < 256) {
-      put_bits(&w, ll_code[t], ll_len[t]);
-    } else {
-      unsigned L = t - 256, c = len_sym[L], s = 257 + c;
-      /* the length code, its extra bits and the distance code (0, one bit) */
-      put_bits(&w, ll_code[s] | (uint32_t)(L - k_len_base[c]) << ll_len[s],
-               ll_len[s] + k_len_extra[c] + 1);
-    }
+  for (int i = 0; i < ncl; i++) {
+    int sy = cl_sym[i];
+    put_bits(&w, cl_code[sy], cl_len[sy]);
+    if (sy >= 16) put_bits(&w, cl_extra[i], cl_extra_bits[sy - 16]);
+    bits_flush(&w);
+  }
+  /* two tokens (at most 21 bits each) per flush */
+  size_t i = 0;
+  for (; i + 2 <= nt; i += 2) {
+    unsigned t0 = tok[i], t1 = tok[i + 1];
+    put_bits(&w, tcode[t0], tlen[t0]);
+    put_bits(&w, tcode[t1], tlen[t1]);
+    bits_flush(&w);
+  }
+  if (i < nt) {
+    put_bits(&w, tcode[tok[i]], tlen[tok[i]]);
+    bits_flush(&w);
   }
   put_bits(&w, ll_code[END_OF_BLOCK], ll_len[END_OF_BLOCK]);
   if (!final) put_bits(&w, 0, 3); /* the sync flush: an empty stored block */
-  flush_bits(&w);
-  if (!final && !w.overrun) {
-    if (w.end - w.p >= 4) {
-      memcpy(w.p, "\x00\x00\xff\xff", 4);
-      w.p += 4;
-    } else {
-      w.overrun = 1;
-    }
+  bits_flush(&w);
+  /* the last partial byte (zero-padded) is already stored */
+  if (w.n) w.p++;
+  if (!final) {
+    memcpy(w.p, "\x00\x00\xff\xff", 4);
+    w.p += 4;
   }
   free(tok);
-  if (w.overrun) *out_len = write_stored(in, n, final, out);
-  else *out_len = (size_t)(w.p - out);
+  *out_len = (size_t)(w.p - out);
   return 1;
 }
 

@@ -434,7 +434,10 @@ done:
  * only at the grid pixels whose ray points into that box (with a margin far
  * above rounding) into a fresh zeroed image whose other pages are never
  * written (and so never backed), and the full frame is freed: the bytes the
- * mapping reads, and so its result, are those of the full frames. */
+ * mapping reads, and so its result, are those of the full frames. The
+ * copies are slices of one zeroed block for all views: a frame-sized
+ * calloc of its own may get memory the heap had freed, which calloc then
+ * clears, backing every page. */
 #define BAKE_BOX_MARGIN 2e-3 /* normalised units: about 3 px of a 1400 px focal length */
 
 typedef struct bake_grid {
@@ -469,13 +472,21 @@ static int bake_box(const hearth_mesh *mesh, const hearth_rigid *T_world_from_ca
 
 /* replace *img (a decoded frame of the camera's size) by a copy holding
  * only the pixels the mapping can read from pose T */
+/* into dst (zeroed, the frame's size; NULL: an image of its own); *in_dst
+ * is set when img's pixels are then dst's */
 static hearth_status bake_sparse(const bake_grid *g, const hearth_mesh *mesh, const hearth_rigid *T,
-                                 hearth_image *img, hearth_err *err) {
+                                 hearth_image *img, uint8_t *dst, uint8_t *in_dst,
+                                 hearth_err *err) {
   double box[4];
+  *in_dst = 0;
   if (!bake_box(mesh, T, box)) return HEARTH_OK; /* the whole frame stays */
-  hearth_image sp;
-  hearth_status s = hearth_image_alloc(&sp, img->width, img->height, 3, HEARTH_PIX_U8, err);
-  if (s) return s;
+  hearth_image sp = *img;
+  if (dst) {
+    sp.data = dst;
+  } else {
+    hearth_status s = hearth_image_alloc(&sp, img->width, img->height, 3, HEARTH_PIX_U8, err);
+    if (s) return s;
+  }
   const uint8_t *in = img->data;
   uint8_t *out = sp.data;
   for (size_t gy = 0; gy < g->gh; gy++)
@@ -489,6 +500,7 @@ static hearth_status bake_sparse(const bake_grid *g, const hearth_mesh *mesh, co
     }
   hearth_image_free(img);
   *img = sp;
+  *in_dst = dst != NULL;
   return HEARTH_OK;
 }
 
@@ -523,6 +535,8 @@ hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err) {
   hearth_map_view *views = NULL;
   hearth_map_result r = {0};
   bake_grid grid = {0};
+  uint8_t *block = NULL, *in_block = NULL; /* the sparse copies; per view: its copy is there */
+  size_t frame = 0;
   if ((s = hearth_rig_read(rig_path, &rig, err)) ||
       (s = hearth_rig_require_stereo(&rig, rig_path, "mapping", err)))
     goto done;
@@ -543,6 +557,11 @@ hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err) {
     grid.gh = ((size_t)rig.rgb.height + grid.stride - 1) / grid.stride;
     if ((grid.dir = hearth_alloc_array(grid.gw * grid.gh, 3 * sizeof *grid.dir)))
       hearth_camera_ray_grid(&rig.rgb, grid.stride, grid.dir);
+    /* without the block (too large to map) each copy is an image of its own */
+    if (grid.dir && man.n_views &&
+        hearth_mul_size((size_t)rig.rgb.width * 3, (size_t)rig.rgb.height, &frame) &&
+        frame <= SIZE_MAX / man.n_views && (in_block = calloc(man.n_views, 1)))
+      block = calloc(man.n_views, frame);
   }
   for (size_t k = 0; k < man.n_views; k++) {
     const hearth_view_files *vf = &man.views[k];
@@ -563,10 +582,13 @@ hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err) {
       goto done;
     }
     /* a frame of another size stays whole: the mapping refuses it */
+    uint8_t sliced = 0;
     if (grid.dir && imgs[k].width == (size_t)rig.rgb.width &&
         imgs[k].height == (size_t)rig.rgb.height &&
-        (s = bake_sparse(&grid, &mesh, &vp->T_world_from_cam, &imgs[k], err)))
+        (s = bake_sparse(&grid, &mesh, &vp->T_world_from_cam, &imgs[k],
+                         block ? block + k * frame : NULL, &sliced, err)))
       goto done;
+    if (in_block) in_block[k] = sliced;
     views[k].image = &imgs[k];
     views[k].T_world_from_cam = vp->T_world_from_cam;
   }
@@ -599,8 +621,13 @@ hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err) {
 done:
   hearth_map_result_free(&r);
   if (imgs)
-    for (size_t k = 0; k < man.n_views; k++) hearth_image_free(&imgs[k]);
+    for (size_t k = 0; k < man.n_views; k++) {
+      if (in_block && in_block[k]) imgs[k].data = NULL; /* the block's */
+      hearth_image_free(&imgs[k]);
+    }
   free(imgs);
+  free(block);
+  free(in_block);
   free(views);
   free(grid.dir);
   hearth_mesh_free(&mesh);

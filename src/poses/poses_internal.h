@@ -23,6 +23,13 @@ static inline hearth_status rf_pathf(char *buf, const char *fmt, ...) {
  * pixel in raster order; NULL on allocation failure */
 float *rf_pixel_rays(const hearth_camera *cam);
 
+/* 1 if the mesh is closed (vertices welded by exact position, every
+ * directed edge once and its reverse once), so consistently oriented, and
+ * faces outward (positive signed volume); 0 otherwise and when out of
+ * memory. From a camera with every vertex in front of it, the nearest
+ * surface of such a mesh along any ray is a front face. */
+int rf_mesh_closed_outward(const hearth_mesh *m);
+
 /* the k-th smallest of v[0..n) (0-based, n > 0; v is reordered so that
  * v[0..k) <= v[k] <= v(k..n)): quickselect, linear on average */
 double rf_select(double *v, size_t n, size_t k);

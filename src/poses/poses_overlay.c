@@ -2,9 +2,18 @@
  * thermal image, per view and as a contact sheet (include/hearth/poses.h).
  *
  * The thermal camera is the same in every view, so the rays through its
- * sub-pixel centres are undistorted once per zoom (ov_grid) and only rotated
- * per pose. They are cast in packets, and only inside the box the mesh's
- * vertices project to (the whole grid when a hit touches the box's border).
+ * sub-pixel centres are undistorted once per zoom (ov_grid).
+ *
+ * A ray caster sees back faces too, but where the mesh is closed (every edge
+ * shared by two triangles running it in opposite directions, vertices
+ * welded by position), faces outward (positive signed volume) and lies
+ * wholly in front of the camera (so the camera is outside it), the nearest
+ * surface along every ray is a front face: there the grid is cast by
+ * rasterising the front faces through its ray fan (include/hearth/mesh.h),
+ * exact like the ray caster up to float rounding along silhouettes.
+ * Otherwise the rays are rotated per pose and traced in packets, only inside
+ * the box the mesh's vertices project to (the whole grid when a hit touches
+ * the box's border).
  * Views are drawn in parallel, each worker with scratch of its own; the
  * contact sheet is assembled in view order afterwards. */
 #include <math.h>
@@ -23,6 +32,10 @@ typedef struct ov_grid {
   int zoom;
   size_t w, h;
   double *dir; /* 3 per sub-pixel, camera frame; NaN where the lens cannot be inverted */
+  /* the same sub-pixels as the pixel grid of the camera enlarged zoom
+     times; NULL where the mesh does not allow it or it cannot be made
+     (then rays are traced) */
+  hearth_ray_fan *fan;
 } ov_grid;
 
 /* per worker */
@@ -31,13 +44,18 @@ typedef struct ov_scratch {
   uint8_t *edge; /* w x h: outline sub-pixels */
   float org[3 * OV_BATCH], dir[3 * OV_BATCH];
   hearth_ray_hit hits[OV_BATCH];
-  size_t pix[OV_BATCH]; /* grid index of each ray of the batch */
-  double *vals;         /* thermal pixels, for the range */
-  uint8_t *turbo;       /* 3 per thermal pixel */
+  size_t pix[OV_BATCH];     /* grid index of each ray of the batch */
+  void *fan_scratch;        /* hearth_ray_fan_scratch_size of the largest fan */
+  hearth_ray_hit *fan_hits; /* w x h of the largest grid */
+  double *vals;             /* thermal pixels, for the range */
+  uint8_t *turbo;           /* 3 per thermal pixel */
   hearth_image temps;
 } ov_scratch;
 
-static hearth_status ov_grid_make(const hearth_camera *cam, int zoom, ov_grid *g, hearth_err *err) {
+/* the grid at zoom, and with with_fan its ray fan (NULL where it cannot
+   be made: then rays are traced) */
+static hearth_status ov_grid_make(const hearth_camera *cam, int zoom, int with_fan, ov_grid *g,
+                                  hearth_err *err) {
   g->zoom = zoom;
   g->w = (size_t)cam->width * (size_t)zoom;
   g->h = (size_t)cam->height * (size_t)zoom;
@@ -50,7 +68,93 @@ static hearth_status ov_grid_make(const hearth_camera *cam, int zoom, ov_grid *g
       double *d = g->dir + 3 * (y * g->w + x);
       if (hearth_camera_ray(cam, u, v, d) < 0) d[0] = d[1] = d[2] = NAN;
     }
+  /* sub-pixel (x, y) is pixel (x, y) of the camera whose pixel coordinates
+     are zoom (u + 1/2) - 1/2: focal lengths times zoom, the centre moved
+     with them */
+  if (!with_fan) return HEARTH_OK;
+  hearth_camera cz = *cam;
+  cz.width = (int)g->w;
+  cz.height = (int)g->h;
+  cz.fx = cam->fx * zoom;
+  cz.fy = cam->fy * zoom;
+  cz.cx = zoom * (cam->cx + 0.5) - 0.5;
+  cz.cy = zoom * (cam->cy + 0.5) - 0.5;
+  if (g->w <= INT32_MAX && g->h <= INT32_MAX && hearth_ray_fan_new(&cz, 1, &g->fan, NULL))
+    g->fan = NULL;
   return HEARTH_OK;
+}
+
+static void ov_grid_free(ov_grid *g) {
+  free(g->dir);
+  hearth_ray_fan_free(g->fan);
+}
+
+typedef struct ov_vkey {
+  float p[3];
+  uint32_t v;
+} ov_vkey;
+
+static int cmp_vkey(const void *a, const void *b) {
+  const ov_vkey *x = a, *y = b;
+  for (int k = 0; k < 3; k++)
+    if (x->p[k] != y->p[k]) return x->p[k] < y->p[k] ? -1 : 1;
+  return (x->v > y->v) - (x->v < y->v);
+}
+
+static int cmp_edge(const void *a, const void *b) {
+  uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+  return (x > y) - (x < y);
+}
+
+int rf_mesh_closed_outward(const hearth_mesh *m) {
+  const size_t nv = m->n_vertices, nt = m->n_triangles;
+  if (!nv || !nt || nv > UINT32_MAX || nt > SIZE_MAX / 3) return 0;
+  ov_vkey *keys = hearth_alloc_array(nv, sizeof *keys);
+  uint32_t *id = hearth_alloc_array(nv, sizeof *id);
+  uint64_t *e = hearth_alloc_array(3 * nt, sizeof *e);
+  int ok = keys && id && e;
+  for (size_t i = 0; ok && i < nv; i++) {
+    memcpy(keys[i].p, m->positions + 3 * i, sizeof keys[i].p);
+    keys[i].v = (uint32_t)i;
+    ok = isfinite(keys[i].p[0]) && isfinite(keys[i].p[1]) && isfinite(keys[i].p[2]);
+  }
+  if (ok) {
+    /* weld: a vertex's id is the first of its position's vertices in order */
+    qsort(keys, nv, sizeof *keys, cmp_vkey);
+    for (size_t i = 0, first = 0; i < nv; i++) {
+      if (i && memcmp(keys[i].p, keys[i - 1].p, sizeof keys[i].p)) first = i;
+      id[keys[i].v] = (uint32_t)first;
+    }
+    /* directed edges a -> b as a << 32 | b */
+    double vol = 0.0;
+    for (size_t t = 0; ok && t < nt; t++) {
+      const uint32_t *ix = m->indices + 3 * t;
+      for (int k = 0; k < 3; k++) {
+        uint32_t a = id[ix[k]], b = id[ix[(k + 1) % 3]];
+        ok = a != b;
+        e[3 * t + (size_t)k] = (uint64_t)a << 32 | b;
+      }
+      const float *p0 = m->positions + 3 * (size_t)ix[0], *p1 = m->positions + 3 * (size_t)ix[1],
+                  *p2 = m->positions + 3 * (size_t)ix[2];
+      vol += (double)p0[0] * ((double)p1[1] * p2[2] - (double)p1[2] * p2[1]) -
+             (double)p0[1] * ((double)p1[0] * p2[2] - (double)p1[2] * p2[0]) +
+             (double)p0[2] * ((double)p1[0] * p2[1] - (double)p1[1] * p2[0]);
+    }
+    ok = ok && vol > 0.0;
+    if (ok) {
+      /* each directed edge once, and its reverse there too */
+      qsort(e, 3 * nt, sizeof *e, cmp_edge);
+      for (size_t i = 0; ok && i < 3 * nt; i++) {
+        ok = !(i && e[i] == e[i - 1]);
+        uint64_t r = e[i] << 32 | e[i] >> 32;
+        ok = ok && bsearch(&r, e, 3 * nt, sizeof *e, cmp_edge) != NULL;
+      }
+    }
+  }
+  free(keys);
+  free(id);
+  free(e);
+  return ok;
 }
 
 static void ov_scratch_free(ov_scratch *s) {
@@ -59,19 +163,27 @@ static void ov_scratch_free(ov_scratch *s) {
   free(s->edge);
   free(s->vals);
   free(s->turbo);
+  free(s->fan_scratch);
+  free(s->fan_hits);
   hearth_image_free(&s->temps);
 }
 
-/* scratch for grids of up to n_sub sub-pixels and images of n_px pixels;
- * NULL when out of memory */
-static ov_scratch *ov_scratch_new(size_t n_sub, size_t n_px) {
+/* scratch for grids of up to n_sub sub-pixels and images of n_px pixels,
+ * and (fan_bytes > 0) fan casts of that many bytes of scratch; NULL when
+ * out of memory */
+static ov_scratch *ov_scratch_new(size_t n_sub, size_t n_px, size_t fan_bytes) {
   ov_scratch *s = calloc(1, sizeof *s);
   if (!s) return NULL;
   s->depth = hearth_alloc_array(n_sub ? n_sub : 1, sizeof *s->depth);
   s->edge = hearth_alloc_array(n_sub ? n_sub : 1, 1);
   s->vals = hearth_alloc_array(n_px ? n_px : 1, sizeof *s->vals);
   s->turbo = hearth_alloc_array(n_px ? n_px : 1, 3);
-  if (!s->depth || !s->edge || !s->vals || !s->turbo) {
+  if (fan_bytes) {
+    s->fan_scratch = calloc(1, fan_bytes);
+    s->fan_hits = hearth_alloc_array(n_sub ? n_sub : 1, sizeof *s->fan_hits);
+  }
+  if (!s->depth || !s->edge || !s->vals || !s->turbo ||
+      (fan_bytes && (!s->fan_scratch || !s->fan_hits))) {
     ov_scratch_free(s);
     free(s);
     return NULL;
@@ -140,17 +252,30 @@ static void ov_outline(const hearth_raycaster *rc, const hearth_mesh *mesh,
   for (size_t i = 0; i < w * h; i++) depth[i] = INFINITY;
   size_t b[4] = {0, w, 0, h}; /* x0, x1, y0, y1 */
   int pb[4];
-  if (mesh && rf_mesh_box(mesh, cam, T, OV_MARGIN, pb)) {
+  size_t fb[4];
+  if (mesh && g->fan && s->fan_scratch &&
+      !hearth_ray_fan_cast(g->fan, mesh, T, s->fan_scratch, s->fan_hits, fb, NULL)) {
+    /* every hit lies in the fan's box */
+    if (fb[0] > fb[1]) b[0] = b[1] = b[2] = b[3] = 0;
+    else b[0] = fb[0], b[1] = fb[1] + 1, b[2] = fb[2], b[3] = fb[3] + 1;
+    for (size_t y = b[2]; y < b[3]; y++)
+      for (size_t x = b[0]; x < b[1]; x++) {
+        const hearth_ray_hit *hit = s->fan_hits + y * w + x;
+        if (hit->prim != UINT32_MAX) depth[y * w + x] = hit->t;
+      }
+  } else if (mesh && rf_mesh_box(mesh, cam, T, OV_MARGIN, pb)) {
     b[0] = (size_t)pb[0] * zoom;
     b[1] = (size_t)pb[2] * zoom;
     b[2] = (size_t)pb[1] * zoom;
     b[3] = (size_t)pb[3] * zoom;
-  }
-  ov_cast(rc, g, T, b[0], b[1], b[2], b[3], s);
-  if (ov_hit_on_border(g, depth, b)) {
-    /* the surface may go on beyond the box: cast the whole grid */
+    ov_cast(rc, g, T, b[0], b[1], b[2], b[3], s);
+    if (ov_hit_on_border(g, depth, b)) {
+      /* the surface may go on beyond the box: cast the whole grid */
+      ov_cast(rc, g, T, 0, w, 0, h, s);
+      b[0] = 0, b[1] = w, b[2] = 0, b[3] = h;
+    }
+  } else {
     ov_cast(rc, g, T, 0, w, 0, h, s);
-    b[0] = 0, b[1] = w, b[2] = 0, b[3] = h;
   }
   memset(edge, 0, w * h);
   /* every surface sub-pixel lies in the box */
@@ -222,7 +347,7 @@ hearth_status hearth_overlay_render(const hearth_raycaster *rc, const hearth_cam
     return hearth_err_set(err, HEARTH_E_ARG, "overlay: zoom %d outside 1..16", zoom);
   size_t n = temps->width * temps->height, w = temps->width * (size_t)zoom,
          h = temps->height * (size_t)zoom;
-  ov_scratch *s = ov_scratch_new(w * h, n);
+  ov_scratch *s = ov_scratch_new(w * h, n, 0);
   ov_grid g = {0};
   hearth_status st = HEARTH_OK;
   if (!s) return hearth_err_set(err, HEARTH_E_NOMEM, "overlay: out of memory");
@@ -235,11 +360,11 @@ hearth_status hearth_overlay_render(const hearth_raycaster *rc, const hearth_cam
     st = hearth_err_set(err, HEARTH_E_SIZE, "overlay: target image has the wrong size");
     goto done;
   }
-  if ((st = ov_grid_make(cam, zoom, &g, err))) goto done;
+  if ((st = ov_grid_make(cam, zoom, 0, &g, err))) goto done;
   ov_outline(rc, NULL, cam, &g, T_world_from_cam, s);
   ov_paint(out, s->edge, rgb);
 done:
-  free(g.dir);
+  ov_grid_free(&g);
   ov_scratch_free(s);
   free(s);
   return st;
@@ -256,7 +381,8 @@ typedef struct ov_ctx {
   const hearth_poses *before, *after; /* before: NULL when there is none */
   const char *after_path, *dir;
   const char *rig_path;       /* the camera's document, named in size errors */
-  const ov_grid *big, *small; /* at the job's zoom and at 1 */
+  const ov_grid *big, *small; /* at the job's zoom and at 1; fans only where the mesh
+                                 allows them (see above) */
   ov_scratch **scratch;       /* per worker */
   hearth_image (*thumbs)[2];  /* per view: the sheet's before and after cells */
   hearth_status *st;          /* per view */
@@ -368,8 +494,9 @@ hearth_status hearth_overlay_run(const hearth_overlay_job *job, size_t *n_writte
   hearth_draw_text(&sheet, 4, 4, title, white, 1);
   if (!man.n_views) goto sheet;
   /* the rays of the thermal camera, once for every view */
-  if ((s = ov_grid_make(&rig.thermal, zoom, &big, err))) goto done;
-  if (zoom != 1 && (s = ov_grid_make(&rig.thermal, 1, &small, err))) goto done;
+  int fan = rf_mesh_closed_outward(&mesh);
+  if ((s = ov_grid_make(&rig.thermal, zoom, fan, &big, err))) goto done;
+  if (zoom != 1 && (s = ov_grid_make(&rig.thermal, 1, fan, &small, err))) goto done;
   nt = job->threads > 0 ? job->threads : hearth_default_threads();
   if ((size_t)nt > man.n_views) nt = (int)man.n_views;
   if (nt < 1) nt = 1;
@@ -381,8 +508,14 @@ hearth_status hearth_overlay_run(const hearth_overlay_job *job, size_t *n_writte
   c.st = calloc(man.n_views, sizeof *c.st);
   c.errs = calloc(man.n_views, sizeof *c.errs);
   int nomem = !c.scratch || !c.thumbs || !c.st || !c.errs;
+  /* fan scratch for the larger fan serves the smaller one too */
+  size_t fan_bytes = big.fan ? hearth_ray_fan_scratch_size(big.fan, mesh.n_vertices) : 0;
+  if (small.fan) {
+    size_t k = hearth_ray_fan_scratch_size(small.fan, mesh.n_vertices);
+    if (k > fan_bytes) fan_bytes = k;
+  }
   for (int t = 0; t < nt && !nomem; t++)
-    nomem = !(c.scratch[t] = ov_scratch_new(big.w * big.h, cw * ch));
+    nomem = !(c.scratch[t] = ov_scratch_new(big.w * big.h, cw * ch, fan_bytes));
   if (nomem) {
     s = hearth_err_set(err, HEARTH_E_NOMEM, "overlay: out of memory");
     goto done;
@@ -429,8 +562,8 @@ done:
   free(c.thumbs);
   free(c.st);
   free(c.errs);
-  free(big.dir);
-  free(small.dir);
+  ov_grid_free(&big);
+  ov_grid_free(&small);
   hearth_image_free(&sheet);
   hearth_manifest_free(&man);
   hearth_raycaster_free(rc);

@@ -112,6 +112,14 @@ int main(void) {
   for (int k = 0; k <= 10; k++) bands[k] = (size_t)k * N / 10;
   CHECK(round_trip(buf, bands, 10, NULL));
 
+  /* every short size, of two-valued bytes (runs of every length start and
+     end at every offset, also within the last 18 bytes, where the search
+     for matches goes byte by byte) */
+  for (size_t n = 1; n <= 80; n++) {
+    for (size_t i = 0; i < n; i++) buf[i] = (uint8_t)(next_u32(&seed) % 2);
+    CHECK_MSG(one_piece(buf, n, NULL), "%zu two-valued bytes", n);
+  }
+
   /* random pieces of random mixtures */
   for (int trial = 0; trial < 40; trial++) {
     size_t n = 1 + next_u32(&seed) % 20000;
