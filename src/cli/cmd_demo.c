@@ -85,6 +85,9 @@ int hearth_cmd_demo(int argc, char **argv) {
   bo.threads = threads;
   bo.resolution = R;
   bo.rgb_resolution = 512;
+  /* the rig's effects are on: the fusion that corrects for them
+     (docs/virtual-rig.md, "Which fusion") */
+  bo.fusion = HEARTH_FUSE_CORRECTED;
   bo.quiet = quiet;
   hearth_build_report br;
   hearth_status s = hearth_build_release(root, &bo, &br, &err);
