@@ -71,6 +71,8 @@ typedef struct hearth_map_view {
   hearth_rigid T_world_from_cam;
   double time_s; /* when it was taken (s from the state's preparation); only
                     HEARTH_FUSE_CORRECTED reads it; all 0: no cooling correction */
+  int pass;      /* the pass it belongs to (the manifest's elevation index): the
+                    cooling rate is estimated within passes; 0 for all: one */
 } hearth_map_view;
 
 typedef struct hearth_map_result {

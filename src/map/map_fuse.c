@@ -221,6 +221,7 @@ static int fold_robust(const map_ctx *m, hearth_map_result *out, band_scratch *b
 /* one view's record of a texel for the corrected fusion */
 typedef struct cr {
   float v, w, c, t; /* value, weight, viewing cosine, the view's time */
+  int pass;         /* the view's pass */
 } cr;
 static int cmp_cr(const void *a, const void *b) {
   float x = ((const cr *)a)->v, y = ((const cr *)b)->v;
@@ -267,7 +268,8 @@ static size_t gather_cr(const map_ctx *m, uint32_t *cnt, cr **all, size_t *cap, 
     const float *rd = r->d[v];
     const float tv = (float)m->views[v].time_s;
     for (size_t k = lower_bound_u32(rq, r->n[v], (uint32_t)q0); k < r->n[v] && rq[k] < q1; k++)
-      (*all)[cnt[rq[k] - q0]++] = (cr){rd[k * RW + 2], rd[k * RW], rd[k * RW + 1], tv};
+      (*all)[cnt[rq[k] - q0]++] =
+          (cr){rd[k * RW + 2], rd[k * RW], rd[k * RW + 1], tv, m->views[v].pass};
   }
   return total;
 }
@@ -354,19 +356,28 @@ static void rate_bands(void *ctx, size_t b, size_t e, int t) {
       size_t nm = k < 64 ? k : 64;
       memcpy(med_buf, tmp, nm * sizeof *med_buf);
       const double med = cr_median(med_buf, nm), tol = 1.0 + 0.4 * fabs(med - A);
-      double sw = 0, st = 0, sy = 0, stt = 0, sty = 0;
-      for (size_t j = 0; j < k; j++) {
-        if (fabs(tmp[j].v - med) > tol || (tmp[j].v - A) * (med - A) <= 0) continue;
-        const double w = tmp[j].w, x = tmp[j].t, y = log(fabs(tmp[j].v - A));
-        sw += w;
-        st += w * x;
-        sy += w * y;
-        stt += w * x * x;
-        sty += w * x * y;
+      /* centred within each pass: across passes the viewing geometry
+         changes with time (the elevation rises), within one only the
+         azimuth does */
+      for (size_t j0 = 0; j0 < k; j0++) {
+        int seen = 0;
+        for (size_t j1 = 0; j1 < j0 && !seen; j1++) seen = tmp[j1].pass == tmp[j0].pass;
+        if (seen) continue;
+        double sw = 0, st = 0, sy = 0, stt = 0, sty = 0;
+        for (size_t j = j0; j < k; j++) {
+          if (tmp[j].pass != tmp[j0].pass) continue;
+          if (fabs(tmp[j].v - med) > tol || (tmp[j].v - A) * (med - A) <= 0) continue;
+          const double w = tmp[j].w, x = tmp[j].t, y = log(fabs(tmp[j].v - A));
+          sw += w;
+          st += w * x;
+          sy += w * y;
+          stt += w * x * x;
+          sty += w * x * y;
+        }
+        if (sw <= 0) continue;
+        sxx += stt - st * st / sw;
+        sxy += sty - st * sy / sw;
       }
-      if (sw <= 0) continue;
-      sxx += stt - st * st / sw;
-      sxy += sty - st * sy / sw;
     }
     rp->sxx[bi] = sxx;
     rp->sxy[bi] = sxy;

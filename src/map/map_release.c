@@ -313,6 +313,7 @@ hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats
     views[k].image = &imgs[k];
     views[k].T_world_from_cam = vp->T_world_from_cam;
     views[k].time_s = vf->has_time ? vf->time_s : 0.0;
+    views[k].pass = vf->elevation_index;
   }
   /* the mesh is read and the layout (UV raster, islands, pixel grid and
      fan: mesh and camera only) made on a thread of their own while the CSVs
