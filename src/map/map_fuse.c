@@ -463,8 +463,7 @@ void map_fuse_bands(void *ctx, size_t b, size_t e, int t) {
   }
   if (fusion == HEARTH_FUSE_CORRECTED) ctmp = hearth_alloc_array(nv ? nv : 1, sizeof *ctmp);
   if ((fusion == HEARTH_FUSE_MEAN && !bs.acc) ||
-      ((fusion == HEARTH_FUSE_ROBUST || fusion == HEARTH_FUSE_CORRECTED) &&
-       (!bs.cnt || !bs.tmp)) ||
+      ((fusion == HEARTH_FUSE_ROBUST || fusion == HEARTH_FUSE_CORRECTED) && (!bs.cnt || !bs.tmp)) ||
       (fusion == HEARTH_FUSE_CORRECTED && !ctmp)) {
     fp->nomem[t] = 1;
     goto done;

@@ -100,10 +100,10 @@ hearth_status hb_params_parse(const char *text, size_t len, const char *name, hb
   for (int i = 0; f && i < 4; i++)
     if (!strcmp(f, k_fusion_names[i])) fi = i;
   if (fi < 0) {
-    s = hearth_err_set(err, HEARTH_E_PARSE,
-                       "%s: fusion: expected \"max\", \"robust\", \"mean\" or \"corrected\", found %s%s%s",
-                       name,
-                       f ? "\"" : type_name(v), f ? f : "", f ? "\"" : "");
+    s = hearth_err_set(
+        err, HEARTH_E_PARSE,
+        "%s: fusion: expected \"max\", \"robust\", \"mean\" or \"corrected\", found %s%s%s", name,
+        f ? "\"" : type_name(v), f ? f : "", f ? "\"" : "");
     goto done;
   }
   p->fusion = (hearth_fusion)fi;
@@ -153,7 +153,8 @@ static char *params_text(const hb_params *p, int prec) {
 
 hearth_status hb_params_write(const char *path, const hb_params *p, hearth_err *err) {
   if ((unsigned)p->fusion > 3)
-    return hearth_err_set(err, HEARTH_E_ARG, "%s: fusion %d: expected max, robust or mean", path,
+    return hearth_err_set(err, HEARTH_E_ARG,
+                          "%s: fusion %d: expected max, robust, mean or corrected", path,
                           (int)p->fusion);
   /* min_cos in the shortest of 15, 16 or 17 digits that reads back exactly */
   char *text = NULL;

@@ -75,8 +75,8 @@ static hearth_status report_effects(const char *root, const char *inst, const ch
   snprintf(path, sizeof path, "%s/ground_truth/instances/%s/%s/conditions.npy", root, inst, state);
   if ((s = hearth_npy_read(path, &cond, err))) goto done;
   if (app.ndim != 2 || app.dtype != HEARTH_NPY_F32 || app.shape[0] != R || app.shape[1] != R ||
-      cond.ndim != 3 || cond.dtype != HEARTH_NPY_F32 || cond.shape[0] != R ||
-      cond.shape[1] != R || cond.shape[2] != 3)
+      cond.ndim != 3 || cond.dtype != HEARTH_NPY_F32 || cond.shape[0] != R || cond.shape[1] != R ||
+      cond.shape[2] != 3)
     goto done; /* another layout: not compared */
   const float *a = app.data, *c = cond.data;
   double *da = hearth_alloc_array(n, sizeof *da), *dt = hearth_alloc_array(n, sizeof *dt);

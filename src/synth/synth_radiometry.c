@@ -59,16 +59,21 @@ double synth_camera_radiance(const synth_band *b, double eps_set, double refl_c,
 }
 
 double synth_camera_reading(const synth_band *b, double eps_set, double refl_c, double L) {
-  return synth_band_temperature(b, (L - (1.0 - eps_set) * synth_band_radiance(b, refl_c)) / eps_set);
+  return synth_band_temperature(b,
+                                (L - (1.0 - eps_set) * synth_band_radiance(b, refl_c)) / eps_set);
 }
 
 /* ---- surfaces ---------------------------------------------------------------- */
 
 /* normal emissivities in 8-14 um; sources per row in docs/virtual-rig.md */
-#define PAINT(e) {e, IR_DIELECTRIC, 1}
-#define MATTE(e) {e, IR_DIELECTRIC, 0}
-#define GLOSS(e) {e, IR_DIELECTRIC, 1}
-#define METAL(e) {e, IR_METAL, 1}
+#define PAINT(e) \
+  { e, IR_DIELECTRIC, 1 }
+#define MATTE(e) \
+  { e, IR_DIELECTRIC, 0 }
+#define GLOSS(e) \
+  { e, IR_DIELECTRIC, 1 }
+#define METAL(e) \
+  { e, IR_METAL, 1 }
 static const synth_ir k_ir[S_COUNT] = {
     [S_PLAIN] = PAINT(0.93),        /* kettle: painted / enamelled shell */
     [S_GLAZE] = GLOSS(0.92),        /* glazed ceramic (porcelain, glazed) */
@@ -160,8 +165,8 @@ static const struct {
   const char *category;
   double tau_s;
 } k_tau[] = {
-    {"cup", 1800},          {"electric_kettle", 4500}, {"pot", 5000},   {"sponge", 400},
-    {"canned_drink", 4000}, {"bottled_drink", 5000},   {"orange", 3000}, {"smartphone", 800},
+    {"cup", 1800},          {"electric_kettle", 4500}, {"pot", 5000},     {"sponge", 400},
+    {"canned_drink", 4000}, {"bottled_drink", 5000},   {"orange", 3000},  {"smartphone", 800},
     {"laptop", 900},        {"mouse", 1000},           {"headset", 1000},
 };
 

@@ -281,7 +281,8 @@ static double surface_radiance(const synth_view_job *job, const hearth_ray_hit *
     dn = -dn;
   }
   const synth_object *obj = s->obj;
-  int style = obj->style_of_tri && h->prim < obj->mesh.n_triangles ? obj->style_of_tri[h->prim] : -1;
+  int style =
+      obj->style_of_tri && h->prim < obj->mesh.n_triangles ? obj->style_of_tri[h->prim] : -1;
   const synth_ir *m = synth_ir_of_style(style);
   double eps = synth_ir_emissivity(m, -dn, fx->emissivity, fx->grazing);
   double env = synth_band_radiance(f->band, amb);
