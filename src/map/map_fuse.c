@@ -311,12 +311,15 @@ static int fold_corrected(const map_ctx *m, hearth_map_result *out, uint32_t *cn
   return 1;
 }
 
-/* the cooling-rate estimate: per band the within-texel sums of a
-   regression of log |reading - ambient| on time */
+/* the cooling-rate estimate: per texel the slope of a regression of
+   log |reading - ambient| on time (centred within each pass) and its
+   weight, per band; the rate is their weighted median */
 typedef struct rate_pass {
   const map_ctx *m;
-  double *sxx, *sxy; /* per band */
-  int *nomem;        /* per worker */
+  vw **slopes;  /* per band: (slope, weight) per texel that has one; owned */
+  size_t *n;    /* per band */
+  size_t *seen; /* per band: texels with any record */
+  int *nomem;   /* per worker */
 } rate_pass;
 
 static void rate_bands(void *ctx, size_t b, size_t e, int t) {
@@ -334,14 +337,20 @@ static void rate_bands(void *ctx, size_t b, size_t e, int t) {
   }
   for (size_t bi = b; bi < e; bi++) {
     const size_t q0 = bi * band, q1 = q0 + band < N ? q0 + band : N;
-    double sxx = 0, sxy = 0;
     size_t total = gather_cr(m, cnt, &all, &cap, q0, q1);
     if (total == SIZE_MAX) {
       rp->nomem[t] = 1;
       goto done;
     }
+    vw *out = total ? hearth_alloc_array(q1 - q0, sizeof *out) : NULL;
+    if (total && !out) {
+      rp->nomem[t] = 1;
+      goto done;
+    }
+    rp->slopes[bi] = out;
     for (size_t i = 0, start = 0; total && i < q1 - q0; start = cnt[i], i++) {
       size_t n = cnt[i] - start, k = 0;
+      rp->seen[bi] += n > 0;
       if (n < 2) continue;
       /* the views the fold keeps (near the best angle, so that emissivity
          changes little among them), within 60 degrees of the normal and
@@ -356,6 +365,8 @@ static void rate_bands(void *ctx, size_t b, size_t e, int t) {
       size_t nm = k < 64 ? k : 64;
       memcpy(med_buf, tmp, nm * sizeof *med_buf);
       const double med = cr_median(med_buf, nm), tol = 1.0 + 0.4 * fabs(med - A);
+      if (fabs(med - A) < 3.0) continue; /* too close to ambient to tell a rate */
+      double sxx = 0, sxy = 0;
       /* centred within each pass: across passes the viewing geometry
          changes with time (the elevation rises), within one only the
          azimuth does */
@@ -378,9 +389,8 @@ static void rate_bands(void *ctx, size_t b, size_t e, int t) {
         sxx += stt - st * st / sw;
         sxy += sty - st * sy / sw;
       }
+      if (sxx > 1.0) out[rp->n[bi]++] = (vw){(float)(-sxy / sxx), (float)sxx};
     }
-    rp->sxx[bi] = sxx;
-    rp->sxy[bi] = sxy;
   }
 done:
   free(cnt);
@@ -422,25 +432,41 @@ int map_correction_estimate(map_ctx *m, int nt) {
   free(ring);
   m->corr_rate = 0;
   if (!n) return 1;
-  /* the rate: the pooled within-texel slope, in band order */
+  /* the rate: the weighted median of the texels' slopes, gathered in band
+     order (a texel's weight is its spread of times, so texels seen over a
+     short time count little; outlying texels do not pull it) */
   const size_t R = m->l->R, rows = R < BAND_TEXELS ? BAND_TEXELS / R : 1;
   const size_t nb = (R + rows - 1) / rows;
-  rate_pass rp = {m, calloc(nb, sizeof(double)), calloc(nb, sizeof(double)),
-                  calloc((size_t)nt, sizeof(int))};
-  int ok = rp.sxx && rp.sxy && rp.nomem;
+  rate_pass rp = {m, calloc(nb, sizeof(vw *)), calloc(nb, sizeof(size_t)),
+                  calloc(nb, sizeof(size_t)), calloc((size_t)nt, sizeof(int))};
+  int ok = rp.slopes && rp.n && rp.seen && rp.nomem;
   if (ok) hearth_parallel_chunks(nb, 4, nt, rate_bands, &rp);
   for (int t = 0; ok && t < nt; t++) ok = !rp.nomem[t];
-  if (ok) {
-    double sxx = 0, sxy = 0;
-    for (size_t b = 0; b < nb; b++) {
-      sxx += rp.sxx[b];
-      sxy += rp.sxy[b];
-    }
-    double k = sxx > 0 ? -sxy / sxx : 0.0;
-    m->corr_rate = k < 0 ? 0 : k > 0.01 ? 0.01 : k;
+  size_t total = 0, seen = 0;
+  for (size_t b = 0; ok && b < nb; b++) {
+    total += rp.n[b];
+    seen += rp.seen[b];
   }
-  free(rp.sxx);
-  free(rp.sxy);
+  /* a rate needs support: at least 2 % of the observed texels (a state
+     near ambient has almost none, and no rate to correct) */
+  if (total < 64 || total < seen / 50) total = 0;
+  vw *all = ok && total ? hearth_alloc_array(total, sizeof *all) : NULL;
+  if (ok && total && !all) ok = 0;
+  if (ok && total) {
+    size_t k0 = 0;
+    for (size_t b = 0; b < nb; b++) {
+      if (rp.n[b]) memcpy(all + k0, rp.slopes[b], rp.n[b] * sizeof *all);
+      k0 += rp.n[b];
+    }
+    double k = weighted_median(all, total);
+    m->corr_rate = k < 0 ? 0 : k > 0.01 ? 0.01 : k;
+      fprintf(stderr, "corr: A %.3f k %.6g texels %zu\n", m->corr_ambient, m->corr_rate, total);
+  }
+  free(all);
+  for (size_t b = 0; rp.slopes && b < nb; b++) free(rp.slopes[b]);
+  free(rp.slopes);
+  free(rp.n);
+  free(rp.seen);
   free(rp.nomem);
   return ok;
 }
