@@ -239,6 +239,26 @@ static double cr_median(cr *a, size_t n) {
   return n ? a[n - 1].v : NAN;
 }
 
+/* The emissivity of a typical dielectric surface (paint, glaze, plastic,
+   glass: refractive index 1.6 in the long-wave infrared, normal emissivity
+   0.947) at viewing cosine c relative to its normal value, from Fresnel's
+   equations: the factor a reading's excess over ambient is divided by. */
+static double dielectric_falloff(double c) {
+  const double n = 1.6;
+  if (c > 1.0) c = 1.0;
+  double ct = sqrt(1.0 - (1.0 - c * c) / (n * n));
+  double rs = (c - n * ct) / (c + n * ct), rp = (n * c - ct) / (n * c + ct);
+  double r0 = (n - 1.0) / (n + 1.0);
+  return (1.0 - 0.5 * (rs * rs + rp * rp)) / (1.0 - r0 * r0);
+}
+
+/* a reading of excess v - A over ambient seen at cosine c, as seen along
+   the normal (the correction limited to 25 %) */
+static double normal_equivalent(double v, double A, double c) {
+  double f = dielectric_falloff(c);
+  return A + (v - A) / (f < 0.8 ? 0.8 : f);
+}
+
 /* the records of texels [q0, q1) gathered texel by texel in view order:
    on return cnt[i] is the end of texel i's records in bs_all. Returns the
    count, or SIZE_MAX out of memory. */
@@ -305,7 +325,10 @@ static int fold_corrected(const map_ctx *m, hearth_map_result *out, uint32_t *cn
     for (size_t j = 0; j < n; j++)
       if (out->best_cos && tmp[j].c > out->best_cos[q0 + i]) out->best_cos[q0 + i] = tmp[j].c;
     n = keep_near_best(tmp, n);
-    for (size_t j = 0; j < n; j++) tmp[j].v = (float)(A + (tmp[j].v - A) * exp(k * tmp[j].t));
+    for (size_t j = 0; j < n; j++) {
+      double v = normal_equivalent(tmp[j].v, A, tmp[j].c);
+      tmp[j].v = (float)(A + (v - A) * exp(k * tmp[j].t));
+    }
     out->observed[q0 + i] = (float)cr_median(tmp, n);
   }
   return 1;
@@ -357,8 +380,10 @@ static void rate_bands(void *ctx, size_t b, size_t e, int t) {
          clearly off ambient */
       memcpy(tmp, all + start, n * sizeof *tmp);
       n = keep_near_best(tmp, n);
-      for (size_t j = 0; j < n; j++)
+      for (size_t j = 0; j < n; j++) {
+        tmp[j].v = (float)normal_equivalent(tmp[j].v, A, tmp[j].c);
         if (tmp[j].c >= 0.5f && fabs(tmp[j].v - A) >= 1.5) tmp[k++] = tmp[j];
+      }
       if (k < 2) continue;
       /* readings far from the texel's median (mirrored sources) left out */
       cr med_buf[64];
@@ -460,7 +485,7 @@ int map_correction_estimate(map_ctx *m, int nt) {
     }
     double k = weighted_median(all, total);
     m->corr_rate = k < 0 ? 0 : k > 0.01 ? 0.01 : k;
-      fprintf(stderr, "corr: A %.3f k %.6g texels %zu\n", m->corr_ambient, m->corr_rate, total);
+    fprintf(stderr, "corr: A %.3f k %.6g texels %zu\n", m->corr_ambient, m->corr_rate, total);
   }
   free(all);
   for (size_t b = 0; rp.slopes && b < nb; b++) free(rp.slopes[b]);
