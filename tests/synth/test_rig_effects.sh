@@ -4,7 +4,7 @@
 # corrected fusion must hold against the normal-incidence apparent
 # temperature (ground_truth/, an independent forward model) where the
 # paper's max does not: per non-neutral state its median |error| at most
-# half of max's and 0.3 degC, its p95 no worse than max's; neutral states
+# half of max's and 0.2 degC (the target), its p95 no worse than max's; neutral states
 # within 0.1 degC (median). Figures: bench/rig_effects.sh.
 # usage: test_rig_effects.sh BUILD_DIR SOURCE_DIR
 set -eu
@@ -29,7 +29,7 @@ for inst, st in pairs:
     if st == "neutral":
         if co[0] > 0.1: bad.append(f"{inst}/{st}: median {co[0]} > 0.1")
         continue
-    if co[0] > 0.5 * mx[0] or co[0] > 0.3:
+    if co[0] > 0.5 * mx[0] or co[0] > 0.2:
         bad.append(f"{inst}/{st}: median {co[0]} vs max {mx[0]}")
     if co[1] > mx[1]:
         bad.append(f"{inst}/{st}: p95 {co[1]} vs max {mx[1]}")
