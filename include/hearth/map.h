@@ -33,10 +33,11 @@ typedef enum hearth_fusion {
   HEARTH_FUSE_MEAN = 2,   /* weighted mean over views (colour textures) */
   /* ROBUST's silhouette rejection and weighted median, made aware of the
      capture's physics: views far from a texel's best viewing angle are
-     dropped and the rest weighted by cos^4 (emissivity falls off towards
-     grazing), and each view's reading is brought back to the start of the
-     scan with a Newton cooling rate towards ambient estimated from the
-     views' times and readings (ambient: the median of the images' borders) */
+     dropped and the rest weighted by cos^4, each reading's excess over
+     ambient (the median of the images' borders) is referred to the normal
+     with a typical dielectric's Fresnel fall-off, and brought back to the
+     start of the scan with a Newton cooling rate estimated from the views'
+     times, passes and readings (docs/virtual-rig.md, "Which fusion") */
   HEARTH_FUSE_CORRECTED = 3
 } hearth_fusion;
 
