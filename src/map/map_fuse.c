@@ -485,7 +485,6 @@ int map_correction_estimate(map_ctx *m, int nt) {
     }
     double k = weighted_median(all, total);
     m->corr_rate = k < 0 ? 0 : k > 0.01 ? 0.01 : k;
-    fprintf(stderr, "corr: A %.3f k %.6g texels %zu\n", m->corr_ambient, m->corr_rate, total);
   }
   free(all);
   for (size_t b = 0; rp.slopes && b < nb; b++) free(rp.slopes[b]);
