@@ -15,6 +15,7 @@ static const char *test_sim_release(const char *dir) {
   hearth_remove_tree(root, NULL);
   hearth_synth_opts so;
   hearth_synth_opts_default(&so);
+  so.ideal = 1; /* closed-form: the clean rig */
   so.out_root = root;
   static const char *cats[] = {"cup",    "canned_drink", "electric_kettle", "eraser",
                                "orange", "smartphone",   "sponge"};

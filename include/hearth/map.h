@@ -30,7 +30,15 @@ extern "C" {
 typedef enum hearth_fusion {
   HEARTH_FUSE_MAX = 0,    /* paper: upper envelope of the per-view means */
   HEARTH_FUSE_ROBUST = 1, /* silhouette pixels rejected, weighted median over views */
-  HEARTH_FUSE_MEAN = 2    /* weighted mean over views (colour textures) */
+  HEARTH_FUSE_MEAN = 2,   /* weighted mean over views (colour textures) */
+  /* ROBUST's silhouette rejection and weighted median, made aware of the
+     capture's physics: views far from a texel's best viewing angle are
+     dropped and the rest weighted by cos^4, each reading's excess over
+     ambient (the median of the images' borders) is referred to the normal
+     with a typical dielectric's Fresnel fall-off, and brought back to the
+     start of the scan with a Newton cooling rate estimated from the views'
+     times, passes and readings (docs/virtual-rig.md, "Which fusion") */
+  HEARTH_FUSE_CORRECTED = 3
 } hearth_fusion;
 
 /* Mask values of a map (also the values of mask.npy). */
@@ -62,6 +70,10 @@ void hearth_map_opts_default(hearth_map_opts *o);
 typedef struct hearth_map_view {
   const hearth_image *image;
   hearth_rigid T_world_from_cam;
+  double time_s; /* when it was taken (s from the state's preparation); only
+                    HEARTH_FUSE_CORRECTED reads it; all 0: no cooling correction */
+  int pass;      /* the pass it belongs to (the manifest's elevation index): the
+                    cooling rate is estimated within passes; 0 for all: one */
 } hearth_map_view;
 
 typedef struct hearth_map_result {

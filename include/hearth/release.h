@@ -200,6 +200,16 @@ typedef struct hearth_report_entry {
   double coverage;                /* observed / surface texels */
   double median_abs_c, p95_abs_c; /* |observed - true| over observed texels; NaN without truth */
   double mean_signed_c;           /* mean (observed - true) */
+  /* with the virtual rig's object effects (ground_truth's temperature_apparent.npy and
+     conditions.npy): on observed texels seen within 60 degrees of the normal (n_away),
+     |observed - apparent| (the normal-incidence reading at the scan's start) and
+     |observed - true|; and among the worst 5 % of all observed texels against the
+     apparent truth, the shares seen only obliquely (best cosine < 0.5), mirroring the
+     warm source in some view, and drifting by more than 1 degC from cooling */
+  int has_apparent;
+  size_t n_away;
+  double app_median_abs_c, app_p95_abs_c, away_true_median_abs_c, away_true_p95_abs_c;
+  double worst_grazing, worst_mirror, worst_cooling;
 } hearth_report_entry;
 
 typedef struct hearth_report {

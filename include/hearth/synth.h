@@ -22,6 +22,25 @@ extern "C" {
 
 #define HEARTH_SYNTH_MAX_ITEMS 32
 
+/* The physics of the object captures that make the rig as hard as a real
+ * bench (docs/virtual-rig.md, "Object physics", gives the physics and the
+ * source of every default). Each magnitude of 0 turns its effect off. */
+typedef struct hearth_synth_effects {
+  double emissivity;        /* scale of each material's (1 - normal emissivity); default 1,
+                               0: black bodies */
+  double grazing;           /* the Fresnel fall-off of emissivity towards grazing, blended in;
+                               default 1, 0: the normal emissivity at every angle */
+  double warm_source_c;     /* excess over ambient (degC) of a warm source (the operator)
+                               mirrored by glossy surfaces; default 12, 0: none */
+  double cooling;           /* scale of the Newton cooling rates (1 / tau); default 1, 0: the
+                               state holds during the scan */
+  double scan_s;            /* duration of a state's scan (s), three passes (elevations) of
+                               equal length; default 300 */
+  int restore;              /* 1: the state is restored before each pass (its time restarts);
+                               default 0 */
+  double camera_emissivity; /* the thermal camera's emissivity setting; default 0.95 */
+} hearth_synth_effects;
+
 /* Strings are borrowed: they must stay valid during hearth_synth_release. */
 typedef struct hearth_synth_opts {
   uint64_t seed;        /* default 1 */
@@ -64,9 +83,16 @@ typedef struct hearth_synth_opts {
   int calib_clutter, calib_low_contrast, calib_invert;
   int threads;               /* 0 = hearth_default_threads() */
   int quiet;                 /* no progress output */
+  /* 1: the clean rig, every effect off (black bodies, no reflections, nothing
+     cools; no view times in the manifests, no temperature_apparent.npy): the
+     bytes of the rig before the effects, for closed-form tests. Default 0. */
+  int ideal;
+  hearth_synth_effects effects; /* used unless ideal */
 } hearth_synth_opts;
 
 void hearth_synth_opts_default(hearth_synth_opts *o);
+/* the default magnitudes of every effect */
+void hearth_synth_effects_default(hearth_synth_effects *e);
 /* Write a complete release tree (atomically: built under a temporary name
  * beside out_root, renamed at the end; removed on failure). */
 hearth_status hearth_synth_release(const hearth_synth_opts *o, hearth_err *err);

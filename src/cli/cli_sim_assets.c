@@ -27,6 +27,7 @@ int sim_cli_assets(const char *release, int gt, char *root, size_t rootsz, char 
   snprintf(root, rootsz, "%s/release", tmpdir);
   hearth_synth_opts so;
   hearth_synth_opts_default(&so);
+  so.ideal = 1; /* the clean rig: assets as before the effects */
   so.out_root = root;
   const char *cats[] = {"cup",    "canned_drink", "electric_kettle", "eraser",
                         "orange", "smartphone",   "sponge"};

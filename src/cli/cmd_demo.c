@@ -85,6 +85,9 @@ int hearth_cmd_demo(int argc, char **argv) {
   bo.threads = threads;
   bo.resolution = R;
   bo.rgb_resolution = 512;
+  /* the rig's effects are on: the fusion that corrects for them
+     (docs/virtual-rig.md, "Which fusion") */
+  bo.fusion = HEARTH_FUSE_CORRECTED;
   bo.quiet = quiet;
   hearth_build_report br;
   hearth_status s = hearth_build_release(root, &bo, &br, &err);
@@ -133,12 +136,14 @@ int hearth_cmd_demo(int argc, char **argv) {
     printf("\n");
     hearth_release_stats_print(&st, stdout);
   }
-  printf("\n%-18s %-8s %9s %12s %10s\n", "instance", "state", "observed", "median|err|",
-         "p95|err|");
+  printf("\n%-18s %-8s %9s %12s %10s %12s %10s\n", "instance", "state", "observed", "median|err|",
+         "p95|err|", "med|app|<60", "p95|app|");
   for (size_t i = 0; i < rep.n; i++) {
     const hearth_report_entry *e = &rep.entries[i];
-    printf("%-18s %-8s %8.1f%% %10.2f C %8.2f C\n", e->instance, e->state, 100.0 * e->coverage,
+    printf("%-18s %-8s %8.1f%% %10.2f C %8.2f C", e->instance, e->state, 100.0 * e->coverage,
            e->median_abs_c, e->p95_abs_c);
+    if (e->has_apparent) printf(" %10.2f C %8.2f C", e->app_median_abs_c, e->app_p95_abs_c);
+    printf("\n");
   }
   hearth_report_free(&rep);
   printf(

@@ -80,7 +80,9 @@ int hearth_cmd_map(int argc, char **argv) {
       CLI_SIZE("--resolution", "R", &ctx.job.map.resolution, 2, 16384, "UV map size R x R"),
       CLI_CHOICE("--fusion", &fusion, cli_fusion_names, cli_fusion_values,
                  "max: the paper's upper envelope of the per-view means; robust: silhouette "
-                 "pixels rejected, weighted median across views (for iced objects)"),
+                 "pixels rejected, weighted median across views (for iced objects); "
+                 "corrected: robust near each texel's best angle, with emissivity fall-off "
+                 "and cooling during the scan corrected (manifest time_s)"),
       CLI_NUM("--min-cos", "C", &ctx.job.map.min_cos, 0, 1,
               "ignore surface seen more obliquely than this cosine", .flags = CLI_HI_OPEN),
       CLI_FLAG("--keep-edges", &ctx.job.map.keep_edges, 1,

@@ -76,6 +76,14 @@ static hearth_status view_files_from_json(hj_ctx *c, const json_t *v, void *elem
     if ((s = hr_get_checked(c, v, k_file_keys[k], dst[k], sizeof f->rgb, hj_relative_path_ok,
                             "a relative path without '..' or empty components")))
       return s;
+  f->has_time = 0;
+  f->time_s = 0;
+  if (json_object_get(v, "time_s")) {
+    if ((s = hj_get_number(c, v, "time_s", &f->time_s))) return s;
+    if (!(f->time_s >= 0 && f->time_s <= 1e6))
+      return hj_fail(c, HEARTH_E_RANGE, "time_s: expected seconds in 0..1e6, found %g", f->time_s);
+    f->has_time = 1;
+  }
   return HEARTH_OK;
 }
 
@@ -209,7 +217,8 @@ hearth_status hearth_manifest_write(const char *path, const hearth_manifest *m, 
          hj_set(v, "rgb", hj_str(f->rgb)) && hj_set(v, "cutout", hj_str(f->cutout)) &&
          hj_set(v, "depth", hj_str(f->depth)) &&
          hj_set(v, "depth_intrinsics", hj_str(f->depth_intrinsics)) &&
-         hj_set(v, "thermal", hj_str(f->thermal));
+         hj_set(v, "thermal", hj_str(f->thermal)) &&
+         (!f->has_time || hj_set(v, "time_s", hj_real(f->time_s)));
     if (!ok || json_array_append_new(vv, v) != 0) {
       if (ok) ok = 0;
       else json_decref(v);

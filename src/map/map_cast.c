@@ -398,7 +398,8 @@ static void process_view(map_ctx *m, size_t v, int t) {
   else cast_rays(m, v, w, &box);
   if (m->failed) return;
   if (box.x0 > box.x1) box = (pix_box){1, 0, 1, 0}; /* no hit: empty */
-  const int edges = m->opts->fusion == HEARTH_FUSE_ROBUST || !m->opts->keep_edges;
+  const int edges = m->opts->fusion == HEARTH_FUSE_ROBUST ||
+                    m->opts->fusion == HEARTH_FUSE_CORRECTED || !m->opts->keep_edges;
   if (edges && box.x0 <= box.x1) {
     /* the ray arrays are free again: scratch for the filters */
     const size_t n = l->np;

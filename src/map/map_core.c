@@ -119,7 +119,9 @@ static hearth_status fuse_views(map_ctx *m, hearth_map_result *out, island_box *
   const size_t rows = R < BAND_TEXELS ? BAND_TEXELS / R : 1;
   int *nomem = calloc((size_t)nt, sizeof *nomem), failed = !nomem;
   fuse_pass fp = {m, out, p, nomem};
-  if (nomem) hearth_parallel_chunks((R + rows - 1) / rows, 4, nt, map_fuse_bands, &fp);
+  if (nomem && m->opts->fusion == HEARTH_FUSE_CORRECTED && !map_correction_estimate(m, nt))
+    failed = 1;
+  if (nomem && !failed) hearth_parallel_chunks((R + rows - 1) / rows, 4, nt, map_fuse_bands, &fp);
   for (int t = 0; nomem && t < nt; t++) failed |= nomem[t];
   free(nomem);
   if (failed) return hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory while fusing");
@@ -186,9 +188,9 @@ hearth_status hearth_map_views_with_layout(const hearth_map_layout *l,
   hearth_status s = view_channels(&l->cam, views, n_views, &C, err);
   if (s) return s;
   if (opts.fusion != HEARTH_FUSE_MAX && opts.fusion != HEARTH_FUSE_ROBUST &&
-      opts.fusion != HEARTH_FUSE_MEAN)
+      opts.fusion != HEARTH_FUSE_MEAN && opts.fusion != HEARTH_FUSE_CORRECTED)
     return hearth_err_set(err, HEARTH_E_ARG, "map: unknown fusion rule %d", (int)opts.fusion);
-  if (opts.fusion == HEARTH_FUSE_ROBUST && C != 1)
+  if ((opts.fusion == HEARTH_FUSE_ROBUST || opts.fusion == HEARTH_FUSE_CORRECTED) && C != 1)
     return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "map: robust fusion is for temperatures only");
   map_ctx m;
   memset(&m, 0, sizeof m);

@@ -217,6 +217,284 @@ static int fold_robust(const map_ctx *m, hearth_map_result *out, band_scratch *b
   return 1;
 }
 
+/* ---- corrected fusion ------------------------------------------------------------- */
+/* one view's record of a texel for the corrected fusion */
+typedef struct cr {
+  float v, w, c, t; /* value, weight, viewing cosine, the view's time */
+  int pass;         /* the view's pass */
+} cr;
+static int cmp_cr(const void *a, const void *b) {
+  float x = ((const cr *)a)->v, y = ((const cr *)b)->v;
+  return (x > y) - (x < y);
+}
+/* weighted median of the values of n records; sorts a */
+static double cr_median(cr *a, size_t n) {
+  qsort(a, n, sizeof *a, cmp_cr);
+  double total = 0, acc = 0;
+  for (size_t i = 0; i < n; i++) total += a[i].w;
+  for (size_t i = 0; i < n; i++) {
+    acc += a[i].w;
+    if (acc >= 0.5 * total) return a[i].v;
+  }
+  return n ? a[n - 1].v : NAN;
+}
+
+/* The emissivity of a typical dielectric surface (paint, glaze, plastic,
+   glass: refractive index 1.6 in the long-wave infrared, normal emissivity
+   0.947) at viewing cosine c relative to its normal value, from Fresnel's
+   equations: the factor a reading's excess over ambient is divided by. */
+static double dielectric_falloff(double c) {
+  const double n = 1.6;
+  if (c > 1.0) c = 1.0;
+  double ct = sqrt(1.0 - (1.0 - c * c) / (n * n));
+  double rs = (c - n * ct) / (c + n * ct), rp = (n * c - ct) / (n * c + ct);
+  double r0 = (n - 1.0) / (n + 1.0);
+  return (1.0 - 0.5 * (rs * rs + rp * rp)) / (1.0 - r0 * r0);
+}
+
+/* a reading of excess v - A over ambient seen at cosine c, as seen along
+   the normal (the correction limited to 25 %) */
+static double normal_equivalent(double v, double A, double c) {
+  double f = dielectric_falloff(c);
+  return A + (v - A) / (f < 0.8 ? 0.8 : f);
+}
+
+/* the records of texels [q0, q1) gathered texel by texel in view order:
+   on return cnt[i] is the end of texel i's records in bs_all. Returns the
+   count, or SIZE_MAX out of memory. */
+static size_t gather_cr(const map_ctx *m, uint32_t *cnt, cr **all, size_t *cap, size_t q0,
+                        size_t q1) {
+  const view_records *r = m->rec;
+  const size_t RW = REC_WORDS(m->C), nq = q1 - q0;
+  size_t total = 0;
+  memset(cnt, 0, (nq + 1) * sizeof *cnt);
+  for (size_t v = 0; v < r->n_views; v++) {
+    const uint32_t *rq = r->q[v];
+    for (size_t k = lower_bound_u32(rq, r->n[v], (uint32_t)q0); k < r->n[v] && rq[k] < q1; k++) {
+      cnt[rq[k] - q0 + 1]++;
+      total++;
+    }
+  }
+  if (!total) return 0;
+  if (total > *cap) {
+    free(*all);
+    *cap = total;
+    *all = hearth_alloc_array(total, sizeof **all);
+    if (!*all) return SIZE_MAX;
+  }
+  for (size_t i = 0; i < nq; i++) cnt[i + 1] += cnt[i];
+  for (size_t v = 0; v < r->n_views; v++) {
+    const uint32_t *rq = r->q[v];
+    const float *rd = r->d[v];
+    const float tv = (float)m->views[v].time_s;
+    for (size_t k = lower_bound_u32(rq, r->n[v], (uint32_t)q0); k < r->n[v] && rq[k] < q1; k++)
+      (*all)[cnt[rq[k] - q0]++] =
+          (cr){rd[k * RW + 2], rd[k * RW], rd[k * RW + 1], tv, m->views[v].pass};
+  }
+  return total;
+}
+
+/* the views kept at a texel: within 0.2 of its best cosine (and above
+   0.2), weighted by cos^4 */
+static size_t keep_near_best(cr *a, size_t n) {
+  float best = 0;
+  for (size_t i = 0; i < n; i++) best = a[i].c > best ? a[i].c : best;
+  const float lo = best - 0.2f > 0.2f ? best - 0.2f : 0.2f;
+  size_t k = 0;
+  for (size_t i = 0; i < n; i++)
+    if (a[i].c >= lo) {
+      float c2 = a[i].c * a[i].c;
+      a[k] = a[i];
+      a[k++].w *= c2 * c2;
+    }
+  return k;
+}
+
+/* texels [q0, q1), corrected fusion: each kept view's reading brought back
+   to time 0, then their weighted median */
+static int fold_corrected(const map_ctx *m, hearth_map_result *out, uint32_t *cnt, cr **all,
+                          size_t *cap, cr *tmp, size_t q0, size_t q1) {
+  size_t total = gather_cr(m, cnt, all, cap, q0, q1);
+  if (total == SIZE_MAX) return 0;
+  if (!total) return 1;
+  const double A = m->corr_ambient, k = m->corr_rate;
+  for (size_t i = 0, start = 0; i < q1 - q0; start = cnt[i], i++) {
+    size_t n = cnt[i] - start;
+    if (!n) continue;
+    memcpy(tmp, *all + start, n * sizeof *tmp);
+    for (size_t j = 0; j < n; j++)
+      if (out->best_cos && tmp[j].c > out->best_cos[q0 + i]) out->best_cos[q0 + i] = tmp[j].c;
+    n = keep_near_best(tmp, n);
+    for (size_t j = 0; j < n; j++) {
+      double v = normal_equivalent(tmp[j].v, A, tmp[j].c);
+      tmp[j].v = (float)(A + (v - A) * exp(k * tmp[j].t));
+    }
+    out->observed[q0 + i] = (float)cr_median(tmp, n);
+  }
+  return 1;
+}
+
+/* the cooling-rate estimate: per texel the slope of a regression of
+   log |reading - ambient| on time (centred within each pass) and its
+   weight, per band; the rate is their weighted median */
+typedef struct rate_pass {
+  const map_ctx *m;
+  vw **slopes;  /* per band: (slope, weight) per texel that has one; owned */
+  size_t *n;    /* per band */
+  size_t *seen; /* per band: texels with any record */
+  int *nomem;   /* per worker */
+} rate_pass;
+
+static void rate_bands(void *ctx, size_t b, size_t e, int t) {
+  rate_pass *rp = ctx;
+  const map_ctx *m = rp->m;
+  const size_t R = m->l->R, N = R * R;
+  const size_t rows = R < BAND_TEXELS ? BAND_TEXELS / R : 1, band = rows * R;
+  uint32_t *cnt = hearth_alloc_array(band + 1, sizeof *cnt);
+  cr *tmp = hearth_alloc_array(m->n_views ? m->n_views : 1, sizeof *tmp), *all = NULL;
+  size_t cap = 0;
+  const double A = m->corr_ambient;
+  if (!cnt || !tmp) {
+    rp->nomem[t] = 1;
+    goto done;
+  }
+  for (size_t bi = b; bi < e; bi++) {
+    const size_t q0 = bi * band, q1 = q0 + band < N ? q0 + band : N;
+    size_t total = gather_cr(m, cnt, &all, &cap, q0, q1);
+    if (total == SIZE_MAX) {
+      rp->nomem[t] = 1;
+      goto done;
+    }
+    vw *out = total ? hearth_alloc_array(q1 - q0, sizeof *out) : NULL;
+    if (total && !out) {
+      rp->nomem[t] = 1;
+      goto done;
+    }
+    rp->slopes[bi] = out;
+    for (size_t i = 0, start = 0; total && i < q1 - q0; start = cnt[i], i++) {
+      size_t n = cnt[i] - start, k = 0;
+      rp->seen[bi] += n > 0;
+      if (n < 2) continue;
+      /* the views the fold keeps (near the best angle, so that emissivity
+         changes little among them), within 60 degrees of the normal and
+         clearly off ambient */
+      memcpy(tmp, all + start, n * sizeof *tmp);
+      n = keep_near_best(tmp, n);
+      for (size_t j = 0; j < n; j++) {
+        tmp[j].v = (float)normal_equivalent(tmp[j].v, A, tmp[j].c);
+        if (tmp[j].c >= 0.5f && fabs(tmp[j].v - A) >= 1.5) tmp[k++] = tmp[j];
+      }
+      if (k < 2) continue;
+      /* readings far from the texel's median (mirrored sources) left out */
+      cr med_buf[64];
+      size_t nm = k < 64 ? k : 64;
+      memcpy(med_buf, tmp, nm * sizeof *med_buf);
+      const double med = cr_median(med_buf, nm), tol = 1.0 + 0.4 * fabs(med - A);
+      if (fabs(med - A) < 3.0) continue; /* too close to ambient to tell a rate */
+      double sxx = 0, sxy = 0;
+      /* centred within each pass: across passes the viewing geometry
+         changes with time (the elevation rises), within one only the
+         azimuth does */
+      for (size_t j0 = 0; j0 < k; j0++) {
+        int seen = 0;
+        for (size_t j1 = 0; j1 < j0 && !seen; j1++) seen = tmp[j1].pass == tmp[j0].pass;
+        if (seen) continue;
+        double sw = 0, st = 0, sy = 0, stt = 0, sty = 0;
+        for (size_t j = j0; j < k; j++) {
+          if (tmp[j].pass != tmp[j0].pass) continue;
+          if (fabs(tmp[j].v - med) > tol || (tmp[j].v - A) * (med - A) <= 0) continue;
+          const double w = tmp[j].w, x = tmp[j].t, y = log(fabs(tmp[j].v - A));
+          sw += w;
+          st += w * x;
+          sy += w * y;
+          stt += w * x * x;
+          sty += w * x * y;
+        }
+        if (sw <= 0) continue;
+        sxx += stt - st * st / sw;
+        sxy += sty - st * sy / sw;
+      }
+      if (sxx > 1.0) out[rp->n[bi]++] = (vw){(float)(-sxy / sxx), (float)sxx};
+    }
+  }
+done:
+  free(cnt);
+  free(tmp);
+  free(all);
+}
+
+static int cmp_float(const void *a, const void *b) {
+  float x = *(const float *)a, y = *(const float *)b;
+  return (x > y) - (x < y);
+}
+
+int map_correction_estimate(map_ctx *m, int nt) {
+  /* ambient: the median of every view's border ring, 3 pixels wide, where
+     the turntable, the table and the backdrop are seen */
+  size_t n = 0, cap = 0;
+  for (size_t v = 0; v < m->n_views; v++) {
+    const hearth_image *im = m->views[v].image;
+    if (im->width > 6 && im->height > 6) cap += 2 * 3 * (im->width + im->height);
+  }
+  float *ring = hearth_alloc_array(cap ? cap : 1, sizeof *ring);
+  if (!ring) return 0;
+  for (size_t v = 0; v < m->n_views; v++) {
+    const hearth_image *im = m->views[v].image;
+    if (!(im->width > 6 && im->height > 6)) continue;
+    const float *px = im->data;
+    for (size_t y = 0; y < im->height; y++)
+      for (size_t x = 0; x < im->width; x++)
+        if ((x < 3 || y < 3 || x + 3 >= im->width || y + 3 >= im->height) && n < cap &&
+            isfinite(px[y * im->width + x]))
+          ring[n++] = px[y * im->width + x];
+  }
+  if (n) {
+    qsort(ring, n, sizeof *ring, cmp_float);
+    m->corr_ambient = ring[n / 2];
+  } else {
+    m->corr_ambient = 0;
+  }
+  free(ring);
+  m->corr_rate = 0;
+  if (!n) return 1;
+  /* the rate: the weighted median of the texels' slopes, gathered in band
+     order (a texel's weight is its spread of times, so texels seen over a
+     short time count little; outlying texels do not pull it) */
+  const size_t R = m->l->R, rows = R < BAND_TEXELS ? BAND_TEXELS / R : 1;
+  const size_t nb = (R + rows - 1) / rows;
+  rate_pass rp = {m, calloc(nb, sizeof(vw *)), calloc(nb, sizeof(size_t)),
+                  calloc(nb, sizeof(size_t)), calloc((size_t)nt, sizeof(int))};
+  int ok = rp.slopes && rp.n && rp.seen && rp.nomem;
+  if (ok) hearth_parallel_chunks(nb, 4, nt, rate_bands, &rp);
+  for (int t = 0; ok && t < nt; t++) ok = !rp.nomem[t];
+  size_t total = 0, seen = 0;
+  for (size_t b = 0; ok && b < nb; b++) {
+    total += rp.n[b];
+    seen += rp.seen[b];
+  }
+  /* a rate needs support: at least 2 % of the observed texels (a state
+     near ambient has almost none, and no rate to correct) */
+  if (total < 64 || total < seen / 50) total = 0;
+  vw *all = ok && total ? hearth_alloc_array(total, sizeof *all) : NULL;
+  if (ok && total && !all) ok = 0;
+  if (ok && total) {
+    size_t k0 = 0;
+    for (size_t b = 0; b < nb; b++) {
+      if (rp.n[b]) memcpy(all + k0, rp.slopes[b], rp.n[b] * sizeof *all);
+      k0 += rp.n[b];
+    }
+    double k = weighted_median(all, total);
+    m->corr_rate = k < 0 ? 0 : k > 0.01 ? 0.01 : k;
+  }
+  free(all);
+  for (size_t b = 0; rp.slopes && b < nb; b++) free(rp.slopes[b]);
+  free(rp.slopes);
+  free(rp.n);
+  free(rp.seen);
+  free(rp.nomem);
+  return ok;
+}
+
 /* A worker sets nomem[t] if its scratch cannot be had. */
 void map_fuse_bands(void *ctx, size_t b, size_t e, int t) {
   const fuse_pass *fp = ctx;
@@ -226,13 +504,17 @@ void map_fuse_bands(void *ctx, size_t b, size_t e, int t) {
   const size_t rows = R < BAND_TEXELS ? BAND_TEXELS / R : 1, band = rows * R;
   const int fusion = m->opts->fusion;
   band_scratch bs = {0};
+  cr *call = NULL, *ctmp = NULL;
+  size_t ccap = 0;
   if (fusion == HEARTH_FUSE_MEAN) bs.acc = hearth_alloc_array(band, (C + 1) * sizeof *bs.acc);
-  if (fusion == HEARTH_FUSE_ROBUST) {
+  if (fusion == HEARTH_FUSE_ROBUST || fusion == HEARTH_FUSE_CORRECTED) {
     bs.cnt = hearth_alloc_array(band + 1, sizeof *bs.cnt);
     bs.tmp = hearth_alloc_array(nv ? nv : 1, sizeof *bs.tmp);
   }
+  if (fusion == HEARTH_FUSE_CORRECTED) ctmp = hearth_alloc_array(nv ? nv : 1, sizeof *ctmp);
   if ((fusion == HEARTH_FUSE_MEAN && !bs.acc) ||
-      (fusion == HEARTH_FUSE_ROBUST && (!bs.cnt || !bs.tmp))) {
+      ((fusion == HEARTH_FUSE_ROBUST || fusion == HEARTH_FUSE_CORRECTED) && (!bs.cnt || !bs.tmp)) ||
+      (fusion == HEARTH_FUSE_CORRECTED && !ctmp)) {
     fp->nomem[t] = 1;
     goto done;
   }
@@ -244,7 +526,12 @@ void map_fuse_bands(void *ctx, size_t b, size_t e, int t) {
     } else {
       clear_band(m, out, q0, q1);
       if (fusion == HEARTH_FUSE_MEAN) fold_mean(m, out, &bs, q0, q1);
-      else if (!fold_robust(m, out, &bs, q0, q1)) {
+      else if (fusion == HEARTH_FUSE_CORRECTED) {
+        if (!fold_corrected(m, out, bs.cnt, &call, &ccap, ctmp, q0, q1)) {
+          fp->nomem[t] = 1;
+          goto done;
+        }
+      } else if (!fold_robust(m, out, &bs, q0, q1)) {
         fp->nomem[t] = 1;
         goto done;
       }
@@ -252,6 +539,8 @@ void map_fuse_bands(void *ctx, size_t b, size_t e, int t) {
     map_fill_prepare_rows(R, C, m->l->island_of_texel, q0 / R, q1 / R, out, box);
   }
 done:
+  free(call);
+  free(ctmp);
   free(bs.acc);
   free(bs.cnt);
   free(bs.all);

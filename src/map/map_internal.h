@@ -117,6 +117,8 @@ typedef struct map_ctx {
   max_maps *max;           /* max fusion, else NULL */
   view_records *rec;       /* mean and robust fusion, else NULL */
   uint32_t *view_hits;     /* per view: pixels on the surface */
+  double corr_ambient;     /* corrected fusion: the ambient estimate (degC) */
+  double corr_rate;        /* corrected fusion: the cooling rate (1/s) towards it */
   _Atomic int failed;      /* 1 out of memory, 2 a view not in front after all */
 } map_ctx;
 
@@ -170,6 +172,9 @@ typedef struct fuse_pass {
 } fuse_pass;
 /* bands [b, e) of BAND_TEXELS texels (whole rows) on worker t */
 void map_fuse_bands(void *ctx, size_t b, size_t e, int t);
+/* corrected fusion: m's corr_ambient and corr_rate from the views and
+   their records, over bands on nt workers. Returns 0 out of memory. */
+int map_correction_estimate(map_ctx *m, int nt);
 
 /* map_fill.c */
 /* For rows [y0, y1) of fused maps: the mask of the observed texels, the

@@ -77,7 +77,10 @@ static json_t *vec_json(const double *v, int n) {
 }
 
 static const char *fusion_name(hearth_fusion f) {
-  return f == HEARTH_FUSE_MAX ? "max" : f == HEARTH_FUSE_ROBUST ? "robust" : "mean";
+  return f == HEARTH_FUSE_MAX        ? "max"
+         : f == HEARTH_FUSE_ROBUST    ? "robust"
+         : f == HEARTH_FUSE_CORRECTED ? "corrected"
+                                      : "mean";
 }
 
 static json_t *camera_json(const hearth_camera *c) {
@@ -311,6 +314,8 @@ hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats
     }
     views[k].image = &imgs[k];
     views[k].T_world_from_cam = vp->T_world_from_cam;
+    views[k].time_s = vf->has_time ? vf->time_s : 0.0;
+    views[k].pass = vf->elevation_index;
   }
   /* the mesh is read and the layout (UV raster, islands, pixel grid and
      fan: mesh and camera only) made on a thread of their own while the CSVs

@@ -11,7 +11,7 @@
 
 #define PARAMS_MAX_BYTES (64u << 20)
 
-static const char *const k_fusion_names[] = {"max", "robust", "mean"};
+static const char *const k_fusion_names[] = {"max", "robust", "mean", "corrected"};
 
 void hb_params_default(hb_params *p) {
   p->resolution = 1024;
@@ -97,12 +97,13 @@ hearth_status hb_params_parse(const char *text, size_t len, const char *name, hb
   if ((s = member(name, o, "fusion", &v, err))) goto done;
   const char *f = json_string_value(v);
   int fi = -1;
-  for (int i = 0; f && i < 3; i++)
+  for (int i = 0; f && i < 4; i++)
     if (!strcmp(f, k_fusion_names[i])) fi = i;
   if (fi < 0) {
-    s = hearth_err_set(err, HEARTH_E_PARSE,
-                       "%s: fusion: expected \"max\", \"robust\" or \"mean\", found %s%s%s", name,
-                       f ? "\"" : type_name(v), f ? f : "", f ? "\"" : "");
+    s = hearth_err_set(
+        err, HEARTH_E_PARSE,
+        "%s: fusion: expected \"max\", \"robust\", \"mean\" or \"corrected\", found %s%s%s", name,
+        f ? "\"" : type_name(v), f ? f : "", f ? "\"" : "");
     goto done;
   }
   p->fusion = (hearth_fusion)fi;
@@ -151,8 +152,9 @@ static char *params_text(const hb_params *p, int prec) {
 }
 
 hearth_status hb_params_write(const char *path, const hb_params *p, hearth_err *err) {
-  if ((unsigned)p->fusion > 2)
-    return hearth_err_set(err, HEARTH_E_ARG, "%s: fusion %d: expected max, robust or mean", path,
+  if ((unsigned)p->fusion > 3)
+    return hearth_err_set(err, HEARTH_E_ARG,
+                          "%s: fusion %d: expected max, robust, mean or corrected", path,
                           (int)p->fusion);
   /* min_cos in the shortest of 15, 16 or 17 digits that reads back exactly */
   char *text = NULL;

@@ -59,6 +59,76 @@ static hearth_status write_turbo(const char *path, const float *v, const uint8_t
   return s;
 }
 
+/* the errors against the apparent truth and where the largest sit (the
+   object effects' ground truth); leaves e->has_apparent 0 without it */
+static hearth_status report_effects(const char *root, const char *inst, const char *state,
+                                    const uint8_t *m, const float *o, const float *t, size_t R,
+                                    hearth_report_entry *e, hearth_err *err) {
+  char path[PATH_SZ];
+  hearth_npy app = {0}, cond = {0};
+  hearth_status s = HEARTH_OK;
+  const size_t n = R * R;
+  snprintf(path, sizeof path, "%s/ground_truth/instances/%s/%s/temperature_apparent.npy", root,
+           inst, state);
+  if (!hearth_path_exists(path)) return HEARTH_OK;
+  if ((s = hearth_npy_read(path, &app, err))) return s;
+  snprintf(path, sizeof path, "%s/ground_truth/instances/%s/%s/conditions.npy", root, inst, state);
+  if ((s = hearth_npy_read(path, &cond, err))) goto done;
+  if (app.ndim != 2 || app.dtype != HEARTH_NPY_F32 || app.shape[0] != R || app.shape[1] != R ||
+      cond.ndim != 3 || cond.dtype != HEARTH_NPY_F32 || cond.shape[0] != R || cond.shape[1] != R ||
+      cond.shape[2] != 3)
+    goto done; /* another layout: not compared */
+  const float *a = app.data, *c = cond.data;
+  double *da = hearth_alloc_array(n, sizeof *da), *dt = hearth_alloc_array(n, sizeof *dt);
+  double *all = hearth_alloc_array(n, sizeof *all);
+  if (!da || !dt || !all) {
+    free(da);
+    free(dt);
+    free(all);
+    s = hearth_err_set(err, HEARTH_E_NOMEM, "report: out of memory");
+    goto done;
+  }
+  size_t na = 0, nall = 0;
+  for (size_t i = 0; i < n; i++) {
+    if (m[i] != 1 || !isfinite(o[i]) || !isfinite(a[i])) continue;
+    all[nall++] = fabs((double)o[i] - a[i]);
+    if (c[3 * i] >= 0.5f) {
+      da[na] = fabs((double)o[i] - a[i]);
+      dt[na++] = isfinite(t[i]) ? fabs((double)o[i] - t[i]) : 0.0;
+    }
+  }
+  e->has_apparent = 1;
+  e->n_away = na;
+  qsort(da, na, sizeof *da, cmp_double);
+  qsort(dt, na, sizeof *dt, cmp_double);
+  e->app_median_abs_c = quantile(da, na, 0.5);
+  e->app_p95_abs_c = quantile(da, na, 0.95);
+  e->away_true_median_abs_c = quantile(dt, na, 0.5);
+  e->away_true_p95_abs_c = quantile(dt, na, 0.95);
+  /* the worst 5 % of all observed texels */
+  qsort(all, nall, sizeof *all, cmp_double);
+  const double cut = quantile(all, nall, 0.95);
+  size_t nw = 0, ng = 0, nm = 0, nc = 0;
+  for (size_t i = 0; nall && i < n; i++) {
+    if (m[i] != 1 || !isfinite(o[i]) || !isfinite(a[i]) || fabs((double)o[i] - a[i]) < cut)
+      continue;
+    nw++;
+    ng += c[3 * i] < 0.5f;
+    nm += c[3 * i + 1] > 0.0f;
+    nc += c[3 * i + 2] > 1.0f;
+  }
+  e->worst_grazing = nw ? (double)ng / (double)nw : NAN;
+  e->worst_mirror = nw ? (double)nm / (double)nw : NAN;
+  e->worst_cooling = nw ? (double)nc / (double)nw : NAN;
+  free(da);
+  free(dt);
+  free(all);
+done:
+  hearth_npy_free(&app);
+  hearth_npy_free(&cond);
+  return s;
+}
+
 /* numbers and images of one state; names of written files go to the html */
 static hearth_status report_state(const char *root, const char *out_dir, const char *inst,
                                   const char *state, hearth_report_entry *e, int *have_truth_png,
@@ -70,6 +140,9 @@ static hearth_status report_state(const char *root, const char *out_dir, const c
   snprintf(e->instance, sizeof e->instance, "%s", inst);
   snprintf(e->state, sizeof e->state, "%s", state);
   e->median_abs_c = e->p95_abs_c = e->mean_signed_c = NAN;
+  e->app_median_abs_c = e->app_p95_abs_c = NAN;
+  e->away_true_median_abs_c = e->away_true_p95_abs_c = NAN;
+  e->worst_grazing = e->worst_mirror = e->worst_cooling = NAN;
   *have_truth_png = *have_overlay = 0;
   snprintf(path, sizeof path, "%s/instances/%s/derived/%s/mask.npy", root, inst, state);
   if ((s = hearth_npy_read(path, &mask, err))) return s;
@@ -144,6 +217,7 @@ static hearth_status report_state(const char *root, const char *out_dir, const c
       free(keep);
       if (s) goto done;
       *have_truth_png = 1;
+      if ((s = report_effects(root, inst, state, m, o, t, R, e, err))) goto done;
     }
   }
   snprintf(path, sizeof path, "%s/instances/%s/derived/overlay/%s/contact_sheet.png", root, inst,
@@ -268,6 +342,39 @@ hearth_status hearth_report_write(const char *root, const char *out_dir, const c
         e->instance, e->state, e->instance, e->state, e->R, e->n_surface, cov, med, p95, mean);
   }
   fputs("</table>\n", f);
+  int effects = 0;
+  for (size_t j = 0; j < rep->n; j++) effects |= rep->entries[j].has_apparent;
+  if (effects) {
+    fputs(
+        "<h2>Against both truths (the rig's object effects)</h2>\n<p>On observed texels seen "
+        "within 60&deg; of the normal: |observed &minus; apparent| (what a view along the normal "
+        "reads at the start of the scan) and |observed &minus; true| (the true surface "
+        "temperature then). Of the worst 5 % of all observed texels against the apparent truth: "
+        "the shares seen only beyond 60&deg; (grazing), mirroring the warm source in a view "
+        "(reflections), and drifting by more than 1 &deg;C during the scan (cooling).</p>\n"
+        "<table class=\"n\"><tr><th>instance</th><th>state</th><th>texels</th>"
+        "<th>median |err| apparent</th><th>p95</th><th>median |err| true</th><th>p95</th>"
+        "<th>worst: grazing</th><th>reflections</th><th>cooling</th></tr>\n",
+        f);
+    for (size_t j = 0; j < rep->n; j++) {
+      const hearth_report_entry *e = &rep->entries[j];
+      if (!e->has_apparent) continue;
+      char v[7][32];
+      fmt2(v[0], sizeof v[0], e->app_median_abs_c);
+      fmt2(v[1], sizeof v[1], e->app_p95_abs_c);
+      fmt2(v[2], sizeof v[2], e->away_true_median_abs_c);
+      fmt2(v[3], sizeof v[3], e->away_true_p95_abs_c);
+      fmt2(v[4], sizeof v[4], 100.0 * e->worst_grazing);
+      fmt2(v[5], sizeof v[5], 100.0 * e->worst_mirror);
+      fmt2(v[6], sizeof v[6], 100.0 * e->worst_cooling);
+      fprintf(f,
+              "<tr><td style=\"text-align:left\">%s</td><td style=\"text-align:left\">%s</td>"
+              "<td>%zu</td><td>%s</td><td>%s</td><td>%s</td><td>%s</td><td>%s %%</td>"
+              "<td>%s %%</td><td>%s %%</td></tr>\n",
+              e->instance, e->state, e->n_away, v[0], v[1], v[2], v[3], v[4], v[5], v[6]);
+    }
+    fputs("</table>\n", f);
+  }
   if (validate_text) {
     fputs("<h2>Validation</h2>\n<pre>", f);
     html_escape(f, validate_text);

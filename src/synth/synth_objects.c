@@ -1252,6 +1252,7 @@ void synth_object_free(synth_object *obj) {
   if (!obj) return;
   hearth_mesh_free(&obj->mesh);
   free(obj->part_of_tri);
+  free(obj->style_of_tri);
   hearth_image_free(&obj->albedo);
   memset(obj, 0, sizeof *obj);
 }
@@ -1355,6 +1356,21 @@ hearth_status synth_object_make(const char *category, uint64_t seed, size_t targ
                           category);
   }
   pack_islands(b);
+  /* each triangle's material: the style of the island its first vertex is in */
+  obj->style_of_tri = malloc(cb.nt ? cb.nt : 1);
+  uint8_t *vstyle = malloc(cb.nv ? cb.nv : 1);
+  if (!obj->style_of_tri || !vstyle) {
+    free(vstyle);
+    free(b);
+    synth_object_free(obj);
+    return hearth_err_set(err, HEARTH_E_NOMEM, "synth_object_make(%s): out of memory", category);
+  }
+  memset(vstyle, 0, cb.nv ? cb.nv : 1);
+  for (int k = 0; k < b->np; k++)
+    for (size_t v = b->patches[k].v0; v < b->patches[k].v1 && v < cb.nv; v++)
+      vstyle[v] = (uint8_t)b->patches[k].style;
+  for (size_t t = 0; t < cb.nt; t++) obj->style_of_tri[t] = vstyle[obj->mesh.indices[3 * t]];
+  free(vstyle);
   /* rest on z = 0 exactly (bumps may dip below the nominal bottom) */
   {
     float zmin = 1e30f;

@@ -40,6 +40,17 @@ void hearth_synth_opts_default(hearth_synth_opts *o) {
   o->mesh_size_m = 0.12;
   o->mesh_category = "cup";
   o->netd_c = 0.05;
+  hearth_synth_effects_default(&o->effects);
+}
+
+void hearth_synth_effects_default(hearth_synth_effects *e) {
+  memset(e, 0, sizeof *e);
+  e->emissivity = 1.0;
+  e->grazing = 1.0;
+  e->warm_source_c = 12.0;
+  e->cooling = 1.0;
+  e->scan_s = 300.0;
+  e->camera_emissivity = 0.95;
 }
 
 size_t hearth_synth_categories(const char **names, size_t max) {
@@ -153,6 +164,9 @@ hearth_status synth_instance_make(const hearth_synth_opts *o, const hearth_rig *
       vd->index = idx;
       vd->elevation_index = e;
       vd->azimuth_index = a;
+      double scan = o->effects.scan_s > 0 ? o->effects.scan_s : 300.0;
+      vd->pass_s = e * scan / 3.0;
+      vd->time_s = vd->pass_s + a * scan / 30.0;
       double az = az0 + (36.0 * a + 12.0 * e + hearth_rng_range(&rs, -1.5, 1.5)) * DEG;
       double el = elev[e] + hearth_rng_range(&rs, -0.7, 0.7) * DEG;
       double dd = dist * (1.0 + hearth_rng_range(&rs, -0.02, 0.02));
@@ -255,7 +269,30 @@ typedef struct render_ctx {
   const float *draft_rgb_rays;
   hearth_progress *prog;
   int threads;
+  const synth_band *band; /* the camera's band radiance; NULL: the clean rig (ideal) */
 } render_ctx;
+
+/* The warm source an instance's glossy surfaces mirror: the operator,
+ * standing 0.9 m from the turntable axis at an azimuth drawn per instance
+ * (a stream of its own), chest 0.45 m above the turntable top, as a sphere
+ * of radius 0.25 m. */
+static void warm_source(const synth_instance *inst, double src[4]) {
+  hearth_rng r;
+  hearth_rng_seed(&r, inst->seed ^ synth_hash("warm source"));
+  double az = hearth_rng_range(&r, 0, 2 * PI);
+  src[0] = 0.9 * cos(az);
+  src[1] = 0.9 * sin(az);
+  src[2] = 0.45;
+  src[3] = 0.25;
+}
+
+/* the state's excess over ambient left at a view's time (Newton cooling) */
+static double view_decay(const hearth_synth_effects *fx, const synth_instance *inst, size_t s,
+                         const synth_view_def *vd) {
+  double t = fx->restore ? vd->time_s - vd->pass_s : vd->time_s;
+  double tau = synth_cooling_tau_s(inst->category, inst->states[s]);
+  return exp(-fx->cooling * t / tau);
+}
 
 static hearth_status write_contact_sheet(const char *path, hearth_image *thumbs,
                                          hearth_image *temps, const synth_view_def *views, size_t n,
@@ -316,8 +353,12 @@ static hearth_status render_state(const render_ctx *rc, const char *root, synth_
     return hearth_err_set(err, HEARTH_E_NOMEM, "%s/%s: out of memory", inst->id, state);
   }
   hearth_depth_intrinsics di = {rc->rig->depth, rc->rig->T_depth_from_rgb};
+  synth_thermal_fx tfx = {rc->band, &o->effects, inst->ambient_c, {0, 0, 0, 0}, 0, 1};
+  warm_source(inst, tfx.source);
+  tfx.source_c = inst->ambient_c + o->effects.warm_source_c;
   for (size_t v = 0; v < inst->n_views && !st; v++) {
     const synth_view_def *vd = &inst->views[s][v];
+    tfx.decay = view_decay(&o->effects, inst, s, vd);
     synth_view_job job = {scene,
                           &inst->fields[s],
                           rc->rig,
@@ -327,11 +368,17 @@ static hearth_status render_state(const render_ctx *rc, const char *root, synth_
                           vd->T_world_from_rgb,
                           inst->seed ^ synth_hash(state) ^ ((uint64_t)vd->index * 0x100000001B3ULL),
                           o->netd_c,
-                          rc->threads};
+                          rc->threads,
+                          rc->band ? &tfx : NULL};
     hearth_view_files *vf = &man.views[v];
     snprintf(vf->view, sizeof vf->view, "%s", vd->name);
     vf->elevation_index = vd->elevation_index;
     vf->azimuth_index = vd->azimuth_index;
+    if (rc->band) {
+      /* the operator's log: seconds since the state was prepared (or restored) */
+      vf->has_time = 1;
+      vf->time_s = o->effects.restore ? vd->time_s - vd->pass_s : vd->time_s;
+    }
     snprintf(vf->rgb, sizeof vf->rgb, "rgb/%s.jpg", vd->name);
     snprintf(vf->cutout, sizeof vf->cutout, "cutout/%s.png", vd->name);
     snprintf(vf->depth, sizeof vf->depth, "depth/%s.png", vd->name);
@@ -446,6 +493,237 @@ static hearth_status write_poses(const char *path, const synth_instance *inst,
   return st;
 }
 
+/* ---- ground truth of the object effects ---------------------------------------------- */
+/* One state's effect maps over texel rows: the normal-incidence apparent
+ * temperature at the start of the scan, and per texel what its views saw
+ * (conditions.npy, docs/dataset.md): the best viewing cosine of a view
+ * that sees it, the share of its views within 60 degrees of the normal in
+ * which it mirrors the warm source, and the largest cooling drift of the
+ * normal-incidence reading among those views. */
+typedef struct fxmap_ctx {
+  const render_ctx *rc;
+  const synth_instance *inst;
+  const synth_scene *scene;
+  size_t s;
+  const uint32_t *tri;
+  const float *bary, *truth;
+  size_t R;
+  const hearth_rigid *T_th_from_world; /* per view */
+  const double *decay;                 /* per view */
+  double src[4];
+  float *app, *cond;
+  int failed;
+} fxmap_ctx;
+
+static double normal_reading(const fxmap_ctx *c, const synth_ir *m, double t) {
+  const hearth_synth_effects *fx = &c->rc->o->effects;
+  const synth_band *b = c->rc->band;
+  double amb = c->inst->ambient_c, e = synth_ir_emissivity(m, 1.0, fx->emissivity, fx->grazing);
+  double L = e * synth_band_radiance(b, t) + (1.0 - e) * synth_band_radiance(b, amb);
+  return synth_camera_reading(b, fx->camera_emissivity, amb, L);
+}
+
+static void fxmap_rows(void *vctx, size_t b, size_t e, int ti) {
+  fxmap_ctx *c = vctx;
+  (void)ti;
+  const synth_instance *inst = c->inst;
+  const synth_object *obj = &inst->obj;
+  const hearth_camera *cam = &c->rc->rig->thermal;
+  const size_t R = c->R, nv = inst->n_views;
+  const float *P = c->scene->world.positions;
+  float *org = hearth_alloc_array(R * nv, 3 * sizeof(float));
+  float *dir = hearth_alloc_array(R * nv, 3 * sizeof(float));
+  hearth_ray_hit *hits = hearth_alloc_array(R * nv, sizeof *hits);
+  double *dist = hearth_alloc_array(R * nv, sizeof(double));
+  if (!org || !dir || !hits || !dist) {
+    c->failed = 1;
+    free(org);
+    free(dir);
+    free(hits);
+    free(dist);
+    return;
+  }
+  for (size_t y = b; y < e; y++) {
+    size_t n = 0;
+    for (size_t x = 0; x < R; x++) {
+      size_t q = y * R + x;
+      if (c->tri[q] == UINT32_MAX) continue;
+      const uint32_t *id = obj->mesh.indices + 3 * (size_t)c->tri[q];
+      double pw[3] = {0, 0, 0};
+      for (int v = 0; v < 3; v++)
+        for (int k = 0; k < 3; k++) pw[k] += c->bary[3 * q + v] * P[3 * id[v] + k];
+      for (size_t v = 0; v < nv; v++, n++) {
+        const hearth_rigid *T = &c->T_th_from_world[v];
+        double o[3], d[3];
+        /* the camera centre: -R^T t */
+        for (int k = 0; k < 3; k++)
+          o[k] = -(T->R[k] * T->t[0] + T->R[3 + k] * T->t[1] + T->R[6 + k] * T->t[2]);
+        for (int k = 0; k < 3; k++) d[k] = pw[k] - o[k];
+        double l = hearth_norm3(d);
+        dist[n] = l;
+        for (int k = 0; k < 3; k++) {
+          org[3 * n + k] = (float)o[k];
+          dir[3 * n + k] = (float)(d[k] / l);
+        }
+      }
+    }
+    if (n) hearth_raycast_batch(c->scene->rc, n, org, dir, 0.0f, 1e4f, hits);
+    n = 0;
+    for (size_t x = 0; x < R; x++) {
+      size_t q = y * R + x;
+      float *cd = c->cond + 3 * q;
+      if (c->tri[q] == UINT32_MAX) {
+        c->app[q] = NAN;
+        cd[0] = cd[1] = cd[2] = NAN;
+        continue;
+      }
+      uint32_t t = c->tri[q];
+      int style = obj->style_of_tri ? obj->style_of_tri[t] : -1;
+      const synth_ir *m = synth_ir_of_style(style);
+      double amb = inst->ambient_c, t0 = c->truth[q], a0 = normal_reading(c, m, t0);
+      c->app[q] = (float)a0;
+      /* the world normal of the texel's triangle */
+      const uint32_t *id = obj->mesh.indices + 3 * (size_t)t;
+      double u[3], w[3], nrm[3];
+      for (int k = 0; k < 3; k++) {
+        u[k] = P[3 * id[1] + k] - P[3 * id[0] + k];
+        w[k] = P[3 * id[2] + k] - P[3 * id[0] + k];
+      }
+      hearth_cross3(u, w, nrm);
+      double nl = hearth_norm3(nrm);
+      if (nl > 0)
+        for (int k = 0; k < 3; k++) nrm[k] /= nl;
+      double best = 0, drift = 0;
+      int usable = 0, mirrored = 0;
+      for (size_t v = 0; v < nv; v++, n++) {
+        const hearth_ray_hit *h = &hits[n];
+        if (h->prim == UINT32_MAX || !(h->prim == t || h->t > dist[n] - 1e-3)) continue;
+        double pw[3], pc[3], uv[2], d[3];
+        for (int k = 0; k < 3; k++) {
+          d[k] = dir[3 * n + k];
+          pw[k] = org[3 * n + k] + dist[n] * d[k];
+        }
+        hearth_rigid_apply(&c->T_th_from_world[v], pw, pc);
+        if (!synth_lens_project(cam, pc, uv) || uv[0] < -0.5 || uv[1] < -0.5 ||
+            uv[0] > cam->width - 0.5 || uv[1] > cam->height - 0.5)
+          continue;
+        double dn = hearth_dot3(nrm, d), cs = fabs(dn);
+        if (cs > best) best = cs;
+        if (cs < 0.5) continue;
+        usable++;
+        double at = normal_reading(c, m, amb + (t0 - amb) * c->decay[v]);
+        if (fabs(at - a0) > drift) drift = fabs(at - a0);
+        if (m->glossy && c->rc->o->effects.warm_source_c > 0) {
+          double r[3], oc[3];
+          for (int k = 0; k < 3; k++) {
+            r[k] = d[k] - 2.0 * dn * nrm[k];
+            oc[k] = c->src[k] - pw[k];
+          }
+          double tca = hearth_dot3(oc, r), d2 = hearth_dot3(oc, oc) - tca * tca;
+          if (tca > 0 && d2 < c->src[3] * c->src[3]) mirrored++;
+        }
+      }
+      cd[0] = (float)best;
+      cd[1] = usable ? (float)mirrored / (float)usable : 0.0f;
+      cd[2] = (float)drift;
+    }
+  }
+  free(org);
+  free(dir);
+  free(hits);
+  free(dist);
+}
+
+static hearth_status write_effect_maps(const render_ctx *rc, const char *gt,
+                                       const synth_instance *inst, const synth_scene *scene,
+                                       size_t s, const uint32_t *tri, const float *bary,
+                                       const float *truth, hearth_err *err) {
+  const size_t R = rc->o->map_resolution ? rc->o->map_resolution : 1024, nv = inst->n_views;
+  fxmap_ctx c = {rc, inst, scene, s, tri, bary, truth, R, NULL, NULL, {0}, NULL, NULL, 0};
+  hearth_rigid *T = hearth_alloc_array(nv, sizeof *T);
+  double *decay = hearth_alloc_array(nv, sizeof *decay);
+  c.app = hearth_alloc_array(R * R, sizeof(float));
+  c.cond = hearth_alloc_array(R * R, 3 * sizeof(float));
+  hearth_status st = HEARTH_OK;
+  if (!T || !decay || !c.app || !c.cond)
+    st = hearth_err_set(err, HEARTH_E_NOMEM, "%s/%s: effect maps: out of memory", inst->id,
+                        inst->states[s]);
+  if (!st) {
+    for (size_t v = 0; v < nv; v++) {
+      const synth_view_def *vd = &inst->views[s][v];
+      hearth_rigid T_rgb_from_th, T_world_from_th;
+      hearth_rigid_inverse(&rc->rig->T_thermal_from_rgb, &T_rgb_from_th);
+      hearth_rigid_compose(&vd->T_world_from_rgb, &T_rgb_from_th, &T_world_from_th);
+      hearth_rigid_inverse(&T_world_from_th, &T[v]);
+      decay[v] = view_decay(&rc->o->effects, inst, s, vd);
+    }
+    c.T_th_from_world = T;
+    c.decay = decay;
+    warm_source(inst, c.src);
+    hearth_parallel_for(R, rc->threads, fxmap_rows, &c);
+    if (c.failed)
+      st = hearth_err_set(err, HEARTH_E_NOMEM, "%s/%s: effect maps: out of memory", inst->id,
+                          inst->states[s]);
+  }
+  char p[4096];
+  if (!st) {
+    size_t shape[2] = {R, R};
+    snprintf(p, sizeof p, "%s/%s/temperature_apparent.npy", gt, inst->states[s]);
+    st = hearth_npy_write(p, HEARTH_NPY_F32, 2, shape, c.app, err);
+  }
+  if (!st) {
+    size_t shape[3] = {R, R, 3};
+    snprintf(p, sizeof p, "%s/%s/conditions.npy", gt, inst->states[s]);
+    st = hearth_npy_write(p, HEARTH_NPY_F32, 3, shape, c.cond, err);
+  }
+  free(T);
+  free(decay);
+  free(c.app);
+  free(c.cond);
+  return st;
+}
+
+/* ground_truth/instances/<id>/<state>/: the true temperature per texel at
+ * the start of the scan, and with the object effects the normal-incidence
+ * apparent temperature and the conditions of the texel's views */
+static hearth_status write_truth_maps(const render_ctx *rc, const char *gt, synth_instance *inst,
+                                      const synth_scene *scene, hearth_err *err) {
+  const hearth_synth_opts *o = rc->o;
+  char p[4096];
+  hearth_status st = HEARTH_OK;
+  /* true temperature per texel */
+  size_t R = o->map_resolution ? o->map_resolution : 1024, RR;
+  if (!hearth_mul_size(R, R, &RR)) return hearth_err_set(err, HEARTH_E_NOMEM, "map too large");
+  uint32_t *tri = hearth_alloc_array(RR, sizeof(uint32_t));
+  float *bary = hearth_alloc_array(RR, 3 * sizeof(float));
+  float *map = hearth_alloc_array(RR, sizeof(float));
+  if (!tri || !bary || !map) st = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
+  if (!st) st = hearth_uv_rasterize(&inst->obj.mesh, R, tri, bary, err);
+  /* ground truth without surface would be all NaN: the UVs cover no texel */
+  size_t covered = 0;
+  for (size_t q = 0; !st && q < RR && !covered; q++) covered = tri[q] != UINT32_MAX;
+  if (!st && !covered)
+    st = hearth_err_set(err, HEARTH_E_RANGE,
+                        "%s/%s: %s: the mesh's UV layout covers no texel of the %zux%zu "
+                        "temperature_true map (surface 0 texels): its UVs lie outside [0,1] or "
+                        "its UV triangles are too small to hold a texel centre",
+                        inst->id, inst->states[0], o->mesh_path ? o->mesh_path : "generated mesh",
+                        R, R);
+  for (size_t s = 0; s < inst->n_states && !st; s++) {
+    tmap_ctx c = {&inst->obj, &inst->fields[s], tri, bary, R, map};
+    hearth_parallel_for(R, rc->threads, tmap_rows, &c);
+    if ((st = mkdirf(err, "%s/%s", gt, inst->states[s]))) break;
+    snprintf(p, sizeof p, "%s/%s/temperature_true.npy", gt, inst->states[s]);
+    size_t shape[2] = {R, R};
+    st = hearth_npy_write(p, HEARTH_NPY_F32, 2, shape, map, err);
+    if (!st && rc->band) st = write_effect_maps(rc, gt, inst, scene, s, tri, bary, map, err);
+  }
+  free(tri);
+  free(bary);
+  free(map);
+  return st;
+}
+
 static hearth_status write_instance(const render_ctx *rc, const char *root, synth_instance *inst,
                                     hearth_err *err) {
   const hearth_synth_opts *o = rc->o;
@@ -477,6 +755,7 @@ static hearth_status write_instance(const render_ctx *rc, const char *root, synt
     return hearth_err_prefix(err, "%s: ", inst->id);
   for (size_t s = 0; s < inst->n_states && !st; s++)
     st = render_state(rc, root, inst, &scene, s, err);
+  if (!st) st = write_truth_maps(rc, gt, inst, &scene, err);
   synth_scene_free(&scene);
   if (st) return st;
 
@@ -516,36 +795,7 @@ static hearth_status write_instance(const render_ctx *rc, const char *root, synt
   snprintf(p, sizeof p, "%s/scale.json", gt);
   if ((st = hearth_scale_doc_write(p, &sd, err))) return st;
 
-  /* true temperature per texel */
-  size_t R = o->map_resolution ? o->map_resolution : 1024, RR;
-  if (!hearth_mul_size(R, R, &RR)) return hearth_err_set(err, HEARTH_E_NOMEM, "map too large");
-  uint32_t *tri = hearth_alloc_array(RR, sizeof(uint32_t));
-  float *bary = hearth_alloc_array(RR, 3 * sizeof(float));
-  float *map = hearth_alloc_array(RR, sizeof(float));
-  if (!tri || !bary || !map) st = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
-  if (!st) st = hearth_uv_rasterize(&inst->obj.mesh, R, tri, bary, err);
-  /* ground truth without surface would be all NaN: the UVs cover no texel */
-  size_t covered = 0;
-  for (size_t q = 0; !st && q < RR && !covered; q++) covered = tri[q] != UINT32_MAX;
-  if (!st && !covered)
-    st = hearth_err_set(err, HEARTH_E_RANGE,
-                        "%s/%s: %s: the mesh's UV layout covers no texel of the %zux%zu "
-                        "temperature_true map (surface 0 texels): its UVs lie outside [0,1] or "
-                        "its UV triangles are too small to hold a texel centre",
-                        inst->id, inst->states[0], o->mesh_path ? o->mesh_path : "generated mesh",
-                        R, R);
-  for (size_t s = 0; s < inst->n_states && !st; s++) {
-    tmap_ctx c = {&inst->obj, &inst->fields[s], tri, bary, R, map};
-    hearth_parallel_for(R, rc->threads, tmap_rows, &c);
-    if ((st = mkdirf(err, "%s/%s", gt, inst->states[s]))) break;
-    snprintf(p, sizeof p, "%s/%s/temperature_true.npy", gt, inst->states[s]);
-    size_t shape[2] = {R, R};
-    st = hearth_npy_write(p, HEARTH_NPY_F32, 2, shape, map, err);
-  }
-  free(tri);
-  free(bary);
-  free(map);
-  return st;
+  return HEARTH_OK;
 }
 
 /* ---- the release ----------------------------------------------------------------------- */
@@ -681,7 +931,18 @@ static hearth_status build_tree(const hearth_synth_opts *o, const char *root, he
   }
   hearth_progress prog;
   hearth_progress_begin(&prog, "rendering views", total_views, o->quiet);
-  render_ctx rc = {o, &rig, trays, crays, drays, NULL, NULL, &prog, threads};
+  synth_band *band = NULL;
+  if (!o->ideal) {
+    band = malloc(sizeof *band);
+    if (!band) {
+      st = hearth_err_set(err, HEARTH_E_NOMEM, "synth: out of memory");
+      hearth_progress_end(&prog);
+      hearth_release_free(&rel);
+      goto done;
+    }
+    synth_band_init(band);
+  }
+  render_ctx rc = {o, &rig, trays, crays, drays, NULL, NULL, &prog, threads, band};
   hearth_rig draft_rig = rig;
   if (!o->rgb_full_size) {
     hearth_camera *dc = &draft_rig.rgb;
@@ -720,6 +981,7 @@ static hearth_status build_tree(const hearth_synth_opts *o, const char *root, he
     st = hearth_release_write(p, &rel, err);
   }
   hearth_release_free(&rel);
+  free(band);
 done:
   hearth_mesh_free(&given);
   free(trays);

@@ -247,6 +247,60 @@ typedef struct thermal_ctx {
 
 #define TSS 4
 
+/* the radiance of a surface the camera would read as t_app (degC) */
+static double apparent_radiance(const synth_thermal_fx *f, double t_app) {
+  return synth_camera_radiance(f->band, f->fx->camera_emissivity, f->ambient_c, t_app);
+}
+
+/* the temperature the camera shows for band radiance L */
+static double camera_reading(const synth_thermal_fx *f, double L) {
+  return synth_camera_reading(f->band, f->fx->camera_emissivity, f->ambient_c, L);
+}
+
+/* The radiance leaving the object towards the camera at hit h of the ray
+ * from o along d: the surface at its temperature cooled to the view's time (t0
+ * the field's, at the start of the scan), emitting with its directional
+ * emissivity, and reflecting the rest of the surroundings: the room at
+ * ambient, and where a glossy surface mirrors it, the warm source. */
+static double surface_radiance(const synth_view_job *job, const hearth_ray_hit *h,
+                               const double o[3], const double d[3], double t0) {
+  const synth_thermal_fx *f = job->tfx;
+  const synth_scene *s = job->scene;
+  const hearth_synth_effects *fx = f->fx;
+  double amb = f->ambient_c, t = amb + (t0 - amb) * f->decay;
+  const uint32_t *id = s->world.indices + 3 * (size_t)h->prim;
+  double b0 = 1.0 - h->b1 - h->b2, bw[3] = {b0, h->b1, h->b2}, n[3] = {0, 0, 0};
+  for (int v = 0; v < 3; v++)
+    for (int k = 0; k < 3; k++) n[k] += bw[v] * s->normals[3 * id[v] + k];
+  double nn = hearth_norm3(n);
+  if (nn > 0)
+    for (int k = 0; k < 3; k++) n[k] /= nn;
+  double dn = hearth_dot3(n, d);
+  if (dn > 0) {
+    for (int k = 0; k < 3; k++) n[k] = -n[k];
+    dn = -dn;
+  }
+  const synth_object *obj = s->obj;
+  int style =
+      obj->style_of_tri && h->prim < obj->mesh.n_triangles ? obj->style_of_tri[h->prim] : -1;
+  const synth_ir *m = synth_ir_of_style(style);
+  double eps = synth_ir_emissivity(m, -dn, fx->emissivity, fx->grazing);
+  double env = synth_band_radiance(f->band, amb);
+  if (m->glossy && fx->warm_source_c > 0) {
+    /* the mirror direction, and whether it meets the source */
+    double r[3], p[3], oc[3];
+    for (int k = 0; k < 3; k++) {
+      r[k] = d[k] - 2.0 * dn * n[k];
+      p[k] = o[k] + h->t * d[k];
+      oc[k] = f->source[k] - p[k];
+    }
+    double tca = hearth_dot3(oc, r), d2 = hearth_dot3(oc, oc) - tca * tca;
+    if (tca > 0 && d2 < f->source[3] * f->source[3])
+      env = synth_band_radiance(f->band, f->source_c);
+  }
+  return eps * synth_band_radiance(f->band, t) + (1.0 - eps) * env;
+}
+
 static void thermal_rows(void *vctx, size_t b, size_t e, int ti) {
   thermal_ctx *c = vctx;
   const synth_view_job *job = c->job;
@@ -272,6 +326,7 @@ static void thermal_rows(void *vctx, size_t b, size_t e, int ti) {
       bg_hit h;
       background(s, c->g.bd, o, d, &h);
       bgt[i] = background_temp(s, &h);
+      if (job->tfx) bgt[i] = apparent_radiance(job->tfx, bgt[i]);
       if (sphere_may_hit(s, o, d)) {
         batch_add(&rb, o, d, (uint32_t)i);
         rb.hits[rb.n - 1].t = (float)h.t; /* remember the plane distance */
@@ -290,15 +345,23 @@ static void thermal_rows(void *vctx, size_t b, size_t e, int ti) {
         if (h->prim == UINT32_MAX || !(h->t < tmax[i])) continue;
         double p[3];
         hit_point_obj(s->obj, h, p);
-        val[rb.slot[i]] = synth_field_eval(job->field, s->obj, h->prim, p);
+        double t = synth_field_eval(job->field, s->obj, h->prim, p);
+        if (job->tfx) {
+          double d[3] = {rb.dir[3 * i], rb.dir[3 * i + 1], rb.dir[3 * i + 2]};
+          val[rb.slot[i]] = surface_radiance(job, h, o, d, t);
+        } else {
+          val[rb.slot[i]] = t;
+        }
       }
       free(tmax);
     }
-    /* integrate over the pixel footprint */
+    /* integrate over the pixel footprint (radiance with the effects: what
+       the sensor integrates; the temperature it shows, after) */
     for (size_t x = 0; x < W; x++) {
       double sum = 0;
       for (size_t k = 0; k < per; k++) sum += val[x * per + k];
-      c->img[y * W + x] = (float)(sum / (double)per);
+      if (job->tfx) c->img[y * W + x] = (float)camera_reading(job->tfx, sum / (double)per);
+      else c->img[y * W + x] = (float)(sum / (double)per);
     }
   }
   batch_free(&rb);

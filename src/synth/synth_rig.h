@@ -17,6 +17,7 @@
 #include "hearth/dataset.h"
 #include "hearth/synth.h"
 #include "synth/synth_object.h"
+#include "synth/synth_radiometry.h"
 
 /* ---- lens (synth_rig.c) --------------------------------------------------- */
 /* Brown-Conrady [k1 k2 p1 p2 k3] on normalised coordinates. */
@@ -72,6 +73,16 @@ hearth_status synth_scene_init(synth_scene *s, const synth_object *obj,
                                hearth_err *err);
 void synth_scene_free(synth_scene *s);
 
+/* The object effects of one thermal view (NULL in a job: the clean rig). */
+typedef struct synth_thermal_fx {
+  const synth_band *band;
+  const hearth_synth_effects *fx;
+  double ambient_c; /* the room, and the camera's reflected-temperature setting */
+  double source[4]; /* the warm source: a sphere, centre (world) and radius (m) */
+  double source_c;  /* its temperature */
+  double decay;     /* the state's excess over ambient left at the view's time, exp(-t / tau) */
+} synth_thermal_fx;
+
 /* Everything a view render needs. Tables come from synth_ray_table:
  * thermal with ss = 4, rgb and depth with ss = 1. */
 typedef struct synth_view_job {
@@ -83,6 +94,7 @@ typedef struct synth_view_job {
   uint64_t noise_seed; /* per view */
   double netd_c;
   int threads;
+  const synth_thermal_fx *tfx; /* the object effects; NULL: none */
 } synth_view_job;
 
 /* Outputs: thermal 1-channel F32 (degC), rgb 3-channel U8, mask 1-channel
@@ -159,6 +171,9 @@ typedef struct synth_view_def {
   char name[8]; /* "v07" */
   int index, elevation_index, azimuth_index;
   hearth_rigid T_world_from_rgb;
+  double time_s; /* from the start of the state's scan: its pass (elevation) starts at
+                    elevation_index * scan / 3, views every scan / 30 */
+  double pass_s; /* the start of its pass */
 } synth_view_def;
 
 typedef struct synth_instance {

@@ -23,6 +23,7 @@ int main(void) {
   snprintf(log, sizeof log, "%s.log", root);
   hearth_synth_opts o;
   hearth_synth_opts_default(&o);
+  o.ideal = 1; /* closed-form: the clean rig */
   o.seed = 5;
   o.out_root = root;
   o.n_views = 1;

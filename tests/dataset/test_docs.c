@@ -200,6 +200,8 @@ static void test_round_trips(void) {
   CHECK(cam_eq(&di.depth, &di2.depth) && rigid_eq(&di.T_depth_from_rgb, &di2.T_depth_from_rgb));
 
   hearth_manifest m = sample_manifest(), m2;
+  m.views[1].has_time = 1; /* the optional view time */
+  m.views[1].time_s = 12.5;
   CHECK_OK(hearth_manifest_write(tpath("manifest.json"), &m, &err), &err);
   CHECK_OK(hearth_manifest_read(tpath("manifest.json"), &m2, &err), &err);
   CHECK(m2.n_views == m.n_views && !strcmp(m2.instance, "cup_03") && !strcmp(m2.state, "hot"));
@@ -564,6 +566,7 @@ static void test_bad_documents(void) {
       {"views[1].depth", "\"depth//v01.png\"", HEARTH_E_RANGE, "views[1].depth", "relative"},
       {"views[4].elevation_index", "-1", HEARTH_E_RANGE, "views[4].elevation_index", "[0,"},
       {"views[4].azimuth_index", "1.5", HEARTH_E_PARSE, "views[4].azimuth_index", "integer"},
+      {"views[2].time_s", "-2", HEARTH_E_RANGE, "views[2]", "0..1e6"},
       {"instance", "\"mug_03\"", HEARTH_E_RANGE, "instance", "18 categories"},
       {"state", "\"boiling\"", HEARTH_E_RANGE, "state", "neutral, hot"},
       {"views", "[]", HEARTH_E_SIZE, "views", "at least 1"},

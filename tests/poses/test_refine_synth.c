@@ -79,6 +79,7 @@ int main(void) {
   snprintf(root, sizeof root, "%s/release", dir);
   hearth_synth_opts so;
   hearth_synth_opts_default(&so);
+  so.ideal = 1; /* closed-form: the clean rig */
   so.out_root = root;
   so.seed = 11;
   so.n_categories = NI;

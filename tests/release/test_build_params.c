@@ -65,6 +65,7 @@ int main(void) {
   snprintf(root, sizeof root, "%s/rel", base);
   hearth_synth_opts so;
   hearth_synth_opts_default(&so);
+  so.ideal = 1; /* closed-form: the clean rig */
   so.out_root = root;
   so.seed = 3;
   so.n_views = 2;

@@ -59,6 +59,7 @@ int main(void) {
   /* a tiny release built stage by stage with the library */
   hearth_synth_opts so;
   hearth_synth_opts_default(&so);
+  so.ideal = 1; /* closed-form: the clean rig */
   so.out_root = g_root;
   so.seed = 5;
   so.n_views = 3;
