@@ -71,7 +71,7 @@ int main(void) {
   snprintf(cmd, sizeof cmd,
            "'%s' synth --out '%s' --categories cup --views 4 --triangles 1500 --texture 128 "
            "--map-res 64 --thermal-frames 10 --stereo-pairs 6 --draft-rgb --target grid "
-           "--thermal-size 160x120 --seed 3 --threads 2 --quiet && "
+           "--thermal-size 160x120 --seed 3 --ideal --threads 2 --quiet && "
            "'%s' build '%s' --resolution 64 --threads 2 && '%s' validate '%s'",
            HEARTH_EXE, root, HEARTH_EXE, root, HEARTH_EXE, root);
   int rc = run(cmd, out, sizeof out);
@@ -132,7 +132,7 @@ int main(void) {
   snprintf(cmd, sizeof cmd,
            "'%s' synth --out '%s' --categories cup --states neutral --views 1 --triangles 600 "
            "--texture 64 --map-res 16 --thermal-frames 8 --stereo-pairs 4 --draft-rgb "
-           "--target hex:6x8 --thermal-size 382x288 --seed 4 --threads 2 --quiet && "
+           "--target hex:6x8 --thermal-size 382x288 --seed 4 --ideal --threads 2 --quiet && "
            "'%s' detect '%s' --no-overlays --threads 2 && '%s' calibrate '%s'",
            HEARTH_EXE, root, HEARTH_EXE, root, HEARTH_EXE, root);
   rc = run(cmd, out, sizeof out);
