@@ -71,6 +71,11 @@ typedef struct hearth_calib_opts {
    * centroid of a tilted hole's image is not the image of its centre) from
    * the estimated poses, and re-solve; default 1 */
   int perspective_correction;
+  /* with perspective_correction: a hole of a plate with a thickness
+   * (target.json "thickness_m") shows only the overlap of its front and back
+   * openings; correct that centroid to the front opening's projected centre
+   * too; default 1 (0: the centroid taken as a thin hole's) */
+  int wall_correction;
   double hole_radius_m; /* default 0.004; the release stage takes the target's */
   /* hearth_calib_intrinsics: the lens model solved for; default
    * HEARTH_LENS_BROWN5 (the rational model starts from the 5-parameter

@@ -152,6 +152,9 @@ typedef struct hearth_target {
   hearth_lattice lattice;
   int rows, cols;
   double pitch_m, hole_diameter_m;
+  /* the plate's thickness (target.json "thickness_m", optional); 0: unknown
+   * or thin, hole centres are then taken as if the plate had no depth */
+  double thickness_m;
 } hearth_target;
 
 #define HEARTH_TARGET_MAX_HOLES 512

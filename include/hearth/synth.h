@@ -39,6 +39,21 @@ typedef struct hearth_synth_effects {
   int restore;              /* 1: the state is restored before each pass (its time restarts);
                                default 0 */
   double camera_emissivity; /* the thermal camera's emissivity setting; default 0.95 */
+  /* the calibration bench (docs/virtual-rig.md, "Calibration physics") */
+  double plate_thickness_m; /* plate thickness; < 0 (default -1): drawn per seed in 3..6 mm;
+                               0: an infinitely thin plate */
+  double lamp;              /* scale of the lamp's uneven heating of the backing (a hot spot
+                               and a gradient); default 1 */
+  double plate_warming_c;   /* the plate's warming over the whole capture (degC); default 1.5 */
+  double vignetting;        /* blend of a cos^4 fall-off of thermal contrast; default 0.3 */
+  double fpn_offset_c;      /* fixed-pattern offset per thermal pixel (1 sigma, degC);
+                               default 0.05 */
+  double fpn_gain;          /* fixed-pattern gain per thermal pixel (1 sigma); default 0.01 */
+  double motion_blur_px;    /* longest linear motion blur of a colour frame (px); default 2 */
+  int jpeg_quality;         /* quality of the colour calibration JPEGs; default 90 (ideal: 92) */
+  double trigger_ms;        /* longest trigger offset between the two cameras (ms); default 2 */
+  double hand_speed_m_s;    /* speed of the hand-held plate (m/s); default 0.05 */
+  double hand_turn_rad_s;   /* turn rate of the hand-held plate (rad/s); default 0.1 */
 } hearth_synth_effects;
 
 /* Strings are borrowed: they must stay valid during hearth_synth_release. */

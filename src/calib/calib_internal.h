@@ -45,9 +45,13 @@ int calib_project_pose(const hearth_camera *cam, const double R[9], const double
                        double d_pose[12], double Xc_out[3]);
 
 /* Per-point bias (n x 2) of a circle's image centroid over the projected
- * centre, for circles of `radius` (metres) around obj on the plate plane. */
+ * centre, for circles of `radius` (metres) around obj on the plate plane.
+ * thickness > 0: the holes go through a plate that deep (its back face at
+ * plate z = +thickness, away from the camera), so what shows through is the
+ * overlap of the projected front and back openings; the bias is that
+ * overlap's centroid over the projected front centre. */
 void calib_circle_bias(const hearth_camera *cam, const hearth_rigid *T, const double (*obj)[3],
-                       size_t n, double radius, double *bias);
+                       size_t n, double radius, double thickness, double *bias);
 
 /* ---- shared by the release stages (calib_release.c) and the thermal-only
  * calibration (calib_thermal_only.c) ---- */

@@ -14,6 +14,7 @@ void hearth_calib_opts_default(hearth_calib_opts *o) {
   o->outlier_factor = 2.5;
   o->outlier_min_px = 0.01;
   o->perspective_correction = 1;
+  o->wall_correction = 1;
   o->hole_radius_m = 0.004;
 }
 
@@ -407,9 +408,100 @@ hearth_status hearth_calib_pose(const hearth_camera *cam, const double (*obj)[3]
  * it biases the calibration. With a camera and a plate pose, the bias is the
  * area centroid of the projected rim (a fine polygon) minus the projected
  * centre. */
+/* clip the convex polygon p (n points, counter-clockwise or clockwise as
+ * q) by the half-plane left of (or right of, s = -1) the edge a->b into out;
+ * returns the new count */
+static int clip_edge(const double (*p)[2], int n, const double a[2], const double b[2], double s,
+                     double (*out)[2]) {
+  int m = 0;
+  for (int i = 0; i < n; i++) {
+    const double *P = p[i], *Q = p[(i + 1) % n];
+    double dp = s * ((b[0] - a[0]) * (P[1] - a[1]) - (b[1] - a[1]) * (P[0] - a[0]));
+    double dq = s * ((b[0] - a[0]) * (Q[1] - a[1]) - (b[1] - a[1]) * (Q[0] - a[0]));
+    if (dp >= 0) {
+      out[m][0] = P[0];
+      out[m][1] = P[1];
+      m++;
+    }
+    if ((dp >= 0) != (dq >= 0)) {
+      double t = dp / (dp - dq);
+      out[m][0] = P[0] + t * (Q[0] - P[0]);
+      out[m][1] = P[1] + t * (Q[1] - P[1]);
+      m++;
+    }
+  }
+  return m;
+}
+
+/* area centroid of the overlap of two convex polygons (relative
+ * coordinates), by clipping a with every edge of b; 0 if empty */
+static int overlap_centroid(const double (*a)[2], int na, const double (*b)[2], int nb,
+                            double c[2]) {
+  enum { MAXP = 256 };
+  double buf[2][MAXP][2];
+  int n = na;
+  memcpy(buf[0], a, sizeof(double) * 2 * (size_t)na);
+  double orient = 0;
+  for (int k = 0; k < nb; k++)
+    orient += b[k][0] * b[(k + 1) % nb][1] - b[(k + 1) % nb][0] * b[k][1];
+  double s = orient >= 0 ? 1.0 : -1.0;
+  int cur = 0;
+  for (int k = 0; k < nb && n > 0; k++) {
+    if (n + 1 >= MAXP) return 0;
+    n = clip_edge((const double(*)[2])buf[cur], n, b[k], b[(k + 1) % nb], s, buf[1 - cur]);
+    cur = 1 - cur;
+  }
+  double A = 0, sx = 0, sy = 0;
+  for (int k = 0; k < n; k++) {
+    const double *P = buf[cur][k], *Q = buf[cur][(k + 1) % n];
+    double cr = P[0] * Q[1] - Q[0] * P[1];
+    A += cr;
+    sx += (P[0] + Q[0]) * cr;
+    sy += (P[1] + Q[1]) * cr;
+  }
+  if (fabs(A) < 1e-12) return 0;
+  c[0] = sx / (3 * A);
+  c[1] = sy / (3 * A);
+  return 1;
+}
+
 void calib_circle_bias(const hearth_camera *cam, const hearth_rigid *T, const double (*obj)[3],
-                       size_t n, double radius, double *bias) {
+                       size_t n, double radius, double thickness, double *bias) {
   enum { NR = 48 };
+  if (thickness > 0) {
+    /* the overlap of the front and back openings; finer rims, since the
+     * overlap's edge is made of two arcs */
+    enum { NW = 96 };
+    double cw[NW][2];
+    for (int k = 0; k < NW; k++) {
+      cw[k][0] = cos(2 * M_PI * k / NW);
+      cw[k][1] = sin(2 * M_PI * k / NW);
+    }
+    for (size_t j = 0; j < n; j++) {
+      double f[NW][2], b[NW][2], c[2], Xc[3], z[2];
+      int ok = 1;
+      hearth_rigid_apply(T, obj[j], Xc);
+      ok &= hearth_camera_project(cam, Xc, c, NULL);
+      for (int k = 0; k < NW && ok; k++) {
+        double P[3] = {obj[j][0] + radius * cw[k][0], obj[j][1] + radius * cw[k][1], obj[j][2]};
+        hearth_rigid_apply(T, P, Xc);
+        ok &= hearth_camera_project(cam, Xc, f[k], NULL);
+        P[2] += thickness;
+        hearth_rigid_apply(T, P, Xc);
+        ok &= hearth_camera_project(cam, Xc, b[k], NULL);
+        f[k][0] -= c[0];
+        f[k][1] -= c[1];
+        b[k][0] -= c[0];
+        b[k][1] -= c[1];
+      }
+      bias[2 * j] = bias[2 * j + 1] = 0;
+      if (!ok || !overlap_centroid((const double(*)[2])f, NW, (const double(*)[2])b, NW, z))
+        continue;
+      bias[2 * j] = z[0];
+      bias[2 * j + 1] = z[1];
+    }
+    return;
+  }
   double cs[NR][2];
   for (int k = 0; k < NR; k++) {
     cs[k][0] = cos(2 * M_PI * k / NR);

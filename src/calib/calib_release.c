@@ -650,6 +650,9 @@ hearth_status hearth_calib_calibrate_release(const char *root, const hearth_cali
   const size_t NH = hearth_target_holes(&target);
   const double hole_r =
       o->hole_radius_m != def_hole_radius() ? o->hole_radius_m : 0.5 * target.hole_diameter_m;
+  /* the plate's depth hides part of each hole at a tilt (target.json
+   * "thickness_m"); without the wall correction holes are taken as thin */
+  const double wall_t = o->wall_correction ? target.thickness_m : 0.0;
   size_t n = dets.n;
   double(*obj)[3] = hearth_alloc_array(NH, sizeof *obj);
   double *bias = hearth_alloc_array(2 * NH, sizeof(double));
@@ -751,7 +754,7 @@ hearth_status hearth_calib_calibrate_release(const char *root, const hearth_cali
                  sizeof(double) * 2 * NH);
       for (size_t k = 0; pass > 0 && k < m; k++) {
         calib_circle_bias(&th, &poses[k], (const double(*)[3])obj, NH,
-                          hole_r, bias);
+                          hole_r, wall_t, bias);
         for (size_t q = 0; q < 2 * NH; q++)
           pts[2 * NH * k + q] -= bias[q];
       }
@@ -773,7 +776,7 @@ hearth_status hearth_calib_calibrate_release(const char *root, const hearth_cali
                sizeof(double) * 2 * NH);
     for (size_t k = 0; k < m; k++) {
       calib_circle_bias(&th, &poses[k], (const double(*)[3])obj, NH,
-                        hole_r, bias);
+                        hole_r, wall_t, bias);
       for (size_t q = 0; q < 2 * NH; q++)
         pts[2 * NH * k + q] -= bias[q];
     }
@@ -835,7 +838,7 @@ hearth_status hearth_calib_calibrate_release(const char *root, const hearth_cali
           if (hearth_calib_pose(cc, (const double(*)[3])obj, NH, p, &T, NULL, &e2))
             break;
           calib_circle_bias(cc, &T, (const double(*)[3])obj, NH, hole_r,
-                            bias);
+                            wall_t, bias);
           for (size_t q = 0; q < 2 * NH; q++) p[q] = raw[q] - bias[q];
         }
       }

@@ -329,7 +329,7 @@ static hearth_status robust_fit(const to_problem *p, hearth_lens_model model, to
     pack_used(p, f->used, f->pts, &f->m);
     for (size_t k = 0; k < f->m; k++) {
       double bias[2 * HEARTH_TARGET_MAX_HOLES];
-      calib_circle_bias(&f->cam, &poses[k], p->obj, p->np, p->o->hole_radius_m, bias);
+      calib_circle_bias(&f->cam, &poses[k], p->obj, p->np, p->o->hole_radius_m, 0.0, bias);
       for (size_t q = 0; q < 2 * p->np; q++) f->pts[2 * p->np * k + q] -= bias[q];
     }
     if ((st = solve(p, model, f->pts, f->m, &f->cam, &f->rms, tmp, poses, err))) goto done;

@@ -86,6 +86,10 @@ int hearth_cmd_calibrate(int argc, char **argv) {
                "use the detected centroids as they are (by default each centroid is moved to "
                "the projected hole centre using the estimated pose, removing the perspective "
                "bias of circles)"),
+      CLI_FLAG("--no-wall-correction", &o.wall_correction, 0,
+               "take each hole as a thin one even when calibration/target.json gives the "
+               "plate's thickness_m (by default the centroid of what shows through both "
+               "openings is moved to the front opening's projected centre)"),
       CLI_FLAG("--quiet", &quiet, 1, "summary line only"),
       CLI_GROUP("with --detect, the options of `hearth detect`", detect_opts, &detect_opt),
       CLI_END,

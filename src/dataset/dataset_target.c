@@ -100,20 +100,25 @@ hearth_status hearth_target_check(const hearth_target *t, const char *name, hear
                           "%s: hole_diameter_m: expected > 0 and at most 0.8 pitch_m (%.6g), "
                           "found %.17g",
                           name, 0.8 * t->pitch_m, t->hole_diameter_m);
+  if (!(t->thickness_m >= 0 && t->thickness_m <= 0.05))
+    return hearth_err_set(err, HEARTH_E_RANGE, "%s: thickness_m: expected 0..0.05, found %.17g",
+                          name, t->thickness_m);
   return HEARTH_OK;
 }
 
 static hearth_status target_from_json(hj_ctx *c, const json_t *root, void *out) {
-  static const char *const keys[5] = {"lattice", "rows", "cols", "pitch_m", "hole_diameter_m"};
+  static const char *const keys[6] = {"lattice",  "rows",           "cols",
+                                      "pitch_m",  "hole_diameter_m", "thickness_m"};
   const char *key;
   json_t *v;
   json_object_foreach((json_t *)root, key, v) {
     int known = 0;
-    for (int i = 0; i < 5; i++) known |= !strcmp(key, keys[i]);
+    for (int i = 0; i < 6; i++) known |= !strcmp(key, keys[i]);
     if (!known) {
       hj_push_key(c, key);
       return hj_fail(c, HEARTH_E_PARSE,
-                     "unknown key (expected lattice, rows, cols, pitch_m, hole_diameter_m)");
+                     "unknown key (expected lattice, rows, cols, pitch_m, hole_diameter_m, "
+                     "thickness_m)");
     }
   }
   hearth_target t;
@@ -150,6 +155,13 @@ static hearth_status target_from_json(hj_ctx *c, const json_t *root, void *out) 
     return hj_fail(c, HEARTH_E_RANGE, "expected > 0 and at most 0.8 pitch_m (%.6g), found %.17g",
                    0.8 * t.pitch_m, t.hole_diameter_m);
   }
+  if (json_object_get(root, "thickness_m")) {
+    if ((s = hj_get_number(c, root, "thickness_m", &t.thickness_m))) return s;
+    if (!(t.thickness_m >= 0 && t.thickness_m <= 0.05)) {
+      hj_push_key(c, "thickness_m");
+      return hj_fail(c, HEARTH_E_RANGE, "expected 0..0.05 (metres), found %.17g", t.thickness_m);
+    }
+  }
   *(hearth_target *)out = t;
   return HEARTH_OK;
 }
@@ -180,7 +192,8 @@ hearth_status hearth_target_write(const char *path, const hearth_target *t, hear
   int ok = o && hj_set(o, "lattice", json_string(hearth_lattice_name(t->lattice))) &&
            hj_set(o, "rows", json_integer(t->rows)) && hj_set(o, "cols", json_integer(t->cols)) &&
            hj_set(o, "pitch_m", hj_real(t->pitch_m)) &&
-           hj_set(o, "hole_diameter_m", hj_real(t->hole_diameter_m));
+           hj_set(o, "hole_diameter_m", hj_real(t->hole_diameter_m)) &&
+           (!(t->thickness_m > 0) || hj_set(o, "thickness_m", hj_real(t->thickness_m)));
   if (!ok) {
     json_decref(o);
     o = NULL;

@@ -13,7 +13,9 @@
 
 #define DEG (3.14159265358979323846 / 180.0)
 
-enum { C_OUT = 0, C_PLATE = 1, C_HOLE = 2 };
+/* C_WALL: a ray that enters a hole's front opening but meets its wall
+ * before the back opening (a plate of real thickness) */
+enum { C_OUT = 0, C_PLATE = 1, C_HOLE = 2, C_WALL = 3 };
 
 void synth_plate_geom_init(synth_plate_geom *g, const hearth_target *target) {
   hearth_target tdef;
@@ -53,7 +55,7 @@ void synth_plate_centre(const synth_plate_geom *g, double c[3]) {
   c[2] = 0.0;
 }
 
-static int classify_plate(const synth_plate_geom *g, double x, double y) {
+static int classify_plate(const synth_plate_geom *g, double x, double y, const double **hole) {
   if (fabs(x - g->cx) > g->half_w || fabs(y - g->cy) > g->half_h) return C_OUT;
   const double R = g->r, P = g->t.pitch_m;
   /* quick accept of the margin around the pattern */
@@ -67,7 +69,10 @@ static int classify_plate(const synth_plate_geom *g, double x, double y) {
     for (int cc = c0 - 1; cc <= c0 + 1; cc++) {
       if (cc < 0 || cc >= ncol) continue;
       const double *h = g->holes[g->row_start[r] + cc];
-      if ((x - h[0]) * (x - h[0]) + (y - h[1]) * (y - h[1]) < R * R) return C_HOLE;
+      if ((x - h[0]) * (x - h[0]) + (y - h[1]) * (y - h[1]) < R * R) {
+        if (hole) *hole = h;
+        return C_HOLE;
+      }
     }
   }
   return C_PLATE;
@@ -87,12 +92,26 @@ typedef struct clutter {
   double spots[8][3]; /* x, y, radius */
 } clutter;
 
+/* the bench's physics of one frame (docs/virtual-rig.md, "Calibration
+ * physics"); all zero: the ideal bench */
+typedef struct plate_fx {
+  double thickness;        /* plate thickness (m); the back face is at plate z = +thickness */
+  double lamp_spot;        /* hot spot's excess, a fraction of the hole contrast */
+  double lamp_xy[2], lamp_sigma; /* its centre and width on the backing (plate coordinates) */
+  double lamp_grad[2];     /* gradient: fraction of the hole contrast per metre */
+  double vignetting;       /* blend of cos^4 */
+  double fpn_offset, fpn_gain;
+  uint64_t fpn_seed;       /* the thermal camera's fixed pattern */
+  double motion_px, motion_dir; /* colour: linear blur length (px) and direction (rad) */
+} plate_fx;
+
 typedef struct plate_view {
   const hearth_camera *cam;
   const synth_plate_geom *g;
   hearth_rigid T; /* camera from plate */
   double n[3];    /* plate normal in the camera */
   double nt;      /* n . t */
+  plate_fx fx;
   /* thermal */
   double ambient, plate_dt, hole_dt;
   /* colour */
@@ -172,13 +191,38 @@ static int classify_ray(const plate_view *v, const double d[3], double p[2]) {
   /* plate coordinates: R^T q */
   p[0] = v->T.R[0] * q[0] + v->T.R[3] * q[1] + v->T.R[6] * q[2];
   p[1] = v->T.R[1] * q[0] + v->T.R[4] * q[1] + v->T.R[7] * q[2];
-  return classify_plate(v->g, p[0], p[1]);
+  const double *h = NULL;
+  int cls = classify_plate(v->g, p[0], p[1], &h);
+  if (cls != C_HOLE || v->fx.thickness <= 0) return cls;
+  /* a thick plate: the ray sees the backing only if it also passes the back
+   * opening (the same circle at plate z = thickness); p becomes the point
+   * where it leaves the hole */
+  double e[3];
+  for (int k = 0; k < 3; k++) e[k] = v->T.R[k] * d[0] + v->T.R[3 + k] * d[1] + v->T.R[6 + k] * d[2];
+  if (fabs(e[2]) < 1e-12) return C_WALL;
+  double s = v->fx.thickness / fabs(e[2]);
+  double bx = p[0] + s * e[0] - h[0], by = p[1] + s * e[1] - h[1];
+  if (bx * bx + by * by >= v->g->r * v->g->r) return C_WALL;
+  p[0] += s * e[0];
+  p[1] += s * e[1];
+  return C_HOLE;
 }
 
 static double thermal_value(const plate_view *v, int cls, const double p[2], const double d[3]) {
   switch (cls) {
     case C_PLATE: return v->ambient + v->plate_dt + 1.5 * (p[0] - 0.06);
-    case C_HOLE: return v->ambient + v->hole_dt + 4.0 * (p[1] - 0.036);
+    case C_WALL: return v->ambient + v->plate_dt; /* the plate's own wall */
+    case C_HOLE: {
+      double T = v->ambient + v->hole_dt + 4.0 * (p[1] - 0.036);
+      if (v->fx.lamp_spot > 0 || v->fx.lamp_grad[0] != 0 || v->fx.lamp_grad[1] != 0) {
+        double dx = p[0] - v->fx.lamp_xy[0], dy = p[1] - v->fx.lamp_xy[1];
+        double s2 = v->fx.lamp_sigma * v->fx.lamp_sigma;
+        T += v->hole_dt * (v->fx.lamp_spot * exp(-(dx * dx + dy * dy) / (2 * s2)) +
+                           v->fx.lamp_grad[0] * (p[0] - v->g->cx) +
+                           v->fx.lamp_grad[1] * (p[1] - v->g->cy));
+      }
+      return T;
+    }
     default: break;
   }
   switch (clutter_at(&v->cl, d)) {
@@ -194,6 +238,7 @@ static double thermal_value(const plate_view *v, int cls, const double p[2], con
 static double rgb_value(const plate_view *v, int cls, const double p[2], const double d[3]) {
   switch (cls) {
     case C_PLATE: return v->white * (1.0 - 0.3 * (p[1] - 0.036));
+    case C_WALL: return v->white * (1.0 - 0.3 * (p[1] - 0.036)); /* the plate's own white */
     case C_HOLE: return v->hole_grey;
     default: break;
   }
@@ -273,6 +318,60 @@ static hearth_status render_thermal_plate(const plate_view *v, const float *rays
   float *px = out->data;
   for (size_t i = 0; i < out->width * out->height; i++)
     px[i] += (float)(netd * hearth_rng_normal(noise));
+  const plate_fx *fx = &v->fx;
+  if (fx->vignetting > 0 || fx->fpn_offset > 0 || fx->fpn_gain > 0) {
+    /* contrast to the shutter's reference (ambient) falls off as cos^4 of
+     * the field angle, blended by fx->vignetting; then the camera's fixed
+     * pattern of offset and gain, the same in every frame */
+    hearth_rng fp;
+    hearth_rng_seed(&fp, fx->fpn_seed);
+    for (size_t y = 0; y < out->height; y++)
+      for (size_t x = 0; x < out->width; x++) {
+        double u[2];
+        synth_lens_unproject(v->cam, (double)x, (double)y, u);
+        double c2 = 1.0 / (1.0 + u[0] * u[0] + u[1] * u[1]);
+        double vig = 1.0 - fx->vignetting * (1.0 - c2 * c2);
+        double go = hearth_rng_normal(&fp), gg = hearth_rng_normal(&fp);
+        size_t i = y * out->width + x;
+        double dT = ((double)px[i] - v->ambient) * vig;
+        px[i] = (float)(v->ambient + dT * (1.0 + fx->fpn_gain * gg) + fx->fpn_offset * go);
+      }
+  }
+  return HEARTH_OK;
+}
+
+/* a linear motion blur of length len pixels along direction dir: the mean
+ * of 9 bilinear samples along the segment centred on each pixel */
+static hearth_status motion_blur_f32(hearth_image *im, double len, double dir, hearth_err *err) {
+  if (len <= 0) return HEARTH_OK;
+  size_t W = im->width, H = im->height;
+  float *src = hearth_alloc_array(W * H, sizeof(float));
+  if (!src) return hearth_err_set(err, HEARTH_E_NOMEM, "motion blur: out of memory");
+  memcpy(src, im->data, W * H * sizeof(float));
+  float *dst = im->data;
+  enum { NT = 9 };
+  double ox[NT], oy[NT];
+  for (int k = 0; k < NT; k++) {
+    double s = len * ((double)k / (NT - 1) - 0.5);
+    ox[k] = s * cos(dir);
+    oy[k] = s * sin(dir);
+  }
+  for (size_t y = 0; y < H; y++)
+    for (size_t x = 0; x < W; x++) {
+      double sum = 0;
+      for (int k = 0; k < NT; k++) {
+        double fx = (double)x + ox[k], fy = (double)y + oy[k];
+        fx = fx < 0 ? 0 : fx > (double)W - 1 ? (double)W - 1 : fx;
+        fy = fy < 0 ? 0 : fy > (double)H - 1 ? (double)H - 1 : fy;
+        size_t x0 = (size_t)fx, y0 = (size_t)fy;
+        size_t x1 = x0 + 1 < W ? x0 + 1 : x0, y1 = y0 + 1 < H ? y0 + 1 : y0;
+        double a = fx - (double)x0, b = fy - (double)y0;
+        sum += (1 - a) * (1 - b) * src[y0 * W + x0] + a * (1 - b) * src[y0 * W + x1] +
+               (1 - a) * b * src[y1 * W + x0] + a * b * src[y1 * W + x1];
+      }
+      dst[y * W + x] = (float)(sum / NT);
+    }
+  free(src);
   return HEARTH_OK;
 }
 
@@ -334,6 +433,7 @@ static hearth_status render_rgb_plate(const plate_view *v, const float *rays, do
   hearth_parallel_for(H, threads, cplate_edge_rows, &c);
   free(cls);
   st = synth_blur_f32(&f, blur, err);
+  if (!st) st = motion_blur_f32(&f, v->fx.motion_px, v->fx.motion_dir, err);
   if (!st) st = hearth_image_alloc(out, W, H, 3, HEARTH_PIX_U8, err);
   if (st) {
     hearth_image_free(&f);
@@ -539,6 +639,42 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
   hearth_rigid_inverse(&rig->T_thermal_from_rgb, &T_rgb_from_th);
   st = HEARTH_OK;
 
+  /* the bench's physics, from streams of their own (the ideal bench draws
+   * nothing from them) */
+  const int phys = !o->ideal;
+  const hearth_synth_effects *E = &o->effects;
+  plate_fx fx0;
+  memset(&fx0, 0, sizeof fx0);
+  if (phys) {
+    hearth_rng b;
+    hearth_rng_fork(&base, 77001, &b);
+    double th = hearth_rng_range(&b, 0.003, 0.006);
+    fx0.thickness = E->plate_thickness_m < 0 ? th : E->plate_thickness_m;
+    fx0.lamp_xy[0] = g->cx + hearth_rng_range(&b, -0.4, 0.4) * g->half_w;
+    fx0.lamp_xy[1] = g->cy + hearth_rng_range(&b, -0.4, 0.4) * g->half_h;
+    fx0.lamp_sigma = hearth_rng_range(&b, 0.3, 0.5) * g->half_w;
+    fx0.lamp_spot = E->lamp * hearth_rng_range(&b, 0.15, 0.30);
+    /* 10..20 % of the hole contrast across the plate's width */
+    double ga = hearth_rng_range(&b, 0, 2 * 3.14159265358979323846);
+    double gm = E->lamp * hearth_rng_range(&b, 0.10, 0.20) / (2 * g->half_w);
+    fx0.lamp_grad[0] = gm * cos(ga);
+    fx0.lamp_grad[1] = gm * sin(ga);
+    fx0.vignetting = E->vignetting;
+    fx0.fpn_offset = E->fpn_offset_c;
+    fx0.fpn_gain = E->fpn_gain;
+    fx0.fpn_seed = hearth_rng_u64(&b);
+    if (fx0.thickness > 0) {
+      /* the plate's thickness, measured (callipers) and given to the pipeline */
+      hearth_target tt = g->t;
+      tt.thickness_m = fx0.thickness;
+      g->t.thickness_m = fx0.thickness;
+      dets.target = g->t;
+      snprintf(path, sizeof path, "%s/calibration/target.json", root);
+      st = hearth_target_write(path, &tt, err);
+    }
+  }
+  const double nframes = (double)(nf + np > 1 ? nf + np - 1 : 1);
+
   /* thermal-only frames for the intrinsics */
   for (int i = 0; i < nf && !st; i++) {
     hearth_rng r, noise;
@@ -561,6 +697,10 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
     v.plate_dt = hearth_rng_range(&r, 0.5, 1.5);
     v.hole_dt = hearth_rng_range(&r, 15.0, 25.0);
     if (lk) apply_look(&v, 1, lk, hearth_rng_u64(&noise) ^ (uint64_t)i);
+    if (phys) {
+      v.fx = fx0;
+      v.plate_dt += E->plate_warming_c * (double)i / nframes;
+    }
     char name[16];
     snprintf(name, sizeof name, "f%03d", i);
     snprintf(path, sizeof path, "%s/%s.csv", dir_th, name);
@@ -602,6 +742,44 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
       /* the same room behind the plate in both cameras is not modelled:
        * each camera gets its own clutter */
     }
+    if (phys) {
+      hearth_rng f;
+      hearth_rng_fork(&base, 9000 + (uint64_t)i, &f);
+      vt.fx = fx0;
+      vt.plate_dt += E->plate_warming_c * (double)(nf + i) / nframes;
+      vc.fx = fx0;
+      vc.fx.motion_px = E->motion_blur_px * hearth_rng_uniform(&f);
+      vc.fx.motion_dir = hearth_rng_range(&f, 0, 2 * 3.14159265358979323846);
+      /* the trigger offset: the hand-held plate moves between the thermal
+       * and the colour exposure, a small rigid motion about its centre */
+      double dt = 1e-3 * E->trigger_ms * hearth_rng_uniform(&f);
+      double a[3], w[3], tr[3], na = 0, nw = 0;
+      for (int k = 0; k < 3; k++) {
+        a[k] = hearth_rng_normal(&f);
+        w[k] = hearth_rng_normal(&f);
+        na += a[k] * a[k];
+        nw += w[k] * w[k];
+      }
+      na = sqrt(na);
+      nw = sqrt(nw);
+      for (int k = 0; k < 3; k++) {
+        tr[k] = E->hand_speed_m_s * dt * a[k] / (na > 0 ? na : 1);
+        w[k] = E->hand_turn_rad_s * dt * w[k] / (nw > 0 ? nw : 1);
+      }
+      hearth_rigid M;
+      double pc[3], C[3], RC[3];
+      hearth_rotvec_to_matrix(w, M.R);
+      synth_plate_centre(g, pc);
+      hearth_rigid_apply(&T_rgb, pc, C);
+      hearth_rigid_rotate(&M, C, RC);
+      for (int k = 0; k < 3; k++) M.t[k] = C[k] - RC[k] + tr[k];
+      hearth_rigid moved;
+      hearth_rigid_compose(&M, &T_rgb, &moved);
+      T_rgb = moved;
+      vc.T = T_rgb;
+      for (int k = 0; k < 3; k++) vc.n[k] = T_rgb.R[k * 3 + 2];
+      vc.nt = dot3(vc.n, T_rgb.t);
+    }
     char name[16];
     snprintf(name, sizeof name, "p%03d", i);
     snprintf(path, sizeof path, "%s/%s_thermal.csv", dir_st, name);
@@ -611,7 +789,7 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
       hearth_image img = {0};
       st = render_rgb_plate(&vc, rgb_rays, blurred ? 3.0 : 0.6, &noise, o->threads, &img, err);
       snprintf(path, sizeof path, "%s/%s_rgb.jpg", dir_st, name);
-      if (!st) st = hearth_jpeg_write(path, &img, 92, err);
+      if (!st) st = hearth_jpeg_write(path, &img, phys ? E->jpeg_quality : 92, err);
       hearth_image_free(&img);
     }
     det_fill(&dets.frames[dets.n++], name, "thermal", &rig->thermal, g, &T_th);

@@ -51,6 +51,17 @@ void hearth_synth_effects_default(hearth_synth_effects *e) {
   e->cooling = 1.0;
   e->scan_s = 300.0;
   e->camera_emissivity = 0.95;
+  e->plate_thickness_m = -1.0;
+  e->lamp = 1.0;
+  e->plate_warming_c = 1.5;
+  e->vignetting = 0.3;
+  e->fpn_offset_c = 0.05;
+  e->fpn_gain = 0.01;
+  e->motion_blur_px = 2.0;
+  e->jpeg_quality = 90;
+  e->trigger_ms = 2.0;
+  e->hand_speed_m_s = 0.05;
+  e->hand_turn_rad_s = 0.1;
 }
 
 size_t hearth_synth_categories(const char **names, size_t max) {

@@ -209,7 +209,7 @@ static void test_circle_bias(void) {
   T.t[2] = 0.25;
   double obj[NP][3], bias[2 * NP];
   calib_plate_points(obj);
-  calib_circle_bias(&c, &T, (const double(*)[3])obj, NP, 0.004, bias);
+  calib_circle_bias(&c, &T, (const double(*)[3])obj, NP, 0.004, 0.0, bias);
   hearth_rigid Ti;
   hearth_rigid_inverse(&T, &Ti);
   double n[3] = {T.R[2], T.R[5], T.R[8]}, d = hearth_dot3(n, T.t);
@@ -248,13 +248,70 @@ static void test_circle_bias(void) {
   T.t[0] = -obj[40][0];
   T.t[1] = -obj[40][1];
   T.t[2] = 0.3;
-  calib_circle_bias(&c0, &T, (const double(*)[3])obj, NP, 0.004, bias);
+  calib_circle_bias(&c0, &T, (const double(*)[3])obj, NP, 0.004, 0.0, bias);
   CHECK_NEAR(bias[80], 0, 1e-9);
   CHECK_NEAR(bias[81], 0, 1e-9);
 }
 
+/* a plate 5 mm thick: the bias is the centroid of what shows through both
+ * openings, against the same kind of independent raster: each sample ray is
+ * met with the front plane (z = 0) and the back plane (z = 5 mm) of the
+ * plate and must fall inside the hole on both */
+static void test_circle_bias_thick(void) {
+  hearth_camera c;
+  td_thermal_cam(&c);
+  hearth_rigid T;
+  double w[3] = {0.45, -0.25, 0.1};
+  hearth_rotvec_to_matrix(w, T.R);
+  T.t[0] = -0.07;
+  T.t[1] = -0.03;
+  T.t[2] = 0.25;
+  const double h = 0.005, R = 0.004;
+  double obj[NP][3], bias[2 * NP], thin[2 * NP];
+  calib_plate_points(obj);
+  calib_circle_bias(&c, &T, (const double(*)[3])obj, NP, R, h, bias);
+  calib_circle_bias(&c, &T, (const double(*)[3])obj, NP, R, 0.0, thin);
+  hearth_rigid Ti;
+  hearth_rigid_inverse(&T, &Ti);
+  double n[3] = {T.R[2], T.R[5], T.R[8]}, d0 = hearth_dot3(n, T.t), d1 = d0 + h;
+  int holes[3] = {0, 40, 83};
+  double maxd = 0;
+  for (int k = 0; k < 3; k++) {
+    int i = holes[k];
+    double Xc[3], uv[2];
+    hearth_rigid_apply(&T, obj[i], Xc);
+    hearth_camera_project(&c, Xc, uv, NULL);
+    double sa = 0, su = 0, sv = 0, step = 0.02;
+    for (double v = uv[1] - 6; v <= uv[1] + 6; v += step)
+      for (double u = uv[0] - 6; u <= uv[0] + 6; u += step) {
+        double dir[3], P[3], Q[3];
+        hearth_camera_ray(&c, u, v, dir);
+        int in = 1;
+        for (int f = 0; f < 2 && in; f++) {
+          double s = (f ? d1 : d0) / hearth_dot3(n, dir);
+          for (int q = 0; q < 3; q++) P[q] = s * dir[q];
+          hearth_rigid_apply(&Ti, P, Q);
+          double dx = Q[0] - obj[i][0], dy = Q[1] - obj[i][1];
+          in = dx * dx + dy * dy < R * R;
+        }
+        if (in) {
+          sa += 1;
+          su += u - uv[0];
+          sv += v - uv[1];
+        }
+      }
+    CHECK(sa > 0);
+    CHECK_NEAR(bias[2 * i], su / sa, 3e-3);
+    CHECK_NEAR(bias[2 * i + 1], sv / sa, 3e-3);
+    maxd = fmax(maxd, hypot(bias[2 * i] - thin[2 * i], bias[2 * i + 1] - thin[2 * i + 1]));
+  }
+  /* the wall's shift is much larger than the thin hole's bias here */
+  CHECK(maxd > 0.1);
+}
+
 int main(void) {
   test_circle_bias();
+  test_circle_bias_thick();
   test_zhang_exact();
   test_jacobians();
   test_intrinsics();

@@ -60,7 +60,24 @@ static void test_default_and_json(const char *dir) {
   /* python's json reads what was written, with the keys of docs/dataset.md */
   char *text = test_slurp(path, NULL);
   CHECK(text && strstr(text, "\"lattice\": \"grid\"") && strstr(text, "\"hole_diameter_m\": 0.008"));
+  CHECK(text && !strstr(text, "thickness_m")); /* a thin plate writes no thickness */
   free(text);
+  /* an optional plate thickness round-trips; out of range is refused */
+  hearth_target gt = g;
+  gt.thickness_m = 0.0045;
+  CHECK_OK(hearth_target_write(path, &gt, &err), &err);
+  CHECK_OK(hearth_target_read(path, &t, &err), &err);
+  CHECK(t.thickness_m == 0.0045 && t.rows == 7 && t.cols == 5);
+  gt.thickness_m = 0.2;
+  CHECK(hearth_target_write(path, &gt, &err) == HEARTH_E_RANGE);
+  CHECK(strstr(err.msg, "thickness_m") != NULL);
+  {
+    const char *neg = "{\"lattice\": \"grid\", \"rows\": 7, \"cols\": 7, \"pitch_m\": 0.015, "
+                      "\"hole_diameter_m\": 0.008, \"thickness_m\": -0.001}";
+    CHECK(hearth_target_parse(neg, strlen(neg), "t.json", &t, &err) == HEARTH_E_RANGE);
+    CHECK(strstr(err.msg, "thickness_m") != NULL);
+  }
+  CHECK_OK(hearth_target_write(path, &g, &err), &err); /* the thin grid again */
 
   static const struct {
     const char *text, *want;

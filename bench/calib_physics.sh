@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# Calibration accuracy on the virtual rig with the bench's physics on (the
+# default synth: thick plate, lamp-heated backing, warming plate, vignetting,
+# fixed-pattern noise, colour motion blur and JPEG, trigger offset), over
+# seeds, with the wall-corrected hole centres (the default) and with the
+# naive centroid (--no-wall-correction), against ground_truth/rig.json:
+#   bench/calib_physics.sh BUILD_DIR OUT_DIR [SEEDS...]   (default seeds 1 2 3 4)
+# One line per seed and estimator: stereo RMS (px), thermal fx error (%),
+# rotation (deg) and translation (mm) of T_thermal_from_rgb.
+set -euo pipefail
+build=$(cd "$1" && pwd)
+out=$2
+shift 2
+seeds=${*:-1 2 3 4}
+here=$(cd "$(dirname "$0")" && pwd)
+h="$build/hearth"
+mkdir -p "$out"
+for s in $seeds; do
+  r="$out/seed$s"
+  rm -rf "$r"
+  "$h" synth --out "$r" --categories cup --states neutral --views 1 --seed "$s" --quiet >/dev/null
+  "$h" detect "$r" >/dev/null
+  for est in wall naive; do
+    if [ "$est" = wall ]; then "$h" calibrate "$r" --quiet >/dev/null
+    else "$h" calibrate "$r" --quiet --no-wall-correction >/dev/null; fi
+    /usr/bin/python3 - "$r" "$s" "$est" <<'PY'
+import json, math, sys
+import numpy as np
+r, s, est = sys.argv[1:4]
+e = json.load(open(f"{r}/calibration/rig.json"))
+t = json.load(open(f"{r}/ground_truth/rig.json"))
+th = json.load(open(f"{r}/calibration/target.json")).get("thickness_m", 0)
+Ke, Kt = np.array(e["thermal"]["K"]), np.array(t["thermal"]["K"])
+Re, Rt = np.array(e["T_thermal_from_rgb"]["R"]), np.array(t["T_thermal_from_rgb"]["R"])
+c = max(-1.0, min(1.0, (np.trace(Re @ Rt.T) - 1) / 2))
+dt = 1000 * np.linalg.norm(np.array(e["T_thermal_from_rgb"]["t"]) - np.array(t["T_thermal_from_rgb"]["t"]))
+print(f"seed {s} {est:5s} thickness {1000*th:.2f} mm  stereo_rms {e['stereo_rms_px']:.3f} px  "
+      f"thermal_rms {e['thermal_rms_px']:.4f} px  fx {100*abs(Ke[0,0]-Kt[0,0])/Kt[0,0]:.3f} %  "
+      f"fy {100*abs(Ke[1,1]-Kt[1,1])/Kt[1,1]:.3f} %  cx {abs(Ke[0,2]-Kt[0,2]):.2f} px  "
+      f"cy {abs(Ke[1,2]-Kt[1,2]):.2f} px  rot {math.degrees(math.acos(c)):.4f} deg  t {dt:.3f} mm")
+PY
+  done
+done
