@@ -48,10 +48,16 @@ static const char *k_about_merge =
 /* --task of render and collect: hearth_sim_task values */
 static const char *const k_task_names[] = {"H1", "H2", "H3", NULL};
 static const int k_task_values[] = {HEARTH_SIM_H1, HEARTH_SIM_H2, HEARTH_SIM_H3};
+/* --thermal of render and collect: hearth_sim_thermal values */
+static const char *const k_thermal_names[] = {"static", "dynamic", NULL};
+static const int k_thermal_values[] = {HEARTH_SIM_THERMAL_STATIC, HEARTH_SIM_THERMAL_DYNAMIC};
+#define SIM_THERMAL_HELP                                                                   \
+  "static: the assets' fixed temperature textures (the paper); dynamic: a lumped thermal " \
+  "network per object, cooling and warming with air, table and finger contacts"
 
 int hearth_cmd_sim_render(int argc, char **argv) {
   const char *out = NULL, *release = NULL, *gl = NULL, *renderer = NULL;
-  int only = 0, size = 256, gt = 0, shadows = 0;
+  int only = 0, size = 256, gt = 0, shadows = 0, thermal = HEARTH_SIM_THERMAL_STATIC;
   uint64_t seed = 1;
   const cli_opt opts[] = {
       CLI_STR("--out", "DIR", &out, "output directory (created)", .flags = CLI_REQUIRED),
@@ -66,6 +72,8 @@ int hearth_cmd_sim_render(int argc, char **argv) {
       CLI_INT("--size", "N", &size, 16, 4096, "image side in pixels"),
       CLI_U64("--seed", "N", &seed, "layout seed"),
       CLI_FLAG("--shadows", &shadows, 1, "shadow-mapped light in the RGB views (off by default)"),
+      CLI_CHOICE("--thermal", &thermal, k_thermal_names, k_thermal_values, SIM_THERMAL_HELP,
+                 .def = "static"),
       CLI_STR("--renderer", "soft|gl", &renderer,
               "soft: hearth's deterministic software rasteriser; gl: MuJoCo's OpenGL renderer "
               "(needed for --shadows)",
@@ -95,6 +103,7 @@ int hearth_cmd_sim_render(int argc, char **argv) {
     o.shadows = shadows;
     o.gl = gl;
     o.renderer = renderer;
+    o.thermal = thermal;
     char prefix[4200];
     snprintf(prefix, sizeof prefix, "%s/%s", out, hearth_sim_task_name(o.task));
     if (hearth_sim_render_scene(&o, seed, prefix, &err)) rc = cli_fail("sim render", &err);
@@ -128,6 +137,12 @@ int hearth_cmd_sim_collect(int argc, char **argv) {
                "with --release: a virtual-rig release's ground_truth/ assets"),
       CLI_FLAG("--keep-failures", &o.keep_failures, 1, "also store episodes that did not succeed"),
       CLI_FLAG("--shadows", &o.shadows, 1, "shadow-mapped light in the RGB views (off by default)"),
+      CLI_CHOICE("--thermal", &o.thermal, k_thermal_names, k_thermal_values,
+                 SIM_THERMAL_HELP "; dynamic stores obs/thermal_state",
+                 .def = "static"),
+      CLI_NUM("--thermal-speedup", "X", &o.thermal_speedup, 0, 1e6,
+              "with --thermal dynamic: thermal seconds per simulated second",
+              .flags = CLI_LO_OPEN, .def = "1"),
       CLI_STR("--renderer", "soft|gl|none", &o.renderer,
               "soft: hearth's deterministic software rasteriser; gl: MuJoCo's OpenGL renderer "
               "(needed for --shadows); none: no images (times physics, control and the expert "

@@ -70,6 +70,9 @@ static int measured_nothing(const hearth_eval_results *r) {
 /* --task: bits (1 << task) of hearth_eval_opts.tasks */
 static const char *const k_task_names[] = {"H1", "H2", "H3", "all", NULL};
 static const int k_task_bits[] = {1 << 1, 1 << 2, 1 << 3, (1 << 1) | (1 << 2) | (1 << 3)};
+/* --thermal: hearth_sim_thermal values */
+static const char *const k_thermal_names[] = {"static", "dynamic", NULL};
+static const int k_thermal_values[] = {HEARTH_SIM_THERMAL_STATIC, HEARTH_SIM_THERMAL_DYNAMIC};
 
 int hearth_cmd_sim_eval(int argc, char **argv) {
   hearth_eval_opts o;
@@ -91,6 +94,10 @@ int hearth_cmd_sim_eval(int argc, char **argv) {
               "rendered view side (as sim collect stores)"),
       CLI_FLAG("--shadows", &o.shadows, 1,
                "shadow-mapped light in the RGB views (as at collection)"),
+      CLI_CHOICE("--thermal", &o.thermal_mode, k_thermal_names, k_thermal_values,
+                 "static: fixed temperature textures (the paper); dynamic: lumped thermal "
+                 "networks (as sim collect --thermal)",
+                 .def = "static"),
       CLI_STR("--renderer", "soft|gl", &o.renderer,
               "soft: hearth's deterministic software rasteriser; gl: MuJoCo's OpenGL renderer "
               "(needed for --shadows); the same default as sim collect",

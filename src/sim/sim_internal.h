@@ -23,6 +23,9 @@ typedef struct sim_asset {
   hearth_mesh mesh;     /* no texture inside */
   hearth_image rgb;     /* U8 RGB */
   hearth_image thermal; /* U8 RGB Turbo 10..60 degC */
+  float *temp;          /* temp_R x temp_R degC per texel (NaN: no surface), rows as
+                         * in thermal: the true map, or the Turbo image read back */
+  size_t temp_R;
   double size[3];       /* bounding box extents */
   double mass, friction;
 } sim_asset;
