@@ -49,10 +49,11 @@ static void write_png(const char *path, const uint8_t *rgb, int w, int h) {
   printf("wrote %s\n", path);
 }
 
-static hearth_sim_env *make_env(const char *root, double h_table, double h_finger,
-                                double speedup, int size) {
+static hearth_sim_env *make_env_r(const char *root, double h_table, double h_finger,
+                                  double speedup, int size, const char *renderer) {
   hearth_sim_opts o;
   hearth_sim_opts_default(&o);
+  o.renderer = renderer;
   o.task = HEARTH_SIM_H1;
   o.release_root = root;
   o.width = o.height = size;
@@ -64,6 +65,38 @@ static hearth_sim_env *make_env(const char *root, double h_table, double h_finge
   hearth_err err = {0};
   CHECK_OK(hearth_sim_env_new(&o, &e, &err), &err);
   return e;
+}
+
+static hearth_sim_env *make_env(const char *root, double h_table, double h_finger,
+                                double speedup, int size) {
+  return make_env_r(root, h_table, h_finger, speedup, size, "soft");
+}
+
+/* MuJoCo's GL renderer (OSMesa) shows the re-uploaded texture too: the
+ * hot cup's pixels get colder after 20 steps of 30 s each */
+static void check_gl(const char *root) {
+  hearth_err err = {0};
+  const int S = 64;
+  hearth_sim_env *e = make_env_r(root, 0, 0, 600.0, S, "gl");
+  if (!e) return;
+  CHECK_OK(hearth_sim_reset(e, 7, 0, 0, &err), &err);
+  hearth_sim_obs ob;
+  size_t npx = (size_t)S * S;
+  uint8_t *a = malloc(npx * 3), *sel = calloc(npx, 1);
+  CHECK_OK(hearth_sim_observe(e, &ob, &err), &err);
+  memcpy(a, ob.agentview_thermal, npx * 3);
+  for (size_t p = 0; p < npx; p++) {
+    uint8_t one = 1;
+    sel[p] = image_mean_temp(a + 3 * p, &one, 1) > 35.0;
+  }
+  double zero[7] = {0, 0, 0, 0, 0, 0, -1};
+  for (int t = 0; t < 20; t++) CHECK_OK(hearth_sim_step(e, zero, &err), &err);
+  CHECK_OK(hearth_sim_observe(e, &ob, &err), &err);
+  double t0 = image_mean_temp(a, sel, npx), t1 = image_mean_temp(ob.agentview_thermal, sel, npx);
+  printf("gl: hot pixels %.2f -> %.2f degC after 10 thermal minutes\n", t0, t1);
+  CHECK_MSG(t1 < t0 - 1.0, "gl thermal view %.2f -> %.2f", t0, t1);
+  free(a), free(sel);
+  hearth_sim_env_free(e);
 }
 
 /* the hot cup (object 0 of H1) with no contact links: the env's state at
@@ -289,6 +322,7 @@ int main(void) {
   const char *root = test_sim_release(dirbuf);
   check_alone(root, dirbuf);
   check_finger(root);
+  check_gl(root);
   check_files(root, dirbuf);
   return g_test_failures ? 1 : 0;
 }
