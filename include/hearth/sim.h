@@ -205,7 +205,7 @@ typedef struct hearth_sim_collect_opts {
   int split_instructions;       /* one file per instruction: out_path without ".hdf5", plus
                          * "_instr1.hdf5" and "_instr2.hdf5" (hearth_sim_split_path) */
   int quiet;
-  int thermal; /* as hearth_sim_opts.thermal; dynamic adds obs/thermal_state */
+  int thermal;            /* as hearth_sim_opts.thermal; dynamic adds obs/thermal_state */
   double thermal_speedup; /* as hearth_sim_opts.thermal_speedup; 0 = 1 */
   const char *out_path; /* .hdf5, written atomically (layout: docs/simulation.md) */
 } hearth_sim_collect_opts;

@@ -68,20 +68,14 @@ int sim_cli_parse_tasks(void *dst, const char *value, char *why, size_t whysz) {
     const char *q = strchr(p, ',');
     size_t n = q ? (size_t)(q - p) : strlen(p);
     char item[16];
-    if (n == 0 || n >= sizeof item) {
-      snprintf(why, whysz, "'%s': expected H1, H2, H3, a comma-separated list of them or all",
-               value);
-      return 1;
-    }
+    /* a bad item: the parser's "expected <expect>, found '<value>'" */
+    if (n == 0 || n >= sizeof item) return 1;
     memcpy(item, p, n);
     item[n] = 0;
     if (strcasecmp(item, "all") == 0) bits |= SIM_CLI_ALL_TASKS;
     else {
       hearth_sim_task t = hearth_sim_task_parse(item);
-      if (!t) {
-        snprintf(why, whysz, "'%s' is not a task (H1, H2, H3 or all)", item);
-        return 1;
-      }
+      if (!t) return 1;
       bits |= 1u << t;
     }
     if (!q) break;

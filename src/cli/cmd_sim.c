@@ -60,8 +60,9 @@ int hearth_cmd_sim_render(int argc, char **argv) {
   uint64_t seed = 1;
   const cli_opt opts[] = {
       CLI_STR("--out", "DIR", &out, "output directory (created)", .flags = CLI_REQUIRED),
-      CLI_CALL("--task", "LIST", &only, sim_cli_parse_tasks, "H1, H2, H3, a list such as H1,H3, or all",
-               "the tasks rendered", .def = "all three"),
+      CLI_CALL("--task", "LIST", &only, sim_cli_parse_tasks,
+               "H1, H2, H3, a list such as H1,H3, or all", "the tasks rendered",
+               .def = "all three"),
       CLI_STR("--release", "ROOT", &release,
               "assets from a release (derived/ meshes and thermal_turbo.png)",
               .def = "a small release made by the virtual rig"),
@@ -142,11 +143,10 @@ int hearth_cmd_sim_collect(int argc, char **argv) {
       CLI_FLAG("--keep-failures", &o.keep_failures, 1, "also store episodes that did not succeed"),
       CLI_FLAG("--shadows", &o.shadows, 1, "shadow-mapped light in the RGB views (off by default)"),
       CLI_CHOICE("--thermal", &o.thermal, k_thermal_names, k_thermal_values,
-                 SIM_THERMAL_HELP "; dynamic stores obs/thermal_state",
-                 .def = "static"),
+                 SIM_THERMAL_HELP "; dynamic stores obs/thermal_state", .def = "static"),
       CLI_NUM("--thermal-speedup", "X", &o.thermal_speedup, 0, 1e6,
-              "with --thermal dynamic: thermal seconds per simulated second",
-              .flags = CLI_LO_OPEN, .def = "1"),
+              "with --thermal dynamic: thermal seconds per simulated second", .flags = CLI_LO_OPEN,
+              .def = "1"),
       CLI_STR("--renderer", "soft|gl|none", &o.renderer,
               "soft: hearth's deterministic software rasteriser; gl: MuJoCo's OpenGL renderer "
               "(needed for --shadows); none: no images (times physics, control and the expert "

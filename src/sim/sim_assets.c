@@ -251,6 +251,17 @@ static void make_upright(hearth_mesh *m, const double up[3], const sim_category 
   for (int k = 0; k < 3; k++) size[k] = sc * ext[k];
 }
 
+hearth_status sim_asset_temperatures(sim_asset *a, hearth_err *err) {
+  if (a->temp) return HEARTH_OK;
+  if (a->thermal.width != a->thermal.height || a->thermal.channels < 3)
+    return hearth_err_set(err, HEARTH_E_SIZE,
+                          "sim asset %s/%s: thermal texture %zux%zu is not square RGB", a->category,
+                          a->state, a->thermal.width, a->thermal.height);
+  hearth_status st = turbo_to_temp(&a->thermal, &a->temp, err);
+  if (!st) a->temp_R = a->thermal.width;
+  return st;
+}
+
 hearth_status sim_asset_load(const char *root, int use_gt, const char *category, const char *state,
                              sim_asset *a, hearth_err *err) {
   memset(a, 0, sizeof *a);
@@ -302,13 +313,6 @@ hearth_status sim_asset_load(const char *root, int use_gt, const char *category,
   }
   if (!st) st = to_rgb(&a->rgb, "colour texture", err);
   if (!st) st = to_rgb(&a->thermal, "thermal texture", err);
-  if (!st && !a->temp) {
-    if (a->thermal.width != a->thermal.height)
-      st = hearth_err_set(err, HEARTH_E_SIZE, "thermal texture: %zux%zu is not square",
-                          a->thermal.width, a->thermal.height);
-    else st = turbo_to_temp(&a->thermal, &a->temp, err);
-    if (!st) a->temp_R = a->thermal.width;
-  }
   if (st) {
     sim_asset_free(a);
     return hearth_err_prefix(err, "sim asset %s/%s: ", category, state);

@@ -33,7 +33,7 @@ int hearth_sim_thermal_parse(const char *s) {
  * the thermo template that adds a liquid region (cup, can) */
 typedef struct th_category {
   const char *name, *material;
-  double thickness; /* m */
+  double thickness;   /* m */
   const char *thermo; /* hearth_thermo_category_net name, or NULL */
 } th_category;
 
@@ -74,18 +74,20 @@ static hearth_status build_object(hearth_sim_env *e, int k, hearth_err *err) {
   sim_asset *a = &e->assets[k];
   sim_thermal_obj *o = &e->th[k];
   const th_category *tc = th_category_find(a->category);
-  if (!tc) return hearth_err_set(err, HEARTH_E_NOT_FOUND, "sim thermal: no parameters for '%s'",
-                                 a->category);
+  if (!tc)
+    return hearth_err_set(err, HEARTH_E_NOT_FOUND, "sim thermal: no parameters for '%s'",
+                          a->category);
   const hearth_thermo_material *mat = hearth_thermo_material_find(tc->material);
   if (!mat)
     return hearth_err_set(err, HEARTH_E_NOT_FOUND, "sim thermal: no material '%s'", tc->material);
+  hearth_status st = sim_asset_temperatures(a, err);
+  if (st) return st;
   size_t R = a->temp_R, n = R * R;
   uint8_t *mask = malloc(n);
   if (!mask) return hearth_err_set(err, HEARTH_E_NOMEM, "sim thermal: out of memory");
   for (size_t i = 0; i < n; i++) mask[i] = isfinite(a->temp[i]) ? 1 : 0; /* OBSERVED : NONE */
   hearth_thermo_regions reg = {0};
-  hearth_status st = hearth_thermo_regions_from_map(R, mask, a->temp, a->temp, NULL,
-                                                    SIM_TH_CLUSTERS, &reg, err);
+  st = hearth_thermo_regions_from_map(R, mask, a->temp, a->temp, NULL, SIM_TH_CLUSTERS, &reg, err);
   free(mask);
   if (st) return hearth_err_prefix(err, "sim thermal %s/%s: ", a->category, a->state);
   /* the shell: the template's body region, else the category's mass */
@@ -99,8 +101,8 @@ static hearth_status build_object(hearth_sim_env *e, int k, hearth_err *err) {
       return st;
     }
     size_t ib = 0, il = 0;
-    if (hearth_thermo_find(&tpl, "body", &ib, NULL) == HEARTH_OK) C_body = tpl.region[ib].C,
-                                                                 h_body = tpl.region[ib].h_conv;
+    if (hearth_thermo_find(&tpl, "body", &ib, NULL) == HEARTH_OK)
+      C_body = tpl.region[ib].C, h_body = tpl.region[ib].h_conv;
     if (hearth_thermo_find(&tpl, "liquid", &il, NULL) == HEARTH_OK)
       liquid = &tpl.region[il], G_liquid = tpl.G[ib][il];
   }
@@ -140,8 +142,8 @@ static hearth_status build_object(hearth_sim_env *e, int k, hearth_err *err) {
       if (!edges[i][j]) continue;
       double L = (double)edges[i][j] * texel;
       double d = 0.5 * (sqrt(o->net.region[i].area) + sqrt(o->net.region[j].area));
-      if (d > 0) st = hearth_thermo_set_conductance(&o->net, i, j, mat->k * tc->thickness * L / d,
-                                                    err);
+      if (d > 0)
+        st = hearth_thermo_set_conductance(&o->net, i, j, mat->k * tc->thickness * L / d, err);
     }
   if (!st && liquid) {
     hearth_thermo_region r = *liquid;
@@ -223,8 +225,7 @@ static hearth_status build_object(hearth_sim_env *e, int k, hearth_err *err) {
 hearth_status sim_thermal_init(hearth_sim_env *e, hearth_err *err) {
   if (e->thermal != HEARTH_SIM_THERMAL_DYNAMIC) return HEARTH_OK;
   const mjModel *m = e->m;
-  for (int i = 0; i < SIM_TH_LUT; i++)
-    hearth_turbo((double)i / (SIM_TH_LUT - 1), e->th_lut[i]);
+  for (int i = 0; i < SIM_TH_LUT; i++) hearth_turbo((double)i / (SIM_TH_LUT - 1), e->th_lut[i]);
   for (int k = 0; k < SIM_NOBJ; k++) {
     hearth_status st = build_object(e, k, err);
     if (st) return st;
@@ -236,14 +237,14 @@ hearth_status sim_thermal_init(hearth_sim_env *e, hearth_err *err) {
     if (o->texid < 0 || m->tex_width[o->texid] != (int)R || m->tex_height[o->texid] != (int)R ||
         img->width != R)
       return hearth_err_set(err, HEARTH_E_UNSUPPORTED,
-                            "sim thermal: object %d's thermal texture is not its %zux%zu map", k,
-                            R, R);
+                            "sim thermal: object %d's thermal texture is not its %zux%zu map", k, R,
+                            R);
     /* which row order MuJoCo keeps the texture in */
     const uint8_t *tx = m->tex_rgb + m->tex_adr[o->texid], *px = img->data;
-    if (memcmp(tx, px, 3 * R) == 0 && memcmp(tx + 3 * R * (R - 1), px + 3 * R * (R - 1), 3 * R) == 0)
+    if (memcmp(tx, px, 3 * R) == 0 &&
+        memcmp(tx + 3 * R * (R - 1), px + 3 * R * (R - 1), 3 * R) == 0)
       o->flip = 0;
-    else if (memcmp(tx, px + 3 * R * (R - 1), 3 * R) == 0)
-      o->flip = 1;
+    else if (memcmp(tx, px + 3 * R * (R - 1), 3 * R) == 0) o->flip = 1;
     else
       return hearth_err_set(err, HEARTH_E_UNSUPPORTED,
                             "sim thermal: object %d's model texture is not its thermal image", k);
@@ -330,8 +331,8 @@ hearth_status sim_thermal_step(hearth_sim_env *e, double dt, hearth_err *err) {
     for (size_t r = 0; r < o->net.n; r++)
       for (int kind = 0; kind < 3; kind++)
         if (G[r][kind] > 0) {
-          hearth_status st = hearth_thermo_add_contact(&o->net, r, G[r][kind],
-                                                       HEARTH_SIM_THERMAL_ROOM, err);
+          hearth_status st =
+              hearth_thermo_add_contact(&o->net, r, G[r][kind], HEARTH_SIM_THERMAL_ROOM, err);
           if (st) return st;
         }
   }

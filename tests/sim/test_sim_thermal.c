@@ -49,8 +49,8 @@ static void write_png(const char *path, const uint8_t *rgb, int w, int h) {
   printf("wrote %s\n", path);
 }
 
-static hearth_sim_env *make_env_r(const char *root, double h_table, double h_finger,
-                                  double speedup, int size, const char *renderer) {
+static hearth_sim_env *make_env_r(const char *root, double h_table, double h_finger, double speedup,
+                                  int size, const char *renderer) {
   hearth_sim_opts o;
   hearth_sim_opts_default(&o);
   o.renderer = renderer;
@@ -67,8 +67,8 @@ static hearth_sim_env *make_env_r(const char *root, double h_table, double h_fin
   return e;
 }
 
-static hearth_sim_env *make_env(const char *root, double h_table, double h_finger,
-                                double speedup, int size) {
+static hearth_sim_env *make_env(const char *root, double h_table, double h_finger, double speedup,
+                                int size) {
   return make_env_r(root, h_table, h_finger, speedup, size, "soft");
 }
 
@@ -160,22 +160,23 @@ static void check_alone(const char *root, const char *dir) {
       double d = fabs(net->region[i].T - ref.region[i].T);
       double df = fabs((double)col[i] - ref.region[i].T);
       if (d > max_dev) max_dev = d;
-      CHECK_MSG(df <= 1e-5 * fabs(ref.region[i].T) + 1e-6, "step %d region %zu stored %.7f ref %.7f",
-                t, i, col[i], ref.region[i].T);
+      CHECK_MSG(df <= 1e-5 * fabs(ref.region[i].T) + 1e-6,
+                "step %d region %zu stored %.7f ref %.7f", t, i, col[i], ref.region[i].T);
     }
   }
   CHECK_MSG(max_dev <= 1e-9, "env vs library: %.3g degC", max_dev);
   /* the cup cooled: energy lost equals the heat the env booked */
-  double E = hearth_thermo_energy(hearth_sim_thermal_net(e, 0)), q = hearth_sim_thermal_heat_in(e, 0);
-  CHECK_MSG(E < E0 && fabs(E - E0 - q) <= 1e-9 * fabs(E0), "E0 %.6f E %.6f heat_in %.6f", E0, E,
-            q);
+  double E = hearth_thermo_energy(hearth_sim_thermal_net(e, 0)),
+         q = hearth_sim_thermal_heat_in(e, 0);
+  CHECK_MSG(E < E0 && fabs(E - E0 - q) <= 1e-9 * fabs(E0), "E0 %.6f E %.6f heat_in %.6f", E0, E, q);
   size_t nsel = 0;
   for (size_t p = 0; p < npx; p++) nsel += sel[p];
   CHECK_MSG(nsel > 20, "hot cup pixels: %zu", nsel);
-  printf("hot cup (slot %c, %zu px): image mean %.2f -> %.2f -> %.2f degC over %d steps (x60: "
-         "%.0f s); hottest region %.2f -> %.2f degC\n",
-         slot >= 0 ? 'A' + slot : '?', nsel, img_T[0], img_T[1], img_T[2], steps,
-         steps * 60.0 / HEARTH_SIM_CONTROL_HZ, T_hot0, hearth_sim_thermal_net(e, 0)->region[hot].T);
+  printf(
+      "hot cup (slot %c, %zu px): image mean %.2f -> %.2f -> %.2f degC over %d steps (x60: "
+      "%.0f s); hottest region %.2f -> %.2f degC\n",
+      slot >= 0 ? 'A' + slot : '?', nsel, img_T[0], img_T[1], img_T[2], steps,
+      steps * 60.0 / HEARTH_SIM_CONTROL_HZ, T_hot0, hearth_sim_thermal_net(e, 0)->region[hot].T);
   CHECK_MSG(img_T[2] < img_T[1] && img_T[1] < img_T[0], "image mean %.3f %.3f %.3f", img_T[0],
             img_T[1], img_T[2]);
   free(col), free(sel), free(first);
@@ -208,7 +209,8 @@ static void check_finger(const char *root) {
     if (hearth_sim_success(e[0])) break;
   }
   CHECK_MSG(worst <= 1e-9 * E0, "energy bookkeeping with contacts off by %.3g J", worst);
-  const hearth_thermo_net *f = hearth_sim_thermal_net(e[0], 0), *z = hearth_sim_thermal_net(e[1], 0);
+  const hearth_thermo_net *f = hearth_sim_thermal_net(e[0], 0),
+                          *z = hearth_sim_thermal_net(e[1], 0);
   size_t rc = 0, ru = SIZE_MAX;
   for (size_t i = 0; i < f->n; i++)
     if (touched[i] > touched[rc]) rc = i;
