@@ -62,6 +62,7 @@ typedef struct hearth_eval_opts {
                           * hearth_sim_collect, so evaluation sees the images
                           * training saw */
   const char *gl;        /* as hearth_sim_opts.gl */
+  int thermal_mode;      /* as hearth_sim_opts.thermal (static by default) */
   int image_size;        /* policy image side; default 224 (openpi's model input) */
   int max_steps;         /* 0 = hearth_eval_time_limit(task) */
   int replan_steps;      /* default 5 */

@@ -16,6 +16,7 @@
 #include <stddef.h>
 #include <stdint.h>
 #include "hearth/core.h"
+#include "hearth/thermo.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -55,6 +56,20 @@ const char *hearth_sim_instruction_text(hearth_sim_task t, int instruction);
  * <state>/temperature_true.npy; otherwise derived/mesh.glb and
  * derived/<state>/thermal_turbo.png. Strings are borrowed for the call that
  * takes the options. */
+/* temperature textures: fixed (the paper) or from a lumped thermal model
+ * per object (docs/simulation.md, "Dynamic temperatures") */
+typedef enum hearth_sim_thermal {
+  HEARTH_SIM_THERMAL_STATIC = 0,
+  HEARTH_SIM_THERMAL_DYNAMIC = 1
+} hearth_sim_thermal;
+/* "static" / "dynamic" -> the mode, -1 if neither */
+int hearth_sim_thermal_parse(const char *s);
+/* air, table and fingers, degC */
+#define HEARTH_SIM_THERMAL_ROOM 22.0
+/* default contact conductance per unit area, W/(m^2 K): a light dry
+ * press of non-metal surfaces (docs/simulation.md has the reasoning) */
+#define HEARTH_SIM_H_CONTACT 1000.0
+
 typedef struct hearth_sim_opts {
   hearth_sim_task task;
   const char *release_root;
@@ -79,6 +94,16 @@ typedef struct hearth_sim_opts {
                           * NULL: $HEARTH_GL, else "osmesa" */
   const char *work_dir; /* scratch for the MJCF/mesh files; NULL = a fresh dir under
                           * $TMPDIR (else /tmp), removed with the env */
+  int thermal;          /* HEARTH_SIM_THERMAL_STATIC (default: the paper's fixed
+                          * temperature textures) or _DYNAMIC (a lumped thermal
+                          * network per object, integrated with the physics) */
+  /* dynamic: contact conductances per unit area, W/(m^2 K), of the table
+   * (and mat) and of the finger pads, both held at HEARTH_SIM_THERMAL_ROOM;
+   * defaults HEARTH_SIM_H_CONTACT; 0 removes that kind of link */
+  double h_contact_table, h_contact_finger;
+  /* dynamic: thermal seconds per simulated second (default 1; e.g. 60
+   * makes a 20 s episode show 20 minutes of cooling), > 0 */
+  double thermal_speedup;
 } hearth_sim_opts;
 void hearth_sim_opts_default(hearth_sim_opts *o);
 
@@ -141,6 +166,18 @@ hearth_status hearth_sim_visibility(hearth_sim_env *env, double *target_frac, do
  * front view, slot A then slot B (privileged; tests and audits). */
 hearth_status hearth_sim_candidate_boxes(hearth_sim_env *env, int boxes[2][4], hearth_err *err);
 
+/* ---- dynamic temperatures (opts.thermal = HEARTH_SIM_THERMAL_DYNAMIC) ---- */
+/* Object k's (0..3) thermal network now, contact links of the last step
+ * included; NULL with static temperatures or k out of range. */
+const hearth_thermo_net *hearth_sim_thermal_net(const hearth_sim_env *env, int k);
+/* Heat object k took in from outside (air, table, fingers) since reset, J:
+ * its network's energy now minus at reset, to rounding. */
+double hearth_sim_thermal_heat_in(const hearth_sim_env *env, int k);
+/* The region temperatures of objects 0..3 one after another (the columns
+ * of obs/thermal_state); returns their count and writes them when max is
+ * at least that (T may be NULL). 0 with static temperatures. */
+size_t hearth_sim_thermal_state(const hearth_sim_env *env, float *T, size_t max);
+
 /* The scripted expert (privileged state): approach, grasp, lift, transport,
  * release. Call once per step after reset. */
 void hearth_sim_expert_action(hearth_sim_env *env, double action[7]);
@@ -168,6 +205,8 @@ typedef struct hearth_sim_collect_opts {
   int split_instructions;       /* one file per instruction: out_path without ".hdf5", plus
                          * "_instr1.hdf5" and "_instr2.hdf5" (hearth_sim_split_path) */
   int quiet;
+  int thermal;            /* as hearth_sim_opts.thermal; dynamic adds obs/thermal_state */
+  double thermal_speedup; /* as hearth_sim_opts.thermal_speedup; 0 = 1 */
   const char *out_path; /* .hdf5, written atomically (layout: docs/simulation.md) */
 } hearth_sim_collect_opts;
 void hearth_sim_collect_opts_default(hearth_sim_collect_opts *o);

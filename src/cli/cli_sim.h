@@ -13,6 +13,11 @@ int sim_cli_assets(const char *release, int gt, char *root, size_t rootsz, char 
 /* Removes what sim_cli_assets made (nothing for a given release). */
 void sim_cli_drop_assets(const char *tmpdir);
 
+/* --task of the hearth-sim commands: "H1", "H1,H3" or "all" (any case)
+ * into *(unsigned *)dst as bits 1 << task; the CLI_CALL parser */
+#define SIM_CLI_ALL_TASKS ((1u << 1) | (1u << 2) | (1u << 3))
+int sim_cli_parse_tasks(void *dst, const char *value, char *why, size_t whysz);
+
 /* the subcommands (argv[0] is the subcommand's name) */
 int hearth_cmd_sim_render(int argc, char **argv);
 int hearth_cmd_sim_collect(int argc, char **argv);

@@ -2,10 +2,13 @@
  * small virtual-rig release made in a temporary directory. */
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
+#include <strings.h>
 #include <unistd.h>
 
 #include "cli/cli.h"
 #include "cli/cli_sim.h"
+#include "hearth/sim.h"
 #include "hearth/synth.h"
 
 /* assets: a release root given, or a tiny virtual-rig release in a temp dir */
@@ -56,4 +59,28 @@ int sim_cli_assets(const char *release, int gt, char *root, size_t rootsz, char 
 
 void sim_cli_drop_assets(const char *tmpdir) {
   if (tmpdir[0]) hearth_remove_tree(tmpdir, NULL);
+}
+
+int sim_cli_parse_tasks(void *dst, const char *value, char *why, size_t whysz) {
+  unsigned bits = 0;
+  const char *p = value;
+  while (1) {
+    const char *q = strchr(p, ',');
+    size_t n = q ? (size_t)(q - p) : strlen(p);
+    char item[16];
+    /* a bad item: the parser's "expected <expect>, found '<value>'" */
+    if (n == 0 || n >= sizeof item) return 1;
+    memcpy(item, p, n);
+    item[n] = 0;
+    if (strcasecmp(item, "all") == 0) bits |= SIM_CLI_ALL_TASKS;
+    else {
+      hearth_sim_task t = hearth_sim_task_parse(item);
+      if (!t) return 1;
+      bits |= 1u << t;
+    }
+    if (!q) break;
+    p = q + 1;
+  }
+  *(unsigned *)dst = bits;
+  return 0;
 }

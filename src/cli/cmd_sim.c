@@ -1,6 +1,7 @@
 /* hearth sim render, collect, merge: scene pictures, demonstrations and
  * the merge of a sharded collection */
 #include <stdio.h>
+#include <string.h>
 #include <stdlib.h>
 #include <unistd.h>
 
@@ -45,18 +46,23 @@ static const char *k_about_merge =
     "one unsharded run with the same options. For --split-instructions, merge the\n"
     "files of each instruction separately.\n";
 
-/* --task of render and collect: hearth_sim_task values */
-static const char *const k_task_names[] = {"H1", "H2", "H3", NULL};
-static const int k_task_values[] = {HEARTH_SIM_H1, HEARTH_SIM_H2, HEARTH_SIM_H3};
+/* --thermal of render and collect: hearth_sim_thermal values */
+static const char *const k_thermal_names[] = {"static", "dynamic", NULL};
+static const int k_thermal_values[] = {HEARTH_SIM_THERMAL_STATIC, HEARTH_SIM_THERMAL_DYNAMIC};
+#define SIM_THERMAL_HELP                                                                   \
+  "static: the assets' fixed temperature textures (the paper); dynamic: a lumped thermal " \
+  "network per object, cooling and warming with air, table and finger contacts"
 
 int hearth_cmd_sim_render(int argc, char **argv) {
   const char *out = NULL, *release = NULL, *gl = NULL, *renderer = NULL;
-  int only = 0, size = 256, gt = 0, shadows = 0;
+  int size = 256, gt = 0, shadows = 0, thermal = HEARTH_SIM_THERMAL_STATIC;
+  unsigned only = 0;
   uint64_t seed = 1;
   const cli_opt opts[] = {
       CLI_STR("--out", "DIR", &out, "output directory (created)", .flags = CLI_REQUIRED),
-      CLI_CHOICE("--task", &only, k_task_names, k_task_values, "only this task",
-                 .flags = CLI_NOCASE, .def = "all three"),
+      CLI_CALL("--task", "LIST", &only, sim_cli_parse_tasks,
+               "H1, H2, H3, a list such as H1,H3, or all", "the tasks rendered",
+               .def = "all three"),
       CLI_STR("--release", "ROOT", &release,
               "assets from a release (derived/ meshes and thermal_turbo.png)",
               .def = "a small release made by the virtual rig"),
@@ -66,6 +72,8 @@ int hearth_cmd_sim_render(int argc, char **argv) {
       CLI_INT("--size", "N", &size, 16, 4096, "image side in pixels"),
       CLI_U64("--seed", "N", &seed, "layout seed"),
       CLI_FLAG("--shadows", &shadows, 1, "shadow-mapped light in the RGB views (off by default)"),
+      CLI_CHOICE("--thermal", &thermal, k_thermal_names, k_thermal_values, SIM_THERMAL_HELP,
+                 .def = "static"),
       CLI_STR("--renderer", "soft|gl", &renderer,
               "soft: hearth's deterministic software rasteriser; gl: MuJoCo's OpenGL renderer "
               "(needed for --shadows)",
@@ -85,7 +93,7 @@ int hearth_cmd_sim_render(int argc, char **argv) {
   if (sim_cli_assets(release, gt, root, sizeof root, tmpdir, sizeof tmpdir, &use_gt, 0)) return 1;
   rc = 0;
   for (int t = 1; t <= 3 && !rc; t++) {
-    if (only && t != only) continue;
+    if (only && !(only & (1u << t))) continue;
     hearth_sim_opts o;
     hearth_sim_opts_default(&o);
     o.task = (hearth_sim_task)t;
@@ -95,6 +103,7 @@ int hearth_cmd_sim_render(int argc, char **argv) {
     o.shadows = shadows;
     o.gl = gl;
     o.renderer = renderer;
+    o.thermal = thermal;
     char prefix[4200];
     snprintf(prefix, sizeof prefix, "%s/%s", out, hearth_sim_task_name(o.task));
     if (hearth_sim_render_scene(&o, seed, prefix, &err)) rc = cli_fail("sim render", &err);
@@ -104,14 +113,19 @@ int hearth_cmd_sim_render(int argc, char **argv) {
   return rc;
 }
 
+static int collect_one(const hearth_sim_collect_opts *op);
+
 int hearth_cmd_sim_collect(int argc, char **argv) {
   hearth_sim_collect_opts o;
   hearth_sim_collect_opts_default(&o);
   const char *release = NULL;
-  int task = 0, gt = 0;
+  unsigned tasks = 0;
+  int gt = 0;
   const cli_opt opts[] = {
-      CLI_CHOICE("--task", &task, k_task_names, k_task_values, "the task",
-                 .flags = CLI_REQUIRED | CLI_NOCASE),
+      CLI_CALL("--task", "LIST", &tasks, sim_cli_parse_tasks,
+               "H1, H2, H3, a list such as H1,H3, or all",
+               "the task; with several, one file each: OUT with _H<n> before .hdf5",
+               .flags = CLI_REQUIRED),
       CLI_STR("--out", "FILE.hdf5", &o.out_path, "output file (written atomically)",
               .flags = CLI_REQUIRED),
       CLI_INT("--layouts", "N", &o.layouts, 1, 100000,
@@ -128,6 +142,11 @@ int hearth_cmd_sim_collect(int argc, char **argv) {
                "with --release: a virtual-rig release's ground_truth/ assets"),
       CLI_FLAG("--keep-failures", &o.keep_failures, 1, "also store episodes that did not succeed"),
       CLI_FLAG("--shadows", &o.shadows, 1, "shadow-mapped light in the RGB views (off by default)"),
+      CLI_CHOICE("--thermal", &o.thermal, k_thermal_names, k_thermal_values,
+                 SIM_THERMAL_HELP "; dynamic stores obs/thermal_state", .def = "static"),
+      CLI_NUM("--thermal-speedup", "X", &o.thermal_speedup, 0, 1e6,
+              "with --thermal dynamic: thermal seconds per simulated second", .flags = CLI_LO_OPEN,
+              .def = "1"),
       CLI_STR("--renderer", "soft|gl|none", &o.renderer,
               "soft: hearth's deterministic software rasteriser; gl: MuJoCo's OpenGL renderer "
               "(needed for --shadows); none: no images (times physics, control and the expert "
@@ -146,16 +165,39 @@ int hearth_cmd_sim_collect(int argc, char **argv) {
   const cli_command cmd = {.name = "hearth sim collect", .about = k_about_collect, .opts = opts};
   int rc = cli_parse(&cmd, argc, argv, NULL);
   if (rc != CLI_RUN) return rc;
-  o.task = (hearth_sim_task)task;
   char root[4096], tmpdir[4096];
   if (sim_cli_assets(release, gt, root, sizeof root, tmpdir, sizeof tmpdir, &o.use_ground_truth,
                      o.quiet))
     return 1;
   o.release_root = root;
+  int n_tasks = 0;
+  for (int t = 1; t <= 3; t++) n_tasks += (tasks >> t) & 1;
+  const char *out_given = o.out_path;
+  rc = 0;
+  for (int t = 1; t <= 3 && !rc; t++) {
+    if (!(tasks & (1u << t))) continue;
+    o.task = (hearth_sim_task)t;
+    /* several tasks: OUT_H<n>.hdf5 each */
+    char per_task[4200];
+    if (n_tasks > 1) {
+      size_t n = strlen(out_given);
+      if (n >= 5 && strcmp(out_given + n - 5, ".hdf5") == 0) n -= 5;
+      snprintf(per_task, sizeof per_task, "%.*s_%s.hdf5", (int)n, out_given,
+               hearth_sim_task_name(o.task));
+      o.out_path = per_task;
+    }
+    rc = collect_one(&o);
+  }
+  sim_cli_drop_assets(tmpdir);
+  return rc;
+}
+
+/* one task's collection and its summary lines */
+static int collect_one(const hearth_sim_collect_opts *op) {
+  hearth_sim_collect_opts o = *op;
   hearth_err err = {0};
   hearth_sim_collect_stats s;
   hearth_status st = hearth_sim_collect(&o, &s, &err);
-  sim_cli_drop_assets(tmpdir);
   if (st) return cli_fail("sim collect", &err);
   for (int i = 0; i < 2; i++)
     printf("instruction %d \"%s\": %d/%d successful\n", i + 1,

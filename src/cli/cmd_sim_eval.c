@@ -67,18 +67,20 @@ static int measured_nothing(const hearth_eval_results *r) {
   return 1;
 }
 
-/* --task: bits (1 << task) of hearth_eval_opts.tasks */
-static const char *const k_task_names[] = {"H1", "H2", "H3", "all", NULL};
-static const int k_task_bits[] = {1 << 1, 1 << 2, 1 << 3, (1 << 1) | (1 << 2) | (1 << 3)};
+/* --thermal: hearth_sim_thermal values */
+static const char *const k_thermal_names[] = {"static", "dynamic", NULL};
+static const int k_thermal_values[] = {HEARTH_SIM_THERMAL_STATIC, HEARTH_SIM_THERMAL_DYNAMIC};
 
 int hearth_cmd_sim_eval(int argc, char **argv) {
   hearth_eval_opts o;
   hearth_eval_opts_default(&o);
   const char *out = NULL, *release = NULL;
-  int tasks = (int)o.tasks, gt = 0;
+  unsigned tasks = o.tasks;
+  int gt = 0;
   const cli_opt opts[] = {
       CLI_STR("--policy", "SPEC", &o.policy, "the policy, as listed above"),
-      CLI_CHOICE("--task", &tasks, k_task_names, k_task_bits, "tasks", .flags = CLI_NOCASE),
+      CLI_CALL("--task", "LIST", &tasks, sim_cli_parse_tasks,
+               "H1, H2, H3, a list such as H1,H3, or all", "tasks", .def = "all"),
       CLI_INT("--episodes", "N", &o.episodes, 1, 100000, "episodes per instruction"),
       CLI_FLAG("--no-thermal", &o.thermal, 0,
                "leave observation/thermal_image out (the RGB-only condition)"),
@@ -91,6 +93,10 @@ int hearth_cmd_sim_eval(int argc, char **argv) {
               "rendered view side (as sim collect stores)"),
       CLI_FLAG("--shadows", &o.shadows, 1,
                "shadow-mapped light in the RGB views (as at collection)"),
+      CLI_CHOICE("--thermal", &o.thermal_mode, k_thermal_names, k_thermal_values,
+                 "static: fixed temperature textures (the paper); dynamic: lumped thermal "
+                 "networks (as sim collect --thermal)",
+                 .def = "static"),
       CLI_STR("--renderer", "soft|gl", &o.renderer,
               "soft: hearth's deterministic software rasteriser; gl: MuJoCo's OpenGL renderer "
               "(needed for --shadows); the same default as sim collect",
@@ -114,7 +120,7 @@ int hearth_cmd_sim_eval(int argc, char **argv) {
   const cli_command cmd = {.name = "hearth sim eval", .about = k_about, .opts = opts};
   int rc = cli_parse(&cmd, argc, argv, NULL);
   if (rc != CLI_RUN) return rc;
-  o.tasks = (unsigned)tasks;
+  o.tasks = tasks;
   char root[4200], tmpdir[4200] = "";
   /* the same virtual-rig assets as `hearth sim collect` makes by default */
   if (sim_cli_assets(release, gt, root, sizeof root, tmpdir, sizeof tmpdir, &o.use_ground_truth,

@@ -283,6 +283,7 @@ hearth_status hearth_eval_run(const hearth_eval_opts *o, hearth_eval_results *r,
     so.width = so.height = o->render_size;
     so.shadows = o->shadows;
     so.renderer = o->renderer;
+    so.thermal = o->thermal_mode;
     so.gl = o->gl;
     int limit = o->max_steps > 0 ? o->max_steps : hearth_eval_time_limit(so.task);
     so.max_steps = limit + o->wait_steps;

@@ -38,6 +38,7 @@ void sim_asset_free(sim_asset *a) {
   hearth_mesh_free(&a->mesh);
   hearth_image_free(&a->rgb);
   hearth_image_free(&a->thermal);
+  free(a->temp);
   memset(a, 0, sizeof *a);
 }
 
@@ -100,7 +101,8 @@ static void dilate_rgb(uint8_t *rgb, uint8_t *valid, size_t R, int iters, const 
 }
 
 /* temperature map -> Turbo texture with dilated seams */
-static hearth_status thermal_texture(const char *path, hearth_image *out, hearth_err *err) {
+static hearth_status thermal_texture(const char *path, hearth_image *out, float **temp,
+                                     hearth_err *err) {
   hearth_npy a;
   memset(&a, 0, sizeof a);
   hearth_status st = hearth_npy_read(path, &a, err);
@@ -125,8 +127,40 @@ static hearth_status thermal_texture(const char *path, hearth_image *out, hearth
     dilate_rgb(px, valid, R, 4, room);
   }
   free(valid);
+  if (!st) *temp = a.data, a.data = NULL; /* the map itself, kept for the thermal model */
   hearth_npy_free(&a);
   return st;
+}
+
+/* a Turbo image (10..60 degC) read back into temperatures: each texel the
+ * nearest of 501 Turbo colours (0.1 degC apart) */
+static hearth_status turbo_to_temp(const hearth_image *img, float **temp, hearth_err *err) {
+  enum { N = 501 };
+  uint8_t lut[N][3];
+  for (int i = 0; i < N; i++) hearth_turbo((double)i / (N - 1), lut[i]);
+  size_t n = img->width * img->height;
+  float *t = hearth_alloc_array(n, sizeof(float));
+  if (!t) return hearth_err_set(err, HEARTH_E_NOMEM, "sim: out of memory");
+  const uint8_t *px = img->data;
+  uint32_t last = 0xffffffffu;
+  float last_t = 0;
+  for (size_t i = 0; i < n; i++) {
+    const uint8_t *c = px + (size_t)img->channels * i;
+    uint32_t key = (uint32_t)c[0] << 16 | (uint32_t)c[1] << 8 | c[2];
+    if (key != last) {
+      int best = 0, bd = 1 << 30;
+      for (int j = 0; j < N; j++) {
+        int d0 = c[0] - lut[j][0], d1 = c[1] - lut[j][1], d2 = c[2] - lut[j][2];
+        int d = d0 * d0 + d1 * d1 + d2 * d2;
+        if (d < bd) bd = d, best = j;
+      }
+      last = key;
+      last_t = (float)(SIM_TLO + (SIM_THI - SIM_TLO) * best / (N - 1));
+    }
+    t[i] = last_t;
+  }
+  *temp = t;
+  return HEARTH_OK;
 }
 
 static hearth_status to_rgb(hearth_image *img, const char *name, hearth_err *err) {
@@ -217,6 +251,17 @@ static void make_upright(hearth_mesh *m, const double up[3], const sim_category 
   for (int k = 0; k < 3; k++) size[k] = sc * ext[k];
 }
 
+hearth_status sim_asset_temperatures(sim_asset *a, hearth_err *err) {
+  if (a->temp) return HEARTH_OK;
+  if (a->thermal.width != a->thermal.height || a->thermal.channels < 3)
+    return hearth_err_set(err, HEARTH_E_SIZE,
+                          "sim asset %s/%s: thermal texture %zux%zu is not square RGB", a->category,
+                          a->state, a->thermal.width, a->thermal.height);
+  hearth_status st = turbo_to_temp(&a->thermal, &a->temp, err);
+  if (!st) a->temp_R = a->thermal.width;
+  return st;
+}
+
 hearth_status sim_asset_load(const char *root, int use_gt, const char *category, const char *state,
                              sim_asset *a, hearth_err *err) {
   memset(a, 0, sizeof *a);
@@ -247,7 +292,8 @@ hearth_status sim_asset_load(const char *root, int use_gt, const char *category,
     if (!st) {
       snprintf(p, sizeof p, "%s/ground_truth/instances/%s/%s/temperature_true.npy", root, id,
                state);
-      st = thermal_texture(p, &a->thermal, err);
+      st = thermal_texture(p, &a->thermal, &a->temp, err);
+      if (!st) a->temp_R = a->thermal.width;
     }
   } else {
     snprintf(p, sizeof p, "%s/instances/%s/derived/mesh.glb", root, id);

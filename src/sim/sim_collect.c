@@ -57,6 +57,7 @@ static hearth_status rollout(hearth_sim_env *e, uint64_t seed, uint64_t layout, 
     r[2] = ob.ee_pos[0], r[3] = ob.ee_pos[1], r[4] = ob.ee_pos[2];
     r[5] = ob.ee_quat[1], r[6] = ob.ee_quat[2], r[7] = ob.ee_quat[3], r[8] = ob.ee_quat[0];
     hearth_sim_state(e, b->states + b->nstate * i, b->nstate);
+    if (b->nth) hearth_sim_thermal_state(e, b->th + b->nth * i, b->nth);
     double a[7];
     hearth_sim_expert_action(e, a);
     memcpy(b->actions + 7 * i, a, sizeof a);
@@ -67,6 +68,28 @@ static hearth_status rollout(hearth_sim_env *e, uint64_t seed, uint64_t layout, 
       break;
     }
   }
+  return HEARTH_OK;
+}
+
+/* dynamic temperatures: the columns of obs/thermal_state (names and heat
+ * capacities of every object's regions) */
+static hearth_status thermal_columns(const hearth_sim_env *e, sim_demo *b, hearth_err *err) {
+  b->nth = hearth_sim_thermal_state(e, NULL, 0);
+  if (!b->nth) return HEARTH_OK;
+  hearth_strbuf names = {0};
+  b->th_C = hearth_alloc_array(b->nth, sizeof(double));
+  size_t j = 0;
+  for (int k = 0; k < SIM_NOBJ; k++) {
+    const hearth_thermo_net *n = hearth_sim_thermal_net(e, k);
+    for (size_t r = 0; r < n->n; r++, j++) {
+      hearth_strbuf_printf(&names, "%sobj%d/%s/%s/%s", j ? ";" : "", k, e->assets[k].category,
+                           e->assets[k].state, n->region[r].name);
+      if (b->th_C) b->th_C[j] = n->region[r].C;
+    }
+  }
+  b->th_names = hearth_strbuf_take(&names);
+  if (!b->th_C || !b->th_names)
+    return hearth_err_set(err, HEARTH_E_NOMEM, "sim collect: out of memory");
   return HEARTH_OK;
 }
 
@@ -107,6 +130,8 @@ static hearth_status run_open(collect_run *c, hearth_err *err) {
   so.shadows = o->shadows;
   so.renderer = o->renderer;
   so.gl = o->gl;
+  so.thermal = o->thermal;
+  if (o->thermal_speedup > 0) so.thermal_speedup = o->thermal_speedup;
   hearth_status st = hearth_sim_env_new(&so, &c->env, err);
   if (st) return st;
   if (!o->quiet) fprintf(stderr, "renderer: %s\n", hearth_sim_renderer(c->env));
@@ -121,6 +146,7 @@ static hearth_status run_open(collect_run *c, hearth_err *err) {
     c->demo[i].img = c->env->render_kind == SIM_RENDER_NONE
                          ? 0
                          : (size_t)o->image_size * (size_t)o->image_size * 3;
+    if ((st = thermal_columns(c->env, &c->demo[i], err))) return st;
   }
   for (int i = 0; i < c->nfile && !st; i++) {
     if (c->nfile == 2) hearth_sim_split_path(o->out_path, i, c->path[i], sizeof c->path[i]);

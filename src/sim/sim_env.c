@@ -20,12 +20,16 @@ void hearth_sim_opts_default(hearth_sim_opts *o) {
   o->width = o->height = 256;
   o->max_steps = 400;
   o->render_wrist = 1;
+  o->thermal = HEARTH_SIM_THERMAL_STATIC;
+  o->h_contact_table = o->h_contact_finger = HEARTH_SIM_H_CONTACT;
+  o->thermal_speedup = 1.0;
 }
 
 /* ---- env construction ---------------------------------------------------- */
 void hearth_sim_env_free(hearth_sim_env *e) {
   if (!e) return;
   sim_render_free(e);
+  sim_thermal_free(e);
   if (e->d) mj_deleteData(e->d);
   if (e->m) mj_deleteModel(e->m);
   for (int k = 0; k < SIM_NOBJ; k++) sim_asset_free(&e->assets[k]);
@@ -48,6 +52,23 @@ hearth_status hearth_sim_env_new(const hearth_sim_opts *o, hearth_sim_env **out,
   e->max_steps = o->max_steps > 0 ? o->max_steps : 400;
   e->render_wrist = o->render_wrist;
   e->shadows = o->shadows;
+  if (o->thermal != HEARTH_SIM_THERMAL_STATIC && o->thermal != HEARTH_SIM_THERMAL_DYNAMIC) {
+    free(e);
+    return hearth_err_set(err, HEARTH_E_ARG, "sim: thermal mode %d is not static or dynamic",
+                          o->thermal);
+  }
+  if (!(o->h_contact_table >= 0 && o->h_contact_finger >= 0 && isfinite(o->h_contact_table) &&
+        isfinite(o->h_contact_finger))) {
+    free(e);
+    return hearth_err_set(err, HEARTH_E_RANGE, "sim: contact conductances must be finite, >= 0");
+  }
+  e->thermal = o->thermal;
+  e->h_table = o->h_contact_table, e->h_finger = o->h_contact_finger;
+  e->thermal_speedup = o->thermal_speedup > 0 ? o->thermal_speedup : 1.0;
+  if (!isfinite(e->thermal_speedup) || e->thermal_speedup > 1e6) {
+    free(e);
+    return hearth_err_set(err, HEARTH_E_RANGE, "sim: thermal speed-up must be in (0, 1e6]");
+  }
   const char *gl = o->gl && *o->gl ? o->gl : getenv("HEARTH_GL");
   if (!gl || !*gl) gl = "osmesa";
   if (strcmp(gl, "osmesa") != 0 && strcmp(gl, "egl") != 0) {
@@ -153,7 +174,9 @@ hearth_status hearth_sim_env_new(const hearth_sim_opts *o, hearth_sim_env **out,
       e->obj_geom_th[k] = mj_name2id(m, mjOBJ_GEOM, nm);
     }
     e->mat_geom = mj_name2id(m, mjOBJ_GEOM, "mat");
+    e->table_geom = mj_name2id(m, mjOBJ_GEOM, "table");
     st = sim_render_init(e, err);
+    if (!st) st = sim_thermal_init(e, err);
   }
   if (st) {
     hearth_sim_env_free(e);
@@ -267,6 +290,7 @@ hearth_status hearth_sim_reset(hearth_sim_env *e, uint64_t seed, uint64_t layout
   e->steps = 0;
   e->phase = 0;
   e->phase_steps = 0;
+  sim_thermal_reset(e);
   return HEARTH_OK;
 }
 
@@ -298,6 +322,9 @@ hearth_status hearth_sim_step(hearth_sim_env *e, const double action[7], hearth_
     if (!isfinite(d->qpos[i]))
       return hearth_err_set(err, HEARTH_E_NUMERIC, "sim step %d: the simulation diverged",
                             e->steps);
+  /* the heat exchanged over the control step, with the contacts at its end */
+  hearth_status st = sim_thermal_step(e, e->thermal_speedup / HEARTH_SIM_CONTROL_HZ, err);
+  if (st) return st;
   e->steps++;
   return HEARTH_OK;
 }

@@ -10,6 +10,20 @@
 
 typedef struct sim_render sim_render;
 
+/* one object's thermal model (sim_thermal.c): its network, the texture
+ * regions it came from and what maps texels and contacts to regions */
+typedef struct sim_thermal_obj {
+  hearth_thermo_net net;
+  double T0[HEARTH_THERMO_MAX_REGIONS]; /* region temperatures at reset */
+  double heat_in;                       /* J since reset */
+  size_t R;                             /* texture side */
+  uint8_t *label;                       /* R*R network region per texel, 255: none */
+  float *offset;                        /* R*R degC over the region's temperature */
+  uint8_t *vregion;                     /* per mesh vertex: network region */
+  int texid;                            /* the thermal texture in the model */
+  int flip;                             /* model texture rows reversed from the map's */
+} sim_thermal_obj;
+
 /* which renderer an env draws its views with */
 enum { SIM_RENDER_SOFT = 0, SIM_RENDER_GL = 1, SIM_RENDER_NONE = 2 };
 
@@ -34,6 +48,14 @@ struct hearth_sim_env {
   double goal_pos[3], goal_R[9], R0[9], grip_cmd;
   int phase, phase_steps;
   sim_render *rnd;
+  /* dynamic temperatures */
+  int thermal;
+  double h_table, h_finger, thermal_speedup;
+  int thermal_dirty; /* textures behind the networks' temperatures */
+  int table_geom;
+#define SIM_TH_LUT 2048
+  uint8_t th_lut[SIM_TH_LUT][3]; /* Turbo over SIM_TLO..SIM_THI */
+  sim_thermal_obj th[SIM_NOBJ];
 };
 
 /* visibility rule of a layout: both candidates at least this visible */
@@ -48,5 +70,15 @@ double sim_visible_frac(const hearth_sim_env *e, int k);
 /* sim_render.c: the GL context and scene of an env, and their release */
 hearth_status sim_render_init(hearth_sim_env *e, hearth_err *err);
 void sim_render_free(hearth_sim_env *e);
+/* sim_render.c: the model's texture id was rewritten; update the renderer's copy */
+void sim_render_texture_changed(hearth_sim_env *e, int texid);
+/* sim_thermal.c: the objects' networks (after the model is loaded), their
+ * reset, one control step's heat exchange, the textures from the current
+ * temperatures, and their release */
+hearth_status sim_thermal_init(hearth_sim_env *e, hearth_err *err);
+void sim_thermal_reset(hearth_sim_env *e);
+hearth_status sim_thermal_step(hearth_sim_env *e, double dt, hearth_err *err);
+void sim_thermal_update_textures(hearth_sim_env *e);
+void sim_thermal_free(hearth_sim_env *e);
 
 #endif

@@ -8,6 +8,9 @@
 
 #include "sim/sim_h5.h"
 
+/* the most region columns a file may hold (4 objects of at most 16 regions) */
+#define SIM_NOBJ_MAX_REGIONS 64
+
 const char *const sim_h5_key_names[SIM_H5_NKEYS] = {"env_name",          "problem_info",
                                                     "env_args",          "bddl_file_name",
                                                     "bddl_file_content", "macros_image_convention",
@@ -25,6 +28,13 @@ int sim_demo_grow(sim_demo *b, size_t cap) {
     free(*dp[i]);
     *dp[i] = q;
   }
+  if (b->nth) {
+    float *q = hearth_alloc_array(cap * b->nth, sizeof(float));
+    if (!q) return 0;
+    if (b->th) memcpy(q, b->th, b->T * b->nth * sizeof(float));
+    free(b->th);
+    b->th = q;
+  }
   uint8_t **ip[] = {&b->front, &b->thermal, &b->wrist};
   for (int i = 0; i < 3 && b->img; i++) {
     void *q = hearth_alloc_array(cap, b->img);
@@ -40,6 +50,7 @@ int sim_demo_grow(sim_demo *b, size_t cap) {
 void sim_demo_free(sim_demo *b) {
   free(b->actions), free(b->states), free(b->joint), free(b->grip), free(b->ee), free(b->robot);
   free(b->front), free(b->thermal), free(b->wrist);
+  free(b->th), free(b->th_names), free(b->th_C);
   memset(b, 0, sizeof *b);
 }
 
@@ -169,6 +180,16 @@ hearth_status sim_h5_add_demo(sim_h5_out *o, const sim_demo *b, int S, const cha
            h5_write(ob, "ee_states", f64, nd, 2, d6, b->ee) &&
            h5_write(ob, "ee_pos", f64, nd, 2, d3, pos) &&
            h5_write(ob, "ee_ori", f64, nd, 2, d3, ori);
+    if (ok && b->nth) {
+      /* dynamic temperatures: the region temperatures and their columns */
+      hsize_t dT[2] = {T, b->nth};
+      ok = h5_write(ob, "thermal_state", H5T_IEEE_F32LE, H5T_NATIVE_FLOAT, 2, dT, b->th);
+      hid_t ds = ok ? H5Dopen2(ob, "thermal_state", H5P_DEFAULT) : -1;
+      ok = ds >= 0 && h5_str_attr(ds, "region_names", b->th_names ? b->th_names : "") &&
+           h5_f64_array_attr(ds, "heat_capacity", b->th_C, b->nth) &&
+           h5_str_attr(ds, "units", "degC");
+      if (ds >= 0) H5Dclose(ds);
+    }
     if (ob >= 0) H5Gclose(ob);
   }
   free(rew), free(don), free(pos), free(ori);
@@ -318,6 +339,41 @@ hearth_status sim_h5_open(sim_h5_in *in, const char *path, hearth_err *err) {
   return HEARTH_OK;
 }
 
+/* obs/thermal_state of a dynamic collection into b (nth 0 when absent) */
+static hearth_status read_thermal_state(sim_h5_in *in, hid_t ob, const char *name, size_t T,
+                                        sim_demo *b, hearth_err *err) {
+  free(b->th), free(b->th_names), free(b->th_C);
+  b->th = NULL, b->th_names = NULL, b->th_C = NULL, b->nth = 0;
+  if (H5Lexists(ob, "thermal_state", H5P_DEFAULT) <= 0) return HEARTH_OK;
+  hsize_t d[2] = {0};
+  hid_t ds = -1;
+  int ok = h5_dims(ob, "thermal_state", 2, d) && d[0] == T && d[1] >= 1 &&
+           d[1] <= SIM_NOBJ_MAX_REGIONS && (ds = H5Dopen2(ob, "thermal_state", H5P_DEFAULT)) >= 0;
+  if (ok) {
+    b->nth = (size_t)d[1];
+    b->th = hearth_alloc_array(T * b->nth, sizeof(float));
+    b->th_C = hearth_alloc_array(b->nth, sizeof(double));
+    b->th_names = h5_read_str(ds, "region_names");
+    hid_t a = b->th_C && H5Aexists(ds, "heat_capacity") > 0
+                  ? H5Aopen(ds, "heat_capacity", H5P_DEFAULT)
+                  : -1;
+    hid_t sp = a >= 0 ? H5Aget_space(a) : -1;
+    ok = b->th && b->th_names && a >= 0 && sp >= 0 &&
+         H5Sget_simple_extent_npoints(sp) == (hssize_t)b->nth &&
+         H5Aread(a, H5T_NATIVE_DOUBLE, b->th_C) >= 0 &&
+         H5Dread(ds, H5T_NATIVE_FLOAT, H5S_ALL, H5S_ALL, H5P_DEFAULT, b->th) >= 0;
+    if (sp >= 0) H5Sclose(sp);
+    if (a >= 0) H5Aclose(a);
+  }
+  if (ds >= 0) H5Dclose(ds);
+  if (!ok)
+    return hearth_err_set(err, HEARTH_E_PARSE,
+                          "%s: data/%s/obs/thermal_state: expected float32 (T, R) with attributes "
+                          "region_names and heat_capacity (R)",
+                          in->path, name);
+  return HEARTH_OK;
+}
+
 hearth_status sim_h5_read_demo(sim_h5_in *in, int idx, sim_demo *b, int *S, char **instruction,
                                char **model_file, hearth_err *err) {
   *instruction = *model_file = NULL;
@@ -396,6 +452,7 @@ hearth_status sim_h5_read_demo(sim_h5_in *in, int idx, sim_demo *b, int *S, char
       }
     }
   }
+  if (!st && T > 0) st = read_thermal_state(in, ob, name, (size_t)T, b, err);
   if (ob >= 0) H5Gclose(ob);
   H5Gclose(g);
   if (st) {

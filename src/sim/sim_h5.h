@@ -26,6 +26,12 @@ typedef struct sim_demo {
   uint8_t *front, *thermal, *wrist; /* T x img each */
   uint64_t layout;
   int instruction; /* 0 or 1: index into the task's instructions */
+  /* dynamic temperatures (nth 0: none): region temperatures per sample,
+   * T x nth, and what the columns are (owned, malloc'd) */
+  size_t nth;
+  float *th;
+  char *th_names; /* "obj<k>/<category>/<state>/<region>" per column, ';'-separated */
+  double *th_C;   /* nth heat capacities, J/K */
 } sim_demo;
 /* Make room for cap samples (keeps what is stored); 0 when out of memory. */
 int sim_demo_grow(sim_demo *b, size_t cap);

@@ -23,6 +23,10 @@ typedef struct sim_asset {
   hearth_mesh mesh;     /* no texture inside */
   hearth_image rgb;     /* U8 RGB */
   hearth_image thermal; /* U8 RGB Turbo 10..60 degC */
+  float *temp;          /* temp_R x temp_R degC per texel (NaN: no surface), rows as
+                         * in thermal: the true map (ground truth), or NULL until
+                         * sim_asset_temperatures reads the Turbo image back */
+  size_t temp_R;
   double size[3];       /* bounding box extents */
   double mass, friction;
 } sim_asset;
@@ -30,6 +34,9 @@ void sim_asset_free(sim_asset *a);
 /* Load <category>'s first instance of root in `state`. */
 hearth_status sim_asset_load(const char *root, int use_gt, const char *category, const char *state,
                              sim_asset *a, hearth_err *err);
+/* a->temp from the thermal texture read back through the Turbo scale
+ * (0.1 degC steps) when the load kept no temperature map (derived assets) */
+hearth_status sim_asset_temperatures(sim_asset *a, hearth_err *err);
 /* Turbo colour of the room temperature (22 degC over 10..60). */
 void sim_room_rgb(uint8_t rgb[3]);
 #define SIM_ROOM_C 22.0

@@ -381,9 +381,19 @@ static int seg_geom(const hearth_sim_env *e, const uint8_t *px) {
   return -1;
 }
 
+void sim_render_texture_changed(hearth_sim_env *e, int texid) {
+  sim_render *r = e->rnd;
+  if (!r || texid < 0) return;
+  if (r->kind == SIM_RENDER_SOFT) sim_soft_update_tex(r->sw, e->m, texid);
+  else if (r->kind == SIM_RENDER_GL && r->have_con && make_current(e))
+    mjr_uploadTexture(e->m, &r->con, texid);
+}
+
 hearth_status hearth_sim_observe(hearth_sim_env *e, hearth_sim_obs *o, hearth_err *err) {
   sim_render *r = e->rnd;
   memset(o, 0, sizeof *o);
+  /* dynamic temperatures: the thermal textures from the current state */
+  if (r->kind != SIM_RENDER_NONE) sim_thermal_update_textures(e);
   o->width = e->width, o->height = e->height;
   if (r->kind == SIM_RENDER_SOFT && r->twin_ok) {
     /* one pass draws the front RGB view and, from the same surfaces, the

@@ -417,6 +417,7 @@ static int make_shape(soft_shape *s, const mjModel *m, int g) {
 }
 
 /* ---- textures ---------------------------------------------------------------- */
+static void tex_fill(soft_tex *t, const mjModel *m, int id);
 static int make_tex(soft_tex *t, const mjModel *m, int id) {
   if (m->tex_type[id] != mjTEXTURE_2D) return 1;
   int w = m->tex_width[id], h = m->tex_height[id];
@@ -431,7 +432,13 @@ static int make_tex(soft_tex *t, const mjModel *m, int id) {
   }
   t->rgb = malloc(total);
   if (!t->rgb) return 0;
-  memcpy(t->rgb, m->tex_rgb + m->tex_adr[id], (size_t)w * h * 3);
+  tex_fill(t, m, id);
+  return 1;
+}
+
+/* the texture's level 0 from the model and the mip levels below it */
+static void tex_fill(soft_tex *t, const mjModel *m, int id) {
+  memcpy(t->rgb, m->tex_rgb + m->tex_adr[id], (size_t)t->w[0] * t->h[0] * 3);
   /* each level the rounded mean of (up to) 2 x 2 texels of the one above */
   for (int l = 1; l < t->levels; l++) {
     const uint8_t *src = t->rgb + t->off[l - 1];
@@ -448,7 +455,12 @@ static int make_tex(soft_tex *t, const mjModel *m, int id) {
         }
       }
   }
-  return 1;
+}
+
+void sim_soft_update_tex(sim_soft *s, const mjModel *m, int id) {
+  if (!s || id < 0 || id >= s->ntex || !s->tex[id].rgb) return;
+  if (s->tex[id].w[0] != m->tex_width[id] || s->tex[id].h[0] != m->tex_height[id]) return;
+  tex_fill(&s->tex[id], m, id);
 }
 
 /* bilinear lookup with wrap-around in level l, into c[3] (0..1) */

@@ -51,6 +51,9 @@ typedef struct sim_soft_view {
  * of memory. It keeps no pointer into m. */
 sim_soft *sim_soft_new(const mjModel *m, int w, int h);
 void sim_soft_free(sim_soft *s);
+/* Re-read 2D texture id from m->tex_rgb (same size as when the context was
+ * made) and rebuild its mip levels: for textures the caller rewrites. */
+void sim_soft_update_tex(sim_soft *s, const mjModel *m, int id);
 
 /* Render view v of (m, d) into rgb (w*h*3; may be NULL in SEGMENT mode)
  * and, when ids is not NULL, the geom id of each pixel (-1: background).

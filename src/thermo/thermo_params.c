@@ -14,6 +14,8 @@ static const hearth_thermo_material k_materials[] = {
     {"aluminium_painted", 903.0, 237.0, 0.94, "INC-A1, IDEAL-eps"},
     {"glass", 840.0, 1.4, 0.94, "ETB-c, INC-A3, IDEAL-eps"},
     {"stainless_steel", 477.0, 14.9, 0.16, "INC-A1, IDEAL-eps"},
+    {"rubber", 2010.0, 0.13, 0.90, "INC-A3"},
+    {"urethane_foam", 1045.0, 0.026, 0.90, "INC-A3"},
 };
 
 const hearth_thermo_material *hearth_thermo_material_find(const char *name) {
