@@ -12,7 +12,7 @@ build=${1:-build}
 [ $sanitize = 1 ] && [ "$build" = build ] && build=build-asan
 
 pkgs="build-essential cmake pkg-config clang libclang-rt-14-dev git
-  libembree-dev libjansson-dev libpng-dev zlib1g-dev libjpeg62-turbo-dev libtiff-dev
+  libembree-dev libjansson-dev libpng-dev zlib1g-dev libdeflate-dev libjpeg62-turbo-dev libtiff-dev
   liblapacke-dev liblapack-dev libblas-dev libhdf5-dev
   libmujoco-dev libosmesa6-dev libegl-dev libegl-mesa0
   python3 python3-numpy python3-h5py python3-opencv python3-websockets python3-msgpack

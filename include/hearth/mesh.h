@@ -131,6 +131,11 @@ hearth_status hearth_glb_parse(const void *data, size_t size, const char *name,
  * same bytes to *out (malloc'ed, the caller frees it). */
 hearth_status hearth_glb_write(const char *path, const hearth_mesh *m, hearth_err *err);
 hearth_status hearth_glb_encode(const hearth_mesh *m, uint8_t **out, size_t *size, hearth_err *err);
+/* As hearth_glb_write, with m->texture's PNG already encoded: tex_png's
+ * tex_size bytes (hearth_png_encode of m->texture, so the file is the one
+ * hearth_glb_write gives) are embedded as they are, not encoded again. */
+hearth_status hearth_glb_write_png(const char *path, const hearth_mesh *m, const uint8_t *tex_png,
+                                   size_t tex_size, hearth_err *err);
 
 /* ---- ray casting (Embree) ------------------------------------------------ */
 typedef struct hearth_raycaster hearth_raycaster;

@@ -1,11 +1,13 @@
-/* PNG reading through libpng, writing with our own DEFLATE encoder and
- * zlib's checksums (see the encoder below).
+/* PNG reading through libpng, with a faster path of our own for the plain
+ * layouts; writing with our own DEFLATE encoder and zlib's checksums (see
+ * the encoder below).
  *
  * libpng reports errors by longjmp. Each setjmp lives in a small function
  * whose only locals are set before setjmp and never changed afterwards; all
  * state that changes during decoding (buffers, the image, the message) sits
  * in a context struct owned by the caller's frame, so nothing is
  * indeterminate after the jump and the caller frees everything in one place. */
+#include <libdeflate.h>
 #include <png.h>
 #include <setjmp.h>
 #include <stdlib.h>
@@ -138,9 +140,181 @@ static int png_decode(png_structp png, png_infop info, png_reader *r) {
   return 0;
 }
 
+/* ---- the plain path ------------------------------------------------------------ */
+
+/* The fast path takes only files that libpng decodes without a transform
+ * and without a warning: IHDR first, 8- or 16-bit gray, gray + alpha, RGB or
+ * RGBA, not interlaced; then only consecutive IDATs, pHYs, tIME and small
+ * tEXt chunks, and IEND; every CRC right; IDATs no longer than libpng
+ * allows; one zlib stream (a 32 KiB window, or a smaller one that the whole
+ * image fits in) that fills the image exactly with the last IDAT byte. It
+ * inflates with libdeflate (whole buffer, checking the Adler-32) and undoes the row
+ * filters itself, which gives libpng's pixels exactly: both follow the
+ * PNG specification's integer arithmetic. Anything else, and every image
+ * that the caller's expectations or the limits refuse, goes to libpng, so
+ * errors and their messages are libpng's. */
+
+static uint32_t get_be32(const uint8_t *p) {
+  return (uint32_t)p[0] << 24 | (uint32_t)p[1] << 16 | (uint32_t)p[2] << 8 | p[3];
+}
+
+/* undo row y's filter in place: cur the row (rb bytes after its filter
+   byte f), prev the row above already undone (NULL for the first row) */
+static int unfilter_row(uint8_t f, uint8_t *cur, const uint8_t *prev, size_t rb, size_t bpp) {
+  switch (f) {
+    case 0:
+      return 1;
+    case 1:
+      for (size_t i = bpp; i < rb; i++) cur[i] = (uint8_t)(cur[i] + cur[i - bpp]);
+      return 1;
+    case 2:
+      if (prev)
+        for (size_t i = 0; i < rb; i++) cur[i] = (uint8_t)(cur[i] + prev[i]);
+      return 1;
+    case 3:
+      for (size_t i = 0; i < rb; i++) {
+        unsigned a = i >= bpp ? cur[i - bpp] : 0u, b = prev ? prev[i] : 0u;
+        cur[i] = (uint8_t)(cur[i] + ((a + b) >> 1));
+      }
+      return 1;
+    case 4:
+      for (size_t i = 0; i < rb; i++) {
+        int a = i >= bpp ? cur[i - bpp] : 0, b = prev ? prev[i] : 0,
+            c = (i >= bpp && prev) ? prev[i - bpp] : 0;
+        int p = a + b - c, pa = abs(p - a), pb = abs(p - b), pc = abs(p - c);
+        int pred = (pa <= pb && pa <= pc) ? a : pb <= pc ? b : c;
+        cur[i] = (uint8_t)(cur[i] + pred);
+      }
+      return 1;
+    default:
+      return 0;
+  }
+}
+
+/* 1: the file decoded into *img; 0: not taken here (nothing allocated) */
+static int png_fast_decode(const uint8_t *d, size_t size, const hearth_image_expect *want,
+                           hearth_image *img) {
+  static const char k_ihdr[4] = {'I', 'H', 'D', 'R'};
+  if (size < 8 + 25 || get_be32(d + 8) != 13 || memcmp(d + 12, k_ihdr, 4) != 0) return 0;
+  if (libdeflate_crc32(0, d + 12, 17) != get_be32(d + 29)) return 0;
+  const uint8_t *ih = d + 16;
+  uint32_t w = get_be32(ih), h = get_be32(ih + 4);
+  int depth = ih[8], ctype = ih[9];
+  if (ih[10] != 0 || ih[11] != 0 || ih[12] != 0) return 0; /* methods, no interlace */
+  if (depth != 8 && depth != 16) return 0;
+  int channels = ctype == 0 ? 1 : ctype == 4 ? 2 : ctype == 2 ? 3 : ctype == 6 ? 4 : 0;
+  if (!channels || w == 0 || h == 0 || w > HEARTH_IMAGE_MAX_DIM || h > HEARTH_IMAGE_MAX_DIM)
+    return 0;
+  size_t bpp = (size_t)channels * (size_t)(depth / 8), rb = (size_t)w * bpp;
+  size_t raw = (rb + 1) * (size_t)h;
+  if (raw / 1100 > size + 4096) return 0;
+  char msg[512];
+  if (hearth_image_expect_check(want, w, h, channels, msg, sizeof msg) != HEARTH_OK) return 0;
+  if (want && want->header_only) return 0;
+  /* an IDAT chunk's data may exceed the filtered rows by the stored blocks'
+     overhead (libpng refuses more: a bound no larger than libpng's own) */
+  size_t idat_max = raw + 6 + 5 * (raw / 32566 + 1);
+  /* the chunks: where the IDAT run starts and ends, its data's total */
+  size_t pos = 33, idat_first = 0, idat_end = 0, idat_bytes = 0, n_idat = 0;
+  int idat_done = 0, iend = 0;
+  while (!iend) {
+    if (size - pos < 12) return 0;
+    uint32_t len = get_be32(d + pos);
+    const uint8_t *type = d + pos + 4;
+    if (len > 0x7fffffffu || size - pos - 12 < len) return 0;
+    if (libdeflate_crc32(0, type, (size_t)len + 4) != get_be32(d + pos + 8 + len)) return 0;
+    if (!memcmp(type, "IDAT", 4)) {
+      if (idat_done || len > idat_max) return 0;
+      if (!n_idat) idat_first = pos;
+      idat_end = pos + 12 + len;
+      idat_bytes += len;
+      n_idat++;
+    } else {
+      if (n_idat) idat_done = 1;
+      if (!memcmp(type, "IEND", 4)) {
+        if (len != 0 || !n_idat) return 0;
+        iend = 1;
+      } else if (memcmp(type, "pHYs", 4) && memcmp(type, "tIME", 4) &&
+                 (memcmp(type, "tEXt", 4) || len > 65536)) {
+        return 0;
+      }
+    }
+    pos += 12 + (size_t)len;
+  }
+  const uint8_t *z = d + idat_first + 8;
+  uint8_t *joined = NULL;
+  if (n_idat > 1) {
+    if (!(joined = malloc(idat_bytes ? idat_bytes : 1))) return 0;
+    size_t k = 0;
+    for (size_t p = idat_first; p < idat_end;) {
+      uint32_t len = get_be32(d + p);
+      memcpy(joined + k, d + p + 8, len);
+      k += len;
+      p += 12 + (size_t)len;
+    }
+    z = joined;
+  }
+  int ok = 0;
+  uint8_t *buf = NULL;
+  struct libdeflate_decompressor *dec = NULL;
+  /* deflate, no preset dictionary; a window smaller than 32 KiB (libpng
+     writes one for small images) only where the image fits in it, so that
+     no distance can reach past it (zlib would refuse that, libdeflate not) */
+  if (idat_bytes < 2 || (z[0] & 0x0f) != 8 || (z[0] >> 4) > 7 || (z[1] & 0x20)) goto out;
+  if ((z[0] >> 4) < 7 && raw > (size_t)1 << ((z[0] >> 4) + 8)) goto out;
+  hearth_err aerr;
+  if (!(buf = malloc(raw)) || !(dec = libdeflate_alloc_decompressor())) goto out;
+  size_t used_in = 0;
+  if (libdeflate_zlib_decompress_ex(dec, z, idat_bytes, buf, raw, &used_in, NULL) !=
+          LIBDEFLATE_SUCCESS ||
+      used_in != idat_bytes)
+    goto out;
+  if (hearth_image_alloc(img, w, h, channels, depth == 16 ? HEARTH_PIX_U16 : HEARTH_PIX_U8,
+                         &aerr) != HEARTH_OK)
+    goto out;
+  uint8_t *px = img->data;
+  for (size_t y = 0; y < h; y++) {
+    uint8_t *cur = px + y * rb;
+    memcpy(cur, buf + y * (rb + 1) + 1, rb);
+    if (!unfilter_row(buf[y * (rb + 1)], cur, y ? cur - rb : NULL, rb, bpp)) {
+      hearth_image_free(img);
+      goto out;
+    }
+  }
+  /* 16-bit samples are big-endian in the file and native in memory */
+  if (depth == 16 && host_is_little_endian()) {
+    size_t n = rb * (size_t)h;
+    for (size_t i = 0; i < n; i += 2) {
+      uint8_t t = px[i];
+      px[i] = px[i + 1];
+      px[i + 1] = t;
+    }
+  }
+  ok = 1;
+out:
+  libdeflate_free_decompressor(dec);
+  free(buf);
+  free(joined);
+  if (!ok) memset(img, 0, sizeof *img);
+  return ok;
+}
+
 static hearth_status png_read_mem(const void *data, size_t size, const char *name,
                                   const hearth_image_expect *want, hearth_image *img,
                                   hearth_err *err) {
+  if (!name) name = "<memory>";
+  memset(img, 0, sizeof *img);
+  if (!data && size) return hearth_err_set(err, HEARTH_E_ARG, "%s: no data", name);
+  static const uint8_t sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  if (size < 8 || memcmp(data, sig, 8) != 0)
+    return hearth_err_set(err, HEARTH_E_PARSE, "%s: not a PNG file (bad signature)", name);
+  if (png_fast_decode(data, size, want, img)) return HEARTH_OK;
+  return hearth_png_read_mem_libpng(data, size, name, want, img, err);
+}
+
+hearth_status hearth_png_read_mem_libpng(const void *data, size_t size, const char *name,
+                                         const hearth_image_expect *want, hearth_image *img,
+                                         hearth_err *err) {
   if (!name) name = "<memory>";
   memset(img, 0, sizeof *img);
   if (!data && size) return hearth_err_set(err, HEARTH_E_ARG, "%s: no data", name);

@@ -542,6 +542,8 @@ hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err) {
   bake_grid grid = {0};
   uint8_t *block = NULL, *in_block = NULL; /* the sparse copies; per view: its copy is there */
   size_t frame = 0;
+  uint8_t *tex_png = NULL; /* the colour texture, PNG-encoded */
+  size_t tex_size = 0;
   if ((s = hearth_rig_read(rig_path, &rig, err)) ||
       (s = hearth_rig_require_stereo(&rig, rig_path, "mapping", err)))
     goto done;
@@ -619,11 +621,17 @@ hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err) {
   if ((s = hearth_map_texture(&r, 0, 255, 8, grey, &mesh.texture, err))) goto done;
   if (job->out_texture) snprintf(path, PATH_SZ, "%s", job->out_texture);
   else joinf(path, "%s/instances/%s/derived/rgb_texture.png", root, inst);
-  if ((s = hearth_png_write(path, &mesh.texture, err))) goto done;
+  /* one PNG encoding: the texture file and the GLB's embedded image */
+  if ((s = hearth_png_encode(&mesh.texture, &tex_png, &tex_size, err))) {
+    hearth_err_prefix(err, "%s", path);
+    goto done;
+  }
+  if ((s = hearth_write_file_atomic(path, tex_png, tex_size, err))) goto done;
   if (job->out_mesh) snprintf(path, PATH_SZ, "%s", job->out_mesh);
   else joinf(path, "%s/instances/%s/derived/mesh.glb", root, inst);
-  s = hearth_glb_write(path, &mesh, err);
+  s = hearth_glb_write_png(path, &mesh, tex_png, tex_size, err);
 done:
+  free(tex_png);
   hearth_map_result_free(&r);
   if (imgs)
     for (size_t k = 0; k < man.n_views; k++) {

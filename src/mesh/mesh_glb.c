@@ -1224,8 +1224,10 @@ static json_t *vec3_json(const float v[3]) {
   return a;
 }
 
-hearth_status hearth_glb_encode(const hearth_mesh *m, uint8_t **out, size_t *size,
-                                hearth_err *err) {
+/* the GLB of m; tex_png: m->texture already PNG-encoded (its tex_size bytes
+   are embedded as they are), NULL: encoded here */
+static hearth_status glb_encode(const hearth_mesh *m, const uint8_t *tex_png, size_t tex_size,
+                                uint8_t **out, size_t *size, hearth_err *err) {
   if (!m || !out || !size) return hearth_err_set(err, HEARTH_E_ARG, "glb encode: NULL argument");
   *out = NULL;
   *size = 0;
@@ -1256,6 +1258,7 @@ hearth_status hearth_glb_encode(const hearth_mesh *m, uint8_t **out, size_t *siz
 
   hearth_status s = HEARTH_OK;
   uint8_t *png = NULL, *bin = NULL, *file = NULL;
+  const uint8_t *png_bytes = NULL; /* png, or the caller's tex_png */
   size_t png_size = 0;
   double *nacc = NULL;
   char *jtext = NULL;
@@ -1263,7 +1266,13 @@ hearth_status hearth_glb_encode(const hearth_mesh *m, uint8_t **out, size_t *siz
   if (m->texture.data) {
     if (m->texture.type != HEARTH_PIX_U8)
       return hearth_err_set(err, HEARTH_E_ARG, "glb encode: texture must be 8-bit");
-    if ((s = hearth_png_encode(&m->texture, &png, &png_size, err))) return s;
+    if (tex_png) {
+      png_bytes = tex_png;
+      png_size = tex_size;
+    } else {
+      if ((s = hearth_png_encode(&m->texture, &png, &png_size, err))) return s;
+      png_bytes = png;
+    }
   }
 
   /* BIN layout: positions | normals | uvs | indices | png, each 4-aligned */
@@ -1321,7 +1330,7 @@ hearth_status hearth_glb_encode(const hearth_mesh *m, uint8_t **out, size_t *siz
     }
   }
   for (size_t i = 0; i < 3 * nt; i++) wr_u32(bin + off_idx + 4 * i, m->indices[i]);
-  if (png_size) memcpy(bin + off_png, png, png_size);
+  if (png_size) memcpy(bin + off_png, png_bytes, png_size);
 
   /* JSON: one scene, node, mesh, primitive, material */
   root = json_object();
@@ -1463,10 +1472,16 @@ done:
   return s;
 }
 
-hearth_status hearth_glb_write(const char *path, const hearth_mesh *m, hearth_err *err) {
+hearth_status hearth_glb_encode(const hearth_mesh *m, uint8_t **out, size_t *size,
+                                hearth_err *err) {
+  return glb_encode(m, NULL, 0, out, size, err);
+}
+
+static hearth_status glb_write(const char *path, const hearth_mesh *m, const uint8_t *tex_png,
+                               size_t tex_size, hearth_err *err) {
   uint8_t *data = NULL;
   size_t size = 0;
-  hearth_status s = hearth_glb_encode(m, &data, &size, err);
+  hearth_status s = glb_encode(m, tex_png, tex_size, &data, &size, err);
   if (s) {
     hearth_err_prefix(err, "%s", path);
     return s;
@@ -1474,6 +1489,17 @@ hearth_status hearth_glb_write(const char *path, const hearth_mesh *m, hearth_er
   s = hearth_write_file_atomic(path, data, size, err);
   free(data);
   return s;
+}
+
+hearth_status hearth_glb_write(const char *path, const hearth_mesh *m, hearth_err *err) {
+  return glb_write(path, m, NULL, 0, err);
+}
+
+hearth_status hearth_glb_write_png(const char *path, const hearth_mesh *m, const uint8_t *tex_png,
+                                   size_t tex_size, hearth_err *err) {
+  if (!tex_png || !tex_size)
+    return hearth_err_set(err, HEARTH_E_ARG, "%s: glb encode: no texture PNG bytes", path);
+  return glb_write(path, m, tex_png, tex_size, err);
 }
 
 void hearth_glb_read_opts_default(hearth_glb_read_opts *o) { memset(o, 0, sizeof *o); }

@@ -313,11 +313,27 @@ static void ov_auto_range(const hearth_image *temps, double *vals, double *lo, d
   if (!(*hi > *lo)) *hi = *lo + 1.0;
 }
 
-/* Turbo colour of every thermal pixel over [lo, hi] */
+/* Turbo colour of every thermal pixel over [lo, hi]. A pixel's colour
+   depends on its value's bits alone, and a thermal image holds few distinct
+   values (its CSV's decimals), so colours are kept in a direct-mapped table
+   by those bits and each distinct value is coloured about once. */
 static void ov_colours(const hearth_image *temps, double lo, double hi, uint8_t *turbo) {
+  enum { OV_TURBO_BITS = 12, OV_TURBO_N = 1 << OV_TURBO_BITS };
+  uint32_t key[OV_TURBO_N];
+  uint8_t col[OV_TURBO_N][3], used[OV_TURBO_N];
+  memset(used, 0, sizeof used);
   const float *t = temps->data;
-  for (size_t i = 0; i < temps->width * temps->height; i++)
-    hearth_turbo((t[i] - lo) / (hi - lo), turbo + 3 * i);
+  for (size_t i = 0; i < temps->width * temps->height; i++) {
+    uint32_t b;
+    memcpy(&b, &t[i], sizeof b);
+    uint32_t slot = (b * 2654435761u) >> (32 - OV_TURBO_BITS);
+    if (!used[slot] || key[slot] != b) {
+      hearth_turbo((t[i] - lo) / (hi - lo), col[slot]);
+      key[slot] = b;
+      used[slot] = 1;
+    }
+    memcpy(turbo + 3 * i, col[slot], 3);
+  }
 }
 
 /* a new image of the colours enlarged zoom times (nearest) */
