@@ -189,9 +189,22 @@ static void test_release(void) {
     snprintf(path, sizeof path, "%s/instances/cup_01/recon/%s", root, k_files[i]);
     CHECK_MSG(hearth_path_exists(path), "%s", path);
   }
-  snprintf(path, sizeof path, "%s/instances/cup_01/recon/mesh.glb", root);
-  CHECK(!hearth_path_exists(path));
+  /* the other tool's mesh.glb is replaced by the mesh with its own atlas */
   hearth_err err = {0};
+  snprintf(path, sizeof path, "%s/instances/cup_01/recon/mesh.glb", root);
+  {
+    hearth_glb_read_opts ro;
+    hearth_glb_read_opts_default(&ro);
+    ro.require_uvs = 1;
+    hearth_mesh am;
+    CHECK_OK(hearth_glb_read(path, &ro, &am, &err), &err);
+    CHECK(am.uvs != NULL && am.n_triangles > 1000 && am.n_triangles <= 4000);
+    hearth_mesh_free(&am);
+    snprintf(path, sizeof path, "%s/instances/cup_01/recon/report.json", root);
+    char *rep = test_slurp(path, NULL);
+    CHECK(rep && strstr(rep, "\"atlas\": {\"charts\": ") && strstr(rep, "\"stretch_l2\": "));
+    free(rep);
+  }
   hearth_poses p;
   snprintf(path, sizeof path, "%s/instances/cup_01/recon/poses_rgb.json", root);
   CHECK_OK(hearth_poses_read(path, &p, &err), &err);
