@@ -10,6 +10,7 @@
 #include <sys/wait.h>
 #include "hearth/dataset.h"
 #include "hearth/image.h"
+#include "hearth/npy.h"
 #include "hearth/recon.h"
 #include "hearth/recon_geom.h"
 #include "../test_util.h"
@@ -219,6 +220,27 @@ static void test_release(void) {
   char *rep = test_slurp(path, NULL);
   CHECK(rep && strstr(rep, "\"icp_rms_mm\"") && strstr(rep, "\"per_view\""));
   free(rep);
+
+  /* the reconstructed release maps: scale, transfer, bake and map run on
+     hearth's own mesh and atlas (the true rig stands in for calibration) */
+  snprintf(cmd, sizeof cmd,
+           "cp '%s/ground_truth/rig.json' '%s/calibration/rig.json' && "
+           "'%s' build '%s' --resolution 64 --threads 2 >/dev/null 2>&1",
+           root, root, HEARTH_EXE, root);
+  CHECK(system(cmd) == 0);
+  {
+    hearth_npy mask = {0};
+    snprintf(path, sizeof path, "%s/instances/cup_01/derived/neutral/mask.npy", root);
+    CHECK_OK(hearth_npy_read(path, &mask, &err), &err);
+    size_t n = mask.ndim == 2 ? mask.shape[0] * mask.shape[1] : 0, on = 0;
+    for (size_t i = 0; mask.data && mask.dtype == HEARTH_NPY_U8 && i < n; i++)
+      on += ((const uint8_t *)mask.data)[i] != 0;
+    /* the observed texels of a cup seen from 10 views */
+    CHECK_MSG(n == 64 * 64 && on > n / 10, "mask: %zu of %zu texels observed", on, n);
+    hearth_npy_free(&mask);
+    snprintf(path, sizeof path, "%s/instances/cup_01/derived/rgb_texture.png", root);
+    CHECK(hearth_path_exists(path));
+  }
 
   /* bad input names the file: a missing depth map, an empty cut-out */
   snprintf(cmd, sizeof cmd, "mv '%s/instances/cup_01/raw/neutral/depth/v03.png' '%s/v03.png'", root,
