@@ -189,8 +189,8 @@ static int split_list(atlas_ctx *c, const uint32_t *faces, size_t n) {
 }
 
 /* ---- first charts: normal clustering ------------------------------------- */
-static const double k_axes[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0},
-                                    {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+static const double k_axes[6][3] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                    {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
 
 static int nearest_dir(const double n[3], const double dir[6][3]) {
   int best = 0;
@@ -377,8 +377,9 @@ static void chart_stats(const hearth_mesh *out, hearth_atlas_stats *st) {
       }
       double Ss[3], St[3];
       for (int j = 0; j < 3; j++) {
-        Ss[j] = (q[0][j] * (tt[1] - tt[2]) + q[1][j] * (tt[2] - tt[0]) + q[2][j] * (tt[0] - tt[1])) /
-                (2 * au);
+        Ss[j] =
+            (q[0][j] * (tt[1] - tt[2]) + q[1][j] * (tt[2] - tt[0]) + q[2][j] * (tt[0] - tt[1])) /
+            (2 * au);
         St[j] = (q[0][j] * (s[2] - s[1]) + q[1][j] * (s[0] - s[2]) + q[2][j] * (s[1] - s[0])) /
                 (2 * au);
       }
@@ -421,7 +422,8 @@ static hearth_status write_output(atlas_ctx *c, hearth_mesh *out, uint32_t *char
     }
     for (size_t f = 0; f < ch->n_faces; f++) {
       size_t t = ch->face[f];
-      for (int j = 0; j < 3; j++) out->indices[3 * t + j] = (uint32_t)(base + ch->corner[3 * f + j]);
+      for (int j = 0; j < 3; j++)
+        out->indices[3 * t + j] = (uint32_t)(base + ch->corner[3 * f + j]);
       if (chart_of_tri) chart_of_tri[t] = (uint32_t)k;
     }
     base += ch->n_vertices;
@@ -430,14 +432,12 @@ static hearth_status write_output(atlas_ctx *c, hearth_mesh *out, uint32_t *char
 }
 
 hearth_status hearth_mesh_atlas(const hearth_mesh *in, const hearth_atlas_opts *opts,
-                                hearth_mesh *out, uint32_t *chart_of_tri,
-                                hearth_atlas_stats *stats, hearth_err *err) {
+                                hearth_mesh *out, uint32_t *chart_of_tri, hearth_atlas_stats *stats,
+                                hearth_err *err) {
   memset(out, 0, sizeof *out);
   hearth_atlas_opts o;
-  if (opts)
-    o = *opts;
-  else
-    hearth_atlas_opts_default(&o);
+  if (opts) o = *opts;
+  else hearth_atlas_opts_default(&o);
   if (!in || in->n_triangles == 0 || in->n_vertices == 0)
     return hearth_err_set(err, HEARTH_E_ARG, "atlas: empty mesh");
   if (in->n_triangles >= UINT32_MAX / 3 || in->n_vertices >= UINT32_MAX)

@@ -11,21 +11,21 @@
 
 /* A flattened chart; owns its arrays. */
 typedef struct atlas_chart {
-  uint32_t *face;    /* the mesh's triangles, n_faces */
+  uint32_t *face; /* the mesh's triangles, n_faces */
   size_t n_faces;
-  uint32_t *vertex;  /* the mesh's vertex of each chart vertex, n_vertices */
+  uint32_t *vertex; /* the mesh's vertex of each chart vertex, n_vertices */
   size_t n_vertices;
-  uint32_t *corner;  /* 3 per face: chart vertex of each corner */
-  double *uv;        /* 2 per chart vertex: surface-length units until packed,
+  uint32_t *corner; /* 3 per face: chart vertex of each corner */
+  double *uv;       /* 2 per chart vertex: surface-length units until packed,
                         then the atlas's [0,1]^2 */
-  double w, h;       /* extent after turning to its minimal box (surface units) */
+  double w, h;      /* extent after turning to its minimal box (surface units) */
   int cg_iterations;
 } atlas_chart;
 void ra_chart_free(atlas_chart *c);
 
 /* Scratch reused from chart to chart (zeroed to start). */
 typedef struct ra_flat_scratch {
-  uint32_t *vmap; /* per mesh vertex: its chart vertex, UINT32_MAX outside */
+  uint32_t *vmap;  /* per mesh vertex: its chart vertex, UINT32_MAX outside */
   uint32_t *fmark; /* per mesh face: stamp of the chart it is in */
   uint32_t stamp;
   size_t nv, nt;

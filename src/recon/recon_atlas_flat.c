@@ -30,8 +30,8 @@ static uint32_t uf_find(uint32_t *p, uint32_t a) {
  * twice (interior) within it, every vertex on 0 or 2 boundary edges, one
  * boundary loop, V - E + F = 1. Connectedness is the caller's. -1 without
  * memory. */
-static int is_disc(const uint32_t *adj, const uint32_t *fmark, uint32_t st,
-                   const uint32_t *faces, const uint32_t *corner, size_t n, size_t nv) {
+static int is_disc(const uint32_t *adj, const uint32_t *fmark, uint32_t st, const uint32_t *faces,
+                   const uint32_t *corner, size_t n, size_t nv) {
   uint32_t *deg = calloc(nv, sizeof *deg), *par = malloc(nv * sizeof *par);
   if (!deg || !par) {
     free(deg), free(par);
@@ -221,15 +221,17 @@ static int simple_boundary(const uint32_t *adj, const uint32_t *fmark, uint32_t 
 
 /* L2 stretch of triangle q (its own plane) mapped to UV triangle w */
 static double tri_stretch(const double q[3][2], const double w[3][2]) {
-  double au = 0.5 * ((w[1][0] - w[0][0]) * (w[2][1] - w[0][1]) -
-                     (w[2][0] - w[0][0]) * (w[1][1] - w[0][1]));
+  double au =
+      0.5 * ((w[1][0] - w[0][0]) * (w[2][1] - w[0][1]) - (w[2][0] - w[0][0]) * (w[1][1] - w[0][1]));
   if (!(au > 0)) return INFINITY;
   double a = 0, c = 0;
   for (int k = 0; k < 2; k++) {
     double ss = (q[0][k] * (w[1][1] - w[2][1]) + q[1][k] * (w[2][1] - w[0][1]) +
-                 q[2][k] * (w[0][1] - w[1][1])) / (2 * au);
+                 q[2][k] * (w[0][1] - w[1][1])) /
+                (2 * au);
     double sv = (q[0][k] * (w[2][0] - w[1][0]) + q[1][k] * (w[0][0] - w[2][0]) +
-                 q[2][k] * (w[1][0] - w[0][0])) / (2 * au);
+                 q[2][k] * (w[1][0] - w[0][0])) /
+                (2 * au);
     a += ss * ss, c += sv * sv;
   }
   return sqrt(0.5 * (a + c));
@@ -274,7 +276,8 @@ static int flatten_lscm(const hearth_mesh *m, const uint32_t *adj, const uint32_
   /* pins: the extremes along the start's longer extent */
   double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
   for (size_t v = 0; v < nv; v++)
-    for (int k = 0; k < 2; k++) lo[k] = fmin(lo[k], x[2 * v + k]), hi[k] = fmax(hi[k], x[2 * v + k]);
+    for (int k = 0; k < 2; k++)
+      lo[k] = fmin(lo[k], x[2 * v + k]), hi[k] = fmax(hi[k], x[2 * v + k]);
   int a = hi[1] - lo[1] > hi[0] - lo[0];
   uint32_t p0 = 0, p1 = 0;
   for (size_t v = 1; v < nv; v++) {
@@ -411,10 +414,8 @@ int ra_chart_flatten(const hearth_mesh *m, const uint32_t *adj, const uint32_t *
     }
   } else {
     r = is_disc(adj, sc->fmark, st, faces, out->corner, n, nv);
-    if (r == 1)
-      r = flatten_lscm(m, adj, sc->fmark, st, faces, n, out, lim);
-    else if (r == 0)
-      r = n > 1 ? 1 : 0; /* a lone face with a repeated vertex: kept as it is */
+    if (r == 1) r = flatten_lscm(m, adj, sc->fmark, st, faces, n, out, lim);
+    else if (r == 0) r = n > 1 ? 1 : 0; /* a lone face with a repeated vertex: kept as it is */
     if (r == 0 && !out->uv) {
       out->uv = calloc(2 * nv, sizeof *out->uv);
       if (!out->uv) r = -1;
@@ -464,8 +465,10 @@ static int orient_chart(atlas_chart *c) {
     double cs = dx / l, sn = dy / l;
     double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
     for (size_t i = 0; i < nh; i++) {
-      double u = cs * hull[2 * i] + sn * hull[2 * i + 1], v = -sn * hull[2 * i] + cs * hull[2 * i + 1];
-      lo[0] = fmin(lo[0], u), hi[0] = fmax(hi[0], u), lo[1] = fmin(lo[1], v), hi[1] = fmax(hi[1], v);
+      double u = cs * hull[2 * i] + sn * hull[2 * i + 1],
+             v = -sn * hull[2 * i] + cs * hull[2 * i + 1];
+      lo[0] = fmin(lo[0], u), hi[0] = fmax(hi[0], u), lo[1] = fmin(lo[1], v),
+      hi[1] = fmax(hi[1], v);
     }
     double ar = (hi[0] - lo[0]) * (hi[1] - lo[1]);
     if (ar < best - 1e-12 * fabs(best)) best = ar, bc = cs, bs = sn;
@@ -473,7 +476,8 @@ static int orient_chart(atlas_chart *c) {
   free(pt), free(hull);
   double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
   for (size_t i = 0; i < nv; i++) {
-    double u = bc * c->uv[2 * i] + bs * c->uv[2 * i + 1], v = -bs * c->uv[2 * i] + bc * c->uv[2 * i + 1];
+    double u = bc * c->uv[2 * i] + bs * c->uv[2 * i + 1],
+           v = -bs * c->uv[2 * i] + bc * c->uv[2 * i + 1];
     c->uv[2 * i] = u, c->uv[2 * i + 1] = v;
     lo[0] = fmin(lo[0], u), hi[0] = fmax(hi[0], u), lo[1] = fmin(lo[1], v), hi[1] = fmax(hi[1], v);
   }
@@ -482,8 +486,7 @@ static int orient_chart(atlas_chart *c) {
     double u = c->uv[2 * i] - lo[0], v = c->uv[2 * i + 1] - lo[1];
     if (tall) /* a quarter turn: (u, v) -> (H - v, u) */
       c->uv[2 * i] = (hi[1] - lo[1]) - v, c->uv[2 * i + 1] = u;
-    else
-      c->uv[2 * i] = u, c->uv[2 * i + 1] = v;
+    else c->uv[2 * i] = u, c->uv[2 * i + 1] = v;
   }
   c->w = tall ? hi[1] - lo[1] : hi[0] - lo[0];
   c->h = tall ? hi[0] - lo[0] : hi[1] - lo[1];
@@ -538,16 +541,13 @@ hearth_status ra_pack(atlas_chart *charts, size_t n, double gutter, hearth_err *
   if (!shelves(charts, ord, n, lo, gutter, NULL)) {
     free(ord), free(pos);
     return hearth_err_set(err, HEARTH_E_LIMIT,
-                          "atlas: %zu charts do not fit the unit square with gutter %g", n,
-                          gutter);
+                          "atlas: %zu charts do not fit the unit square with gutter %g", n, gutter);
   }
   if (shelves(charts, ord, n, hi, gutter, NULL)) lo = hi;
   for (int it = 0; it < 60 && lo < hi; it++) {
     double mid = 0.5 * (lo + hi);
-    if (shelves(charts, ord, n, mid, gutter, NULL))
-      lo = mid;
-    else
-      hi = mid;
+    if (shelves(charts, ord, n, mid, gutter, NULL)) lo = mid;
+    else hi = mid;
   }
   shelves(charts, ord, n, lo, gutter, pos);
   for (size_t i = 0; i < n; i++) {

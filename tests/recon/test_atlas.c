@@ -164,8 +164,8 @@ static void check_atlas(const char *name, const hearth_mesh *in, const hearth_me
                         const uint32_t *chart, size_t n_charts, double gutter, atlas_check *r) {
   memset(r, 0, sizeof *r);
   r->n_charts = n_charts;
-  CHECK_MSG(out->n_triangles == in->n_triangles, "%s: %zu of %zu triangles", name,
-            out->n_triangles, in->n_triangles);
+  CHECK_MSG(out->n_triangles == in->n_triangles, "%s: %zu of %zu triangles", name, out->n_triangles,
+            in->n_triangles);
   CHECK(out->uvs != NULL);
   if (out->n_triangles != in->n_triangles || !out->uvs) return;
   const size_t nt = in->n_triangles;
@@ -236,8 +236,10 @@ static void check_atlas(const char *name, const hearth_mesh *in, const hearth_me
     }
     double Ss[3], St[3];
     for (int k = 0; k < 3; k++) {
-      Ss[k] = (q[0][k] * (w[1] - w[2]) + q[1][k] * (w[2] - w[0]) + q[2][k] * (w[0] - w[1])) / (2 * Au);
-      St[k] = (q[0][k] * (s[2] - s[1]) + q[1][k] * (s[0] - s[2]) + q[2][k] * (s[1] - s[0])) / (2 * Au);
+      Ss[k] =
+          (q[0][k] * (w[1] - w[2]) + q[1][k] * (w[2] - w[0]) + q[2][k] * (w[0] - w[1])) / (2 * Au);
+      St[k] =
+          (q[0][k] * (s[2] - s[1]) + q[1][k] * (s[0] - s[2]) + q[2][k] * (s[1] - s[0])) / (2 * Au);
     }
     jac[4 * t] = Ss[0] * Ss[0] + Ss[1] * Ss[1] + Ss[2] * Ss[2];
     jac[4 * t + 1] = St[0] * St[0] + St[1] * St[1] + St[2] * St[2];
@@ -264,10 +266,13 @@ static void check_atlas(const char *name, const hearth_mesh *in, const hearth_me
     double P[3][2];
     for (int j = 0; j < 3; j++)
       for (int k = 0; k < 2; k++) P[j][k] = out->uvs[2 * (size_t)out->indices[3 * t + j] + k] * R;
-    double area = (P[1][0] - P[0][0]) * (P[2][1] - P[0][1]) - (P[2][0] - P[0][0]) * (P[1][1] - P[0][1]);
+    double area =
+        (P[1][0] - P[0][0]) * (P[2][1] - P[0][1]) - (P[2][0] - P[0][0]) * (P[1][1] - P[0][1]);
     double sg = area > 0 ? 1 : -1;
-    int x0 = (int)floor(fmin(P[0][0], fmin(P[1][0], P[2][0]))), x1 = (int)ceil(fmax(P[0][0], fmax(P[1][0], P[2][0])));
-    int y0 = (int)floor(fmin(P[0][1], fmin(P[1][1], P[2][1]))), y1 = (int)ceil(fmax(P[0][1], fmax(P[1][1], P[2][1])));
+    int x0 = (int)floor(fmin(P[0][0], fmin(P[1][0], P[2][0]))),
+        x1 = (int)ceil(fmax(P[0][0], fmax(P[1][0], P[2][0])));
+    int y0 = (int)floor(fmin(P[0][1], fmin(P[1][1], P[2][1]))),
+        y1 = (int)ceil(fmax(P[0][1], fmax(P[1][1], P[2][1])));
     for (int y = y0 < 0 ? 0 : y0; y <= y1 && y < R; y++)
       for (int x = x0 < 0 ? 0 : x0; x <= x1 && x < R; x++) {
         double px = x + 0.5, py = y + 0.5;
@@ -290,18 +295,19 @@ static void check_atlas(const char *name, const hearth_mesh *in, const hearth_me
   CHECK_OK(hearth_uv_islands(out, isl, &n_isl, &e), &e);
   CHECK_MSG(n_isl == n_charts, "%s: %u UV islands, %zu charts", name, n_isl, n_charts);
   free(isl);
-  printf("%s: %zu triangles, %zu charts, L2 stretch %.4f (max %.4f), packing %.3f; "
-         "%zu non-disc charts, %zu overlapping texels, %zu UVs outside, %zu folded\n",
-         name, nt, n_charts, r->stretch, r->stretch_max, r->efficiency, r->non_discs,
-         r->overlaps, r->outside, r->folded);
+  printf(
+      "%s: %zu triangles, %zu charts, L2 stretch %.4f (max %.4f), packing %.3f; "
+      "%zu non-disc charts, %zu overlapping texels, %zu UVs outside, %zu folded\n",
+      name, nt, n_charts, r->stretch, r->stretch_max, r->efficiency, r->non_discs, r->overlaps,
+      r->outside, r->folded);
   CHECK_MSG(r->non_discs == 0, "%s: %zu charts are no disc", name, r->non_discs);
   CHECK_MSG(r->overlaps == 0, "%s: %zu texels under two UV triangles", name, r->overlaps);
   CHECK_MSG(r->outside == 0, "%s: %zu UV coordinates in the gutter or outside", name, r->outside);
   CHECK_MSG(r->folded == 0, "%s: %zu folded UV triangles", name, r->folded);
 }
 
-static void run_case(const char *name, const hearth_mesh *m, atlas_check *r,
-                     hearth_atlas_stats *st, hearth_mesh *keep) {
+static void run_case(const char *name, const hearth_mesh *m, atlas_check *r, hearth_atlas_stats *st,
+                     hearth_mesh *keep) {
   hearth_err e = {0};
   hearth_atlas_opts o;
   hearth_atlas_opts_default(&o);
@@ -327,10 +333,8 @@ static void run_case(const char *name, const hearth_mesh *m, atlas_check *r,
         memcmp(again.indices, out.indices, 3 * out.n_triangles * sizeof(uint32_t)) == 0);
   hearth_mesh_free(&again);
   free(chart);
-  if (keep)
-    *keep = out;
-  else
-    hearth_mesh_free(&out);
+  if (keep) *keep = out;
+  else hearth_mesh_free(&out);
 }
 
 static void test_closed_forms(void) {
@@ -438,10 +442,11 @@ int main(int argc, char **argv) {
     hearth_mesh out;
     CHECK_OK(hearth_mesh_atlas(&m, NULL, &out, NULL, &st, &e), &e);
     if (g_test_failures) return 1;
-    printf("%s: %zu triangles, %zu charts, L2 stretch %.4f (max %.4f), area %.4f, angle %.4f, "
-           "packing %.3f\n",
-           argv[1], m.n_triangles, st.n_charts, st.stretch_l2, st.stretch_l2_max,
-           st.area_distortion, st.angle_distortion, st.packing_efficiency);
+    printf(
+        "%s: %zu triangles, %zu charts, L2 stretch %.4f (max %.4f), area %.4f, angle %.4f, "
+        "packing %.3f\n",
+        argv[1], m.n_triangles, st.n_charts, st.stretch_l2, st.stretch_l2_max, st.area_distortion,
+        st.angle_distortion, st.packing_efficiency);
     if (argc >= 3) CHECK_OK(hearth_glb_write(argv[2], &out, &e), &e);
     hearth_mesh_free(&m), hearth_mesh_free(&out);
     return g_test_failures;
