@@ -228,8 +228,14 @@ static void smooth_normals(const atlas_ctx *c, const double *fn, const double *a
   }
 }
 
+static uint32_t set_find(uint32_t *par, uint32_t a) {
+  while (par[a] != a) a = par[a] = par[par[a]];
+  return a;
+}
+
 /* Label faces by k-means on their normals, split into components, merge
- * small components into their best neighbour, push every component. */
+ * small components, and islands inside one larger component, into their
+ * best neighbour; push every component. */
 static hearth_status first_charts(atlas_ctx *c, const double *fn, const double *area,
                                   hearth_err *err) {
   const size_t nt = c->m->n_triangles;
@@ -289,25 +295,27 @@ static hearth_status first_charts(atlas_ctx *c, const double *fn, const double *
      of one component are found through a bucket list */
   uint32_t *first = malloc(((size_t)ncomp + 1) * sizeof *first);
   uint32_t *order = malloc(nt * sizeof *order);
-  if (!first || !order) {
-    free(comp), free(csize), free(count), free(first), free(order);
+  uint32_t *par = malloc(((size_t)ncomp + 1) * sizeof *par); /* merged sets */
+  if (!first || !order || !par) {
+    free(comp), free(csize), free(count), free(first), free(order), free(par);
     return hearth_err_set(err, HEARTH_E_NOMEM, "atlas: charts");
   }
   first[0] = 0;
   for (uint32_t k = 0; k < ncomp; k++) first[k + 1] = first[k] + csize[k];
-  for (uint32_t k = 0; k < ncomp; k++) count[k] = first[k];
+  for (uint32_t k = 0; k < ncomp; k++) count[k] = first[k], par[k] = k;
   for (size_t t = 0; t < nt; t++) order[count[comp[t]]++] = (uint32_t)t;
   memset(count, 0, nt * sizeof *count);
   uint32_t *touched = c->faces_buf;
   for (uint32_t k = 0; k < ncomp; k++) {
-    if (csize[k] >= c->o->min_chart_faces) continue;
+    if (par[k] != k) continue;
     size_t nto = 0;
     for (uint32_t i = first[k]; i < first[k + 1]; i++) {
       uint32_t t = order[i];
       for (int e = 0; e < 3; e++) {
         uint32_t nb = c->adj[3 * (size_t)t + e];
-        if (nb == NO_FACE || comp[nb] == comp[t]) continue;
-        if (count[comp[nb]]++ == 0) touched[nto++] = comp[nb];
+        if (nb == NO_FACE) continue;
+        uint32_t q = set_find(par, comp[nb]);
+        if (q != k && count[q]++ == 0) touched[nto++] = q;
       }
     }
     uint32_t best = NO_FACE, bc = 0;
@@ -316,11 +324,17 @@ static hearth_status first_charts(atlas_ctx *c, const double *fn, const double *
       if (count[q] > bc || (count[q] == bc && q < best)) bc = count[q], best = q;
       count[q] = 0;
     }
-    if (best == NO_FACE) continue;
-    for (uint32_t i = first[k]; i < first[k + 1]; i++) comp[order[i]] = best;
+    /* small, or an island inside one larger chart (which it would leave
+       with a hole) */
+    if (best == NO_FACE ||
+        !(csize[k] < c->o->min_chart_faces || (nto == 1 && csize[k] < csize[best])))
+      continue;
+    par[k] = best;
     csize[best] += csize[k];
     csize[k] = 0;
   }
+  for (size_t t = 0; t < nt; t++) comp[t] = set_find(par, comp[t]);
+  free(par);
   /* every surviving component as a list, faces ascending */
   for (uint32_t k = 0; k < ncomp; k++) count[k] = 0;
   for (size_t t = 0; t < nt; t++) count[comp[t]]++;
