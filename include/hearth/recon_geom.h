@@ -185,16 +185,85 @@ hearth_status hearth_recon_turntable(const char *root, const char *instance,
                                      const hearth_turntable_opts *opts, hearth_poses *out,
                                      hearth_turntable_result *res, hearth_err *err);
 
+/* ---- UV atlas (recon_atlas.c) ---------------------------------------------- */
+/* A UV atlas for a triangle mesh, one island per chart:
+ *  - charts: each face goes to the nearest of six directions (k-means on
+ *    the area-weighted face normals, smoothed over their neighbours,
+ *    started at +-x, +-y, +-z), each label
+ *    is split into edge-connected components, components under
+ *    min_chart_faces faces join the neighbour they share most edges with;
+ *  - a chart that is not a topological disc (connected, manifold, one
+ *    boundary loop, Euler characteristic 1) is cut in two at the median of
+ *    its face centroids along its longest extent, and its pieces are
+ *    charted again (a band around a cylinder becomes two discs);
+ *  - each disc is flattened by least squares conformal maps (LSCM: two
+ *    rows per triangle, the Cauchy-Riemann residuals weighted by the root
+ *    of its area; two vertices far apart pinned at their places in the
+ *    chart's mean plane; conjugate gradients on the normal equations with
+ *    a Jacobi preconditioner, in double, sequential); a flattening with a
+ *    folded triangle, a boundary that meets itself, or more stretch than
+ *    max_chart_stretch / max_face_stretch allow is cut as above and tried
+ *    again (one triangle always works);
+ *  - every chart is scaled to the same texel density (UV area proportional
+ *    to 3-D area), turned to its minimal-area bounding box (rotating
+ *    calipers on its convex hull) lying wide, and the boxes are packed in
+ *    shelves (tallest first) into the unit square with gutter_texels /
+ *    texture_size between boxes and from the border, at the largest
+ *    density that fits (bisection).
+ * The output has the input's triangles in the input's order; a vertex is
+ * repeated once per chart it belongs to (vertices in chart order, then by
+ * first use). Deterministic: no threads, no randomness. */
+typedef struct hearth_atlas_opts {
+  size_t min_chart_faces; /* default 8 */
+  int kmeans_iterations;  /* default 4; 0: the six axes as they are */
+  int smooth_passes;      /* face normals averaged with their neighbours'
+                             this many times before clustering; default 3 */
+  int texture_size;       /* texels per side the gutter is counted in; default 1024 */
+  double gutter_texels;   /* default 4 */
+  int cg_max_iterations;  /* per chart; default 4000 */
+  double max_chart_stretch; /* a chart's L2 stretch over its own area above
+                               this cuts it; default 1.1 */
+  double max_face_stretch;  /* so does one triangle's; default 2 */
+} hearth_atlas_opts;
+void hearth_atlas_opts_default(hearth_atlas_opts *o);
+
+/* Distortion of the map from the surface to UV, over non-degenerate
+ * triangles, after removing the atlas's common scale (so an isometry up to
+ * scale gives stretch 1, area 0, angle 0). Per triangle, the singular
+ * values s1 >= s2 of the Jacobian from UV to the surface: L2 stretch
+ * sqrt((s1^2 + s2^2) / 2) (Sander, Snyder, Gortler, Hoppe 2001). */
+typedef struct hearth_atlas_stats {
+  size_t n_charts;
+  size_t n_splits;       /* charts cut because they were no disc or folded */
+  double stretch_l2;     /* the mesh's L2 stretch: sqrt(area-weighted mean of L2^2) */
+  double stretch_l2_max; /* largest per-triangle L2 stretch */
+  double area_distortion;  /* area-weighted mean of |ln(s1 s2)| */
+  double angle_distortion; /* area-weighted mean of ln(s1 / s2) */
+  double packing_efficiency; /* UV area of the triangles / area of the unit square */
+  int cg_iterations_max;   /* most CG iterations one chart took */
+} hearth_atlas_stats;
+
+/* Atlas of in (positions and indices; UVs and texture ignored) into out
+ * (allocated; positions, UVs, indices, no texture). chart_of_tri (NULL or
+ * the caller's in->n_triangles entries) receives each triangle's chart.
+ * stats may be NULL. opts NULL: the defaults. Empty mesh: HEARTH_E_ARG. */
+hearth_status hearth_mesh_atlas(const hearth_mesh *in, const hearth_atlas_opts *opts,
+                                hearth_mesh *out, uint32_t *chart_of_tri,
+                                hearth_atlas_stats *stats, hearth_err *err);
+
 /* ---- hearth recon ROOT (recon_run.c) -------------------------------------- */
 /* The embedded route over one instance: colour poses by
  * hearth_recon_turntable, written as recon/poses_rgb.json with the factory
  * colour camera beside it (recon/poses_rgb_cameras.json, as the COLMAP
  * route writes), then the metric mesh from the depth maps with those poses
- * (hearth_recon_tsdf) as recon/mesh_geometry.glb (no UVs yet: the atlas
- * and texture are not made here), and recon/report.json:
+ * (hearth_recon_tsdf) as recon/mesh_geometry.glb (no UVs), its UV atlas
+ * (hearth_mesh_atlas) as recon/mesh.glb (UVs, no texture: map --rgb bakes
+ * the colour texture into derived/), and recon/report.json:
  *   {"instance", "route": "turntable", "views": N, "pairs", "iterations",
  *    "icp_rms_start_mm", "icp_rms_mm", "icp_median_mm", "seconds",
  *    "mesh": {"vertices", "triangles", "voxel_m"},
+ *    "atlas": {"charts", "stretch_l2", "stretch_l2_max", "area_distortion",
+ *              "angle_distortion", "packing_efficiency"},
  *    "per_view": [{"state", "view", "points", "plane_inliers",
  *                  "plane_rms_mm", "height_m", "elevation_deg", "pairs",
  *                  "matches", "icp_rms_mm", "d_azimuth_deg"}]}
@@ -206,6 +275,7 @@ typedef struct hearth_recon_job {
   const char *root, *instance;
   hearth_turntable_opts poses;
   hearth_recon_tsdf_opts geometry; /* .poses is set by the job */
+  hearth_atlas_opts atlas;
   int no_mesh;                     /* 1: poses and report only */
   int force;
   int quiet;
@@ -215,7 +285,8 @@ void hearth_recon_job_default(hearth_recon_job *job);
 typedef struct hearth_recon_summary {
   hearth_turntable_result poses; /* owned: hearth_recon_summary_free */
   size_t mesh_vertices, mesh_triangles;
-  char poses_path[1400], mesh_path[1400], report_path[1400];
+  hearth_atlas_stats atlas; /* of recon/mesh.glb */
+  char poses_path[1400], mesh_path[1400], atlas_path[1400], report_path[1400];
 } hearth_recon_summary;
 void hearth_recon_summary_free(hearth_recon_summary *s);
 hearth_status hearth_recon_run(const hearth_recon_job *job, hearth_recon_summary *sum,

@@ -106,8 +106,10 @@ static const char *k_about =
     "point-to-plane ICP on the cut-out depth of all views of all states refines the angles\n"
     "and horizontal positions. Writes recon/poses_rgb.json (metres, +z up the axis, the\n"
     "turntable top at z = 0), recon/poses_rgb_cameras.json (the factory colour camera),\n"
-    "recon/mesh_geometry.glb (the depth maps fused with those poses; no UVs yet) and\n"
-    "recon/report.json (views, ICP residuals, per-view plane and match figures).\n"
+    "recon/mesh_geometry.glb (the depth maps fused with those poses; no UVs),\n"
+    "recon/mesh.glb (that mesh with a UV atlas of its own: normal-clustered disc charts,\n"
+    "LSCM, packed with gutters; no texture, map --rgb bakes it) and recon/report.json\n"
+    "(views, ICP residuals, per-view plane and match figures, chart stretch and packing).\n"
     "--poses colmap runs COLMAP (Debian's `colmap`, CPU only): feature_extractor with the\n"
     "cut-outs as masks and one camera shared by all views, exhaustive_matcher and mapper\n"
     "over every view of every state, then imports the model with the most registered\n"
@@ -131,9 +133,13 @@ static int run_turntable(const char *root, const char *instance, const hearth_re
   printf("recon %s: %zu views, %zu pairs, ICP rms %.3f -> %.3f mm (median %.3f), %.1f s -> %s\n",
          instance, r->n_views, r->n_pairs, r->icp_rms_start_mm, r->icp_rms_mm, r->icp_median_mm,
          r->seconds, sum.poses_path);
-  if (!job.no_mesh)
+  if (!job.no_mesh) {
     printf("recon %s: mesh %zu vertices, %zu triangles -> %s\n", instance, sum.mesh_vertices,
            sum.mesh_triangles, sum.mesh_path);
+    printf("recon %s: atlas %zu charts, L2 stretch %.4f (max %.3f), packing %.3f -> %s\n",
+           instance, sum.atlas.n_charts, sum.atlas.stretch_l2, sum.atlas.stretch_l2_max,
+           sum.atlas.packing_efficiency, sum.atlas_path);
+  }
   hearth_recon_summary_free(&sum);
   return 0;
 }

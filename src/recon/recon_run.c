@@ -1,5 +1,6 @@
 /* recon_run.c - `hearth recon ROOT` on the embedded route: turntable poses,
- * the metric mesh from depth with them, and the reconstruction report. */
+ * the metric mesh from depth with them, its UV atlas, and the
+ * reconstruction report. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -12,6 +13,7 @@ void hearth_recon_job_default(hearth_recon_job *job) {
   memset(job, 0, sizeof *job);
   hearth_turntable_opts_default(&job->poses);
   hearth_recon_tsdf_opts_default(&job->geometry);
+  hearth_atlas_opts_default(&job->atlas);
 }
 
 void hearth_recon_summary_free(hearth_recon_summary *s) {
@@ -66,7 +68,7 @@ static hearth_status cameras_of(const hearth_camera *rgb, const hearth_poses *p,
 
 static hearth_status write_report(const char *path, const char *instance,
                                   const hearth_turntable_result *r, const hearth_mesh *m,
-                                  double voxel, hearth_err *err) {
+                                  double voxel, const hearth_atlas_stats *at, hearth_err *err) {
   hearth_strbuf b = {0};
   hearth_strbuf_printf(&b, "{\n  \"instance\": ");
   rc_json_string(&b, instance);
@@ -88,6 +90,22 @@ static hearth_status write_report(const char *path, const char *instance,
     hearth_strbuf_printf(&b, "  \"mesh\": {\"vertices\": %zu, \"triangles\": %zu, \"voxel_m\": ",
                          m->n_vertices, m->n_triangles);
     rc_json_real(&b, voxel);
+    hearth_strbuf_printf(&b, "},\n");
+  }
+  if (at) {
+    hearth_strbuf_printf(&b, "  \"atlas\": {\"charts\": %zu", at->n_charts);
+    const struct {
+      const char *k;
+      double v;
+    } a[] = {{"stretch_l2", at->stretch_l2},
+             {"stretch_l2_max", at->stretch_l2_max},
+             {"area_distortion", at->area_distortion},
+             {"angle_distortion", at->angle_distortion},
+             {"packing_efficiency", at->packing_efficiency}};
+    for (size_t i = 0; i < sizeof a / sizeof a[0]; i++) {
+      hearth_strbuf_printf(&b, ", \"%s\": ", a[i].k);
+      rc_json_real(&b, a[i].v);
+    }
     hearth_strbuf_printf(&b, "},\n");
   }
   hearth_strbuf_printf(&b, "  \"per_view\": [");
@@ -130,6 +148,7 @@ hearth_status hearth_recon_run(const hearth_recon_job *job, hearth_recon_summary
     return hearth_err_set(err, HEARTH_E_LIMIT, "recon: path too long");
   snprintf(sum->poses_path, sizeof sum->poses_path, "%s/poses_rgb.json", dir);
   snprintf(sum->mesh_path, sizeof sum->mesh_path, "%s/mesh_geometry.glb", dir);
+  snprintf(sum->atlas_path, sizeof sum->atlas_path, "%s/mesh.glb", dir);
   snprintf(sum->report_path, sizeof sum->report_path, "%s/report.json", dir);
   if (hearth_path_exists(sum->poses_path) && !job->force)
     return hearth_err_set(err, HEARTH_E_ARG,
@@ -182,9 +201,20 @@ hearth_status hearth_recon_run(const hearth_recon_job *job, hearth_recon_summary
       sum->mesh_triangles = mesh.n_triangles;
     }
   }
+  hearth_mesh atlas = {0};
+  if (!s && have_mesh) {
+    if (!job->quiet) fprintf(stderr, "recon: UV atlas of %zu triangles\n", mesh.n_triangles);
+    s = hearth_mesh_atlas(&mesh, &job->atlas, &atlas, NULL, &sum->atlas, err);
+    if (!s) s = hearth_glb_write(sum->atlas_path, &atlas, err);
+    if (!s && !job->quiet)
+      fprintf(stderr, "recon: %zu charts, L2 stretch %.3f (max %.2f), packing %.2f\n",
+              sum->atlas.n_charts, sum->atlas.stretch_l2, sum->atlas.stretch_l2_max,
+              sum->atlas.packing_efficiency);
+  }
   if (!s)
     s = write_report(sum->report_path, job->instance, &sum->poses, have_mesh ? &mesh : NULL,
-                     job->geometry.voxel_m, err);
+                     job->geometry.voxel_m, have_mesh ? &sum->atlas : NULL, err);
+  hearth_mesh_free(&atlas);
   hearth_mesh_free(&mesh);
   if (s) hearth_recon_summary_free(sum);
   return s;

@@ -5,6 +5,7 @@
 #define HEARTH_TEST_MESH_DISTANCE_H
 
 #include <float.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include "hearth/mesh.h"
@@ -71,11 +72,12 @@ static double dot3(const double a[3], const double b[3]) {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
-/* Squared distance from p to triangle abc (Voronoi regions of the
- * triangle, Ericson's closest-point construction written out). */
-static double point_tri_d2(const double p[3], const double a[3], const double b[3],
-                           const double c[3]) {
-  double ab[3], ac[3], ap[3], q[3];
+/* Squared distance from p to triangle abc and the closest point q
+ * (Voronoi regions of the triangle, Ericson's closest-point construction
+ * written out). */
+static double point_tri_closest(const double p[3], const double a[3], const double b[3],
+                                const double c[3], double q[3]) {
+  double ab[3], ac[3], ap[3];
   for (int i = 0; i < 3; i++) {
     ab[i] = b[i] - a[i];
     ac[i] = c[i] - a[i];
@@ -83,13 +85,13 @@ static double point_tri_d2(const double p[3], const double a[3], const double b[
   }
   double d1 = dot3(ab, ap), d2 = dot3(ac, ap);
   if (d1 <= 0 && d2 <= 0) {
-    memcpy(q, a, sizeof q);
+    memcpy(q, a, 3 * sizeof *q);
     goto out;
   }
   double bp[3] = {p[0] - b[0], p[1] - b[1], p[2] - b[2]};
   double d3 = dot3(ab, bp), d4 = dot3(ac, bp);
   if (d3 >= 0 && d4 <= d3) {
-    memcpy(q, b, sizeof q);
+    memcpy(q, b, 3 * sizeof *q);
     goto out;
   }
   double vc = d1 * d4 - d3 * d2;
@@ -101,7 +103,7 @@ static double point_tri_d2(const double p[3], const double a[3], const double b[
   double cp[3] = {p[0] - c[0], p[1] - c[1], p[2] - c[2]};
   double d5 = dot3(ab, cp), d6 = dot3(ac, cp);
   if (d6 >= 0 && d5 <= d6) {
-    memcpy(q, c, sizeof q);
+    memcpy(q, c, 3 * sizeof *q);
     goto out;
   }
   double vb = d5 * d2 - d1 * d6;
@@ -125,8 +127,19 @@ out:
          (p[2] - q[2]) * (p[2] - q[2]);
 }
 
-/* Distance from p to the mesh of g (searching rings of cells outwards). */
-static double tri_grid_dist(const tri_grid *g, const double p[3]) {
+static inline double point_tri_d2(const double p[3], const double a[3], const double b[3],
+                           const double c[3]) {
+  double q[3];
+  return point_tri_closest(p, a, b, c, q);
+}
+
+/* Distance from p to the mesh of g (searching rings of cells outwards);
+ * tri and q (both may be NULL) get the nearest triangle and point. */
+static double tri_grid_nearest(const tri_grid *g, const double p[3], uint32_t *tri, double q[3]);
+static inline double tri_grid_dist(const tri_grid *g, const double p[3]) {
+  return tri_grid_nearest(g, p, NULL, NULL);
+}
+static double tri_grid_nearest(const tri_grid *g, const double p[3], uint32_t *tri, double q[3]) {
   int c0[3];
   for (int a = 0; a < 3; a++) c0[a] = (int)floor((p[a] - g->lo[a]) / g->cell);
   double best = DBL_MAX;
@@ -138,13 +151,17 @@ static double tri_grid_dist(const tri_grid *g, const double p[3]) {
           if (abs(i - c0[0]) != r && abs(j - c0[1]) != r && abs(k - c0[2]) != r) continue;
           if (i < 0 || j < 0 || k < 0 || i >= g->n[0] || j >= g->n[1] || k >= g->n[2]) continue;
           size_t c = cell_of(g, i, j, k);
-          for (size_t q = g->start[c]; q < g->start[c + 1]; q++) {
-            const uint32_t *f = g->m->indices + 3 * (size_t)g->tris[q];
+          for (size_t q_ = g->start[c]; q_ < g->start[c + 1]; q_++) {
+            const uint32_t *f = g->m->indices + 3 * (size_t)g->tris[q_];
             double v[3][3];
             for (int e = 0; e < 3; e++)
               for (int a = 0; a < 3; a++) v[e][a] = g->m->positions[3 * (size_t)f[e] + a];
-            double d2 = point_tri_d2(p, v[0], v[1], v[2]);
-            if (d2 < best) best = d2;
+            double qq[3], d2 = point_tri_closest(p, v[0], v[1], v[2], qq);
+            if (d2 < best) {
+              best = d2;
+              if (tri) *tri = g->tris[q_];
+              if (q) memcpy(q, qq, sizeof qq);
+            }
           }
         }
     /* every point within r cells of p's cell has been seen */
@@ -154,7 +171,7 @@ static double tri_grid_dist(const tri_grid *g, const double p[3]) {
 }
 
 /* RMS and max distance of a's vertices to mesh b. */
-static void mesh_to_mesh(const hearth_mesh *a, const hearth_mesh *b, double *rms, double *mx) {
+static inline void mesh_to_mesh(const hearth_mesh *a, const hearth_mesh *b, double *rms, double *mx) {
   tri_grid g;
   tri_grid_build(&g, b, 0.004);
   double s = 0, m = 0;

@@ -10,6 +10,7 @@
 #include <sys/wait.h>
 #include "hearth/dataset.h"
 #include "hearth/image.h"
+#include "hearth/npy.h"
 #include "hearth/recon.h"
 #include "hearth/recon_geom.h"
 #include "../test_util.h"
@@ -189,9 +190,22 @@ static void test_release(void) {
     snprintf(path, sizeof path, "%s/instances/cup_01/recon/%s", root, k_files[i]);
     CHECK_MSG(hearth_path_exists(path), "%s", path);
   }
-  snprintf(path, sizeof path, "%s/instances/cup_01/recon/mesh.glb", root);
-  CHECK(!hearth_path_exists(path));
+  /* the other tool's mesh.glb is replaced by the mesh with its own atlas */
   hearth_err err = {0};
+  snprintf(path, sizeof path, "%s/instances/cup_01/recon/mesh.glb", root);
+  {
+    hearth_glb_read_opts ro;
+    hearth_glb_read_opts_default(&ro);
+    ro.require_uvs = 1;
+    hearth_mesh am;
+    CHECK_OK(hearth_glb_read(path, &ro, &am, &err), &err);
+    CHECK(am.uvs != NULL && am.n_triangles > 1000 && am.n_triangles <= 4000);
+    hearth_mesh_free(&am);
+    snprintf(path, sizeof path, "%s/instances/cup_01/recon/report.json", root);
+    char *rep = test_slurp(path, NULL);
+    CHECK(rep && strstr(rep, "\"atlas\": {\"charts\": ") && strstr(rep, "\"stretch_l2\": "));
+    free(rep);
+  }
   hearth_poses p;
   snprintf(path, sizeof path, "%s/instances/cup_01/recon/poses_rgb.json", root);
   CHECK_OK(hearth_poses_read(path, &p, &err), &err);
@@ -206,6 +220,27 @@ static void test_release(void) {
   char *rep = test_slurp(path, NULL);
   CHECK(rep && strstr(rep, "\"icp_rms_mm\"") && strstr(rep, "\"per_view\""));
   free(rep);
+
+  /* the reconstructed release maps: scale, transfer, bake and map run on
+     hearth's own mesh and atlas (the true rig stands in for calibration) */
+  snprintf(cmd, sizeof cmd,
+           "cp '%s/ground_truth/rig.json' '%s/calibration/rig.json' && "
+           "'%s' build '%s' --resolution 64 --threads 2 >/dev/null 2>&1",
+           root, root, HEARTH_EXE, root);
+  CHECK(system(cmd) == 0);
+  {
+    hearth_npy mask = {0};
+    snprintf(path, sizeof path, "%s/instances/cup_01/derived/neutral/mask.npy", root);
+    CHECK_OK(hearth_npy_read(path, &mask, &err), &err);
+    size_t n = mask.ndim == 2 ? mask.shape[0] * mask.shape[1] : 0, on = 0;
+    for (size_t i = 0; mask.data && mask.dtype == HEARTH_NPY_U8 && i < n; i++)
+      on += ((const uint8_t *)mask.data)[i] != 0;
+    /* the observed texels of a cup seen from 10 views */
+    CHECK_MSG(n == 64 * 64 && on > n / 10, "mask: %zu of %zu texels observed", on, n);
+    hearth_npy_free(&mask);
+    snprintf(path, sizeof path, "%s/instances/cup_01/derived/rgb_texture.png", root);
+    CHECK(hearth_path_exists(path));
+  }
 
   /* bad input names the file: a missing depth map, an empty cut-out */
   snprintf(cmd, sizeof cmd, "mv '%s/instances/cup_01/raw/neutral/depth/v03.png' '%s/v03.png'", root,

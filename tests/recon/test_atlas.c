@@ -1,0 +1,457 @@
+/* The UV atlas (hearth_mesh_atlas) on closed-form meshes and on the TSDF
+ * mesh of a small virtual-rig release. What is asserted is measured here,
+ * independently of the atlas code: each chart's Euler characteristic and
+ * boundary from the output's own indices, UV triangle overlaps by
+ * rasterising all UV triangles at 512 x 512 (texel centres strictly inside
+ * two triangles), the gutter, orientation, the L2 stretch (Sander et al.
+ * 2001) recomputed from the UVs, one UV island per chart, the GLB through
+ * the Khronos validator and hearth's reader.
+ *
+ * With arguments GLB_IN [GLB_OUT] it only runs the atlas on that mesh and
+ * prints its figures (bench use). */
+#include <float.h>
+#include <sys/wait.h>
+#include "hearth/recon_geom.h"
+#include "../test_util.h"
+
+/* ---- closed meshes, welded by exact positions ---------------------------- */
+typedef struct soup {
+  float *p; /* 9 per triangle */
+  size_t n, cap;
+} soup;
+
+static void soup_tri(soup *s, const double a[3], const double b[3], const double c[3]) {
+  if (s->n == s->cap) {
+    s->cap = s->cap ? 2 * s->cap : 256;
+    s->p = realloc(s->p, s->cap * 9 * sizeof *s->p);
+  }
+  const double *v[3] = {a, b, c};
+  for (int j = 0; j < 3; j++)
+    for (int k = 0; k < 3; k++) s->p[9 * s->n + 3 * j + k] = (float)v[j][k];
+  s->n++;
+}
+
+static const float *g_sort_p;
+static int cmp_corner(const void *pa, const void *pb) {
+  const float *a = g_sort_p + 3 * *(const uint32_t *)pa, *b = g_sort_p + 3 * *(const uint32_t *)pb;
+  for (int k = 0; k < 3; k++)
+    if (a[k] != b[k]) return a[k] < b[k] ? -1 : 1;
+  return 0;
+}
+
+/* the soup as an indexed mesh, corners at equal positions joined */
+static void soup_weld(soup *s, hearth_mesh *m) {
+  hearth_err e = {0};
+  size_t nc = 3 * s->n;
+  uint32_t *ord = malloc(nc * sizeof *ord), *id = malloc(nc * sizeof *id);
+  for (size_t i = 0; i < nc; i++) ord[i] = (uint32_t)i;
+  g_sort_p = s->p;
+  qsort(ord, nc, sizeof *ord, cmp_corner);
+  size_t nv = 0;
+  for (size_t i = 0; i < nc; i++) {
+    if (i == 0 || cmp_corner(&ord[i - 1], &ord[i]) != 0) nv++;
+    id[ord[i]] = (uint32_t)(nv - 1);
+  }
+  CHECK_OK(hearth_mesh_alloc(m, nv, s->n, 0, &e), &e);
+  for (size_t i = 0; i < nc; i++) {
+    m->indices[i] = id[i];
+    memcpy(m->positions + 3 * (size_t)id[i], s->p + 3 * i, 3 * sizeof(float));
+  }
+  free(ord), free(id), free(s->p);
+  memset(s, 0, sizeof *s);
+}
+
+/* the cube [-h, h]^3, each face a k x k grid of squares, outward faces */
+static void make_cube(hearth_mesh *m, int k, double h) {
+  soup s = {0};
+  for (int ax = 0; ax < 3; ax++)
+    for (int sg = -1; sg <= 1; sg += 2) {
+      int a1 = (ax + 1) % 3, a2 = (ax + 2) % 3;
+      for (int i = 0; i < k; i++)
+        for (int j = 0; j < k; j++) {
+          double q[4][3];
+          const int di[4] = {0, 1, 1, 0}, dj[4] = {0, 0, 1, 1};
+          for (int c = 0; c < 4; c++) {
+            q[c][ax] = sg * h;
+            q[c][a1] = -h + 2 * h * (i + di[c]) / k;
+            q[c][a2] = -h + 2 * h * (j + dj[c]) / k;
+          }
+          /* a1 x a2 = ax: counter-clockwise seen from +ax */
+          if (sg > 0) {
+            soup_tri(&s, q[0], q[1], q[2]);
+            soup_tri(&s, q[0], q[2], q[3]);
+          } else {
+            soup_tri(&s, q[0], q[2], q[1]);
+            soup_tri(&s, q[0], q[3], q[2]);
+          }
+        }
+    }
+  soup_weld(&s, m);
+}
+
+/* a surface of revolution point: torus (R, r) or sphere (R = 0) */
+static void rev_point(double R, double r, double th, double ph, double o[3]) {
+  double rho = R + r * sin(th);
+  o[0] = rho * cos(ph);
+  o[1] = rho * sin(ph);
+  o[2] = -r * cos(th);
+}
+
+/* sphere (R = 0, th in [0, pi]) or torus (th in [0, 2 pi]) on a grid of
+ * nu x nv quads, tilted about x by tilt radians */
+static void make_rev(hearth_mesh *m, double R, double r, int nu, int nv, double tilt) {
+  soup s = {0};
+  double thmax = R > 0 ? 2 * M_PI : M_PI;
+  for (int i = 0; i < nv; i++)
+    for (int j = 0; j < nu; j++) {
+      double q[4][3];
+      const int di[4] = {0, 0, 1, 1}, dj[4] = {0, 1, 1, 0};
+      for (int c = 0; c < 4; c++) {
+        int ii = i + di[c], jj = (j + dj[c]) % nu;
+        if (R == 0 && (ii == 0 || ii == nv)) jj = 0; /* one pole vertex */
+        if (R > 0) ii %= nv;
+        rev_point(R, r, thmax * ii / nv, 2 * M_PI * jj / nu, q[c]);
+        double y = q[c][1], z = q[c][2];
+        q[c][1] = cos(tilt) * y - sin(tilt) * z;
+        q[c][2] = sin(tilt) * y + cos(tilt) * z;
+      }
+      if (!(R == 0 && i == 0)) soup_tri(&s, q[0], q[1], q[2]);
+      if (!(R == 0 && i == nv - 1)) soup_tri(&s, q[0], q[2], q[3]);
+    }
+  soup_weld(&s, m);
+}
+
+/* closed cylinder of radius r, height h, n segments, rings bands; caps are
+ * fans around a centre vertex */
+static void make_cylinder(hearth_mesh *m, double r, double h, int n, int rings) {
+  soup s = {0};
+  for (int j = 0; j < n; j++) {
+    double a0 = 2 * M_PI * j / n, a1 = 2 * M_PI * ((j + 1) % n) / n;
+    for (int i = 0; i < rings; i++) {
+      double z0 = h * i / rings, z1 = h * (i + 1) / rings;
+      double p00[3] = {r * cos(a0), r * sin(a0), z0}, p10[3] = {r * cos(a1), r * sin(a1), z0};
+      double p01[3] = {r * cos(a0), r * sin(a0), z1}, p11[3] = {r * cos(a1), r * sin(a1), z1};
+      soup_tri(&s, p00, p10, p11);
+      soup_tri(&s, p00, p11, p01);
+    }
+    double c0[3] = {0, 0, 0}, c1[3] = {0, 0, h};
+    double b0[3] = {r * cos(a0), r * sin(a0), 0}, b1[3] = {r * cos(a1), r * sin(a1), 0};
+    double t0[3] = {r * cos(a0), r * sin(a0), h}, t1[3] = {r * cos(a1), r * sin(a1), h};
+    soup_tri(&s, c0, b1, b0);
+    soup_tri(&s, c1, t0, t1);
+  }
+  soup_weld(&s, m);
+}
+
+/* ---- the independent checks ---------------------------------------------- */
+typedef struct edge_key {
+  uint32_t a, b, chart;
+} edge_key;
+static int cmp_edge(const void *pa, const void *pb) {
+  const edge_key *x = pa, *y = pb;
+  if (x->chart != y->chart) return x->chart < y->chart ? -1 : 1;
+  if (x->a != y->a) return x->a < y->a ? -1 : 1;
+  return x->b < y->b ? -1 : x->b > y->b;
+}
+
+typedef struct atlas_check {
+  size_t n_charts, non_discs, overlaps, outside, folded;
+  double stretch, stretch_max, efficiency;
+} atlas_check;
+
+/* every check on out (from in, with chart_of_tri); gutter in UV units */
+static void check_atlas(const char *name, const hearth_mesh *in, const hearth_mesh *out,
+                        const uint32_t *chart, size_t n_charts, double gutter, atlas_check *r) {
+  memset(r, 0, sizeof *r);
+  r->n_charts = n_charts;
+  CHECK_MSG(out->n_triangles == in->n_triangles, "%s: %zu of %zu triangles", name, out->n_triangles,
+            in->n_triangles);
+  CHECK(out->uvs != NULL);
+  if (out->n_triangles != in->n_triangles || !out->uvs) return;
+  const size_t nt = in->n_triangles;
+  /* same surface: each corner at the input's position */
+  size_t moved = 0;
+  for (size_t c = 0; c < 3 * nt; c++)
+    moved += memcmp(out->positions + 3 * (size_t)out->indices[c],
+                    in->positions + 3 * (size_t)in->indices[c], 3 * sizeof(float)) != 0;
+  CHECK_MSG(moved == 0, "%s: %zu corners moved", name, moved);
+  /* every chart a disc: V - E + F = 1 and a boundary, from out's indices */
+  size_t *nf = calloc(n_charts, sizeof *nf), *ne = calloc(n_charts, sizeof *ne),
+         *nb = calloc(n_charts, sizeof *nb), *nvc = calloc(n_charts, sizeof *nvc);
+  uint32_t *vchart = malloc(out->n_vertices * sizeof *vchart);
+  for (size_t v = 0; v < out->n_vertices; v++) vchart[v] = UINT32_MAX;
+  edge_key *ek = malloc(3 * nt * sizeof *ek);
+  size_t shared_vertices = 0;
+  for (size_t t = 0; t < nt; t++) {
+    CHECK(chart[t] < n_charts);
+    nf[chart[t]]++;
+    for (int j = 0; j < 3; j++) {
+      uint32_t a = out->indices[3 * t + j], b = out->indices[3 * t + (j + 1) % 3];
+      ek[3 * t + j] = (edge_key){a < b ? a : b, a < b ? b : a, chart[t]};
+      if (vchart[a] == UINT32_MAX) vchart[a] = chart[t], nvc[chart[t]]++;
+      else if (vchart[a] != chart[t]) shared_vertices++;
+    }
+  }
+  CHECK_MSG(shared_vertices == 0, "%s: %zu corners use a vertex of another chart", name,
+            shared_vertices);
+  qsort(ek, 3 * nt, sizeof *ek, cmp_edge);
+  for (size_t i = 0; i < 3 * nt;) {
+    size_t j = i + 1;
+    while (j < 3 * nt && cmp_edge(&ek[i], &ek[j]) == 0) j++;
+    ne[ek[i].chart]++;
+    if (j - i == 1) nb[ek[i].chart]++;
+    i = j;
+  }
+  for (size_t k = 0; k < n_charts; k++) {
+    long chi = (long)nvc[k] - (long)ne[k] + (long)nf[k];
+    if (chi != 1 || nb[k] == 0) r->non_discs++;
+  }
+  free(nf), free(ne), free(nb), free(nvc), free(vchart), free(ek);
+  /* UVs inside the gutter; orientation; L2 stretch over the common scale */
+  double a3 = 0, auv = 0;
+  for (size_t v = 0; v < out->n_vertices; v++)
+    for (int k = 0; k < 2; k++) {
+      float u = out->uvs[2 * v + k];
+      if (!(u >= gutter - 1e-6 && u <= 1 - gutter + 1e-6)) r->outside++;
+    }
+  double *jac = malloc(nt * 4 * sizeof *jac); /* a, c, b, area3 per triangle */
+  for (size_t t = 0; t < nt; t++) {
+    const uint32_t *ix = out->indices + 3 * t;
+    double q[3][3], s[3], w[3];
+    for (int j = 0; j < 3; j++) {
+      for (int k = 0; k < 3; k++) q[j][k] = out->positions[3 * (size_t)ix[j] + k];
+      s[j] = out->uvs[2 * (size_t)ix[j]], w[j] = out->uvs[2 * (size_t)ix[j] + 1];
+    }
+    double e1[3], e2[3], n[3];
+    for (int k = 0; k < 3; k++) e1[k] = q[1][k] - q[0][k], e2[k] = q[2][k] - q[0][k];
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1], n[1] = e1[2] * e2[0] - e1[0] * e2[2],
+    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    double A3 = 0.5 * sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    double Au = 0.5 * ((s[1] - s[0]) * (w[2] - w[0]) - (s[2] - s[0]) * (w[1] - w[0]));
+    jac[4 * t + 3] = 0;
+    if (!(A3 > 1e-14)) continue;
+    if (!(Au > 0)) {
+      r->folded++;
+      continue;
+    }
+    double Ss[3], St[3];
+    for (int k = 0; k < 3; k++) {
+      Ss[k] =
+          (q[0][k] * (w[1] - w[2]) + q[1][k] * (w[2] - w[0]) + q[2][k] * (w[0] - w[1])) / (2 * Au);
+      St[k] =
+          (q[0][k] * (s[2] - s[1]) + q[1][k] * (s[0] - s[2]) + q[2][k] * (s[1] - s[0])) / (2 * Au);
+    }
+    jac[4 * t] = Ss[0] * Ss[0] + Ss[1] * Ss[1] + Ss[2] * Ss[2];
+    jac[4 * t + 1] = St[0] * St[0] + St[1] * St[1] + St[2] * St[2];
+    jac[4 * t + 3] = A3;
+    a3 += A3, auv += Au;
+  }
+  double sum = 0;
+  for (size_t t = 0; t < nt; t++) {
+    double A3 = jac[4 * t + 3];
+    if (!(A3 > 0)) continue;
+    /* scaled so the whole map has UV area = surface area */
+    double l2sq = 0.5 * (jac[4 * t] + jac[4 * t + 1]) * auv / a3;
+    sum += A3 * l2sq;
+    if (sqrt(l2sq) > r->stretch_max) r->stretch_max = sqrt(l2sq);
+  }
+  free(jac);
+  r->stretch = a3 > 0 ? sqrt(sum / a3) : 0;
+  r->efficiency = auv;
+  /* overlaps at 512 x 512: texel centres strictly inside two UV triangles */
+  const int R = 512;
+  uint8_t *cov = calloc((size_t)R * R, 1);
+  uint32_t *who = getenv("ATLAS_DEBUG") ? calloc((size_t)R * R, sizeof *who) : NULL;
+  for (size_t t = 0; t < nt; t++) {
+    double P[3][2];
+    for (int j = 0; j < 3; j++)
+      for (int k = 0; k < 2; k++) P[j][k] = out->uvs[2 * (size_t)out->indices[3 * t + j] + k] * R;
+    double area =
+        (P[1][0] - P[0][0]) * (P[2][1] - P[0][1]) - (P[2][0] - P[0][0]) * (P[1][1] - P[0][1]);
+    double sg = area > 0 ? 1 : -1;
+    int x0 = (int)floor(fmin(P[0][0], fmin(P[1][0], P[2][0]))),
+        x1 = (int)ceil(fmax(P[0][0], fmax(P[1][0], P[2][0])));
+    int y0 = (int)floor(fmin(P[0][1], fmin(P[1][1], P[2][1]))),
+        y1 = (int)ceil(fmax(P[0][1], fmax(P[1][1], P[2][1])));
+    for (int y = y0 < 0 ? 0 : y0; y <= y1 && y < R; y++)
+      for (int x = x0 < 0 ? 0 : x0; x <= x1 && x < R; x++) {
+        double px = x + 0.5, py = y + 0.5;
+        int inside = 1;
+        for (int j = 0; j < 3 && inside; j++) {
+          const double *a = P[j], *b = P[(j + 1) % 3];
+          inside = sg * ((b[0] - a[0]) * (py - a[1]) - (b[1] - a[1]) * (px - a[0])) > 0;
+        }
+        if (inside && who && cov[(size_t)y * R + x])
+          fprintf(stderr, "overlap at %d %d: triangles %u (chart %u) and %zu (chart %u)\n", x, y,
+                  who[(size_t)y * R + x], chart[who[(size_t)y * R + x]], t, chart[t]);
+        if (inside && who) who[(size_t)y * R + x] = (uint32_t)t;
+        if (inside && cov[(size_t)y * R + x]++ == 1) r->overlaps++;
+      }
+  }
+  free(cov), free(who);
+  /* one UV island per chart */
+  uint32_t *isl = malloc(nt * sizeof *isl), n_isl = 0;
+  hearth_err e = {0};
+  CHECK_OK(hearth_uv_islands(out, isl, &n_isl, &e), &e);
+  CHECK_MSG(n_isl == n_charts, "%s: %u UV islands, %zu charts", name, n_isl, n_charts);
+  free(isl);
+  printf(
+      "%s: %zu triangles, %zu charts, L2 stretch %.4f (max %.4f), packing %.3f; "
+      "%zu non-disc charts, %zu overlapping texels, %zu UVs outside, %zu folded\n",
+      name, nt, n_charts, r->stretch, r->stretch_max, r->efficiency, r->non_discs, r->overlaps,
+      r->outside, r->folded);
+  CHECK_MSG(r->non_discs == 0, "%s: %zu charts are no disc", name, r->non_discs);
+  CHECK_MSG(r->overlaps == 0, "%s: %zu texels under two UV triangles", name, r->overlaps);
+  CHECK_MSG(r->outside == 0, "%s: %zu UV coordinates in the gutter or outside", name, r->outside);
+  CHECK_MSG(r->folded == 0, "%s: %zu folded UV triangles", name, r->folded);
+}
+
+static void run_case(const char *name, const hearth_mesh *m, atlas_check *r, hearth_atlas_stats *st,
+                     hearth_mesh *keep) {
+  hearth_err e = {0};
+  hearth_atlas_opts o;
+  hearth_atlas_opts_default(&o);
+  hearth_mesh out, again;
+  uint32_t *chart = malloc(m->n_triangles * sizeof *chart);
+  CHECK_OK(hearth_mesh_atlas(m, &o, &out, chart, st, &e), &e);
+  if (!out.uvs) {
+    free(chart);
+    return;
+  }
+  check_atlas(name, m, &out, chart, st->n_charts, o.gutter_texels / o.texture_size, r);
+  /* the library's own figures agree with the ones measured here */
+  CHECK_NEAR(st->stretch_l2, r->stretch, 1e-3 * r->stretch);
+  CHECK_NEAR(st->packing_efficiency, r->efficiency, 1e-4);
+  printf("  (library: stretch %.4f max %.4f, area %.4f, angle %.4f, %zu splits, CG <= %d)\n",
+         st->stretch_l2, st->stretch_l2_max, st->area_distortion, st->angle_distortion,
+         st->n_splits, st->cg_iterations_max);
+  /* deterministic */
+  hearth_atlas_stats st2;
+  CHECK_OK(hearth_mesh_atlas(m, &o, &again, NULL, &st2, &e), &e);
+  CHECK(again.n_vertices == out.n_vertices &&
+        memcmp(again.uvs, out.uvs, 2 * out.n_vertices * sizeof(float)) == 0 &&
+        memcmp(again.indices, out.indices, 3 * out.n_triangles * sizeof(uint32_t)) == 0);
+  hearth_mesh_free(&again);
+  free(chart);
+  if (keep) *keep = out;
+  else hearth_mesh_free(&out);
+}
+
+static void test_closed_forms(void) {
+  hearth_mesh m;
+  atlas_check r;
+  hearth_atlas_stats st;
+  make_cube(&m, 4, 0.05);
+  run_case("cube", &m, &r, &st, NULL);
+  CHECK_MSG(st.n_charts == 6, "cube: %zu charts", st.n_charts);
+  CHECK_NEAR(r.stretch, 1, 1e-5);
+  CHECK_NEAR(r.stretch_max, 1, 1e-5);
+  CHECK_NEAR(st.area_distortion, 0, 1e-5);
+  CHECK_NEAR(st.angle_distortion, 0, 1e-5);
+  /* six equal squares in shelves of the unit square: at least 6/9 of it
+     less the gutters */
+  CHECK_MSG(r.efficiency > 0.6, "cube: packing %g", r.efficiency);
+  hearth_mesh_free(&m);
+
+  make_rev(&m, 0, 0.05, 32, 16, 0.3);
+  run_case("sphere", &m, &r, &st, NULL);
+  CHECK_MSG(r.stretch < 1.15 && r.stretch_max < 2, "sphere: stretch %g max %g", r.stretch,
+            r.stretch_max);
+  CHECK_MSG(r.efficiency > 0.4, "sphere: packing %g", r.efficiency);
+  hearth_mesh_free(&m);
+
+  make_cylinder(&m, 0.03, 0.1, 32, 8);
+  run_case("cylinder", &m, &r, &st, NULL);
+  CHECK_MSG(r.stretch < 1.15, "cylinder: stretch %g", r.stretch);
+  hearth_mesh_free(&m);
+
+  /* a torus: the normal clusters include bands around the hole, which are
+     no discs and must be cut */
+  make_rev(&m, 0.05, 0.02, 48, 24, 0.2);
+  run_case("torus", &m, &r, &st, NULL);
+  CHECK_MSG(st.n_splits > 0, "torus: no chart was cut");
+  CHECK_MSG(r.stretch < 1.25, "torus: stretch %g", r.stretch);
+  hearth_mesh_free(&m);
+
+  /* errors */
+  hearth_err e = {0};
+  hearth_mesh empty = {0}, out;
+  CHECK(hearth_mesh_atlas(&empty, NULL, &out, NULL, NULL, &e) == HEARTH_E_ARG);
+}
+
+static int run_validator(const char *path) {
+  const char *src = getenv("HEARTH_SOURCE_DIR");
+  char cmd[4096];
+  snprintf(cmd, sizeof cmd, "node '%s/tests/mesh/validate_glb.js' '%s'", src ? src : ".", path);
+  int rc = system(cmd);
+  return rc == -1 || !WIFEXITED(rc) ? -1 : WEXITSTATUS(rc);
+}
+
+/* the atlas of a fused mesh, written as GLB, validated and read back */
+static void atlas_glb(const char *name, const hearth_mesh *m, const char *path) {
+  hearth_err e = {0};
+  atlas_check r;
+  hearth_atlas_stats st;
+  hearth_mesh out = {0};
+  run_case(name, m, &r, &st, &out);
+  if (!out.uvs) return;
+  CHECK_OK(hearth_glb_write(path, &out, &e), &e);
+  int rc = run_validator(path);
+  CHECK_MSG(rc == 0, "%s: validator exit status %d", path, rc);
+  hearth_glb_read_opts ro;
+  hearth_glb_read_opts_default(&ro);
+  ro.require_uvs = 1;
+  hearth_mesh back;
+  CHECK_OK(hearth_glb_read(path, &ro, &back, &e), &e);
+  CHECK(back.n_triangles == out.n_triangles && back.uvs != NULL);
+  if (back.uvs && back.n_vertices == out.n_vertices)
+    CHECK(memcmp(back.uvs, out.uvs, 2 * out.n_vertices * sizeof(float)) == 0);
+  hearth_mesh_free(&back);
+  hearth_mesh_free(&out);
+}
+
+static void test_release(void) {
+  const char *dir = test_tmpdir("recon_atlas");
+  char root[1100], cmd[1400], path[1200];
+  snprintf(root, sizeof root, "%s/rel", dir);
+  snprintf(cmd, sizeof cmd,
+           "%s synth --out '%s' --categories cup --states neutral --views 10 --no-calibration "
+           "--draft-rgb --texture 256 --map-res 64 --quiet",
+           HEARTH_EXE, root);
+  CHECK(system(cmd) == 0);
+  hearth_err e = {0};
+  hearth_recon_tsdf_opts o;
+  hearth_recon_tsdf_opts_default(&o);
+  o.voxel_m = 0.003;
+  o.target_triangles = 8000;
+  hearth_mesh m;
+  CHECK_OK(hearth_recon_tsdf(root, "cup_01", NULL, 0, &o, &m, &e), &e);
+  if (!m.n_triangles) return;
+  snprintf(path, sizeof path, "%s/cup_atlas.glb", dir);
+  atlas_glb("cup (TSDF)", &m, path);
+  hearth_mesh_free(&m);
+}
+
+int main(int argc, char **argv) {
+  if (argc >= 2) {
+    hearth_err e = {0};
+    hearth_mesh m;
+    CHECK_OK(hearth_glb_read(argv[1], NULL, &m, &e), &e);
+    if (g_test_failures) return 1;
+    hearth_atlas_stats st;
+    hearth_mesh out;
+    CHECK_OK(hearth_mesh_atlas(&m, NULL, &out, NULL, &st, &e), &e);
+    if (g_test_failures) return 1;
+    printf(
+        "%s: %zu triangles, %zu charts, L2 stretch %.4f (max %.4f), area %.4f, angle %.4f, "
+        "packing %.3f\n",
+        argv[1], m.n_triangles, st.n_charts, st.stretch_l2, st.stretch_l2_max, st.area_distortion,
+        st.angle_distortion, st.packing_efficiency);
+    if (argc >= 3) CHECK_OK(hearth_glb_write(argv[2], &out, &e), &e);
+    hearth_mesh_free(&m), hearth_mesh_free(&out);
+    return g_test_failures;
+  }
+  test_closed_forms();
+  test_release();
+  return g_test_failures;
+}
