@@ -169,7 +169,7 @@ typedef struct hearth_calib_report {
   hearth_calib_frame_report *thermal; /* owned */
   hearth_calib_frame_report *pairs;   /* owned */
   hearth_rig rig;
-  double t_calib_s; /* seconds spent reading, solving (not writing) */
+  double t_calib_s;        /* seconds spent reading, solving (not writing) */
   hearth_lens_choice lens; /* thermal-only calibration only */
 } hearth_calib_report;
 /* Frees the frame lists and zeroes r; accepts a zeroed report. */

@@ -48,8 +48,8 @@ hearth_status hearth_rig_write(const char *path, const hearth_rig *rig, hearth_e
 /* HEARTH_OK for a rig with the stereo calibration; for a thermal-only rig
  * an error (HEARTH_E_UNSUPPORTED) naming path and saying that `stage`
  * needs T_thermal_from_rgb. */
-hearth_status hearth_rig_require_stereo(const hearth_rig *rig, const char *path,
-                                        const char *stage, hearth_err *err);
+hearth_status hearth_rig_require_stereo(const hearth_rig *rig, const char *path, const char *stage,
+                                        hearth_err *err);
 
 /* ---- depth/vNN.json: per-frame depth intrinsics ------------------------- */
 typedef struct hearth_depth_intrinsics {

@@ -214,13 +214,13 @@ hearth_status hearth_recon_turntable(const char *root, const char *instance,
  * repeated once per chart it belongs to (vertices in chart order, then by
  * first use). Deterministic: no threads, no randomness. */
 typedef struct hearth_atlas_opts {
-  size_t min_chart_faces; /* default 8 */
-  int kmeans_iterations;  /* default 4; 0: the six axes as they are */
-  int smooth_passes;      /* face normals averaged with their neighbours'
+  size_t min_chart_faces;   /* default 8 */
+  int kmeans_iterations;    /* default 4; 0: the six axes as they are */
+  int smooth_passes;        /* face normals averaged with their neighbours'
                              this many times before clustering; default 3 */
-  int texture_size;       /* texels per side the gutter is counted in; default 1024 */
-  double gutter_texels;   /* default 4 */
-  int cg_max_iterations;  /* per chart; default 4000 */
+  int texture_size;         /* texels per side the gutter is counted in; default 1024 */
+  double gutter_texels;     /* default 4 */
+  int cg_max_iterations;    /* per chart; default 4000 */
   double max_chart_stretch; /* a chart's L2 stretch over its own area above
                                this cuts it; default 1.1 */
   double max_face_stretch;  /* so does one triangle's; default 2 */
@@ -234,13 +234,13 @@ void hearth_atlas_opts_default(hearth_atlas_opts *o);
  * sqrt((s1^2 + s2^2) / 2) (Sander, Snyder, Gortler, Hoppe 2001). */
 typedef struct hearth_atlas_stats {
   size_t n_charts;
-  size_t n_splits;       /* charts cut because they were no disc or folded */
-  double stretch_l2;     /* the mesh's L2 stretch: sqrt(area-weighted mean of L2^2) */
-  double stretch_l2_max; /* largest per-triangle L2 stretch */
-  double area_distortion;  /* area-weighted mean of |ln(s1 s2)| */
-  double angle_distortion; /* area-weighted mean of ln(s1 / s2) */
+  size_t n_splits;           /* charts cut because they were no disc or folded */
+  double stretch_l2;         /* the mesh's L2 stretch: sqrt(area-weighted mean of L2^2) */
+  double stretch_l2_max;     /* largest per-triangle L2 stretch */
+  double area_distortion;    /* area-weighted mean of |ln(s1 s2)| */
+  double angle_distortion;   /* area-weighted mean of ln(s1 / s2) */
   double packing_efficiency; /* UV area of the triangles / area of the unit square */
-  int cg_iterations_max;   /* most CG iterations one chart took */
+  int cg_iterations_max;     /* most CG iterations one chart took */
 } hearth_atlas_stats;
 
 /* Atlas of in (positions and indices; UVs and texture ignored) into out
@@ -248,8 +248,8 @@ typedef struct hearth_atlas_stats {
  * the caller's in->n_triangles entries) receives each triangle's chart.
  * stats may be NULL. opts NULL: the defaults. Empty mesh: HEARTH_E_ARG. */
 hearth_status hearth_mesh_atlas(const hearth_mesh *in, const hearth_atlas_opts *opts,
-                                hearth_mesh *out, uint32_t *chart_of_tri,
-                                hearth_atlas_stats *stats, hearth_err *err);
+                                hearth_mesh *out, uint32_t *chart_of_tri, hearth_atlas_stats *stats,
+                                hearth_err *err);
 
 /* ---- hearth recon ROOT (recon_run.c) -------------------------------------- */
 /* The embedded route over one instance: colour poses by
@@ -276,7 +276,7 @@ typedef struct hearth_recon_job {
   hearth_turntable_opts poses;
   hearth_recon_tsdf_opts geometry; /* .poses is set by the job */
   hearth_atlas_opts atlas;
-  int no_mesh;                     /* 1: poses and report only */
+  int no_mesh; /* 1: poses and report only */
   int force;
   int quiet;
 } hearth_recon_job;

@@ -207,7 +207,7 @@ typedef struct hearth_sim_collect_opts {
   int quiet;
   int thermal;            /* as hearth_sim_opts.thermal; dynamic adds obs/thermal_state */
   double thermal_speedup; /* as hearth_sim_opts.thermal_speedup; 0 = 1 */
-  const char *out_path; /* .hdf5, written atomically (layout: docs/simulation.md) */
+  const char *out_path;   /* .hdf5, written atomically (layout: docs/simulation.md) */
 } hearth_sim_collect_opts;
 void hearth_sim_collect_opts_default(hearth_sim_collect_opts *o);
 

@@ -96,8 +96,8 @@ typedef struct hearth_synth_opts {
      thermal), low contrast (holes a few degC / grey levels off the plate),
      inverted polarity (holes cooler in thermal, brighter in colour) */
   int calib_clutter, calib_low_contrast, calib_invert;
-  int threads;               /* 0 = hearth_default_threads() */
-  int quiet;                 /* no progress output */
+  int threads; /* 0 = hearth_default_threads() */
+  int quiet;   /* no progress output */
   /* 1: the clean rig, every effect off (black bodies, no reflections, nothing
      cools; no view times in the manifests, no temperature_apparent.npy): the
      bytes of the rig before the effects, for closed-form tests. Default 0. */

@@ -185,8 +185,8 @@ hearth_status hearth_calib_intrinsics(const double (*obj)[3], size_t n_pts, cons
       st = hearth_err_set(err, HEARTH_E_NOMEM, "intrinsic calibration: out of memory");
       goto done;
     }
-    st = hearth_calib_intrinsics(obj, n_pts, img, n_frames, width, height, &o5, &c5, NULL, NULL,
-                                 T5, err);
+    st = hearth_calib_intrinsics(obj, n_pts, img, n_frames, width, height, &o5, &c5, NULL, NULL, T5,
+                                 err);
     for (size_t f = 0; !st && f < n_frames; f++) calib_params_from_rigid(&T5[f], poses + 6 * f);
     free(T5);
     if (st) goto done;

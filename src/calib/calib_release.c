@@ -636,9 +636,9 @@ hearth_status hearth_calib_calibrate_release(const char *root, const hearth_cali
       return hearth_err_set(err, HEARTH_E_INCONSISTENT,
                             "%s: made for a %s %d x %d target of pitch %.6g m, but %s describes "
                             "a %s %d x %d target of pitch %.6g m (run `hearth detect` again)",
-                            pdet, hearth_lattice_name(dt->lattice), dt->rows, dt->cols,
-                            dt->pitch_m, path, hearth_lattice_name(target.lattice), target.rows,
-                            target.cols, target.pitch_m);
+                            pdet, hearth_lattice_name(dt->lattice), dt->rows, dt->cols, dt->pitch_m,
+                            path, hearth_lattice_name(target.lattice), target.rows, target.cols,
+                            target.pitch_m);
     }
   }
   /* the thermal camera's size: that of its captures */
@@ -706,11 +706,9 @@ hearth_status hearth_calib_calibrate_release(const char *root, const hearth_cali
     size_t m = 0;
     double *pts = img_b; /* scratch: the used frames packed */
     for (size_t i = 0; i < nt; i++)
-      if (used[i])
-        memcpy(pts + 2 * NH * m++, img_t + 2 * NH * i,
-               sizeof(double) * 2 * NH);
-    if ((st = hearth_calib_intrinsics((const double(*)[3])obj, NH, pts, m, tw, th_h,
-                                      o, &th, &trms, tmp, NULL, err))) {
+      if (used[i]) memcpy(pts + 2 * NH * m++, img_t + 2 * NH * i, sizeof(double) * 2 * NH);
+    if ((st = hearth_calib_intrinsics((const double(*)[3])obj, NH, pts, m, tw, th_h, o, &th, &trms,
+                                      tmp, NULL, err))) {
       hearth_err_prefix(err, "%s", pdet);
       goto done;
     }
@@ -718,8 +716,8 @@ hearth_status hearth_calib_calibrate_release(const char *root, const hearth_cali
     for (size_t i = 0; i < nt; i++) {
       hearth_rigid T;
       hearth_err e2;
-      if (hearth_calib_pose(&th, (const double(*)[3])obj, NH,
-                            img_t + 2 * NH * i, &T, &frms[i], &e2))
+      if (hearth_calib_pose(&th, (const double(*)[3])obj, NH, img_t + 2 * NH * i, &T, &frms[i],
+                            &e2))
         frms[i] = INFINITY;
     }
     size_t k = 0;
@@ -749,17 +747,13 @@ hearth_status hearth_calib_calibrate_release(const char *root, const hearth_cali
       double *pts = img_b;
       size_t m = 0;
       for (size_t i = 0; i < nt; i++)
-        if (used[i])
-          memcpy(pts + 2 * NH * m++, img_t + 2 * NH * i,
-                 sizeof(double) * 2 * NH);
+        if (used[i]) memcpy(pts + 2 * NH * m++, img_t + 2 * NH * i, sizeof(double) * 2 * NH);
       for (size_t k = 0; pass > 0 && k < m; k++) {
-        calib_circle_bias(&th, &poses[k], (const double(*)[3])obj, NH,
-                          hole_r, wall_t, bias);
-        for (size_t q = 0; q < 2 * NH; q++)
-          pts[2 * NH * k + q] -= bias[q];
+        calib_circle_bias(&th, &poses[k], (const double(*)[3])obj, NH, hole_r, wall_t, bias);
+        for (size_t q = 0; q < 2 * NH; q++) pts[2 * NH * k + q] -= bias[q];
       }
-      if ((st = hearth_calib_intrinsics((const double(*)[3])obj, NH, pts, m, tw,
-                                        th_h, o, &th, &trms, tmp, poses, err))) {
+      if ((st = hearth_calib_intrinsics((const double(*)[3])obj, NH, pts, m, tw, th_h, o, &th,
+                                        &trms, tmp, poses, err))) {
         hearth_err_prefix(err, "%s", pdet);
         goto done;
       }
@@ -771,17 +765,13 @@ hearth_status hearth_calib_calibrate_release(const char *root, const hearth_cali
     double *pts = img_b;
     size_t m = 0;
     for (size_t i = 0; i < nt; i++)
-      if (used[i])
-        memcpy(pts + 2 * NH * m++, img_t + 2 * NH * i,
-               sizeof(double) * 2 * NH);
+      if (used[i]) memcpy(pts + 2 * NH * m++, img_t + 2 * NH * i, sizeof(double) * 2 * NH);
     for (size_t k = 0; k < m; k++) {
-      calib_circle_bias(&th, &poses[k], (const double(*)[3])obj, NH,
-                        hole_r, wall_t, bias);
-      for (size_t q = 0; q < 2 * NH; q++)
-        pts[2 * NH * k + q] -= bias[q];
+      calib_circle_bias(&th, &poses[k], (const double(*)[3])obj, NH, hole_r, wall_t, bias);
+      for (size_t q = 0; q < 2 * NH; q++) pts[2 * NH * k + q] -= bias[q];
     }
-    if ((st = hearth_calib_intrinsics((const double(*)[3])obj, NH, pts, m, tw, th_h,
-                                      o, &th, &trms, tmp, poses, err))) {
+    if ((st = hearth_calib_intrinsics((const double(*)[3])obj, NH, pts, m, tw, th_h, o, &th, &trms,
+                                      tmp, poses, err))) {
       hearth_err_prefix(err, "%s", pdet);
       goto done;
     }
@@ -835,10 +825,8 @@ hearth_status hearth_calib_calibrate_release(const char *root, const hearth_cali
         for (int pass = 0; pass < 2; pass++) {
           hearth_rigid T;
           hearth_err e2;
-          if (hearth_calib_pose(cc, (const double(*)[3])obj, NH, p, &T, NULL, &e2))
-            break;
-          calib_circle_bias(cc, &T, (const double(*)[3])obj, NH, hole_r,
-                            wall_t, bias);
+          if (hearth_calib_pose(cc, (const double(*)[3])obj, NH, p, &T, NULL, &e2)) break;
+          calib_circle_bias(cc, &T, (const double(*)[3])obj, NH, hole_r, wall_t, bias);
           for (size_t q = 0; q < 2 * NH; q++) p[q] = raw[q] - bias[q];
         }
       }
@@ -846,8 +834,8 @@ hearth_status hearth_calib_calibrate_release(const char *root, const hearth_cali
   }
   hearth_rigid Tth;
   double srms;
-  if ((st = hearth_calib_stereo(&fc.rgb, &th, (const double(*)[3])obj, NH, img_a,
-                                img_b, npair, o, &Tth, &srms, frms, used, err))) {
+  if ((st = hearth_calib_stereo(&fc.rgb, &th, (const double(*)[3])obj, NH, img_a, img_b, npair, o,
+                                &Tth, &srms, frms, used, err))) {
     hearth_err_prefix(err, "%s", pdet);
     goto done;
   }

@@ -269,7 +269,8 @@ typedef struct to_fit {
 static void pack_used(const to_problem *p, const int *used, double *pts, size_t *m) {
   *m = 0;
   for (size_t i = 0; i < p->nt; i++)
-    if (used[i]) memcpy(pts + 2 * p->np * (*m)++, p->img + 2 * p->np * i, sizeof(double) * 2 * p->np);
+    if (used[i])
+      memcpy(pts + 2 * p->np * (*m)++, p->img + 2 * p->np * i, sizeof(double) * 2 * p->np);
 }
 
 static hearth_status solve(const to_problem *p, hearth_lens_model model, const double *pts,
@@ -277,8 +278,8 @@ static hearth_status solve(const to_problem *p, hearth_lens_model model, const d
                            hearth_rigid *poses, hearth_err *err) {
   hearth_calib_opts o = *p->o;
   o.lens_model = model;
-  return hearth_calib_intrinsics(p->obj, p->np, pts, m, p->width, p->height, &o, cam, rms, frms, poses,
-                                 err);
+  return hearth_calib_intrinsics(p->obj, p->np, pts, m, p->width, p->height, &o, cam, rms, frms,
+                                 poses, err);
 }
 
 /* outlier rounds (frames far above the median residual dropped, the solve

@@ -33,8 +33,7 @@ static void print_thermal_only(const hearth_calib_report *rep, int quiet) {
     for (size_t i = 0; i < rep->n_thermal; i++) {
       const hearth_calib_frame_report *f = &rep->thermal[i];
       if (isfinite(f->rms_px))
-        printf("  %-12s %-4s %8.4f px  %s\n", f->frame, f->used ? "used" : "-", f->rms_px,
-               f->note);
+        printf("  %-12s %-4s %8.4f px  %s\n", f->frame, f->used ? "used" : "-", f->rms_px, f->note);
       else printf("  %-12s %-4s %8s     %s\n", f->frame, f->used ? "used" : "-", "", f->note);
     }
     printf("lens model   train RMS   held-out RMS\n");

@@ -136,8 +136,8 @@ static int run_turntable(const char *root, const char *instance, const hearth_re
   if (!job.no_mesh) {
     printf("recon %s: mesh %zu vertices, %zu triangles -> %s\n", instance, sum.mesh_vertices,
            sum.mesh_triangles, sum.mesh_path);
-    printf("recon %s: atlas %zu charts, L2 stretch %.4f (max %.3f), packing %.3f -> %s\n",
-           instance, sum.atlas.n_charts, sum.atlas.stretch_l2, sum.atlas.stretch_l2_max,
+    printf("recon %s: atlas %zu charts, L2 stretch %.4f (max %.3f), packing %.3f -> %s\n", instance,
+           sum.atlas.n_charts, sum.atlas.stretch_l2, sum.atlas.stretch_l2_max,
            sum.atlas.packing_efficiency, sum.atlas_path);
   }
   hearth_recon_summary_free(&sum);

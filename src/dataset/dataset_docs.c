@@ -141,8 +141,8 @@ static hearth_status rig_validate(const char *text, size_t len, const char *name
   return hearth_rig_parse(text, len, name, &r, err);
 }
 
-hearth_status hearth_rig_require_stereo(const hearth_rig *rig, const char *path,
-                                        const char *stage, hearth_err *err) {
+hearth_status hearth_rig_require_stereo(const hearth_rig *rig, const char *path, const char *stage,
+                                        hearth_err *err) {
   if (!rig->thermal_only) return HEARTH_OK;
   return hearth_err_set(err, HEARTH_E_UNSUPPORTED,
                         "%s: a thermal-only rig (hearth calibrate --thermal-only) has no colour "

@@ -78,11 +78,9 @@ hearth_status hearth_target_check(const hearth_target *t, const char *name, hear
     return hearth_err_set(err, HEARTH_E_RANGE, "%s: lattice: unknown lattice %d", name,
                           (int)t->lattice);
   if (t->rows < 3 || t->rows > 64)
-    return hearth_err_set(err, HEARTH_E_RANGE, "%s: rows: expected 3..64, found %d", name,
-                          t->rows);
+    return hearth_err_set(err, HEARTH_E_RANGE, "%s: rows: expected 3..64, found %d", name, t->rows);
   if (t->cols < 3 || t->cols > 64)
-    return hearth_err_set(err, HEARTH_E_RANGE, "%s: cols: expected 3..64, found %d", name,
-                          t->cols);
+    return hearth_err_set(err, HEARTH_E_RANGE, "%s: cols: expected 3..64, found %d", name, t->cols);
   if (t->lattice == HEARTH_LATTICE_HEX_ALTERNATING && t->cols < 4)
     return hearth_err_set(err, HEARTH_E_RANGE,
                           "%s: cols: expected 4..64 for hex-alternating (rows of C and C-1), "
@@ -107,8 +105,8 @@ hearth_status hearth_target_check(const hearth_target *t, const char *name, hear
 }
 
 static hearth_status target_from_json(hj_ctx *c, const json_t *root, void *out) {
-  static const char *const keys[6] = {"lattice",  "rows",           "cols",
-                                      "pitch_m",  "hole_diameter_m", "thickness_m"};
+  static const char *const keys[6] = {"lattice",         "rows",       "cols", "pitch_m",
+                                      "hole_diameter_m", "thickness_m"};
   const char *key;
   json_t *v;
   json_object_foreach((json_t *)root, key, v) {

@@ -549,8 +549,7 @@ hearth_status hearth_detections_write(const char *path, const hearth_detections 
     json_t *v = json_object();
     ok = hj_set(v, "frame", hj_str(f->frame)) && hj_set(v, "camera", hj_str(f->camera)) &&
          hj_set(v, "found", json_boolean(f->found));
-    if (ok && f->found)
-      ok = hj_set(v, "centres", hj_mat_new(&f->centres[0][0], holes, 2));
+    if (ok && f->found) ok = hj_set(v, "centres", hj_mat_new(&f->centres[0][0], holes, 2));
     else if (ok) ok = hj_set(v, "reason", hj_str(f->reason));
     if (!ok || json_array_append_new(fv, v) != 0) {
       if (ok) ok = 0;

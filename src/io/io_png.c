@@ -162,8 +162,7 @@ static uint32_t get_be32(const uint8_t *p) {
    byte f), prev the row above already undone (NULL for the first row) */
 static int unfilter_row(uint8_t f, uint8_t *cur, const uint8_t *prev, size_t rb, size_t bpp) {
   switch (f) {
-    case 0:
-      return 1;
+    case 0: return 1;
     case 1:
       for (size_t i = bpp; i < rb; i++) cur[i] = (uint8_t)(cur[i] + cur[i - bpp]);
       return 1;
@@ -186,8 +185,7 @@ static int unfilter_row(uint8_t f, uint8_t *cur, const uint8_t *prev, size_t rb,
         cur[i] = (uint8_t)(cur[i] + pred);
       }
       return 1;
-    default:
-      return 0;
+    default: return 0;
   }
 }
 

@@ -77,7 +77,7 @@ static json_t *vec_json(const double *v, int n) {
 }
 
 static const char *fusion_name(hearth_fusion f) {
-  return f == HEARTH_FUSE_MAX        ? "max"
+  return f == HEARTH_FUSE_MAX         ? "max"
          : f == HEARTH_FUSE_ROBUST    ? "robust"
          : f == HEARTH_FUSE_CORRECTED ? "corrected"
                                       : "mean";

@@ -285,10 +285,10 @@ typedef struct build_ctx {
 } build_ctx;
 
 static void fusion_params(const hearth_build_opts *o, char *buf, size_t n) {
-  const char *f = o->fusion == HEARTH_FUSE_MAX      ? "max"
-                  : o->fusion == HEARTH_FUSE_ROBUST ? "robust"
+  const char *f = o->fusion == HEARTH_FUSE_MAX         ? "max"
+                  : o->fusion == HEARTH_FUSE_ROBUST    ? "robust"
                   : o->fusion == HEARTH_FUSE_CORRECTED ? "corrected"
-                                                    : "mean";
+                                                       : "mean";
   char mc[32];
   hearth_format_fixed(mc, sizeof mc, o->min_cos, 6);
   snprintf(buf, n, "resolution=%zu fusion=%s min_cos=%s turbo=10..60", o->resolution, f, mc);

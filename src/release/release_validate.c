@@ -181,8 +181,7 @@ static int present(const char *path) {
 }
 
 /* tw x th: the thermal camera's size (0 x 0: any consistent rectangle) */
-static void check_csv(hearth_problems *p, const char *path, size_t tw, size_t th,
-                      size_t *nfiles) {
+static void check_csv(hearth_problems *p, const char *path, size_t tw, size_t th, size_t *nfiles) {
   hearth_csv_opts co = {tw, th};
   hearth_image img = {0};
   hearth_err e = {0};
@@ -605,8 +604,7 @@ static void check_calibration(const char *root, const hearth_validate_opts *o, h
                         "the stereo calibration (the colour camera and T_thermal_from_rgb)");
   } else if (rig.rgb.width != 1920 || rig.rgb.height != 1080 || rig.depth.width != 640 ||
              rig.depth.height != 576) {
-    hearth_problems_add(p, path,
-                        "camera sizes rgb %dx%d, depth %dx%d; expected 1920x1080, 640x576",
+    hearth_problems_add(p, path, "camera sizes rgb %dx%d, depth %dx%d; expected 1920x1080, 640x576",
                         (int)rig.rgb.width, (int)rig.rgb.height, (int)rig.depth.width,
                         (int)rig.depth.height);
   } else {
@@ -665,8 +663,8 @@ static void check_calibration(const char *root, const hearth_validate_opts *o, h
     } else {
       hearth_target td;
       const hearth_target *dt = hearth_target_or_default(&d.target, &td);
-      if (target_ok && (dt->lattice != target.lattice || dt->rows != target.rows ||
-                        dt->cols != target.cols))
+      if (target_ok &&
+          (dt->lattice != target.lattice || dt->rows != target.rows || dt->cols != target.cols))
         hearth_problems_add(p, path,
                             "made for a %s %d x %d target, calibration/target.json says %s %d x %d",
                             hearth_lattice_name(dt->lattice), dt->rows, dt->cols,

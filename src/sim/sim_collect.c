@@ -153,8 +153,7 @@ static hearth_status run_open(collect_run *c, hearth_err *err) {
     else snprintf(c->path[i], sizeof c->path[i], "%s", o->out_path);
     st = sim_h5_describe(o, c->nfile == 2 ? i : 0, c->nfile == 2 ? 1 : 2,
                          c->env->render_kind == SIM_RENDER_GL ? c->env->gl : c->env->render_name,
-                         &c->meta[i],
-                         err);
+                         &c->meta[i], err);
     if (!st) st = sim_h5_create(&c->out[i], c->path[i], err);
   }
   return st;

@@ -31,7 +31,7 @@ struct hearth_sim_env {
   hearth_sim_task task;
   int width, height, max_steps, render_wrist, shadows;
   char gl[16];
-  int render_kind;    /* SIM_RENDER_* */
+  int render_kind;     /* SIM_RENDER_* */
   char render_name[8]; /* "soft", "gl", "none" */
   char work_dir[4096];
   int own_work_dir;

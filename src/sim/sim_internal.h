@@ -27,7 +27,7 @@ typedef struct sim_asset {
                          * in thermal: the true map (ground truth), or NULL until
                          * sim_asset_temperatures reads the Turbo image back */
   size_t temp_R;
-  double size[3];       /* bounding box extents */
+  double size[3]; /* bounding box extents */
   double mass, friction;
 } sim_asset;
 void sim_asset_free(sim_asset *a);

@@ -298,11 +298,12 @@ static void room_shown(uint8_t out[3]) {
 }
 
 /* one camera with the software renderer; ids (may be NULL) gets geom ids */
-static void soft_view(hearth_sim_env *e, int cam, int mode, int only_geom, uint8_t *out,
-                      int *ids) {
+static void soft_view(hearth_sim_env *e, int cam, int mode, int only_geom, uint8_t *out, int *ids) {
   sim_render *r = e->rnd;
   sim_soft_view v = {.cam = cam, .only_geom = only_geom, .tex_geom = r->th_geom};
-  v.mode = mode == VIEW_RGB ? SIM_SOFT_LIT : mode == VIEW_THERMAL ? SIM_SOFT_UNLIT : SIM_SOFT_SEGMENT;
+  v.mode = mode == VIEW_RGB       ? SIM_SOFT_LIT
+           : mode == VIEW_THERMAL ? SIM_SOFT_UNLIT
+                                  : SIM_SOFT_SEGMENT;
   /* MuJoCo's default groups 0-2; the thermal view swaps group 2 (colour
    * meshes) for 3 (thermal meshes) */
   v.groups[0] = v.groups[1] = 1;
@@ -398,8 +399,11 @@ hearth_status hearth_sim_observe(hearth_sim_env *e, hearth_sim_obs *o, hearth_er
   if (r->kind == SIM_RENDER_SOFT && r->twin_ok) {
     /* one pass draws the front RGB view and, from the same surfaces, the
      * thermal one */
-    sim_soft_view v = {.cam = e->cam_front, .mode = SIM_SOFT_LIT, .only_geom = -1,
-                       .twin_tex = r->twin_tex, .groups = {1, 1, 1, 0, 0, 0}};
+    sim_soft_view v = {.cam = e->cam_front,
+                       .mode = SIM_SOFT_LIT,
+                       .only_geom = -1,
+                       .twin_tex = r->twin_tex,
+                       .groups = {1, 1, 1, 0, 0, 0}};
     room_shown(v.flat_rgb);
     sim_soft_render(r->sw, e->m, e->d, &v, r->front, r->thermal, NULL);
     o->agentview_rgb = r->front, o->agentview_thermal = r->thermal;

@@ -118,11 +118,11 @@ struct sim_soft {
   int w, h, ngeom, ntex;
   soft_shape *shape;
   soft_tex *tex;
-  float *depth; /* 1/w of the nearest surface; 0: nothing */
-  int *order;    /* ngeom: drawing order of a view */
-  double *key;   /* ngeom: its sort keys */
-  soft_vtx *vtx; /* per vertex of the geom at hand: camera frame, */
-  soft_svtx *sv; /* on screen (in front of the near plane only), */
+  float *depth;       /* 1/w of the nearest surface; 0: nothing */
+  int *order;         /* ngeom: drawing order of a view */
+  double *key;        /* ngeom: its sort keys */
+  soft_vtx *vtx;      /* per vertex of the geom at hand: camera frame, */
+  soft_svtx *sv;      /* on screen (in front of the near plane only), */
   unsigned char *lit; /* 1 once placed, 2 once lit */
   float *pcam;        /* per distinct position: camera frame x y z, then */
   double *pscr;       /* screen x y and 1/w (in front of the near plane) */
@@ -175,9 +175,11 @@ static int shape_planes(soft_shape *s) {
   for (int t = 0; t < s->nt; t++) {
     const float *a = s->pos + 3 * s->tri[3 * t], *b = s->pos + 3 * s->tri[3 * t + 1],
                 *c = s->pos + 3 * s->tri[3 * t + 2];
-    float u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    float u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]},
+          v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
     float *p = s->plane + 4 * t;
-    p[0] = u[1] * v[2] - u[2] * v[1], p[1] = u[2] * v[0] - u[0] * v[2], p[2] = u[0] * v[1] - u[1] * v[0];
+    p[0] = u[1] * v[2] - u[2] * v[1], p[1] = u[2] * v[0] - u[0] * v[2],
+    p[2] = u[0] * v[1] - u[1] * v[0];
     p[3] = p[0] * a[0] + p[1] * a[1] + p[2] * a[2];
   }
   return 1;
@@ -262,8 +264,8 @@ static int make_box(soft_shape *s, const double sz[3], int q, const float scl[2]
 /* rings of a surface of revolution about z, top to bottom: ring k at
  * height z[k], radius r[k], normal (nr[k] radial, nz[k] axial); quads
  * between consecutive rings, `sl` slices */
-static int make_rings(soft_shape *s, int nring, const double *z, const double *r,
-                      const double *nr, const double *nz, int sl) {
+static int make_rings(soft_shape *s, int nring, const double *z, const double *r, const double *nr,
+                      const double *nz, int sl) {
   if (!shape_alloc(s, nring * (sl + 1), 2 * (nring - 1) * sl, 0)) return 0;
   int nv = 0, nt = 0;
   for (int k = 0; k < nring; k++)
@@ -423,8 +425,8 @@ static int make_tex(soft_tex *t, const mjModel *m, int id) {
   int w = m->tex_width[id], h = m->tex_height[id];
   size_t total = 0;
   t->levels = 0;
-  for (int lw = w, lh = h; t->levels < SOFT_MAXLEVEL; lw = lw > 1 ? lw / 2 : 1,
-           lh = lh > 1 ? lh / 2 : 1) {
+  for (int lw = w, lh = h;
+       t->levels<SOFT_MAXLEVEL; lw = lw> 1 ? lw / 2 : 1, lh = lh > 1 ? lh / 2 : 1) {
     t->w[t->levels] = lw, t->h[t->levels] = lh, t->off[t->levels] = total;
     total += (size_t)lw * (size_t)lh * 3;
     t->levels++;
@@ -523,7 +525,8 @@ sim_soft *sim_soft_new(const mjModel *m, int w, int h) {
    * and spot lights */
   pow_add(s, 0.5f * 128.0f);
   for (int i = 0; i < m->nmat; i++) pow_add(s, m->mat_shininess[i] * 128.0f);
-  for (int i = 0; i < m->nlight; i++) pow_add(s, m->light_directional[i] ? 0.0f : m->light_exponent[i]);
+  for (int i = 0; i < m->nlight; i++)
+    pow_add(s, m->light_directional[i] ? 0.0f : m->light_exponent[i]);
   size_t nv = (size_t)(s->vcap > 0 ? s->vcap : 1);
   if (ok) {
     s->vtx = malloc(sizeof(soft_vtx) * nv), s->sv = malloc(sizeof(soft_svtx) * nv);
@@ -553,8 +556,8 @@ typedef struct soft_mat {
   const soft_tex *tex;
   int unlit;
   float flat[3];
-  uint8_t *twin;         /* LIT with a twin image: its buffer, */
-  const soft_tex *tex2;  /* the texture it shows (NULL: flat2) */
+  uint8_t *twin;        /* LIT with a twin image: its buffer, */
+  const soft_tex *tex2; /* the texture it shows (NULL: flat2) */
   uint8_t flat2[3];
   int id;
 } soft_mat;
@@ -949,7 +952,8 @@ void sim_soft_render(sim_soft *s, const mjModel *m, const mjData *d, const sim_s
     double z = 0;
     for (int r = 0; r < 3; r++) z += cam.R[3 * r + 2] * (xg[r] - cam.p[r]);
     int k = g;
-    while (k > 0 && s->key[k - 1] < z) s->order[k] = s->order[k - 1], s->key[k] = s->key[k - 1], k--;
+    while (k > 0 && s->key[k - 1] < z)
+      s->order[k] = s->order[k - 1], s->key[k] = s->key[k - 1], k--;
     s->order[k] = g, s->key[k] = z;
   }
   for (int gi = 0; gi < m->ngeom; gi++) {

@@ -35,13 +35,13 @@ typedef enum sim_soft_mode {
 } sim_soft_mode;
 
 typedef struct sim_soft_view {
-  int cam;                  /* model camera id */
+  int cam; /* model camera id */
   sim_soft_mode mode;
-  unsigned char groups[6];  /* geom groups drawn (mjNGROUP) */
-  int only_geom;            /* >= 0: draw just this geom */
+  unsigned char groups[6];       /* geom groups drawn (mjNGROUP) */
+  int only_geom;                 /* >= 0: draw just this geom */
   const unsigned char *tex_geom; /* UNLIT: ngeom flags, 1 = show its texture */
-  uint8_t flat_rgb[3];      /* UNLIT, twin: the colour of every other geom */
-  const int *twin_tex;      /* LIT with a twin image: ngeom texture ids, the
+  uint8_t flat_rgb[3];           /* UNLIT, twin: the colour of every other geom */
+  const int *twin_tex;           /* LIT with a twin image: ngeom texture ids, the
                              * texture geom g shows there unlit at its own
                              * texture coordinates (-1: flat_rgb) */
 } sim_soft_view;

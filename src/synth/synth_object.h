@@ -20,8 +20,8 @@
 
 typedef struct synth_object {
   char category[64];
-  hearth_mesh mesh;     /* object frame; mesh.texture unused (see albedo) */
-  uint8_t *part_of_tri; /* n_triangles part ids, < n_parts */
+  hearth_mesh mesh;      /* object frame; mesh.texture unused (see albedo) */
+  uint8_t *part_of_tri;  /* n_triangles part ids, < n_parts */
   uint8_t *style_of_tri; /* n_triangles albedo styles (S_*, synth_category.h): the surface's
                             material; NULL for a given mesh (one plain material) */
   int n_parts;

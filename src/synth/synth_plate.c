@@ -26,7 +26,8 @@ void synth_plate_geom_init(synth_plate_geom *g, const hearth_target *target) {
   g->step = hearth_target_row_step(t);
   g->r = 0.5 * t->hole_diameter_m;
   g->row_start[0] = 0;
-  for (int r = 0; r < t->rows; r++) g->row_start[r + 1] = g->row_start[r] + hearth_target_row_holes(t, r);
+  for (int r = 0; r < t->rows; r++)
+    g->row_start[r + 1] = g->row_start[r] + hearth_target_row_holes(t, r);
   double xyz[HEARTH_TARGET_MAX_HOLES][3];
   hearth_target_points(t, xyz);
   for (size_t i = 0; i < g->n; i++) {
@@ -85,9 +86,9 @@ typedef struct clutter {
   int on;
   double wx0, wx1, wy0, wy1; /* window */
   int wnx, wny;
-  double mull;              /* mullion half width (normalised) */
+  double mull;               /* mullion half width (normalised) */
   double desk_y, desk_slope; /* below the line: desk */
-  double px, py, prx, pry;  /* person ellipse */
+  double px, py, prx, pry;   /* person ellipse */
   int n_spots;
   double spots[8][3]; /* x, y, radius */
 } clutter;
@@ -95,13 +96,13 @@ typedef struct clutter {
 /* the bench's physics of one frame (docs/virtual-rig.md, "Calibration
  * physics"); all zero: the ideal bench */
 typedef struct plate_fx {
-  double thickness;        /* plate thickness (m); the back face is at plate z = +thickness */
-  double lamp_spot;        /* hot spot's excess, a fraction of the hole contrast */
+  double thickness;              /* plate thickness (m); the back face is at plate z = +thickness */
+  double lamp_spot;              /* hot spot's excess, a fraction of the hole contrast */
   double lamp_xy[2], lamp_sigma; /* its centre and width on the backing (plate coordinates) */
-  double lamp_grad[2];     /* gradient: fraction of the hole contrast per metre */
-  double vignetting;       /* blend of cos^4 */
+  double lamp_grad[2];           /* gradient: fraction of the hole contrast per metre */
+  double vignetting;             /* blend of cos^4 */
   double fpn_offset, fpn_gain;
-  uint64_t fpn_seed;       /* the thermal camera's fixed pattern */
+  uint64_t fpn_seed;            /* the thermal camera's fixed pattern */
   double motion_px, motion_dir; /* colour: linear blur length (px) and direction (rad) */
 } plate_fx;
 
@@ -217,9 +218,9 @@ static double thermal_value(const plate_view *v, int cls, const double p[2], con
       if (v->fx.lamp_spot > 0 || v->fx.lamp_grad[0] != 0 || v->fx.lamp_grad[1] != 0) {
         double dx = p[0] - v->fx.lamp_xy[0], dy = p[1] - v->fx.lamp_xy[1];
         double s2 = v->fx.lamp_sigma * v->fx.lamp_sigma;
-        T += v->hole_dt * (v->fx.lamp_spot * exp(-(dx * dx + dy * dy) / (2 * s2)) +
-                           v->fx.lamp_grad[0] * (p[0] - v->g->cx) +
-                           v->fx.lamp_grad[1] * (p[1] - v->g->cy));
+        T += v->hole_dt *
+             (v->fx.lamp_spot * exp(-(dx * dx + dy * dy) / (2 * s2)) +
+              v->fx.lamp_grad[0] * (p[0] - v->g->cx) + v->fx.lamp_grad[1] * (p[1] - v->g->cy));
       }
       return T;
     }
@@ -246,7 +247,7 @@ static double rgb_value(const plate_view *v, int cls, const double p[2], const d
     case 1: return 0.95; /* daylight through the window */
     case 2: return 0.15;
     case 3: return 0.50 + 0.05 * sin(40.0 * d[0]); /* wood */
-    case 4: return 0.22; /* dark clothes */
+    case 4: return 0.22;                           /* dark clothes */
     case 5: return v->hole_grey;
     default: return 0.36 + 0.08 * d[1] - 0.05 * d[0];
   }
@@ -591,7 +592,8 @@ hearth_status synth_tone_map8(const hearth_image *temps, hearth_image *out, hear
   uint8_t *q = out->data;
   double span = hi > lo ? (double)hi - lo : 1.0;
   /* a camera's automatic gain: min..max to 0..255 with a display gamma */
-  for (size_t i = 0; i < n; i++) q[i] = (uint8_t)lrint(255.0 * pow(((double)T[i] - lo) / span, 1 / 1.4));
+  for (size_t i = 0; i < n; i++)
+    q[i] = (uint8_t)lrint(255.0 * pow(((double)T[i] - lo) / span, 1 / 1.4));
   return HEARTH_OK;
 }
 
@@ -684,7 +686,8 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
     hearth_rigid T;
     for (int tries = 0; tries < 200; tries++) {
       double d = hearth_rng_range(&r, 0.22, 0.40) * ds;
-      double ox = hearth_rng_range(&r, -0.24, 0.24) * os, oy = hearth_rng_range(&r, -0.16, 0.16) * os;
+      double ox = hearth_rng_range(&r, -0.24, 0.24) * os,
+             oy = hearth_rng_range(&r, -0.16, 0.16) * os;
       if (partial)
         ox = (hearth_rng_uniform(&r) < 0.5 ? -1 : 1) * hearth_rng_range(&r, 0.38, 0.5) * os;
       synth_plate_pose(g, &r, d, ox, oy, &T);
@@ -719,7 +722,8 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
     hearth_rigid T_th, T_rgb;
     for (int tries = 0; tries < 200; tries++) {
       double d = hearth_rng_range(&r, 0.27, 0.45) * ds;
-      double ox = hearth_rng_range(&r, -0.14, 0.14) * os, oy = hearth_rng_range(&r, -0.08, 0.08) * os;
+      double ox = hearth_rng_range(&r, -0.14, 0.14) * os,
+             oy = hearth_rng_range(&r, -0.08, 0.08) * os;
       if (partial)
         ox = (hearth_rng_uniform(&r) < 0.5 ? -1 : 1) * hearth_rng_range(&r, 0.38, 0.5) * os;
       synth_plate_pose(g, &r, d, ox, oy, &T_th);
@@ -809,9 +813,8 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
 
 /* ---- for the thermal-only captures (synth_thermal_only.c) ------------------------------ */
 hearth_status synth_plate_thermal_frame(const hearth_camera *cam, const synth_plate_geom *g,
-                                        const hearth_rigid *T,
-                                        const float *rays, double ambient, double plate_dt,
-                                        double hole_dt, double blur, double netd,
+                                        const hearth_rigid *T, const float *rays, double ambient,
+                                        double plate_dt, double hole_dt, double blur, double netd,
                                         uint64_t noise_seed, int threads, hearth_image *out,
                                         hearth_err *err) {
   plate_view v;

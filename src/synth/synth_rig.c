@@ -20,7 +20,8 @@ void synth_lens_distort(const double d[5], double x, double y, double *xd, doubl
  * a ratio of two cubics in r^2 */
 static void rational_distort(const double d[8], double x, double y, double *xd, double *yd) {
   double r2 = x * x + y * y, r4 = r2 * r2, r6 = r4 * r2;
-  double radial = (1.0 + d[0] * r2 + d[1] * r4 + d[4] * r6) / (1.0 + d[5] * r2 + d[6] * r4 + d[7] * r6);
+  double radial =
+      (1.0 + d[0] * r2 + d[1] * r4 + d[4] * r6) / (1.0 + d[5] * r2 + d[6] * r4 + d[7] * r6);
   *xd = x * radial + 2.0 * d[2] * x * y + d[3] * (r2 + 2.0 * x * x);
   *yd = y * radial + d[2] * (r2 + 2.0 * y * y) + 2.0 * d[3] * x * y;
 }

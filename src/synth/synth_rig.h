@@ -40,8 +40,7 @@ void synth_rig_draw(uint64_t seed, hearth_rig *rig);
 /* The same with a thermal sensor of thermal_w x thermal_h pixels and, if
  * wide, a ~90 degree lens with strong barrel distortion; 256, 192, 0 give
  * synth_rig_draw's rig exactly. */
-void synth_rig_draw_thermal(uint64_t seed, int thermal_w, int thermal_h, int wide,
-                            hearth_rig *rig);
+void synth_rig_draw_thermal(uint64_t seed, int thermal_w, int thermal_h, int wide, hearth_rig *rig);
 /* OpenCV-axes camera at eye looking at target, world z up. */
 void synth_look_at(const double eye[3], const double target[3], hearth_rigid *T_world_from_cam);
 /* Cheap approximately normal noise (sum of four 16-bit uniforms, unit
@@ -158,9 +157,8 @@ hearth_status synth_tone_map8(const hearth_image *temps, hearth_image *out, hear
  * degC): plate ambient + plate_dt, holes ambient + hole_dt, Gaussian blur,
  * noise netd (seeded by noise_seed); rays from synth_ray_table(cam, 4). */
 hearth_status synth_plate_thermal_frame(const hearth_camera *cam, const synth_plate_geom *g,
-                                        const hearth_rigid *T,
-                                        const float *rays, double ambient, double plate_dt,
-                                        double hole_dt, double blur, double netd,
+                                        const hearth_rigid *T, const float *rays, double ambient,
+                                        double plate_dt, double hole_dt, double blur, double netd,
                                         uint64_t noise_seed, int threads, hearth_image *out,
                                         hearth_err *err);
 

@@ -40,9 +40,9 @@ static void test_default_and_json(const char *dir) {
                 g = {HEARTH_LATTICE_GRID, 7, 5, 0.015, 0.008};
   CHECK(hearth_target_holes(&h) == 48 && hearth_target_holes(&g) == 35);
   hearth_target_points(&h, xyz);
-  CHECK_NEAR(xyz[8][0], 0.006, 1e-15);                /* row 1 shifted by P/2 */
-  CHECK_NEAR(xyz[8][1], 0.0103923, 1e-15);            /* rows P sqrt(3)/2 apart */
-  CHECK_NEAR(xyz[47][0], 7 * 0.012 + 0.006, 1e-15);   /* odd rows keep C holes */
+  CHECK_NEAR(xyz[8][0], 0.006, 1e-15);              /* row 1 shifted by P/2 */
+  CHECK_NEAR(xyz[8][1], 0.0103923, 1e-15);          /* rows P sqrt(3)/2 apart */
+  CHECK_NEAR(xyz[47][0], 7 * 0.012 + 0.006, 1e-15); /* odd rows keep C holes */
   hearth_target_points(&g, xyz);
   CHECK_NEAR(xyz[34][0], 0.060, 1e-15);
   CHECK_NEAR(xyz[34][1], 0.090, 1e-15);
@@ -59,7 +59,8 @@ static void test_default_and_json(const char *dir) {
   CHECK(!memcmp(&t, &g, sizeof t));
   /* python's json reads what was written, with the keys of docs/dataset.md */
   char *text = test_slurp(path, NULL);
-  CHECK(text && strstr(text, "\"lattice\": \"grid\"") && strstr(text, "\"hole_diameter_m\": 0.008"));
+  CHECK(text && strstr(text, "\"lattice\": \"grid\"") &&
+        strstr(text, "\"hole_diameter_m\": 0.008"));
   CHECK(text && !strstr(text, "thickness_m")); /* a thin plate writes no thickness */
   free(text);
   /* an optional plate thickness round-trips; out of range is refused */
@@ -72,8 +73,9 @@ static void test_default_and_json(const char *dir) {
   CHECK(hearth_target_write(path, &gt, &err) == HEARTH_E_RANGE);
   CHECK(strstr(err.msg, "thickness_m") != NULL);
   {
-    const char *neg = "{\"lattice\": \"grid\", \"rows\": 7, \"cols\": 7, \"pitch_m\": 0.015, "
-                      "\"hole_diameter_m\": 0.008, \"thickness_m\": -0.001}";
+    const char *neg =
+        "{\"lattice\": \"grid\", \"rows\": 7, \"cols\": 7, \"pitch_m\": 0.015, "
+        "\"hole_diameter_m\": 0.008, \"thickness_m\": -0.001}";
     CHECK(hearth_target_parse(neg, strlen(neg), "t.json", &t, &err) == HEARTH_E_RANGE);
     CHECK(strstr(err.msg, "thickness_m") != NULL);
   }

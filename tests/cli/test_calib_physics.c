@@ -41,8 +41,7 @@ int main(void) {
   hearth_target tg;
   snprintf(path, sizeof path, "%s/calibration/target.json", root);
   CHECK_OK(hearth_target_read(path, &tg, &err), &err);
-  CHECK_MSG(tg.thickness_m >= 0.003 && tg.thickness_m <= 0.006, "thickness %g",
-            tg.thickness_m);
+  CHECK_MSG(tg.thickness_m >= 0.003 && tg.thickness_m <= 0.006, "thickness %g", tg.thickness_m);
   CHECK(hearth_target_is_default(&tg));
 
   CHECK(sh("'" HEARTH_EXE "' detect '%s' --no-overlays > '%s' 2>&1", root, log) == 0);

@@ -48,7 +48,8 @@ static void check_rig(const char *root, int w, int h) {
   CHECK_OK(hearth_rig_read(p, &tru, &err), &err);
   CHECK_MSG(est.thermal.width == w && est.thermal.height == h, "rig.json thermal %dx%d",
             est.thermal.width, est.thermal.height);
-  double efx = fabs(est.thermal.fx / tru.thermal.fx - 1), efy = fabs(est.thermal.fy / tru.thermal.fy - 1);
+  double efx = fabs(est.thermal.fx / tru.thermal.fx - 1),
+         efy = fabs(est.thermal.fy / tru.thermal.fy - 1);
   double ecx = fabs(est.thermal.cx - tru.thermal.cx), ecy = fabs(est.thermal.cy - tru.thermal.cy);
   double er = rot_deg(est.T_thermal_from_rgb.R, tru.T_thermal_from_rgb.R);
   double et = 0;
@@ -145,8 +146,10 @@ int main(void) {
   snprintf(p, sizeof p, "%s/calibration/target.json", root);
   FILE *f = fopen(p, "w");
   if (f) {
-    fputs("{\"lattice\": \"grid\", \"rows\": 6, \"cols\": 8, \"pitch_m\": 0.012, "
-          "\"hole_diameter_m\": 0.008}\n", f);
+    fputs(
+        "{\"lattice\": \"grid\", \"rows\": 6, \"cols\": 8, \"pitch_m\": 0.012, "
+        "\"hole_diameter_m\": 0.008}\n",
+        f);
     fclose(f);
   }
   snprintf(cmd, sizeof cmd, "'%s' calibrate '%s'", HEARTH_EXE, root);
@@ -155,7 +158,8 @@ int main(void) {
   /* and validate says so */
   snprintf(cmd, sizeof cmd, "'%s' validate '%s'", HEARTH_EXE, root);
   rc = run(cmd, out, sizeof out);
-  CHECK_MSG(rc != 0 && strstr(out, "made for a hex 6 x 8 target, calibration/target.json says grid 6 x 8"),
+  CHECK_MSG(rc != 0 &&
+                strstr(out, "made for a hex 6 x 8 target, calibration/target.json says grid 6 x 8"),
             "%s", out);
   TEST_MAIN_END();
 }

@@ -295,7 +295,8 @@ static void test_ws_thermal(const char *decl, const char *keys, int thermal, hea
                                      : "\"thermal_used\": false";
     CHECK_MSG(js && strstr(js, used) && strstr(js, "\"server\": \"hearth-test\"") &&
                   strstr(js, "\"render_size\": 48") && strstr(js, "\"image_size\": 32") &&
-                  strstr(js, "\"replan_steps\": 5") && strstr(js, "\"renderer\": \"soft: hearth rasteriser"),
+                  strstr(js, "\"replan_steps\": 5") &&
+                  strstr(js, "\"renderer\": \"soft: hearth rasteriser"),
               "results.json: %s", js ? js : "(null)");
     const char *label = want_used < 0 ? "H1     w/?" : thermal ? "H1     w/ " : "H1     w/o";
     CHECK_MSG(txt && strstr(txt, label) &&

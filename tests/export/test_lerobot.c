@@ -92,16 +92,18 @@ static void check_dataset(const char *ds, const char *eval_dir, const char *flag
   static const char *const readers[] = {"read_parquet.js", "read_parquet_arrow.js"};
   for (int k = 0; k < 2; k++) {
     char cmd[8000];
-    snprintf(cmd, sizeof cmd, "node '%s/tests/io/%s' '%s.dump%d.json' '%s'/data/chunk-000/*.parquet",
-             g_src, readers[k], ds, k, ds);
+    snprintf(cmd, sizeof cmd,
+             "node '%s/tests/io/%s' '%s.dump%d.json' '%s'/data/chunk-000/*.parquet", g_src,
+             readers[k], ds, k, ds);
     int rc = run(cmd);
     CHECK_MSG(rc == 0, "%s on %s: exit status %d (1: unreadable, 3: its npm packages missing)",
               readers[k], ds, rc);
     if (rc) continue;
-    snprintf(cmd, sizeof cmd,
-             "/usr/bin/python3 '%s/tests/export/check_lerobot.py' check '%s' '%s.dump%d.json' '%s' %s "
-             "'%s'",
-             g_src, ds, ds, k, eval_dir, flags, h5);
+    snprintf(
+        cmd, sizeof cmd,
+        "/usr/bin/python3 '%s/tests/export/check_lerobot.py' check '%s' '%s.dump%d.json' '%s' %s "
+        "'%s'",
+        g_src, ds, ds, k, eval_dir, flags, h5);
     CHECK_MSG(run(cmd) == 0, "check_lerobot.py found differences in %s (read by %s)", ds,
               readers[k]);
   }

@@ -126,8 +126,8 @@ int main(void) {
     snprintf(cmd, sizeof cmd, "node '%s/tests/io/%s' '%s' '%s' '%s'", src, readers[k], dump, a,
              empty);
     int rc = run(cmd);
-    CHECK_MSG(rc == 0, "%s exit status %d (1: unreadable, 3: its npm packages missing)",
-              readers[k], rc);
+    CHECK_MSG(rc == 0, "%s exit status %d (1: unreadable, 3: its npm packages missing)", readers[k],
+              rc);
     if (rc == 0) {
       snprintf(cmd, sizeof cmd, "/usr/bin/python3 '%s/tests/io/check_parquet.py' '%s' %d", src,
                dump, ROWS);

@@ -424,7 +424,6 @@ static void test_expect(const char *dir) {
   CHECK(back.width == 16384 && back.channels == 4 && back.type == HEARTH_PIX_U16 && !back.data);
 }
 
-
 /* ---- files written by libpng with each row filter ------------------------------ */
 
 static void on_mem_write(png_structp png, png_bytep data, png_size_t n) {
@@ -472,8 +471,8 @@ static bytes libpng_encode(const hearth_image *img, int filters, size_t idat, in
    many, random and smooth pixels: the reader (its fast path takes these
    files) gives the pixels written, and so does its libpng route */
 static void test_libpng_filters(void) {
-  static const int filters[6] = {PNG_FILTER_NONE, PNG_FILTER_SUB, PNG_FILTER_UP,
-                                 PNG_FILTER_AVG, PNG_FILTER_PAETH, PNG_ALL_FILTERS};
+  static const int filters[6] = {PNG_FILTER_NONE, PNG_FILTER_SUB,   PNG_FILTER_UP,
+                                 PNG_FILTER_AVG,  PNG_FILTER_PAETH, PNG_ALL_FILTERS};
   hearth_err err;
   for (int type = 1; type <= 2; type++)
     for (int ch = 1; ch <= 4; ch++)

@@ -128,7 +128,7 @@ out:
 }
 
 static inline double point_tri_d2(const double p[3], const double a[3], const double b[3],
-                           const double c[3]) {
+                                  const double c[3]) {
   double q[3];
   return point_tri_closest(p, a, b, c, q);
 }
@@ -171,7 +171,8 @@ static double tri_grid_nearest(const tri_grid *g, const double p[3], uint32_t *t
 }
 
 /* RMS and max distance of a's vertices to mesh b. */
-static inline void mesh_to_mesh(const hearth_mesh *a, const hearth_mesh *b, double *rms, double *mx) {
+static inline void mesh_to_mesh(const hearth_mesh *a, const hearth_mesh *b, double *rms,
+                                double *mx) {
   tri_grid g;
   tri_grid_build(&g, b, 0.004);
   double s = 0, m = 0;

@@ -188,7 +188,8 @@ static void check_depth(int near_first) {
        * camera) and z = top of B (2 - 0.001) at these x, y */
       double rx = (x + 0.5 - 0.5 * W) / f, ry = (y + 0.5 - 0.5 * W) / f;
       double xa = rx * (2 - 0.201), ya = ry * (2 - 0.201), xb = rx * 1.999, yb = ry * 1.999;
-      int in_a = fabs(xa + 0.05) < 0.1 && fabs(ya) < 0.1, in_b = fabs(xb - 0.05) < 0.1 && fabs(yb) < 0.1;
+      int in_a = fabs(xa + 0.05) < 0.1 && fabs(ya) < 0.1,
+          in_b = fabs(xb - 0.05) < 0.1 && fabs(yb) < 0.1;
       /* pixels within a hair of an edge are not judged */
       int edge = fabs(fabs(xa + 0.05) - 0.1) < 2e-3 || fabs(fabs(ya) - 0.1) < 2e-3 ||
                  fabs(fabs(xb - 0.05) - 0.1) < 2e-3 || fabs(fabs(yb) - 0.1) < 2e-3;
@@ -322,7 +323,8 @@ int main(int argc, char **argv) {
   }
   for (int i = 0; i < 2; i++) {
     pthread_join(th[i], NULL);
-    CHECK_MSG(memcmp(tj[i].rgb, main_job.rgb, n) == 0 && memcmp(tj[i].twin, main_job.twin, n) == 0 &&
+    CHECK_MSG(memcmp(tj[i].rgb, main_job.rgb, n) == 0 &&
+                  memcmp(tj[i].twin, main_job.twin, n) == 0 &&
                   memcmp(tj[i].th, main_job.th, n) == 0,
               "thread %d rendered other bytes", i);
     free_job(&tj[i]);
