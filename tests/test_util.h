@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/wait.h>
 
 static int g_test_failures = 0;
 
@@ -82,6 +83,20 @@ static inline const char *test_tmpdir(const char *name) {
     exit(2);
   }
   return buf;
+}
+
+/* Runs cmd through the shell with stderr joined to stdout, keeping the first
+ * cap - 1 bytes of its output in out (NUL-terminated); returns its exit
+ * status, -1 if it could not run or did not exit. */
+static inline int test_run_capture(const char *cmd, char *out, size_t cap) {
+  char full[16384];
+  snprintf(full, sizeof full, "%s 2>&1", cmd);
+  FILE *p = popen(full, "r");
+  if (!p) return -1;
+  size_t n = fread(out, 1, cap - 1, p);
+  out[n] = 0;
+  int st = pclose(p);
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
 #define TEST_MAIN_END()                                                            \

@@ -9,17 +9,6 @@
 #include <unistd.h>
 #include "test_util.h"
 
-static int run(const char *cmd, char *out, size_t cap) {
-  char full[16384];
-  snprintf(full, sizeof full, "%s 2>&1", cmd);
-  FILE *p = popen(full, "r");
-  if (!p) return -1;
-  size_t n = fread(out, 1, cap - 1, p);
-  out[n] = 0;
-  int st = pclose(p);
-  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-
 /* sha256 of every file except the stamps (they record input mtimes) */
 static int tree_hash(const char *root, const char *out_file) {
   char cmd[4096];
@@ -39,9 +28,9 @@ int main(void) {
   snprintf(pristine, sizeof pristine, "%s/pristine", base);
 
   snprintf(cmd, sizeof cmd, "'%s' build --help", HEARTH_EXE);
-  CHECK(run(cmd, out, sizeof out) == 0 && strstr(out, "--shard") && strstr(out, "-j"));
+  CHECK(test_run_capture(cmd, out, sizeof out) == 0 && strstr(out, "--shard") && strstr(out, "-j"));
   snprintf(cmd, sizeof cmd, "'%s' build '%s' --shard 3/2", HEARTH_EXE, root);
-  CHECK(run(cmd, out, sizeof out) == 2 && strstr(out, "--shard"));
+  CHECK(test_run_capture(cmd, out, sizeof out) == 2 && strstr(out, "--shard"));
 
   /* 10 instances, 2 views per state, tiny meshes and maps; the true rig
      stands in for calibration (no captures: no release-level stages) */
@@ -51,20 +40,20 @@ int main(void) {
       "--triangles 600 --texture 64 --map-res 32 --no-calibration --threads 2 --quiet && "
       "cp '%s/ground_truth/rig.json' '%s/calibration/rig.json' && cp -a '%s' '%s'",
       HEARTH_EXE, root, root, root, root, pristine);
-  int rc = run(cmd, out, sizeof out);
+  int rc = test_run_capture(cmd, out, sizeof out);
   CHECK_MSG(rc == 0, "synth: %s", out);
   const char *opts = "--resolution 32 --no-bake -j 2 --threads 2";
 
   /* full build */
   snprintf(cmd, sizeof cmd, "'%s' build '%s' %s", HEARTH_EXE, root, opts);
-  rc = run(cmd, out, sizeof out);
+  rc = test_run_capture(cmd, out, sizeof out);
   CHECK_MSG(rc == 0, "build: %s", out);
   CHECK_MSG(strstr(out, "10 instance(s): 10 complete, 0 failed; 20/20 state(s) mapped"), "%s", out);
   /* plain lines when not on a terminal */
   CHECK(strstr(out, "build [1/") != NULL);
 
   /* second run: no work */
-  rc = run(cmd, out, sizeof out);
+  rc = test_run_capture(cmd, out, sizeof out);
   CHECK(rc == 0);
   CHECK_MSG(strstr(out, " 0 stage(s) run") != NULL, "second run did work: %s", out);
   snprintf(a, sizeof a, "%s/hash_full.txt", base);
@@ -72,10 +61,10 @@ int main(void) {
 
   /* validate and stats of the result */
   snprintf(cmd, sizeof cmd, "'%s' validate '%s'", HEARTH_EXE, root);
-  rc = run(cmd, out, sizeof out);
+  rc = test_run_capture(cmd, out, sizeof out);
   CHECK_MSG(rc == 0, "validate: %s", out);
   snprintf(cmd, sizeof cmd, "'%s' stats '%s' --format json", HEARTH_EXE, root);
-  CHECK(run(cmd, out, sizeof out) == 0);
+  CHECK(test_run_capture(cmd, out, sizeof out) == 0);
   CHECK(strstr(out, "\"instances\": 10") && strstr(out, "\"object_states\": 20") &&
         strstr(out, "\"temperature_maps\": 20") && strstr(out, "\"rgb_thermal_pairs\": 40"));
 
@@ -97,7 +86,7 @@ int main(void) {
       "'%s' build '%s' %s",
       root, d3, d3, dead, d3, dead, d3, dead, d3, dead, d3, dead, d3, dead, d3, d3, dead, d3, live,
       HEARTH_EXE, root, opts);
-  rc = run(cmd, out, sizeof out);
+  rc = test_run_capture(cmd, out, sizeof out);
   CHECK_MSG(rc == 0 && strstr(out, " 1 stage(s) run") && strstr(out, "cup_03 map hot: done"), "%s",
             out);
   CHECK_MSG(strstr(out, "removed 5 temporary file(s)/folder(s)"), "%s", out);
@@ -111,7 +100,7 @@ int main(void) {
   CHECK_MSG(system(cmd) == 0, "stale temporaries: wrong files removed");
   /* validate names the one left (its writer still runs) */
   snprintf(cmd, sizeof cmd, "'%s' validate '%s'", HEARTH_EXE, root);
-  rc = run(cmd, out, sizeof out);
+  rc = test_run_capture(cmd, out, sizeof out);
   char want[256];
   snprintf(want, sizeof want,
            "overlay/neutral/v01.png.tmp-%ld-Zz9y8X: a temporary of process %ld, "
@@ -127,9 +116,9 @@ int main(void) {
            "for i in $(seq 1 6000); do grep -q 'build \\[12/' '%s/log' && break; sleep 0.05; done; "
            "kill -9 $pid; wait $pid; true)",
            root, pristine, root, HEARTH_EXE, root, opts, base, base);
-  CHECK(run(cmd, out, sizeof out) == 0);
+  CHECK(test_run_capture(cmd, out, sizeof out) == 0);
   snprintf(cmd, sizeof cmd, "'%s' build '%s' %s", HEARTH_EXE, root, opts);
-  rc = run(cmd, out, sizeof out);
+  rc = test_run_capture(cmd, out, sizeof out);
   CHECK_MSG(rc == 0, "resume: %s", out);
   CHECK_MSG(strstr(out, "10 complete") && !strstr(out, " 0 up to date"),
             "resume did not reuse finished stages: %s", out);
@@ -147,7 +136,7 @@ int main(void) {
       "rm -rf '%s' '%s/elsewhere' && mkdir -p '%s/elsewhere' && cp -a '%s' '%s' && '%s' build '%s' %s --shard 0/2 && "
       "'%s' build '%s' %s --shard 1/2",
       root, base, base, pristine, moved, HEARTH_EXE, moved, opts, HEARTH_EXE, moved, opts);
-  rc = run(cmd, out, sizeof out);
+  rc = test_run_capture(cmd, out, sizeof out);
   CHECK_MSG(rc == 0 && strstr(out, "5 instance(s): 5 complete"), "shards: %s", out);
   snprintf(b, sizeof b, "%s/hash_shards.txt", base);
   CHECK(tree_hash(moved, b) == 0);

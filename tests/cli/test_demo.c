@@ -11,26 +11,15 @@
 #include "hearth/core.h"
 #include "test_util.h"
 
-static int run(const char *cmd, char *out, size_t cap) {
-  char full[8192];
-  snprintf(full, sizeof full, "%s 2>&1", cmd);
-  FILE *p = popen(full, "r");
-  if (!p) return -1;
-  size_t n = fread(out, 1, cap - 1, p);
-  out[n] = 0;
-  int st = pclose(p);
-  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-
 int main(void) {
   static char out[1 << 17];
   char cmd[4096], p[2048];
   const char *base = test_tmpdir("demo_cli");
   snprintf(cmd, sizeof cmd, "'%s' demo --help", HEARTH_EXE);
-  CHECK(run(cmd, out, sizeof out) == 0 && strstr(out, "usage: hearth demo"));
+  CHECK(test_run_capture(cmd, out, sizeof out) == 0 && strstr(out, "usage: hearth demo"));
   snprintf(cmd, sizeof cmd, "'%s' demo '%s/d' --views 12 --resolution 64 --threads 2 --quiet",
            HEARTH_EXE, base);
-  int rc = run(cmd, out, sizeof out);
+  int rc = test_run_capture(cmd, out, sizeof out);
   CHECK_MSG(rc == 0, "demo: exit %d: %s", rc, out);
   CHECK(strstr(out, "0 problem(s)") != NULL);
   CHECK(strstr(out, "report/index.html") != NULL);
@@ -69,7 +58,7 @@ int main(void) {
   }
   CHECK_MSG(rows == 6, "%zu summary rows", rows);
   /* a second run reuses the release and rebuilds nothing */
-  rc = run(cmd, out, sizeof out);
+  rc = test_run_capture(cmd, out, sizeof out);
   CHECK(rc == 0 && strstr(out, " 0 stage(s) run"));
   TEST_MAIN_END();
 }

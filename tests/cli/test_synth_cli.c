@@ -11,25 +11,13 @@
 #include "synth/synth_object.h"
 #include "test_util.h"
 
-/* run a shell command, capturing stdout+stderr into out; returns exit status */
-static int run(const char *cmd, char *out, size_t cap) {
-  char full[8192];
-  snprintf(full, sizeof full, "%s 2>&1", cmd);
-  FILE *p = popen(full, "r");
-  if (!p) return -1;
-  size_t n = fread(out, 1, cap - 1, p);
-  out[n] = 0;
-  int st = pclose(p);
-  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-
 int main(void) {
   static char out[1 << 16];
   char cmd[4096], p[4096];
   const char *base = test_tmpdir("synth_cli");
 
   snprintf(cmd, sizeof cmd, "'%s' synth --help", HEARTH_EXE);
-  CHECK(run(cmd, out, sizeof out) == 0);
+  CHECK(test_run_capture(cmd, out, sizeof out) == 0);
   CHECK(strstr(out, "usage: hearth synth") != NULL);
   CHECK(strstr(out, "--contact-sheet") != NULL && strstr(out, "--views") != NULL);
 
@@ -38,7 +26,7 @@ int main(void) {
            "'%s' synth --out '%s/rel' --seed 3 --views 2 --triangles 1500 --texture 128 "
            "--map-res 64 --thermal-frames 1 --stereo-pairs 1 --contact-sheet --threads 2 --quiet",
            HEARTH_EXE, base);
-  int rc = run(cmd, out, sizeof out);
+  int rc = test_run_capture(cmd, out, sizeof out);
   CHECK_MSG(rc == 0, "exit %d: %s", rc, out);
   hearth_err err = {0};
   hearth_release_doc rel;
@@ -62,7 +50,7 @@ int main(void) {
   hearth_image_free(&img);
 
   /* the same root again: refused, exit status 1, the message names it */
-  rc = run(cmd, out, sizeof out);
+  rc = test_run_capture(cmd, out, sizeof out);
   CHECK(rc == 1);
   CHECK(strstr(out, "/rel") != NULL);
 
@@ -79,7 +67,7 @@ int main(void) {
   };
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
     snprintf(cmd, sizeof cmd, "'%s' synth --out '%s/bad%zu' %s", HEARTH_EXE, base, i, bad[i][0]);
-    rc = run(cmd, out, sizeof out);
+    rc = test_run_capture(cmd, out, sizeof out);
     CHECK_MSG(rc == 2, "'%s': exit %d", bad[i][0], rc);
     CHECK_MSG(strstr(out, bad[i][1]) != NULL, "'%s': message does not name the option: %s",
               bad[i][0], out);
@@ -100,7 +88,7 @@ int main(void) {
            "'%s' synth --out '%s/meshrel' --mesh '%s' --mesh-size 0.1 --mesh-category "
            "canned_drink --views 1 --texture 64 --map-res 32 --no-calibration --quiet",
            HEARTH_EXE, base, p);
-  rc = run(cmd, out, sizeof out);
+  rc = test_run_capture(cmd, out, sizeof out);
   CHECK_MSG(rc == 0, "exit %d: %s", rc, out);
   hearth_mesh gm = {0};
   hearth_glb_read_opts ro = {1, 0, 0};
@@ -118,14 +106,14 @@ int main(void) {
   hearth_mesh_free(&gm);
   snprintf(cmd, sizeof cmd, "'%s' synth --out '%s/meshbad' --mesh '%s/nope.glb' --quiet",
            HEARTH_EXE, base, base);
-  rc = run(cmd, out, sizeof out);
+  rc = test_run_capture(cmd, out, sizeof out);
   CHECK(rc == 1 && strstr(out, "nope.glb") != NULL);
   snprintf(p, sizeof p, "%s/meshbad", base);
   CHECK(!hearth_path_exists(p));
 
   /* --out is required */
   snprintf(cmd, sizeof cmd, "'%s' synth --views 2", HEARTH_EXE);
-  rc = run(cmd, out, sizeof out);
+  rc = test_run_capture(cmd, out, sizeof out);
   CHECK(rc == 2 && strstr(out, "--out") != NULL);
   TEST_MAIN_END();
 }

@@ -16,17 +16,6 @@
 #include "hearth/npy.h"
 #include "test_util.h"
 
-static int run(const char *cmd, char *out, size_t cap) {
-  char full[16384];
-  snprintf(full, sizeof full, "%s 2>&1", cmd);
-  FILE *p = popen(full, "r");
-  if (!p) return -1;
-  size_t n = fread(out, 1, cap - 1, p);
-  out[n] = 0;
-  int st = pclose(p);
-  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-
 static double rot_deg(const double A[9], const double B[9]) {
   /* angle of A B^T */
   double tr = 0;
@@ -77,7 +66,7 @@ int main(void) {
            "--thermal-size 160x120 --ideal --seed 3 --threads 2 --quiet && "
            "'%s' build '%s' --resolution 64 --threads 2 && '%s' validate '%s'",
            HEARTH_EXE, root, HEARTH_EXE, root, HEARTH_EXE, root);
-  int rc = run(cmd, out, sizeof out);
+  int rc = test_run_capture(cmd, out, sizeof out);
   CHECK_MSG(rc == 0, "synth/build/validate: %s", out);
   CHECK_MSG(strstr(out, "1 complete, 0 failed; 2/2 state(s) mapped"), "%s", out);
   check_rig(root, 160, 120);
@@ -138,7 +127,7 @@ int main(void) {
            "--target hex:6x8 --thermal-size 382x288 --ideal --seed 4 --threads 2 --quiet && "
            "'%s' detect '%s' --no-overlays --threads 2 && '%s' calibrate '%s'",
            HEARTH_EXE, root, HEARTH_EXE, root, HEARTH_EXE, root);
-  rc = run(cmd, out, sizeof out);
+  rc = test_run_capture(cmd, out, sizeof out);
   CHECK_MSG(rc == 0, "synth/detect/calibrate: %s", out);
   check_rig(root, 382, 288);
 
@@ -153,11 +142,11 @@ int main(void) {
     fclose(f);
   }
   snprintf(cmd, sizeof cmd, "'%s' calibrate '%s'", HEARTH_EXE, root);
-  rc = run(cmd, out, sizeof out);
+  rc = test_run_capture(cmd, out, sizeof out);
   CHECK_MSG(rc != 0 && strstr(out, "target.json") && strstr(out, "hex 6 x 8"), "%s", out);
   /* and validate says so */
   snprintf(cmd, sizeof cmd, "'%s' validate '%s'", HEARTH_EXE, root);
-  rc = run(cmd, out, sizeof out);
+  rc = test_run_capture(cmd, out, sizeof out);
   CHECK_MSG(rc != 0 &&
                 strstr(out, "made for a hex 6 x 8 target, calibration/target.json says grid 6 x 8"),
             "%s", out);

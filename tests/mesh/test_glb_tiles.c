@@ -312,18 +312,6 @@ static void test_texture_transform(void) {
   free(f);
 }
 
-/* ---- end to end through the command line ------------------------------------ */
-static int run(const char *cmd, char *out, size_t cap) {
-  char full[8192];
-  snprintf(full, sizeof full, "%s 2>&1", cmd);
-  FILE *p = popen(full, "r");
-  if (!p) return -1;
-  size_t n = fread(out, 1, cap - 1, p);
-  out[n] = 0;
-  int st = pclose(p);
-  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-
 static int same_file(const char *a, const char *b) {
   uint8_t *x = NULL, *y = NULL;
   size_t nx = 0, ny = 0;
@@ -357,7 +345,7 @@ static void test_end_to_end(void) {
              "'%s' synth --out '%s/%s' --mesh '%s' --mesh-size 0.1 --mesh-category cup --views 2 "
              "--texture 64 --map-res 64 --states hot --no-calibration --threads 2 --quiet",
              HEARTH_EXE, dir, names[c], a);
-    int rc = run(cmd, out, sizeof out);
+    int rc = test_run_capture(cmd, out, sizeof out);
     CHECK_MSG(rc == 0, "%s: synth exit %d: %s", names[c], rc, out);
     const char *g = "ground_truth/instances/cup_01";
     snprintf(cmd, sizeof cmd,
@@ -365,7 +353,7 @@ static void test_end_to_end(void) {
              "'%s/%s/%s/poses_thermal.json' --rig '%s/%s/ground_truth/rig.json' --resolution 64 "
              "--threads 2",
              HEARTH_EXE, dir, names[c], dir, names[c], g, dir, names[c], g, dir, names[c]);
-    rc = run(cmd, out, sizeof out);
+    rc = test_run_capture(cmd, out, sizeof out);
     CHECK_MSG(rc == 0 && strstr(out, "surface 0 texels") == NULL, "%s: map exit %d: %s", names[c],
               rc, out);
   }
@@ -394,7 +382,7 @@ static void test_end_to_end(void) {
            "'%s' synth --out '%s/point' --mesh '%s' --mesh-size 0.1 --views 1 --texture 64 "
            "--map-res 64 --states hot --no-calibration --threads 2 --quiet",
            HEARTH_EXE, dir, a);
-  int rc = run(cmd, out, sizeof out);
+  int rc = test_run_capture(cmd, out, sizeof out);
   CHECK_MSG(rc != 0 && strstr(out, "surface 0 texels") && strstr(out, "point.glb") &&
                 strstr(out, "hot"),
             "synth on a point layout: exit %d: %s", rc, out);
@@ -404,7 +392,7 @@ static void test_end_to_end(void) {
            "'%s/plain/%s/poses_thermal.json' --rig '%s/plain/ground_truth/rig.json' "
            "--resolution 64 --threads 2",
            HEARTH_EXE, dir, a, dir, g, dir);
-  rc = run(cmd, out, sizeof out);
+  rc = test_run_capture(cmd, out, sizeof out);
   CHECK_MSG(rc != 0 && strstr(out, "surface 0 texels") && strstr(out, "point.glb") &&
                 strstr(out, "cup_01/hot"),
             "map on a point layout: exit %d: %s", rc, out);
