@@ -55,11 +55,11 @@ void calib_circle_bias(const hearth_camera *cam, const hearth_rigid *T, const do
 
 /* ---- shared by the release stages (calib_release.c) and the thermal-only
  * calibration (calib_thermal_only.c) ---- */
-/* The overlay of a detection (as `detect` draws it), PNG-encoded into *png
- * (malloc'ed, the caller frees). */
+/* The overlay of a detection of target (as `detect` draws it), PNG-encoded
+ * into *png (malloc'ed, the caller frees). */
 hearth_status calib_overlay_encode(const hearth_image *img, int thermal,
-                                   const hearth_detection *det, uint8_t **png, size_t *size,
-                                   hearth_err *err);
+                                   const hearth_target *target, const hearth_detection *det,
+                                   uint8_t **png, size_t *size, hearth_err *err);
 /* OpenCV FileStorage YAML pieces: a number (locale-free, 16 digits) and a
  * !!opencv-matrix of doubles. */
 void calib_yaml_num(FILE *fp, double x);

@@ -224,10 +224,12 @@ static hearth_status draw_overlay(det_job *j, const hearth_image *img, hearth_er
 }
 
 hearth_status calib_overlay_encode(const hearth_image *img, int thermal,
-                                   const hearth_detection *det, uint8_t **png, size_t *size,
-                                   hearth_err *err) {
+                                   const hearth_target *target, const hearth_detection *det,
+                                   uint8_t **png, size_t *size, hearth_err *err) {
   det_job *j = calloc(1, sizeof *j);
   if (!j) return hearth_err_set(err, HEARTH_E_NOMEM, "overlay: out of memory");
+  hearth_target tdef;
+  j->target = hearth_target_or_default(target, &tdef);
   j->thermal = thermal;
   j->det = *det;
   hearth_status st = draw_overlay(j, img, err);

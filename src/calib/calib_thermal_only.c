@@ -153,7 +153,8 @@ static void to_range(void *vctx, size_t b, size_t e, int ti) {
       if (!j->st && d2.found) j->det = d2;
     }
     if (!j->st && c->run->overlays)
-      j->st = calib_overlay_encode(&img, 1, &j->det, &j->png, &j->png_size, &j->err);
+      j->st = calib_overlay_encode(&img, 1, &c->run->detect.target, &j->det, &j->png, &j->png_size,
+                                   &j->err);
     hearth_image_free(&img);
     hearth_image_free(&neg);
     if (j->st && !strstr(j->err.msg, j->path)) hearth_err_prefix(&j->err, "%s", j->path);

@@ -131,6 +131,31 @@ int main(void) {
   CHECK_MSG(rc == 0, "synth/detect/calibrate: %s", out);
   check_rig(root, 382, 288);
 
+  /* the same 6x8 hex frames as a thermal-only root (only target.json and the
+     thermal captures), with overlays drawn: detect, calibrate --thermal-only */
+  char solo[1300];
+  snprintf(solo, sizeof solo, "%s/hex382_thermal_only", base);
+  snprintf(cmd, sizeof cmd,
+           "mkdir -p '%s/calibration/captures' && cp -r '%s/calibration/captures/thermal' "
+           "'%s/calibration/captures/' && cp '%s/calibration/target.json' '%s/calibration/' && "
+           "'%s' detect '%s' --threads 2 && '%s' calibrate '%s' --thermal-only",
+           solo, root, solo, root, solo, HEARTH_EXE, solo, HEARTH_EXE, solo);
+  rc = test_run_capture(cmd, out, sizeof out);
+  CHECK_MSG(rc == 0, "thermal-only detect/calibrate: %s", out);
+  {
+    hearth_rig est, tru;
+    hearth_err e2 = {0};
+    snprintf(p, sizeof p, "%s/calibration/rig.json", solo);
+    CHECK_OK(hearth_rig_read(p, &est, &e2), &e2);
+    snprintf(p, sizeof p, "%s/ground_truth/rig.json", root);
+    CHECK_OK(hearth_rig_read(p, &tru, &e2), &e2);
+    CHECK(est.thermal_only && est.thermal.width == 382 && est.thermal.height == 288);
+    CHECK_MSG(fabs(est.thermal.fx / tru.thermal.fx - 1) < 0.002, "thermal-only fx %.4f vs %.4f",
+              est.thermal.fx, tru.thermal.fx);
+    snprintf(p, sizeof p, "%s/calibration/overlays", solo);
+    CHECK_MSG(hearth_path_exists(p), "%s: no overlays", p);
+  }
+
   /* calibrate refuses detections of another target than target.json */
   snprintf(p, sizeof p, "%s/calibration/target.json", root);
   FILE *f = fopen(p, "w");
