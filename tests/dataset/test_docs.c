@@ -132,7 +132,7 @@ static hearth_poses sample_poses(void) {
 }
 
 static hearth_detections sample_detections(void) {
-  hearth_detections d;
+  hearth_detections d = {0}; /* zeroed target: the paper's plate */
   d.n = 3;
   d.frames = calloc(d.n, sizeof *d.frames);
   for (size_t k = 0; k < d.n; k++) {
@@ -300,7 +300,7 @@ static void test_exact_numbers(void) {
                    1e22,
                    1e21};
   size_t n = sizeof vals / sizeof vals[0];
-  hearth_detections d;
+  hearth_detections d = {0};
   d.n = 1;
   d.frames = calloc(1, sizeof *d.frames);
   snprintf(d.frames[0].frame, HEARTH_NAME_MAX, "f001");
