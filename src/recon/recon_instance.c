@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "hearth/recon.h"
+#include "recon_internal.h"
 
 hearth_status hearth_recon_match_instance(const char *root, const char *instance,
                                           const hearth_poses *p, hearth_recon_coverage *cov,
@@ -52,4 +53,21 @@ hearth_status hearth_recon_match_instance(const char *root, const char *instance
                          p->views[i].state, p->views[i].view, instance);
   free(seen);
   return s;
+}
+
+hearth_status recon_instance_inputs(const char *root, const char *instance,
+                                    hearth_instance_doc *inst, const char **own,
+                                    const char *const **states, size_t *n_states,
+                                    hearth_factory_calib *fac, hearth_err *err) {
+  char path[1400];
+  snprintf(path, sizeof path, "%s/instances/%s/instance.json", root, instance);
+  hearth_status s = hearth_instance_read(path, inst, err);
+  if (s) return s;
+  if (!*states || !*n_states) {
+    for (size_t i = 0; i < inst->n_states; i++) own[i] = inst->states[i];
+    *states = own;
+    *n_states = inst->n_states;
+  }
+  snprintf(path, sizeof path, "%s/calibration/factory.json", root);
+  return hearth_factory_read(path, fac, err);
 }

@@ -69,4 +69,14 @@ void rc_json_real(hearth_strbuf *b, double x);
 /* s as a JSON string literal. */
 void rc_json_string(hearth_strbuf *b, const char *s);
 
+/* The inputs every depth-based reconstruction of an instance starts from
+ * (recon_instance.c): its instance.json into *inst; with states NULL or
+ * n_states 0, *states and *n_states become all the instance's states (their
+ * names in own[HEARTH_MAX_STATES], which the caller keeps alive); and
+ * calibration/factory.json into *fac. */
+hearth_status recon_instance_inputs(const char *root, const char *instance,
+                                    hearth_instance_doc *inst, const char **own,
+                                    const char *const **states, size_t *n_states,
+                                    hearth_factory_calib *fac, hearth_err *err);
+
 #endif

@@ -317,18 +317,11 @@ hearth_status hearth_recon_tsdf(const char *root, const char *instance, const ch
   memset(out, 0, sizeof *out);
   char path[1400];
   hearth_instance_doc inst;
-  snprintf(path, sizeof path, "%s/instances/%s/instance.json", root, instance);
-  hearth_status s = hearth_instance_read(path, &inst, err);
-  if (s) return s;
   const char *own[HEARTH_MAX_STATES];
-  if (!states || !n_states) {
-    for (size_t i = 0; i < inst.n_states; i++) own[i] = inst.states[i];
-    states = own;
-    n_states = inst.n_states;
-  }
   hearth_factory_calib fac;
-  snprintf(path, sizeof path, "%s/calibration/factory.json", root);
-  if ((s = hearth_factory_read(path, &fac, err))) return s;
+  hearth_status s =
+      recon_instance_inputs(root, instance, &inst, own, &states, &n_states, &fac, err);
+  if (s) return s;
   hearth_poses poses = {0};
   if (o.poses) snprintf(path, sizeof path, "%s/%s", root, o.poses);
   else snprintf(path, sizeof path, "%s/ground_truth/instances/%s/poses_rgb.json", root, instance);

@@ -755,18 +755,11 @@ hearth_status hearth_recon_turntable(const char *root, const char *instance,
   double t0 = hearth_now();
   char path[1400];
   hearth_instance_doc inst;
-  snprintf(path, sizeof path, "%s/instances/%s/instance.json", root, instance);
-  hearth_status s = hearth_instance_read(path, &inst, err);
-  if (s) return s;
   const char *own[HEARTH_MAX_STATES];
-  if (!states || !n_states) {
-    for (size_t i = 0; i < inst.n_states; i++) own[i] = inst.states[i];
-    states = own;
-    n_states = inst.n_states;
-  }
   hearth_factory_calib fac;
-  snprintf(path, sizeof path, "%s/calibration/factory.json", root);
-  if ((s = hearth_factory_read(path, &fac, err))) return s;
+  hearth_status s =
+      recon_instance_inputs(root, instance, &inst, own, &states, &n_states, &fac, err);
+  if (s) return s;
 
   /* every view of every state */
   hearth_manifest *man = calloc(n_states, sizeof *man);
