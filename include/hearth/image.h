@@ -39,6 +39,9 @@ size_t hearth_image_bytes(const hearth_image *img);
 
 /* Limits applied to untrusted image files. */
 #define HEARTH_IMAGE_MAX_DIM 16384
+/* and at most this many bytes of decoded pixels (a tiny palette PNG can
+ * declare gigabytes of RGBA) */
+#define HEARTH_IMAGE_MAX_BYTES ((size_t)1 << 29)
 
 /* What a caller expects of an image file. The readers check it against the
  * file's header before allocating any pixels, so a small file declaring a

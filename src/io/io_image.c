@@ -40,6 +40,19 @@ hearth_status hearth_image_alloc(hearth_image *img, size_t width, size_t height,
   return HEARTH_OK;
 }
 
+hearth_status hearth_image_bytes_check(size_t w, size_t h, int channels, int sample_bytes,
+                                       char *msg, size_t msgsz) {
+  size_t n;
+  if (hearth_mul_size(w, h, &n) && hearth_mul_size(n, (size_t)channels, &n) &&
+      hearth_mul_size(n, (size_t)sample_bytes, &n) && n <= HEARTH_IMAGE_MAX_BYTES)
+    return HEARTH_OK;
+  snprintf(
+      msg, msgsz,
+      "image of %zux%zu pixels x %d channel(s) x %d byte(s) exceeds the limit of %zu MiB decoded",
+      w, h, channels, sample_bytes, HEARTH_IMAGE_MAX_BYTES >> 20);
+  return HEARTH_E_LIMIT;
+}
+
 hearth_status hearth_image_expect_check(const hearth_image_expect *want, size_t w, size_t h,
                                         int channels, char *msg, size_t msgsz) {
   if (!want) return HEARTH_OK;

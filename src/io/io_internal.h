@@ -8,6 +8,10 @@
  * pixels are allocated) against what the caller expects (NULL: anything).
  * HEARTH_OK, or the status with a message (without the file's name) in
  * msg. */
+/* HEARTH_E_LIMIT (with msg) when a w x h image of channels samples of
+ * sample_bytes each exceeds HEARTH_IMAGE_MAX_BYTES */
+hearth_status hearth_image_bytes_check(size_t w, size_t h, int channels, int sample_bytes,
+                                       char *msg, size_t msgsz);
 hearth_status hearth_image_expect_check(const hearth_image_expect *want, size_t w, size_t h,
                                         int channels, char *msg, size_t msgsz);
 

@@ -108,6 +108,7 @@ static int jpeg_decode(jpeg_reader *r) {
     r->img = (hearth_image){w, h, channels, HEARTH_PIX_U8, NULL};
     return 0;
   }
+  if ((r->status = hearth_image_bytes_check(w, h, channels, 1, r->msg, sizeof r->msg))) return 2;
   jpeg_start_decompress(&r->cinfo);
   if ((int)r->cinfo.output_components != channels || r->cinfo.output_width != w ||
       r->cinfo.output_height != h) {

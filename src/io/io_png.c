@@ -7,6 +7,7 @@
  * state that changes during decoding (buffers, the image, the message) sits
  * in a context struct owned by the caller's frame, so nothing is
  * indeterminate after the jump and the caller frees everything in one place. */
+#include <ctype.h>
 #include <libdeflate.h>
 #include <png.h>
 #include <setjmp.h>
@@ -20,6 +21,8 @@
 
 /* files larger than this are refused before decoding */
 #define PNG_MAX_FILE_BYTES ((size_t)1 << 30)
+/* and ancillary chunks (text, ICC profiles) larger than this, even unpacked */
+#define PNG_MAX_CHUNK_BYTES ((png_alloc_size_t)8 << 20)
 
 static int host_is_little_endian(void) {
   const uint16_t one = 1;
@@ -68,6 +71,9 @@ static int png_decode(png_structp png, png_infop info, png_reader *r) {
   if (setjmp(png_jmpbuf(png))) return 1;
   png_set_read_fn(png, r, read_from_mem);
   png_set_user_limits(png, HEARTH_IMAGE_MAX_DIM, HEARTH_IMAGE_MAX_DIM);
+  /* an ancillary chunk (text, profile) is buffered whole: a header claiming
+     gigabytes must not allocate them */
+  png_set_chunk_malloc_max(png, PNG_MAX_CHUNK_BYTES);
   png_read_info(png, info);
   png_uint_32 w = png_get_image_width(png, info), h = png_get_image_height(png, info);
   int depth = png_get_bit_depth(png, info), ctype = png_get_color_type(png, info);
@@ -114,6 +120,8 @@ static int png_decode(png_structp png, png_infop info, png_reader *r) {
     r->img = (hearth_image){w, h, channels, type, NULL};
     return 0;
   }
+  if ((r->status = hearth_image_bytes_check(w, h, channels, (int)type, r->msg, sizeof r->msg)))
+    return 2;
   hearth_err aerr;
   if (hearth_image_alloc(&r->img, w, h, channels, type, &aerr) != HEARTH_OK) {
     r->status = aerr.status;
@@ -209,6 +217,7 @@ static int png_fast_decode(const uint8_t *d, size_t size, const hearth_image_exp
   char msg[512];
   if (hearth_image_expect_check(want, w, h, channels, msg, sizeof msg) != HEARTH_OK) return 0;
   if (want && want->header_only) return 0;
+  if (hearth_image_bytes_check(w, h, channels, depth / 8, msg, sizeof msg) != HEARTH_OK) return 0;
   /* an IDAT chunk's data may exceed the filtered rows by the stored blocks'
      overhead (libpng refuses more: a bound no larger than libpng's own) */
   size_t idat_max = raw + 6 + 5 * (raw / 32566 + 1);
@@ -319,6 +328,22 @@ hearth_status hearth_png_read_mem_libpng(const void *data, size_t size, const ch
   static const uint8_t sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
   if (size < 8 || memcmp(data, sig, 8) != 0)
     return hearth_err_set(err, HEARTH_E_PARSE, "%s: not a PNG file (bad signature)", name);
+  /* libpng allocates a chunk's declared length before reading it: a chunk
+     that claims more bytes than the file has left is refused here */
+  for (size_t pos = 8; size - pos >= 8;) {
+    const uint8_t *c = (const uint8_t *)data + pos;
+    uint32_t len = get_be32(c);
+    if (len > 0x7fffffffu || size - pos - 8 < len)
+      return hearth_err_set(err, HEARTH_E_PARSE,
+                            "%s: chunk '%c%c%c%c' at byte %zu claims %u bytes, the file has %zu "
+                            "left (truncated?)",
+                            name, isprint(c[4]) ? c[4] : '?', isprint(c[5]) ? c[5] : '?',
+                            isprint(c[6]) ? c[6] : '?', isprint(c[7]) ? c[7] : '?', pos,
+                            (unsigned)len, size - pos - 8);
+    if (!memcmp(c + 4, "IEND", 4)) break;
+    pos += 12 + (size_t)len;
+    if (pos > size) break;
+  }
   png_reader r;
   memset(&r, 0, sizeof r);
   r.data = data;

@@ -311,6 +311,17 @@ static void test_bad_inputs(const char *dir) {
   bytes huge = make_png(16000, 16000, 8, 0, raw, 1, NULL, 0, NULL, 0);
   expect_fail(huge.p, huge.n, "huge.png", HEARTH_E_PARSE);
   free(huge.p);
+  /* a 1-bit palette image with transparency expands 32-fold to RGBA: the
+     file's data fits 16384 x 16384, the decoded 1 GiB does not */
+  {
+    size_t rb = 16384 / 8 + 1, nraw = rb * 16384;
+    uint8_t *zeros = calloc(nraw, 1);
+    uint8_t plte[3] = {10, 20, 30}, trns[1] = {128};
+    bytes pal = make_png(16384, 16384, 1, 3, zeros, nraw, plte, 3, trns, 1);
+    free(zeros);
+    expect_fail(pal.p, pal.n, "palette.png", HEARTH_E_LIMIT);
+    free(pal.p);
+  }
   /* rows missing from the data */
   uint8_t rows[4] = {0, 1, 2, 3};
   bytes short_data = make_png(3, 2, 8, 0, rows, 4, NULL, 0, NULL, 0);
