@@ -12,6 +12,14 @@ for f in build-fuzz/fuzz_*; do
   work=$(mktemp -d)
   cp fuzz/corpus/"$short"/* "$work"/ 2>/dev/null || true
   echo "fuzz: $short for ${secs}s"
-  "$f" -max_total_time="$secs" -max_len=65536 -timeout=10 -rss_limit_mb=2048 "$work" 2>&1 | tail -2
-  rm -rf "$work"
+  log=$(mktemp)
+  if ! "$f" -max_total_time="$secs" -max_len=65536 -timeout=10 -rss_limit_mb=2048 \
+      -artifact_prefix="$PWD/build-fuzz/$short-" "$work" >"$log" 2>&1; then
+    tail -60 "$log"
+    echo "fuzz: $short failed; the input is build-fuzz/$short-*" >&2
+    rm -rf "$work" "$log"
+    exit 1
+  fi
+  tail -2 "$log"
+  rm -rf "$work" "$log"
 done
