@@ -107,6 +107,13 @@ typedef struct hearth_thermo_link {
 hearth_status hearth_thermo_step_coupled(hearth_thermo_net *const *nets, size_t n_nets,
                                          const hearth_thermo_link *links, size_t n_links, double dt,
                                          double *heat_in, hearth_err *err);
+/* The same step with heat_in (may be NULL) an array of n_nets: each
+ * network's heat from outside the joined system (its air, contacts and
+ * power, J). The heat a network got through links is its energy change
+ * minus its heat_in; over all networks those sum to zero, to rounding. */
+hearth_status hearth_thermo_step_coupled_each(hearth_thermo_net *const *nets, size_t n_nets,
+                                              const hearth_thermo_link *links, size_t n_links,
+                                              double dt, double *heat_in, hearth_err *err);
 
 /* ---- regions over a texture ---------------------------------------------- */
 /* Texel regions from a temperature map (hearth_map_result's R, mask,

@@ -188,10 +188,11 @@ typedef struct step_ws {
   size_t base[HEARTH_THERMO_MAX_NETS];
 } step_ws;
 
-hearth_status hearth_thermo_step_coupled(hearth_thermo_net *const *nets, size_t n_nets,
-                                         const hearth_thermo_link *links, size_t n_links, double dt,
-                                         double *heat_in, hearth_err *err) {
-  if (heat_in) *heat_in = 0;
+hearth_status hearth_thermo_step_coupled_each(hearth_thermo_net *const *nets, size_t n_nets,
+                                              const hearth_thermo_link *links, size_t n_links,
+                                              double dt, double *heat_in, hearth_err *err) {
+  if (heat_in)
+    for (size_t a = 0; a < n_nets && a < HEARTH_THERMO_MAX_NETS; a++) heat_in[a] = 0;
   if (!(dt > 0) || !isfinite(dt))
     return hearth_err_set(err, HEARTH_E_ARG, "thermal step: dt = %g s, expected > 0", dt);
   if (n_nets == 0 || n_nets > HEARTH_THERMO_MAX_NETS)
@@ -262,16 +263,29 @@ hearth_status hearth_thermo_step_coupled(hearth_thermo_net *const *nets, size_t 
   for (size_t i = 0; i < n; i++) ws.A[i][i] += C[i] / dt + ws.d_ext[i];
   if (solve_dense(ws.A, ws.rhs, n) != 0)
     return hearth_err_set(err, HEARTH_E_NUMERIC, "thermal step: singular system");
-  double in = 0;
-  for (size_t a = 0; a < n_nets; a++)
+  for (size_t a = 0; a < n_nets; a++) {
+    double in = 0;
     for (size_t i = 0; i < nets[a]->n; i++) {
       size_t u = ws.base[a] + i;
       double Tn = T[u] + ws.rhs[u];
       in += dt * (ws.q_ext[u] - ws.d_ext[u] * Tn);
       nets[a]->region[i].T = Tn;
     }
-  if (heat_in) *heat_in = in;
+    if (heat_in) heat_in[a] = in;
+  }
   return HEARTH_OK;
+}
+
+hearth_status hearth_thermo_step_coupled(hearth_thermo_net *const *nets, size_t n_nets,
+                                         const hearth_thermo_link *links, size_t n_links, double dt,
+                                         double *heat_in, hearth_err *err) {
+  double each[HEARTH_THERMO_MAX_NETS];
+  hearth_status s = hearth_thermo_step_coupled_each(nets, n_nets, links, n_links, dt, each, err);
+  if (heat_in) {
+    *heat_in = 0;
+    for (size_t a = 0; s == HEARTH_OK && a < n_nets; a++) *heat_in += each[a];
+  }
+  return s;
 }
 
 hearth_status hearth_thermo_step(hearth_thermo_net *net, double dt, double *heat_in,

@@ -182,6 +182,24 @@ static void test_coupled(void) {
   }
   CHECK_NEAR(hearth_thermo_energy(&a) + hearth_thermo_energy(&b), E0, 1e-9 * E0);
   CHECK_NEAR(a.region[0].T, b.region[0].T, 1e-3);
+  /* with air on both (convection only): each network's booked heat is
+   * dt h A (T_air - T') at its new temperature, and what the link carried,
+   * dt G (T_b' - T_a') by backward Euler, is each one's energy change
+   * beyond that, equal and opposite */
+  a.region[0].T = 80, b.region[0].T = 10;
+  a.region[0].area = 0.02, b.region[0].area = 0.001;
+  a.region[0].h_conv = 7, b.region[0].h_conv = 20;
+  a.T_air = b.T_air = 22;
+  for (int i = 0; i < 50; i++) {
+    double Ea = hearth_thermo_energy(&a), Eb = hearth_thermo_energy(&b), each[2],
+           dt = 5.0 * (i + 1);
+    CHECK_OK(hearth_thermo_step_coupled_each(nets, 2, &link, 1, dt, each, &err), &err);
+    double Ta = a.region[0].T, Tb = b.region[0].T, q = dt * link.G * (Tb - Ta);
+    CHECK_NEAR(each[0], dt * 7 * 0.02 * (22 - Ta), 1e-9 * fabs(each[0]) + 1e-12);
+    CHECK_NEAR(each[1], dt * 20 * 0.001 * (22 - Tb), 1e-9 * fabs(each[1]) + 1e-12);
+    CHECK_NEAR(hearth_thermo_energy(&a) - Ea - each[0], q, 1e-9 * Ea);
+    CHECK_NEAR(hearth_thermo_energy(&b) - Eb - each[1], -q, 1e-9 * Ea);
+  }
   /* bad input is refused with a message */
   CHECK(hearth_thermo_step(&a, 0, NULL, &err) == HEARTH_E_ARG);
   CHECK(hearth_thermo_step(&a, NAN, NULL, &err) == HEARTH_E_ARG);
