@@ -101,6 +101,10 @@ typedef struct hearth_sim_opts {
    * (and mat) and of the finger pads, both held at HEARTH_SIM_THERMAL_ROOM;
    * defaults HEARTH_SIM_H_CONTACT; 0 removes that kind of link */
   double h_contact_table, h_contact_finger;
+  /* dynamic: contact conductance per unit area, W/(m^2 K), of two objects
+   * touching (a link between their networks); default HEARTH_SIM_H_CONTACT,
+   * 0 removes the links */
+  double h_contact_object;
   /* dynamic: thermal seconds per simulated second (default 1; e.g. 60
    * makes a 20 s episode show 20 minutes of cooling), > 0 */
   double thermal_speedup;
@@ -170,9 +174,17 @@ hearth_status hearth_sim_candidate_boxes(hearth_sim_env *env, int boxes[2][4], h
 /* Object k's (0..3) thermal network now, contact links of the last step
  * included; NULL with static temperatures or k out of range. */
 const hearth_thermo_net *hearth_sim_thermal_net(const hearth_sim_env *env, int k);
-/* Heat object k took in from outside (air, table, fingers) since reset, J:
- * its network's energy now minus at reset, to rounding. */
+/* Heat object k took in from outside (air, table, fingers) since reset, J,
+ * as the thermo library books it. Its network's energy now minus at reset
+ * is this plus hearth_sim_thermal_heat_exchanged, to rounding. */
 double hearth_sim_thermal_heat_in(const hearth_sim_env *env, int k);
+/* Heat object k got from the other objects through contact links since
+ * reset, J (over the four objects these sum to zero, to rounding). */
+double hearth_sim_thermal_heat_exchanged(const hearth_sim_env *env, int k);
+/* The object-object links of the last step (net indices a, b are object
+ * numbers 0..3, ra, rb their regions); returns their count and writes up
+ * to max of them (links may be NULL). */
+size_t hearth_sim_thermal_links(const hearth_sim_env *env, hearth_thermo_link *links, size_t max);
 /* The region temperatures of objects 0..3 one after another (the columns
  * of obs/thermal_state); returns their count and writes them when max is
  * at least that (T may be NULL). 0 with static temperatures. */

@@ -21,7 +21,7 @@ void hearth_sim_opts_default(hearth_sim_opts *o) {
   o->max_steps = 400;
   o->render_wrist = 1;
   o->thermal = HEARTH_SIM_THERMAL_STATIC;
-  o->h_contact_table = o->h_contact_finger = HEARTH_SIM_H_CONTACT;
+  o->h_contact_table = o->h_contact_finger = o->h_contact_object = HEARTH_SIM_H_CONTACT;
   o->thermal_speedup = 1.0;
 }
 
@@ -57,13 +57,15 @@ hearth_status hearth_sim_env_new(const hearth_sim_opts *o, hearth_sim_env **out,
     return hearth_err_set(err, HEARTH_E_ARG, "sim: thermal mode %d is not static or dynamic",
                           o->thermal);
   }
-  if (!(o->h_contact_table >= 0 && o->h_contact_finger >= 0 && isfinite(o->h_contact_table) &&
-        isfinite(o->h_contact_finger))) {
+  if (!(o->h_contact_table >= 0 && o->h_contact_finger >= 0 && o->h_contact_object >= 0 &&
+        isfinite(o->h_contact_table) && isfinite(o->h_contact_finger) &&
+        isfinite(o->h_contact_object))) {
     free(e);
     return hearth_err_set(err, HEARTH_E_RANGE, "sim: contact conductances must be finite, >= 0");
   }
   e->thermal = o->thermal;
   e->h_table = o->h_contact_table, e->h_finger = o->h_contact_finger;
+  e->h_object = o->h_contact_object;
   e->thermal_speedup = o->thermal_speedup > 0 ? o->thermal_speedup : 1.0;
   if (!isfinite(e->thermal_speedup) || e->thermal_speedup > 1e6) {
     free(e);

@@ -15,7 +15,8 @@ typedef struct sim_render sim_render;
 typedef struct sim_thermal_obj {
   hearth_thermo_net net;
   double T0[HEARTH_THERMO_MAX_REGIONS]; /* region temperatures at reset */
-  double heat_in;                       /* J since reset */
+  double heat_in;                       /* J from air, table, fingers since reset */
+  double heat_link;                     /* J from the other objects since reset */
   size_t R;                             /* texture side */
   uint8_t *label;                       /* R*R network region per texel, 255: none */
   float *offset;                        /* R*R degC over the region's temperature */
@@ -50,12 +51,17 @@ struct hearth_sim_env {
   sim_render *rnd;
   /* dynamic temperatures */
   int thermal;
-  double h_table, h_finger, thermal_speedup;
+  double h_table, h_finger, h_object, thermal_speedup;
   int thermal_dirty; /* textures behind the networks' temperatures */
   int table_geom;
 #define SIM_TH_LUT 2048
   uint8_t th_lut[SIM_TH_LUT][3]; /* Turbo over SIM_TLO..SIM_THI */
   sim_thermal_obj th[SIM_NOBJ];
+  /* the last step's object-object links, at most one per pair of regions */
+#define SIM_TH_MAX_LINKS \
+  (SIM_NOBJ * (SIM_NOBJ - 1) / 2 * HEARTH_THERMO_MAX_REGIONS * HEARTH_THERMO_MAX_REGIONS)
+  size_t n_th_links;
+  hearth_thermo_link th_links[SIM_TH_MAX_LINKS];
 };
 
 /* visibility rule of a layout: both candidates at least this visible */

@@ -1,7 +1,8 @@
 /* Dynamic temperatures: a lumped thermal network per object (thermo.h),
  * built from the object's temperature map and its category's materials,
  * integrated once per control step with heat exchanged with the air, the
- * table and the finger pads through MuJoCo's contacts, and the thermal
+ * table, the finger pads and the other objects through MuJoCo's contacts
+ * (touching objects' networks are solved as one system), and the thermal
  * texture re-composed from the region temperatures plus the map's offset
  * field. Model, parameters and sources: docs/simulation.md, "Dynamic
  * temperatures". */
@@ -20,6 +21,9 @@
  * on (a tenth of its footprint) */
 #define SIM_TH_FINGER_AREA 1.0e-4
 #define SIM_TH_TABLE_FRACTION 0.1
+/* the patch of two objects touching: two rigid curved surfaces, taken as
+ * the finger pad's 1 cm^2 */
+#define SIM_TH_OBJECT_AREA 1.0e-4
 
 int hearth_sim_thermal_parse(const char *s) {
   if (!s) return -1;
@@ -266,8 +270,9 @@ void sim_thermal_reset(hearth_sim_env *e) {
     sim_thermal_obj *o = &e->th[k];
     for (size_t i = 0; i < o->net.n; i++) o->net.region[i].T = o->T0[i];
     hearth_thermo_clear_contacts(&o->net);
-    o->heat_in = 0;
+    o->heat_in = o->heat_link = 0;
   }
+  e->n_th_links = 0;
   e->thermal_dirty = 1;
 }
 
@@ -295,6 +300,46 @@ static int contact_kind(const hearth_sim_env *e, int g) {
   for (int s = 0; s < 2; s++)
     if (e->pad_geom[s] >= 0 && b == e->m->geom_bodyid[e->pad_geom[s]]) return 1 + s;
   return -1;
+}
+
+/* the object (0..3) geom g belongs to, or -1 */
+static int contact_object(const hearth_sim_env *e, int g) {
+  int b = e->m->geom_bodyid[g];
+  for (int k = 0; k < SIM_NOBJ; k++)
+    if (e->obj_body[k] == b) return k;
+  return -1;
+}
+
+/* the links of objects touching each other: one patch of h A per pair,
+ * shared equally by the pair's contact points, each point linking the
+ * regions of both objects nearest to it (one link per pair of regions) */
+static void object_links(hearth_sim_env *e) {
+  const mjData *d = e->d;
+  e->n_th_links = 0;
+  if (!(e->h_object > 0)) return;
+  int count[SIM_NOBJ][SIM_NOBJ] = {{0}};
+  for (int i = 0; i < d->ncon; i++) {
+    int a = contact_object(e, d->contact[i].geom1), b = contact_object(e, d->contact[i].geom2);
+    if (a >= 0 && b >= 0 && a != b) count[a < b ? a : b][a < b ? b : a]++;
+  }
+  for (int i = 0; i < d->ncon; i++) {
+    int a = contact_object(e, d->contact[i].geom1), b = contact_object(e, d->contact[i].geom2);
+    if (a < 0 || b < 0 || a == b) continue;
+    if (a > b) {
+      int t = a;
+      a = b, b = t;
+    }
+    size_t ra = contact_region(e, a, d->contact[i].pos),
+           rb = contact_region(e, b, d->contact[i].pos);
+    double G = e->h_object * SIM_TH_OBJECT_AREA / (double)count[a][b];
+    size_t l = 0;
+    while (l < e->n_th_links && !(e->th_links[l].a == (size_t)a && e->th_links[l].b == (size_t)b &&
+                                  e->th_links[l].ra == ra && e->th_links[l].rb == rb))
+      l++;
+    if (l == e->n_th_links) /* at most SIM_TH_MAX_LINKS distinct (a, ra, b, rb) */
+      e->th_links[e->n_th_links++] = (hearth_thermo_link){(size_t)a, ra, (size_t)b, rb, 0};
+    e->th_links[l].G += G;
+  }
 }
 
 hearth_status sim_thermal_step(hearth_sim_env *e, double dt, hearth_err *err) {
@@ -336,11 +381,31 @@ hearth_status sim_thermal_step(hearth_sim_env *e, double dt, hearth_err *err) {
           if (st) return st;
         }
   }
-  for (int k = 0; k < SIM_NOBJ; k++) {
-    double q = 0;
-    hearth_status st = hearth_thermo_step(&e->th[k].net, dt, &q, err);
-    if (st) return hearth_err_prefix(err, "sim thermal object %d: ", k);
-    e->th[k].heat_in += q;
+  object_links(e);
+  if (!e->n_th_links) {
+    for (int k = 0; k < SIM_NOBJ; k++) {
+      double q = 0;
+      hearth_status st = hearth_thermo_step(&e->th[k].net, dt, &q, err);
+      if (st) return hearth_err_prefix(err, "sim thermal object %d: ", k);
+      e->th[k].heat_in += q;
+    }
+  } else {
+    /* touching objects: all four networks as one system */
+    hearth_thermo_net *nets[SIM_NOBJ];
+    for (int k = 0; k < SIM_NOBJ; k++) nets[k] = &e->th[k].net;
+    double q[SIM_NOBJ];
+    hearth_status st =
+        hearth_thermo_step_coupled_each(nets, SIM_NOBJ, e->th_links, e->n_th_links, dt, q, err);
+    if (st) return hearth_err_prefix(err, "sim thermal: ");
+    for (int k = 0; k < SIM_NOBJ; k++) e->th[k].heat_in += q[k];
+    /* what each link carried over the step (backward Euler: at the new
+     * temperatures), given to b's side and taken from a's */
+    for (size_t l = 0; l < e->n_th_links; l++) {
+      const hearth_thermo_link *k = &e->th_links[l];
+      double h = dt * k->G * (nets[k->a]->region[k->ra].T - nets[k->b]->region[k->rb].T);
+      e->th[k->b].heat_link += h;
+      e->th[k->a].heat_link -= h;
+    }
   }
   e->thermal_dirty = 1;
   return HEARTH_OK;
@@ -380,6 +445,17 @@ const hearth_thermo_net *hearth_sim_thermal_net(const hearth_sim_env *e, int k) 
 double hearth_sim_thermal_heat_in(const hearth_sim_env *e, int k) {
   if (!e || e->thermal != HEARTH_SIM_THERMAL_DYNAMIC || k < 0 || k >= SIM_NOBJ) return 0;
   return e->th[k].heat_in;
+}
+
+double hearth_sim_thermal_heat_exchanged(const hearth_sim_env *e, int k) {
+  if (!e || e->thermal != HEARTH_SIM_THERMAL_DYNAMIC || k < 0 || k >= SIM_NOBJ) return 0;
+  return e->th[k].heat_link;
+}
+
+size_t hearth_sim_thermal_links(const hearth_sim_env *e, hearth_thermo_link *links, size_t max) {
+  if (!e || e->thermal != HEARTH_SIM_THERMAL_DYNAMIC) return 0;
+  for (size_t l = 0; links && l < e->n_th_links && l < max; l++) links[l] = e->th_links[l];
+  return e->n_th_links;
 }
 
 size_t hearth_sim_thermal_state(const hearth_sim_env *e, float *T, size_t max) {

@@ -1,7 +1,9 @@
 /* dynamic temperatures in the simulator: a hot cup left alone follows its
  * own network's backward Euler integration, a finger contact cools the
  * region it touches faster than an untouched one, the energy balance holds
- * with contacts, the rendered thermal view of a cooling cup gets colder,
+ * with contacts, an object stacked on the hot cup takes the heat the cup
+ * gives through their link (energy conserved, no overshoot at any step
+ * size), the rendered thermal view of a cooling cup gets colder,
  * and static collections are the bytes of ones made without the option
  * while dynamic ones add obs/thermal_state beside the same motion. */
 #include <hdf5.h>
@@ -13,6 +15,7 @@
 #include "hearth/image.h"
 #include "hearth/sim.h"
 #include "hearth/thermo.h"
+#include "sim/sim_env.h"
 #include "test_util.h"
 #include "test_sim_release.h"
 
@@ -49,8 +52,8 @@ static void write_png(const char *path, const uint8_t *rgb, int w, int h) {
   printf("wrote %s\n", path);
 }
 
-static hearth_sim_env *make_env_r(const char *root, double h_table, double h_finger, double speedup,
-                                  int size, const char *renderer) {
+static hearth_sim_env *make_env_o(const char *root, double h_table, double h_finger,
+                                  double h_object, double speedup, int size, const char *renderer) {
   hearth_sim_opts o;
   hearth_sim_opts_default(&o);
   o.renderer = renderer;
@@ -59,12 +62,17 @@ static hearth_sim_env *make_env_r(const char *root, double h_table, double h_fin
   o.width = o.height = size;
   o.render_wrist = 0;
   o.thermal = HEARTH_SIM_THERMAL_DYNAMIC;
-  o.h_contact_table = h_table, o.h_contact_finger = h_finger;
+  o.h_contact_table = h_table, o.h_contact_finger = h_finger, o.h_contact_object = h_object;
   o.thermal_speedup = speedup;
   hearth_sim_env *e = NULL;
   hearth_err err = {0};
   CHECK_OK(hearth_sim_env_new(&o, &e, &err), &err);
   return e;
+}
+
+static hearth_sim_env *make_env_r(const char *root, double h_table, double h_finger, double speedup,
+                                  int size, const char *renderer) {
+  return make_env_o(root, h_table, h_finger, 0, speedup, size, renderer);
 }
 
 static hearth_sim_env *make_env(const char *root, double h_table, double h_finger, double speedup,
@@ -229,6 +237,94 @@ static void check_finger(const char *root) {
   hearth_sim_env_free(e[1]);
 }
 
+static double net_mean_T(const hearth_thermo_net *n) {
+  double C = 0;
+  for (size_t i = 0; i < n->n; i++) C += n->region[i].C;
+  return hearth_thermo_energy(n) / C;
+}
+
+/* a neutral distractor (object 2) set on top of the hot cup (object 0),
+ * no table or finger links: every step links the two networks; each
+ * object's energy change is the heat the library booked from its air plus
+ * what it got through the links, the links' heat sums to zero, the cup
+ * ends cooler and the distractor warmer than their twins of a run without
+ * object links; at a step of 1e4 s no temperature leaves the range of the
+ * start temperatures and the air */
+static void check_objects(const char *root) {
+  hearth_err err = {0};
+  hearth_sim_env *e[2] = {make_env_o(root, 0, 0, HEARTH_SIM_H_CONTACT, 60.0, 16, "none"),
+                          make_env_o(root, 0, 0, 0, 60.0, 16, "none")};
+  if (!e[0] || !e[1]) return;
+  for (int r = 0; r < 2; r++) {
+    CHECK_OK(hearth_sim_reset(e[r], 7, 0, 0, &err), &err);
+    double p[3];
+    sim_object_pos(e[r], 0, p);
+    p[2] += e[r]->assets[0].size[2] + 0.001;
+    sim_place_object(e[r], 2, p);
+  }
+  double E0[SIM_NOBJ], worst = 0, worst_sum = 0, Tlo = HEARTH_SIM_THERMAL_ROOM, Thi = Tlo;
+  for (int k = 0; k < SIM_NOBJ; k++) {
+    const hearth_thermo_net *n = hearth_sim_thermal_net(e[0], k);
+    E0[k] = hearth_thermo_energy(n);
+    for (size_t i = 0; i < n->n; i++) {
+      if (n->region[i].T < Tlo) Tlo = n->region[i].T;
+      if (n->region[i].T > Thi) Thi = n->region[i].T;
+    }
+  }
+  int linked = 0, steps = 220;
+  double zero[7] = {0, 0, 0, 0, 0, 0, -1}, overshoot = 0;
+  double q0 = 0, q2 = 0, c0 = 0, t0 = 0, c2 = 0, t2 = 0;
+  for (int t = 0; t < steps; t++) {
+    if (t == 200) {
+      /* 10 thermal minutes: the exchange so far; then steps of dt = 1e4 s */
+      q0 = hearth_sim_thermal_heat_exchanged(e[0], 0),
+      q2 = hearth_sim_thermal_heat_exchanged(e[0], 2);
+      c0 = net_mean_T(hearth_sim_thermal_net(e[0], 0)),
+      t0 = net_mean_T(hearth_sim_thermal_net(e[1], 0));
+      c2 = net_mean_T(hearth_sim_thermal_net(e[0], 2)),
+      t2 = net_mean_T(hearth_sim_thermal_net(e[1], 2));
+      e[0]->thermal_speedup = e[1]->thermal_speedup = 2e5;
+    }
+    for (int r = 0; r < 2; r++) CHECK_OK(hearth_sim_step(e[r], zero, &err), &err);
+    hearth_thermo_link lk[8];
+    size_t nl = hearth_sim_thermal_links(e[0], lk, 8);
+    for (size_t l = 0; l < nl && l < 8; l++)
+      CHECK_MSG(lk[l].a == 0 && lk[l].b == 2 && lk[l].G > 0, "step %d link %zu: %zu-%zu G %g", t, l,
+                lk[l].a, lk[l].b, lk[l].G);
+    linked += nl > 0;
+    CHECK(hearth_sim_thermal_links(e[1], NULL, 0) == 0);
+    double sum = 0, scale = 0;
+    for (int k = 0; k < SIM_NOBJ; k++) {
+      const hearth_thermo_net *n = hearth_sim_thermal_net(e[0], k);
+      double dE = hearth_thermo_energy(n) - E0[k] - hearth_sim_thermal_heat_in(e[0], k) -
+                  hearth_sim_thermal_heat_exchanged(e[0], k);
+      if (fabs(dE) > worst) worst = fabs(dE);
+      sum += hearth_sim_thermal_heat_exchanged(e[0], k);
+      scale += fabs(hearth_sim_thermal_heat_exchanged(e[0], k));
+      for (size_t i = 0; i < n->n; i++) {
+        double o = fmax(n->region[i].T - Thi, Tlo - n->region[i].T);
+        if (o > overshoot) overshoot = o;
+      }
+    }
+    if (fabs(sum) > worst_sum) worst_sum = fabs(sum);
+    CHECK_MSG(fabs(sum) <= 1e-12 * scale + 1e-12, "step %d: links' heat sums to %.3g J", t, sum);
+  }
+  CHECK_MSG(linked >= steps * 9 / 10, "the stacked objects were linked in %d of %d steps", linked,
+            steps);
+  CHECK_MSG(worst <= 1e-9 * fabs(E0[0]), "energy bookkeeping with object links off by %.3g J",
+            worst);
+  CHECK_MSG(overshoot <= 1e-9, "a temperature left [%.2f, %.2f] by %.3g degC", Tlo, Thi, overshoot);
+  printf(
+      "objects: linked %d/%d steps; after 600 s the cup gave %.1f J, the distractor got %.1f J; "
+      "cup %.3f vs twin %.3f, distractor %.3f vs twin %.3f degC; bookkeeping %.2g J, links' sum "
+      "%.2g J\n",
+      linked, steps, -q0, q2, c0, t0, c2, t2, worst, worst_sum);
+  CHECK_MSG(q0 < 0 && q2 > 0, "link heat: cup %.3f J, distractor %.3f J", q0, q2);
+  CHECK_MSG(c0 < t0 && c2 > t2, "cup %.4f twin %.4f; distractor %.4f twin %.4f", c0, t0, c2, t2);
+  hearth_sim_env_free(e[0]);
+  hearth_sim_env_free(e[1]);
+}
+
 static unsigned char *slurp(const char *path, size_t *n) {
   FILE *fp = fopen(path, "rb");
   if (!fp) return NULL;
@@ -324,6 +420,7 @@ int main(void) {
   const char *root = test_sim_release(dirbuf);
   check_alone(root, dirbuf);
   check_finger(root);
+  check_objects(root);
   check_gl(root);
   check_files(root, dirbuf);
   return g_test_failures ? 1 : 0;
