@@ -9,7 +9,9 @@
  *
  * Features, in this order: image, wrist_image, thermal_image (dtype
  * "image": PNG bytes in a struct<bytes, path> Parquet column), state
- * (float32 (8,)), actions (float32 (7,)), then LeRobot's timestamp,
+ * (float32 (8,)), actions (float32 (7,)), thermal_state (float32 (R,),
+ * only from dynamic-temperature collections: obs/thermal_state with its
+ * region names), then LeRobot's timestamp,
  * frame_index, episode_index, index and task_index. Images are the HDF5's
  * rotated by 180 degrees (OpenGL rows -> openpi's LIBERO convention, what
  * `hearth sim eval` sends before resizing); the state is the grip site's
@@ -58,7 +60,7 @@ typedef struct hearth_lerobot_opts {
   const char *const *inputs; /* collection files, exported in this order */
   size_t n_inputs;           /* 1..HEARTH_LEROBOT_MAX_INPUTS */
   const char *robot_type;    /* default "panda" (openpi's LIBERO example) */
-  int thermal;               /* include thermal_image; default 1 */
+  int thermal;               /* include thermal_image and thermal_state; default 1 */
   int threads;               /* PNG encoding; 0 = hearth_default_threads() */
   int quiet;
 } hearth_lerobot_opts;

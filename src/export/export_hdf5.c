@@ -45,6 +45,22 @@ static int int_attr(hid_t obj, const char *name, int64_t *v) {
   return ok;
 }
 
+/* obs/thermal_state of group obs: its column count (0 when absent, -1 when
+ * it is not float (T, 1..EX_STATS_MAX_DIM) with region_names fitting names) */
+static int thermal_state_shape(hid_t obs, hsize_t *rows, char *names, size_t n) {
+  if (H5Lexists(obs, "thermal_state", H5P_DEFAULT) <= 0) return 0;
+  hid_t d = H5Dopen2(obs, "thermal_state", H5P_DEFAULT);
+  if (d < 0) return -1;
+  hid_t sp = H5Dget_space(d), t = H5Dget_type(d);
+  hsize_t dims[2] = {0, 0};
+  int ok = H5Sget_simple_extent_ndims(sp) == 2 && H5Sget_simple_extent_dims(sp, dims, NULL) == 2 &&
+           H5Tget_class(t) == H5T_FLOAT && dims[1] >= 1 && dims[1] <= EX_STATS_MAX_DIM &&
+           str_attr(d, "region_names", names, n);
+  H5Tclose(t), H5Sclose(sp), H5Dclose(d);
+  if (rows) *rows = dims[0];
+  return ok ? (int)dims[1] : -1;
+}
+
 static void copy_str(char *dst, size_t n, json_t *v) {
   const char *s = json_string_value(v);
   snprintf(dst, n, "%s", s ? s : "");
@@ -111,6 +127,20 @@ hearth_status ex_source_open(const char *path, ex_source *s, hearth_err *err) {
     ex_source_close(s);
     return hearth_err_set(err, HEARTH_E_RANGE, "%s: data@num_demos = %lld", path,
                           (long long)s->num_demos);
+  }
+  /* the thermal state's columns, from the first demo */
+  if (s->num_demos > 0 && H5Lexists(f, "data/demo_0", H5P_DEFAULT) > 0 &&
+      H5Lexists(f, "data/demo_0/obs", H5P_DEFAULT) > 0) {
+    hid_t ob = H5Gopen2(f, "data/demo_0/obs", H5P_DEFAULT);
+    s->th_dim = ob >= 0 ? thermal_state_shape(ob, NULL, s->th_names, sizeof s->th_names) : 0;
+    if (ob >= 0) H5Gclose(ob);
+    if (s->th_dim < 0) {
+      ex_source_close(s);
+      return hearth_err_set(err, HEARTH_E_SIZE,
+                            "%s: data/demo_0/obs/thermal_state: expected float (T, 1..%d) with "
+                            "attribute region_names",
+                            path, EX_STATS_MAX_DIM);
+    }
   }
   return HEARTH_OK;
 }
@@ -223,6 +253,23 @@ hearth_status ex_demo_read(const ex_source *s, int64_t k, int want_thermal, ex_d
                     arrays[a].u8 ? 1 : sizeof(double), &buf[a], err);
   d->actions = buf[0], d->ee_pos = buf[1], d->ee_ori = buf[2], d->gripper = buf[3];
   d->rgb = buf[4], d->wrist = buf[5], d->thermal = buf[6];
+  /* the thermal state: the columns and names of demo_0 in every demo */
+  if (!st) {
+    char names[sizeof s->th_names];
+    hsize_t rows = 0;
+    int dim = thermal_state_shape(obs, &rows, names, sizeof names);
+    if (dim != s->th_dim || (dim > 0 && (rows != (hsize_t)T || strcmp(names, s->th_names) != 0)))
+      st = hearth_err_set(err, HEARTH_E_INCONSISTENT, "%s: data/%s/obs/thermal_state: expected %s",
+                          s->path, demo,
+                          s->th_dim ? "the (T, R) shape and region_names of demo_0"
+                                    : "none (demo_0 has none)");
+    else if (dim > 0 && want_thermal) {
+      const hsize_t ts[2] = {(hsize_t)T, (hsize_t)dim};
+      void *b = NULL;
+      st = read_array(s, obs, od, "thermal_state", 2, ts, H5T_NATIVE_FLOAT, sizeof(float), &b, err);
+      d->thermal_state = b;
+    }
+  }
   if (obs >= 0) H5Gclose(obs);
   H5Gclose(g);
   return st;
@@ -230,6 +277,6 @@ hearth_status ex_demo_read(const ex_source *s, int64_t k, int want_thermal, ex_d
 
 void ex_demo_free(ex_demo *d) {
   free(d->actions), free(d->ee_pos), free(d->ee_ori), free(d->gripper);
-  free(d->rgb), free(d->wrist), free(d->thermal);
+  free(d->rgb), free(d->wrist), free(d->thermal), free(d->thermal_state);
   memset(d, 0, sizeof *d);
 }

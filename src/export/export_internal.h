@@ -18,6 +18,11 @@ typedef struct ex_source {
   char asset_source[64]; /* env_kwargs.asset_source, "" if absent */
   char renderer[64];     /* env_kwargs.renderer, "" if absent */
   int64_t num_demos;
+  /* a dynamic-temperature collection's obs/thermal_state (docs/simulation.md):
+   * its columns in demo_0 and their region_names (`;`-separated); 0 and ""
+   * when the file has none. Every demo must have the same. */
+  int th_dim;
+  char th_names[4096];
   int64_t file_id; /* the open HDF5 file (hid_t) */
 } ex_source;
 
@@ -31,10 +36,12 @@ typedef struct ex_demo {
   char instruction[1024];
   double *actions, *ee_pos, *ee_ori, *gripper; /* T x 7, 3, 3, 2 */
   uint8_t *rgb, *wrist, *thermal;              /* T x size x size x 3, OpenGL rows */
+  float *thermal_state;                        /* T x th_dim, degC, or NULL */
 } ex_demo;
 
-/* Read data/demo_<k> (thermal only if want_thermal); d is zeroed first and
- * freed with ex_demo_free (also after a failure). */
+/* Read data/demo_<k> (agentview_thermal and thermal_state only if
+ * want_thermal); d is zeroed first and freed with ex_demo_free (also after
+ * a failure). */
 hearth_status ex_demo_read(const ex_source *s, int64_t k, int want_thermal, ex_demo *d,
                            hearth_err *err);
 void ex_demo_free(ex_demo *d);
@@ -63,15 +70,17 @@ double ex_np_sum(const double *x, size_t n);
 double ex_np_sum_into(double acc, const double *x, size_t n);
 
 /* One feature's stats as lerobot's compute_episode_stats leaves them. */
+#define EX_STATS_MAX_DIM 64
 typedef struct ex_stats {
   int dim;     /* values per frame (image features: 3 channels) */
   int integer; /* min and max are integers (int64 features) */
   int image;   /* shape (3, 1, 1) */
-  double min[8], max[8], mean[8], std[8];
+  double min[EX_STATS_MAX_DIM], max[EX_STATS_MAX_DIM], mean[EX_STATS_MAX_DIM],
+      std[EX_STATS_MAX_DIM];
   int64_t count;
 } ex_stats;
 
-/* float32 (T, dim), reduced over axis 0 in float32 (dim <= 8). */
+/* float32 (T, dim), reduced over axis 0 in float32 (dim <= EX_STATS_MAX_DIM). */
 void ex_stats_f32(const float *x, size_t T, int dim, ex_stats *s);
 /* float64 (T,), e.g. timestamps (frame_index / fps in Python floats). */
 hearth_status ex_stats_f64(const double *x, size_t T, ex_stats *s, hearth_err *err);

@@ -54,23 +54,37 @@ typedef struct feature {
 /* LeRobot's order: the dataset's features, then DEFAULT_FEATURES */
 static const feature k_features[] = {
     {"image", F_IMAGE, 0},     {"wrist_image", F_IMAGE, 0}, {"thermal_image", F_IMAGE, 0},
-    {"state", F_VECTOR, 8},    {"actions", F_VECTOR, 7},    {"timestamp", F_FLOAT, 1},
-    {"frame_index", F_INT, 1}, {"episode_index", F_INT, 1}, {"index", F_INT, 1},
-    {"task_index", F_INT, 1},
+    {"state", F_VECTOR, 8},    {"actions", F_VECTOR, 7},    {"thermal_state", F_VECTOR, 0},
+    {"timestamp", F_FLOAT, 1}, {"frame_index", F_INT, 1},   {"episode_index", F_INT, 1},
+    {"index", F_INT, 1},       {"task_index", F_INT, 1},
 };
 #define N_FEATURES (sizeof k_features / sizeof k_features[0])
 
-static int feature_on(const hearth_lerobot_opts *o, size_t f) {
-  return o->thermal || strcmp(k_features[f].name, "thermal_image") != 0;
+/* what the inputs carry: the thermal view (unless opts.thermal is 0) and a
+ * dynamic collection's obs/thermal_state of th_dim named columns */
+typedef struct schema {
+  int thermal, th_dim;
+  const char *th_names; /* `;`-separated */
+} schema;
+
+static int feature_on(const schema *sc, size_t f) {
+  const char *nm = k_features[f].name;
+  if (strcmp(nm, "thermal_image") == 0) return sc->thermal;
+  if (strcmp(nm, "thermal_state") == 0) return sc->thermal && sc->th_dim > 0;
+  return 1;
+}
+
+static int feature_len(const schema *sc, size_t f) {
+  return k_features[f].len ? k_features[f].len : sc->th_dim;
 }
 
 /* datasets' Features.to_dict() as json.dumps writes it: the Parquet
  * files' "huggingface" metadata */
-static void hf_metadata(const hearth_lerobot_opts *o, ex_text *t) {
+static void hf_metadata(const schema *sc, ex_text *t) {
   ex_puts(t, "{\"info\": {\"features\": {");
   int first = 1;
   for (size_t f = 0; f < N_FEATURES; f++) {
-    if (!feature_on(o, f)) continue;
+    if (!feature_on(sc, f)) continue;
     const feature *ft = &k_features[f];
     if (!first) ex_puts(t, ", ");
     first = 0;
@@ -81,7 +95,7 @@ static void hf_metadata(const hearth_lerobot_opts *o, ex_text *t) {
         ex_printf(
             t,
             ": {\"feature\": {\"dtype\": \"float32\", \"_type\": \"Value\"}, \"length\": %d, \"_type\": \"Sequence\"}",
-            ft->len);
+            feature_len(sc, f));
         break;
       case F_FLOAT: ex_puts(t, ": {\"dtype\": \"float32\", \"_type\": \"Value\"}"); break;
       case F_INT: ex_puts(t, ": {\"dtype\": \"int64\", \"_type\": \"Value\"}"); break;
@@ -91,10 +105,23 @@ static void hf_metadata(const hearth_lerobot_opts *o, ex_text *t) {
 }
 
 /* info.json's "features" */
-static json_t *info_features(const hearth_lerobot_opts *o, int size) {
+/* the region names of thermal_state as a JSON array */
+static json_t *name_list(const char *names) {
+  json_t *a = json_array();
+  const char *p = names;
+  while (*p) {
+    const char *e = strchr(p, ';');
+    size_t n = e ? (size_t)(e - p) : strlen(p);
+    json_array_append_new(a, json_stringn(p, n));
+    p += n + (e ? 1 : 0);
+  }
+  return a;
+}
+
+static json_t *info_features(const schema *sc, int size) {
   json_t *fs = json_object();
   for (size_t f = 0; f < N_FEATURES; f++) {
-    if (!feature_on(o, f)) continue;
+    if (!feature_on(sc, f)) continue;
     const feature *ft = &k_features[f];
     json_t *j = json_object();
     if (ft->kind == F_IMAGE) {
@@ -103,9 +130,11 @@ static json_t *info_features(const hearth_lerobot_opts *o, int size) {
       json_object_set_new(j, "names", json_pack("[sss]", "height", "width", "channel"));
     } else {
       json_object_set_new(j, "dtype", json_string(ft->kind == F_INT ? "int64" : "float32"));
-      json_object_set_new(j, "shape", json_pack("[i]", ft->len));
+      json_object_set_new(j, "shape", json_pack("[i]", feature_len(sc, f)));
       json_object_set_new(j, "names",
-                          ft->kind == F_VECTOR ? json_pack("[s]", ft->name) : json_null());
+                          ft->kind != F_VECTOR                     ? json_null()
+                          : strcmp(ft->name, "thermal_state") == 0 ? name_list(sc->th_names)
+                                                                   : json_pack("[s]", ft->name));
     }
     json_object_set_new(fs, ft->name, j);
   }
@@ -137,6 +166,7 @@ static void encode_pngs(void *ctx, size_t b, size_t e, int t) {
 /* everything the export accumulates */
 typedef struct exporter {
   const hearth_lerobot_opts *o;
+  schema sc;
   char tmp[4200];
   int size, fps;
   char **tasks;
@@ -172,7 +202,8 @@ static hearth_status grow_norm(exporter *x, size_t T, hearth_err *err) {
 
 /* the Parquet file of one episode */
 static hearth_status write_parquet(exporter *x, const png_job *pj, const float *state,
-                                   const float *actions, size_t T, int task, hearth_err *err) {
+                                   const float *actions, const float *th, size_t T, int task,
+                                   hearth_err *err) {
   char dir[4400], path[4500];
   size_t chunk = x->episode / HEARTH_LEROBOT_CHUNK_SIZE;
   snprintf(dir, sizeof dir, "%s/data/chunk-%03zu", x->tmp, chunk);
@@ -182,7 +213,7 @@ static hearth_status write_parquet(exporter *x, const png_job *pj, const float *
   hearth_pq_column cols[N_FEATURES];
   size_t nc = 0;
   for (size_t f = 0; f < N_FEATURES; f++) {
-    if (!feature_on(x->o, f)) continue;
+    if (!feature_on(&x->sc, f)) continue;
     static const hearth_pq_kind kinds[] = {HEARTH_PQ_BLOB, HEARTH_PQ_FLOAT_LIST, HEARTH_PQ_FLOAT,
                                            HEARTH_PQ_INT64};
     cols[nc++] = (hearth_pq_column){k_features[f].name, kinds[k_features[f].kind]};
@@ -198,7 +229,7 @@ static hearth_status write_parquet(exporter *x, const png_job *pj, const float *
     size_t c = 0;
     int view = 0;
     for (size_t f = 0; f < N_FEATURES; f++) {
-      if (!feature_on(x->o, f)) continue;
+      if (!feature_on(&x->sc, f)) continue;
       hearth_pq_cell *cl = &cells[c++];
       memset(cl, 0, sizeof *cl);
       const char *nm = k_features[f].name;
@@ -209,6 +240,9 @@ static hearth_status write_parquet(exporter *x, const png_job *pj, const float *
         cl->list = state + 8 * i, cl->list_len = 8;
       } else if (strcmp(nm, "actions") == 0) {
         cl->list = actions + 7 * i, cl->list_len = 7;
+      } else if (strcmp(nm, "thermal_state") == 0) {
+        size_t R = (size_t)x->sc.th_dim;
+        cl->list = th + R * i, cl->list_len = R;
       } else if (strcmp(nm, "timestamp") == 0) {
         cl->f = (float)((double)i / (double)x->fps);
       } else if (strcmp(nm, "frame_index") == 0) {
@@ -232,7 +266,8 @@ static hearth_status write_parquet(exporter *x, const png_job *pj, const float *
 
 /* the episode's line of meta/episodes_stats.jsonl */
 static hearth_status episode_stats(exporter *x, const png_job *pj, const float *state,
-                                   const float *actions, size_t T, int task, hearth_err *err) {
+                                   const float *actions, const float *th, size_t T, int task,
+                                   hearth_err *err) {
   double *ts = hearth_alloc_array(T, sizeof *ts);
   int64_t *iv = hearth_alloc_array(T, sizeof *iv);
   if (!ts || !iv) {
@@ -244,13 +279,14 @@ static hearth_status episode_stats(exporter *x, const png_job *pj, const float *
   ex_printf(t, "{\"episode_index\": %zu, \"stats\": {", x->episode);
   int view = 0, first = 1;
   for (size_t f = 0; f < N_FEATURES && !st; f++) {
-    if (!feature_on(x->o, f)) continue;
+    if (!feature_on(&x->sc, f)) continue;
     const char *nm = k_features[f].name;
     ex_stats s;
     if (k_features[f].kind == F_IMAGE) {
       st = ex_stats_images(pj->views[view++], T, pj->size, pj->size, &s, err);
     } else if (k_features[f].kind == F_VECTOR) {
-      ex_stats_f32(strcmp(nm, "state") == 0 ? state : actions, T, k_features[f].len, &s);
+      const float *v = strcmp(nm, "state") == 0 ? state : strcmp(nm, "actions") == 0 ? actions : th;
+      ex_stats_f32(v, T, feature_len(&x->sc, f), &s);
     } else if (k_features[f].kind == F_FLOAT) {
       for (size_t i = 0; i < T; i++) ts[i] = (double)i / (double)x->fps;
       st = ex_stats_f64(ts, T, &s, err);
@@ -319,8 +355,8 @@ static hearth_status export_demo(exporter *x, const ex_source *src, size_t src_i
     task = task_index(x, d.instruction);
     if (task < 0) st = hearth_err_set(err, HEARTH_E_NOMEM, "export: tasks");
   }
-  if (!st) st = write_parquet(x, &pj, state, actions, T, task, err);
-  if (!st) st = episode_stats(x, &pj, state, actions, T, task, err);
+  if (!st) st = write_parquet(x, &pj, state, actions, d.thermal_state, T, task, err);
+  if (!st) st = episode_stats(x, &pj, state, actions, d.thermal_state, T, task, err);
   if (!st) st = grow_norm(x, T, err);
   if (!st) {
     memcpy(x->norm_state + 8 * x->frames, state, T * 8 * sizeof *state);
@@ -383,7 +419,7 @@ static hearth_status write_info(const exporter *x, const ex_source *src,
   json_object_set_new(
       j, "video_path",
       json_string("videos/chunk-{episode_chunk:03d}/{video_key}/episode_{episode_index:06d}.mp4"));
-  json_object_set_new(j, "features", info_features(o, x->size));
+  json_object_set_new(j, "features", info_features(&x->sc, x->size));
   json_t *h = json_object();
   json_object_set_new(h, "software_version", json_string(HEARTH_VERSION));
   json_object_set_new(h, "images",
@@ -394,6 +430,11 @@ static hearth_status write_info(const exporter *x, const ex_source *src,
                           "ee_pos (3), continuous axis-angle of ee_ori (3), gripper_states (2)"));
   json_object_set_new(h, "actions",
                       json_string("[dx dy dz dax day daz grip] in [-1, 1], as stored"));
+  if (x->sc.thermal && x->sc.th_dim > 0)
+    json_object_set_new(h, "thermal_state",
+                        json_string(
+                            "obs/thermal_state as stored: the lumped thermal model's region "
+                            "temperatures (degC) of objects 0..3, columns as named"));
   json_t *srcs = json_array();
   for (size_t k = 0; k < o->n_inputs; k++) {
     char eps[64];
@@ -549,6 +590,13 @@ hearth_status hearth_lerobot_export(const hearth_lerobot_opts *o, hearth_lerobot
           "has one image shape and one fps)",
           src[opened].path, src[opened].size, src[opened].fps, src[0].path, src[0].size,
           src[0].fps);
+    else if (opened && o->thermal &&
+             (src[opened].th_dim != src[0].th_dim ||
+              strcmp(src[opened].th_names, src[0].th_names) != 0))
+      st = hearth_err_set(err, HEARTH_E_INCONSISTENT,
+                          "%s: obs/thermal_state has %d columns, %s has %d (or other region names; "
+                          "one LeRobot dataset has one set of features)",
+                          src[opened].path, src[opened].th_dim, src[0].path, src[0].th_dim);
   }
   if (!st && total == 0) st = hearth_err_set(err, HEARTH_E_SIZE, "export: the inputs hold no demo");
   exporter x = {.o = o};
@@ -562,7 +610,8 @@ hearth_status hearth_lerobot_export(const hearth_lerobot_opts *o, hearth_lerobot
     free(src), free(first);
     return st;
   }
-  hf_metadata(o, &x.hfmeta);
+  x.sc = (schema){o->thermal, src[0].th_dim, src[0].th_names};
+  hf_metadata(&x.sc, &x.hfmeta);
   hearth_progress prog;
   hearth_progress_begin(&prog, "export", total, o->quiet);
   for (size_t f = 0; f < o->n_inputs && !st; f++) {

@@ -176,7 +176,8 @@ void ex_stats_f32(const float *x, size_t T, int dim, ex_stats *s) {
   memset(s, 0, sizeof *s);
   s->dim = dim;
   s->count = (int64_t)T;
-  float sum[8] = {0}, mn[8], mx[8], var[8] = {0};
+  float sum[EX_STATS_MAX_DIM] = {0}, mn[EX_STATS_MAX_DIM], mx[EX_STATS_MAX_DIM],
+        var[EX_STATS_MAX_DIM] = {0};
   for (int j = 0; j < dim; j++) mn[j] = mx[j] = x[j];
   for (size_t i = 0; i < T; i++)
     for (int j = 0; j < dim; j++) {
@@ -185,7 +186,7 @@ void ex_stats_f32(const float *x, size_t T, int dim, ex_stats *s) {
       if (v < mn[j]) mn[j] = v;
       if (v > mx[j]) mx[j] = v;
     }
-  float mean[8];
+  float mean[EX_STATS_MAX_DIM];
   for (int j = 0; j < dim; j++) mean[j] = sum[j] / (float)T;
   for (size_t i = 0; i < T; i++)
     for (int j = 0; j < dim; j++) {

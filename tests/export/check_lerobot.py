@@ -13,7 +13,8 @@ quat2axisangle), every PNG decoded against the HDF5 frame rotated 180 degrees
 and against what `hearth sim eval` encoded for that frame (EVAL_DIR/ep<E>_f<K>_
 <feature>.npy, written by test_lerobot.c), the meta files rebuilt as LeRobot's
 writer (lerobot 0cf86487 with datasets 3.6, numpy) would write them and
-compared as text, and norm_stats.json; the axis-angle must not jump between frames (with
+compared as text, and norm_stats.json; a dynamic-temperature collection's
+obs/thermal_state against the thermal_state column and its names; the axis-angle must not jump between frames (with
 --expect-flip some demo's ee_ori must, so that check is not idle). Exits 1
 listing what differs.
 
@@ -143,17 +144,23 @@ def load_demos(paths, thermal):
                      "wrist_image": g["obs/eye_in_hand_rgb"][()]}
                 if thermal:
                     d["thermal_image"] = g["obs/agentview_thermal"][()]
+                    if "thermal_state" in g["obs"]:
+                        ts = g["obs/thermal_state"]
+                        d["thermal_state"] = ts[()]
+                        d["thermal_names"] = attr_text(ts.attrs["region_names"]).split(";")
                 demos.append(d)
     return demos
 
 
-def expected_features(thermal, size):
+def expected_features(thermal, size, thermal_names=None):
     img = {"dtype": "image", "shape": [size, size, 3], "names": ["height", "width", "channel"]}
     fs = {"image": dict(img), "wrist_image": dict(img)}
     if thermal:
         fs["thermal_image"] = dict(img)
     fs["state"] = {"dtype": "float32", "shape": [8], "names": ["state"]}
     fs["actions"] = {"dtype": "float32", "shape": [7], "names": ["actions"]}
+    if thermal and thermal_names:
+        fs["thermal_state"] = {"dtype": "float32", "shape": [len(thermal_names)], "names": thermal_names}
     for k, dt in (("timestamp", "float32"), ("frame_index", "int64"), ("episode_index", "int64"),
                   ("index", "int64"), ("task_index", "int64")):
         fs[k] = {"dtype": dt, "shape": [1], "names": None}
@@ -184,7 +191,9 @@ def check_dataset(root, dump_path, eval_dir, thermal, expect_flip, paths):
         dump = {os.path.relpath(d["file"], root): d for d in json.load(f)}
     size = demos[0]["image"].shape[1]
     fps = demos[0]["fps"]
-    features = expected_features(thermal, size)
+    names = demos[0].get("thermal_names")
+    check(all(d.get("thermal_names") == names for d in demos), "demos with different thermal_state columns")
+    features = expected_features(thermal, size, names)
     image_keys = [k for k, ft in features.items() if ft["dtype"] == "image"]
 
     # tasks in order of first appearance, as LeRobotDatasetMetadata.add_task
@@ -245,11 +254,13 @@ def check_dataset(root, dump_path, eval_dir, thermal, expect_flip, paths):
         for k in image_keys:
             check(types[k] == image_t, f"{rel}: {k} is {types[k]}")
         check(types["state"] == list_t and types["actions"] == list_t and types["timestamp"] == float_t
+              and (names is None or types["thermal_state"] == list_t)
               and all(types[k] == int_t for k in ("frame_index", "episode_index", "index", "task_index")),
               f"{rel}: column types {types}")
         task = tasks.index(d["instruction"])
         state = np.zeros((T, 8), np.float32)
         actions = np.zeros((T, 7), np.float32)
+        th = np.zeros((T, len(names)), np.float32) if names else None
         images = {k: [] for k in image_keys}
         for i, r in enumerate(rows[:T]):
             ok = (r["frame_index"] == i and r["episode_index"] == e and r["index"] == index + i and
@@ -257,6 +268,8 @@ def check_dataset(root, dump_path, eval_dir, thermal, expect_flip, paths):
             check(ok, f"{rel} row {i}: indices or timestamp wrong: {[r[k] for k in ('frame_index', 'episode_index', 'index', 'task_index', 'timestamp')]}")
             state[i] = [value(v) for v in r["state"]]
             actions[i] = [value(v) for v in r["actions"]]
+            if names:
+                th[i] = [value(v) for v in r["thermal_state"]]
             for k in image_keys:
                 check(r[k]["path"] == f"frame_{i:06d}.png", f"{rel} row {i}: {k}.path = {r[k]['path']}")
                 img = png(r[k])
@@ -269,6 +282,9 @@ def check_dataset(root, dump_path, eval_dir, thermal, expect_flip, paths):
                     evals += 1
                     check(np.array_equal(np.load(ev), img), f"{rel} row {i}: {k} != what sim eval sends for that frame")
         check(np.array_equal(actions, d["actions"].astype(np.float32)), f"{rel}: actions != the HDF5's")
+        if names:
+            check(d["thermal_state"].dtype == np.float32 and np.array_equal(th, d["thermal_state"]),
+                  f"{rel}: thermal_state != the HDF5's obs/thermal_state")
         check(np.array_equal(state[:, :3], d["ee_pos"].astype(np.float32)), f"{rel}: state[0:3] != ee_pos")
         check(np.array_equal(state[:, 6:], d["gripper"].astype(np.float32)), f"{rel}: state[6:8] != gripper_states")
         aa = np.array([axis_angle(r) for r in d["ee_ori"]])
@@ -286,6 +302,8 @@ def check_dataset(root, dump_path, eval_dir, thermal, expect_flip, paths):
         cols = {"state": state, "actions": actions, "timestamp": np.stack([i / fps for i in range(T)]),
                 "frame_index": np.stack(list(range(T))), "episode_index": np.full((T,), e),
                 "index": np.arange(index, index + T), "task_index": np.array([task] * T)}
+        if names:
+            cols["thermal_state"] = th
         cols.update(images)
         want = json.dumps({"episode_index": e, "stats": tolist(episode_stats(cols, features))}, ensure_ascii=False)
         if e < len(st_lines) and st_lines[e] != want + "\n":

@@ -7,8 +7,10 @@
  * eval` encodes for the same frame (written here as .npy) and the meta files
  * with what LeRobot's writer makes. Also: the bytes do not depend on the
  * thread count, the state's axis-angle stays continuous where the rotation
- * vector flips, and refused exports (non-empty output, mixed image sizes, a
- * missing file) say why and leave nothing. */
+ * vector flips, a dynamic-temperature collection adds the thermal_state
+ * column (its values and region names those of obs/thermal_state; dropped
+ * with --no-thermal), and refused exports (non-empty output, mixed image
+ * sizes, mixed thermal states, a missing file) say why and leave nothing. */
 #include <dirent.h>
 #include <stdio.h>
 #include <string.h>
@@ -188,6 +190,32 @@ int main(void) {
   CHECK(export_cli(args, errp) == 0);
   snprintf(cmd, sizeof cmd, "diff -r '%s' '%s' >/dev/null", ds, ds1);
   CHECK_MSG(run(cmd) == 0, "%s and %s differ", ds, ds1);
+
+  /* dynamic temperatures: obs/thermal_state becomes the thermal_state column */
+  char dyn[1200];
+  snprintf(dyn, sizeof dyn, "%s/h1_dynamic.hdf5", g_dir);
+  c.layouts = 1;
+  c.thermal = HEARTH_SIM_THERMAL_DYNAMIC;
+  c.thermal_speedup = 60;
+  c.out_path = dyn;
+  CHECK_OK(hearth_sim_collect(&c, &cs, &err), &err);
+  snprintf(ds, sizeof ds, "%s/ds_dyn", g_dir);
+  snprintf(args, sizeof args, "--lerobot '%s' '%s'", ds, dyn);
+  CHECK_MSG(export_cli(args, errp) == 0, "export of %s failed", dyn);
+  char info[1400];
+  snprintf(info, sizeof info, "%s/meta/info.json", ds);
+  CHECK(file_has(info, "\"thermal_state\"") && file_has(info, "obj0/cup/hot/liquid"));
+  check_dataset(ds, "-", "", dyn);
+  snprintf(ds, sizeof ds, "%s/ds_dyn_rgb", g_dir);
+  snprintf(args, sizeof args, "--no-thermal --lerobot '%s' '%s'", ds, dyn);
+  CHECK(export_cli(args, errp) == 0);
+  snprintf(info, sizeof info, "%s/meta/info.json", ds);
+  CHECK(!file_has(info, "thermal_state"));
+  /* one dataset, one set of columns: a static and a dynamic file are refused */
+  snprintf(ds, sizeof ds, "%s/ds_mixed_thermal", g_dir);
+  snprintf(args, sizeof args, "--lerobot '%s' '%s' '%s'", ds, dyn, h1);
+  CHECK(export_cli(args, errp) == 1 && file_has(errp, "thermal_state"));
+  CHECK(!hearth_path_exists(ds));
 
   /* synthetic: downsampled statistics, a short demo, JSON escapes; and without thermal */
   snprintf(ds, sizeof ds, "%s/ds_syn", g_dir);
