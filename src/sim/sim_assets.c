@@ -309,6 +309,7 @@ hearth_status sim_asset_load(const char *root, int use_gt, const char *category,
     if (!st) {
       snprintf(p, sizeof p, "%s/instances/%s/derived/%s/thermal_turbo.png", root, id, state);
       st = hearth_png_read(p, &a->thermal, err);
+      snprintf(a->map_dir, sizeof a->map_dir, "%s/instances/%s/derived/%s", root, id, state);
     }
   }
   if (!st) st = to_rgb(&a->rgb, "colour texture", err);

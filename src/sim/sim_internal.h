@@ -27,7 +27,10 @@ typedef struct sim_asset {
                          * in thermal: the true map (ground truth), or NULL until
                          * sim_asset_temperatures reads the Turbo image back */
   size_t temp_R;
-  double size[3]; /* bounding box extents */
+  char map_dir[4096]; /* derived assets: derived/<state>/ of the instance (the
+                       * map's mask and observed and filled arrays); "" with
+                       * ground truth */
+  double size[3];     /* bounding box extents */
   double mass, friction;
 } sim_asset;
 void sim_asset_free(sim_asset *a);

@@ -12,6 +12,8 @@
 #include <string.h>
 
 #include "hearth/image.h"
+#include "hearth/map.h"
+#include "hearth/npy.h"
 #include "sim/sim_env.h"
 
 /* texture clusters (k-means over the map's temperatures) per object */
@@ -71,9 +73,64 @@ static double mesh_area(const hearth_mesh *m) {
   return a;
 }
 
+/* an object's temperature map as hearth_thermo_regions_from_map takes it:
+ * a derived asset's mask.npy, temperature_observed.npy and
+ * temperature_filled.npy (docs/dataset.md; the Turbo image would clamp at
+ * 10..60 degC and colour texels without surface), else the asset's
+ * temperatures (the true map) observed wherever they are finite */
+typedef struct th_map {
+  size_t R;
+  uint8_t *mask;
+  const float *observed, *filled;
+  hearth_npy npy[3];
+} th_map;
+
+static void th_map_free(th_map *mp) {
+  if (!mp->npy[0].data) free(mp->mask);
+  for (int i = 0; i < 3; i++) hearth_npy_free(&mp->npy[i]);
+  memset(mp, 0, sizeof *mp);
+}
+
+static hearth_status th_map_load(sim_asset *a, th_map *mp, hearth_err *err) {
+  memset(mp, 0, sizeof *mp);
+  if (!a->map_dir[0]) {
+    hearth_status st = sim_asset_temperatures(a, err);
+    if (st) return st;
+    size_t n = a->temp_R * a->temp_R;
+    mp->R = a->temp_R;
+    mp->mask = malloc(n ? n : 1);
+    if (!mp->mask) return hearth_err_set(err, HEARTH_E_NOMEM, "sim thermal: out of memory");
+    for (size_t i = 0; i < n; i++)
+      mp->mask[i] = isfinite(a->temp[i]) ? HEARTH_TEXEL_OBSERVED : HEARTH_TEXEL_NONE;
+    mp->observed = mp->filled = a->temp;
+    return HEARTH_OK;
+  }
+  static const char *files[3] = {"mask.npy", "temperature_observed.npy", "temperature_filled.npy"};
+  size_t R = a->thermal.width;
+  for (int i = 0; i < 3; i++) {
+    char p[4200];
+    snprintf(p, sizeof p, "%s/%s", a->map_dir, files[i]);
+    hearth_status st = hearth_npy_read(p, &mp->npy[i], err);
+    const hearth_npy *q = &mp->npy[i];
+    if (!st && (q->dtype != (i ? HEARTH_NPY_F32 : HEARTH_NPY_U8) || q->ndim != 2 ||
+                q->shape[0] != R || q->shape[1] != R))
+      st = hearth_err_set(err, HEARTH_E_SIZE, "%s: expected %s [%zu][%zu] beside thermal_turbo.png",
+                          p, i ? "float32" : "uint8", R, R);
+    if (st) {
+      th_map_free(mp);
+      return st;
+    }
+  }
+  mp->R = R;
+  mp->mask = mp->npy[0].data;
+  mp->observed = mp->npy[1].data, mp->filled = mp->npy[2].data;
+  return HEARTH_OK;
+}
+
 /* one object's network from its map: the shell split over the texture
- * regions (C and area by texel share), conductances between regions that
- * share texel edges (k t L / d), and the template's liquid */
+ * regions (C and area by their share of the texels with a value),
+ * conductances between regions that share texel edges (k t L / d), and the
+ * template's liquid */
 static hearth_status build_object(hearth_sim_env *e, int k, hearth_err *err) {
   sim_asset *a = &e->assets[k];
   sim_thermal_obj *o = &e->th[k];
@@ -84,16 +141,29 @@ static hearth_status build_object(hearth_sim_env *e, int k, hearth_err *err) {
   const hearth_thermo_material *mat = hearth_thermo_material_find(tc->material);
   if (!mat)
     return hearth_err_set(err, HEARTH_E_NOT_FOUND, "sim thermal: no material '%s'", tc->material);
-  hearth_status st = sim_asset_temperatures(a, err);
+  th_map mp;
+  hearth_status st = th_map_load(a, &mp, err);
   if (st) return st;
-  size_t R = a->temp_R, n = R * R;
-  uint8_t *mask = malloc(n);
-  if (!mask) return hearth_err_set(err, HEARTH_E_NOMEM, "sim thermal: out of memory");
-  for (size_t i = 0; i < n; i++) mask[i] = isfinite(a->temp[i]) ? 1 : 0; /* OBSERVED : NONE */
+  size_t R = mp.R, n = R * R;
   hearth_thermo_regions reg = {0};
-  st = hearth_thermo_regions_from_map(R, mask, a->temp, a->temp, NULL, SIM_TH_CLUSTERS, &reg, err);
-  free(mask);
+  st = hearth_thermo_regions_from_map(R, mp.mask, mp.observed, mp.filled, NULL, SIM_TH_CLUSTERS,
+                                      &reg, err);
+  /* each region's share of the shell: of the texels with a value (observed
+   * or filled; an unobserved island's temperature is unknown, so it takes
+   * none), else of all texels */
+  double share[HEARTH_THERMO_MAX_CLUSTERS] = {0};
+  size_t valued[HEARTH_THERMO_MAX_CLUSTERS] = {0}, n_valued = 0, total = 0;
+  for (size_t i = 0; !st && i < n; i++)
+    if (reg.label[i] != HEARTH_THERMO_NO_LABEL &&
+        (mp.mask[i] == HEARTH_TEXEL_OBSERVED || mp.mask[i] == HEARTH_TEXEL_FILLED))
+      valued[reg.label[i]]++, n_valued++;
+  th_map_free(&mp);
   if (st) return hearth_err_prefix(err, "sim thermal %s/%s: ", a->category, a->state);
+  for (size_t l = 0; l < reg.k; l++) total += reg.n_texels[l];
+  for (size_t l = 0; l < reg.k; l++)
+    share[l] = n_valued ? (double)valued[l] / (double)n_valued
+               : total  ? (double)reg.n_texels[l] / (double)total
+                        : 0.0;
   /* the shell: the template's body region, else the category's mass */
   hearth_thermo_net tpl;
   double C_body = a->mass * mat->c, h_body = HEARTH_THERMO_H_NATURAL, G_liquid = 0;
@@ -111,13 +181,11 @@ static hearth_status build_object(hearth_sim_env *e, int k, hearth_err *err) {
       liquid = &tpl.region[il], G_liquid = tpl.G[ib][il];
   }
   double A_body = mesh_area(&a->mesh);
-  size_t total = 0;
-  for (size_t l = 0; l < reg.k; l++) total += reg.n_texels[l];
   hearth_thermo_net_init(&o->net);
   o->net.T_air = HEARTH_SIM_THERMAL_ROOM;
   double mean_T = 0;
   for (size_t l = 0; l < reg.k && !st; l++) {
-    double f = total ? (double)reg.n_texels[l] / (double)total : 0.0;
+    double f = share[l];
     hearth_thermo_region r = {0};
     snprintf(r.name, sizeof r.name, "shell%zu", l);
     r.C = C_body * (f > 0 ? f : 1e-6);
@@ -156,7 +224,7 @@ static hearth_status build_object(hearth_sim_env *e, int k, hearth_err *err) {
     size_t il = 0;
     st = hearth_thermo_add_region(&o->net, &r, &il, err);
     for (size_t l = 0; l < reg.k && !st; l++) {
-      double f = total ? (double)reg.n_texels[l] / (double)total : 0.0;
+      double f = share[l];
       if (f > 0) st = hearth_thermo_set_conductance(&o->net, l, il, G_liquid * f, err);
     }
   }
