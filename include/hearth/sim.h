@@ -174,6 +174,13 @@ hearth_status hearth_sim_candidate_boxes(hearth_sim_env *env, int boxes[2][4], h
 /* Object k's (0..3) thermal network now, contact links of the last step
  * included; NULL with static temperatures or k out of range. */
 const hearth_thermo_net *hearth_sim_thermal_net(const hearth_sim_env *env, int k);
+/* Set region `region` of object k's network to T degC now (an experiment's
+ * start state, e.g. a cup just filled; the next reset restores the map's
+ * temperatures); the heat bookkeeping starts again from this state.
+ * HEARTH_E_ARG with static temperatures or indices out of range,
+ * HEARTH_E_RANGE for T not above -273.15. */
+hearth_status hearth_sim_thermal_set(hearth_sim_env *env, int k, size_t region, double T,
+                                     hearth_err *err);
 /* Heat object k took in from outside (air, table, fingers) since reset, J,
  * as the thermo library books it. Its network's energy now minus at reset
  * is this plus hearth_sim_thermal_heat_exchanged, to rounding. */

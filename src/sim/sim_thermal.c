@@ -23,6 +23,12 @@
  * on (a tenth of its footprint) */
 #define SIM_TH_FINGER_AREA 1.0e-4
 #define SIM_TH_TABLE_FRACTION 0.1
+/* the table top: wood (Incropera Table A.3, oak across the grain,
+ * 0.17 W/(m K)), 22 degC far from the objects. Heat leaves a patch of area
+ * A into it through the contact's h_c A in series with the spreading
+ * conductance of an isothermal disc of diameter D on a half-space, S k
+ * with S = 2 D (Incropera Table 4.1), D the disc of area A */
+#define SIM_TH_TABLE_K 0.17
 /* the patch of two objects touching: two rigid curved surfaces, taken as
  * the finger pad's 1 cm^2 */
 #define SIM_TH_OBJECT_AREA 1.0e-4
@@ -428,8 +434,10 @@ hearth_status sim_thermal_step(hearth_sim_env *e, double dt, hearth_err *err) {
     }
     if (!count[0] && !count[1] && !count[2]) continue;
     const double *sz = e->assets[k].size;
-    double GA[3] = {e->h_table * SIM_TH_TABLE_FRACTION * sz[0] * sz[1],
-                    e->h_finger * SIM_TH_FINGER_AREA, e->h_finger * SIM_TH_FINGER_AREA};
+    double A_table = SIM_TH_TABLE_FRACTION * sz[0] * sz[1], Gc = e->h_table * A_table,
+           Gs = SIM_TH_TABLE_K * 4.0 * sqrt(A_table / M_PI);
+    double GA[3] = {Gc > 0 ? Gc * Gs / (Gc + Gs) : 0, e->h_finger * SIM_TH_FINGER_AREA,
+                    e->h_finger * SIM_TH_FINGER_AREA};
     double G[HEARTH_THERMO_MAX_REGIONS][3] = {{0}};
     for (int i = 0; i < d->ncon; i++) {
       int g1 = d->contact[i].geom1, g2 = d->contact[i].geom2, other = -1;
@@ -513,6 +521,21 @@ const hearth_thermo_net *hearth_sim_thermal_net(const hearth_sim_env *e, int k) 
 double hearth_sim_thermal_heat_in(const hearth_sim_env *e, int k) {
   if (!e || e->thermal != HEARTH_SIM_THERMAL_DYNAMIC || k < 0 || k >= SIM_NOBJ) return 0;
   return e->th[k].heat_in;
+}
+
+hearth_status hearth_sim_thermal_set(hearth_sim_env *e, int k, size_t region, double T,
+                                     hearth_err *err) {
+  if (!e || e->thermal != HEARTH_SIM_THERMAL_DYNAMIC || k < 0 || k >= SIM_NOBJ ||
+      region >= e->th[k].net.n)
+    return hearth_err_set(err, HEARTH_E_ARG,
+                          "sim thermal: no region %zu of object %d (dynamic temperatures only)",
+                          region, k);
+  if (!isfinite(T) || T <= -273.15)
+    return hearth_err_set(err, HEARTH_E_RANGE, "sim thermal: T = %g degC", T);
+  e->th[k].net.region[region].T = T;
+  for (int j = 0; j < SIM_NOBJ; j++) e->th[j].heat_in = e->th[j].heat_link = 0;
+  e->thermal_dirty = 1;
+  return HEARTH_OK;
 }
 
 double hearth_sim_thermal_heat_exchanged(const hearth_sim_env *e, int k) {
