@@ -84,7 +84,11 @@ int main(int argc, char **argv) {
   run(e, STRAT_T0, 13, strat);
   printf("stratigrafia.org: %.2f degC at 13 min, published %.1f (%+.2f)\n", strat[13], STRAT_T13,
          strat[13] - STRAT_T13);
-  if (csv) fprintf(csv, "stratigrafia,13,%.3f,%.1f\n", strat[13], STRAT_T13);
+  for (int m = 0; csv && m <= 13; m++) {
+    fprintf(csv, "stratigrafia,%d,%.3f,", m, strat[m]);
+    if (m == 0 || m == 13) fprintf(csv, "%.1f", m ? STRAT_T13 : STRAT_T0);
+    fprintf(csv, "\n");
+  }
   CHECK_MSG(fabs(strat[13] - STRAT_T13) <= 2.0, "13 min: model %.2f, published %.1f", strat[13],
             STRAT_T13);
   if (csv) fclose(csv);
