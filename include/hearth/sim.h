@@ -181,12 +181,14 @@ const hearth_thermo_net *hearth_sim_thermal_net(const hearth_sim_env *env, int k
  * HEARTH_E_RANGE for T not above -273.15. */
 hearth_status hearth_sim_thermal_set(hearth_sim_env *env, int k, size_t region, double T,
                                      hearth_err *err);
-/* Heat object k took in from outside (air, table, fingers) since reset, J,
- * as the thermo library books it. Its network's energy now minus at reset
- * is this plus hearth_sim_thermal_heat_exchanged, to rounding. */
+/* Heat object k took in from outside (air, table, fingers) since reset
+ * (or the last hearth_sim_thermal_set), J, as the thermo library books it.
+ * Its network's energy now minus then is this plus
+ * hearth_sim_thermal_heat_exchanged, to rounding. */
 double hearth_sim_thermal_heat_in(const hearth_sim_env *env, int k);
 /* Heat object k got from the other objects through contact links since
- * reset, J (over the four objects these sum to zero, to rounding). */
+ * reset (or the last hearth_sim_thermal_set), J (over the four objects
+ * these sum to zero, to rounding). */
 double hearth_sim_thermal_heat_exchanged(const hearth_sim_env *env, int k);
 /* The object-object links of the last step (net indices a, b are object
  * numbers 0..3, ra, rb their regions); returns their count and writes up
