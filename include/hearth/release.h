@@ -15,6 +15,7 @@
 #include <stdio.h>
 #include "hearth/core.h"
 #include "hearth/map.h"
+#include "hearth/recon.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -190,6 +191,35 @@ hearth_status hearth_build_release(const char *root, const hearth_build_opts *o,
 /* Print the end-of-build summary. */
 void hearth_build_report_print(const hearth_build_report *r, FILE *out);
 
+/* ---- ground truth through surface correspondence ------------------------------- */
+/* The virtual rig's truth of one state resampled onto the UV layout of the
+ * built derived/mesh.glb at R x R: each texel's surface point (the texel
+ * centre on its UV triangle) is taken into the truth's frame by ref_from_est
+ * (NULL: the similarity that best maps derived/poses_rgb.json onto
+ * ground_truth/.../poses_rgb.json) and matched to the nearest point of
+ * ground_truth/.../mesh.glb, whose UV picks the true texel (nearest) of
+ * temperature_true.npy, and of temperature_apparent.npy and conditions.npy
+ * where the truth has them. away[q] is 1 when some thermal view of the state
+ * (derived/poses_thermal.json, the thermal camera of calibration/rig.json)
+ * sees the texel's point inside its frame, unoccluded by the built mesh,
+ * within 60 degrees of the triangle's normal. Arrays are owned (free with
+ * hearth_truth_match_free, which accepts a zeroed struct); texels off the
+ * surface hold NaN and away 0. */
+typedef struct hearth_truth_match {
+  size_t R;
+  float *t_true;                   /* R*R degC */
+  float *t_apparent;               /* R*R degC, or NULL: the truth has no apparent map */
+  float *conditions;               /* R*R*3 (best cosine, mirror share, drift), or NULL */
+  float *dist_m;                   /* R*R: distance to the matched true point, metres */
+  uint8_t *away;                   /* R*R */
+  int same_uvs;                    /* the built mesh has the truth's UVs (the stand-in) */
+  hearth_pose_alignment alignment; /* derived/poses_rgb.json onto the true poses */
+} hearth_truth_match;
+void hearth_truth_match_free(hearth_truth_match *m);
+hearth_status hearth_truth_match_state(const char *root, const char *instance, const char *state,
+                                       size_t R, const hearth_similarity *ref_from_est,
+                                       hearth_truth_match *out, hearth_err *err);
+
 /* ---- report ------------------------------------------------------------------ */
 /* One state of the report: coverage and, with ground truth (virtual rig), the
  * error of the observed texels against ground_truth/.../temperature_true.npy. */
@@ -210,6 +240,16 @@ typedef struct hearth_report_entry {
   size_t n_away;
   double app_median_abs_c, app_p95_abs_c, away_true_median_abs_c, away_true_p95_abs_c;
   double worst_grazing, worst_mirror, worst_cooling;
+  /* through surface correspondence (hearth_truth_match_state): on observed
+     texels seen by some thermal view within 60 degrees of the normal (n_corr,
+     corr_share of the observed ones), |observed - true| at the nearest true
+     surface point, |observed - apparent| there (NaN without the rig's object
+     effects), and the distances to those points */
+  int has_corr, same_uvs;
+  size_t n_corr;
+  double corr_share, corr_median_abs_c, corr_p95_abs_c;
+  double corr_app_median_abs_c, corr_app_p95_abs_c;
+  double corr_dist_median_mm, corr_dist_p95_mm;
 } hearth_report_entry;
 
 typedef struct hearth_report {
