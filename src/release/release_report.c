@@ -62,9 +62,11 @@ static hearth_status write_turbo(const char *path, const float *v, const uint8_t
 
 /* the errors against the apparent truth a[] and where the largest sit,
    with the truth's viewing conditions c[] (3 per texel); all in the map's
-   UV layout */
+   UV layout. A texel counts as seen within 60 degrees where away[] is 1
+   (hearth's mesh and poses: hearth_truth_match), or without away[] where
+   the truth's best viewing cosine c[0] is at least 0.5 (the stand-in) */
 static hearth_status report_effects(const uint8_t *m, const float *o, const float *t,
-                                    const float *a, const float *c, size_t R,
+                                    const float *a, const float *c, const uint8_t *away, size_t R,
                                     hearth_report_entry *e, hearth_err *err) {
   const size_t n = R * R;
   double *da = hearth_alloc_array(n, sizeof *da), *dt = hearth_alloc_array(n, sizeof *dt);
@@ -79,7 +81,7 @@ static hearth_status report_effects(const uint8_t *m, const float *o, const floa
   for (size_t i = 0; i < n; i++) {
     if (m[i] != 1 || !isfinite(o[i]) || !isfinite(a[i])) continue;
     all[nall++] = fabs((double)o[i] - a[i]);
-    if (c[3 * i] >= 0.5f) {
+    if (away ? away[i] != 0 : c[3 * i] >= 0.5f) {
       da[na] = fabs((double)o[i] - a[i]);
       dt[na++] = isfinite(t[i]) ? fabs((double)o[i] - t[i]) : 0.0;
     }
@@ -100,7 +102,7 @@ static hearth_status report_effects(const uint8_t *m, const float *o, const floa
     if (m[i] != 1 || !isfinite(o[i]) || !isfinite(a[i]) || fabs((double)o[i] - a[i]) < cut)
       continue;
     nw++;
-    ng += c[3 * i] < 0.5f;
+    ng += away ? !away[i] : c[3 * i] < 0.5f;
     nm += c[3 * i + 1] > 0.0f;
     nc += c[3 * i + 2] > 1.0f;
   }
@@ -131,7 +133,7 @@ static hearth_status report_effects_files(const char *root, const char *inst, co
       cond.ndim != 3 || cond.dtype != HEARTH_NPY_F32 || cond.shape[0] != R || cond.shape[1] != R ||
       cond.shape[2] != 3)
     goto done; /* another layout: not compared */
-  s = report_effects(m, o, t, app.data, cond.data, R, e, err);
+  s = report_effects(m, o, t, app.data, cond.data, NULL, R, e, err);
 done:
   hearth_npy_free(&app);
   hearth_npy_free(&cond);
@@ -287,7 +289,7 @@ static hearth_status report_state(const char *root, const char *out_dir, const c
       *have_truth_png = 1;
       if (!have_tm || tm.same_uvs) s = report_effects_files(root, inst, state, m, o, t, R, e, err);
       else if (tm.t_apparent && tm.conditions)
-        s = report_effects(m, o, t, tm.t_apparent, tm.conditions, R, e, err);
+        s = report_effects(m, o, t, tm.t_apparent, tm.conditions, tm.away, R, e, err);
       if (s) goto done;
     }
   }
