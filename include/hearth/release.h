@@ -177,12 +177,14 @@ typedef struct hearth_build_report {
 void hearth_build_report_free(hearth_build_report *r);
 
 /* The per-instance stages, in order, and whether each is part of this build
- * (scale, transfer, refine, bake, map). */
+ * (recon, scale, bake, transfer, refine, map, overlay; recon runs only for
+ * instances without a recon/ of another tool). */
 size_t hearth_build_instance_stages(const char **names, int *available, size_t max);
 
 /* Run every stale stage: release-level stages once, then for each instance
- * of this shard (in parallel) scale, transfer, refine, colour baking and
- * every state's map. Returns HEARTH_OK when the build could run (even with
+ * of this shard (in parallel) hearth's own reconstruction (when recon/ is
+ * missing, or was made by an earlier build: its stamp), scale, transfer,
+ * refine, colour baking and every state's map. Returns HEARTH_OK when the build could run (even with
  * failed instances, which are listed in rep); an error when release.json
  * cannot be read or a release-level stage fails. rep is filled either way
  * (the caller frees it with hearth_build_report_free). */
