@@ -48,8 +48,8 @@ awk '
     split($0, a, "] "); split(a[2], w, " "); n = w[2]; sub(":", "", n)
     s = $0; sub(/.*\(/, "", s); t[n] += s + 0; c[n]++ }
   END {
-    split("detect calibrate scale bake transfer refine map overlay", order, " ")
-    for (i = 1; i <= 8; i++) if (order[i] in t)
+    split("detect calibrate recon scale bake transfer refine map overlay", order, " ")
+    for (i = 1; i <= 9; i++) if (order[i] in t)
       printf "  %-10s %3d run(s) %7.2f s\n", order[i], c[order[i]], t[order[i]]
   }' "$work/build.log"
 grep "^build summary" "$work/build.log" | sed 's/^/  /'

@@ -15,6 +15,7 @@
 #include <stdio.h>
 #include "hearth/core.h"
 #include "hearth/map.h"
+#include "hearth/recon.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -176,12 +177,14 @@ typedef struct hearth_build_report {
 void hearth_build_report_free(hearth_build_report *r);
 
 /* The per-instance stages, in order, and whether each is part of this build
- * (scale, transfer, refine, bake, map). */
+ * (recon, scale, bake, transfer, refine, map, overlay; recon runs only for
+ * instances without a recon/ of another tool). */
 size_t hearth_build_instance_stages(const char **names, int *available, size_t max);
 
 /* Run every stale stage: release-level stages once, then for each instance
- * of this shard (in parallel) scale, transfer, refine, colour baking and
- * every state's map. Returns HEARTH_OK when the build could run (even with
+ * of this shard (in parallel) hearth's own reconstruction (when recon/ is
+ * missing, or was made by an earlier build: its stamp), scale, transfer,
+ * refine, colour baking and every state's map. Returns HEARTH_OK when the build could run (even with
  * failed instances, which are listed in rep); an error when release.json
  * cannot be read or a release-level stage fails. rep is filled either way
  * (the caller frees it with hearth_build_report_free). */
@@ -189,6 +192,35 @@ hearth_status hearth_build_release(const char *root, const hearth_build_opts *o,
                                    hearth_build_report *rep, hearth_err *err);
 /* Print the end-of-build summary. */
 void hearth_build_report_print(const hearth_build_report *r, FILE *out);
+
+/* ---- ground truth through surface correspondence ------------------------------- */
+/* The virtual rig's truth of one state resampled onto the UV layout of the
+ * built derived/mesh.glb at R x R: each texel's surface point (the texel
+ * centre on its UV triangle) is taken into the truth's frame by ref_from_est
+ * (NULL: the similarity that best maps derived/poses_rgb.json onto
+ * ground_truth/.../poses_rgb.json) and matched to the nearest point of
+ * ground_truth/.../mesh.glb, whose UV picks the true texel (nearest) of
+ * temperature_true.npy, and of temperature_apparent.npy and conditions.npy
+ * where the truth has them. away[q] is 1 when some thermal view of the state
+ * (derived/poses_thermal.json, the thermal camera of calibration/rig.json)
+ * sees the texel's point inside its frame, unoccluded by the built mesh,
+ * within 60 degrees of the triangle's normal. Arrays are owned (free with
+ * hearth_truth_match_free, which accepts a zeroed struct); texels off the
+ * surface hold NaN and away 0. */
+typedef struct hearth_truth_match {
+  size_t R;
+  float *t_true;                   /* R*R degC */
+  float *t_apparent;               /* R*R degC, or NULL: the truth has no apparent map */
+  float *conditions;               /* R*R*3 (best cosine, mirror share, drift), or NULL */
+  float *dist_m;                   /* R*R: distance to the matched true point, metres */
+  uint8_t *away;                   /* R*R */
+  int same_uvs;                    /* the built mesh has the truth's UVs (the stand-in) */
+  hearth_pose_alignment alignment; /* derived/poses_rgb.json onto the true poses */
+} hearth_truth_match;
+void hearth_truth_match_free(hearth_truth_match *m);
+hearth_status hearth_truth_match_state(const char *root, const char *instance, const char *state,
+                                       size_t R, const hearth_similarity *ref_from_est,
+                                       hearth_truth_match *out, hearth_err *err);
 
 /* ---- report ------------------------------------------------------------------ */
 /* One state of the report: coverage and, with ground truth (virtual rig), the
@@ -210,6 +242,16 @@ typedef struct hearth_report_entry {
   size_t n_away;
   double app_median_abs_c, app_p95_abs_c, away_true_median_abs_c, away_true_p95_abs_c;
   double worst_grazing, worst_mirror, worst_cooling;
+  /* through surface correspondence (hearth_truth_match_state): on observed
+     texels seen by some thermal view within 60 degrees of the normal (n_corr,
+     corr_share of the observed ones), |observed - true| at the nearest true
+     surface point, |observed - apparent| there (NaN without the rig's object
+     effects), and the distances to those points */
+  int has_corr, same_uvs;
+  size_t n_corr;
+  double corr_share, corr_median_abs_c, corr_p95_abs_c;
+  double corr_app_median_abs_c, corr_app_p95_abs_c;
+  double corr_dist_median_mm, corr_dist_p95_mm;
 } hearth_report_entry;
 
 typedef struct hearth_report {

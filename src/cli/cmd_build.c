@@ -6,7 +6,10 @@
 
 static const char *k_about =
     "Runs every stage of a release: detection and calibration once (when\n"
-    "calibration/captures/ exists), then for every instance: scale (metric mesh and\n"
+    "calibration/captures/ exists), then for every instance: recon (only when its\n"
+    "recon/ is missing: `hearth recon`'s turntable poses, mesh and atlas, and the\n"
+    "colour texture baked into recon/; a recon/ of another tool is never touched),\n"
+    "scale (metric mesh and\n"
     "poses from depth), transfer (thermal poses through the rig), refine (automatic\n"
     "thermal-pose refinement, when built in), bake (colour texture), and per state\n"
     "map (temperature maps, mask, Turbo texture, provenance) and overlay (before/\n"

@@ -27,9 +27,11 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include "hearth/dataset.h"
 #include "hearth/map.h"
 #include "hearth/poses.h"
-#include "hearth/dataset.h"
+#include "hearth/recon.h"
+#include "hearth/recon_geom.h"
 #include "hearth/release.h"
 #include "release/release_internal.h"
 
@@ -238,11 +240,13 @@ void hearth_build_report_free(hearth_build_report *r) {
 }
 
 /* ---- per-instance stages --------------------------------------------------------- */
-/* bake comes before refine and map: it rewrites derived/mesh.glb (texture only),
- * which they read, so a finished build has every later stamp taken after it */
-enum { ST_SCALE, ST_BAKE, ST_TRANSFER, ST_REFINE, ST_MAP, ST_OVERLAY, ST_COUNT };
-static const char *const k_stage_names[ST_COUNT] = {"scale",  "bake", "transfer",
-                                                    "refine", "map",  "overlay"};
+/* recon (hearth's own reconstruction, only for instances without a recon/ of
+ * another tool) comes first: scale reads recon/. bake comes before refine and
+ * map: it rewrites derived/mesh.glb (texture only), which they read, so a
+ * finished build has every later stamp taken after it */
+enum { ST_RECON, ST_SCALE, ST_BAKE, ST_TRANSFER, ST_REFINE, ST_MAP, ST_OVERLAY, ST_COUNT };
+static const char *const k_stage_names[ST_COUNT] = {"recon",  "scale", "bake",   "transfer",
+                                                    "refine", "map",   "overlay"};
 
 /* every stage is part of every build (kept as a hook for optional stages) */
 static int stage_available(int st) {
@@ -265,6 +269,7 @@ typedef struct inst_plan {
   char states[HEARTH_MAX_STATES][HEARTH_NAME_MAX];
   hearth_manifest man[HEARTH_MAX_STATES];
   int readable;
+  int own_recon; /* recon/ is hearth's to make: missing, or made by an earlier build */
   char why[1024];
 } inst_plan;
 
@@ -294,6 +299,15 @@ static void fusion_params(const hearth_build_opts *o, char *buf, size_t n) {
   snprintf(buf, n, "resolution=%zu fusion=%s min_cos=%s turbo=10..60", o->resolution, f, mc);
 }
 
+/* the recon stage bakes the colour texture into recon/ when the release has
+   a calibrated rig (the bake's colour camera); without one recon/mesh.glb
+   stays untextured */
+static int recon_bakes(const char *root) {
+  char path[PATH_SZ];
+  snprintf(path, sizeof path, "%s/calibration/rig.json", root);
+  return hearth_path_exists(path);
+}
+
 /* the inputs and outputs of stage st for (instance, state) */
 static hearth_status stage_files(const build_ctx *c, const inst_plan *p, int st, size_t k,
                                  hearth_build_files *in, hearth_build_files *out, char *params,
@@ -306,6 +320,30 @@ static hearth_status stage_files(const build_ctx *c, const inst_plan *p, int st,
   if (!s) s = hearth_build_files_add(out, __VA_ARGS__)
   params[0] = 0;
   switch (st) {
+    case ST_RECON:
+      /* the turntable route with its defaults, the colour texture baked at
+         the build's colour resolution */
+      snprintf(params, psz, "turntable defaults bake=%zu stride=2", c->o->rgb_resolution);
+      IN("instances/%s/instance.json", id);
+      IN("calibration/factory.json");
+      IN("calibration/rig.json");
+      for (size_t j = 0; j < p->n_states; j++) {
+        IN("instances/%s/raw/%s/manifest.json", id, p->states[j]);
+        for (size_t v = 0; v < p->man[j].n_views; v++) {
+          const hearth_view_files *vf = &p->man[j].views[v];
+          IN("instances/%s/raw/%s/%s", id, p->states[j], vf->rgb);
+          IN("instances/%s/raw/%s/%s", id, p->states[j], vf->cutout);
+          IN("instances/%s/raw/%s/%s", id, p->states[j], vf->depth);
+          IN("instances/%s/raw/%s/%s", id, p->states[j], vf->depth_intrinsics);
+        }
+      }
+      OUT("instances/%s/recon/poses_rgb.json", id);
+      OUT("instances/%s/recon/poses_rgb_cameras.json", id);
+      OUT("instances/%s/recon/mesh_geometry.glb", id);
+      OUT("instances/%s/recon/mesh.glb", id);
+      if (recon_bakes(c->root)) OUT("instances/%s/recon/rgb_texture.png", id);
+      OUT("instances/%s/recon/report.json", id);
+      break;
     case ST_SCALE:
       snprintf(params, psz, "scale defaults");
       IN("instances/%s/instance.json", id);
@@ -382,10 +420,58 @@ static hearth_status stage_files(const build_ctx *c, const inst_plan *p, int st,
   return s;
 }
 
+/* hearth recon ROOT --instance ID (turntable poses, mesh from depth, its
+ * atlas), then the colour texture baked from the first state's views into
+ * recon/rgb_texture.png and recon/mesh.glb: the hand-over an outside tool
+ * gives. A pending stamp is written first, so recon/ files of a killed run
+ * are known as the build's own (and replaced) on the next one. Errors name
+ * the instance and the step. */
+static hearth_status run_recon(const build_ctx *c, const inst_plan *p, hearth_err *err) {
+  char stamp[PATH_SZ], dir[PATH_SZ], mesh[PATH_SZ], poses[PATH_SZ], tex[PATH_SZ];
+  snprintf(stamp, sizeof stamp, "%s/instances/%s/derived/.stamps/recon.json", c->root, p->id);
+  snprintf(dir, sizeof dir, "%s", stamp);
+  *strrchr(dir, '/') = 0;
+  hearth_status s = hearth_mkdirs(dir, err);
+  static const char k_pending[] = "{\"stage\": \"recon\", \"inputs_hash\": \"pending\"}\n";
+  if (!s) s = hearth_write_file_atomic(stamp, k_pending, sizeof k_pending - 1, err);
+  if (s) return s;
+  hearth_recon_job job;
+  hearth_recon_job_default(&job);
+  job.root = c->root;
+  job.instance = p->id;
+  job.force = 1;
+  job.quiet = 1;
+  job.poses.threads = c->stage_threads;
+  hearth_recon_summary sum;
+  if ((s = hearth_recon_run(&job, &sum, err))) {
+    hearth_err_prefix(err, "%s: recon (turntable poses, mesh, atlas)", p->id);
+    return s;
+  }
+  hearth_recon_summary_free(&sum);
+  if (!recon_bakes(c->root)) return HEARTH_OK;
+  snprintf(mesh, sizeof mesh, "%s/instances/%s/recon/mesh.glb", c->root, p->id);
+  snprintf(poses, sizeof poses, "%s/instances/%s/recon/poses_rgb.json", c->root, p->id);
+  snprintf(tex, sizeof tex, "%s/instances/%s/recon/rgb_texture.png", c->root, p->id);
+  hearth_bake_job b;
+  hearth_bake_job_default(&b);
+  b.root = c->root;
+  b.instance = p->id;
+  b.resolution = c->o->rgb_resolution;
+  b.mesh_path = mesh;
+  b.poses_path = poses;
+  b.out_mesh = mesh;
+  b.out_texture = tex;
+  b.threads = c->stage_threads;
+  if ((s = hearth_bake_rgb_run(&b, err)))
+    hearth_err_prefix(err, "%s: recon (colour bake into recon/)", p->id);
+  return s;
+}
+
 static hearth_status stage_run(const build_ctx *c, const inst_plan *p, int st, size_t k,
                                size_t *mapped, hearth_err *err) {
   const hearth_build_opts *o = c->o;
   switch (st) {
+    case ST_RECON: return run_recon(c, p, err);
     case ST_SCALE: {
       hearth_scale_job j = {c->root, p->id, NULL, {0}};
       hearth_scale_opts_default(&j.opts);
@@ -442,10 +528,15 @@ static hearth_status stage_run(const build_ctx *c, const inst_plan *p, int st, s
   return hearth_err_set(err, HEARTH_E_ARG, "unknown stage");
 }
 
+/* the stage is part of this instance's build */
+static int stage_used(const build_ctx *c, const inst_plan *p, int st) {
+  return c->use_stage[st] && (st != ST_RECON || p->own_recon);
+}
+
 static size_t units_of(const build_ctx *c, const inst_plan *p) {
   size_t u = 0;
   for (int st = 0; st < ST_COUNT; st++)
-    if (c->use_stage[st]) u += (st == ST_MAP || st == ST_OVERLAY) ? p->n_states : 1;
+    if (stage_used(c, p, st)) u += (st == ST_MAP || st == ST_OVERLAY) ? p->n_states : 1;
   return u;
 }
 
@@ -568,7 +659,7 @@ static void build_instance(build_ctx *c, size_t idx) {
   }
   int failed = 0;
   for (int st = 0; st < ST_COUNT; st++) {
-    if (!c->use_stage[st]) continue;
+    if (!stage_used(c, p, st)) continue;
     int per_state = st == ST_MAP || st == ST_OVERLAY;
     size_t nk = per_state ? p->n_states : 1;
     for (size_t k = 0; k < nk; k++) {
@@ -597,6 +688,12 @@ static void *worker(void *arg) {
 static void plan_instance(const char *root, inst_plan *p) {
   char path[PATH_SZ];
   hearth_err e = {0};
+  /* recon/ is the build's own when it is missing or an earlier build made it
+     (its stamp, pending or done); another tool's recon/ is never touched */
+  snprintf(path, sizeof path, "%s/instances/%s/recon", root, p->id);
+  p->own_recon = !hearth_path_exists(path);
+  snprintf(path, sizeof path, "%s/instances/%s/derived/.stamps/recon.json", root, p->id);
+  if (hearth_path_exists(path)) p->own_recon = 1;
   hearth_instance_doc doc;
   if (hearth_instance_load(root, p->id, &doc, &e)) {
     snprintf(p->why, sizeof p->why, "%s", e.msg);

@@ -27,4 +27,10 @@ hearth_status hb_params_write(const char *path, const hb_params *p, hearth_err *
  * many. overlays: detection writes its overlay pictures. */
 size_t hb_calib_stages(const char *root, int overlays, hearth_build_stage *stages, size_t max);
 
+/* The contact picture of instance/state of a built release (release_picture.c):
+ * derived/mesh.glb from four viewpoints, colour texture above, the state's
+ * Turbo texture below, as a 1024 x 512 PNG at out_path. */
+hearth_status hb_contact_picture(const char *root, const char *inst, const char *state,
+                                 const char *out_path, hearth_err *err);
+
 #endif

@@ -10,6 +10,7 @@
 #include "hearth/npy.h"
 #include "hearth/dataset.h"
 #include "hearth/release.h"
+#include "release/release_internal.h"
 
 #define PATH_SZ 4096
 
@@ -59,40 +60,28 @@ static hearth_status write_turbo(const char *path, const float *v, const uint8_t
   return s;
 }
 
-/* the errors against the apparent truth and where the largest sit (the
-   object effects' ground truth); leaves e->has_apparent 0 without it */
-static hearth_status report_effects(const char *root, const char *inst, const char *state,
-                                    const uint8_t *m, const float *o, const float *t, size_t R,
+/* the errors against the apparent truth a[] and where the largest sit,
+   with the truth's viewing conditions c[] (3 per texel); all in the map's
+   UV layout. A texel counts as seen within 60 degrees where away[] is 1
+   (hearth's mesh and poses: hearth_truth_match), or without away[] where
+   the truth's best viewing cosine c[0] is at least 0.5 (the stand-in) */
+static hearth_status report_effects(const uint8_t *m, const float *o, const float *t,
+                                    const float *a, const float *c, const uint8_t *away, size_t R,
                                     hearth_report_entry *e, hearth_err *err) {
-  char path[PATH_SZ];
-  hearth_npy app = {0}, cond = {0};
-  hearth_status s = HEARTH_OK;
   const size_t n = R * R;
-  snprintf(path, sizeof path, "%s/ground_truth/instances/%s/%s/temperature_apparent.npy", root,
-           inst, state);
-  if (!hearth_path_exists(path)) return HEARTH_OK;
-  if ((s = hearth_npy_read(path, &app, err))) return s;
-  snprintf(path, sizeof path, "%s/ground_truth/instances/%s/%s/conditions.npy", root, inst, state);
-  if ((s = hearth_npy_read(path, &cond, err))) goto done;
-  if (app.ndim != 2 || app.dtype != HEARTH_NPY_F32 || app.shape[0] != R || app.shape[1] != R ||
-      cond.ndim != 3 || cond.dtype != HEARTH_NPY_F32 || cond.shape[0] != R || cond.shape[1] != R ||
-      cond.shape[2] != 3)
-    goto done; /* another layout: not compared */
-  const float *a = app.data, *c = cond.data;
   double *da = hearth_alloc_array(n, sizeof *da), *dt = hearth_alloc_array(n, sizeof *dt);
   double *all = hearth_alloc_array(n, sizeof *all);
   if (!da || !dt || !all) {
     free(da);
     free(dt);
     free(all);
-    s = hearth_err_set(err, HEARTH_E_NOMEM, "report: out of memory");
-    goto done;
+    return hearth_err_set(err, HEARTH_E_NOMEM, "report: out of memory");
   }
   size_t na = 0, nall = 0;
   for (size_t i = 0; i < n; i++) {
     if (m[i] != 1 || !isfinite(o[i]) || !isfinite(a[i])) continue;
     all[nall++] = fabs((double)o[i] - a[i]);
-    if (c[3 * i] >= 0.5f) {
+    if (away ? away[i] != 0 : c[3 * i] >= 0.5f) {
       da[na] = fabs((double)o[i] - a[i]);
       dt[na++] = isfinite(t[i]) ? fabs((double)o[i] - t[i]) : 0.0;
     }
@@ -113,7 +102,7 @@ static hearth_status report_effects(const char *root, const char *inst, const ch
     if (m[i] != 1 || !isfinite(o[i]) || !isfinite(a[i]) || fabs((double)o[i] - a[i]) < cut)
       continue;
     nw++;
-    ng += c[3 * i] < 0.5f;
+    ng += away ? !away[i] : c[3 * i] < 0.5f;
     nm += c[3 * i + 1] > 0.0f;
     nc += c[3 * i + 2] > 1.0f;
   }
@@ -123,10 +112,73 @@ static hearth_status report_effects(const char *root, const char *inst, const ch
   free(da);
   free(dt);
   free(all);
+  return HEARTH_OK;
+}
+
+/* the apparent truth and conditions of the stand-in (the map's own UV
+   layout at R); leaves e->has_apparent 0 without them */
+static hearth_status report_effects_files(const char *root, const char *inst, const char *state,
+                                          const uint8_t *m, const float *o, const float *t,
+                                          size_t R, hearth_report_entry *e, hearth_err *err) {
+  char path[PATH_SZ];
+  hearth_npy app = {0}, cond = {0};
+  hearth_status s = HEARTH_OK;
+  snprintf(path, sizeof path, "%s/ground_truth/instances/%s/%s/temperature_apparent.npy", root,
+           inst, state);
+  if (!hearth_path_exists(path)) return HEARTH_OK;
+  if ((s = hearth_npy_read(path, &app, err))) return s;
+  snprintf(path, sizeof path, "%s/ground_truth/instances/%s/%s/conditions.npy", root, inst, state);
+  if ((s = hearth_npy_read(path, &cond, err))) goto done;
+  if (app.ndim != 2 || app.dtype != HEARTH_NPY_F32 || app.shape[0] != R || app.shape[1] != R ||
+      cond.ndim != 3 || cond.dtype != HEARTH_NPY_F32 || cond.shape[0] != R || cond.shape[1] != R ||
+      cond.shape[2] != 3)
+    goto done; /* another layout: not compared */
+  s = report_effects(m, o, t, app.data, cond.data, NULL, R, e, err);
 done:
   hearth_npy_free(&app);
   hearth_npy_free(&cond);
   return s;
+}
+
+/* the figures through surface correspondence: observed texels seen within
+   60 degrees of the normal, against the matched true temperature */
+static hearth_status report_correspondence(const uint8_t *m, const float *o,
+                                           const hearth_truth_match *tm, hearth_report_entry *e,
+                                           hearth_err *err) {
+  const size_t n = tm->R * tm->R;
+  double *d = hearth_alloc_array(n, sizeof *d), *dist = hearth_alloc_array(n, sizeof *dist);
+  if (!d || !dist) {
+    free(d);
+    free(dist);
+    return hearth_err_set(err, HEARTH_E_NOMEM, "report: out of memory");
+  }
+  size_t k = 0, ka = 0;
+  if (tm->t_apparent) {
+    for (size_t i = 0; i < n; i++)
+      if (m[i] == 1 && isfinite(o[i]) && tm->away[i] && isfinite(tm->t_apparent[i]))
+        d[ka++] = fabs((double)o[i] - (double)tm->t_apparent[i]);
+    qsort(d, ka, sizeof *d, cmp_double);
+    e->corr_app_median_abs_c = quantile(d, ka, 0.5);
+    e->corr_app_p95_abs_c = quantile(d, ka, 0.95);
+  }
+  for (size_t i = 0; i < n; i++) {
+    if (m[i] != 1 || !isfinite(o[i]) || !tm->away[i] || !isfinite(tm->t_true[i])) continue;
+    d[k] = fabs((double)o[i] - (double)tm->t_true[i]);
+    dist[k++] = tm->dist_m[i];
+  }
+  qsort(d, k, sizeof *d, cmp_double);
+  qsort(dist, k, sizeof *dist, cmp_double);
+  e->has_corr = 1;
+  e->n_corr = k;
+  e->corr_share = e->n_observed ? (double)k / (double)e->n_observed : 0.0;
+  e->corr_median_abs_c = quantile(d, k, 0.5);
+  e->corr_p95_abs_c = quantile(d, k, 0.95);
+  e->corr_dist_median_mm = 1e3 * quantile(dist, k, 0.5);
+  e->corr_dist_p95_mm = 1e3 * quantile(dist, k, 0.95);
+  e->same_uvs = tm->same_uvs;
+  free(d);
+  free(dist);
+  return HEARTH_OK;
 }
 
 /* numbers and images of one state; names of written files go to the html */
@@ -135,6 +187,7 @@ static hearth_status report_state(const char *root, const char *out_dir, const c
                                   int *have_overlay, hearth_err *err) {
   char path[PATH_SZ], dst[PATH_SZ];
   hearth_npy mask = {0}, obs = {0}, truth = {0};
+  hearth_truth_match tm = {0};
   hearth_status s;
   memset(e, 0, sizeof *e);
   snprintf(e->instance, sizeof e->instance, "%s", inst);
@@ -143,6 +196,8 @@ static hearth_status report_state(const char *root, const char *out_dir, const c
   e->app_median_abs_c = e->app_p95_abs_c = NAN;
   e->away_true_median_abs_c = e->away_true_p95_abs_c = NAN;
   e->worst_grazing = e->worst_mirror = e->worst_cooling = NAN;
+  e->corr_median_abs_c = e->corr_p95_abs_c = e->corr_dist_median_mm = e->corr_dist_p95_mm = NAN;
+  e->corr_app_median_abs_c = e->corr_app_p95_abs_c = NAN;
   *have_truth_png = *have_overlay = 0;
   snprintf(path, sizeof path, "%s/instances/%s/derived/%s/mask.npy", root, inst, state);
   if ((s = hearth_npy_read(path, &mask, err))) return s;
@@ -169,15 +224,30 @@ static hearth_status report_state(const char *root, const char *out_dir, const c
   snprintf(dst, sizeof dst, "%s/%s_%s_thermal.png", out_dir, inst, state);
   if ((s = copy_file(path, dst, err))) goto done;
 
-  /* ground truth: the same UV layout at the same R */
+  /* ground truth: through surface correspondence (the built mesh against the
+     true one), and texel for texel where the built mesh has the truth's UVs
+     (the stand-in) or else resampled onto the built layout */
   snprintf(path, sizeof path, "%s/ground_truth/instances/%s/%s/temperature_true.npy", root, inst,
            state);
+  snprintf(dst, sizeof dst, "%s/ground_truth/instances/%s/mesh.glb", root, inst);
+  int have_tm = 0;
+  if (hearth_path_exists(path) && hearth_path_exists(dst)) {
+    if ((s = hearth_truth_match_state(root, inst, state, R, NULL, &tm, err))) goto done;
+    have_tm = 1;
+    if ((s = report_correspondence(m, o, &tm, e, err))) goto done;
+  }
   if (hearth_path_exists(path)) {
-    if ((s = hearth_npy_read(path, &truth, err))) goto done;
-    if (truth.ndim == 2 && truth.dtype == HEARTH_NPY_F32 && truth.shape[0] == R &&
-        truth.shape[1] == R) {
+    const float *t = NULL;
+    if (!have_tm || tm.same_uvs) {
+      if ((s = hearth_npy_read(path, &truth, err))) goto done;
+      if (truth.ndim == 2 && truth.dtype == HEARTH_NPY_F32 && truth.shape[0] == R &&
+          truth.shape[1] == R)
+        t = truth.data;
+    } else {
+      t = tm.t_true;
+    }
+    if (t) {
       e->has_truth = 1;
-      const float *t = truth.data;
       double *ad = hearth_alloc_array(e->n_observed ? e->n_observed : 1, sizeof *ad);
       float *errmap = hearth_alloc_array(n, sizeof *errmap);
       uint8_t *keep = hearth_alloc_array(n, 1);
@@ -217,9 +287,14 @@ static hearth_status report_state(const char *root, const char *out_dir, const c
       free(keep);
       if (s) goto done;
       *have_truth_png = 1;
-      if ((s = report_effects(root, inst, state, m, o, t, R, e, err))) goto done;
+      if (!have_tm || tm.same_uvs) s = report_effects_files(root, inst, state, m, o, t, R, e, err);
+      else if (tm.t_apparent && tm.conditions)
+        s = report_effects(m, o, t, tm.t_apparent, tm.conditions, tm.away, R, e, err);
+      if (s) goto done;
     }
   }
+  snprintf(dst, sizeof dst, "%s/%s_%s_contact.png", out_dir, inst, state);
+  if ((s = hb_contact_picture(root, inst, state, dst, err))) goto done;
   snprintf(path, sizeof path, "%s/instances/%s/derived/overlay/%s/contact_sheet.png", root, inst,
            state);
   if (hearth_path_exists(path)) {
@@ -228,6 +303,7 @@ static hearth_status report_state(const char *root, const char *out_dir, const c
     *have_overlay = 1;
   }
 done:
+  hearth_truth_match_free(&tm);
   hearth_npy_free(&mask);
   hearth_npy_free(&obs);
   hearth_npy_free(&truth);
@@ -326,7 +402,8 @@ hearth_status hearth_report_write(const char *root, const char *out_dir, const c
   fputs(
       "<h2>Summary</h2>\n<table class=\"n\"><tr><th>instance</th><th>state</th><th>R</th>"
       "<th>surface texels</th><th>observed</th><th>median |err| &deg;C</th>"
-      "<th>p95 |err| &deg;C</th><th>mean err &deg;C</th></tr>\n",
+      "<th>p95 |err| &deg;C</th><th>mean err &deg;C</th><th>compared by correspondence</th>"
+      "<th>median |err| &deg;C</th><th>p95 |err| &deg;C</th></tr>\n",
       f);
   for (size_t j = 0; j < rep->n; j++) {
     const hearth_report_entry *e = &rep->entries[j];
@@ -335,11 +412,20 @@ hearth_status hearth_report_write(const char *root, const char *out_dir, const c
     fmt2(med, sizeof med, e->median_abs_c);
     fmt2(p95, sizeof p95, e->p95_abs_c);
     fmt2(mean, sizeof mean, e->mean_signed_c);
+    char cshare[32] = "n/a", cmed[32], cp95[32];
+    if (e->has_corr) {
+      hearth_format_fixed(cshare, sizeof cshare - 2, 100.0 * e->corr_share, 1);
+      strcat(cshare, " %");
+    }
+    fmt2(cmed, sizeof cmed, e->corr_median_abs_c);
+    fmt2(cp95, sizeof cp95, e->corr_p95_abs_c);
     fprintf(
         f,
         "<tr><td style=\"text-align:left\"><a href=\"#%s_%s\">%s</a></td><td style=\"text-align:left\">%s</td>"
-        "<td>%zu</td><td>%zu</td><td>%s %%</td><td>%s</td><td>%s</td><td>%s</td></tr>\n",
-        e->instance, e->state, e->instance, e->state, e->R, e->n_surface, cov, med, p95, mean);
+        "<td>%zu</td><td>%zu</td><td>%s %%</td><td>%s</td><td>%s</td><td>%s</td>"
+        "<td>%s</td><td>%s</td><td>%s</td></tr>\n",
+        e->instance, e->state, e->instance, e->state, e->R, e->n_surface, cov, med, p95, mean,
+        cshare, cmed, cp95);
   }
   fputs("</table>\n", f);
   int effects = 0;
@@ -415,6 +501,26 @@ hearth_status hearth_report_write(const char *root, const char *out_dir, const c
                 inst, e->state);
       }
       fputs("</div>\n", f);
+      if (e->has_corr) {
+        char v[5][32];
+        fmt2(v[0], sizeof v[0], e->corr_median_abs_c);
+        fmt2(v[1], sizeof v[1], e->corr_p95_abs_c);
+        hearth_format_fixed(v[2], sizeof v[2], 100.0 * e->corr_share, 1);
+        fmt2(v[3], sizeof v[3], e->corr_dist_median_mm);
+        fmt2(v[4], sizeof v[4], e->corr_dist_p95_mm);
+        fprintf(f,
+                "<p>Through surface correspondence (%s): on the %s %% of observed texels seen "
+                "within 60&deg; of the normal, median |error| %s &deg;C, p95 %s &deg;C; "
+                "distance to the matched true surface point median %s mm, p95 %s mm.</p>\n",
+                e->same_uvs ? "the stand-in: the truth's own mesh" : "hearth's own reconstruction",
+                v[2], v[0], v[1], v[3], v[4]);
+      }
+      fprintf(f,
+              "<div class=\"row\"><figure class=\"wide\"><img src=\"%s_%s_contact.png\" "
+              "alt=\"contact picture\"><figcaption style=\"max-width:780px\">the built mesh "
+              "from four viewpoints: colour texture (top), thermal texture in Turbo, "
+              "10&ndash;60 &deg;C (bottom)</figcaption></figure></div>\n",
+              inst, e->state);
       if (overlay[j])
         fprintf(
             f,
