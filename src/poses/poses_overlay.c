@@ -31,7 +31,11 @@
 typedef struct ov_grid {
   int zoom;
   size_t w, h;
-  double *dir; /* 3 per sub-pixel, camera frame; NaN where the lens cannot be inverted */
+  hearth_camera cam; /* the camera the grid is of */
+  /* 3 per sub-pixel, camera frame; NaN where the lens cannot be inverted.
+     NULL with a fan: the few views the fan cannot cast compute their rays
+     as they trace them */
+  double *dir;
   /* the same sub-pixels as the pixel grid of the camera enlarged zoom
      times; NULL where the mesh does not allow it or it cannot be made
      (then rays are traced) */
@@ -52,35 +56,42 @@ typedef struct ov_scratch {
   hearth_image temps;
 } ov_scratch;
 
+/* the ray of sub-pixel (x, y) of g into d (NaN where the lens cannot be
+   inverted) */
+static void ov_grid_ray(const ov_grid *g, size_t x, size_t y, double d[3]) {
+  double u = -0.5 + ((double)x + 0.5) / g->zoom, v = -0.5 + ((double)y + 0.5) / g->zoom;
+  if (hearth_camera_ray(&g->cam, u, v, d) < 0) d[0] = d[1] = d[2] = NAN;
+}
+
 /* the grid at zoom, and with with_fan its ray fan (NULL where it cannot
    be made: then rays are traced) */
 static hearth_status ov_grid_make(const hearth_camera *cam, int zoom, int with_fan, ov_grid *g,
                                   hearth_err *err) {
   g->zoom = zoom;
+  g->cam = *cam;
   g->w = (size_t)cam->width * (size_t)zoom;
   g->h = (size_t)cam->height * (size_t)zoom;
   size_t n = g->w * g->h;
-  g->dir = hearth_alloc_array(n ? n : 1, 3 * sizeof *g->dir);
-  if (!g->dir) return hearth_err_set(err, HEARTH_E_NOMEM, "overlay: out of memory");
-  for (size_t y = 0; y < g->h; y++)
-    for (size_t x = 0; x < g->w; x++) {
-      double u = -0.5 + ((double)x + 0.5) / zoom, v = -0.5 + ((double)y + 0.5) / zoom;
-      double *d = g->dir + 3 * (y * g->w + x);
-      if (hearth_camera_ray(cam, u, v, d) < 0) d[0] = d[1] = d[2] = NAN;
-    }
   /* sub-pixel (x, y) is pixel (x, y) of the camera whose pixel coordinates
      are zoom (u + 1/2) - 1/2: focal lengths times zoom, the centre moved
      with them */
-  if (!with_fan) return HEARTH_OK;
-  hearth_camera cz = *cam;
-  cz.width = (int)g->w;
-  cz.height = (int)g->h;
-  cz.fx = cam->fx * zoom;
-  cz.fy = cam->fy * zoom;
-  cz.cx = zoom * (cam->cx + 0.5) - 0.5;
-  cz.cy = zoom * (cam->cy + 0.5) - 0.5;
-  if (g->w <= INT32_MAX && g->h <= INT32_MAX && hearth_ray_fan_new(&cz, 1, &g->fan, NULL))
-    g->fan = NULL;
+  if (with_fan) {
+    hearth_camera cz = *cam;
+    cz.width = (int)g->w;
+    cz.height = (int)g->h;
+    cz.fx = cam->fx * zoom;
+    cz.fy = cam->fy * zoom;
+    cz.cx = zoom * (cam->cx + 0.5) - 0.5;
+    cz.cy = zoom * (cam->cy + 0.5) - 0.5;
+    if (g->w <= INT32_MAX && g->h <= INT32_MAX && hearth_ray_fan_new(&cz, 1, &g->fan, NULL))
+      g->fan = NULL;
+  }
+  /* a grid with a fan rasterises every view: its rays are never traced */
+  if (g->fan) return HEARTH_OK;
+  g->dir = hearth_alloc_array(n ? n : 1, 3 * sizeof *g->dir);
+  if (!g->dir) return hearth_err_set(err, HEARTH_E_NOMEM, "overlay: out of memory");
+  for (size_t y = 0; y < g->h; y++)
+    for (size_t x = 0; x < g->w; x++) ov_grid_ray(g, x, y, g->dir + 3 * (y * g->w + x));
   return HEARTH_OK;
 }
 
@@ -209,7 +220,9 @@ static void ov_cast(const hearth_raycaster *rc, const ov_grid *g, const hearth_r
       for (size_t y = ty; y < ty + 4 && y < y1; y++)
         for (size_t x = tx; x < tx + 4 && x < x1; x++) {
           size_t p = y * g->w + x;
-          const double *dc = g->dir + 3 * p;
+          double own[3];
+          const double *dc = g->dir ? g->dir + 3 * p : own;
+          if (!g->dir) ov_grid_ray(g, x, y, own);
           if (isnan(dc[0])) continue;
           double dw[3];
           hearth_rigid_rotate(T, dc, dw);
