@@ -54,6 +54,7 @@ typedef struct ov_scratch {
   double *vals;             /* thermal pixels, for the range */
   uint8_t *turbo;           /* 3 per thermal pixel */
   hearth_image temps;
+  hearth_image big; /* the per-view file's image, reused from view to view */
 } ov_scratch;
 
 /* the ray of sub-pixel (x, y) of g into d (NaN where the lens cannot be
@@ -177,6 +178,7 @@ static void ov_scratch_free(ov_scratch *s) {
   free(s->fan_scratch);
   free(s->fan_hits);
   hearth_image_free(&s->temps);
+  hearth_image_free(&s->big);
 }
 
 /* scratch for grids of up to n_sub sub-pixels and images of n_px pixels,
@@ -349,12 +351,17 @@ static void ov_colours(const hearth_image *temps, double lo, double hi, uint8_t 
   }
 }
 
-/* a new image of the colours enlarged zoom times (nearest) */
+/* the colours enlarged zoom times (nearest) into out: a new image, or
+   out's pixels where it already has that size (a worker's own, reused) */
 static hearth_status ov_background(const uint8_t *turbo, size_t tw, size_t th, size_t zoom,
                                    hearth_image *out, hearth_err *err) {
   size_t w = tw * zoom, h = th * zoom;
-  hearth_status s = hearth_image_alloc(out, w, h, 3, HEARTH_PIX_U8, err);
-  if (s) return s;
+  if (!(out->data && out->width == w && out->height == h && out->channels == 3 &&
+        out->type == HEARTH_PIX_U8)) {
+    hearth_image_free(out);
+    hearth_status s = hearth_image_alloc(out, w, h, 3, HEARTH_PIX_U8, err);
+    if (s) return s;
+  }
   uint8_t *o = out->data;
   for (size_t ty = 0; ty < th; ty++) {
     uint8_t *row = o + 3 * (ty * zoom) * w;
@@ -440,18 +447,17 @@ static hearth_status ov_view(const ov_ctx *c, ov_scratch *s, size_t k, hearth_im
   ov_colours(&s->temps, lo, hi, s->turbo);
   /* the per-view file: before in magenta under after in white */
   const uint8_t white[3] = {255, 255, 255}, magenta[3] = {255, 0, 255};
-  hearth_image ov = {0};
-  if ((st = ov_background(s->turbo, cw, ch, (size_t)c->big->zoom, &ov, err))) return st;
+  hearth_image *ov = &s->big;
+  if ((st = ov_background(s->turbo, cw, ch, (size_t)c->big->zoom, ov, err))) return st;
   if (pb) {
     ov_outline(c->rc, c->mesh, c->cam, c->big, &pb->T_world_from_cam, s);
-    ov_paint(&ov, s->edge, magenta);
+    ov_paint(ov, s->edge, magenta);
   }
   ov_outline(c->rc, c->mesh, c->cam, c->big, &pa->T_world_from_cam, s);
-  ov_paint(&ov, s->edge, white);
-  hearth_draw_text(&ov, 4, 4, vf->view, white, 2);
+  ov_paint(ov, s->edge, white);
+  hearth_draw_text(ov, 4, 4, vf->view, white, 2);
   rf_pathf(path, "%s/%s.png", c->dir, vf->view);
-  st = hearth_png_write(path, &ov, err);
-  hearth_image_free(&ov);
+  st = hearth_png_write(path, ov, err);
   for (int side = 0; side < 2 && !st; side++) {
     const hearth_view_pose *p = side ? pa : pb;
     if (!p) continue;
