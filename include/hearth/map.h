@@ -62,6 +62,16 @@ typedef struct hearth_map_opts {
                              rasterise it; default 0 (the same hits up to float rounding) */
   int skip_best_cos;    /* 1: leave the result's best_cos NULL, saving an R*R map per
                              worker; default 0 */
+  /* Views whose image is NULL have it made by load(load_ctx, v, &img, err)
+     when their cast reaches them (a U8 RGB or F32 gray image of the
+     camera's size, freed by the mapping after the view's splat), so that a
+     worker holds one view's image at a time. load_channels is their kind
+     (3: U8 RGB, 1: F32 gray). A failed load fails the mapping with the
+     error of the lowest view that failed; NULL load: every view needs its
+     image. */
+  hearth_status (*load)(void *load_ctx, size_t view, hearth_image *img, hearth_err *err);
+  void *load_ctx;
+  int load_channels;
 } hearth_map_opts;
 void hearth_map_opts_default(hearth_map_opts *o);
 

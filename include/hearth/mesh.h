@@ -156,6 +156,11 @@ void hearth_raycaster_free(hearth_raycaster *rc);
 /* Nearest hit in (tnear, tfar). Returns 1 on a hit. Thread-safe. */
 int hearth_raycast(const hearth_raycaster *rc, const double org[3], const double dir[3],
                    double tnear, double tfar, hearth_ray_hit *hit);
+/* Whether the ray meets the mesh anywhere in (tnear, tfar): 1 exactly
+ * where hearth_raycast would return 1 (the same triangle test), found
+ * without looking for the nearest hit. Thread-safe. */
+int hearth_raycast_any(const hearth_raycaster *rc, const double org[3], const double dir[3],
+                       double tnear, double tfar);
 /* Cast n rays (org/dir 3*n floats) into the caller's hits[n];
  * hits[i].prim = UINT32_MAX where none. */
 void hearth_raycast_batch(const hearth_raycaster *rc, size_t n, const float *org, const float *dir,

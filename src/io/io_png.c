@@ -1,5 +1,5 @@
 /* PNG reading through libpng, with a faster path of our own for the plain
- * layouts; writing with our own DEFLATE encoder and zlib's checksums (see
+ * layouts; writing with our own DEFLATE encoder and libdeflate's checksums (see
  * the encoder below).
  *
  * libpng reports errors by longjmp. Each setjmp lives in a small function
@@ -469,7 +469,7 @@ static void encode_bands(void *ctx, size_t b, size_t e, int t) {
     }
     size_t n = (y1 - y0) * rowb;
     j->raw_len[band] = n;
-    j->adler[band] = adler32(adler32(0L, Z_NULL, 0), raw, (uInt)n);
+    j->adler[band] = libdeflate_adler32(1, raw, n);
     j->out[band] = malloc(hearth_deflate_bound(n));
     if (j->out[band] &&
         hearth_deflate_rle(raw, n, band + 1 == j->n_bands, j->out[band], &j->out_len[band]))
@@ -489,12 +489,12 @@ uint8_t *hearth_png_put_chunk(uint8_t *o, const char type[4], const uint8_t *a, 
                               const uint8_t *b, size_t nb, const uint8_t *c, size_t nc) {
   hearth_png_put32(o, (uint32_t)(na + nb + nc));
   memcpy(o + 4, type, 4);
-  uLong crc = crc32(crc32(0L, Z_NULL, 0), o + 4, 4);
+  uint32_t crc = libdeflate_crc32(0, o + 4, 4);
   uint8_t *d = o + 8;
-  if (na) memcpy(d, a, na), crc = crc32(crc, a, (uInt)na), d += na;
-  if (nb) memcpy(d, b, nb), crc = crc32(crc, b, (uInt)nb), d += nb;
-  if (nc) memcpy(d, c, nc), crc = crc32(crc, c, (uInt)nc), d += nc;
-  hearth_png_put32(d, (uint32_t)crc);
+  if (na) memcpy(d, a, na), crc = libdeflate_crc32(crc, a, na), d += na;
+  if (nb) memcpy(d, b, nb), crc = libdeflate_crc32(crc, b, nb), d += nb;
+  if (nc) memcpy(d, c, nc), crc = libdeflate_crc32(crc, c, nc), d += nc;
+  hearth_png_put32(d, crc);
   return d + 4;
 }
 

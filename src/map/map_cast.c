@@ -221,13 +221,12 @@ static void silhouettes(const hearth_map_layout *l, const float *ht, const pix_b
  * silhouette (with edges) or seen more obliquely than min_cos are dropped,
  * and so are footprints entirely off the map. *n_hits counts the hits kept
  * before that last test (the view's pixels on the surface). */
-static size_t splat_hits(const map_ctx *m, size_t v, map_worker *w, const pix_box *box, int edges,
-                         uint32_t *n_hits) {
+static size_t splat_hits(const map_ctx *m, size_t v, const hearth_image *img, map_worker *w,
+                         const pix_box *box, int edges, uint32_t *n_hits) {
   const hearth_map_layout *l = m->l;
   const hearth_mesh *mesh = l->mesh;
   const size_t R = l->R;
   const int C = m->C;
-  const hearth_image *img = m->views[v].image;
   const double *Rw = m->views[v].T_world_from_cam.R;
   const float min_cos = (float)m->opts->min_cos;
   const uint32_t *htri = w->hit_tri;
@@ -390,13 +389,47 @@ static void keep_records(map_ctx *m, size_t v, const map_worker *w, size_t n) {
   memcpy(r->d[v], w->rec_d, n * RW * sizeof *w->rec_d);
 }
 
+/* view v's image made by the caller's loader into img, checked against
+   the camera and the views' kind; 0 (the error in m->load_errs[v]) when
+   it cannot be had */
+static int load_view(map_ctx *m, size_t v, hearth_image *img) {
+  hearth_err *e = &m->load_errs[v];
+  if (m->opts->load(m->opts->load_ctx, v, img, e)) return 0;
+  const hearth_camera *cam = &m->l->cam;
+  int kind = img->type == HEARTH_PIX_F32 && img->channels == 1  ? 1
+             : img->type == HEARTH_PIX_U8 && img->channels >= 3 ? 3
+                                                                : 0;
+  if (!img->data || img->width != (size_t)cam->width || img->height != (size_t)cam->height)
+    hearth_err_set(e, HEARTH_E_SIZE, "map: view %zu is %zux%zu, the camera is %dx%d", v, img->width,
+                   img->height, cam->width, cam->height);
+  else if (kind != m->C)
+    hearth_err_set(e, HEARTH_E_INCONSISTENT, "map: view %zu: its image is not of the views' kind",
+                   v);
+  else return 1;
+  hearth_image_free(img);
+  return 0;
+}
+
 static void process_view(map_ctx *m, size_t v, int t) {
   const hearth_map_layout *l = m->l;
   map_worker *w = &m->workers[t];
   pix_box box = {SIZE_MAX, 0, SIZE_MAX, 0};
+  hearth_image own = {0};
+  const hearth_image *img = m->views[v].image;
+  if (!img) {
+    /* every view tries its load, so the lowest failure is found */
+    if (!load_view(m, v, &own)) {
+      m->failed = 3;
+      return;
+    }
+    img = &own;
+  }
   if (m->view_fan[v]) cast_fan(m, v, w, &box);
   else cast_rays(m, v, w, &box);
-  if (m->failed) return;
+  if (m->failed) {
+    hearth_image_free(&own);
+    return;
+  }
   if (box.x0 > box.x1) box = (pix_box){1, 0, 1, 0}; /* no hit: empty */
   const int edges = m->opts->fusion == HEARTH_FUSE_ROBUST ||
                     m->opts->fusion == HEARTH_FUSE_CORRECTED || !m->opts->keep_edges;
@@ -406,12 +439,17 @@ static void process_view(map_ctx *m, size_t v, int t) {
     silhouettes(l, w->hit_t, &box, w->ray_org, w->ray_org + n, w->ray_dir, w->ray_dir + n, w->sil);
   }
   uint32_t hits = 0;
-  size_t n_sp = splat_hits(m, v, w, &box, edges, &hits);
+  size_t n_sp = splat_hits(m, v, img, w, &box, edges, &hits);
+  hearth_image_free(&own); /* the splats hold the values */
   size_t n_tc = 0;
   const touch *tc = sorted_touches(w, n_sp, l->R, &n_tc);
   m->view_hits[v] = hits;
   size_t n_rec = reduce_touches(m, w, tc, n_tc, t);
-  if (m->rec) keep_records(m, v, w, n_rec);
+  if (m->rec && m->rec->acc) {
+    if (!map_records_fold(m->rec, v, w->rec_q, w->rec_d, n_rec, m->C)) m->failed = 1;
+  } else if (m->rec) {
+    keep_records(m, v, w, n_rec);
+  }
 }
 
 /* views are handed out one at a time to whichever worker is free (they

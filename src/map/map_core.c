@@ -29,10 +29,21 @@ void hearth_map_result_free(hearth_map_result *r) {
 /* the views' channels in *C (1: F32 gray temperatures, 3: U8 RGB; 1 when
    there is no view), each view's image checked against the camera */
 static hearth_status view_channels(const hearth_camera *cam, const hearth_map_view *views,
-                                   size_t n_views, int *C_out, hearth_err *err) {
+                                   size_t n_views, const hearth_map_opts *o, int *C_out,
+                                   hearth_err *err) {
   int C = 0;
   for (size_t v = 0; v < n_views; v++) {
     const hearth_image *im = views[v].image;
+    if (!im && o->load) {
+      /* made when its cast reaches it */
+      if (o->load_channels != 1 && o->load_channels != 3)
+        return hearth_err_set(err, HEARTH_E_ARG, "map: loaded views need 1 or 3 channels, not %d",
+                              o->load_channels);
+      if (C && o->load_channels != C)
+        return hearth_err_set(err, HEARTH_E_INCONSISTENT, "map: views mix image kinds");
+      C = o->load_channels;
+      continue;
+    }
     if (!im || !im->data) return hearth_err_set(err, HEARTH_E_ARG, "map: view %zu has no image", v);
     if (im->width != (size_t)cam->width || im->height != (size_t)cam->height)
       return hearth_err_set(err, HEARTH_E_SIZE, "map: view %zu is %zux%zu, the camera is %dx%d", v,
@@ -82,7 +93,8 @@ static int alloc_phase_state(map_ctx *m, max_maps *mx, view_records *rec, hearth
     return map_max_alloc(mx, nt, m->l->R, m->C, !m->opts->skip_best_cos, out);
   }
   m->rec = rec;
-  return map_records_alloc(rec, m->n_views);
+  return map_records_alloc(rec, m->n_views, m->opts->fusion == HEARTH_FUSE_MEAN, m->l->R, m->C,
+                           !m->opts->skip_best_cos);
 }
 
 static void free_phase_state(map_ctx *m) {
@@ -185,7 +197,7 @@ hearth_status hearth_map_views_with_layout(const hearth_map_layout *l,
         "map: the layout was made for resolution %zu, stride %zu; asked for %zu, %d", l->R,
         l->stride, opts.resolution, opts.pixel_stride);
   int C = 0;
-  hearth_status s = view_channels(&l->cam, views, n_views, &C, err);
+  hearth_status s = view_channels(&l->cam, views, n_views, &opts, &C, err);
   if (s) return s;
   if (opts.fusion != HEARTH_FUSE_MAX && opts.fusion != HEARTH_FUSE_ROBUST &&
       opts.fusion != HEARTH_FUSE_MEAN && opts.fusion != HEARTH_FUSE_CORRECTED)
@@ -222,7 +234,20 @@ hearth_status hearth_map_views_with_layout(const hearth_map_layout *l,
     s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory for %d threads at R=%zu", nt, l->R);
     goto done;
   }
+  if (opts.load && !(m.load_errs = calloc(n_views ? n_views : 1, sizeof *m.load_errs))) {
+    s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
+    goto done;
+  }
   hearth_parallel_chunks(n_views, 1, nt, map_cast_views, &m);
+  if (m.load_errs) {
+    /* every view tried its load: the lowest failure, whatever the threads */
+    for (size_t v = 0; v < n_views; v++)
+      if (m.load_errs[v].status) {
+        s = m.load_errs[v].status;
+        if (err) *err = m.load_errs[v];
+        goto done;
+      }
+  }
   if (m.failed == 2) {
     s = hearth_err_set(err, HEARTH_E_NUMERIC,
                        "map: a view's camera does not have the mesh in front after all");
@@ -249,6 +274,7 @@ hearth_status hearth_map_views_with_layout(const hearth_map_layout *l,
   }
 done:
   free(view_fan);
+  free(m.load_errs);
   free_phase_state(&m);
   hearth_raycaster_free(own_rc);
   free(parts);

@@ -54,12 +54,21 @@ void map_max_free(max_maps *mx) {
   memset(mx, 0, sizeof *mx);
 }
 
-int map_records_alloc(view_records *r, size_t n_views) {
+int map_records_alloc(view_records *r, size_t n_views, int stream, size_t R, int C, int want_cos) {
   r->n_views = n_views;
   r->q = calloc(n_views ? n_views : 1, sizeof *r->q);
   r->d = calloc(n_views ? n_views : 1, sizeof *r->d);
   r->n = calloc(n_views ? n_views : 1, sizeof *r->n);
-  return r->q && r->d && r->n;
+  if (!r->q || !r->d || !r->n) return 0;
+  if (!stream) return 1;
+  /* calloc: the pages of texels no view observes are never touched */
+  r->acc = calloc(R * R, ((size_t)C + 1) * sizeof *r->acc);
+  if (want_cos) r->best_cos = calloc(R * R, sizeof *r->best_cos);
+  r->waiting = calloc(n_views ? n_views : 1, 1);
+  if (!r->acc || (want_cos && !r->best_cos) || !r->waiting) return 0;
+  if (pthread_mutex_init(&r->mu, NULL)) return 0;
+  r->have_mu = 1;
+  return 1;
 }
 
 void map_records_free(view_records *r) {
@@ -68,7 +77,58 @@ void map_records_free(view_records *r) {
   free(r->q);
   free(r->d);
   free(r->n);
+  free(r->acc);
+  free(r->best_cos);
+  free(r->waiting);
+  if (r->have_mu) pthread_mutex_destroy(&r->mu);
   memset(r, 0, sizeof *r);
+}
+
+/* n records of one view into the sums: per texel, its weighted values and
+   its weight added as the band fusion would add them */
+static void add_records(view_records *r, const uint32_t *rq, const float *rd, size_t n, int C) {
+  const size_t RW = REC_WORDS(C), C1 = (size_t)C + 1;
+  for (size_t k = 0; k < n; k++) {
+    const size_t q = rq[k];
+    const float *d = rd + k * RW;
+    if (r->best_cos && d[1] > r->best_cos[q]) r->best_cos[q] = d[1];
+    double *a = r->acc + q * C1;
+    for (size_t c = 0; c < (size_t)C; c++) a[c] += d[2 + c];
+    a[C] += d[0];
+  }
+}
+
+int map_records_fold(view_records *r, size_t v, const uint32_t *q, const float *d, size_t n,
+                     int C) {
+  const size_t RW = REC_WORDS(C);
+  int ok = 1;
+  pthread_mutex_lock(&r->mu);
+  if (v == r->next) {
+    add_records(r, q, d, n, C);
+    /* then the views done before their turn that follow it */
+    for (r->next++; r->next < r->n_views && r->waiting[r->next]; r->next++) {
+      size_t w = r->next;
+      add_records(r, r->q[w], r->d[w], r->n[w], C);
+      free(r->q[w]);
+      free(r->d[w]);
+      r->q[w] = NULL;
+      r->d[w] = NULL;
+    }
+  } else {
+    /* not its turn: kept until the views before it are in */
+    r->n[v] = n;
+    r->q[v] = hearth_alloc_array(n ? n : 1, sizeof *q);
+    r->d[v] = hearth_alloc_array(n ? n : 1, RW * sizeof *d);
+    if (r->q[v] && r->d[v]) {
+      memcpy(r->q[v], q, n * sizeof *q);
+      memcpy(r->d[v], d, n * RW * sizeof *d);
+    } else {
+      ok = 0;
+    }
+    r->waiting[v] = 1;
+  }
+  pthread_mutex_unlock(&r->mu);
+  return ok;
 }
 
 /* a (value, weight) pair of one view at one texel */
@@ -152,6 +212,16 @@ static void fold_mean(const map_ctx *m, hearth_map_result *out, band_scratch *bs
                       size_t q1) {
   const view_records *r = m->rec;
   const size_t C = (size_t)m->C, RW = REC_WORDS(C);
+  if (r->acc) {
+    /* the views are summed already */
+    for (size_t q = q0; q < q1; q++) {
+      const double *a = r->acc + q * (C + 1);
+      if (r->best_cos) out->best_cos[q] = r->best_cos[q];
+      if (a[C] > 0.0)
+        for (size_t c = 0; c < C; c++) out->observed[q * C + c] = (float)(a[c] / a[C]);
+    }
+    return;
+  }
   double *acc = bs->acc;
   memset(acc, 0, (q1 - q0) * (C + 1) * sizeof *acc);
   for (size_t v = 0; v < r->n_views; v++) {
@@ -506,13 +576,14 @@ void map_fuse_bands(void *ctx, size_t b, size_t e, int t) {
   band_scratch bs = {0};
   cr *call = NULL, *ctmp = NULL;
   size_t ccap = 0;
-  if (fusion == HEARTH_FUSE_MEAN) bs.acc = hearth_alloc_array(band, (C + 1) * sizeof *bs.acc);
+  if (fusion == HEARTH_FUSE_MEAN && !m->rec->acc)
+    bs.acc = hearth_alloc_array(band, (C + 1) * sizeof *bs.acc);
   if (fusion == HEARTH_FUSE_ROBUST || fusion == HEARTH_FUSE_CORRECTED) {
     bs.cnt = hearth_alloc_array(band + 1, sizeof *bs.cnt);
     bs.tmp = hearth_alloc_array(nv ? nv : 1, sizeof *bs.tmp);
   }
   if (fusion == HEARTH_FUSE_CORRECTED) ctmp = hearth_alloc_array(nv ? nv : 1, sizeof *ctmp);
-  if ((fusion == HEARTH_FUSE_MEAN && !bs.acc) ||
+  if ((fusion == HEARTH_FUSE_MEAN && !m->rec->acc && !bs.acc) ||
       ((fusion == HEARTH_FUSE_ROBUST || fusion == HEARTH_FUSE_CORRECTED) && (!bs.cnt || !bs.tmp)) ||
       (fusion == HEARTH_FUSE_CORRECTED && !ctmp)) {
     fp->nomem[t] = 1;

@@ -17,6 +17,7 @@
 #ifndef HEARTH_MAP_INTERNAL_H
 #define HEARTH_MAP_INTERNAL_H
 
+#include <pthread.h>
 #include <stdatomic.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -93,12 +94,23 @@ typedef struct max_maps {
 
 /* Mean and robust fusion: each view's records (see REC_WORDS), sorted by
  * texel, in an allocation of their own size; the fusion folds them in view
- * order. */
+ * order. Mean fusion folds them as the views are done instead: a view's
+ * records go into per-texel sums as soon as every view before it has gone
+ * in (the sums see the views in view order, as the fusion would) and are
+ * freed, so only the views done out of order wait as records. */
 typedef struct view_records {
   size_t n_views;
   uint32_t **q; /* per view: n[v] texels */
   float **d;    /* per view: n[v] * REC_WORDS(C) words */
   size_t *n;
+  /* mean fusion (NULL otherwise): R * R * (C + 1) sums (per channel the
+     weighted values, then the weight), zero where no view observed */
+  double *acc;
+  float *best_cos;  /* R * R best viewing cosines (0: none); NULL with skip_best_cos */
+  uint8_t *waiting; /* per view: done, its records kept until its turn */
+  size_t next;      /* the first view not yet folded */
+  pthread_mutex_t mu;
+  int have_mu;
 } view_records;
 
 /* one mapping of a view set: what the cast and fusion phases read, and the
@@ -117,9 +129,11 @@ typedef struct map_ctx {
   max_maps *max;           /* max fusion, else NULL */
   view_records *rec;       /* mean and robust fusion, else NULL */
   uint32_t *view_hits;     /* per view: pixels on the surface */
+  hearth_err *load_errs;   /* per view, with opts->load: its load's error (status 0: none) */
   double corr_ambient;     /* corrected fusion: the ambient estimate (degC) */
   double corr_rate;        /* corrected fusion: the cooling rate (1/s) towards it */
-  _Atomic int failed;      /* 1 out of memory, 2 a view not in front after all */
+  _Atomic int failed;      /* 1 out of memory, 2 a view not in front after all, 3 a load failed
+                              (load_errs) */
 } map_ctx;
 
 /* a float as an unsigned integer of the same order (-0 below +0, NaN not
@@ -151,8 +165,13 @@ void map_cast_views(void *ctx, size_t b, size_t e, int t);
  * out owns them, the maps the others. Returns 0 out of memory. */
 int map_max_alloc(max_maps *mx, int n, size_t R, int C, int want_cos, hearth_map_result *out);
 void map_max_free(max_maps *mx);
-/* room for n views' records. Returns 0 out of memory. */
-int map_records_alloc(view_records *r, size_t n_views);
+/* room for n views' records; with stream (mean fusion), the sums for R x R
+ * texels and C channels, and with want_cos their best cosines, zeroed.
+ * Returns 0 out of memory. */
+int map_records_alloc(view_records *r, size_t n_views, int stream, size_t R, int C, int want_cos);
+/* mean fusion: view v's n records (q, d: REC_WORDS(C) words each) folded
+ * in view order (see view_records); returns 0 out of memory */
+int map_records_fold(view_records *r, size_t v, const uint32_t *q, const float *d, size_t n, int C);
 void map_records_free(view_records *r);
 
 /* The islands' bounding boxes and counts, gathered by the fusion for the

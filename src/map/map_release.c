@@ -431,82 +431,36 @@ done:
   return s;
 }
 
-/* The colour bake's memory. The mapping reads a view's colour only at the
- * stride-grid pixels whose rays meet the mesh; with every vertex in front of
- * the camera those rays point into the box that bounds the vertices'
- * normalised coordinates (x/z, y/z): a hit is a convex combination of its
- * triangle's vertices in those coordinates. So a decoded frame is copied
- * only at the grid pixels whose ray points into that box (with a margin far
- * above rounding) into a fresh zeroed image whose other pages are never
- * written (and so never backed), and the full frame is freed: the bytes the
- * mapping reads, and so its result, are those of the full frames. The
- * copies are slices of one zeroed block for all views: a frame-sized
- * calloc of its own may get memory the heap had freed, which calloc then
- * clears, backing every page. */
-#define BAKE_BOX_MARGIN 2e-3 /* normalised units: about 3 px of a 1400 px focal length */
+/* The colour bake's memory: the mapping decodes each view's frame when its
+ * cast reaches it and frees it after the view's splat (hearth_map_opts'
+ * load), so a worker holds one frame at a time; the frames' headers are
+ * checked, view by view, before the mapping starts. */
+typedef struct bake_frames {
+  const char *root, *inst, *state, *rig_path;
+  const hearth_manifest *man;
+  const hearth_camera *cam;
+} bake_frames;
 
-typedef struct bake_grid {
-  size_t stride, gw, gh;
-  float *dir; /* hearth_camera_ray_grid of the colour camera */
-} bake_grid;
-
-/* the box of the mesh's normalised coordinates seen from T (lo x, lo y, hi
- * x, hi y); 0 if a vertex is not in front of the camera */
-static int bake_box(const hearth_mesh *mesh, const hearth_rigid *T_world_from_cam, double box[4]) {
-  hearth_rigid Tcw;
-  hearth_rigid_inverse(T_world_from_cam, &Tcw);
-  box[0] = box[1] = INFINITY;
-  box[2] = box[3] = -INFINITY;
-  for (size_t i = 0; i < mesh->n_vertices; i++) {
-    const float *pv = mesh->positions + 3 * i;
-    double X[3] = {pv[0], pv[1], pv[2]}, Xc[3];
-    hearth_rigid_apply(&Tcw, X, Xc);
-    if (!(Xc[2] > 0.0)) return 0;
-    double x = Xc[0] / Xc[2], y = Xc[1] / Xc[2];
-    if (x < box[0]) box[0] = x;
-    if (y < box[1]) box[1] = y;
-    if (x > box[2]) box[2] = x;
-    if (y > box[3]) box[3] = y;
+/* view k's colour frame: of the colour camera's size (checked before its
+   pixels are decoded), RGB; header_only: its header alone */
+static hearth_status bake_frame(const bake_frames *f, size_t k, int header_only, hearth_image *img,
+                                hearth_err *err) {
+  char path[PATH_SZ], why[PATH_SZ + 32];
+  joinf(path, "%s/instances/%s/raw/%s/%s", f->root, f->inst, f->state, f->man->views[k].rgb);
+  snprintf(why, sizeof why, "(the colour camera of %s)", f->rig_path);
+  hearth_image_expect want =
+      {(size_t)f->cam->width, (size_t)f->cam->height, 0, 0, header_only, why};
+  hearth_status s = hearth_jpeg_read_expect(path, &want, img, err);
+  if (s) return s;
+  if (img->channels != 3) {
+    hearth_image_free(img);
+    return hearth_err_set(err, HEARTH_E_UNSUPPORTED, "%s: expected an RGB image", path);
   }
-  box[0] -= BAKE_BOX_MARGIN;
-  box[1] -= BAKE_BOX_MARGIN;
-  box[2] += BAKE_BOX_MARGIN;
-  box[3] += BAKE_BOX_MARGIN;
-  return mesh->n_vertices > 0;
+  return HEARTH_OK;
 }
 
-/* replace *img (a decoded frame of the camera's size) by a copy holding
- * only the pixels the mapping can read from pose T */
-/* into dst (zeroed, the frame's size; NULL: an image of its own); *in_dst
- * is set when img's pixels are then dst's */
-static hearth_status bake_sparse(const bake_grid *g, const hearth_mesh *mesh, const hearth_rigid *T,
-                                 hearth_image *img, uint8_t *dst, uint8_t *in_dst,
-                                 hearth_err *err) {
-  double box[4];
-  *in_dst = 0;
-  if (!bake_box(mesh, T, box)) return HEARTH_OK; /* the whole frame stays */
-  hearth_image sp = *img;
-  if (dst) {
-    sp.data = dst;
-  } else {
-    hearth_status s = hearth_image_alloc(&sp, img->width, img->height, 3, HEARTH_PIX_U8, err);
-    if (s) return s;
-  }
-  const uint8_t *in = img->data;
-  uint8_t *out = sp.data;
-  for (size_t gy = 0; gy < g->gh; gy++)
-    for (size_t gx = 0; gx < g->gw; gx++) {
-      const float *d = g->dir + 3 * (gy * g->gw + gx);
-      if (!(d[2] > 0.0f)) continue; /* NaN: the lens cannot be inverted, never cast */
-      double x = (double)d[0] / d[2], y = (double)d[1] / d[2];
-      if (x < box[0] || x > box[2] || y < box[1] || y > box[3]) continue;
-      size_t q = 3 * (gy * g->stride * img->width + gx * g->stride);
-      memcpy(out + q, in + q, 3);
-    }
-  hearth_image_free(img);
-  *img = sp;
-  *in_dst = dst != NULL;
-  return HEARTH_OK;
+static hearth_status bake_load(void *ctx, size_t k, hearth_image *img, hearth_err *err) {
+  return bake_frame(ctx, k, 0, img, err);
 }
 
 hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err) {
@@ -536,12 +490,8 @@ hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err) {
   hearth_manifest man = {0};
   hearth_poses poses = {0};
   hearth_mesh mesh = {0};
-  hearth_image *imgs = NULL;
   hearth_map_view *views = NULL;
   hearth_map_result r = {0};
-  bake_grid grid = {0};
-  uint8_t *block = NULL, *in_block = NULL; /* the sparse copies; per view: its copy is there */
-  size_t frame = 0;
   uint8_t *tex_png = NULL; /* the colour texture, PNG-encoded */
   size_t tex_size = 0;
   if ((s = hearth_rig_read(rig_path, &rig, err)) ||
@@ -551,25 +501,12 @@ hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err) {
   if ((s = hearth_poses_read(poses_path, &poses, err))) goto done;
   hearth_glb_read_opts gopts = {.require_uvs = 1};
   if ((s = hearth_glb_read(mesh_path, &gopts, &mesh, err))) goto done;
-  imgs = calloc(man.n_views ? man.n_views : 1, sizeof *imgs);
   views = calloc(man.n_views ? man.n_views : 1, sizeof *views);
-  if (!imgs || !views) {
+  if (!views) {
     s = hearth_err_set(err, HEARTH_E_NOMEM, "bake: out of memory");
     goto done;
   }
-  /* the rays of the pixels the mapping casts (none: the frames stay whole) */
-  grid.stride = (size_t)(job->pixel_stride > 0 ? job->pixel_stride : 2);
-  if (rig.rgb.width > 0 && rig.rgb.height > 0) {
-    grid.gw = ((size_t)rig.rgb.width + grid.stride - 1) / grid.stride;
-    grid.gh = ((size_t)rig.rgb.height + grid.stride - 1) / grid.stride;
-    if ((grid.dir = hearth_alloc_array(grid.gw * grid.gh, 3 * sizeof *grid.dir)))
-      hearth_camera_ray_grid(&rig.rgb, grid.stride, grid.dir);
-    /* without the block (too large to map) each copy is an image of its own */
-    if (grid.dir && man.n_views &&
-        hearth_mul_size((size_t)rig.rgb.width * 3, (size_t)rig.rgb.height, &frame) &&
-        frame <= SIZE_MAX / man.n_views && (in_block = calloc(man.n_views, 1)))
-      block = calloc(man.n_views, frame);
-  }
+  bake_frames frames = {root, inst, state, rig_path, &man, &rig.rgb};
   for (size_t k = 0; k < man.n_views; k++) {
     const hearth_view_files *vf = &man.views[k];
     const hearth_view_pose *vp = hearth_poses_find(&poses, state, vf->view);
@@ -578,25 +515,9 @@ hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err) {
                          poses_path, state, vf->view);
       goto done;
     }
-    joinf(path, "%s/instances/%s/raw/%s/%s", root, inst, state, vf->rgb);
-    /* the size is the colour camera's, checked before the pixels are decoded */
-    char why[PATH_SZ + 32];
-    snprintf(why, sizeof why, "(the colour camera of %s)", rig_path);
-    hearth_image_expect want = {(size_t)rig.rgb.width, (size_t)rig.rgb.height, 0, 0, 0, why};
-    if ((s = hearth_jpeg_read_expect(path, &want, &imgs[k], err))) goto done;
-    if (imgs[k].channels != 3) {
-      s = hearth_err_set(err, HEARTH_E_UNSUPPORTED, "%s: expected an RGB image", path);
-      goto done;
-    }
-    /* a frame of another size stays whole: the mapping refuses it */
-    uint8_t sliced = 0;
-    if (grid.dir && imgs[k].width == (size_t)rig.rgb.width &&
-        imgs[k].height == (size_t)rig.rgb.height &&
-        (s = bake_sparse(&grid, &mesh, &vp->T_world_from_cam, &imgs[k],
-                         block ? block + k * frame : NULL, &sliced, err)))
-      goto done;
-    if (in_block) in_block[k] = sliced;
-    views[k].image = &imgs[k];
+    hearth_image head;
+    if ((s = bake_frame(&frames, k, 1, &head, err))) goto done;
+    views[k].image = NULL; /* decoded by the mapping (bake_load) */
     views[k].T_world_from_cam = vp->T_world_from_cam;
   }
   hearth_map_opts mo;
@@ -607,6 +528,9 @@ hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err) {
   mo.min_cos = 0.2; /* grazing colour samples smear texture detail */
   mo.threads = job->threads;
   mo.skip_best_cos = 1;
+  mo.load = bake_load;
+  mo.load_ctx = &frames;
+  mo.load_channels = 3;
   if ((s = hearth_map_views(&mesh, NULL, &rig.rgb, views, man.n_views, &mo, &r, err))) goto done;
   if (!r.n_surface) {
     s = hearth_err_set(err, HEARTH_E_RANGE,
@@ -633,16 +557,7 @@ hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err) {
 done:
   free(tex_png);
   hearth_map_result_free(&r);
-  if (imgs)
-    for (size_t k = 0; k < man.n_views; k++) {
-      if (in_block && in_block[k]) imgs[k].data = NULL; /* the block's */
-      hearth_image_free(&imgs[k]);
-    }
-  free(imgs);
-  free(block);
-  free(in_block);
   free(views);
-  free(grid.dir);
   hearth_mesh_free(&mesh);
   hearth_poses_free(&poses);
   hearth_manifest_free(&man);

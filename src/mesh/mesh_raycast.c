@@ -206,6 +206,30 @@ int hearth_raycast(const hearth_raycaster *rc, const double org[3], const double
   return 1;
 }
 
+int hearth_raycast_any(const hearth_raycaster *rc, const double org[3], const double dir[3],
+                       double tnear, double tfar) {
+  float tn = (float)(tnear > 0.0 ? tnear : 0.0), tf = (float)tfar;
+  float o[3] = {(float)org[0], (float)org[1], (float)org[2]};
+  float d[3] = {(float)dir[0], (float)dir[1], (float)dir[2]};
+  if (!ray_ok(o[0], o[1], o[2], d[0], d[1], d[2], tn, tf)) return 0;
+  struct RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  struct RTCRay ray;
+  memset(&ray, 0, sizeof ray);
+  ray.org_x = o[0];
+  ray.org_y = o[1];
+  ray.org_z = o[2];
+  ray.dir_x = d[0];
+  ray.dir_y = d[1];
+  ray.dir_z = d[2];
+  ray.tnear = tn;
+  ray.tfar = tf;
+  ray.mask = 0xFFFFFFFFu;
+  /* Embree sets tfar to -inf where the ray is occluded */
+  rtcOccluded1(rc->scene, &ctx, &ray);
+  return ray.tfar == -INFINITY;
+}
+
 typedef struct batch_ctx {
   const hearth_raycaster *rc;
   const float *org, *dir;

@@ -31,7 +31,11 @@
 typedef struct ov_grid {
   int zoom;
   size_t w, h;
-  double *dir; /* 3 per sub-pixel, camera frame; NaN where the lens cannot be inverted */
+  hearth_camera cam; /* the camera the grid is of */
+  /* 3 per sub-pixel, camera frame; NaN where the lens cannot be inverted.
+     NULL with a fan: the few views the fan cannot cast compute their rays
+     as they trace them */
+  double *dir;
   /* the same sub-pixels as the pixel grid of the camera enlarged zoom
      times; NULL where the mesh does not allow it or it cannot be made
      (then rays are traced) */
@@ -50,37 +54,45 @@ typedef struct ov_scratch {
   double *vals;             /* thermal pixels, for the range */
   uint8_t *turbo;           /* 3 per thermal pixel */
   hearth_image temps;
+  hearth_image big; /* the per-view file's image, reused from view to view */
 } ov_scratch;
+
+/* the ray of sub-pixel (x, y) of g into d (NaN where the lens cannot be
+   inverted) */
+static void ov_grid_ray(const ov_grid *g, size_t x, size_t y, double d[3]) {
+  double u = -0.5 + ((double)x + 0.5) / g->zoom, v = -0.5 + ((double)y + 0.5) / g->zoom;
+  if (hearth_camera_ray(&g->cam, u, v, d) < 0) d[0] = d[1] = d[2] = NAN;
+}
 
 /* the grid at zoom, and with with_fan its ray fan (NULL where it cannot
    be made: then rays are traced) */
 static hearth_status ov_grid_make(const hearth_camera *cam, int zoom, int with_fan, ov_grid *g,
                                   hearth_err *err) {
   g->zoom = zoom;
+  g->cam = *cam;
   g->w = (size_t)cam->width * (size_t)zoom;
   g->h = (size_t)cam->height * (size_t)zoom;
   size_t n = g->w * g->h;
-  g->dir = hearth_alloc_array(n ? n : 1, 3 * sizeof *g->dir);
-  if (!g->dir) return hearth_err_set(err, HEARTH_E_NOMEM, "overlay: out of memory");
-  for (size_t y = 0; y < g->h; y++)
-    for (size_t x = 0; x < g->w; x++) {
-      double u = -0.5 + ((double)x + 0.5) / zoom, v = -0.5 + ((double)y + 0.5) / zoom;
-      double *d = g->dir + 3 * (y * g->w + x);
-      if (hearth_camera_ray(cam, u, v, d) < 0) d[0] = d[1] = d[2] = NAN;
-    }
   /* sub-pixel (x, y) is pixel (x, y) of the camera whose pixel coordinates
      are zoom (u + 1/2) - 1/2: focal lengths times zoom, the centre moved
      with them */
-  if (!with_fan) return HEARTH_OK;
-  hearth_camera cz = *cam;
-  cz.width = (int)g->w;
-  cz.height = (int)g->h;
-  cz.fx = cam->fx * zoom;
-  cz.fy = cam->fy * zoom;
-  cz.cx = zoom * (cam->cx + 0.5) - 0.5;
-  cz.cy = zoom * (cam->cy + 0.5) - 0.5;
-  if (g->w <= INT32_MAX && g->h <= INT32_MAX && hearth_ray_fan_new(&cz, 1, &g->fan, NULL))
-    g->fan = NULL;
+  if (with_fan) {
+    hearth_camera cz = *cam;
+    cz.width = (int)g->w;
+    cz.height = (int)g->h;
+    cz.fx = cam->fx * zoom;
+    cz.fy = cam->fy * zoom;
+    cz.cx = zoom * (cam->cx + 0.5) - 0.5;
+    cz.cy = zoom * (cam->cy + 0.5) - 0.5;
+    if (g->w <= INT32_MAX && g->h <= INT32_MAX && hearth_ray_fan_new(&cz, 1, &g->fan, NULL))
+      g->fan = NULL;
+  }
+  /* a grid with a fan rasterises every view: its rays are never traced */
+  if (g->fan) return HEARTH_OK;
+  g->dir = hearth_alloc_array(n ? n : 1, 3 * sizeof *g->dir);
+  if (!g->dir) return hearth_err_set(err, HEARTH_E_NOMEM, "overlay: out of memory");
+  for (size_t y = 0; y < g->h; y++)
+    for (size_t x = 0; x < g->w; x++) ov_grid_ray(g, x, y, g->dir + 3 * (y * g->w + x));
   return HEARTH_OK;
 }
 
@@ -166,6 +178,7 @@ static void ov_scratch_free(ov_scratch *s) {
   free(s->fan_scratch);
   free(s->fan_hits);
   hearth_image_free(&s->temps);
+  hearth_image_free(&s->big);
 }
 
 /* scratch for grids of up to n_sub sub-pixels and images of n_px pixels,
@@ -209,7 +222,9 @@ static void ov_cast(const hearth_raycaster *rc, const ov_grid *g, const hearth_r
       for (size_t y = ty; y < ty + 4 && y < y1; y++)
         for (size_t x = tx; x < tx + 4 && x < x1; x++) {
           size_t p = y * g->w + x;
-          const double *dc = g->dir + 3 * p;
+          double own[3];
+          const double *dc = g->dir ? g->dir + 3 * p : own;
+          if (!g->dir) ov_grid_ray(g, x, y, own);
           if (isnan(dc[0])) continue;
           double dw[3];
           hearth_rigid_rotate(T, dc, dw);
@@ -336,12 +351,17 @@ static void ov_colours(const hearth_image *temps, double lo, double hi, uint8_t 
   }
 }
 
-/* a new image of the colours enlarged zoom times (nearest) */
+/* the colours enlarged zoom times (nearest) into out: a new image, or
+   out's pixels where it already has that size (a worker's own, reused) */
 static hearth_status ov_background(const uint8_t *turbo, size_t tw, size_t th, size_t zoom,
                                    hearth_image *out, hearth_err *err) {
   size_t w = tw * zoom, h = th * zoom;
-  hearth_status s = hearth_image_alloc(out, w, h, 3, HEARTH_PIX_U8, err);
-  if (s) return s;
+  if (!(out->data && out->width == w && out->height == h && out->channels == 3 &&
+        out->type == HEARTH_PIX_U8)) {
+    hearth_image_free(out);
+    hearth_status s = hearth_image_alloc(out, w, h, 3, HEARTH_PIX_U8, err);
+    if (s) return s;
+  }
   uint8_t *o = out->data;
   for (size_t ty = 0; ty < th; ty++) {
     uint8_t *row = o + 3 * (ty * zoom) * w;
@@ -427,18 +447,17 @@ static hearth_status ov_view(const ov_ctx *c, ov_scratch *s, size_t k, hearth_im
   ov_colours(&s->temps, lo, hi, s->turbo);
   /* the per-view file: before in magenta under after in white */
   const uint8_t white[3] = {255, 255, 255}, magenta[3] = {255, 0, 255};
-  hearth_image ov = {0};
-  if ((st = ov_background(s->turbo, cw, ch, (size_t)c->big->zoom, &ov, err))) return st;
+  hearth_image *ov = &s->big;
+  if ((st = ov_background(s->turbo, cw, ch, (size_t)c->big->zoom, ov, err))) return st;
   if (pb) {
     ov_outline(c->rc, c->mesh, c->cam, c->big, &pb->T_world_from_cam, s);
-    ov_paint(&ov, s->edge, magenta);
+    ov_paint(ov, s->edge, magenta);
   }
   ov_outline(c->rc, c->mesh, c->cam, c->big, &pa->T_world_from_cam, s);
-  ov_paint(&ov, s->edge, white);
-  hearth_draw_text(&ov, 4, 4, vf->view, white, 2);
+  ov_paint(ov, s->edge, white);
+  hearth_draw_text(ov, 4, 4, vf->view, white, 2);
   rf_pathf(path, "%s/%s.png", c->dir, vf->view);
-  st = hearth_png_write(path, &ov, err);
-  hearth_image_free(&ov);
+  st = hearth_png_write(path, ov, err);
   for (int side = 0; side < 2 && !st; side++) {
     const hearth_view_pose *p = side ? pa : pb;
     if (!p) continue;

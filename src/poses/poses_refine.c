@@ -127,8 +127,7 @@ static uint8_t cast_hit(const rf_ctx *c, const hearth_rigid *T, int x, int y) {
   if (isnan(d[0])) return 0;
   double dc[3] = {d[0], d[1], d[2]}, dw[3];
   hearth_rigid_rotate(T, dc, dw);
-  hearth_ray_hit h;
-  return (uint8_t)hearth_raycast(c->rc, T->t, dw, 0.0, INFINITY, &h);
+  return (uint8_t)hearth_raycast_any(c->rc, T->t, dw, 0.0, INFINITY);
 }
 
 /* the outer silhouette of the mesh seen from T: samples in s (at most max) */

@@ -40,6 +40,19 @@ static void look_down(double cx, double cy, double h, hearth_rigid *T) {
   T->t[2] = h;
 }
 
+/* loaders: view v's image copied from ctx's array, or an error naming v */
+static hearth_status copy_image(void *ctx, size_t v, hearth_image *img, hearth_err *err) {
+  const hearth_image *src = ((hearth_image *const *)ctx)[v];
+  hearth_status s = hearth_image_alloc(img, src->width, src->height, src->channels, src->type, err);
+  if (!s) memcpy(img->data, src->data, hearth_image_bytes(src));
+  return s;
+}
+static hearth_status fail_image(void *ctx, size_t v, hearth_image *img, hearth_err *err) {
+  (void)ctx;
+  memset(img, 0, sizeof *img);
+  return hearth_err_set(err, HEARTH_E_IO, "view %zu unreadable", v);
+}
+
 int main(void) {
   hearth_err err = {0};
   hearth_mesh m = {0};
@@ -166,6 +179,61 @@ int main(void) {
   CHECK_OK(hearth_map_views(&m, NULL, &cam, views, 2, &o, &r4, &err), &err);
   CHECK(!memcmp(r3.filled, r4.filled, (size_t)RES * RES * sizeof(float)));
   hearth_map_result_free(&r4);
+  /* a view counted twice: the mean of equal readings is the reading (each
+     sum doubles exactly) */
+  {
+    hearth_map_view twice[2] = {views[0], views[0]};
+    hearth_map_result one, two;
+    o.threads = 1;
+    CHECK_OK(hearth_map_views(&m, NULL, &cam, views, 1, &o, &one, &err), &err);
+    o.threads = 2;
+    CHECK_OK(hearth_map_views(&m, NULL, &cam, twice, 2, &o, &two, &err), &err);
+    CHECK(one.n_observed > 1000 && one.n_observed == two.n_observed);
+    CHECK(!memcmp(one.mask, two.mask, (size_t)RES * RES));
+    size_t same = 0;
+    for (size_t q = 0; q < (size_t)RES * RES; q++)
+      same += one.mask[q] != HEARTH_TEXEL_OBSERVED || one.observed[q] == two.observed[q];
+    CHECK_MSG(same == (size_t)RES * RES, "%zu texels differ", (size_t)RES * RES - same);
+    hearth_map_result_free(&one);
+    hearth_map_result_free(&two);
+  }
+  /* images made by the loader as the casts reach them: the result of the
+     images given, at any thread count; a failed load fails the mapping
+     with the lowest failing view's error */
+  {
+    hearth_image *imgs[2] = {&img0, &img1};
+    hearth_map_view lazy[2] = {views[0], views[1]};
+    lazy[0].image = lazy[1].image = NULL;
+    hearth_map_opts lo = o;
+    lo.load = copy_image;
+    lo.load_ctx = imgs;
+    lo.load_channels = 1;
+    for (int t = 1; t <= 2; t++) {
+      lo.threads = t;
+      CHECK_OK(hearth_map_views(&m, NULL, &cam, lazy, 2, &lo, &r4, &err), &err);
+      CHECK(!memcmp(r3.mask, r4.mask, (size_t)RES * RES));
+      CHECK(!memcmp(r3.observed, r4.observed, (size_t)RES * RES * sizeof(float)));
+      CHECK(!memcmp(r3.filled, r4.filled, (size_t)RES * RES * sizeof(float)));
+      CHECK(!memcmp(r3.best_cos, r4.best_cos, (size_t)RES * RES * sizeof(float)));
+      hearth_map_result_free(&r4);
+    }
+    lo.load = fail_image;
+    CHECK(hearth_map_views(&m, NULL, &cam, lazy, 2, &lo, &r4, &err) == HEARTH_E_IO);
+    CHECK_MSG(strstr(err.msg, "view 0 unreadable") != NULL, "%s", err.msg);
+    lazy[0].image = &img0; /* view 1 alone fails */
+    CHECK(hearth_map_views(&m, NULL, &cam, lazy, 2, &lo, &r4, &err) == HEARTH_E_IO);
+    CHECK_MSG(strstr(err.msg, "view 1 unreadable") != NULL, "%s", err.msg);
+    /* a loaded image of another size than the camera's */
+    lo.load = copy_image;
+    hearth_image *swapped[2] = {&img0, &img0};
+    hearth_image tiny;
+    CHECK_OK(hearth_image_alloc(&tiny, 8, 8, 1, HEARTH_PIX_F32, &err), &err);
+    swapped[1] = &tiny;
+    lo.load_ctx = swapped;
+    CHECK(hearth_map_views(&m, NULL, &cam, lazy, 2, &lo, &r4, &err) == HEARTH_E_SIZE);
+    CHECK(strstr(err.msg, "view 1") != NULL);
+    hearth_image_free(&tiny);
+  }
 
   /* errors: mesh without UVs, wrong image size */
   float *uvs = m.uvs;

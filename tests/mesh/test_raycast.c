@@ -159,6 +159,33 @@ int main(void) {
     double nanv[3] = {NAN, 0, 1};
     CHECK(hearth_raycast(rc, far, nanv, 0.0, INFINITY, &h) == 0);
   }
+  /* any-hit queries: the cube's closed form off its edges, the same answer
+   * as the nearest-hit query everywhere (edges and corners included), and
+   * the (tnear, tfar) interval respected */
+  {
+    int n_in = 0;
+    for (int iy = -24; iy <= 24; iy++)
+      for (int ix = -24; ix <= 24; ix++) {
+        double o[3] = {ix * 0.025, iy * 0.025, -3.0}, d[3] = {0.01 * ix, -0.005 * iy, 1.0};
+        hearth_ray_hit h;
+        int any = hearth_raycast_any(rc, o, d, 0.0, INFINITY);
+        CHECK_MSG(any == hearth_raycast(rc, o, d, 0.0, INFINITY, &h), "ray %d %d", ix, iy);
+        /* where the ray enters the plane z = -0.5 */
+        double x = o[0] + 2.5 * d[0], y = o[1] + 2.5 * d[1];
+        if (fabs(fabs(x) - 0.5) > 1e-6 && fabs(fabs(y) - 0.5) > 1e-6 && fabs(x) < 0.5 &&
+            fabs(y) < 0.5) {
+          CHECK_MSG(any == 1, "ray %d %d through the face", ix, iy);
+          n_in++;
+        }
+      }
+    CHECK(n_in > 100);
+    double o[3] = {0.1, -0.2, -3.0}, d[3] = {0, 0, 1}, nanv[3] = {NAN, 0, 1}, z[3] = {0, 0, 0};
+    CHECK(hearth_raycast_any(rc, o, d, 0.0, 2.4) == 0);
+    CHECK(hearth_raycast_any(rc, o, d, 2.6, INFINITY) == 1);
+    CHECK(hearth_raycast_any(rc, o, d, 3.6, INFINITY) == 0);
+    CHECK(hearth_raycast_any(rc, o, nanv, 0.0, INFINITY) == 0);
+    CHECK(hearth_raycast_any(rc, o, z, 0.0, INFINITY) == 0);
+  }
   hearth_raycaster_free(rc);
 
   /* a mesh with an out-of-range index is refused with the triangle named */
