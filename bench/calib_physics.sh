@@ -5,6 +5,8 @@
 # seeds, with the wall-corrected hole centres (the default) and with the
 # naive centroid (--no-wall-correction), against ground_truth/rig.json:
 #   bench/calib_physics.sh BUILD_DIR OUT_DIR [SEEDS...]   (default seeds 1 2 3 4)
+# SYNTH_ARGS (environment) adds synth options, e.g. SYNTH_ARGS="--plate-bow 0"
+# to see one effect's share.
 # One line per seed and estimator: stereo RMS (px), thermal fx error (%),
 # rotation (deg) and translation (mm) of T_thermal_from_rgb.
 set -euo pipefail
@@ -18,7 +20,8 @@ mkdir -p "$out"
 for s in $seeds; do
   r="$out/seed$s"
   rm -rf "$r"
-  "$h" synth --out "$r" --categories cup --states neutral --views 1 --seed "$s" --quiet >/dev/null
+  "$h" synth --out "$r" --categories cup --states neutral --views 1 --seed "$s" --quiet \
+    ${SYNTH_ARGS:-} >/dev/null
   "$h" detect "$r" >/dev/null
   for est in wall naive; do
     if [ "$est" = wall ]; then "$h" calibrate "$r" --quiet >/dev/null

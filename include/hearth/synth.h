@@ -54,6 +54,14 @@ typedef struct hearth_synth_effects {
   double trigger_ms;        /* longest trigger offset between the two cameras (ms); default 2 */
   double hand_speed_m_s;    /* speed of the hand-held plate (m/s); default 0.05 */
   double hand_turn_rad_s;   /* turn rate of the hand-held plate (rad/s); default 0.1 */
+  double rs_readout_ms;     /* the colour camera's rolling-shutter readout of a full frame
+                               (ms), rows exposed in turn while the plate moves; default 20 */
+  double plate_bow_m;       /* largest bow of the plate (its centre against its corners, m),
+                               drawn per seed in 0.5..1 of it, either sign; default 5e-5 */
+  double plate_flex_m;      /* the hand-held plate's flex: each frame's bow changes by
+                               U(-1, 1) of it (m); default 2e-4 */
+  double hole_burr_m;       /* irregularity of each hole's rim (burrs, drill wander): 1 sigma
+                               of the first three Fourier terms of its radius (m); default 0 */
 } hearth_synth_effects;
 
 /* Strings are borrowed: they must stay valid during hearth_synth_release. */

@@ -56,9 +56,25 @@ void synth_plate_centre(const synth_plate_geom *g, double c[3]) {
   c[2] = 0.0;
 }
 
-static int classify_plate(const synth_plate_geom *g, double x, double y, const double **hole) {
+/* the rim radius of hole i towards plate direction (dx, dy) from its centre */
+static double hole_radius(const synth_plate_geom *g, size_t i, double dx, double dy) {
+  if (g->burr_max <= 0) return g->r;
+  const float *b = g->burr[i];
+  double ph = atan2(dy, dx), r = g->r;
+  for (int k = 1; k <= 3; k++) r += b[2 * k - 2] * cos(k * ph) + b[2 * k - 1] * sin(k * ph);
+  return r;
+}
+
+/* the front face's offset along the plate normal at (x, y) (the bow) */
+static double plate_sag(const synth_plate_geom *g, double x, double y) {
+  if (g->bow == 0) return 0.0;
+  double dx = x - g->cx, dy = y - g->cy;
+  return g->bow * (1.0 - (dx * dx + dy * dy) / (g->half_w * g->half_w + g->half_h * g->half_h));
+}
+
+static int classify_plate(const synth_plate_geom *g, double x, double y, size_t *hole) {
   if (fabs(x - g->cx) > g->half_w || fabs(y - g->cy) > g->half_h) return C_OUT;
-  const double R = g->r, P = g->t.pitch_m;
+  const double R = g->r + g->burr_max, P = g->t.pitch_m;
   /* quick accept of the margin around the pattern */
   if (x < -R || y < -R || x > g->ext_x + R || y > g->ext_y + R) return C_PLATE;
   int r0 = (int)lrint(y / g->step);
@@ -69,9 +85,15 @@ static int classify_plate(const synth_plate_geom *g, double x, double y, const d
     int c0 = (int)lrint((x - off) / P);
     for (int cc = c0 - 1; cc <= c0 + 1; cc++) {
       if (cc < 0 || cc >= ncol) continue;
-      const double *h = g->holes[g->row_start[r] + cc];
-      if ((x - h[0]) * (x - h[0]) + (y - h[1]) * (y - h[1]) < R * R) {
-        if (hole) *hole = h;
+      size_t i = (size_t)(g->row_start[r] + cc);
+      const double *h = g->holes[i];
+      double dx = x - h[0], dy = y - h[1], d2 = dx * dx + dy * dy;
+      if (d2 < R * R) {
+        if (g->burr_max > 0) {
+          double rr = hole_radius(g, i, dx, dy);
+          if (d2 >= rr * rr) continue;
+        }
+        if (hole) *hole = i;
         return C_HOLE;
       }
     }
@@ -104,6 +126,14 @@ typedef struct plate_fx {
   double fpn_offset, fpn_gain;
   uint64_t fpn_seed;            /* the thermal camera's fixed pattern */
   double motion_px, motion_dir; /* colour: linear blur length (px) and direction (rad) */
+  /* colour: the hand-held plate's motion. At time t after the thermal
+   * exposure the plate (camera from plate T0 then) is turned by
+   * turn t w / |w| about pivot (camera coordinates) and moved by
+   * speed t a / |a|; the frame's middle row is read at trigger_s, row y at
+   * trigger_s + readout_s ((y + 0.5) / height - 0.5) */
+  hearth_rigid T0;
+  double mv_a[3], mv_na, mv_w[3], mv_nw, mv_speed, mv_turn, mv_pivot[3];
+  double trigger_s, readout_s;
 } plate_fx;
 
 typedef struct plate_view {
@@ -122,6 +152,37 @@ typedef struct plate_view {
 
 static inline double dot3(const double a[3], const double b[3]) {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+/* camera from plate at time t of the hand-held motion */
+static void plate_moved(const plate_fx *fx, double t, hearth_rigid *T) {
+  double tr[3], w[3], RC[3];
+  for (int k = 0; k < 3; k++) {
+    tr[k] = fx->mv_speed * t * fx->mv_a[k] / (fx->mv_na > 0 ? fx->mv_na : 1);
+    w[k] = fx->mv_turn * t * fx->mv_w[k] / (fx->mv_nw > 0 ? fx->mv_nw : 1);
+  }
+  hearth_rigid M;
+  hearth_rotvec_to_matrix(w, M.R);
+  hearth_rigid_rotate(&M, fx->mv_pivot, RC);
+  for (int k = 0; k < 3; k++) M.t[k] = fx->mv_pivot[k] - RC[k] + tr[k];
+  hearth_rigid_compose(&M, &fx->T0, T);
+}
+
+static void plate_view_set_pose(plate_view *v, const hearth_rigid *T) {
+  v->T = *T;
+  for (int i = 0; i < 3; i++) v->n[i] = T->R[i * 3 + 2];
+  v->nt = dot3(v->n, T->t);
+}
+
+/* the view as row `row` of a rolling-shutter frame sees the plate (a copy
+ * of v without a rolling shutter) */
+static void plate_view_at(const plate_view *v, double row, plate_view *out) {
+  *out = *v;
+  if (v->fx.readout_s <= 0) return;
+  double t = v->fx.trigger_s + v->fx.readout_s * ((row + 0.5) / v->cam->height - 0.5);
+  hearth_rigid T;
+  plate_moved(&v->fx, t, &T);
+  plate_view_set_pose(out, &T);
 }
 
 static void plate_view_init(plate_view *v, const hearth_camera *cam, const synth_plate_geom *g,
@@ -186,24 +247,32 @@ static int clutter_at(const clutter *cl, const double d[3]) {
 static int classify_ray(const plate_view *v, const double d[3], double p[2]) {
   double dn = dot3(v->n, d);
   if (fabs(dn) < 1e-12) return C_OUT;
-  double t = v->nt / dn;
-  if (t <= 0) return C_OUT;
-  double q[3] = {t * d[0] - v->T.t[0], t * d[1] - v->T.t[1], t * d[2] - v->T.t[2]};
-  /* plate coordinates: R^T q */
-  p[0] = v->T.R[0] * q[0] + v->T.R[3] * q[1] + v->T.R[6] * q[2];
-  p[1] = v->T.R[1] * q[0] + v->T.R[4] * q[1] + v->T.R[7] * q[2];
-  const double *h = NULL;
-  int cls = classify_plate(v->g, p[0], p[1], &h);
+  /* a bowed plate: the plane z = sag met again at the sag of the last hit
+   * (the slope is a few thousandths, so three rounds are exact to nm) */
+  double z0 = 0.0;
+  for (int it = 0; it < (v->g->bow != 0 ? 4 : 1); it++) {
+    if (it) z0 = plate_sag(v->g, p[0], p[1]);
+    double t = (v->nt + z0) / dn;
+    if (t <= 0) return C_OUT;
+    double q[3] = {t * d[0] - v->T.t[0], t * d[1] - v->T.t[1], t * d[2] - v->T.t[2]};
+    /* plate coordinates: R^T q */
+    p[0] = v->T.R[0] * q[0] + v->T.R[3] * q[1] + v->T.R[6] * q[2];
+    p[1] = v->T.R[1] * q[0] + v->T.R[4] * q[1] + v->T.R[7] * q[2];
+  }
+  size_t hi = 0;
+  int cls = classify_plate(v->g, p[0], p[1], &hi);
   if (cls != C_HOLE || v->fx.thickness <= 0) return cls;
   /* a thick plate: the ray sees the backing only if it also passes the back
-   * opening (the same circle at plate z = thickness); p becomes the point
+   * opening (the same rim at plate z = sag + thickness); p becomes the point
    * where it leaves the hole */
+  const double *h = v->g->holes[hi];
   double e[3];
   for (int k = 0; k < 3; k++) e[k] = v->T.R[k] * d[0] + v->T.R[3 + k] * d[1] + v->T.R[6 + k] * d[2];
   if (fabs(e[2]) < 1e-12) return C_WALL;
   double s = v->fx.thickness / fabs(e[2]);
   double bx = p[0] + s * e[0] - h[0], by = p[1] + s * e[1] - h[1];
-  if (bx * bx + by * by >= v->g->r * v->g->r) return C_WALL;
+  double rb = hole_radius(v->g, hi, bx, by);
+  if (bx * bx + by * by >= rb * rb) return C_WALL;
   p[0] += s * e[0];
   p[1] += s * e[1];
   return C_HOLE;
@@ -387,20 +456,25 @@ typedef struct cplate_ctx {
 static void cplate_class_rows(void *vctx, size_t b, size_t e, int ti) {
   cplate_ctx *c = vctx;
   size_t W = (size_t)c->v->cam->width;
-  for (size_t y = b; y < e; y++)
+  for (size_t y = b; y < e; y++) {
+    plate_view v;
+    plate_view_at(c->v, (double)y, &v);
     for (size_t x = 0; x < W; x++) {
       const float *r = c->rays + (y * W + x) * 3;
       double d[3] = {r[0], r[1], r[2]}, p[2];
-      int cls = classify_ray(c->v, d, p);
+      int cls = classify_ray(&v, d, p);
       c->cls[y * W + x] = (uint8_t)cls;
-      c->img[y * W + x] = (float)rgb_value(c->v, cls, p, d);
+      c->img[y * W + x] = (float)rgb_value(&v, cls, p, d);
     }
+  }
 }
 
 static void cplate_edge_rows(void *vctx, size_t b, size_t e, int ti) {
   cplate_ctx *c = vctx;
   size_t W = (size_t)c->v->cam->width, H = (size_t)c->v->cam->height;
-  for (size_t y = b; y < e; y++)
+  for (size_t y = b; y < e; y++) {
+    plate_view v;
+    plate_view_at(c->v, (double)y, &v);
     for (size_t x = 0; x < W; x++) {
       uint8_t me = c->cls[y * W + x];
       int mixed = 0;
@@ -413,8 +487,9 @@ static void cplate_edge_rows(void *vctx, size_t b, size_t e, int ti) {
             break;
           }
         }
-      if (mixed) c->img[y * W + x] = (float)pixel_fine(c->v, 0, (double)x, (double)y, 8);
+      if (mixed) c->img[y * W + x] = (float)pixel_fine(&v, 0, (double)x, (double)y, 8);
     }
+  }
 }
 
 static hearth_status render_rgb_plate(const plate_view *v, const float *rays, double blur,
@@ -457,8 +532,8 @@ int synth_plate_truth(const hearth_camera *c, const synth_plate_geom *g, const h
                       double (*centres)[2]) {
   int inside = 0;
   for (size_t i = 0; i < g->n; i++) {
-    double hx = g->holes[i][0], hy = g->holes[i][1];
-    double P[3] = {hx, hy, 0}, Q[3];
+    double hx = g->holes[i][0], hy = g->holes[i][1], hz = plate_sag(g, hx, hy);
+    double P[3] = {hx, hy, hz}, Q[3];
     hearth_rigid_apply(T, P, Q);
     if (!synth_lens_project(c, Q, centres[i])) {
       centres[i][0] = centres[i][1] = -1e9;
@@ -468,7 +543,7 @@ int synth_plate_truth(const hearth_camera *c, const synth_plate_geom *g, const h
     int ok = 1;
     for (int k = 0; k < 12 && ok; k++) {
       double a = k * (2.0 * 3.14159265358979323846 / 12.0), uv[2];
-      double R[3] = {hx + g->r * cos(a), hy + g->r * sin(a), 0}, S[3];
+      double R[3] = {hx + g->r * cos(a), hy + g->r * sin(a), hz}, S[3];
       hearth_rigid_apply(T, R, S);
       if (!synth_lens_project(c, S, uv) || uv[0] < 0.5 || uv[1] < 0.5 || uv[0] > c->width - 1.5 ||
           uv[1] > c->height - 1.5)
@@ -514,6 +589,26 @@ static void det_fill(hearth_detection *det, const char *frame, const char *camer
     memset(det->centres, 0, sizeof det->centres);
     det->found = 0;
     snprintf(det->reason, sizeof det->reason, "only %d holes visible", n);
+  }
+}
+
+/* a rolling-shutter colour frame's true centres: each hole at the pose of
+ * the row its centre is read in (fixed point from the middle row) */
+static void rs_truth(const plate_view *v, hearth_detection *det) {
+  const synth_plate_geom *g = v->g;
+  for (size_t i = 0; i < g->n; i++) {
+    double P[3] = {g->holes[i][0], g->holes[i][1], plate_sag(g, g->holes[i][0], g->holes[i][1])};
+    double row = 0.5 * (v->cam->height - 1), uv[2] = {0, 0};
+    for (int it = 0; it < 4; it++) {
+      plate_view vr;
+      plate_view_at(v, row, &vr);
+      double Q[3];
+      hearth_rigid_apply(&vr.T, P, Q);
+      if (!synth_lens_project(v->cam, Q, uv)) break;
+      row = uv[1];
+    }
+    det->centres[i][0] = uv[0];
+    det->centres[i][1] = uv[1];
   }
 }
 
@@ -597,6 +692,15 @@ hearth_status synth_tone_map8(const hearth_image *temps, hearth_image *out, hear
   return HEARTH_OK;
 }
 
+/* the hand-held plate's flex in one frame: U(-m, m) of bow, from the
+ * frame's own fork of base (nothing drawn when m is 0) */
+static double plate_flex(const hearth_rng *base, uint64_t fork, double m) {
+  if (m <= 0) return 0.0;
+  hearth_rng r;
+  hearth_rng_fork(base, fork, &r);
+  return m * hearth_rng_range(&r, -1.0, 1.0);
+}
+
 hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
                                       const hearth_synth_opts *o, uint64_t seed,
                                       const float *thermal_rays, const float *rgb_rays,
@@ -647,6 +751,7 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
   const hearth_synth_effects *E = &o->effects;
   plate_fx fx0;
   memset(&fx0, 0, sizeof fx0);
+  double bow0 = 0.0; /* the plate's own bow; each frame adds the hand's flex */
   if (phys) {
     hearth_rng b;
     hearth_rng_fork(&base, 77001, &b);
@@ -665,6 +770,26 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
     fx0.fpn_offset = E->fpn_offset_c;
     fx0.fpn_gain = E->fpn_gain;
     fx0.fpn_seed = hearth_rng_u64(&b);
+    /* the plate's bow and its holes' rims, from a stream of their own */
+    hearth_rng wb;
+    hearth_rng_fork(&base, 77002, &wb);
+    bow0 = E->plate_bow_m * hearth_rng_range(&wb, 0.5, 1.0) *
+           (hearth_rng_uniform(&wb) < 0.5 ? -1.0 : 1.0);
+    g->bow = bow0;
+    if (E->hole_burr_m > 0) {
+      /* each term within 3 sigma; burr_max the largest sum of magnitudes */
+      const double lim = 3.0 * E->hole_burr_m;
+      for (size_t i = 0; i < g->n; i++) {
+        double sum = 0;
+        for (int k = 0; k < 6; k++) {
+          double a = E->hole_burr_m * hearth_rng_normal(&wb);
+          a = a < -lim ? -lim : a > lim ? lim : a;
+          g->burr[i][k] = (float)a;
+          sum += fabs((double)g->burr[i][k]);
+        }
+        if (sum > g->burr_max) g->burr_max = sum;
+      }
+    }
     if (fx0.thickness > 0) {
       /* the plate's thickness, measured (callipers) and given to the pipeline */
       hearth_target tt = g->t;
@@ -683,6 +808,7 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
     hearth_rng_fork(&base, 1000 + (uint64_t)i, &r);
     hearth_rng_fork(&base, 5000 + (uint64_t)i, &noise);
     int partial = (i % 9) == 4, blurred = (i % 9) == 7;
+    if (phys) g->bow = bow0 + plate_flex(&base, 11000 + (uint64_t)i, E->plate_flex_m);
     hearth_rigid T;
     for (int tries = 0; tries < 200; tries++) {
       double d = hearth_rng_range(&r, 0.22, 0.40) * ds;
@@ -719,6 +845,7 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
     hearth_rng_fork(&base, 2000 + (uint64_t)i, &r);
     hearth_rng_fork(&base, 6000 + (uint64_t)i, &noise);
     int partial = (i % 8) == 3, blurred = (i % 8) == 6;
+    if (phys) g->bow = bow0 + plate_flex(&base, 12000 + (uint64_t)i, E->plate_flex_m);
     hearth_rigid T_th, T_rgb;
     for (int tries = 0; tries < 200; tries++) {
       double d = hearth_rng_range(&r, 0.27, 0.45) * ds;
@@ -755,34 +882,28 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
       vc.fx.motion_px = E->motion_blur_px * hearth_rng_uniform(&f);
       vc.fx.motion_dir = hearth_rng_range(&f, 0, 2 * 3.14159265358979323846);
       /* the trigger offset: the hand-held plate moves between the thermal
-       * and the colour exposure, a small rigid motion about its centre */
+       * and the colour exposure, a small rigid motion about its centre; a
+       * rolling shutter reads each row at its own time of that motion */
       double dt = 1e-3 * E->trigger_ms * hearth_rng_uniform(&f);
-      double a[3], w[3], tr[3], na = 0, nw = 0;
+      double na = 0, nw = 0;
       for (int k = 0; k < 3; k++) {
-        a[k] = hearth_rng_normal(&f);
-        w[k] = hearth_rng_normal(&f);
-        na += a[k] * a[k];
-        nw += w[k] * w[k];
+        vc.fx.mv_a[k] = hearth_rng_normal(&f);
+        vc.fx.mv_w[k] = hearth_rng_normal(&f);
+        na += vc.fx.mv_a[k] * vc.fx.mv_a[k];
+        nw += vc.fx.mv_w[k] * vc.fx.mv_w[k];
       }
-      na = sqrt(na);
-      nw = sqrt(nw);
-      for (int k = 0; k < 3; k++) {
-        tr[k] = E->hand_speed_m_s * dt * a[k] / (na > 0 ? na : 1);
-        w[k] = E->hand_turn_rad_s * dt * w[k] / (nw > 0 ? nw : 1);
-      }
-      hearth_rigid M;
-      double pc[3], C[3], RC[3];
-      hearth_rotvec_to_matrix(w, M.R);
+      vc.fx.mv_na = sqrt(na);
+      vc.fx.mv_nw = sqrt(nw);
+      vc.fx.mv_speed = E->hand_speed_m_s;
+      vc.fx.mv_turn = E->hand_turn_rad_s;
+      vc.fx.T0 = T_rgb;
+      double pc[3];
       synth_plate_centre(g, pc);
-      hearth_rigid_apply(&T_rgb, pc, C);
-      hearth_rigid_rotate(&M, C, RC);
-      for (int k = 0; k < 3; k++) M.t[k] = C[k] - RC[k] + tr[k];
-      hearth_rigid moved;
-      hearth_rigid_compose(&M, &T_rgb, &moved);
-      T_rgb = moved;
-      vc.T = T_rgb;
-      for (int k = 0; k < 3; k++) vc.n[k] = T_rgb.R[k * 3 + 2];
-      vc.nt = dot3(vc.n, T_rgb.t);
+      hearth_rigid_apply(&T_rgb, pc, vc.fx.mv_pivot);
+      vc.fx.trigger_s = dt;
+      vc.fx.readout_s = 1e-3 * E->rs_readout_ms;
+      plate_moved(&vc.fx, dt, &T_rgb);
+      plate_view_set_pose(&vc, &T_rgb);
     }
     char name[16];
     snprintf(name, sizeof name, "p%03d", i);
@@ -797,7 +918,9 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
       hearth_image_free(&img);
     }
     det_fill(&dets.frames[dets.n++], name, "thermal", &rig->thermal, g, &T_th);
-    det_fill(&dets.frames[dets.n++], name, "rgb", &rig->rgb, g, &T_rgb);
+    det_fill(&dets.frames[dets.n], name, "rgb", &rig->rgb, g, &T_rgb);
+    if (dets.frames[dets.n].found && vc.fx.readout_s > 0) rs_truth(&vc, &dets.frames[dets.n]);
+    dets.n++;
     hearth_progress_step(&prog, 1);
   }
   hearth_progress_end(&prog);

@@ -62,6 +62,10 @@ void hearth_synth_effects_default(hearth_synth_effects *e) {
   e->trigger_ms = 2.0;
   e->hand_speed_m_s = 0.05;
   e->hand_turn_rad_s = 0.1;
+  e->rs_readout_ms = 20.0;
+  e->plate_bow_m = 5e-5;
+  e->plate_flex_m = 2e-4;
+  e->hole_burr_m = 0.0;
 }
 
 size_t hearth_synth_categories(const char **names, size_t max) {

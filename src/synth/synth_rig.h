@@ -116,6 +116,14 @@ typedef struct synth_plate_geom {
   int row_start[65];
   double holes[HEARTH_TARGET_MAX_HOLES][2];
   double ext_x, ext_y, cx, cy, half_w, half_h;
+  /* the plate's bow: its front face at plate z = bow (1 - rho^2), rho^2 the
+   * squared distance from the centre over half_w^2 + half_h^2 (0: flat) */
+  double bow;
+  /* each hole's rim irregularity: radius r + sum_k a_k cos(k phi) + b_k
+   * sin(k phi), k = 1..3, as {a1, b1, a2, b2, a3, b3}; burr_max bounds the
+   * sum (0: round holes, burr unused) */
+  double burr_max;
+  float burr[HEARTH_TARGET_MAX_HOLES][6];
 } synth_plate_geom;
 /* target may be NULL or zeroed (the paper's plate, 200 x 150 mm). */
 void synth_plate_geom_init(synth_plate_geom *g, const hearth_target *target);

@@ -1,7 +1,8 @@
 /* The calibration bench with its physics on (the default synth: a plate of
  * real thickness, a lamp-heated backing, a warming plate, vignetting and
  * fixed-pattern noise in thermal, motion blur and JPEG in colour, a trigger
- * offset between the cameras): `hearth detect` + `hearth calibrate` must
+ * offset between the cameras, the colour camera's rolling shutter, a bowed
+ * plate flexing in the hand): `hearth detect` + `hearth calibrate` must
  * still meet the release targets against the rig's ground truth (thermal
  * focal within 0.2 %, T_thermal_from_rgb within 0.05 deg and 0.5 mm). */
 #include <math.h>
@@ -68,6 +69,9 @@ int main(void) {
   CHECK(fabs(r.thermal.fy / t.thermal.fy - 1) < 0.002);
   CHECK(ang * 180 / M_PI < 0.05);
   CHECK(dt < 0.0005);
-  CHECK(r.stereo_rms_px < 0.5);
+  /* the colour camera's rolling shutter and the plate's flex, which the
+     pipeline does not model, lift the stereo RMS from the clean bench's
+     ~0.03 px towards the paper's 0.1..0.5 px */
+  CHECK_MSG(r.stereo_rms_px >= 0.05 && r.stereo_rms_px < 0.5, "stereo RMS %g", r.stereo_rms_px);
   TEST_MAIN_END();
 }
