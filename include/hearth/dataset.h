@@ -82,8 +82,10 @@ typedef struct hearth_view_files {
   char view[HEARTH_NAME_MAX]; /* "v00" */
   int elevation_index, azimuth_index;
   char rgb[128], cutout[128], depth[128], depth_intrinsics[128], thermal[128];
-  int has_time;  /* the optional "time_s" is present */
-  double time_s; /* seconds from the preparation of the state (0..1e6) to this view */
+  int has_time;         /* the optional "time_s" is present */
+  double time_s;        /* seconds from the preparation of the state (0..1e6) to this view */
+  int has_turntable;    /* the optional "turntable_deg" is present */
+  double turntable_deg; /* the turntable encoder's angle at this view, degrees (-3600..3600) */
 } hearth_view_files;
 
 typedef struct hearth_manifest {

@@ -127,8 +127,17 @@ hearth_status hearth_recon_tsdf(const char *root, const char *instance, const ch
  * degrees of every view jointly over all views of all states (pairs of
  * views whose optical axes are within max_pair_deg, projective association
  * in the target's depth image, Huber weights, a shrinking distance gate;
- * view 0 holds the gauge), with each view's table points held at z = 0 and
- * the turntable's azimuth as a weak prior. The frame of the result: metres,
+ * view 0 holds the gauge), with each view's table points (those within
+ * 0.25 m of its object points) held at z = 0 and the turntable's azimuth
+ * as a weak prior. Where every view of a state carries the manifest's
+ * turntable_deg (and not ignore_encoder), the differences of those views'
+ * angles are held stiffly to the encoder's, over all such states at once
+ * (or each alone: encoder_per_state). The angle of a view is the heading
+ * of the camera's tilt axis: the direction of the camera frame normal to
+ * all views' table normals (a turntable camera tilts about it between
+ * rings); with colour_weight > 0 the views without the encoder add a
+ * photometric term (recon_photo.c: band-passed grey inside the cut-out,
+ * view i's point against view j's image at its depth correspondence). The frame of the result: metres,
  * +z up the axis, the turntable top at z = 0, view 0's azimuth at its
  * nominal value. A surface of revolution without azimuthal detail leaves
  * the angle about its own axis unobserved by its depth: those views keep
@@ -145,6 +154,19 @@ typedef struct hearth_turntable_opts {
   double azimuth_prior;    /* weight (m^2/rad^2) pulling each angle towards the
                               turntable's: (depth noise / azimuth spread)^2;
                               default 3e-3 (0.8 mm, 0.9 degrees) */
+  double encoder_prior;    /* weight, per match a view has, holding the
+                              differences of a state's headings to those of
+                              the manifest's turntable_deg; default 1 */
+  int ignore_encoder;      /* 1: leave the manifest's turntable_deg unused */
+  int encoder_per_state;   /* 1: only angles within a state's pass are compared
+                              (the object was put back between states); 0
+                              (default): one turntable frame for all states */
+  double colour_weight;    /* weight (m^2 per squared grey level, 0..1) of the
+                              photometric term of the views without the
+                              encoder, about (depth noise / grey noise)^2 =
+                              1e-2; default 0 (off: on the virtual rig it
+                              does not yet improve on depth alone) */
+  int colour_with_encoder; /* 1: the photometric term on the encoder's views too */
   int threads;             /* 0: hearth_default_threads() */
   int quiet;               /* 1: no progress on stderr */
 } hearth_turntable_opts;
@@ -171,6 +193,8 @@ typedef struct hearth_turntable_result {
   int iterations;
   double icp_rms_start_mm, icp_rms_mm; /* over all matches, first and last iteration */
   double icp_median_mm;                /* |distance| median at the end */
+  size_t n_encoder_views;              /* views held to a recorded turntable angle */
+  size_t n_colour_views;               /* views with the photometric term */
   double seconds;
 } hearth_turntable_result;
 void hearth_turntable_result_free(hearth_turntable_result *r); /* accepts a zeroed one */
@@ -260,7 +284,7 @@ hearth_status hearth_mesh_atlas(const hearth_mesh *in, const hearth_atlas_opts *
  * (hearth_mesh_atlas) as recon/mesh.glb (UVs, no texture: map --rgb bakes
  * the colour texture into derived/), and recon/report.json:
  *   {"instance", "route": "turntable", "views": N, "pairs", "iterations",
- *    "icp_rms_start_mm", "icp_rms_mm", "icp_median_mm", "seconds",
+ *    "encoder_views", "colour_views", "icp_rms_start_mm", "icp_rms_mm", "icp_median_mm", "seconds",
  *    "mesh": {"vertices", "triangles", "voxel_m"},
  *    "atlas": {"charts", "stretch_l2", "stretch_l2_max", "area_distortion",
  *              "angle_distortion", "packing_efficiency"},

@@ -104,7 +104,11 @@ static const char *k_about =
     "its camera's tilt and height; the turntable geometry (azimuth index x --azimuth-step,\n"
     "plus --ring-shift per elevation index) starts the angle about the axis; joint\n"
     "point-to-plane ICP on the cut-out depth of all views of all states refines the angles\n"
-    "and horizontal positions. Writes recon/poses_rgb.json (metres, +z up the axis, the\n"
+    "and horizontal positions. A state whose manifest records the turntable's encoder\n"
+    "angle (turntable_deg) per view has its angles held to it; --colour W adds, to the\n"
+    "states without it, a photometric term (each view's band-passed grey against its\n"
+    "neighbours').\n"
+    "Writes recon/poses_rgb.json (metres, +z up the axis, the\n"
     "turntable top at z = 0), recon/poses_rgb_cameras.json (the factory colour camera),\n"
     "recon/mesh_geometry.glb (the depth maps fused with those poses; no UVs),\n"
     "recon/mesh.glb (that mesh with a UV atlas of its own: normal-clustered disc charts,\n"
@@ -164,6 +168,12 @@ int hearth_cmd_recon(int argc, char **argv) {
               "turntable: azimuth added per elevation index", .def = "12"),
       CLI_FLAG("--clockwise", &tj.poses.direction, -1,
                "turntable: azimuth grows clockwise seen from above"),
+      CLI_FLAG("--no-encoder", &tj.poses.ignore_encoder, 1,
+               "turntable: leave the manifests' turntable_deg unused"),
+      CLI_NUM("--colour", "W", &tj.poses.colour_weight, 0, 10,
+              "turntable: weight of the photometric term of states without turntable_deg "
+              "(about 0.01; experimental)",
+              .def = "0: off"),
       CLI_NUM("--voxel", "M", &tj.geometry.voxel_m, 0.0002, 0.05,
               "turntable: TSDF voxel of the mesh (metres)", .def = "0.002"),
       CLI_SIZE("--triangles", "N", &tj.geometry.target_triangles, 0, 10000000,

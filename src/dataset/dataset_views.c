@@ -84,6 +84,15 @@ static hearth_status view_files_from_json(hj_ctx *c, const json_t *v, void *elem
       return hj_fail(c, HEARTH_E_RANGE, "time_s: expected seconds in 0..1e6, found %g", f->time_s);
     f->has_time = 1;
   }
+  f->has_turntable = 0;
+  f->turntable_deg = 0;
+  if (json_object_get(v, "turntable_deg")) {
+    if ((s = hj_get_number(c, v, "turntable_deg", &f->turntable_deg))) return s;
+    if (!(f->turntable_deg >= -3600 && f->turntable_deg <= 3600))
+      return hj_fail(c, HEARTH_E_RANGE, "turntable_deg: expected degrees in -3600..3600, found %g",
+                     f->turntable_deg);
+    f->has_turntable = 1;
+  }
   return HEARTH_OK;
 }
 
@@ -218,7 +227,8 @@ hearth_status hearth_manifest_write(const char *path, const hearth_manifest *m, 
          hj_set(v, "depth", hj_str(f->depth)) &&
          hj_set(v, "depth_intrinsics", hj_str(f->depth_intrinsics)) &&
          hj_set(v, "thermal", hj_str(f->thermal)) &&
-         (!f->has_time || hj_set(v, "time_s", hj_real(f->time_s)));
+         (!f->has_time || hj_set(v, "time_s", hj_real(f->time_s))) &&
+         (!f->has_turntable || hj_set(v, "turntable_deg", hj_real(f->turntable_deg)));
     if (!ok || json_array_append_new(vv, v) != 0) {
       if (ok) ok = 0;
       else json_decref(v);

@@ -61,6 +61,22 @@ int rc_track_check(const hearth_colmap_model *m, uint32_t image_id, uint32_t poi
  * object: the alpha channel when there is one, any non-zero channel else. */
 int rc_cutout_at(const hearth_image *c, size_t p);
 
+/* ---- a colour view for the photometric term (recon_photo.c) --------------- */
+/* The grey level of a colour view at half resolution, band-passed inside
+ * its cut-out (NaN off the object). */
+typedef struct rc_photo {
+  int w, h;
+  float *img; /* w * h, owned */
+} rc_photo;
+/* Reads rgb_path (JPEG) and its cut-out cut_path, both of the colour
+ * camera's size. */
+hearth_status rc_photo_load(const char *rgb_path, const char *cut_path, const hearth_camera *rgb,
+                            rc_photo *ph, hearth_err *err);
+void rc_photo_free(rc_photo *ph); /* accepts a zeroed one */
+/* The value at full-resolution pixel uv and, when grad is non-NULL, its
+ * gradient per full-resolution pixel; 0 when that is off the object. */
+int rc_photo_sample(const rc_photo *ph, const double uv[2], double *val, double grad[2]);
+
 /* ---- JSON text (cameras document) ----------------------------------------- */
 /* x in the shortest of %.15g/%.16g/%.17g that reads back to the same
  * double, with '.' whatever the locale and ".0" where it would read as an

@@ -24,12 +24,18 @@
 #define TT_PLANE_TOL_M 0.004
 /* table-plane points each view keeps for the ICP's plane term */
 #define TT_PLANE_SAMPLES 1500
+/* table points farther than this from the object's points are left out */
+#define TT_PLANE_NEAR_M 0.25
 /* table planes fitting within this rms get the full weight */
 #define TT_PLANE_GOOD_M 0.0004
 /* Huber threshold of the ICP distances */
 #define TT_HUBER_M 0.0015
 /* correspondences must have normals within this angle */
 #define TT_NORMAL_COS 0.7
+/* Huber threshold and gate of the photometric residuals (band-passed grey,
+ * 0..1) */
+#define TT_COLOUR_HUBER 0.02
+#define TT_COLOUR_GATE 0.15
 
 void hearth_turntable_opts_default(hearth_turntable_opts *o) {
   memset(o, 0, sizeof *o);
@@ -41,6 +47,8 @@ void hearth_turntable_opts_default(hearth_turntable_opts *o) {
   o->max_pair_deg = 65.0;
   o->erode_px = 8.0;
   o->azimuth_prior = 3e-3;
+  o->encoder_prior = 1.0;
+  o->colour_weight = 0;
 }
 
 void hearth_turntable_result_free(hearth_turntable_result *r) {
@@ -69,11 +77,23 @@ typedef struct tt_view {
   size_t npl;
   float *pl; /* 3 * npl: table-plane inliers (a subsample), colour frame */
   /* pose parameters: T_world_from_cam = (Rz(psi) L, (x, y, height)) */
-  double psi, psi0, x, y;
-  hearth_rigid T; /* current pose */
+  double psi, x, y;
+  /* the heading of the tilt axis (world) the priors pull towards: the
+   * nominal azimuth's, or the encoder's aligned to it; enc: its state's
+   * views all carry the encoder angle */
+  double target, target_nominal;
+  int enc;
+  size_t state_index; /* its encoder group: its state's index, or 0 for all */
+  hearth_rigid T;     /* current pose */
+  /* the photometric term's view (without the encoder) and each point's
+   * band-passed grey in it (NaN: none) */
+  rc_photo photo;
+  float *col;
 } tt_view;
 
 static void tt_view_free(tt_view *v) {
+  rc_photo_free(&v->photo);
+  free(v->col);
   free(v->pl);
   free(v->index);
   free(v->p);
@@ -371,13 +391,28 @@ static hearth_status load_view(tt_view *v, const char *dir, const hearth_view_fi
         cls[p] = 2;
       }
     }
-  /* background points for the plane */
-  size_t nb = 0;
+  /* background points for the plane: those within TT_PLANE_NEAR_M of the
+   * object's points' mean (the turntable top around it, not a backdrop or
+   * far table seen at grazing incidence), or all when too few are */
+  double om[3] = {0, 0, 0};
+  size_t no = 0;
   for (size_t p = 0; p < (size_t)W * H; p++)
-    if (cls[p] == 2) {
+    if (cls[p] == 1) {
+      for (int a = 0; a < 3; a++) om[a] += pts[3 * p + a];
+      no++;
+    }
+  for (int a = 0; a < 3; a++) om[a] /= no ? (double)no : 1.0;
+  size_t nb = 0;
+  for (int pass = 0; pass < 2 && nb < TT_MIN_PLANE; pass++) {
+    nb = 0;
+    for (size_t p = 0; p < (size_t)W * H; p++) {
+      if (cls[p] != 2) continue;
+      double d[3] = {pts[3 * p] - om[0], pts[3 * p + 1] - om[1], pts[3 * p + 2] - om[2]};
+      if (pass == 0 && no && hearth_norm3(d) > TT_PLANE_NEAR_M) continue;
       for (int a = 0; a < 3; a++) dirs[3 * nb + a] = pts[3 * p + a];
       nb++;
     }
+  }
   if (!table_plane(v, dirs, nb, seed)) {
     s = hearth_err_set(err, HEARTH_E_NUMERIC,
                        "%s: no turntable plane found (%zu depth pixels off the cut-out)",
@@ -468,6 +503,27 @@ done:
   return s;
 }
 
+/* the view's colour image for the photometric term, and each object
+ * point's band-passed grey in it */
+static hearth_status load_colour(tt_view *v, const char *dir, const hearth_view_files *vf,
+                                 const hearth_camera *rgb, hearth_err *err) {
+  char rgb_path[1400], cut_path[1400];
+  snprintf(rgb_path, sizeof rgb_path, "%s/%s", dir, vf->rgb);
+  snprintf(cut_path, sizeof cut_path, "%s/%s", dir, vf->cutout);
+  hearth_status s = rc_photo_load(rgb_path, cut_path, rgb, &v->photo, err);
+  if (s) return s;
+  if (!(v->col = malloc((v->n ? v->n : 1) * sizeof *v->col)))
+    return hearth_err_set(err, HEARTH_E_NOMEM, "%s", rgb_path);
+  for (size_t k = 0; k < v->n; k++) {
+    double p[3] = {v->p[3 * k], v->p[3 * k + 1], v->p[3 * k + 2]}, uv[2], val;
+    v->col[k] =
+        hearth_camera_project(rgb, p, uv, NULL) && rc_photo_sample(&v->photo, uv, &val, NULL)
+            ? (float)val
+            : NAN;
+  }
+  return HEARTH_OK;
+}
+
 /* ---- joint ICP ------------------------------------------------------------ */
 typedef struct tt_pair {
   size_t i, j;
@@ -477,6 +533,11 @@ typedef struct tt_pair {
   double ss, ss_all; /* weighted squared distances, squared distances */
   size_t m;
   float *r; /* |distance| of each match (for the median), m of them */
+  /* the photometric term: the gain from view i's band-passed grey to view
+   * j's (fit to the last iteration's matches), its sums, matches and
+   * weighted squared residuals */
+  double gain, s_cc, s_ci, ss_col;
+  size_t m_col;
 } tt_pair;
 
 typedef struct tt_ctx {
@@ -484,7 +545,47 @@ typedef struct tt_ctx {
   tt_pair *pairs;
   size_t max_points;
   double gate;
+  const hearth_camera *rgb;
+  double colour_w;
 } tt_ctx;
+
+/* view i's point q (world) against view j's colour image: the residual
+ * I_j(project(q)) - gain * c with its Jacobian in (w_i, t_i, w_j, t_j) */
+static void colour_term(const tt_ctx *c, tt_pair *pr, const hearth_rigid *Tb_inv, const double q[3],
+                        double col) {
+  const tt_view *a = &c->v[pr->i], *b = &c->v[pr->j];
+  double X[3], uv[2], val, gr[2];
+  hearth_project_jac jac;
+  hearth_rigid_apply(Tb_inv, q, X);
+  if (!hearth_camera_project(c->rgb, X, uv, &jac)) return;
+  if (!rc_photo_sample(&b->photo, uv, &val, gr)) return;
+  pr->s_cc += col * col;
+  pr->s_ci += col * val;
+  double r = val - pr->gain * col;
+  if (fabs(r) > TT_COLOUR_GATE) return;
+  /* dI/dX (camera j), then world: g = R_j (J^T grad) */
+  double gX[3], g[3];
+  for (int k = 0; k < 3; k++) gX[k] = gr[0] * jac.d_point[k] + gr[1] * jac.d_point[3 + k];
+  hearth_rigid_rotate(&b->T, gX, g);
+  double qa[3] = {q[0] - a->T.t[0], q[1] - a->T.t[1], q[2] - a->T.t[2]};
+  double qb[3] = {q[0] - b->T.t[0], q[1] - b->T.t[1], q[2] - b->T.t[2]};
+  double J[12], ci[3], cj[3];
+  hearth_cross3(qa, g, ci);
+  hearth_cross3(qb, g, cj);
+  for (int x = 0; x < 3; x++) {
+    J[x] = ci[x];
+    J[3 + x] = g[x];
+    J[6 + x] = -cj[x];
+    J[9 + x] = -g[x];
+  }
+  double wgt = c->colour_w * (fabs(r) <= TT_COLOUR_HUBER ? 1.0 : TT_COLOUR_HUBER / fabs(r));
+  for (int x = 0; x < 12; x++) {
+    pr->g[x] += wgt * J[x] * r;
+    for (int y = 0; y < 12; y++) pr->H[12 * x + y] += wgt * J[x] * J[y];
+  }
+  pr->ss_col += r * r;
+  pr->m_col++;
+}
 
 /* matches of view i's points in view j's depth image, accumulated */
 static void pair_system(const tt_ctx *c, tt_pair *pr) {
@@ -493,6 +594,9 @@ static void pair_system(const tt_ctx *c, tt_pair *pr) {
   memset(pr->g, 0, sizeof pr->g);
   pr->ss = pr->ss_all = 0;
   pr->m = 0;
+  pr->s_cc = pr->s_ci = pr->ss_col = 0;
+  pr->m_col = 0;
+  int colour = c->colour_w > 0 && a->col && b->photo.img;
   hearth_rigid Tb_inv, T_depth_from_world;
   hearth_rigid_inverse(&b->T, &Tb_inv);
   hearth_rigid_compose(&b->T_depth_from_rgb, &Tb_inv, &T_depth_from_world);
@@ -539,7 +643,10 @@ static void pair_system(const tt_ctx *c, tt_pair *pr) {
     pr->ss_all += r * r;
     if (pr->r) pr->r[pr->m] = (float)fabs(r);
     pr->m++;
+    if (colour && !isnan(a->col[k])) colour_term(c, pr, &Tb_inv, q, a->col[k]);
   }
+  /* the gain for the next iteration */
+  if (colour && pr->s_cc > 0) pr->gain = fmin(2.0, fmax(0.5, pr->s_ci / pr->s_cc));
 }
 
 static void pairs_range(void *vctx, size_t b, size_t e, int ti) {
@@ -581,16 +688,58 @@ static int cmp_float(const void *a, const void *b) {
   return (x > y) - (x < y);
 }
 
-/* the direction of view v's optical axis about the vertical (psi of the
- * start) */
-static double heading(const tt_view *v) { return atan2(v->T.R[5], v->T.R[2]); }
+static void mat3_vec(const double R[9], const double x[3], double y[3]) {
+  for (int a = 0; a < 3; a++) y[a] = R[3 * a] * x[0] + R[3 * a + 1] * x[1] + R[3 * a + 2] * x[2];
+}
+
+/* the heading about the vertical of the tilt axis u (camera frame) of view
+ * v in the world */
+static double heading(const tt_view *v, const double u[3]) {
+  double d[3];
+  mat3_vec(v->T.R, u, d);
+  return atan2(d[1], d[0]);
+}
+
+/* The camera's tilt axis in its own frame: the direction that stays
+ * horizontal in every view, the one normal to all the views' table normals
+ * (their scatter's smallest axis) when the elevations differ enough to fix
+ * it, else the camera's x axis made normal to their mean; signed along +x.
+ * A turntable camera tilts about it between rings, so its heading moves
+ * with the turntable angle alone at every elevation. */
+static void tilt_axis(const tt_view *v, size_t nv, double u[3]) {
+  double C[9] = {0}, m[3] = {0, 0, 0};
+  for (size_t i = 0; i < nv; i++)
+    for (int a = 0; a < 3; a++) {
+      m[a] += v[i].L[6 + a];
+      for (int b = 0; b < 3; b++) C[3 * a + b] += v[i].L[6 + a] * v[i].L[6 + b];
+    }
+  double w[3], V[9];
+  sym3_eigen(C, w, V);
+  int k = 0;
+  for (int i = 1; i < 3; i++)
+    if (w[i] < w[k]) k = i;
+  double w1 = INFINITY;
+  for (int i = 0; i < 3; i++)
+    if (i != k && w[i] < w1) w1 = w[i];
+  /* normals spread by 10 degrees or more about the mean */
+  if (w1 > (double)nv * pow(sin(10.0 * TT_DEG), 2) / 2.0) {
+    for (int a = 0; a < 3; a++) u[a] = V[3 * a + k];
+  } else {
+    double lm = hearth_norm3(m);
+    for (int a = 0; a < 3; a++) m[a] /= lm;
+    for (int a = 0; a < 3; a++) u[a] = (a == 0) - m[0] * m[a];
+  }
+  double lu = hearth_norm3(u);
+  for (int a = 0; a < 3; a++) u[a] /= (u[0] < 0 ? -lu : lu);
+}
 
 /* view v's optical axis (unit, world) */
 static void view_dir(const tt_view *v, double d[3]) {
   for (int a = 0; a < 3; a++) d[a] = v->T.R[3 * a + 2];
 }
 
-static hearth_status run_icp(tt_view *v, size_t nv, const hearth_turntable_opts *o,
+static hearth_status run_icp(tt_view *v, size_t nv, size_t n_states, const double u[3],
+                             const hearth_camera *rgb, const hearth_turntable_opts *o,
                              hearth_turntable_result *res, hearth_err *err) {
   const int iterations = o->iterations;
   const double gate0 = 0.025;
@@ -608,6 +757,7 @@ static hearth_status run_icp(tt_view *v, size_t nv, const hearth_turntable_opts 
       if (hearth_dot3(di, dj) < cmax) continue;
       pairs[np].i = i;
       pairs[np].j = j;
+      pairs[np].gain = 1.0;
       np++;
     }
   const size_t nu = 6 * (nv - 1);
@@ -620,7 +770,7 @@ static hearth_status run_icp(tt_view *v, size_t nv, const hearth_turntable_opts 
   }
   hearth_progress prog;
   hearth_progress_begin(&prog, "recon: ICP", (size_t)iterations, o->quiet);
-  tt_ctx c = {v, pairs, o->max_points, 0.02};
+  tt_ctx c = {v, pairs, o->max_points, 0.02, rgb, o->colour_weight};
   hearth_status s = HEARTH_OK;
   double rms = 0;
   for (int it = 0; it < iterations && !s; it++) {
@@ -678,9 +828,33 @@ static hearth_status run_icp(tt_view *v, size_t nv, const hearth_turntable_opts 
        * squared ratio of the depth noise to the azimuth's spread), so an
        * angle no match constrains (about a surface of revolution) stays
        * at the turntable's */
-      double dh = remainder(heading(tv) - tv->psi0, 2 * TT_PI);
+      double dh = remainder(heading(tv, u) - tv->target, 2 * TT_PI);
       Av[2 * nu + 2] += o->azimuth_prior;
       bv[2] -= o->azimuth_prior * dh;
+    }
+    /* the encoder: within each state that records it, the headings'
+     * differences held to the encoder's, r_k = dh_k - mean(dh) over the
+     * state's views, weighted as encoder_prior times a view's matches (its
+     * Jacobian in the headings is the centring projection; view 0 fixed) */
+    double we = o->encoder_prior * (double)(m / (nv ? nv : 1) + 1);
+    for (size_t st = 0; st < n_states && we > 0; st++) {
+      double mean = 0;
+      size_t ns = 0;
+      for (size_t vi = 0; vi < nv; vi++)
+        if (v[vi].enc && v[vi].state_index == st) {
+          mean += remainder(heading(&v[vi], u) - v[vi].target, 2 * TT_PI);
+          ns++;
+        }
+      if (ns < 2) continue;
+      mean /= (double)ns;
+      for (size_t vi = 1; vi < nv; vi++) {
+        if (!v[vi].enc || v[vi].state_index != st) continue;
+        size_t gi = 6 * (vi - 1) + 2;
+        b[gi] -= we * (remainder(heading(&v[vi], u) - v[vi].target, 2 * TT_PI) - mean);
+        for (size_t vj = 1; vj < nv; vj++)
+          if (v[vj].enc && v[vj].state_index == st)
+            A[gi * nu + 6 * (vj - 1) + 2] += we * ((vi == vj) - 1.0 / (double)ns);
+      }
     }
     /* a scaled Levenberg term and a small floor */
     for (size_t d = 0; d < nu; d++) A[d * nu + d] = A[d * nu + d] * 1.01 + 1e-6;
@@ -769,6 +943,13 @@ hearth_status hearth_recon_turntable(const char *root, const char *instance,
     snprintf(path, sizeof path, "%s/instances/%s/raw/%s/manifest.json", root, instance, states[i]);
     if (!(s = hearth_manifest_read(path, &man[i], err))) nv += man[i].n_views;
   }
+  /* a state whose views all carry the encoder's angle is held to it; the
+   * others get the photometric term */
+  int state_enc[HEARTH_MAX_STATES] = {0};
+  for (size_t i = 0; i < n_states && !s && i < HEARTH_MAX_STATES; i++) {
+    state_enc[i] = !o.ignore_encoder && man[i].n_views > 0;
+    for (size_t j = 0; j < man[i].n_views; j++) state_enc[i] &= man[i].views[j].has_turntable;
+  }
   tt_view *v = s ? NULL : calloc(nv ? nv : 1, sizeof *v);
   if (!s && !v) s = hearth_err_set(err, HEARTH_E_NOMEM, "turntable: views");
   if (!s && nv < 2)
@@ -789,6 +970,9 @@ hearth_status hearth_recon_turntable(const char *root, const char *instance,
       tv->elevation_index = vf->elevation_index;
       tv->azimuth_index = vf->azimuth_index;
       s = load_view(tv, dir, vf, &fac.rgb, o.erode_px, 0x7475726eULL + k, &rays, err);
+      if (!s && (!state_enc[i] || o.colour_with_encoder) && o.colour_weight > 0)
+        s = load_colour(tv, dir, vf, &fac.rgb, err);
+      if (!s && tv->col) res.n_colour_views++;
       hearth_progress_step(&prog, 1);
     }
   }
@@ -796,15 +980,46 @@ hearth_status hearth_recon_turntable(const char *root, const char *instance,
   free(rays.dirs);
   if (!s && !(res.views = calloc(nv, sizeof *res.views)))
     s = hearth_err_set(err, HEARTH_E_NOMEM, "turntable: report");
+  double u[3] = {1, 0, 0};
   if (!s) {
-    /* the start: nominal azimuths, the object's centroid on the axis */
+    tilt_axis(v, nv, u);
+    /* the start: nominal azimuths (or the encoder's angles, aligned to
+     * them in the mean over each encoder group), the object's centroid on
+     * the axis; the tilt axis of a camera at azimuth phi looking at the
+     * axis heads phi + pi / 2 */
+    k = 0;
+    for (size_t i = 0; i < n_states; i++) {
+      int enc = state_enc[i];
+      for (size_t j = 0; j < man[i].n_views; j++) {
+        tt_view *tv = &v[k + j];
+        double phi =
+            o.direction *
+            (tv->azimuth_index * o.azimuth_step_deg + tv->elevation_index * o.ring_shift_deg) *
+            TT_DEG;
+        tv->target = tv->target_nominal = phi + TT_PI / 2;
+        tv->state_index = o.encoder_per_state ? i : 0;
+        tv->enc = enc;
+        if (enc) tv->target = o.direction * man[i].views[j].turntable_deg * TT_DEG + TT_PI / 2;
+      }
+      if (enc) res.n_encoder_views += man[i].n_views;
+      k += man[i].n_views;
+    }
+    for (size_t g = 0; g < n_states; g++) {
+      double cs = 0, sn = 0;
+      for (size_t i = 0; i < nv; i++)
+        if (v[i].enc && v[i].state_index == g) {
+          cs += cos(v[i].target_nominal - v[i].target);
+          sn += sin(v[i].target_nominal - v[i].target);
+        }
+      double off = cs || sn ? atan2(sn, cs) : 0;
+      for (size_t i = 0; i < nv; i++)
+        if (v[i].enc && v[i].state_index == g) v[i].target += off;
+    }
     for (size_t i = 0; i < nv; i++) {
       tt_view *tv = &v[i];
-      double phi =
-          o.direction *
-          (tv->azimuth_index * o.azimuth_step_deg + tv->elevation_index * o.ring_shift_deg) *
-          TT_DEG;
-      tv->psi = tv->psi0 = phi + TT_PI; /* forward points at the axis */
+      double Lu[3];
+      mat3_vec(tv->L, u, Lu);
+      tv->psi = tv->target - atan2(Lu[1], Lu[0]);
       tv->x = tv->y = 0;
       tt_pose(tv);
       double cw[3];
@@ -813,7 +1028,7 @@ hearth_status hearth_recon_turntable(const char *root, const char *instance,
       tv->y = -cw[1];
       tt_pose(tv);
     }
-    s = run_icp(v, nv, &o, &res, err);
+    s = run_icp(v, nv, n_states, u, &fac.rgb, &o, &res, err);
   }
   if (!s) {
     out->views = calloc(nv, sizeof *out->views);
@@ -836,7 +1051,7 @@ hearth_status hearth_recon_turntable(const char *root, const char *instance,
       rv->height_m = v[i].height;
       /* the optical axis (third column of R) against the horizon */
       rv->elevation_deg = -asin(fmax(-1.0, fmin(1.0, v[i].T.R[8]))) / TT_DEG;
-      double da = remainder(heading(&v[i]) - v[i].psi0, 2 * TT_PI);
+      double da = remainder(heading(&v[i], u) - v[i].target_nominal, 2 * TT_PI);
       rv->d_azimuth_deg = da / TT_DEG;
     }
   }

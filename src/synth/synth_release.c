@@ -170,8 +170,9 @@ hearth_status synth_instance_make(const hearth_synth_opts *o, const hearth_rig *
   int nv = o->n_views <= 0 || o->n_views > 30 ? 30 : o->n_views;
   inst->n_views = (size_t)nv;
   for (size_t s = 0; s < ns; s++) {
-    hearth_rng rs;
+    hearth_rng rs, renc;
     hearth_rng_fork(&r, 100 + s, &rs);
+    hearth_rng_fork(&r, 0x656e63ULL + s, &renc); /* the encoder's error, a stream of its own */
     for (int v = 0; v < nv; v++) {
       int idx = v * 30 / nv, e = idx / 10, a = idx % 10;
       synth_view_def *vd = &inst->views[s][v];
@@ -182,7 +183,9 @@ hearth_status synth_instance_make(const hearth_synth_opts *o, const hearth_rig *
       double scan = o->effects.scan_s > 0 ? o->effects.scan_s : 300.0;
       vd->pass_s = e * scan / 3.0;
       vd->time_s = vd->pass_s + a * scan / 30.0;
-      double az = az0 + (36.0 * a + 12.0 * e + hearth_rng_range(&rs, -1.5, 1.5)) * DEG;
+      double daz = 36.0 * a + 12.0 * e + hearth_rng_range(&rs, -1.5, 1.5);
+      double az = az0 + daz * DEG;
+      vd->turntable_deg = round(1000.0 * (daz + 0.05 * hearth_rng_normal(&renc))) / 1000.0;
       double el = elev[e] + hearth_rng_range(&rs, -0.7, 0.7) * DEG;
       double dd = dist * (1.0 + hearth_rng_range(&rs, -0.02, 0.02));
       double eye[3] = {c[0] + dd * cos(el) * cos(az), c[1] + dd * cos(el) * sin(az),
@@ -389,6 +392,8 @@ static hearth_status render_state(const render_ctx *rc, const char *root, synth_
     snprintf(vf->view, sizeof vf->view, "%s", vd->name);
     vf->elevation_index = vd->elevation_index;
     vf->azimuth_index = vd->azimuth_index;
+    vf->has_turntable = 1;
+    vf->turntable_deg = vd->turntable_deg;
     if (rc->band) {
       /* the operator's log: seconds since the state was prepared (or restored) */
       vf->has_time = 1;

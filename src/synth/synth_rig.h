@@ -177,9 +177,11 @@ typedef struct synth_view_def {
   char name[8]; /* "v07" */
   int index, elevation_index, azimuth_index;
   hearth_rigid T_world_from_rgb;
-  double time_s; /* from the start of the state's scan: its pass (elevation) starts at
+  double time_s;        /* from the start of the state's scan: its pass (elevation) starts at
                     elevation_index * scan / 3, views every scan / 30 */
-  double pass_s; /* the start of its pass */
+  double pass_s;        /* the start of its pass */
+  double turntable_deg; /* the encoder's reading: the view's azimuth from the
+                           instance's start, with a 0.05-degree (sigma) error */
 } synth_view_def;
 
 typedef struct synth_instance {

@@ -202,6 +202,8 @@ static void test_round_trips(void) {
   hearth_manifest m = sample_manifest(), m2;
   m.views[1].has_time = 1; /* the optional view time */
   m.views[1].time_s = 12.5;
+  m.views[1].has_turntable = 1; /* the optional encoder angle */
+  m.views[1].turntable_deg = -123.456;
   CHECK_OK(hearth_manifest_write(tpath("manifest.json"), &m, &err), &err);
   CHECK_OK(hearth_manifest_read(tpath("manifest.json"), &m2, &err), &err);
   CHECK(m2.n_views == m.n_views && !strcmp(m2.instance, "cup_03") && !strcmp(m2.state, "hot"));
@@ -567,6 +569,8 @@ static void test_bad_documents(void) {
       {"views[4].elevation_index", "-1", HEARTH_E_RANGE, "views[4].elevation_index", "[0,"},
       {"views[4].azimuth_index", "1.5", HEARTH_E_PARSE, "views[4].azimuth_index", "integer"},
       {"views[2].time_s", "-2", HEARTH_E_RANGE, "views[2]", "0..1e6"},
+      {"views[2].turntable_deg", "3600.5", HEARTH_E_RANGE, "views[2]", "-3600..3600"},
+      {"views[2].turntable_deg", "\"12\"", HEARTH_E_PARSE, "views[2].turntable_deg", "number"},
       {"instance", "\"mug_03\"", HEARTH_E_RANGE, "instance", "18 categories"},
       {"state", "\"boiling\"", HEARTH_E_RANGE, "state", "neutral, hot"},
       {"views", "[]", HEARTH_E_SIZE, "views", "at least 1"},
