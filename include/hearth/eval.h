@@ -118,7 +118,8 @@ size_t hearth_eval_policy_errors(const hearth_eval_results *r);
 
 /* Success rates: per (task, instruction) and task (NaN where no episode);
  * overall over every episode. Returns the overall fraction. */
-double hearth_eval_rates(const hearth_eval_results *r, double per_instr[4][2], double per_task[4]);
+double hearth_eval_rates(const hearth_eval_results *r, double per_instr[HEARTH_SIM_TASK_END][2],
+                         double per_task[HEARTH_SIM_TASK_END]);
 /* The paper's table (Task, Thermal, Instr. 1, Instr. 2, Average) as text
  * (the setup and server metadata first; ends with a line "overall <pct>
  * (k/n)"), Markdown and JSON (with the setup, the metadata and every

@@ -58,7 +58,7 @@ static void test_oracle(void) {
   hearth_err err = {0};
   CHECK_OK(hearth_eval_run(&o, &r, &err), &err);
   CHECK(r.n == 12);
-  double pi[4][2], pt[4];
+  double pi[HEARTH_SIM_TASK_END][2], pt[HEARTH_SIM_TASK_END];
   hearth_eval_rates(&r, pi, pt);
   for (int t = 1; t <= 3; t++)
     for (int i = 0; i < 2; i++)
