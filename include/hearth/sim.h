@@ -1,9 +1,11 @@
 /* hearth/sim.h - area sim (src/sim/; built with HEARTH_SIM, links MuJoCo,
  * OSMesa and HDF5): the paper's three temperature-aware pick-and-place tasks
  * (H1 study table: hot/normal cup; H2 kitchen: iced/normal can; H3 kitchen:
- * hot phone/hot sponge) on MuJoCo, with hearth assets, a Panda arm under an
- * operational-space pose controller, three rendered views (front RGB, front
- * thermal, wrist RGB), a scripted expert and a LIBERO-layout HDF5 writer.
+ * hot phone/hot sponge) and two whose temperatures change (H5: the cup
+ * still warm; H6: the iced can before it warms up) on MuJoCo, with hearth
+ * assets, a Panda arm under an operational-space pose controller, three
+ * rendered views (front RGB, front thermal, wrist RGB), a scripted expert
+ * and a LIBERO-layout HDF5 writer.
  * Scenes, robot, controller, file layout and image conventions:
  * docs/simulation.md.
  *
@@ -108,13 +110,15 @@ typedef struct hearth_sim_opts {
                           * $TMPDIR (else /tmp), removed with the env */
   int thermal;          /* HEARTH_SIM_THERMAL_STATIC (default: the paper's fixed
                           * temperature textures) or _DYNAMIC (a lumped thermal
-                          * network per object, integrated with the physics) */
+                          * network per object, integrated with the physics);
+                          * H5 and H6 are always dynamic */
   /* dynamic: contact conductances per unit area, W/(m^2 K), of the table
    * (and mat) and of the finger pads, both held at HEARTH_SIM_THERMAL_ROOM;
    * defaults HEARTH_SIM_H_CONTACT; 0 removes that kind of link */
   double h_contact_table, h_contact_finger;
   /* dynamic: thermal seconds per simulated second (default 1; e.g. 60
-   * makes a 20 s episode show 20 minutes of cooling), > 0 */
+   * makes a 20 s episode show 20 minutes of cooling), > 0; H5 and H6 use
+   * their own (30 and 80) */
   double thermal_speedup;
 } hearth_sim_opts;
 void hearth_sim_opts_default(hearth_sim_opts *o);
