@@ -1,5 +1,5 @@
 /* hearth/eval.h - area eval (src/eval/; built with HEARTH_SIM): scoring
- * policies on the sim tasks H1-H3 the way the paper does (10 episodes per
+ * policies on the sim tasks (H1-H3 by default; H5, H6) the way the paper does (10 episodes per
  * instruction, 20 per task, 60 per policy; success = target on the mat
  * within the time limit), for policies running anywhere:
  * the scripted expert (an upper bound), a replay of an HDF5 demonstration
@@ -48,7 +48,7 @@ hearth_status hearth_eval_encode_obs(const hearth_sim_obs *obs, const char *prom
 
 /* ---- evaluation ------------------------------------------------------------ */
 typedef struct hearth_eval_opts {
-  unsigned tasks;       /* bit (1 << task): default all three */
+  unsigned tasks;       /* bit (1 << task): default H1, H2, H3 */
   const char *policy;   /* "oracle", "replay:FILE.hdf5[#K]", "ws://HOST:PORT" */
   int episodes;         /* per instruction; default 10 */
   int thermal;          /* send observation/thermal_image; default 1 */
@@ -118,7 +118,8 @@ size_t hearth_eval_policy_errors(const hearth_eval_results *r);
 
 /* Success rates: per (task, instruction) and task (NaN where no episode);
  * overall over every episode. Returns the overall fraction. */
-double hearth_eval_rates(const hearth_eval_results *r, double per_instr[4][2], double per_task[4]);
+double hearth_eval_rates(const hearth_eval_results *r, double per_instr[HEARTH_SIM_TASK_END][2],
+                         double per_task[HEARTH_SIM_TASK_END]);
 /* The paper's table (Task, Thermal, Instr. 1, Instr. 2, Average) as text
  * (the setup and server metadata first; ends with a line "overall <pct>
  * (k/n)"), Markdown and JSON (with the setup, the metadata and every

@@ -60,9 +60,8 @@ int hearth_cmd_sim_render(int argc, char **argv) {
   uint64_t seed = 1;
   const cli_opt opts[] = {
       CLI_STR("--out", "DIR", &out, "output directory (created)", .flags = CLI_REQUIRED),
-      CLI_CALL("--task", "LIST", &only, sim_cli_parse_tasks,
-               "H1, H2, H3, a list such as H1,H3, or all", "the tasks rendered",
-               .def = "all three"),
+      CLI_CALL("--task", "LIST", &only, sim_cli_parse_tasks, SIM_CLI_TASK_HELP,
+               "the tasks rendered", .def = "all"),
       CLI_STR("--release", "ROOT", &release,
               "assets from a release (derived/ meshes and thermal_turbo.png)",
               .def = "a small release made by the virtual rig"),
@@ -92,8 +91,8 @@ int hearth_cmd_sim_render(int argc, char **argv) {
   int use_gt;
   if (sim_cli_assets(release, gt, root, sizeof root, tmpdir, sizeof tmpdir, &use_gt, 0)) return 1;
   rc = 0;
-  for (int t = 1; t <= 3 && !rc; t++) {
-    if (only && !(only & (1u << t))) continue;
+  for (int t = 1; t < HEARTH_SIM_TASK_END && !rc; t++) {
+    if (!hearth_sim_task_valid((hearth_sim_task)t) || (only && !(only & (1u << t)))) continue;
     hearth_sim_opts o;
     hearth_sim_opts_default(&o);
     o.task = (hearth_sim_task)t;
@@ -122,8 +121,7 @@ int hearth_cmd_sim_collect(int argc, char **argv) {
   unsigned tasks = 0;
   int gt = 0;
   const cli_opt opts[] = {
-      CLI_CALL("--task", "LIST", &tasks, sim_cli_parse_tasks,
-               "H1, H2, H3, a list such as H1,H3, or all",
+      CLI_CALL("--task", "LIST", &tasks, sim_cli_parse_tasks, SIM_CLI_TASK_HELP,
                "the task; with several, one file each: OUT with _H<n> before .hdf5",
                .flags = CLI_REQUIRED),
       CLI_STR("--out", "FILE.hdf5", &o.out_path, "output file (written atomically)",
@@ -171,10 +169,10 @@ int hearth_cmd_sim_collect(int argc, char **argv) {
     return 1;
   o.release_root = root;
   int n_tasks = 0;
-  for (int t = 1; t <= 3; t++) n_tasks += (tasks >> t) & 1;
+  for (int t = 1; t < HEARTH_SIM_TASK_END; t++) n_tasks += (tasks >> t) & 1;
   const char *out_given = o.out_path;
   rc = 0;
-  for (int t = 1; t <= 3 && !rc; t++) {
+  for (int t = 1; t < HEARTH_SIM_TASK_END && !rc; t++) {
     if (!(tasks & (1u << t))) continue;
     o.task = (hearth_sim_task)t;
     /* several tasks: OUT_H<n>.hdf5 each */

@@ -1,4 +1,4 @@
-/* hearth sim eval: score a policy on H1-H3 the way the paper does */
+/* hearth sim eval: score a policy on H1-H3 (and H5, H6) the way the paper does */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -9,11 +9,12 @@
 #include "hearth/hearth.h"
 
 static const char *k_about =
-    "Evaluate a policy on the paper's tasks: N episodes per instruction (default 10:\n"
-    "20 per task, 60 for all three), on held-out layouts (layout 2^32 + k of the seed\n"
-    "stream, never used by collection; both instructions share a layout). Success =\n"
-    "the target resting on the mat, released, within the time limit (280 control steps\n"
-    "per task, after the 10 no-op steps of a server policy). Prints the paper's table\n"
+    "Evaluate a policy on the paper's tasks (H1-H3; H5, H6 with --task): N episodes\n"
+    "per instruction (default 10: 20 per task, 60 for H1-H3), on held-out layouts\n"
+    "(layout 2^32 + k of the seed stream, never used by collection; both instructions\n"
+    "share a layout). Success = the target resting on the mat, released, within the\n"
+    "time limit (280 control steps per task, after the 10 no-op steps of a server\n"
+    "policy) and, for H6, before the iced can warms past its limit. Prints the table\n"
     "(Task, Thermal, Instr. 1, Instr. 2, Average) ending with a line `overall <pct>`.\n"
     "A policy that errs (server gone, garbage, timeout) fails that episode with the\n"
     "reason; the evaluation goes on (reconnecting for the next episode). Such policy\n"
@@ -79,8 +80,8 @@ int hearth_cmd_sim_eval(int argc, char **argv) {
   int gt = 0;
   const cli_opt opts[] = {
       CLI_STR("--policy", "SPEC", &o.policy, "the policy, as listed above"),
-      CLI_CALL("--task", "LIST", &tasks, sim_cli_parse_tasks,
-               "H1, H2, H3, a list such as H1,H3, or all", "tasks", .def = "all"),
+      CLI_CALL("--task", "LIST", &tasks, sim_cli_parse_tasks, SIM_CLI_TASK_HELP, "tasks",
+               .def = "H1,H2,H3 (the paper's)"),
       CLI_INT("--episodes", "N", &o.episodes, 1, 100000, "episodes per instruction"),
       CLI_FLAG("--no-thermal", &o.thermal, 0,
                "leave observation/thermal_image out (the RGB-only condition)"),

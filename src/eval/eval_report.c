@@ -5,15 +5,16 @@
 
 #include "hearth/eval.h"
 
-double hearth_eval_rates(const hearth_eval_results *r, double per_instr[4][2], double per_task[4]) {
-  int n[4][2] = {{0}}, k[4][2] = {{0}}, tot = 0, ok = 0;
+double hearth_eval_rates(const hearth_eval_results *r, double per_instr[HEARTH_SIM_TASK_END][2],
+                         double per_task[HEARTH_SIM_TASK_END]) {
+  int n[HEARTH_SIM_TASK_END][2] = {{0}}, k[HEARTH_SIM_TASK_END][2] = {{0}}, tot = 0, ok = 0;
   for (size_t i = 0; i < r->n; i++) {
     const hearth_eval_episode *e = &r->eps[i];
     n[e->task][e->instruction]++;
     k[e->task][e->instruction] += e->success;
     tot++, ok += e->success;
   }
-  for (int t = 0; t < 4; t++) {
+  for (int t = 0; t < HEARTH_SIM_TASK_END; t++) {
     int nt = n[t][0] + n[t][1];
     if (per_task) per_task[t] = nt ? (double)(k[t][0] + k[t][1]) / nt : NAN;
     for (int i = 0; i < 2; i++)
@@ -57,7 +58,7 @@ static void counts(const hearth_eval_results *r, int *ok, int *tot) {
 }
 
 char *hearth_eval_format_text(const hearth_eval_results *r) {
-  double pi[4][2], pt[4];
+  double pi[HEARTH_SIM_TASK_END][2], pt[HEARTH_SIM_TASK_END];
   double all = hearth_eval_rates(r, pi, pt);
   hearth_strbuf b = {0};
   for (size_t i = 0; i < r->n; i++)
@@ -70,7 +71,7 @@ char *hearth_eval_format_text(const hearth_eval_results *r) {
   setup_lines(r, &b);
   hearth_strbuf_printf(&b, "%-6s %-8s %9s %9s %9s\n", "Task", "Thermal", "Instr. 1", "Instr. 2",
                        "Average");
-  for (int t = 1; t <= 3; t++) {
+  for (int t = 1; t < HEARTH_SIM_TASK_END; t++) {
     if (isnan(pt[t])) continue;
     char a[32], c[32], d[32];
     hearth_strbuf_printf(&b, "%-6s %-8s %9s %9s %9s\n", hearth_sim_task_name((hearth_sim_task)t),
@@ -89,13 +90,13 @@ char *hearth_eval_format_text(const hearth_eval_results *r) {
 }
 
 char *hearth_eval_format_markdown(const hearth_eval_results *r) {
-  double pi[4][2], pt[4];
+  double pi[HEARTH_SIM_TASK_END][2], pt[HEARTH_SIM_TASK_END];
   double all = hearth_eval_rates(r, pi, pt);
   hearth_strbuf b = {0};
   hearth_strbuf_printf(&b, "Task success rates (%%), policy `%s`\n\n", r->policy);
   hearth_strbuf_printf(
       &b, "| Task | Thermal | Instr. 1 | Instr. 2 | Average |\n|---|---|---:|---:|---:|\n");
-  for (int t = 1; t <= 3; t++) {
+  for (int t = 1; t < HEARTH_SIM_TASK_END; t++) {
     if (isnan(pt[t])) continue;
     char a[32], c[32], d[32];
     hearth_strbuf_printf(&b, "| %s | %s | %s | %s | %s |\n",
@@ -116,7 +117,7 @@ static json_t *jnum(double v) {
 }
 
 char *hearth_eval_format_json(const hearth_eval_results *r) {
-  double pi[4][2], pt[4];
+  double pi[HEARTH_SIM_TASK_END][2], pt[HEARTH_SIM_TASK_END];
   double all = hearth_eval_rates(r, pi, pt);
   json_t *root = json_object();
   json_object_set_new(root, "policy", json_string(r->policy));
@@ -147,7 +148,7 @@ char *hearth_eval_format_json(const hearth_eval_results *r) {
   json_object_set_new(root, "policy_errors", json_integer((json_int_t)perr));
   json_object_set_new(root, "task_failures", json_integer(tot - ok - (json_int_t)perr));
   json_t *tasks = json_object();
-  for (int t = 1; t <= 3; t++) {
+  for (int t = 1; t < HEARTH_SIM_TASK_END; t++) {
     if (isnan(pt[t])) continue;
     json_t *jt = json_object();
     json_object_set_new(jt, "instruction_1", jnum(pi[t][0]));

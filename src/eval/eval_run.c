@@ -159,6 +159,10 @@ static hearth_status run_episode(ep_ctx *x, hearth_eval_episode *ep, int limit, 
       t++;
       break;
     }
+    if (hearth_sim_failure(e)) {
+      t++;
+      break;
+    }
   }
   ep->steps = t - wait > 0 ? t - wait : 0;
   ep->success = !perror_ && hearth_sim_success(e);
@@ -170,7 +174,9 @@ static hearth_status run_episode(ep_ctx *x, hearth_eval_episode *ep, int limit, 
     ep->error = 1;
     snprintf(ep->reason, sizeof ep->reason, "%s", perr.msg);
     if (x->ws) eval_ws_drop(x->ws, perr.status == HEARTH_E_PARSE ? 1002 : 1001);
-  } else if (!ep->success)
+  } else if (!ep->success && hearth_sim_failure(e))
+    snprintf(ep->reason, sizeof ep->reason, "%s", hearth_sim_failure(e));
+  else if (!ep->success)
     snprintf(ep->reason, sizeof ep->reason,
              x->demo ? "replay ended without success" : "time limit (%d steps)", limit);
   return HEARTH_OK;
@@ -273,7 +279,8 @@ hearth_status hearth_eval_run(const hearth_eval_opts *o, hearth_eval_results *r,
   r->render_size = o->render_size, r->image_size = o->image_size, r->replan_steps = o->replan_steps;
   r->wait_steps = is_ws ? o->wait_steps : 0, r->shadows = o->shadows;
   if (is_ws) st = check_server(o, &wsp, r, err);
-  for (int task = 1; task <= 3 && !st; task++) {
+  for (int task = 1; task < HEARTH_SIM_TASK_END && !st; task++) {
+    if (!hearth_sim_task_valid((hearth_sim_task)task)) continue;
     if (is_replay ? task != (int)rf.task : !(o->tasks & (1u << task))) continue;
     hearth_sim_opts so;
     hearth_sim_opts_default(&so);

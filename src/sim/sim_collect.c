@@ -67,6 +67,7 @@ static hearth_status rollout(hearth_sim_env *e, uint64_t seed, uint64_t layout, 
       *success = 1;
       break;
     }
+    if (hearth_sim_failure(e)) break;
   }
   return HEARTH_OK;
 }

@@ -37,10 +37,34 @@ void hearth_sim_env_free(hearth_sim_env *e) {
   free(e);
 }
 
+/* a task's candidates that stood in the room before the episode (H5's cup
+ * filled earlier): their networks' reset temperatures carried forward by
+ * age_s of still-air exchange, in 10 s steps */
+static hearth_status age_candidates(hearth_sim_env *e, hearth_err *err) {
+  const sim_task_def *td = sim_task_get(e->task);
+  if (e->thermal != HEARTH_SIM_THERMAL_DYNAMIC) return HEARTH_OK;
+  for (int k = 0; k < 2; k++) {
+    if (!(td->age_s[k] > 0)) continue;
+    sim_thermal_obj *o = &e->th[k];
+    hearth_thermo_net net = o->net;
+    hearth_thermo_clear_contacts(&net);
+    for (size_t i = 0; i < net.n; i++) net.region[i].T = o->T0[i];
+    int n = (int)ceil(td->age_s[k] / 10.0);
+    for (int s = 0; s < n; s++) {
+      double q = 0;
+      hearth_status st = hearth_thermo_step(&net, td->age_s[k] / n, &q, err);
+      if (st) return hearth_err_prefix(err, "sim %s candidate %d: ", td->name, k);
+    }
+    for (size_t i = 0; i < net.n; i++) o->T0[i] = net.region[i].T;
+  }
+  sim_thermal_reset(e);
+  return HEARTH_OK;
+}
+
 hearth_status hearth_sim_env_new(const hearth_sim_opts *o, hearth_sim_env **out, hearth_err *err) {
   *out = NULL;
-  if (!o || o->task < 1 || o->task > 3)
-    return hearth_err_set(err, HEARTH_E_ARG, "sim: task must be H1, H2 or H3");
+  if (!o || !hearth_sim_task_valid(o->task))
+    return hearth_err_set(err, HEARTH_E_ARG, "sim: task must be H1, H2, H3, H5 or H6");
   if (!o->release_root) return hearth_err_set(err, HEARTH_E_ARG, "sim: no asset release root");
   if (o->width < 16 || o->height < 16 || o->width > 4096 || o->height > 4096)
     return hearth_err_set(err, HEARTH_E_RANGE, "sim: image size %dx%d outside 16..4096", o->width,
@@ -67,6 +91,9 @@ hearth_status hearth_sim_env_new(const hearth_sim_opts *o, hearth_sim_env **out,
   e->h_table = o->h_contact_table, e->h_finger = o->h_contact_finger;
   e->h_object = o->h_contact_object;
   e->thermal_speedup = o->thermal_speedup > 0 ? o->thermal_speedup : 1.0;
+  /* tasks of changing temperatures run dynamic at their own pace */
+  const sim_task_def *tdef = sim_task_get(e->task);
+  if (tdef->dynamic) e->thermal = HEARTH_SIM_THERMAL_DYNAMIC, e->thermal_speedup = tdef->speedup;
   if (!isfinite(e->thermal_speedup) || e->thermal_speedup > 1e6) {
     free(e);
     return hearth_err_set(err, HEARTH_E_RANGE, "sim: thermal speed-up must be in (0, 1e6]");
@@ -179,6 +206,7 @@ hearth_status hearth_sim_env_new(const hearth_sim_opts *o, hearth_sim_env **out,
     e->table_geom = mj_name2id(m, mjOBJ_GEOM, "table");
     st = sim_render_init(e, err);
     if (!st) st = sim_thermal_init(e, err);
+    if (!st) st = age_candidates(e, err);
   }
   if (st) {
     hearth_sim_env_free(e);
@@ -292,9 +320,39 @@ hearth_status hearth_sim_reset(hearth_sim_env *e, uint64_t seed, uint64_t layout
   e->steps = 0;
   e->phase = 0;
   e->phase_steps = 0;
+  e->failed = 0;
+  e->fail_msg[0] = 0;
   sim_thermal_reset(e);
   return HEARTH_OK;
 }
+
+double sim_mean_temperature(const hearth_sim_env *e, int k, int at_reset) {
+  if (e->thermal != HEARTH_SIM_THERMAL_DYNAMIC) return NAN;
+  const sim_thermal_obj *o = &e->th[k];
+  double cT = 0, c = 0;
+  for (size_t i = 0; i < o->net.n; i++) {
+    double T = at_reset ? o->T0[i] : o->net.region[i].T;
+    cT += o->net.region[i].C * T, c += o->net.region[i].C;
+  }
+  return c > 0 ? cT / c : NAN;
+}
+
+/* the task's failure rules after a step: H6's target warming past its
+ * limit before it is placed */
+static void check_failure(hearth_sim_env *e) {
+  const sim_task_def *td = sim_task_get(e->task);
+  if (e->failed || !(td->warm_limit_c > 0)) return;
+  if (!(sim_mean_temperature(e, e->target, 1) < td->warm_limit_c)) return;
+  double T = sim_mean_temperature(e, e->target, 0);
+  if (T > td->warm_limit_c && !hearth_sim_success(e)) {
+    e->failed = 1;
+    snprintf(e->fail_msg, sizeof e->fail_msg,
+             "the %s warmed past %.1f degC before it was placed (step %d)",
+             td->cand[e->target].noun, td->warm_limit_c, e->steps);
+  }
+}
+
+const char *hearth_sim_failure(const hearth_sim_env *e) { return e->failed ? e->fail_msg : NULL; }
 
 hearth_status hearth_sim_step(hearth_sim_env *e, const double action[7], hearth_err *err) {
   double a[7];
@@ -328,6 +386,7 @@ hearth_status hearth_sim_step(hearth_sim_env *e, const double action[7], hearth_
   hearth_status st = sim_thermal_step(e, e->thermal_speedup / HEARTH_SIM_CONTROL_HZ, err);
   if (st) return st;
   e->steps++;
+  check_failure(e);
   return HEARTH_OK;
 }
 
@@ -359,6 +418,7 @@ static int touching(const hearth_sim_env *e, int geom_a, int body_b) {
 }
 
 int hearth_sim_success(const hearth_sim_env *e) {
+  if (e->failed) return 0;
   const mjData *d = e->d;
   int k = e->target;
   const double *q = d->qpos + e->obj_qadr[k], *v = d->qvel + e->obj_dadr[k];

@@ -48,6 +48,8 @@ struct hearth_sim_env {
   int layout_attempts; /* draws the visibility check needed (1 = first) */
   double goal_pos[3], goal_R[9], R0[9], grip_cmd;
   int phase, phase_steps;
+  int failed;         /* the episode can no longer succeed (hearth_sim_failure) */
+  char fail_msg[160]; /* why */
   sim_render *rnd;
   /* dynamic temperatures */
   int thermal;
@@ -71,6 +73,9 @@ struct hearth_sim_env {
  * bottom centre) and teleporting it upright at rest to xyz */
 void sim_object_pos(const hearth_sim_env *e, int k, double xyz[3]);
 void sim_place_object(hearth_sim_env *e, int k, const double xyz[3]);
+/* object k's mean temperature (heat-capacity weighted over its network's
+ * regions) now or at reset, degC; NaN with static temperatures */
+double sim_mean_temperature(const hearth_sim_env *e, int k, int at_reset);
 /* fraction of object k's surface samples seen by the front camera */
 double sim_visible_frac(const hearth_sim_env *e, int k);
 /* sim_render.c: the GL context and scene of an env, and their release */

@@ -1,12 +1,15 @@
-/* The three tasks as data: objects, instructions, where things stand on the
- * table, and the layout draw that jitters them. */
+/* The tasks as data: objects, instructions, where things stand on the
+ * table, the thermal set-up of the tasks of changing temperatures, and the
+ * layout draw that jitters them. */
 #include <string.h>
 
 #include "sim/sim_tasks.h"
 #include "hearth/core.h"
 
-/* paper, Table III */
-static const sim_task_def k_tasks[3] = {
+/* H1-H3: paper, Table III. H5, H6: temperatures that change (dynamic
+ * forced; speed-ups and ages measured in docs/simulation.md, "Tasks"). */
+#define SIM_NTASK (HEARTH_SIM_TASK_END - 1)
+static const sim_task_def k_tasks[SIM_NTASK] = {
     {"H1",
      "study",
      {{"cup", "hot", "hot cup"}, {"cup", "neutral", "normal cup"}},
@@ -19,14 +22,39 @@ static const sim_task_def k_tasks[3] = {
      "kitchen",
      {{"smartphone", "hot", "hot phone"}, {"sponge", "hot", "hot sponge"}},
      {{"orange", "neutral", "orange"}, {"cup", "hot", "cup"}}},
+    {0},
+    /* two cups of the same hot asset: the second was filled half an hour
+     * before the first, so it starts cooler; both cool during the episode */
+    {"H5",
+     "study",
+     {{"cup", "hot", "warm cup"}, {"cup", "hot", "cold cup"}},
+     {{"eraser", "neutral", "eraser"}, {"orange", "neutral", "orange"}},
+     1,
+     30.0,
+     {0.0, 1800.0},
+     0.0},
+    /* the iced can warms in the room air and on the table; the normal can
+     * is at room temperature */
+    {"H6",
+     "kitchen",
+     {{"canned_drink", "iced", "iced can"}, {"canned_drink", "neutral", "normal can"}},
+     {{"orange", "neutral", "orange"}, {"cup", "neutral", "cup"}},
+     1,
+     80.0,
+     {0.0, 0.0},
+     12.0},
 };
-static const char *const k_instr[3][2] = {
+static const char *const k_instr[SIM_NTASK][2] = {
     {"pick up the hot cup and place it on the mat",
      "pick up the normal cup and place it on the mat"},
     {"pick up the iced can and place it on the mat",
      "pick up the normal can and place it on the mat"},
     {"pick up the hot phone and place it on the mat",
      "pick up the hot sponge and place it on the mat"},
+    {"", ""},
+    {"bring the cup that is still warm to the mat", "bring the cup that has gone cold to the mat"},
+    {"put the iced can back on the mat before it warms up",
+     "put the can at room temperature on the mat"},
 };
 
 /* distractor 1 stands behind slot B, where even the kettle stays in view
@@ -35,6 +63,9 @@ static const char *const k_instr[3][2] = {
 const double sim_spots[SIM_NOBJ][2] = {{0.05, 0.00}, {0.05, 0.19}, {-0.17, 0.29}, {0.20, -0.07}};
 const double sim_mat_centre[2] = {-0.05, -0.22};
 
+int hearth_sim_task_valid(hearth_sim_task t) {
+  return t >= 1 && t <= SIM_NTASK && k_tasks[t - 1].name != NULL;
+}
 const sim_task_def *sim_task_get(hearth_sim_task t) { return &k_tasks[t - 1]; }
 
 /* the study: a light-gray floor and plaster walls around a dark wooden
@@ -66,15 +97,16 @@ const double sim_cam_front_quat[4] = {0.6380177736282349, 0.3048497438430786, 0.
 
 hearth_sim_task hearth_sim_task_parse(const char *s) {
   if (!s) return 0;
-  if ((s[0] == 'H' || s[0] == 'h') && s[1] >= '1' && s[1] <= '3' && s[2] == 0)
+  if ((s[0] == 'H' || s[0] == 'h') && s[1] >= '1' && s[1] <= '9' && s[2] == 0 &&
+      hearth_sim_task_valid((hearth_sim_task)(s[1] - '0')))
     return (hearth_sim_task)(s[1] - '0');
   return 0;
 }
 const char *hearth_sim_task_name(hearth_sim_task t) {
-  return t >= 1 && t <= 3 ? k_tasks[t - 1].name : "?";
+  return hearth_sim_task_valid(t) ? k_tasks[t - 1].name : "?";
 }
 const char *hearth_sim_instruction_text(hearth_sim_task t, int i) {
-  if (t < 1 || t > 3 || i < 0 || i > 1) return "";
+  if (!hearth_sim_task_valid(t) || i < 0 || i > 1) return "";
   return k_instr[t - 1][i];
 }
 

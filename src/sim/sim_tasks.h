@@ -14,11 +14,22 @@ typedef struct sim_task_obj {
   const char *category, *state, *noun;
 } sim_task_obj;
 typedef struct sim_task_def {
-  const char *name, *scene; /* "H1", "study" or "kitchen" */
+  const char *name, *scene; /* "H1", "study" or "kitchen"; name NULL: no such task */
   sim_task_obj cand[2];     /* instruction i targets cand[i] */
   sim_task_obj dist[2];
+  /* tasks of changing temperatures: dynamic forced, whatever the options
+   * ask, at `speedup` thermal seconds per simulated second */
+  int dynamic;
+  double speedup;
+  /* thermal seconds candidate i cooled (or warmed) in still air on the
+   * table before the episode starts (H5: filled earlier) */
+  double age_s[2];
+  /* H6: the episode fails once the target's mean temperature (heat
+   * capacity weighted over its regions) passes this, degC, when it started
+   * below it; 0: no limit */
+  double warm_limit_c;
 } sim_task_def;
-/* The row of a valid task (1..3). */
+/* The row of a valid task (hearth_sim_task_valid). */
 const sim_task_def *sim_task_get(hearth_sim_task t);
 
 /* How a scene looks (after LIBERO's study and kitchen table scenes): RGB

@@ -69,7 +69,7 @@ def check_obs(obs, args):
         raise ValueError("observation/state: expected float (8,), got %r" % (st,))
     if not np.all(np.isfinite(st)) or not (0.5 < st[2] < 2.0):
         raise ValueError("observation/state: implausible %r" % (st,))
-    if not isinstance(obs["prompt"], str) or "place it on the mat" not in obs["prompt"]:
+    if not isinstance(obs["prompt"], str) or "the mat" not in obs["prompt"]:
         raise ValueError("prompt: %r" % (obs["prompt"],))
 
 

@@ -58,7 +58,7 @@ static void test_oracle(void) {
   hearth_err err = {0};
   CHECK_OK(hearth_eval_run(&o, &r, &err), &err);
   CHECK(r.n == 12);
-  double pi[4][2], pt[4];
+  double pi[HEARTH_SIM_TASK_END][2], pt[HEARTH_SIM_TASK_END];
   hearth_eval_rates(&r, pi, pt);
   for (int t = 1; t <= 3; t++)
     for (int i = 0; i < 2; i++)
@@ -249,6 +249,36 @@ static void test_ws_failure(const char *mode, const char *want, int thermal_clie
       /* 12 policy steps with replan 5: 3 requests per episode */
       CHECK(count_lines(s.log) == 6);
     }
+  }
+  hearth_eval_results_free(&r);
+  stop_server(&s);
+}
+
+/* H6 with a server that only holds still: the iced can warms past its
+ * limit on the table, which ends the episode early as a task failure (not
+ * a policy error) with the simulator's reason; the room-temperature can of
+ * instruction 2 has no limit and runs into the time limit */
+static void test_ws_h6_deadline(void) {
+  server s = {0};
+  const char *extra[] = {"--size", "32", "--mode", "ok", "--thermal", "1", NULL};
+  if (!start_server(&s, "h6", extra)) return;
+  hearth_eval_opts o;
+  base_opts(&o);
+  o.policy = s.url;
+  o.tasks = 1u << HEARTH_SIM_H6;
+  o.episodes = 1;
+  o.wait_steps = 3;
+  hearth_eval_results r;
+  hearth_err err = {0};
+  CHECK_OK(hearth_eval_run(&o, &r, &err), &err);
+  CHECK(r.n == 2);
+  if (r.n == 2) {
+    CHECK_MSG(!r.eps[0].error && !r.eps[0].success && strstr(r.eps[0].reason, "warmed past") &&
+                  r.eps[0].steps < hearth_eval_time_limit(HEARTH_SIM_H6),
+              "H6 instruction 1: %s after %d steps", r.eps[0].reason, r.eps[0].steps);
+    CHECK_MSG(!r.eps[1].error && strstr(r.eps[1].reason, "time limit"), "H6 instruction 2: %s",
+              r.eps[1].reason);
+    printf("H6 with a still policy: %s (%d steps)\n", r.eps[0].reason, r.eps[0].steps);
   }
   hearth_eval_results_free(&r);
   stop_server(&s);
@@ -452,6 +482,8 @@ int main(void) {
   test_ws_failure("nan", "reply.actions[0][0] is NaN: action 0 of the chunk, element 0 (dx)", 1, 1);
   test_ws_failure("wide", "shape (10, 6): width 6, expected 7", 1, 1);
   stamp("ws failures");
+  test_ws_h6_deadline();
+  stamp("ws H6 deadline");
   test_ws_thermal("false", NULL, 1, HEARTH_E_ARG, 0);
   test_ws_thermal("none", "observation/image,observation/wrist_image", 1, HEARTH_E_ARG, 0);
   test_ws_thermal("none", NULL, 1, HEARTH_OK, -1); /* a stock server */
