@@ -172,7 +172,7 @@ hearth_status hearth_sim_observe(hearth_sim_env *env, hearth_sim_obs *obs, heart
  * episode has not failed. */
 int hearth_sim_success(const hearth_sim_env *env);
 /* Why the episode can no longer succeed (H6: "the iced can warmed past
- * 12.0 degC before it was placed"), NULL while it can; owned by the env,
+ * 10.5 degC before it was placed"), NULL while it can; owned by the env,
  * valid until the next reset. Failure is checked after every step. */
 const char *hearth_sim_failure(const hearth_sim_env *env);
 /* Control steps since reset; the time limit. */

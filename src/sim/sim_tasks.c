@@ -42,7 +42,7 @@ static const sim_task_def k_tasks[SIM_NTASK] = {
      1,
      80.0,
      {0.0, 0.0},
-     12.0},
+     10.5},
 };
 static const char *const k_instr[SIM_NTASK][2] = {
     {"pick up the hot cup and place it on the mat",

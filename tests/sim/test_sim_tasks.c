@@ -97,7 +97,7 @@ static void test_h6_deadline(void) {
   CHECK_OK(hearth_sim_reset(e, 1, 0, 0, &err), &err);
   const hearth_thermo_net *n = hearth_sim_thermal_net(e, 0);
   if (!n) return;
-  double limit = 12.0, prev = net_mean(n);
+  double limit = 10.5, prev = net_mean(n); /* the limit docs/simulation.md gives H6 */
   printf("H6 iced can at reset %.2f degC\n", prev);
   CHECK(prev < limit);
   /* a policy that does nothing: the can warms on the table until it fails */
