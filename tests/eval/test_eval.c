@@ -15,6 +15,7 @@
 
 #include "hearth/hearth.h"
 #include "sim/sim_env.h"
+#include "test_probe.h"
 #include "test_util.h"
 
 static char g_root[1200], g_dir[1100];
@@ -373,32 +374,12 @@ static void test_cli_all_policy_errors(void) {
 }
 
 /* ---- the RGB-only probe ------------------------------------------------------ */
-/* temperature of a Turbo colour: nearest of 256 samples over 10..60 degC */
-static double turbo_temp(const uint8_t *c, const uint8_t lut[256][3]) {
-  int best = 0;
-  long bd = -1;
-  for (int k = 0; k < 256; k++) {
-    long d = 0;
-    for (int j = 0; j < 3; j++) d += (long)(c[j] - lut[k][j]) * (c[j] - lut[k][j]);
-    if (bd < 0 || d < bd) bd = d, best = k;
-  }
-  return 10 + 50.0 * best / 255.0;
-}
-
-static double crop_temp(const uint8_t *img, int w, const int b[4], const uint8_t lut[256][3]) {
-  double s = 0;
-  int n = 0;
-  for (int y = b[1]; y <= b[3]; y++)
-    for (int x = b[0]; x <= b[2]; x++) s += turbo_temp(img + 3 * (y * w + x), lut), n++;
-  return n ? s / n : 0;
-}
-
 /* choose a slot from one view: the candidate reading hotter / colder /
  * nearer room temperature as the instruction asks; a difference under 3 degC
  * is no evidence, so slot A */
 static int select_slot(const uint8_t *view, int w, int boxes[2][4], const char *instr,
                        const uint8_t lut[256][3]) {
-  double t0 = crop_temp(view, w, boxes[0], lut), t1 = crop_temp(view, w, boxes[1], lut);
+  double t0 = probe_crop_temp(view, w, boxes[0], lut), t1 = probe_crop_temp(view, w, boxes[1], lut);
   if (fabs(t0 - t1) < 3) return 0;
   if (strstr(instr, "hot")) return t1 > t0;
   if (strstr(instr, "iced")) return t1 < t0;
