@@ -207,7 +207,7 @@ static void test_probe(hearth_sim_task t) {
 }
 
 int main(void) {
-  g_root = test_sim_release(test_tmpdir("sim_tasks"));
+  g_root = test_sim_release(test_tmpdir("sim_h5_h6"));
   test_names();
   test_h5_cooling();
   test_h6_deadline();
