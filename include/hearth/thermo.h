@@ -88,6 +88,9 @@ hearth_status hearth_thermo_net_check(const hearth_thermo_net *net, hearth_err *
 
 /* total energy sum C_i T_i (J, relative to 0 degC) */
 double hearth_thermo_energy(const hearth_thermo_net *net);
+/* the heat-capacity weighted mean temperature (degC); NAN for a network
+ * without heat capacity */
+double hearth_thermo_mean_temperature(const hearth_thermo_net *net);
 /* One backward Euler step of dt seconds (> 0; any size is stable).
  * heat_in (may be NULL) receives the heat taken from outside during the
  * step (J: air, contacts and power), so that the energy after the step is

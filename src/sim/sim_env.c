@@ -329,11 +329,10 @@ hearth_status hearth_sim_reset(hearth_sim_env *e, uint64_t seed, uint64_t layout
 double sim_mean_temperature(const hearth_sim_env *e, int k, int at_reset) {
   if (e->thermal != HEARTH_SIM_THERMAL_DYNAMIC) return NAN;
   const sim_thermal_obj *o = &e->th[k];
+  if (!at_reset) return hearth_thermo_mean_temperature(&o->net);
   double cT = 0, c = 0;
-  for (size_t i = 0; i < o->net.n; i++) {
-    double T = at_reset ? o->T0[i] : o->net.region[i].T;
-    cT += o->net.region[i].C * T, c += o->net.region[i].C;
-  }
+  for (size_t i = 0; i < o->net.n; i++)
+    cT += o->net.region[i].C * o->T0[i], c += o->net.region[i].C;
   return c > 0 ? cT / c : NAN;
 }
 

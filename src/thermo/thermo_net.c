@@ -137,6 +137,12 @@ double hearth_thermo_energy(const hearth_thermo_net *net) {
   return e;
 }
 
+double hearth_thermo_mean_temperature(const hearth_thermo_net *net) {
+  double c = 0;
+  for (size_t i = 0; i < net->n; i++) c += net->region[i].C;
+  return c > 0 ? hearth_thermo_energy(net) / c : NAN;
+}
+
 /* conductance of region r to the air: convection plus the secant of the
  * T^4 law at r's current temperature */
 static double air_conductance(const hearth_thermo_region *r, double T_air) {

@@ -38,12 +38,6 @@ static hearth_sim_env *make_env(hearth_sim_task t, int size, const char *rendere
 }
 
 /* heat-capacity weighted mean of a network */
-static double net_mean(const hearth_thermo_net *n) {
-  double cT = 0, c = 0;
-  for (size_t i = 0; i < n->n; i++) cT += n->region[i].C * n->region[i].T, c += n->region[i].C;
-  return cT / c;
-}
-
 static void test_names(void) {
   CHECK(hearth_sim_task_parse("H5") == HEARTH_SIM_H5);
   CHECK(hearth_sim_task_parse("h6") == HEARTH_SIM_H6);
@@ -72,7 +66,7 @@ static void test_h5_cooling(void) {
   const hearth_thermo_net *n0 = hearth_sim_thermal_net(e, 0), *n1 = hearth_sim_thermal_net(e, 1);
   CHECK(n0 && n1);
   if (!n0 || !n1) return;
-  double m0 = net_mean(n0), m1 = net_mean(n1);
+  double m0 = hearth_thermo_mean_temperature(n0), m1 = hearth_thermo_mean_temperature(n1);
   printf("H5 at reset: fresh cup %.2f degC, older cup %.2f degC\n", m0, m1);
   /* the same asset: the same network, 20 min apart */
   CHECK(n0->n == n1->n);
@@ -84,7 +78,7 @@ static void test_h5_cooling(void) {
   CHECK_MSG(h1 < h0 - 8 && h1 > HEARTH_SIM_THERMAL_ROOM + 8, "hottest regions %.2f %.2f", h0, h1);
   double zero[7] = {0};
   for (int s = 0; s < 40; s++) CHECK_OK(hearth_sim_step(e, zero, &err), &err);
-  double a0 = net_mean(n0), a1 = net_mean(n1);
+  double a0 = hearth_thermo_mean_temperature(n0), a1 = hearth_thermo_mean_temperature(n1);
   printf("H5 after 40 steps (%.0f s of cooling): %.2f, %.2f degC\n", 40 * 30.0 / 20, a0, a1);
   CHECK(a0 < m0 && a1 < m1 && a0 > a1);
   CHECK(hearth_sim_failure(e) == NULL);
@@ -98,7 +92,8 @@ static void test_h6_deadline(void) {
   CHECK_OK(hearth_sim_reset(e, 1, 0, 0, &err), &err);
   const hearth_thermo_net *n = hearth_sim_thermal_net(e, 0);
   if (!n) return;
-  double limit = 10.5, prev = net_mean(n); /* the limit docs/simulation.md gives H6 */
+  double limit = 10.5,
+         prev = hearth_thermo_mean_temperature(n); /* the limit docs/simulation.md gives H6 */
   printf("H6 iced can at reset %.2f degC\n", prev);
   CHECK(prev < limit);
   /* a policy that does nothing: the can warms on the table until it fails */
@@ -106,7 +101,7 @@ static void test_h6_deadline(void) {
   int crossed = -1, failed_at = -1;
   for (int s = 1; s <= 2000 && failed_at < 0; s++) {
     CHECK_OK(hearth_sim_step(e, zero, &err), &err);
-    double m = net_mean(n);
+    double m = hearth_thermo_mean_temperature(n);
     CHECK(m >= prev - 1e-9); /* warming only */
     prev = m;
     if (crossed < 0 && m > limit) crossed = s;
@@ -148,7 +143,8 @@ static void test_oracle(hearth_sim_task t) {
       ok[ins] += hearth_sim_success(e);
       steps += hearth_sim_steps(e);
       if (hearth_sim_steps(e) > most) most = hearth_sim_steps(e);
-      if (ins == 0) warmest = fmax(warmest, net_mean(hearth_sim_thermal_net(e, 0)));
+      if (ins == 0)
+        warmest = fmax(warmest, hearth_thermo_mean_temperature(hearth_sim_thermal_net(e, 0)));
       if (!hearth_sim_success(e))
         printf("%s layout %d instr %d: %s\n", hearth_sim_task_name(t), l, ins + 1,
                hearth_sim_failure(e) ? hearth_sim_failure(e) : "time limit");

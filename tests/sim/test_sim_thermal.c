@@ -237,12 +237,6 @@ static void check_finger(const char *root) {
   hearth_sim_env_free(e[1]);
 }
 
-static double net_mean_T(const hearth_thermo_net *n) {
-  double C = 0;
-  for (size_t i = 0; i < n->n; i++) C += n->region[i].C;
-  return hearth_thermo_energy(n) / C;
-}
-
 /* a neutral distractor (object 2) set on top of the hot cup (object 0),
  * no table or finger links: every step links the two networks; each
  * object's energy change is the heat the library booked from its air plus
@@ -279,10 +273,10 @@ static void check_objects(const char *root) {
       /* 10 thermal minutes: the exchange so far; then steps of dt = 1e4 s */
       q0 = hearth_sim_thermal_heat_exchanged(e[0], 0),
       q2 = hearth_sim_thermal_heat_exchanged(e[0], 2);
-      c0 = net_mean_T(hearth_sim_thermal_net(e[0], 0)),
-      t0 = net_mean_T(hearth_sim_thermal_net(e[1], 0));
-      c2 = net_mean_T(hearth_sim_thermal_net(e[0], 2)),
-      t2 = net_mean_T(hearth_sim_thermal_net(e[1], 2));
+      c0 = hearth_thermo_mean_temperature(hearth_sim_thermal_net(e[0], 0)),
+      t0 = hearth_thermo_mean_temperature(hearth_sim_thermal_net(e[1], 0));
+      c2 = hearth_thermo_mean_temperature(hearth_sim_thermal_net(e[0], 2)),
+      t2 = hearth_thermo_mean_temperature(hearth_sim_thermal_net(e[1], 2));
       e[0]->thermal_speedup = e[1]->thermal_speedup = 2e5;
     }
     for (int r = 0; r < 2; r++) CHECK_OK(hearth_sim_step(e[r], zero, &err), &err);

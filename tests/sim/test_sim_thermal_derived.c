@@ -87,12 +87,6 @@ static hearth_sim_env *make_env(const char *root, int use_gt) {
   return e;
 }
 
-static double mean_T(const hearth_thermo_net *n) {
-  double C = 0;
-  for (size_t i = 0; i < n->n; i++) C += n->region[i].C;
-  return hearth_thermo_energy(n) / C;
-}
-
 /* the range of object k's observed texels in its derived map and the mean
  * of the filled map over the texels with a value (mask 1 or 2) */
 static void map_figures(const hearth_sim_env *e, int k, double *lo, double *hi, double *mean) {
@@ -146,7 +140,7 @@ int main(void) {
                 "%.2f..%.2f",
                 k, d->assets[k].category, d->assets[k].state, nd->region[i].name, nd->region[i].T,
                 lo, hi);
-    double md = mean_T(nd), mg = mean_T(ng);
+    double md = hearth_thermo_mean_temperature(nd), mg = hearth_thermo_mean_temperature(ng);
     printf(
         "object %d %s/%s: %zu regions, mean %.2f degC; its map: observed %.2f..%.2f, mean "
         "%.2f; ground-truth run %.2f\n",
@@ -163,7 +157,8 @@ int main(void) {
                 hearth_sim_thermal_heat_exchanged(d, k);
     CHECK_MSG(fabs(dE) <= 1e-9 * fabs(E0[k]), "object %d: energy off by %.3g J", k, dE);
   }
-  CHECK(mean_T(hearth_sim_thermal_net(d, 0)) < cup0 - 1.0); /* the hot cup cooled */
+  CHECK(hearth_thermo_mean_temperature(hearth_sim_thermal_net(d, 0)) <
+        cup0 - 1.0); /* the hot cup cooled */
   hearth_sim_env_free(d);
   hearth_sim_env_free(g);
 
