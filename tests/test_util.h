@@ -99,6 +99,15 @@ static inline int test_run_capture(const char *cmd, char *out, size_t cap) {
   return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
+/* Runs the shell command fmt (a printf format taking two strings, a and b);
+ * returns its exit status, -1 if it could not run or did not exit. */
+static inline int test_sh(const char *fmt, const char *a, const char *b) {
+  char cmd[8192];
+  snprintf(cmd, sizeof cmd, fmt, a, b);
+  int rc = system(cmd);
+  return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+}
+
 #define TEST_MAIN_END()                                                            \
   do {                                                                             \
     if (g_test_failures) fprintf(stderr, "%d check(s) failed\n", g_test_failures); \

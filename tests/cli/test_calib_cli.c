@@ -10,13 +10,6 @@
 #include "hearth/synth.h"
 #include "test_util.h"
 
-static int sh(const char *fmt, const char *a, const char *b) {
-  char cmd[8192];
-  snprintf(cmd, sizeof cmd, fmt, a, b);
-  int rc = system(cmd);
-  return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
-}
-
 int main(void) {
   char root[1024], path[4096], log[4096];
   snprintf(root, sizeof root, "%s/rel", test_tmpdir("calib_cli"));
@@ -37,8 +30,8 @@ int main(void) {
   hearth_err err = {0};
   CHECK_OK(hearth_synth_release(&o, &err), &err);
 
-  CHECK(sh("'" HEARTH_EXE "' detect '%s' > '%s' 2>&1", root, log) == 0);
-  CHECK(sh("'" HEARTH_EXE "' calibrate '%s' >> '%s' 2>&1", root, log) == 0);
+  CHECK(test_sh("'" HEARTH_EXE "' detect '%s' > '%s' 2>&1", root, log) == 0);
+  CHECK(test_sh("'" HEARTH_EXE "' calibrate '%s' >> '%s' 2>&1", root, log) == 0);
 
   /* detections against the true projected centres */
   hearth_detections d = {0, NULL}, g = {0, NULL};
@@ -108,11 +101,11 @@ int main(void) {
   CHECK(hearth_path_exists(path));
 
   /* usage and input errors */
-  CHECK(sh("'" HEARTH_EXE "' detect --help > /dev/null%s%s", "", "") == 0);
-  CHECK(sh("'" HEARTH_EXE "' calibrate --help > /dev/null%s%s", "", "") == 0);
-  CHECK(sh("'" HEARTH_EXE "' detect 2> /dev/null%s%s", "", "") == 2);
-  CHECK(sh("'" HEARTH_EXE "' calibrate --bogus x 2> /dev/null%s%s", "", "") == 2);
-  CHECK(sh("'" HEARTH_EXE "' detect '%s/nowhere' 2> '%s'", root, log) == 1);
+  CHECK(test_sh("'" HEARTH_EXE "' detect --help > /dev/null%s%s", "", "") == 0);
+  CHECK(test_sh("'" HEARTH_EXE "' calibrate --help > /dev/null%s%s", "", "") == 0);
+  CHECK(test_sh("'" HEARTH_EXE "' detect 2> /dev/null%s%s", "", "") == 2);
+  CHECK(test_sh("'" HEARTH_EXE "' calibrate --bogus x 2> /dev/null%s%s", "", "") == 2);
+  CHECK(test_sh("'" HEARTH_EXE "' detect '%s/nowhere' 2> '%s'", root, log) == 1);
   uint8_t *txt = NULL;
   size_t len = 0;
   CHECK_OK(hearth_read_file(log, 1 << 16, &txt, &len, &err), &err);

@@ -14,13 +14,6 @@
 #include "hearth/synth.h"
 #include "test_util.h"
 
-static int sh(const char *fmt, const char *a, const char *b) {
-  char cmd[8192];
-  snprintf(cmd, sizeof cmd, fmt, a, b);
-  int rc = system(cmd);
-  return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
-}
-
 int main(void) {
   char root[1024], path[4096], log[4096];
   snprintf(root, sizeof root, "%s/rel", test_tmpdir("calib_physics"));
@@ -45,8 +38,8 @@ int main(void) {
   CHECK_MSG(tg.thickness_m >= 0.003 && tg.thickness_m <= 0.006, "thickness %g", tg.thickness_m);
   CHECK(hearth_target_is_default(&tg));
 
-  CHECK(sh("'" HEARTH_EXE "' detect '%s' --no-overlays > '%s' 2>&1", root, log) == 0);
-  CHECK(sh("'" HEARTH_EXE "' calibrate '%s' --quiet >> '%s' 2>&1", root, log) == 0);
+  CHECK(test_sh("'" HEARTH_EXE "' detect '%s' --no-overlays > '%s' 2>&1", root, log) == 0);
+  CHECK(test_sh("'" HEARTH_EXE "' calibrate '%s' --quiet >> '%s' 2>&1", root, log) == 0);
   hearth_rig r, t;
   snprintf(path, sizeof path, "%s/calibration/rig.json", root);
   CHECK_OK(hearth_rig_read(path, &r, &err), &err);

@@ -15,12 +15,6 @@
 
 static char g_root[1024];
 
-static int sh(const char *fmt, const char *a, const char *b) {
-  char cmd[8192];
-  snprintf(cmd, sizeof cmd, fmt, a, b);
-  return system(cmd);
-}
-
 /* problems of the release at root; returns the count, fills a hit flag for a
  * problem whose path ends with `suffix` and whose text contains `needle` */
 static size_t validate(const char *root, const char *suffix, const char *needle, int *hit) {
@@ -47,8 +41,8 @@ static size_t validate(const char *root, const char *suffix, const char *needle,
 static const char *fresh_copy(const char *name) {
   static char dst[1200];
   snprintf(dst, sizeof dst, "%s/../%s", g_root, name);
-  sh("rm -rf '%s'%s", dst, "");
-  sh("cp -a '%s' '%s'", g_root, dst);
+  test_sh("rm -rf '%s'%s", dst, "");
+  test_sh("cp -a '%s' '%s'", g_root, dst);
   return dst;
 }
 
@@ -75,7 +69,7 @@ int main(void) {
   /* calibration: the true rig stands in (calibration has its own tests) */
   snprintf(p, sizeof p, "%s/ground_truth/rig.json", g_root);
   snprintf(q, sizeof q, "%s/calibration/rig.json", g_root);
-  sh("cp '%s' '%s'", p, q);
+  test_sh("cp '%s' '%s'", p, q);
   hearth_scale_job sj = {g_root, "cup_01", NULL, {0}};
   hearth_scale_opts_default(&sj.opts);
   sj.opts.threads = 2;
@@ -101,7 +95,7 @@ int main(void) {
   {
     const char *d = fresh_copy("rawonly");
     snprintf(p, sizeof p, "%s/instances/cup_01/derived", d);
-    sh("rm -rf '%s'%s", p, "");
+    test_sh("rm -rf '%s'%s", p, "");
     n = validate(d, "instances/cup_01/derived", "never built", &hit);
     CHECK(n >= 1 && hit);
     hearth_problems pr = {0};
@@ -122,7 +116,7 @@ int main(void) {
     CHECK_MSG(hit, "missing view file not reported");
     /* the whole view gone: all five files */
     snprintf(p, sizeof p, "%s/instances/cup_01/raw/hot", d);
-    sh("cd '%s' && rm -f rgb/v00.jpg cutout/v00.png depth/v00.png depth/v00.json%s", p, "");
+    test_sh("cd '%s' && rm -f rgb/v00.jpg cutout/v00.png depth/v00.png depth/v00.json%s", p, "");
     n = validate(d, "raw/hot/rgb/v00.jpg", "missing", &hit);
     CHECK(hit && n >= 5);
   }
@@ -130,7 +124,7 @@ int main(void) {
   {
     const char *d = fresh_copy("csv255");
     snprintf(p, sizeof p, "%s/instances/cup_01/raw/neutral/thermal/v00.csv", d);
-    sh("sed -i 's/,[^,]*$//' '%s'%s", p, "");
+    test_sh("sed -i 's/,[^,]*$//' '%s'%s", p, "");
     n = validate(d, "raw/neutral/thermal/v00.csv", NULL, &hit);
     CHECK_MSG(hit && n == 1, "255x192 CSV: hit %d, %zu problem(s)", hit, n);
   }
@@ -156,9 +150,10 @@ int main(void) {
     CHECK_OK(hearth_poses_read(p, &ps, &err), &err);
     /* rewrite the text: the writer refuses a non-rotation, so edit it by hand */
     hearth_poses_free(&ps);
-    sh("python3 -c \"import json,sys; f=sys.argv[1]; d=json.load(open(f)); "
-       "d['views'][1]['T_world_from_cam'][0][0]*=1.5; json.dump(d,open(f,'w'))\" '%s'%s",
-       p, "");
+    test_sh(
+        "python3 -c \"import json,sys; f=sys.argv[1]; d=json.load(open(f)); "
+        "d['views'][1]['T_world_from_cam'][0][0]*=1.5; json.dump(d,open(f,'w'))\" '%s'%s",
+        p, "");
     n = validate(d, "derived/poses_thermal.json", "views[1]", &hit);
     CHECK_MSG(hit, "non-rotation pose not reported");
   }
@@ -166,9 +161,10 @@ int main(void) {
   {
     const char *d = fresh_copy("prov");
     snprintf(p, sizeof p, "%s/instances/cup_01/derived/neutral/provenance.json", d);
-    sh("python3 -c \"import json,sys; f=sys.argv[1]; d=json.load(open(f)); "
-       "d['source_views'].append('v77'); json.dump(d,open(f,'w'))\" '%s'%s",
-       p, "");
+    test_sh(
+        "python3 -c \"import json,sys; f=sys.argv[1]; d=json.load(open(f)); "
+        "d['source_views'].append('v77'); json.dump(d,open(f,'w'))\" '%s'%s",
+        p, "");
     n = validate(d, "derived/neutral/provenance.json", "'v77' does not exist", &hit);
     CHECK_MSG(hit && n == 1, "provenance v77: hit %d, %zu problem(s)", hit, n);
   }
@@ -178,7 +174,7 @@ int main(void) {
     snprintf(p, sizeof p, "%s/instances/cup_01/raw/hot/thermal/v00.csv", d);
     CHECK(remove(p) == 0);
     snprintf(p, sizeof p, "%s/instances/cup_01/raw/neutral/thermal/v00.csv", d);
-    sh("sed -i '$d' '%s'%s", p, "");
+    test_sh("sed -i '$d' '%s'%s", p, "");
     snprintf(p, sizeof p, "%s/instances/cup_01/derived/hot/thermal_turbo.png", d);
     CHECK(remove(p) == 0);
     n = validate(d, NULL, NULL, NULL);
