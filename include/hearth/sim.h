@@ -1,8 +1,9 @@
 /* hearth/sim.h - area sim (src/sim/; built with HEARTH_SIM, links MuJoCo,
  * OSMesa and HDF5): the paper's three temperature-aware pick-and-place tasks
  * (H1 study table: hot/normal cup; H2 kitchen: iced/normal can; H3 kitchen:
- * hot phone/hot sponge) and two whose temperatures change (H5: the cup
- * still warm; H6: the iced can before it warms up) on MuJoCo, with hearth
+ * hot phone/hot sponge), one that needs where an object is hot (H4: a pot
+ * grasped by its cool handle) and two whose temperatures change (H5: the
+ * cup still warm; H6: the iced can before it warms up) on MuJoCo, with hearth
  * assets, a Panda arm under an operational-space pose controller, three
  * rendered views (front RGB, front thermal, wrist RGB), a scripted expert
  * and a LIBERO-layout HDF5 writer.
@@ -36,20 +37,23 @@ extern "C" {
 #define HEARTH_SIM_CONTROL_HZ 20
 #define HEARTH_SIM_TIMESTEP 0.002
 
-/* H1-H3: the paper's tasks (static temperatures by default). H5, H6 need
- * temperatures that change and always run with dynamic ones: H5 two
- * identical hot cups, one filled half an hour before the other; H6 an iced
- * can that must be on the mat before it warms past a limit. (H4, a hot
- * kettle grasped by its cool handle, is not built yet: the number is
- * kept for it.) docs/simulation.md, "Tasks". */
+/* H1-H3: the paper's tasks (static temperatures by default). H4: a hot pot
+ * with two handles alike in colour, one of them hot (which one changes
+ * with the layout): grasp it by the cool one and place it on the mat (the
+ * trivet); a finger touching the pot above 45 degC fails the episode
+ * (always static temperatures). H5, H6 need temperatures that change and
+ * always run with dynamic ones: H5 two identical hot cups, one filled half
+ * an hour before the other; H6 an iced can that must be on the mat before
+ * it warms past a limit. docs/simulation.md, "Tasks". */
 typedef enum hearth_sim_task {
   HEARTH_SIM_H1 = 1,
   HEARTH_SIM_H2 = 2,
   HEARTH_SIM_H3 = 3,
+  HEARTH_SIM_H4 = 4,
   HEARTH_SIM_H5 = 5,
   HEARTH_SIM_H6 = 6
 } hearth_sim_task;
-/* task numbers are below this; not every number below is a task */
+/* task numbers are below this */
 #define HEARTH_SIM_TASK_END 7
 
 /* Parse "H1".."H6" (case-insensitive); 0 if unknown or not built. */
@@ -64,7 +68,7 @@ const char *hearth_sim_instruction_text(hearth_sim_task t, int instruction);
 
 /* Where the assets come from. A release root holds the instances of the
  * categories a task needs (cup, canned_drink, electric_kettle, eraser,
- * orange, smartphone, sponge) in the states it needs (neutral, hot, iced).
+ * orange, pot, smartphone, sponge) in the states it needs (neutral, hot, iced).
  * With use_ground_truth (virtual-rig releases) the metric mesh is
  * ground_truth/instances/<id>/mesh.glb and temperatures come from
  * <state>/temperature_true.npy; otherwise derived/mesh.glb and
@@ -171,8 +175,9 @@ hearth_status hearth_sim_observe(hearth_sim_env *env, hearth_sim_obs *obs, heart
 /* 1 when the target rests on the mat, released by the gripper, and the
  * episode has not failed. */
 int hearth_sim_success(const hearth_sim_env *env);
-/* Why the episode can no longer succeed (H6: "the iced can warmed past
- * 10.5 degC before it was placed"), NULL while it can; owned by the env,
+/* Why the episode can no longer succeed (H4: "a finger touched the pot at
+ * 58.1 degC, above 45 degC"; H6: "the iced can warmed past 10.5 degC
+ * before it was placed"), NULL while it can; owned by the env,
  * valid until the next reset. Failure is checked after every step. */
 const char *hearth_sim_failure(const hearth_sim_env *env);
 /* Control steps since reset; the time limit. */
@@ -188,7 +193,9 @@ size_t hearth_sim_state(const hearth_sim_env *env, double *state, size_t max);
 hearth_status hearth_sim_visibility(hearth_sim_env *env, double *target_frac, double *other_frac,
                                     hearth_err *err);
 /* Pixel boxes [x0 y0 x1 y1] (OpenGL rows) of the two candidates in the
- * front view, slot A then slot B (privileged; tests and audits). */
+ * front view, slot A then slot B (privileged; tests and audits). H4: the
+ * pot's two handles, slot A the one at the image's left (world -y), from
+ * the projection of their outer halves (the part clear of the body). */
 hearth_status hearth_sim_candidate_boxes(hearth_sim_env *env, int boxes[2][4], hearth_err *err);
 
 /* ---- dynamic temperatures (opts.thermal = HEARTH_SIM_THERMAL_DYNAMIC) ---- */

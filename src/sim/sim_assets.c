@@ -19,6 +19,10 @@ static const sim_category k_cats[] = {
     {"electric_kettle", 1.00, 1.0, 0.20, 0.20},
     {"eraser", 0.03, 1.0, 0.06, 0.07},
     {"orange", 0.18, 1.0, 0.07, 0.08},
+    /* H4's pot is held by a handle, not across its body: 20 cm across the
+     * body, 26 cm handle to handle at most; a light (aluminium) pot, so the
+     * 15 N pinch on one handle holds it nearly level */
+    {"pot", 0.20, 1.0, 0.20, 0.26},
     {"smartphone", 0.18, 1.2, 0.062, 0.15},
     {"sponge", 0.03, 1.5, 0.062, 0.11},
 };
@@ -62,10 +66,11 @@ static hearth_status find_instance(const char *root, const char *category, char 
   }
   hearth_release_free(&rd);
   if (!found)
-    return hearth_err_set(err, HEARTH_E_NOT_FOUND,
-                          "%s/release.json: no instance of category '%s' (the sim tasks need "
-                          "cup, canned_drink, electric_kettle, eraser, orange, smartphone, sponge)",
-                          root, category);
+    return hearth_err_set(
+        err, HEARTH_E_NOT_FOUND,
+        "%s/release.json: no instance of category '%s' (the sim tasks need "
+        "cup, canned_drink, electric_kettle, eraser, orange, pot, smartphone, sponge)",
+        root, category);
   return HEARTH_OK;
 }
 
@@ -100,6 +105,26 @@ static void dilate_rgb(uint8_t *rgb, uint8_t *valid, size_t R, int iters, const 
   free(nv);
 }
 
+hearth_status sim_temp_turbo(const float *t, size_t R, hearth_image *out, hearth_err *err) {
+  hearth_status st = hearth_image_alloc(out, R, R, 3, HEARTH_PIX_U8, err);
+  uint8_t *valid = st ? NULL : malloc(R * R);
+  if (!st && !valid) {
+    hearth_image_free(out);
+    return hearth_err_set(err, HEARTH_E_NOMEM, "sim: out of memory");
+  }
+  if (st) return st;
+  uint8_t *px = out->data;
+  for (size_t i = 0; i < R * R; i++) {
+    valid[i] = isfinite(t[i]) ? 1 : 0;
+    if (valid[i]) hearth_turbo((t[i] - SIM_TLO) / (SIM_THI - SIM_TLO), px + 3 * i);
+  }
+  uint8_t room[3];
+  sim_room_rgb(room);
+  dilate_rgb(px, valid, R, 4, room);
+  free(valid);
+  return HEARTH_OK;
+}
+
 /* temperature map -> Turbo texture with dilated seams */
 static hearth_status thermal_texture(const char *path, hearth_image *out, float **temp,
                                      hearth_err *err) {
@@ -111,22 +136,8 @@ static hearth_status thermal_texture(const char *path, hearth_image *out, float 
     hearth_npy_free(&a);
     return hearth_err_set(err, HEARTH_E_SIZE, "%s: expected a square float32 [R][R] map", path);
   }
-  size_t R = a.shape[0];
-  st = hearth_image_alloc(out, R, R, 3, HEARTH_PIX_U8, err);
-  uint8_t *valid = st ? NULL : malloc(R * R);
-  if (!st && !valid) st = hearth_err_set(err, HEARTH_E_NOMEM, "%s: out of memory", path);
-  if (!st) {
-    const float *t = a.data;
-    uint8_t *px = out->data;
-    for (size_t i = 0; i < R * R; i++) {
-      valid[i] = isfinite(t[i]) ? 1 : 0;
-      if (valid[i]) hearth_turbo((t[i] - SIM_TLO) / (SIM_THI - SIM_TLO), px + 3 * i);
-    }
-    uint8_t room[3];
-    sim_room_rgb(room);
-    dilate_rgb(px, valid, R, 4, room);
-  }
-  free(valid);
+  st = sim_temp_turbo(a.data, a.shape[0], out, err);
+  if (st) hearth_err_prefix(err, "%s: ", path);
   if (!st) *temp = a.data, a.data = NULL; /* the map itself, kept for the thermal model */
   hearth_npy_free(&a);
   return st;

@@ -47,6 +47,8 @@ static void bddl_text(hearth_sim_task t, int ins, hearth_strbuf *b) {
   const sim_task_obj *objs[SIM_NOBJ] = {&td->cand[0], &td->cand[1], &td->dist[0], &td->dist[1]};
   char names[SIM_NOBJ][64];
   for (int k = 0; k < SIM_NOBJ; k++) obj_name(objs[k], names[k], sizeof names[k]);
+  const double(*spots)[2] = sim_task_spots(td);
+  int target = sim_task_target(td, ins);
   static const char *const k_regions[SIM_NOBJ] = {"slot_a_region", "slot_b_region",
                                                   "distractor_1_region", "distractor_2_region"};
   hearth_strbuf_printf(
@@ -64,8 +66,8 @@ static void bddl_text(hearth_sim_task t, int ins, hearth_strbuf *b) {
     hearth_strbuf_printf(
         b,
         "    (%s\n      (:target main_table)\n      (:ranges (\n          (%s %s %s %s)\n        )\n      )\n    )\n",
-        k_regions[k], n3(sim_spots[k][0] - 0.025).s, n3(sim_spots[k][1] - 0.025).s,
-        n3(sim_spots[k][0] + 0.025).s, n3(sim_spots[k][1] + 0.025).s);
+        k_regions[k], n3(spots[k][0] - 0.025).s, n3(spots[k][1] - 0.025).s,
+        n3(spots[k][0] + 0.025).s, n3(spots[k][1] + 0.025).s);
   hearth_strbuf_printf(
       b,
       "    (mat_region\n      (:target main_table)\n      (:ranges (\n          (%s %s %s %s)\n"
@@ -77,7 +79,7 @@ static void bddl_text(hearth_sim_task t, int ins, hearth_strbuf *b) {
   for (int k = 0; k < SIM_NOBJ; k++)
     hearth_strbuf_printf(b, "    %s - %s ; %s\n", names[k], objs[k]->category,
                          state_words(objs[k]->state));
-  hearth_strbuf_printf(b, "  )\n  (:obj_of_interest\n    %s\n    mat_1\n  )\n", names[ins]);
+  hearth_strbuf_printf(b, "  )\n  (:obj_of_interest\n    %s\n    mat_1\n  )\n", names[target]);
   hearth_strbuf_printf(
       b,
       "  ; even layouts; odd layouts swap the two candidates' regions\n  (:init\n    (On mat_1 mat_region)\n");
@@ -88,7 +90,7 @@ static void bddl_text(hearth_sim_task t, int ins, hearth_strbuf *b) {
       "  )\n  ; success: the object's bottom centre over the mat, within 2 cm of its top,\n"
       "  ; slower than 0.05 m/s and released by both fingers\n"
       "  (:goal\n    (And (On %s mat_1))\n  )\n)\n",
-      names[ins]);
+      names[target]);
 }
 
 hearth_status sim_h5_describe(const hearth_sim_collect_opts *o, int ins_first, int ins_count,

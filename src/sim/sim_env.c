@@ -30,6 +30,7 @@ void hearth_sim_env_free(hearth_sim_env *e) {
   if (!e) return;
   sim_render_free(e);
   sim_thermal_free(e);
+  sim_handles_free(&e->hd);
   if (e->d) mj_deleteData(e->d);
   if (e->m) mj_deleteModel(e->m);
   for (int k = 0; k < SIM_NOBJ; k++) sim_asset_free(&e->assets[k]);
@@ -64,7 +65,7 @@ static hearth_status age_candidates(hearth_sim_env *e, hearth_err *err) {
 hearth_status hearth_sim_env_new(const hearth_sim_opts *o, hearth_sim_env **out, hearth_err *err) {
   *out = NULL;
   if (!o || !hearth_sim_task_valid(o->task))
-    return hearth_err_set(err, HEARTH_E_ARG, "sim: task must be H1, H2, H3, H5 or H6");
+    return hearth_err_set(err, HEARTH_E_ARG, "sim: task must be H1, H2, H3, H4, H5 or H6");
   if (!o->release_root) return hearth_err_set(err, HEARTH_E_ARG, "sim: no asset release root");
   if (o->width < 16 || o->height < 16 || o->width > 4096 || o->height > 4096)
     return hearth_err_set(err, HEARTH_E_RANGE, "sim: image size %dx%d outside 16..4096", o->width,
@@ -94,6 +95,9 @@ hearth_status hearth_sim_env_new(const hearth_sim_opts *o, hearth_sim_env **out,
   /* tasks of changing temperatures run dynamic at their own pace */
   const sim_task_def *tdef = sim_task_get(e->task);
   if (tdef->dynamic) e->thermal = HEARTH_SIM_THERMAL_DYNAMIC, e->thermal_speedup = tdef->speedup;
+  /* H4's per-layout map is of the asset's fixed temperatures */
+  if (tdef->handles) e->thermal = HEARTH_SIM_THERMAL_STATIC;
+  e->expert_lug = -1;
   if (!isfinite(e->thermal_speedup) || e->thermal_speedup > 1e6) {
     free(e);
     return hearth_err_set(err, HEARTH_E_RANGE, "sim: thermal speed-up must be in (0, 1e6]");
@@ -145,6 +149,7 @@ hearth_status hearth_sim_env_new(const hearth_sim_opts *o, hearth_sim_env **out,
     const sim_task_obj *to = k < 2 ? &td->cand[k] : &td->dist[k - 2];
     st = sim_asset_load(o->release_root, o->use_ground_truth, to->category, to->state,
                         &e->assets[k], err);
+    if (!st && k == 0 && td->handles) st = sim_handles_init(e, err);
     char p[4200];
     if (!st) {
       snprintf(p, sizeof p, "%s/obj%d.obj", e->work_dir, k);
@@ -205,6 +210,7 @@ hearth_status hearth_sim_env_new(const hearth_sim_opts *o, hearth_sim_env **out,
     e->mat_geom = mj_name2id(m, mjOBJ_GEOM, "mat");
     e->table_geom = mj_name2id(m, mjOBJ_GEOM, "table");
     st = sim_render_init(e, err);
+    if (!st && td->handles) st = sim_handles_model(e, err);
     if (!st) st = sim_thermal_init(e, err);
     if (!st) st = age_candidates(e, err);
   }
@@ -269,9 +275,10 @@ hearth_status hearth_sim_reset(hearth_sim_env *e, uint64_t seed, uint64_t layout
                           instruction);
   mjModel *m = e->m;
   mjData *d = e->d;
+  const sim_task_def *td = sim_task_get(e->task);
   mj_resetData(m, d);
   e->instruction = instruction;
-  e->target = instruction; /* object index of the target */
+  e->target = sim_task_target(td, instruction); /* object index of the target */
   for (int i = 0; i < 7; i++) d->qpos[e->arm_qadr[i]] = sim_robot_q_start[i];
   for (int s = 0; s < 2; s++) d->qpos[e->fing_qadr[s]] = 0.04;
   /* visibility check: redraw the layout until both candidates are at
@@ -283,13 +290,15 @@ hearth_status hearth_sim_reset(hearth_sim_env *e, uint64_t seed, uint64_t layout
   for (int attempt = 0; attempt < SIM_MAX_ATTEMPTS; attempt++) {
     double pos[SIM_NOBJ][2];
     int swap;
-    sim_layout(seed, layout, attempt, pos, &swap);
+    sim_layout(seed, layout, attempt, sim_task_spots(td), pos, &swap);
     e->swap = swap;
     for (int k = 0; k < SIM_NOBJ; k++) {
-      int slot = k < 2 ? (k ^ swap) : k;
+      int slot = k < 2 && !td->handles ? (k ^ swap) : k;
       double *q = d->qpos + e->obj_qadr[k];
       q[0] = pos[slot][0], q[1] = pos[slot][1], q[2] = HEARTH_SIM_TABLE_Z + 0.0005;
       q[3] = 1, q[4] = q[5] = q[6] = 0;
+      /* the pot a quarter turn about z: its handles along world y */
+      if (k == 0 && td->handles) q[3] = q[6] = sqrt(0.5);
     }
     mj_forward(m, d);
     double vis = fmin(sim_visible_frac(e, 0), sim_visible_frac(e, 1));
@@ -297,9 +306,9 @@ hearth_status hearth_sim_reset(hearth_sim_env *e, uint64_t seed, uint64_t layout
     if (vis >= SIM_MIN_VISIBLE) break;
     if (attempt == SIM_MAX_ATTEMPTS - 1 && best != attempt) {
       /* none passed: go back to the best draw */
-      sim_layout(seed, layout, best, pos, &swap);
+      sim_layout(seed, layout, best, sim_task_spots(td), pos, &swap);
       for (int k = 0; k < SIM_NOBJ; k++) {
-        int slot = k < 2 ? (k ^ swap) : k;
+        int slot = k < 2 && !td->handles ? (k ^ swap) : k;
         d->qpos[e->obj_qadr[k]] = pos[slot][0], d->qpos[e->obj_qadr[k] + 1] = pos[slot][1];
       }
       mj_forward(m, d);
@@ -309,6 +318,13 @@ hearth_status hearth_sim_reset(hearth_sim_env *e, uint64_t seed, uint64_t layout
   for (int i = 0; i < 3; i++) e->goal_pos[i] = d->site_xpos[3 * e->site_grip + i];
   memcpy(e->goal_R, d->site_xmat + 9 * e->site_grip, sizeof e->goal_R);
   memcpy(e->R0, e->goal_R, sizeof e->R0);
+  if (td->handles) {
+    /* the expert's hand a quarter turn about z: the fingers close along
+     * world x, across the handle */
+    const double Rz[9] = {0, -1, 0, 1, 0, 0, 0, 0, 1};
+    hearth_mat3_mul(Rz, e->goal_R, e->R0);
+    sim_handles_reset(e);
+  }
   e->grip_cmd = -1;
   /* let the objects settle with the arm held */
   for (int i = 0; i < 50; i++) {
@@ -336,10 +352,11 @@ double sim_mean_temperature(const hearth_sim_env *e, int k, int at_reset) {
   return c > 0 ? cT / c : NAN;
 }
 
-/* the task's failure rules after a step: H6's target warming past its
- * limit before it is placed */
+/* the task's failure rules after a step: H4's finger on the pot above the
+ * limit, H6's target warming past its limit before it is placed */
 static void check_failure(hearth_sim_env *e) {
   const sim_task_def *td = sim_task_get(e->task);
+  if (!e->failed && td->handles) sim_handles_check(e, td->handle_limit_c);
   if (e->failed || !(td->warm_limit_c > 0)) return;
   if (!(sim_mean_temperature(e, e->target, 1) < td->warm_limit_c)) return;
   double T = sim_mean_temperature(e, e->target, 0);

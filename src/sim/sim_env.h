@@ -25,6 +25,23 @@ typedef struct sim_thermal_obj {
   int flip;                             /* model texture rows reversed from the map's */
 } sim_thermal_obj;
 
+/* H4's pot (sim_handles.c): collision boxes in its asset frame (handles
+ * along x: handle 0 at -x, 1 at +x), the two temperature maps (map k:
+ * handle k hot) and their Turbo textures, and the episode's hot handle */
+typedef struct sim_handles {
+  double rb;                          /* body radius, m */
+  double body_c[3], body_half[3];     /* the body up to its shoulder */
+  int has_lid;                        /* a lid's dome and knob rise above it */
+  double lid_c[3], lid_half[3];       /* their box */
+  double lug_c[2][3], lug_half[2][3]; /* each handle from the body out */
+  double lug_reach[2];                /* |x| of each handle's far end */
+  float *temp[2];                     /* R*R degC, rows as the asset's map */
+  hearth_image turbo[2];              /* their thermal textures */
+  int hot;                            /* the hot handle now */
+  int texid, flip;                    /* the pot's thermal texture in the model */
+  double finger_max_c;                /* hottest finger contact of the last step */
+} sim_handles;
+
 /* which renderer an env draws its views with */
 enum { SIM_RENDER_SOFT = 0, SIM_RENDER_GL = 1, SIM_RENDER_NONE = 2 };
 
@@ -51,6 +68,9 @@ struct hearth_sim_env {
   int failed;         /* the episode can no longer succeed (hearth_sim_failure) */
   char fail_msg[160]; /* why */
   sim_render *rnd;
+  /* H4 */
+  sim_handles hd;
+  int expert_lug; /* the handle the expert grasps: -1 the cool one (default) */
   /* dynamic temperatures */
   int thermal;
   double h_table, h_finger, h_object, thermal_speedup;
@@ -91,5 +111,22 @@ void sim_thermal_reset(hearth_sim_env *e);
 hearth_status sim_thermal_step(hearth_sim_env *e, double dt, hearth_err *err);
 void sim_thermal_update_textures(hearth_sim_env *e);
 void sim_thermal_free(hearth_sim_env *e);
+/* sim_handles.c (tasks with td->handles): the handles' boxes and maps
+ * from asset 0 (before the scene files are written: the asset's thermal
+ * texture becomes map 1's), the model's texture found after loading, the
+ * episode's map put into it at reset (handle 1 - swap hot), the pot's
+ * collision boxes as MJCF, the temperature of the pot's surface nearest a
+ * world point, the failure test over the finger pads' contacts, the grasp
+ * point of a handle (world) and the handles' pixel boxes in the front view
+ * (slot A handle 0, OpenGL rows) */
+hearth_status sim_handles_init(hearth_sim_env *e, hearth_err *err);
+hearth_status sim_handles_model(hearth_sim_env *e, hearth_err *err);
+void sim_handles_free(sim_handles *hd);
+void sim_handles_reset(hearth_sim_env *e);
+void sim_handles_mjcf(const hearth_sim_env *e, double friction, hearth_strbuf *b);
+double sim_handles_temp_at(const hearth_sim_env *e, const double p[3]);
+void sim_handles_check(hearth_sim_env *e, double limit_c);
+void sim_handles_grasp_point(const hearth_sim_env *e, int lug, double xyz[3]);
+void sim_handles_boxes(const hearth_sim_env *e, int boxes[2][4]);
 
 #endif

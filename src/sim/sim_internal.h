@@ -40,6 +40,10 @@ hearth_status sim_asset_load(const char *root, int use_gt, const char *category,
 /* a->temp from the thermal texture read back through the Turbo scale
  * (0.1 degC steps) when the load kept no temperature map (derived assets) */
 hearth_status sim_asset_temperatures(sim_asset *a, hearth_err *err);
+/* A Turbo texture (10..60 degC) of the R x R map t: NaN texels (no
+ * surface) take their valued neighbours' colour up to 4 texels away, the
+ * room's beyond. */
+hearth_status sim_temp_turbo(const float *t, size_t R, hearth_image *out, hearth_err *err);
 /* Turbo colour of the room temperature (22 degC over 10..60). */
 void sim_room_rgb(uint8_t rgb[3]);
 #define SIM_ROOM_C 22.0

@@ -117,7 +117,8 @@ void sim_mjcf_scene_text(const hearth_sim_env *e, const char *dir, hearth_strbuf
     double h = a->size[2];
     hearth_strbuf_printf(
         &b, "<body name=\"obj%d\" pos=\"%s %s %s\">\n<freejoint name=\"obj%d_free\"/>\n", k,
-        sim_num(sim_spots[k][0]).s, sim_num(sim_spots[k][1]).s, sim_num(tz + 0.002).s, k);
+        sim_num(sim_task_spots(td)[k][0]).s, sim_num(sim_task_spots(td)[k][1]).s,
+        sim_num(tz + 0.002).s, k);
     double sx = a->size[0], sy = a->size[1], mm = a->mass;
     hearth_strbuf_printf(&b, "<inertial pos=\"0 0 %s\" mass=\"%s\" diaginertia=\"%s %s %s\"/>\n",
                          sim_num(0.45 * h).s, sim_num(mm).s, sim_num(mm * (sy * sy + h * h) / 12).s,
@@ -126,12 +127,17 @@ void sim_mjcf_scene_text(const hearth_sim_env *e, const char *dir, hearth_strbuf
     /* MuJoCo 2.2 gives one contact point for mesh collisions, so objects
      * collide through their bounding box (box-box gives stable multi-point
      * contacts); the meshes are visual only */
-    hearth_strbuf_printf(
-        &b,
-        "<geom name=\"obj%d_col\" type=\"box\" size=\"%s %s %s\" pos=\"0 0 %s\" group=\"4\" "
-        "contype=\"1\" conaffinity=\"1\" condim=\"4\" friction=\"%s 0.01 0.0005\" rgba=\"1 1 1 0\"/>\n",
-        k, sim_num(0.5 * sx).s, sim_num(0.5 * a->size[1]).s, sim_num(0.5 * h).s, sim_num(0.5 * h).s,
-        sim_num(a->friction).s);
+    if (k == 0 && td->handles)
+      /* H4's pot: its body, lid and two handles, so the fingers can close
+       * on a handle */
+      sim_handles_mjcf(e, a->friction, &b);
+    else
+      hearth_strbuf_printf(
+          &b,
+          "<geom name=\"obj%d_col\" type=\"box\" size=\"%s %s %s\" pos=\"0 0 %s\" group=\"4\" "
+          "contype=\"1\" conaffinity=\"1\" condim=\"4\" friction=\"%s 0.01 0.0005\" rgba=\"1 1 1 0\"/>\n",
+          k, sim_num(0.5 * sx).s, sim_num(0.5 * a->size[1]).s, sim_num(0.5 * h).s,
+          sim_num(0.5 * h).s, sim_num(a->friction).s);
     hearth_strbuf_printf(
         &b,
         "<geom name=\"obj%d_rgb\" type=\"mesh\" mesh=\"mesh%d\" material=\"mrgb%d\" group=\"2\" "

@@ -481,6 +481,10 @@ hearth_status hearth_sim_visibility(hearth_sim_env *e, double *tf, double *of, h
 }
 
 hearth_status hearth_sim_candidate_boxes(hearth_sim_env *e, int boxes[2][4], hearth_err *err) {
+  if (sim_task_get(e->task)->handles) {
+    sim_handles_boxes(e, boxes);
+    return HEARTH_OK;
+  }
   hearth_status st = render_ids(e, -1, err);
   if (st) return st;
   for (int slot = 0; slot < 2; slot++) {

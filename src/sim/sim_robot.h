@@ -13,6 +13,9 @@ extern const double sim_robot_q_start[7];
 extern const double sim_robot_tau_max[7];
 /* half height of a finger pad (m), centred on the grip site */
 #define SIM_PAD_HALF_Z 0.022
+/* the pad's half width across the closing direction (hand x), m: the
+ * 0.011 of its MJCF box (sim_robot.c) */
+#define SIM_PAD_HALF_X 0.011
 
 /* The arm's body tree inside <worldbody>: base, links 1-7 with joints
  * j1..j7, the hand (camera eye_in_hand, site grip) and the fingers

@@ -6,7 +6,16 @@
 #include "sim/sim_tasks.h"
 #include "hearth/core.h"
 
-/* H1-H3: paper, Table III. H5, H6: temperatures that change (dynamic
+/* H4's spots: the pot (its handles reach 13 cm each way) in the middle,
+ * the eraser behind it on the robot's side, the distractors clear of the
+ * hand at either handle */
+static const double k_h4_spots[SIM_NOBJ][2] = {{0.05, 0.07},
+                                               {-0.20, 0.10},
+                                               {-0.17, 0.33},
+                                               {0.21, -0.12}};
+
+/* H1-H3: paper, Table III. H4: the hot pot's cool handle (our choice of
+ * task, docs/simulation.md). H5, H6: temperatures that change (dynamic
  * forced; speed-ups and ages measured in docs/simulation.md, "Tasks"). */
 #define SIM_NTASK (HEARTH_SIM_TASK_END - 1)
 static const sim_task_def k_tasks[SIM_NTASK] = {
@@ -22,7 +31,15 @@ static const sim_task_def k_tasks[SIM_NTASK] = {
      "kitchen",
      {{"smartphone", "hot", "hot phone"}, {"sponge", "hot", "hot sponge"}},
      {{"orange", "neutral", "orange"}, {"cup", "hot", "cup"}}},
-    {0},
+    /* one hot pot (both instructions target it) with an eraser and two
+     * distractors at room temperature */
+    {"H4",
+     "kitchen",
+     {{"pot", "hot", "pot"}, {"eraser", "neutral", "eraser"}},
+     {{"cup", "neutral", "cup"}, {"orange", "neutral", "orange"}},
+     .handles = 1,
+     .handle_limit_c = 45.0,
+     .spots = k_h4_spots},
     /* two cups of the same hot asset: the second was filled half an hour
      * before the first, so it starts cooler; both cool during the episode */
     {"H5",
@@ -51,7 +68,8 @@ static const char *const k_instr[SIM_NTASK][2] = {
      "pick up the normal can and place it on the mat"},
     {"pick up the hot phone and place it on the mat",
      "pick up the hot sponge and place it on the mat"},
-    {"", ""},
+    {"pick up the pot by its cool handle and put it on the trivet",
+     "one handle of the pot is hot: lift the pot by the other one and set it on the trivet"},
     {"bring the cup that is still warm to the mat", "bring the cup that has gone cold to the mat"},
     {"put the iced can back on the mat before it warms up",
      "put the can at room temperature on the mat"},
@@ -67,6 +85,10 @@ int hearth_sim_task_valid(hearth_sim_task t) {
   return t >= 1 && t <= SIM_NTASK && k_tasks[t - 1].name != NULL;
 }
 const sim_task_def *sim_task_get(hearth_sim_task t) { return &k_tasks[t - 1]; }
+int sim_task_target(const sim_task_def *td, int ins) { return td->handles ? 0 : ins; }
+const double (*sim_task_spots(const sim_task_def *td))[2] {
+  return td->spots ? td->spots : sim_spots;
+}
 
 /* the study: a light-gray floor and plaster walls around a dark wooden
  * desk; the kitchen: gray ceramic tiles and yellow linen walls around a
@@ -110,7 +132,8 @@ const char *hearth_sim_instruction_text(hearth_sim_task t, int i) {
   return k_instr[t - 1][i];
 }
 
-void sim_layout(uint64_t seed, uint64_t layout, int attempt, double pos[SIM_NOBJ][2], int *swap) {
+void sim_layout(uint64_t seed, uint64_t layout, int attempt, const double (*spots)[2],
+                double pos[SIM_NOBJ][2], int *swap) {
   hearth_rng base, r;
   hearth_rng_seed(&base, seed);
   hearth_rng_fork(&base, layout, &r);
@@ -118,8 +141,8 @@ void sim_layout(uint64_t seed, uint64_t layout, int attempt, double pos[SIM_NOBJ
    * plain draw and later attempts never depend on the image size */
   for (int a = 0; a <= attempt; a++)
     for (int k = 0; k < SIM_NOBJ; k++) {
-      pos[k][0] = sim_spots[k][0] + hearth_rng_range(&r, -0.025, 0.025);
-      pos[k][1] = sim_spots[k][1] + hearth_rng_range(&r, -0.025, 0.025);
+      pos[k][0] = spots[k][0] + hearth_rng_range(&r, -0.025, 0.025);
+      pos[k][1] = spots[k][1] + hearth_rng_range(&r, -0.025, 0.025);
     }
   /* candidate identities alternate between the slots: even layouts put
    * candidate 0 in slot A, odd ones in slot B (balanced for any even N) */

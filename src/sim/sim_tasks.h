@@ -28,9 +28,23 @@ typedef struct sim_task_def {
    * capacity weighted over its regions) passes this, degC, when it started
    * below it; 0: no limit */
   double warm_limit_c;
+  /* H4: candidate 0 is a pot with two handles alike in colour, the target
+   * of both instructions; the layout's swap bit picks which handle is hot
+   * (sim_handles.c), not the candidates' slots; a finger touching the pot
+   * above handle_limit_c (degC) fails the episode. Static temperatures */
+  int handles;
+  double handle_limit_c;
+  /* the table-top spots of this task's objects (slot A, slot B,
+   * distractors); NULL: sim_spots */
+  const double (*spots)[2];
 } sim_task_def;
 /* The row of a valid task (hearth_sim_task_valid). */
 const sim_task_def *sim_task_get(hearth_sim_task t);
+/* The object (0..3) instruction ins targets: ins, or 0 for a task of
+ * handles. */
+int sim_task_target(const sim_task_def *td, int ins);
+/* The task's table-top spots (td->spots, else sim_spots). */
+const double (*sim_task_spots(const sim_task_def *td))[2];
 
 /* How a scene looks (after LIBERO's study and kitchen table scenes): RGB
  * colours of the checkered floor (and its repeats over the 6 m floor), the
@@ -62,7 +76,9 @@ extern const double sim_mat_centre[2];
 #define SIM_MAT_HALF 0.08
 
 /* Draw `attempt` of layout `layout` of the stream `seed`: the jittered
- * positions of the four spots and whether the candidates swap slots. */
-void sim_layout(uint64_t seed, uint64_t layout, int attempt, double pos[SIM_NOBJ][2], int *swap);
+ * positions of the four spots (spots: sim_task_spots) and whether the
+ * candidates swap slots (H4: whether the cool handle is the one of slot B). */
+void sim_layout(uint64_t seed, uint64_t layout, int attempt, const double (*spots)[2],
+                double pos[SIM_NOBJ][2], int *swap);
 
 #endif
