@@ -57,7 +57,7 @@ static const command_case k_cases[] = {
     {"sim collect", 0, "--layouts", "0",
      "--task --out --layouts --seed --size --max-steps --release --ground-truth "
      "--keep-failures --shadows --renderer --gl --quiet"},
-    {"sim eval", 0, "--task", "H4",
+    {"sim eval", 0, "--task", "H7",
      "--policy --task --episodes --no-thermal --seed --release --size --shadows --renderer --gl "
      "--image-size --max-steps --replan --wait --timeout --out --video --video-every --quiet"},
 };
