@@ -47,9 +47,12 @@ static int shoot(hearth_sim_env *e, const char *out, const char *task, const cha
   int rc = write_view(p, ob.agentview_rgb, ob.width, ob.height);
   snprintf(p, sizeof p, "%s/%s_%s_thermal.png", out, task, moment);
   rc |= write_view(p, ob.agentview_thermal, ob.width, ob.height);
-  printf("%s %-6s step %3d: candidate 1 %.1f degC, candidate 2 %.1f degC\n", task, moment,
-         hearth_sim_steps(e), net_mean(hearth_sim_thermal_net(e, 0)),
-         net_mean(hearth_sim_thermal_net(e, 1)));
+  if (hearth_sim_thermal_net(e, 0))
+    printf("%s %-6s step %3d: candidate 1 %.1f degC, candidate 2 %.1f degC\n", task, moment,
+           hearth_sim_steps(e), net_mean(hearth_sim_thermal_net(e, 0)),
+           net_mean(hearth_sim_thermal_net(e, 1)));
+  else /* static temperatures (H1-H4 by default) */
+    printf("%s %-6s step %3d\n", task, moment, hearth_sim_steps(e));
   return rc;
 }
 
@@ -81,9 +84,9 @@ int main(int argc, char **argv) {
   so.ideal = 1;
   so.out_root = root;
   const char *cats[] = {"cup",    "canned_drink", "electric_kettle", "eraser",
-                        "orange", "smartphone",   "sponge"};
-  so.n_categories = 7;
-  for (int i = 0; i < 7; i++) so.categories[i] = cats[i];
+                        "orange", "pot",          "smartphone",      "sponge"};
+  so.n_categories = 8;
+  for (int i = 0; i < 8; i++) so.categories[i] = cats[i];
   so.n_states = 3;
   so.states[0] = "neutral", so.states[1] = "hot", so.states[2] = "iced";
   so.n_views = 6;

@@ -15,8 +15,8 @@ void sim_cli_drop_assets(const char *tmpdir);
 
 /* --task of the hearth-sim commands: "H1", "H1,H5" or "all" (any case)
  * into *(unsigned *)dst as bits 1 << task; the CLI_CALL parser */
-#define SIM_CLI_ALL_TASKS ((1u << 1) | (1u << 2) | (1u << 3) | (1u << 5) | (1u << 6))
-#define SIM_CLI_TASK_HELP "H1, H2, H3, H5, H6, a list such as H1,H5, or all"
+#define SIM_CLI_ALL_TASKS ((1u << 1) | (1u << 2) | (1u << 3) | (1u << 4) | (1u << 5) | (1u << 6))
+#define SIM_CLI_TASK_HELP "H1, H2, H3, H4, H5, H6, a list such as H1,H5, or all"
 
 int sim_cli_parse_tasks(void *dst, const char *value, char *why, size_t whysz);
 

@@ -33,9 +33,9 @@ int sim_cli_assets(const char *release, int gt, char *root, size_t rootsz, char 
   so.ideal = 1; /* the clean rig: assets as before the effects */
   so.out_root = root;
   const char *cats[] = {"cup",    "canned_drink", "electric_kettle", "eraser",
-                        "orange", "smartphone",   "sponge"};
-  so.n_categories = 7;
-  for (int i = 0; i < 7; i++) so.categories[i] = cats[i];
+                        "orange", "pot",          "smartphone",      "sponge"};
+  so.n_categories = 8;
+  for (int i = 0; i < 8; i++) so.categories[i] = cats[i];
   so.n_states = 3;
   so.states[0] = "neutral", so.states[1] = "hot", so.states[2] = "iced";
   so.n_views = 6; /* 2 azimuths per elevation: enough for the up direction */

@@ -1,4 +1,4 @@
-/* hearth sim eval: score a policy on H1-H3 (and H5, H6) the way the paper does */
+/* hearth sim eval: score a policy on H1-H3 (and H4-H6) the way the paper does */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -9,12 +9,13 @@
 #include "hearth/hearth.h"
 
 static const char *k_about =
-    "Evaluate a policy on the paper's tasks (H1-H3; H5, H6 with --task): N episodes\n"
+    "Evaluate a policy on the paper's tasks (H1-H3; H4-H6 with --task): N episodes\n"
     "per instruction (default 10: 20 per task, 60 for H1-H3), on held-out layouts\n"
     "(layout 2^32 + k of the seed stream, never used by collection; both instructions\n"
     "share a layout). Success = the target resting on the mat, released, within the\n"
     "time limit (280 control steps per task, after the 10 no-op steps of a server\n"
-    "policy) and, for H6, before the iced can warms past its limit. Prints the table\n"
+    "policy) and, for H4, with no finger touching the pot above 45 degC, for H6,\n"
+    "before the iced can warms past its limit. Prints the table\n"
     "(Task, Thermal, Instr. 1, Instr. 2, Average) ending with a line `overall <pct>`.\n"
     "A policy that errs (server gone, garbage, timeout) fails that episode with the\n"
     "reason; the evaluation goes on (reconnecting for the next episode). Such policy\n"
