@@ -121,8 +121,9 @@ int main(int argc, char **argv) {
       rc = 1;
       break;
     }
-    /* the grasp: the first step the expert closes the hand and lifts */
-    if (!grasped && a[6] > 0 && a[2] > 0.5) grasped = 1, rc |= shoot(e, out, tname, "grasp");
+    /* the grasp: the first step the expert closes the hand and lifts (H4
+     * lifts at a third of the speed: 0.33) */
+    if (!grasped && a[6] > 0 && a[2] > 0.3) grasped = 1, rc |= shoot(e, out, tname, "grasp");
     if (hearth_sim_success(e) || hearth_sim_failure(e)) break;
   }
   if (!rc) rc = shoot(e, out, tname, "end");

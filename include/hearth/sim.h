@@ -115,7 +115,7 @@ typedef struct hearth_sim_opts {
   int thermal;          /* HEARTH_SIM_THERMAL_STATIC (default: the paper's fixed
                           * temperature textures) or _DYNAMIC (a lumped thermal
                           * network per object, integrated with the physics);
-                          * H5 and H6 are always dynamic */
+                          * H4 is always static, H5 and H6 always dynamic */
   /* dynamic: contact conductances per unit area, W/(m^2 K), of the table
    * (and mat) and of the finger pads, both held at HEARTH_SIM_THERMAL_ROOM;
    * defaults HEARTH_SIM_H_CONTACT; 0 removes that kind of link */
