@@ -138,7 +138,7 @@ static hearth_status handle_maps(sim_handles *hd, sim_asset *a, hearth_err *err)
   if (st) return st;
   const hearth_mesh *me = &a->mesh;
   size_t R = a->temp_R, n = R * R;
-  /* per texel: -1 no handle, else the handle's side and its s (x1000) */
+  /* per texel: the handle it shows (-1: none) and its s there */
   float *s_of = hearth_alloc_array(n, sizeof(float));
   int8_t *side = malloc(n ? n : 1);
   for (int k = 0; k < 2; k++) hd->temp[k] = hearth_alloc_array(n, sizeof(float));
