@@ -1,5 +1,5 @@
 /* hearth/eval.h - area eval (src/eval/; built with HEARTH_SIM): scoring
- * policies on the sim tasks (H1-H3 by default; H5, H6) the way the paper does (10 episodes per
+ * policies on the sim tasks (H1-H3 by default; H4-H6) the way the paper does (10 episodes per
  * instruction, 20 per task, 60 per policy; success = target on the mat
  * within the time limit), for policies running anywhere:
  * the scripted expert (an upper bound), a replay of an HDF5 demonstration
