@@ -157,11 +157,84 @@ static int cmp_edge(const void *pa, const void *pb) {
 typedef struct atlas_check {
   size_t n_charts, non_discs, overlaps, outside, folded;
   double stretch, stretch_max, efficiency;
+  double gap; /* least UV distance between two charts' triangles */
 } atlas_check;
 
-/* every check on out (from in, with chart_of_tri); gutter in UV units */
+/* distance from p to segment ab */
+static double point_seg(const double p[2], const double a[2], const double b[2]) {
+  double dx = b[0] - a[0], dy = b[1] - a[1], l2 = dx * dx + dy * dy;
+  double t = l2 > 0 ? ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2 : 0;
+  t = t < 0 ? 0 : t > 1 ? 1 : t;
+  double ex = a[0] + t * dx - p[0], ey = a[1] + t * dy - p[1];
+  return sqrt(ex * ex + ey * ey);
+}
+
+static double cross2(const double o[2], const double a[2], const double b[2]) {
+  return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
+}
+
+/* distance between segments ab and cd (0 when they meet) */
+static double seg_seg(const double a[2], const double b[2], const double c[2], const double d[2]) {
+  double o1 = cross2(a, b, c), o2 = cross2(a, b, d), o3 = cross2(c, d, a), o4 = cross2(c, d, b);
+  if (((o1 > 0 && o2 < 0) || (o1 < 0 && o2 > 0)) && ((o3 > 0 && o4 < 0) || (o3 < 0 && o4 > 0)))
+    return 0;
+  return fmin(fmin(point_seg(a, c, d), point_seg(b, c, d)),
+              fmin(point_seg(c, a, b), point_seg(d, a, b)));
+}
+
+/* The least distance between boundary edges of different charts (seg: 3
+ * per edge, vertex, vertex, chart), over pairs closer than reach: edges
+ * are binned on a grid by their boxes grown by reach. Charts that do not
+ * overlap (checked apart) are that far apart. Returns reach when no pair
+ * is closer. */
+static double chart_gap(const hearth_mesh *out, const uint32_t *seg, size_t ns, double reach) {
+  const int B = 64;
+  size_t *cnt = calloc((size_t)B * B + 1, sizeof *cnt);
+  double gap = reach;
+  for (int pass = 0; pass < 2; pass++) {
+    size_t *fill = pass ? calloc((size_t)B * B, sizeof *fill) : NULL;
+    uint32_t *bin = pass ? malloc((cnt[(size_t)B * B] + 1) * sizeof *bin) : NULL;
+    for (size_t i = 0; i < ns; i++) {
+      const float *a = out->uvs + 2 * (size_t)seg[3 * i],
+                  *b = out->uvs + 2 * (size_t)seg[3 * i + 1];
+      int x0 = (int)floor((fmin(a[0], b[0]) - reach) * B),
+          x1 = (int)floor((fmax(a[0], b[0]) + reach) * B);
+      int y0 = (int)floor((fmin(a[1], b[1]) - reach) * B),
+          y1 = (int)floor((fmax(a[1], b[1]) + reach) * B);
+      for (int y = y0 < 0 ? 0 : y0; y <= y1 && y < B; y++)
+        for (int x = x0 < 0 ? 0 : x0; x <= x1 && x < B; x++) {
+          size_t c = (size_t)y * B + x;
+          if (pass) bin[cnt[c] + fill[c]++] = (uint32_t)i;
+          else cnt[c + 1]++;
+        }
+    }
+    if (!pass) {
+      for (size_t c = 0; c < (size_t)B * B; c++) cnt[c + 1] += cnt[c];
+      continue;
+    }
+    for (size_t c = 0; c < (size_t)B * B; c++)
+      for (size_t i = cnt[c]; i < cnt[c + 1]; i++)
+        for (size_t j = i + 1; j < cnt[c + 1]; j++) {
+          const uint32_t *p = seg + 3 * (size_t)bin[i], *q = seg + 3 * (size_t)bin[j];
+          if (p[2] == q[2]) continue;
+          double A[2], Bq[2], C[2], D[2];
+          for (int k = 0; k < 2; k++) {
+            A[k] = out->uvs[2 * (size_t)p[0] + k], Bq[k] = out->uvs[2 * (size_t)p[1] + k];
+            C[k] = out->uvs[2 * (size_t)q[0] + k], D[k] = out->uvs[2 * (size_t)q[1] + k];
+          }
+          gap = fmin(gap, seg_seg(A, Bq, C, D));
+        }
+    free(fill), free(bin);
+  }
+  free(cnt);
+  return gap;
+}
+
+/* every check on out (from in, with chart_of_tri); gutter and unit (one
+ * texel) in UV units */
 static void check_atlas(const char *name, const hearth_mesh *in, const hearth_mesh *out,
-                        const uint32_t *chart, size_t n_charts, double gutter, atlas_check *r) {
+                        const uint32_t *chart, size_t n_charts, double gutter, double unit,
+                        atlas_check *r) {
   memset(r, 0, sizeof *r);
   r->n_charts = n_charts;
   CHECK_MSG(out->n_triangles == in->n_triangles, "%s: %zu of %zu triangles", name, out->n_triangles,
@@ -195,13 +268,23 @@ static void check_atlas(const char *name, const hearth_mesh *in, const hearth_me
   CHECK_MSG(shared_vertices == 0, "%s: %zu corners use a vertex of another chart", name,
             shared_vertices);
   qsort(ek, 3 * nt, sizeof *ek, cmp_edge);
+  uint32_t *seg = malloc(3 * 3 * nt * sizeof *seg);
+  size_t ns = 0;
   for (size_t i = 0; i < 3 * nt;) {
     size_t j = i + 1;
     while (j < 3 * nt && cmp_edge(&ek[i], &ek[j]) == 0) j++;
     ne[ek[i].chart]++;
-    if (j - i == 1) nb[ek[i].chart]++;
+    if (j - i == 1) {
+      nb[ek[i].chart]++;
+      seg[3 * ns] = ek[i].a, seg[3 * ns + 1] = ek[i].b, seg[3 * ns + 2] = ek[i].chart;
+      ns++;
+    }
     i = j;
   }
+  /* the gutter between charts: boundary edges of two charts no closer than
+     it (with no overlap, checked below, the triangles are as far apart) */
+  r->gap = chart_gap(out, seg, ns, 2 * gutter + 1e-3);
+  free(seg);
   for (size_t k = 0; k < n_charts; k++) {
     long chi = (long)nvc[k] - (long)ne[k] + (long)nf[k];
     if (chi != 1 || nb[k] == 0) r->non_discs++;
@@ -297,13 +380,16 @@ static void check_atlas(const char *name, const hearth_mesh *in, const hearth_me
   free(isl);
   printf(
       "%s: %zu triangles, %zu charts, L2 stretch %.4f (max %.4f), packing %.3f; "
-      "%zu non-disc charts, %zu overlapping texels, %zu UVs outside, %zu folded\n",
+      "%zu non-disc charts, %zu overlapping texels, %zu UVs outside, %zu folded; "
+      "least gap %.2f texels of %.0f\n",
       name, nt, n_charts, r->stretch, r->stretch_max, r->efficiency, r->non_discs, r->overlaps,
-      r->outside, r->folded);
+      r->outside, r->folded, r->gap / unit, gutter / unit);
   CHECK_MSG(r->non_discs == 0, "%s: %zu charts are no disc", name, r->non_discs);
   CHECK_MSG(r->overlaps == 0, "%s: %zu texels under two UV triangles", name, r->overlaps);
   CHECK_MSG(r->outside == 0, "%s: %zu UV coordinates in the gutter or outside", name, r->outside);
   CHECK_MSG(r->folded == 0, "%s: %zu folded UV triangles", name, r->folded);
+  CHECK_MSG(r->gap >= gutter * (1 - 1e-3), "%s: two charts %.3f texels apart, gutter %.3f", name,
+            r->gap / unit, gutter / unit);
 }
 
 static void run_case(const char *name, const hearth_mesh *m, atlas_check *r, hearth_atlas_stats *st,
@@ -318,7 +404,8 @@ static void run_case(const char *name, const hearth_mesh *m, atlas_check *r, hea
     free(chart);
     return;
   }
-  check_atlas(name, m, &out, chart, st->n_charts, o.gutter_texels / o.texture_size, r);
+  check_atlas(name, m, &out, chart, st->n_charts, o.gutter_texels / o.texture_size,
+              1.0 / o.texture_size, r);
   /* the library's own figures agree with the ones measured here */
   CHECK_NEAR(st->stretch_l2, r->stretch, 1e-3 * r->stretch);
   CHECK_NEAR(st->packing_efficiency, r->efficiency, 1e-4);
