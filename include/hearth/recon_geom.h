@@ -267,14 +267,15 @@ void hearth_atlas_opts_default(hearth_atlas_opts *o);
  * sqrt((s1^2 + s2^2) / 2) (Sander, Snyder, Gortler, Hoppe 2001). */
 typedef struct hearth_atlas_stats {
   size_t n_charts;
-  size_t n_splits;           /* charts cut because they were no disc or folded */
-  size_t n_merges;           /* small charts merged into a neighbour */
-  double stretch_l2;         /* the mesh's L2 stretch: sqrt(area-weighted mean of L2^2) */
-  double stretch_l2_max;     /* largest per-triangle L2 stretch */
-  double area_distortion;    /* area-weighted mean of |ln(s1 s2)| */
-  double angle_distortion;   /* area-weighted mean of ln(s1 / s2) */
-  double packing_efficiency; /* UV area of the triangles / area of the unit square */
-  int cg_iterations_max;     /* most CG iterations one chart took */
+  size_t n_splits;             /* charts cut because they were no disc or folded */
+  size_t n_merges;             /* small charts merged into a neighbour */
+  double stretch_l2;           /* the mesh's L2 stretch: sqrt(area-weighted mean of L2^2) */
+  double stretch_l2_max;       /* largest per-triangle L2 stretch */
+  double stretch_l2_chart_max; /* largest chart's L2 stretch (over its own area) */
+  double area_distortion;      /* area-weighted mean of |ln(s1 s2)| */
+  double angle_distortion;     /* area-weighted mean of ln(s1 / s2) */
+  double packing_efficiency;   /* UV area of the triangles / area of the unit square */
+  int cg_iterations_max;       /* most CG iterations one chart took */
 } hearth_atlas_stats;
 
 /* Atlas of in (positions and indices; UVs and texture ignored) into out
@@ -296,8 +297,9 @@ hearth_status hearth_mesh_atlas(const hearth_mesh *in, const hearth_atlas_opts *
  *   {"instance", "route": "turntable", "views": N, "pairs", "iterations",
  *    "encoder_views", "colour_views", "icp_rms_start_mm", "icp_rms_mm", "icp_median_mm", "seconds",
  *    "mesh": {"vertices", "triangles", "voxel_m"},
- *    "atlas": {"charts", "stretch_l2", "stretch_l2_max", "area_distortion",
- *              "angle_distortion", "packing_efficiency"},
+ *    "atlas": {"charts", "merged", "stretch_l2", "stretch_l2_max",
+ *              "stretch_l2_chart_max", "area_distortion", "angle_distortion",
+ *              "packing_efficiency"},
  *    "per_view": [{"state", "view", "points", "plane_inliers",
  *                  "plane_rms_mm", "height_m", "elevation_deg", "pairs",
  *                  "matches", "icp_rms_mm", "d_azimuth_deg"}]}

@@ -432,7 +432,10 @@ static int merge_small(atlas_ctx *c, const ra_flat_limits *lim) {
 }
 
 /* ---- output ---------------------------------------------------------------- */
-static void chart_stats(const hearth_mesh *out, hearth_atlas_stats *st) {
+/* chart: each triangle's chart (n_charts of them); sum: 2 per chart,
+ * zeroed scratch */
+static void chart_stats(const hearth_mesh *out, const uint32_t *chart, double *sum,
+                        hearth_atlas_stats *st) {
   double a3 = 0, auv = 0;
   for (size_t t = 0; t < out->n_triangles; t++) {
     const uint32_t *ix = out->indices + 3 * t;
@@ -485,6 +488,7 @@ static void chart_stats(const hearth_mesh *out, hearth_atlas_stats *st) {
       double l2 = sqrt(0.5 * (A + C));
       s_l2 += a * l2 * l2;
       if (l2 > s_max) s_max = l2;
+      sum[2 * (size_t)chart[t]] += a * l2 * l2, sum[2 * (size_t)chart[t] + 1] += a;
       if (g > 0) {
         s_area += a * fabs(log(G * g));
         s_angle += a * log(G / g);
@@ -492,6 +496,9 @@ static void chart_stats(const hearth_mesh *out, hearth_atlas_stats *st) {
     }
   }
   st->stretch_l2 = sqrt(s_l2 / a3);
+  for (size_t k = 0; k < st->n_charts; k++)
+    if (sum[2 * k + 1] > 0)
+      st->stretch_l2_chart_max = fmax(st->stretch_l2_chart_max, sqrt(sum[2 * k] / sum[2 * k + 1]));
   st->stretch_l2_max = s_max;
   st->area_distortion = s_area / a3;
   st->angle_distortion = s_angle / a3;
@@ -613,14 +620,22 @@ hearth_status hearth_mesh_atlas(const hearth_mesh *in, const hearth_atlas_opts *
     goto done;
   }
   if ((s = ra_pack(c.charts, c.n_charts, o.texture_size, o.gutter_texels, err))) goto done;
-  if ((s = write_output(&c, out, chart_of_tri, err))) goto done;
-  if (stats) {
-    memset(stats, 0, sizeof *stats);
-    stats->n_charts = c.n_charts;
-    stats->n_splits = c.n_splits;
-    stats->n_merges = c.n_merges;
-    stats->cg_iterations_max = c.cg_max;
-    chart_stats(out, stats);
+  {
+    uint32_t *chart = chart_of_tri ? chart_of_tri : hearth_alloc_array(nt, sizeof *chart);
+    double *sum = stats ? calloc(2 * c.n_charts + 2, sizeof *sum) : NULL;
+    if (!chart || (stats && !sum)) s = hearth_err_set(err, HEARTH_E_NOMEM, "atlas: output");
+    if (!s) s = write_output(&c, out, chart, err);
+    if (!s && stats) {
+      memset(stats, 0, sizeof *stats);
+      stats->n_charts = c.n_charts;
+      stats->n_splits = c.n_splits;
+      stats->n_merges = c.n_merges;
+      stats->cg_iterations_max = c.cg_max;
+      chart_stats(out, chart, sum, stats);
+    }
+    if (chart != chart_of_tri) free(chart);
+    free(sum);
+    if (s) goto done;
   }
 done:
   for (size_t k = 0; k < c.n_charts; k++) ra_chart_free(&c.charts[k]);

@@ -413,6 +413,11 @@ static void run_case_at(const char *name, const hearth_mesh *m, int tex, double 
   }
   check_atlas(name, m, &out, chart, st->n_charts, o.gutter_texels / o.texture_size,
               1.0 / o.texture_size, r);
+  /* the worst chart lies between the mesh's stretch and the worst triangle's */
+  CHECK_MSG(st->stretch_l2_chart_max >= st->stretch_l2 * (1 - 1e-9) &&
+                st->stretch_l2_chart_max <= st->stretch_l2_max * (1 + 1e-9),
+            "%s: chart stretch %g outside [%g, %g]", name, st->stretch_l2_chart_max, st->stretch_l2,
+            st->stretch_l2_max);
   /* the library's own figures agree with the ones measured here */
   CHECK_NEAR(st->stretch_l2, r->stretch, 1e-3 * r->stretch);
   CHECK_NEAR(st->packing_efficiency, r->efficiency, 1e-4);
@@ -445,6 +450,7 @@ static void test_closed_forms(void) {
   CHECK_MSG(st.n_charts == 6, "cube: %zu charts", st.n_charts);
   CHECK_NEAR(r.stretch, 1, 1e-5);
   CHECK_NEAR(r.stretch_max, 1, 1e-5);
+  CHECK_NEAR(st.stretch_l2_chart_max, 1, 1e-5);
   CHECK_NEAR(st.area_distortion, 0, 1e-5);
   CHECK_NEAR(st.angle_distortion, 0, 1e-5);
   /* six equal squares in shelves of the unit square: at least 6/9 of it
@@ -611,9 +617,9 @@ int main(int argc, char **argv) {
     if (g_test_failures) return 1;
     printf(
         "%s: %zu triangles, %zu charts, L2 stretch %.4f (max %.4f), area %.4f, angle %.4f, "
-        "packing %.3f\n",
+        "packing %.3f; worst chart %.4f, %zu merged\n",
         argv[1], m.n_triangles, st.n_charts, st.stretch_l2, st.stretch_l2_max, st.area_distortion,
-        st.angle_distortion, st.packing_efficiency);
+        st.angle_distortion, st.packing_efficiency, st.stretch_l2_chart_max, st.n_merges);
     if (argc >= 3) CHECK_OK(hearth_glb_write(argv[2], &out, &e), &e);
     hearth_mesh_free(&m), hearth_mesh_free(&out);
     return g_test_failures;
