@@ -228,12 +228,21 @@ hearth_status hearth_recon_turntable(const char *root, const char *instance,
  *    folded triangle, a boundary that meets itself, or more stretch than
  *    max_chart_stretch / max_face_stretch allow is cut as above and tried
  *    again (one triangle always works);
+ *  - charts of at most 16 faces (mostly left by the cuts) join the
+ *    neighbouring chart (of at most 1024 faces) they share most edges
+ *    with, where the two still flatten as one within the limits above;
  *  - every chart is scaled to the same texel density (UV area proportional
- *    to 3-D area), turned to its minimal-area bounding box (rotating
- *    calipers on its convex hull) lying wide, and the boxes are packed in
- *    shelves (tallest first) into the unit square with gutter_texels /
- *    texture_size between boxes and from the border, at the largest
- *    density that fits (bisection).
+ *    to 3-D area) and turned to its minimal-area bounding box (rotating
+ *    calipers on its convex hull) lying wide; then packed into the unit
+ *    square by the better (larger density) of two packers: its box in
+ *    shelves (tallest first), or its own shape rasterised conservatively
+ *    on a grid of min(texture_size, 512) cells (per row the hull of the
+ *    cells its triangles touch), grown by the gutter and placed largest
+ *    box first where it meets no chart placed before and reaches least
+ *    far down, as it lies or turned a quarter. Either way any two charts,
+ *    and each chart and the border, are at least gutter_texels /
+ *    texture_size apart in UV, at the largest density that fits
+ *    (bisection).
  * The output has the input's triangles in the input's order; a vertex is
  * repeated once per chart it belongs to (vertices in chart order, then by
  * first use). Deterministic: no threads, no randomness. */
@@ -258,13 +267,15 @@ void hearth_atlas_opts_default(hearth_atlas_opts *o);
  * sqrt((s1^2 + s2^2) / 2) (Sander, Snyder, Gortler, Hoppe 2001). */
 typedef struct hearth_atlas_stats {
   size_t n_charts;
-  size_t n_splits;           /* charts cut because they were no disc or folded */
-  double stretch_l2;         /* the mesh's L2 stretch: sqrt(area-weighted mean of L2^2) */
-  double stretch_l2_max;     /* largest per-triangle L2 stretch */
-  double area_distortion;    /* area-weighted mean of |ln(s1 s2)| */
-  double angle_distortion;   /* area-weighted mean of ln(s1 / s2) */
-  double packing_efficiency; /* UV area of the triangles / area of the unit square */
-  int cg_iterations_max;     /* most CG iterations one chart took */
+  size_t n_splits;             /* charts cut because they were no disc or folded */
+  size_t n_merges;             /* small charts merged into a neighbour */
+  double stretch_l2;           /* the mesh's L2 stretch: sqrt(area-weighted mean of L2^2) */
+  double stretch_l2_max;       /* largest per-triangle L2 stretch */
+  double stretch_l2_chart_max; /* largest chart's L2 stretch (over its own area) */
+  double area_distortion;      /* area-weighted mean of |ln(s1 s2)| */
+  double angle_distortion;     /* area-weighted mean of ln(s1 / s2) */
+  double packing_efficiency;   /* UV area of the triangles / area of the unit square */
+  int cg_iterations_max;       /* most CG iterations one chart took */
 } hearth_atlas_stats;
 
 /* Atlas of in (positions and indices; UVs and texture ignored) into out
@@ -286,8 +297,9 @@ hearth_status hearth_mesh_atlas(const hearth_mesh *in, const hearth_atlas_opts *
  *   {"instance", "route": "turntable", "views": N, "pairs", "iterations",
  *    "encoder_views", "colour_views", "icp_rms_start_mm", "icp_rms_mm", "icp_median_mm", "seconds",
  *    "mesh": {"vertices", "triangles", "voxel_m"},
- *    "atlas": {"charts", "stretch_l2", "stretch_l2_max", "area_distortion",
- *              "angle_distortion", "packing_efficiency"},
+ *    "atlas": {"charts", "merged", "stretch_l2", "stretch_l2_max",
+ *              "stretch_l2_chart_max", "area_distortion", "angle_distortion",
+ *              "packing_efficiency"},
  *    "per_view": [{"state", "view", "points", "plane_inliers",
  *                  "plane_rms_mm", "height_m", "elevation_deg", "pairs",
  *                  "matches", "icp_rms_mm", "d_azimuth_deg"}]}

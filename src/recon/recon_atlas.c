@@ -93,7 +93,7 @@ typedef struct atlas_ctx {
   size_t nlists, lcap;
   atlas_chart *charts;
   size_t n_charts, ccap;
-  size_t n_splits;
+  size_t n_splits, n_merges;
   int cg_max;
   ra_flat_scratch flat;
 } atlas_ctx;
@@ -352,8 +352,90 @@ static hearth_status first_charts(atlas_ctx *c, const double *fn, const double *
   return s;
 }
 
+/* ---- small charts merged ------------------------------------------------ */
+typedef struct size_key {
+  size_t n, i;
+} size_key;
+
+static int cmp_size(const void *pa, const void *pb) {
+  const size_key *a = pa, *b = pb;
+  if (a->n != b->n) return a->n < b->n ? -1 : 1;
+  return a->i < b->i ? -1 : a->i > b->i;
+}
+
+/* Each chart of at most RA_MERGE_FACES faces, smallest first, joins the
+ * neighbouring chart of at most RA_MERGE_INTO faces it shares most edges
+ * with (then the next) when the two flatten as one within the limits; the
+ * charts left keep their order. -1 without memory. */
+static int merge_small(atlas_ctx *c, const ra_flat_limits *lim) {
+  const size_t nt = c->m->n_triangles, n = c->n_charts;
+  uint32_t *of = hearth_alloc_array(nt, sizeof *of);
+  size_key *key = hearth_alloc_array(n ? n : 1, sizeof *key);
+  uint32_t *faces = hearth_alloc_array(nt, sizeof *faces);
+  int rc = 0;
+  if (!of || !key || !faces) {
+    free(of), free(key), free(faces);
+    return -1;
+  }
+  for (size_t k = 0; k < n; k++) {
+    for (size_t f = 0; f < c->charts[k].n_faces; f++) of[c->charts[k].face[f]] = (uint32_t)k;
+    key[k] = (size_key){c->charts[k].n_faces, k};
+  }
+  qsort(key, n, sizeof *key, cmp_size);
+  for (size_t i = 0; i < n && rc == 0; i++) {
+    size_t k = key[i].i;
+    atlas_chart *a = &c->charts[k];
+    if (a->n_faces == 0 || a->n_faces > RA_MERGE_FACES) continue;
+    /* the neighbours with their shared edges, at most 3 per face */
+    uint32_t nb[3 * RA_MERGE_FACES], cnt[3 * RA_MERGE_FACES];
+    size_t nn = 0;
+    for (size_t f = 0; f < a->n_faces; f++)
+      for (int e = 0; e < 3; e++) {
+        uint32_t t = c->adj[3 * (size_t)a->face[f] + e];
+        if (t == NO_FACE || of[t] == k) continue;
+        size_t j = 0;
+        while (j < nn && nb[j] != of[t]) j++;
+        if (j == nn) nb[nn] = of[t], cnt[nn++] = 0;
+        cnt[j]++;
+      }
+    for (size_t tries = 0; tries < nn; tries++) {
+      size_t bj = nn;
+      for (size_t j = 0; j < nn; j++)
+        if (cnt[j] && (bj == nn || cnt[j] > cnt[bj] || (cnt[j] == cnt[bj] && nb[j] < nb[bj])))
+          bj = j;
+      if (bj == nn) break;
+      uint32_t q = nb[bj];
+      cnt[bj] = 0;
+      atlas_chart *b = &c->charts[q];
+      if (b->n_faces > RA_MERGE_INTO) continue;
+      memcpy(faces, b->face, b->n_faces * sizeof *faces);
+      memcpy(faces + b->n_faces, a->face, a->n_faces * sizeof *faces);
+      atlas_chart m;
+      int r = ra_chart_flatten(c->m, c->adj, faces, b->n_faces + a->n_faces, lim, &c->flat, &m);
+      if (r < 0) rc = -1;
+      if (r) continue;
+      for (size_t f = 0; f < a->n_faces; f++) of[a->face[f]] = q;
+      if (m.cg_iterations > c->cg_max) c->cg_max = m.cg_iterations;
+      ra_chart_free(a);
+      ra_chart_free(b);
+      *b = m;
+      c->n_merges++;
+      break;
+    }
+  }
+  size_t kept = 0;
+  for (size_t k = 0; k < n; k++)
+    if (c->charts[k].n_faces) c->charts[kept++] = c->charts[k];
+  c->n_charts = kept;
+  free(of), free(key), free(faces);
+  return rc;
+}
+
 /* ---- output ---------------------------------------------------------------- */
-static void chart_stats(const hearth_mesh *out, hearth_atlas_stats *st) {
+/* chart: each triangle's chart (n_charts of them); sum: 2 per chart,
+ * zeroed scratch */
+static void chart_stats(const hearth_mesh *out, const uint32_t *chart, double *sum,
+                        hearth_atlas_stats *st) {
   double a3 = 0, auv = 0;
   for (size_t t = 0; t < out->n_triangles; t++) {
     const uint32_t *ix = out->indices + 3 * t;
@@ -406,6 +488,7 @@ static void chart_stats(const hearth_mesh *out, hearth_atlas_stats *st) {
       double l2 = sqrt(0.5 * (A + C));
       s_l2 += a * l2 * l2;
       if (l2 > s_max) s_max = l2;
+      sum[2 * (size_t)chart[t]] += a * l2 * l2, sum[2 * (size_t)chart[t] + 1] += a;
       if (g > 0) {
         s_area += a * fabs(log(G * g));
         s_angle += a * log(G / g);
@@ -413,6 +496,9 @@ static void chart_stats(const hearth_mesh *out, hearth_atlas_stats *st) {
     }
   }
   st->stretch_l2 = sqrt(s_l2 / a3);
+  for (size_t k = 0; k < st->n_charts; k++)
+    if (sum[2 * k + 1] > 0)
+      st->stretch_l2_chart_max = fmax(st->stretch_l2_chart_max, sqrt(sum[2 * k] / sum[2 * k + 1]));
   st->stretch_l2_max = s_max;
   st->area_distortion = s_area / a3;
   st->angle_distortion = s_angle / a3;
@@ -529,14 +615,27 @@ hearth_status hearth_mesh_atlas(const hearth_mesh *in, const hearth_atlas_opts *
       goto done;
     }
   }
-  if ((s = ra_pack(c.charts, c.n_charts, o.gutter_texels / o.texture_size, err))) goto done;
-  if ((s = write_output(&c, out, chart_of_tri, err))) goto done;
-  if (stats) {
-    memset(stats, 0, sizeof *stats);
-    stats->n_charts = c.n_charts;
-    stats->n_splits = c.n_splits;
-    stats->cg_iterations_max = c.cg_max;
-    chart_stats(out, stats);
+  if (merge_small(&c, &lim)) {
+    s = hearth_err_set(err, HEARTH_E_NOMEM, "atlas: merging charts");
+    goto done;
+  }
+  if ((s = ra_pack(c.charts, c.n_charts, o.texture_size, o.gutter_texels, err))) goto done;
+  {
+    uint32_t *chart = chart_of_tri ? chart_of_tri : hearth_alloc_array(nt, sizeof *chart);
+    double *sum = stats ? calloc(2 * c.n_charts + 2, sizeof *sum) : NULL;
+    if (!chart || (stats && !sum)) s = hearth_err_set(err, HEARTH_E_NOMEM, "atlas: output");
+    if (!s) s = write_output(&c, out, chart, err);
+    if (!s && stats) {
+      memset(stats, 0, sizeof *stats);
+      stats->n_charts = c.n_charts;
+      stats->n_splits = c.n_splits;
+      stats->n_merges = c.n_merges;
+      stats->cg_iterations_max = c.cg_max;
+      chart_stats(out, chart, sum, stats);
+    }
+    if (chart != chart_of_tri) free(chart);
+    free(sum);
+    if (s) goto done;
   }
 done:
   for (size_t k = 0; k < c.n_charts; k++) ra_chart_free(&c.charts[k]);

@@ -1,6 +1,6 @@
 /* recon_atlas.h - private to area recon: one chart of the UV atlas
- * (recon_atlas.c makes the charts; recon_atlas_flat.c flattens and packs
- * them). */
+ * (recon_atlas.c makes the charts, recon_atlas_flat.c flattens them,
+ * recon_atlas_pack.c packs them). */
 #ifndef HEARTH_RECON_ATLAS_H
 #define HEARTH_RECON_ATLAS_H
 
@@ -47,10 +47,27 @@ typedef struct ra_flat_limits {
 int ra_chart_flatten(const hearth_mesh *m, const uint32_t *adj, const uint32_t *faces, size_t n,
                      const ra_flat_limits *lim, ra_flat_scratch *sc, atlas_chart *out);
 
-/* Turn each chart to its minimal-area box lying wide, and pack the boxes
- * in shelves into [0,1]^2 with `gutter` (UV units) between boxes and from
- * the border at the largest common scale that fits; rewrites the charts'
- * UVs. HEARTH_E_LIMIT when the gutters alone do not fit. */
-hearth_status ra_pack(atlas_chart *charts, size_t n, double gutter, hearth_err *err);
+/* Charts of at most RA_MERGE_FACES faces are merged into a neighbouring
+ * chart of at most RA_MERGE_INTO faces where the two flatten as one. */
+#define RA_MERGE_FACES 16
+#define RA_MERGE_INTO 1024
+
+/* The packing grid: texture_size cells a side, at most this many. */
+#define RA_PACK_GRID_MAX 512
+/* Bisection steps of the common scale after the first that fits (each
+ * takes the root of the ratio between the largest scale that fitted and
+ * the smallest that did not, from at most 2). */
+#define RA_PACK_BISECTIONS 7
+
+/* Turn each chart to its minimal-area box lying wide, then place the
+ * charts (largest box first) on a grid of min(texture_size,
+ * RA_PACK_GRID_MAX) cells a side: each where its cells, grown by the
+ * gutter, meet no cell of a chart placed before and it reaches least far
+ * down, as it lies or turned a quarter; at the largest common scale that
+ * fits. Any two charts end at least gutter_texels texels (of
+ * texture_size) apart, and as far from the border. Rewrites the charts'
+ * UVs into [0,1]^2. HEARTH_E_LIMIT when the gutters alone do not fit. */
+hearth_status ra_pack(atlas_chart *charts, size_t n, int texture_size, double gutter_texels,
+                      hearth_err *err);
 
 #endif

@@ -95,12 +95,14 @@ static hearth_status write_report(const char *path, const char *instance,
     hearth_strbuf_printf(&b, "},\n");
   }
   if (at) {
-    hearth_strbuf_printf(&b, "  \"atlas\": {\"charts\": %zu", at->n_charts);
+    hearth_strbuf_printf(&b, "  \"atlas\": {\"charts\": %zu, \"merged\": %zu", at->n_charts,
+                         at->n_merges);
     const struct {
       const char *k;
       double v;
     } a[] = {{"stretch_l2", at->stretch_l2},
              {"stretch_l2_max", at->stretch_l2_max},
+             {"stretch_l2_chart_max", at->stretch_l2_chart_max},
              {"area_distortion", at->area_distortion},
              {"angle_distortion", at->angle_distortion},
              {"packing_efficiency", at->packing_efficiency}};

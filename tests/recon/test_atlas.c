@@ -3,9 +3,13 @@
  * independently of the atlas code: each chart's Euler characteristic and
  * boundary from the output's own indices, UV triangle overlaps by
  * rasterising all UV triangles at 512 x 512 (texel centres strictly inside
- * two triangles), the gutter, orientation, the L2 stretch (Sander et al.
- * 2001) recomputed from the UVs, one UV island per chart, the GLB through
- * the Khronos validator and hearth's reader.
+ * two triangles), the gutter from the border and between charts (the least
+ * distance between two charts' boundary edges), orientation, the L2
+ * stretch (Sander et al. 2001) recomputed from the UVs, one UV island per
+ * chart, the GLB through the Khronos validator and hearth's reader.
+ * Packing bounds in closed form: 64 equal squares fill an 8 x 8 grid, (1 -
+ * 9 g)^2 of the square at gutter g, at three texture sizes and gutters;
+ * 64 parallelograms beat 2/3, the most any packing of their boxes holds.
  *
  * With arguments GLB_IN [GLB_OUT] it only runs the atlas on that mesh and
  * prints its figures (bench use). */
@@ -157,11 +161,84 @@ static int cmp_edge(const void *pa, const void *pb) {
 typedef struct atlas_check {
   size_t n_charts, non_discs, overlaps, outside, folded;
   double stretch, stretch_max, efficiency;
+  double gap; /* least UV distance between two charts' triangles */
 } atlas_check;
 
-/* every check on out (from in, with chart_of_tri); gutter in UV units */
+/* distance from p to segment ab */
+static double point_seg(const double p[2], const double a[2], const double b[2]) {
+  double dx = b[0] - a[0], dy = b[1] - a[1], l2 = dx * dx + dy * dy;
+  double t = l2 > 0 ? ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2 : 0;
+  t = t < 0 ? 0 : t > 1 ? 1 : t;
+  double ex = a[0] + t * dx - p[0], ey = a[1] + t * dy - p[1];
+  return sqrt(ex * ex + ey * ey);
+}
+
+static double cross2(const double o[2], const double a[2], const double b[2]) {
+  return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
+}
+
+/* distance between segments ab and cd (0 when they meet) */
+static double seg_seg(const double a[2], const double b[2], const double c[2], const double d[2]) {
+  double o1 = cross2(a, b, c), o2 = cross2(a, b, d), o3 = cross2(c, d, a), o4 = cross2(c, d, b);
+  if (((o1 > 0 && o2 < 0) || (o1 < 0 && o2 > 0)) && ((o3 > 0 && o4 < 0) || (o3 < 0 && o4 > 0)))
+    return 0;
+  return fmin(fmin(point_seg(a, c, d), point_seg(b, c, d)),
+              fmin(point_seg(c, a, b), point_seg(d, a, b)));
+}
+
+/* The least distance between boundary edges of different charts (seg: 3
+ * per edge, vertex, vertex, chart), over pairs closer than reach: edges
+ * are binned on a grid by their boxes grown by reach. Charts that do not
+ * overlap (checked apart) are that far apart. Returns reach when no pair
+ * is closer. */
+static double chart_gap(const hearth_mesh *out, const uint32_t *seg, size_t ns, double reach) {
+  const int B = 64;
+  size_t *cnt = calloc((size_t)B * B + 1, sizeof *cnt);
+  double gap = reach;
+  for (int pass = 0; pass < 2; pass++) {
+    size_t *fill = pass ? calloc((size_t)B * B, sizeof *fill) : NULL;
+    uint32_t *bin = pass ? malloc((cnt[(size_t)B * B] + 1) * sizeof *bin) : NULL;
+    for (size_t i = 0; i < ns; i++) {
+      const float *a = out->uvs + 2 * (size_t)seg[3 * i],
+                  *b = out->uvs + 2 * (size_t)seg[3 * i + 1];
+      int x0 = (int)floor((fmin(a[0], b[0]) - reach) * B),
+          x1 = (int)floor((fmax(a[0], b[0]) + reach) * B);
+      int y0 = (int)floor((fmin(a[1], b[1]) - reach) * B),
+          y1 = (int)floor((fmax(a[1], b[1]) + reach) * B);
+      for (int y = y0 < 0 ? 0 : y0; y <= y1 && y < B; y++)
+        for (int x = x0 < 0 ? 0 : x0; x <= x1 && x < B; x++) {
+          size_t c = (size_t)y * B + x;
+          if (pass) bin[cnt[c] + fill[c]++] = (uint32_t)i;
+          else cnt[c + 1]++;
+        }
+    }
+    if (!pass) {
+      for (size_t c = 0; c < (size_t)B * B; c++) cnt[c + 1] += cnt[c];
+      continue;
+    }
+    for (size_t c = 0; c < (size_t)B * B; c++)
+      for (size_t i = cnt[c]; i < cnt[c + 1]; i++)
+        for (size_t j = i + 1; j < cnt[c + 1]; j++) {
+          const uint32_t *p = seg + 3 * (size_t)bin[i], *q = seg + 3 * (size_t)bin[j];
+          if (p[2] == q[2]) continue;
+          double A[2], Bq[2], C[2], D[2];
+          for (int k = 0; k < 2; k++) {
+            A[k] = out->uvs[2 * (size_t)p[0] + k], Bq[k] = out->uvs[2 * (size_t)p[1] + k];
+            C[k] = out->uvs[2 * (size_t)q[0] + k], D[k] = out->uvs[2 * (size_t)q[1] + k];
+          }
+          gap = fmin(gap, seg_seg(A, Bq, C, D));
+        }
+    free(fill), free(bin);
+  }
+  free(cnt);
+  return gap;
+}
+
+/* every check on out (from in, with chart_of_tri); gutter and unit (one
+ * texel) in UV units */
 static void check_atlas(const char *name, const hearth_mesh *in, const hearth_mesh *out,
-                        const uint32_t *chart, size_t n_charts, double gutter, atlas_check *r) {
+                        const uint32_t *chart, size_t n_charts, double gutter, double unit,
+                        atlas_check *r) {
   memset(r, 0, sizeof *r);
   r->n_charts = n_charts;
   CHECK_MSG(out->n_triangles == in->n_triangles, "%s: %zu of %zu triangles", name, out->n_triangles,
@@ -195,13 +272,23 @@ static void check_atlas(const char *name, const hearth_mesh *in, const hearth_me
   CHECK_MSG(shared_vertices == 0, "%s: %zu corners use a vertex of another chart", name,
             shared_vertices);
   qsort(ek, 3 * nt, sizeof *ek, cmp_edge);
+  uint32_t *seg = malloc(3 * 3 * nt * sizeof *seg);
+  size_t ns = 0;
   for (size_t i = 0; i < 3 * nt;) {
     size_t j = i + 1;
     while (j < 3 * nt && cmp_edge(&ek[i], &ek[j]) == 0) j++;
     ne[ek[i].chart]++;
-    if (j - i == 1) nb[ek[i].chart]++;
+    if (j - i == 1) {
+      nb[ek[i].chart]++;
+      seg[3 * ns] = ek[i].a, seg[3 * ns + 1] = ek[i].b, seg[3 * ns + 2] = ek[i].chart;
+      ns++;
+    }
     i = j;
   }
+  /* the gutter between charts: boundary edges of two charts no closer than
+     it (with no overlap, checked below, the triangles are as far apart) */
+  r->gap = chart_gap(out, seg, ns, 2 * gutter + 1e-3);
+  free(seg);
   for (size_t k = 0; k < n_charts; k++) {
     long chi = (long)nvc[k] - (long)ne[k] + (long)nf[k];
     if (chi != 1 || nb[k] == 0) r->non_discs++;
@@ -297,20 +384,26 @@ static void check_atlas(const char *name, const hearth_mesh *in, const hearth_me
   free(isl);
   printf(
       "%s: %zu triangles, %zu charts, L2 stretch %.4f (max %.4f), packing %.3f; "
-      "%zu non-disc charts, %zu overlapping texels, %zu UVs outside, %zu folded\n",
+      "%zu non-disc charts, %zu overlapping texels, %zu UVs outside, %zu folded; "
+      "least gap %.2f texels of %.0f\n",
       name, nt, n_charts, r->stretch, r->stretch_max, r->efficiency, r->non_discs, r->overlaps,
-      r->outside, r->folded);
+      r->outside, r->folded, r->gap / unit, gutter / unit);
   CHECK_MSG(r->non_discs == 0, "%s: %zu charts are no disc", name, r->non_discs);
   CHECK_MSG(r->overlaps == 0, "%s: %zu texels under two UV triangles", name, r->overlaps);
   CHECK_MSG(r->outside == 0, "%s: %zu UV coordinates in the gutter or outside", name, r->outside);
   CHECK_MSG(r->folded == 0, "%s: %zu folded UV triangles", name, r->folded);
+  CHECK_MSG(r->gap >= gutter * (1 - 1e-3), "%s: two charts %.3f texels apart, gutter %.3f", name,
+            r->gap / unit, gutter / unit);
 }
 
-static void run_case(const char *name, const hearth_mesh *m, atlas_check *r, hearth_atlas_stats *st,
-                     hearth_mesh *keep) {
+/* the atlas of m with the defaults, or texture_size and gutter_texels
+ * when tex > 0 */
+static void run_case_at(const char *name, const hearth_mesh *m, int tex, double gutter,
+                        atlas_check *r, hearth_atlas_stats *st, hearth_mesh *keep) {
   hearth_err e = {0};
   hearth_atlas_opts o;
   hearth_atlas_opts_default(&o);
+  if (tex > 0) o.texture_size = tex, o.gutter_texels = gutter;
   hearth_mesh out, again;
   uint32_t *chart = malloc(m->n_triangles * sizeof *chart);
   CHECK_OK(hearth_mesh_atlas(m, &o, &out, chart, st, &e), &e);
@@ -318,7 +411,13 @@ static void run_case(const char *name, const hearth_mesh *m, atlas_check *r, hea
     free(chart);
     return;
   }
-  check_atlas(name, m, &out, chart, st->n_charts, o.gutter_texels / o.texture_size, r);
+  check_atlas(name, m, &out, chart, st->n_charts, o.gutter_texels / o.texture_size,
+              1.0 / o.texture_size, r);
+  /* the worst chart lies between the mesh's stretch and the worst triangle's */
+  CHECK_MSG(st->stretch_l2_chart_max >= st->stretch_l2 * (1 - 1e-9) &&
+                st->stretch_l2_chart_max <= st->stretch_l2_max * (1 + 1e-9),
+            "%s: chart stretch %g outside [%g, %g]", name, st->stretch_l2_chart_max, st->stretch_l2,
+            st->stretch_l2_max);
   /* the library's own figures agree with the ones measured here */
   CHECK_NEAR(st->stretch_l2, r->stretch, 1e-3 * r->stretch);
   CHECK_NEAR(st->packing_efficiency, r->efficiency, 1e-4);
@@ -337,6 +436,11 @@ static void run_case(const char *name, const hearth_mesh *m, atlas_check *r, hea
   else hearth_mesh_free(&out);
 }
 
+static void run_case(const char *name, const hearth_mesh *m, atlas_check *r, hearth_atlas_stats *st,
+                     hearth_mesh *keep) {
+  run_case_at(name, m, 0, 0, r, st, keep);
+}
+
 static void test_closed_forms(void) {
   hearth_mesh m;
   atlas_check r;
@@ -346,6 +450,7 @@ static void test_closed_forms(void) {
   CHECK_MSG(st.n_charts == 6, "cube: %zu charts", st.n_charts);
   CHECK_NEAR(r.stretch, 1, 1e-5);
   CHECK_NEAR(r.stretch_max, 1, 1e-5);
+  CHECK_NEAR(st.stretch_l2_chart_max, 1, 1e-5);
   CHECK_NEAR(st.area_distortion, 0, 1e-5);
   CHECK_NEAR(st.angle_distortion, 0, 1e-5);
   /* six equal squares in shelves of the unit square: at least 6/9 of it
@@ -385,6 +490,74 @@ static int run_validator(const char *path) {
   snprintf(cmd, sizeof cmd, "node '%s/tests/mesh/validate_glb.js' '%s'", src ? src : ".", path);
   int rc = system(cmd);
   return rc == -1 || !WIFEXITED(rc) ? -1 : WEXITSTATUS(rc);
+}
+
+/* n x n disjoint tiles in the plane z = 0, each a square of side a or,
+ * with slant, a parallelogram (0,0) (a,0) (2a,a) (a,a); two triangles */
+static void make_tiles(hearth_mesh *m, int n, double a, int slant) {
+  soup s = {0};
+  for (int i = 0; i < n; i++)
+    for (int j = 0; j < n; j++) {
+      double x = 3 * a * i, y = 3 * a * j;
+      double sh = slant ? a : 0;
+      double p0[3] = {x, y, 0}, p1[3] = {x + a, y, 0}, p2[3] = {x + a + sh, y + a, 0},
+             p3[3] = {x + sh, y + a, 0};
+      soup_tri(&s, p0, p1, p2);
+      soup_tri(&s, p0, p2, p3);
+    }
+  soup_weld(&s, m);
+}
+
+/* the least bounding box, over turns of 0.005 degree, of the n points p
+ * (2 each) */
+static double least_box(const double *p, int n) {
+  double best = INFINITY;
+  for (int t = 0; t < 18000; t++) {
+    double th = M_PI * t / 36000, c = cos(th), sn = sin(th);
+    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+    for (int k = 0; k < n; k++) {
+      double u = c * p[2 * k] - sn * p[2 * k + 1], v = sn * p[2 * k] + c * p[2 * k + 1];
+      lo[0] = fmin(lo[0], u), hi[0] = fmax(hi[0], u), lo[1] = fmin(lo[1], v),
+      hi[1] = fmax(hi[1], v);
+    }
+    best = fmin(best, (hi[0] - lo[0]) * (hi[1] - lo[1]));
+  }
+  return best;
+}
+
+/* packing bounds on tiles: 64 equal squares fill an 8 x 8 grid with 9
+ * gutters a side, (1 - 9 g)^2 of the square */
+static void test_tiles(void) {
+  hearth_mesh m;
+  atlas_check r;
+  hearth_atlas_stats st;
+  const struct {
+    int tex;
+    double gutter;
+  } at[] = {{1024, 4}, {256, 2}, {512, 6.5}};
+  for (size_t i = 0; i < sizeof at / sizeof at[0]; i++) {
+    char name[64];
+    snprintf(name, sizeof name, "64 squares at %d, gutter %g", at[i].tex, at[i].gutter);
+    make_tiles(&m, 8, 0.01, 0);
+    run_case_at(name, &m, at[i].tex, at[i].gutter, &r, &st, NULL);
+    double g = at[i].gutter / at[i].tex, bound = (1 - 9 * g) * (1 - 9 * g);
+    CHECK_MSG(st.n_charts == 64, "%s: %zu charts", name, st.n_charts);
+    CHECK_MSG(r.efficiency >= bound - 1e-4, "%s: packing %g, 8 x 8 gives %g", name, r.efficiency,
+              bound);
+    hearth_mesh_free(&m);
+  }
+  /* parallelograms (sides a and a sqrt 2 at 45 degrees): their least box
+     holds 2/3 of them (1.5 a^2, along the long sides; measured here too),
+     so boxes alone pack at most that; packed by shape they interlock */
+  const double P[8] = {0, 0, 1, 0, 2, 1, 1, 1};
+  double box_eff = 1 / least_box(P, 4);
+  make_tiles(&m, 8, 0.01, 1);
+  run_case("64 parallelograms", &m, &r, &st, NULL);
+  CHECK_NEAR(box_eff, 2.0 / 3, 1e-6);
+  CHECK_MSG(st.n_charts == 64, "parallelograms: %zu charts", st.n_charts);
+  CHECK_MSG(r.efficiency > box_eff, "parallelograms: packing %g, boxes alone <= %g", r.efficiency,
+            box_eff);
+  hearth_mesh_free(&m);
 }
 
 /* the atlas of a fused mesh, written as GLB, validated and read back */
@@ -444,14 +617,15 @@ int main(int argc, char **argv) {
     if (g_test_failures) return 1;
     printf(
         "%s: %zu triangles, %zu charts, L2 stretch %.4f (max %.4f), area %.4f, angle %.4f, "
-        "packing %.3f\n",
+        "packing %.3f; worst chart %.4f, %zu merged\n",
         argv[1], m.n_triangles, st.n_charts, st.stretch_l2, st.stretch_l2_max, st.area_distortion,
-        st.angle_distortion, st.packing_efficiency);
+        st.angle_distortion, st.packing_efficiency, st.stretch_l2_chart_max, st.n_merges);
     if (argc >= 3) CHECK_OK(hearth_glb_write(argv[2], &out, &e), &e);
     hearth_mesh_free(&m), hearth_mesh_free(&out);
     return g_test_failures;
   }
   test_closed_forms();
+  test_tiles();
   test_release();
   return g_test_failures;
 }
