@@ -2,8 +2,9 @@
 # Calibration accuracy on the virtual rig with the bench's physics on (the
 # default synth: thick plate, lamp-heated backing, warming plate, vignetting,
 # fixed-pattern noise, colour motion blur and JPEG, trigger offset), over
-# seeds, with the wall-corrected hole centres (the default) and with the
-# naive centroid (--no-wall-correction), against ground_truth/rig.json:
+# seeds, with the wall-corrected hole centres and the rolling-shutter stereo
+# (the defaults), with the naive centroid (--no-wall-correction) and with a
+# rigid plate per pair (--no-rolling-shutter), against ground_truth/rig.json:
 #   bench/calib_physics.sh BUILD_DIR OUT_DIR [SEEDS...]   (default seeds 1 2 3 4)
 # SYNTH_ARGS (environment) adds synth options, e.g. SYNTH_ARGS="--plate-bow 0"
 # to see one effect's share.
@@ -23,9 +24,12 @@ for s in $seeds; do
   "$h" synth --out "$r" --categories cup --states neutral --views 1 --seed "$s" --quiet \
     ${SYNTH_ARGS:-} >/dev/null
   "$h" detect "$r" >/dev/null
-  for est in wall naive; do
-    if [ "$est" = wall ]; then "$h" calibrate "$r" --quiet >/dev/null
-    else "$h" calibrate "$r" --quiet --no-wall-correction >/dev/null; fi
+  for est in wall naive rigid; do
+    case $est in
+      wall) "$h" calibrate "$r" --quiet >/dev/null ;;
+      naive) "$h" calibrate "$r" --quiet --no-wall-correction >/dev/null ;;
+      rigid) "$h" calibrate "$r" --quiet --no-rolling-shutter >/dev/null ;;
+    esac
     /usr/bin/python3 - "$r" "$s" "$est" <<'PY'
 import json, math, sys
 import numpy as np

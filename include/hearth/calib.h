@@ -81,6 +81,11 @@ typedef struct hearth_calib_opts {
    * HEARTH_LENS_BROWN5 (the rational model starts from the 5-parameter
    * solution) */
   hearth_lens_model lens_model;
+  /* hearth_calib_stereo: camera a has a rolling shutter (reads its rows in
+   * turn) and the plate may move during the readout: a velocity per pair
+   * (first order in each point's row time) is solved with its pose and kept
+   * when it explains more than noise would; default 1 */
+  int rolling_shutter;
 } hearth_calib_opts;
 void hearth_calib_opts_default(hearth_calib_opts *o);
 
@@ -108,7 +113,12 @@ hearth_status hearth_calib_pose(const hearth_camera *cam, const double (*obj)[3]
  * refines T_b_from_a and the per-pair plate poses in camera a. Pairs whose
  * RMS exceeds the outlier rule are dropped and the solve repeated.
  * rms_px = sqrt(mean squared point error over both cameras and the pairs
- * used). pair_rms (n_pairs) and pair_used (n_pairs) may be NULL. */
+ * used). pair_rms (n_pairs) and pair_used (n_pairs) may be NULL. With
+ * o->rolling_shutter, camera a's point at row v is taken as seen at time
+ * (v + 0.5) / height - 0.5 of a frame from its middle row (camera b's at
+ * that middle row), each pair's plate moving at a velocity solved with its
+ * pose; the model is kept only when it explains more than noise, otherwise
+ * the result is the rigid solve's. */
 hearth_status hearth_calib_stereo(const hearth_camera *cam_a, const hearth_camera *cam_b,
                                   const double (*obj)[3], size_t n_pts, const double *img_a,
                                   const double *img_b, size_t n_pairs, const hearth_calib_opts *o,

@@ -60,8 +60,18 @@ typedef struct hearth_synth_effects {
                                drawn per seed in 0.5..1 of it, either sign; default 5e-5 */
   double plate_flex_m;      /* the hand-held plate's flex: each frame's bow changes by
                                U(-1, 1) of it (m); default 2e-4 */
+  double plate_twist_m;     /* the hand-held plate's twist: each frame's corners rise and
+                               fall by U(-1, 1) of it (a saddle, m); default 0 */
   double hole_burr_m;       /* irregularity of each hole's rim (burrs, drill wander): 1 sigma
                                of the first three Fourier terms of its radius (m); default 0 */
+  double lens_residual_px;  /* the thermal lens's departure from its 5-parameter model in the
+                               calibration captures: rms per axis (px) of a smooth field of
+                               2.5..6 cycles across the image; default 0 */
+  double rgb_residual_px;   /* the same for the colour camera against its factory model;
+                               default 0 */
+  double backing_texture;   /* the warm backing's mm-scale non-uniformity (heater traces,
+                               paint): rms fraction of the hole contrast, waves of 6..15 mm;
+                               default 0 */
 } hearth_synth_effects;
 
 /* Strings are borrowed: they must stay valid during hearth_synth_release. */

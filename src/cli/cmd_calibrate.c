@@ -89,6 +89,10 @@ int hearth_cmd_calibrate(int argc, char **argv) {
                "take each hole as a thin one even when calibration/target.json gives the "
                "plate's thickness_m (by default the centroid of what shows through both "
                "openings is moved to the front opening's projected centre)"),
+      CLI_FLAG("--no-rolling-shutter", &o.rolling_shutter, 0,
+               "take each colour frame of a stereo pair as read at one instant (by default a "
+               "plate velocity per pair is solved when the residuals show the rows were read "
+               "while it moved)"),
       CLI_FLAG("--quiet", &quiet, 1, "summary line only"),
       CLI_GROUP("with --detect, the options of `hearth detect`", detect_opts, &detect_opt),
       CLI_END,

@@ -180,8 +180,20 @@ int hearth_cmd_synth(int argc, char **argv) {
               "largest bow of the calibration plate, centre against corners (m; 0: flat)"),
       CLI_NUM("--plate-flex", "M", &o.effects.plate_flex_m, 0, 0.01,
               "the hand-held plate's flex: each frame's bow changes by up to M (m; 0: rigid)"),
+      CLI_NUM("--plate-twist", "M", &o.effects.plate_twist_m, 0, 0.01,
+              "the hand-held plate's twist: each frame's corners rise and fall by up to M (m; "
+              "0: none)"),
       CLI_NUM("--hole-burr", "M", &o.effects.hole_burr_m, 0, 0.001,
               "1 sigma irregularity of each hole's rim (m; 0: round)"),
+      CLI_NUM("--lens-residual", "PX", &o.effects.lens_residual_px, 0, 5,
+              "rms per axis of the thermal lens's departure from its 5-parameter model in the "
+              "calibration captures (px; 0: the model lens)"),
+      CLI_NUM("--rgb-lens-residual", "PX", &o.effects.rgb_residual_px, 0, 5,
+              "the same for the colour camera against its factory model (px; 0: the model "
+              "lens)"),
+      CLI_NUM("--backing-texture", "S", &o.effects.backing_texture, 0, 1,
+              "rms of the calibration backing's mm-scale non-uniformity, a fraction of the "
+              "hole contrast (0: even)"),
       CLI_INT("--threads", "N", &o.threads, 1, 1024, "worker threads",
               .def = "HEARTH_THREADS or all cores"),
       CLI_FLAG("--quiet", &o.quiet, 1, "no progress output"),

@@ -67,9 +67,10 @@ static double hole_radius(const synth_plate_geom *g, size_t i, double dx, double
 
 /* the front face's offset along the plate normal at (x, y) (the bow) */
 static double plate_sag(const synth_plate_geom *g, double x, double y) {
-  if (g->bow == 0) return 0.0;
+  if (g->bow == 0 && g->twist == 0) return 0.0;
   double dx = x - g->cx, dy = y - g->cy;
-  return g->bow * (1.0 - (dx * dx + dy * dy) / (g->half_w * g->half_w + g->half_h * g->half_h));
+  return g->bow * (1.0 - (dx * dx + dy * dy) / (g->half_w * g->half_w + g->half_h * g->half_h)) +
+         g->twist * dx * dy / (g->half_w * g->half_h);
 }
 
 static int classify_plate(const synth_plate_geom *g, double x, double y, size_t *hole) {
@@ -115,6 +116,94 @@ typedef struct clutter {
   double spots[8][3]; /* x, y, radius */
 } clutter;
 
+/* the thermal lens's departure from its 5-parameter model: a smooth field
+ * of image displacement (pixels), a sum of plane waves of 2.5..6 cycles
+ * across the image with random directions and phases (higher orders than
+ * any Brown-Conrady term); n = 0: the model lens */
+enum { LENS_RES_TERMS = 8 };
+typedef struct lens_res {
+  int n;
+  double k[LENS_RES_TERMS][2];  /* wave vector (radians per pixel) */
+  double ph[LENS_RES_TERMS][2]; /* phases of the u and v displacement */
+  double a[LENS_RES_TERMS][2];  /* amplitudes (pixels) of the u and v displacement */
+} lens_res;
+
+/* displacement of the image point (u, v) */
+static void lens_res_at(const lens_res *L, double u, double v, double d[2]) {
+  d[0] = d[1] = 0.0;
+  for (int i = 0; i < L->n; i++) {
+    double q = L->k[i][0] * u + L->k[i][1] * v;
+    d[0] += L->a[i][0] * cos(q + L->ph[i][0]);
+    d[1] += L->a[i][1] * cos(q + L->ph[i][1]);
+  }
+}
+
+/* a field of rms `rms` pixels per axis for a width x height image, from r */
+static void lens_res_draw(lens_res *L, double rms, int width, int height, hearth_rng *r) {
+  memset(L, 0, sizeof *L);
+  if (rms <= 0) return;
+  L->n = LENS_RES_TERMS;
+  double size = width > height ? width : height;
+  for (int i = 0; i < L->n; i++) {
+    double dir = hearth_rng_range(r, 0, 2 * 3.14159265358979323846);
+    double cyc = hearth_rng_range(r, 2.5, 6.0);
+    L->k[i][0] = 2 * 3.14159265358979323846 * cyc / size * cos(dir);
+    L->k[i][1] = 2 * 3.14159265358979323846 * cyc / size * sin(dir);
+    for (int c = 0; c < 2; c++) {
+      L->ph[i][c] = hearth_rng_range(r, 0, 2 * 3.14159265358979323846);
+      /* a cosine has rms amplitude / sqrt 2: n terms of equal amplitude */
+      L->a[i][c] = rms * sqrt(2.0 / L->n);
+    }
+  }
+}
+
+/* the model-lens pixel whose ray the true lens images at (u, v): q with
+ * q + d(q) = (u, v), by fixed-point steps (the field's slope is ~0.03) */
+static void lens_res_undo(const lens_res *L, double u, double v, double q[2]) {
+  q[0] = u;
+  q[1] = v;
+  for (int it = 0; it < 4 && L->n; it++) {
+    double d[2];
+    lens_res_at(L, q[0], q[1], d);
+    q[0] = u - d[0];
+    q[1] = v - d[1];
+  }
+}
+
+typedef struct lens_res_table {
+  const hearth_camera *c;
+  const lens_res *L;
+  size_t ss;
+  float *out;
+} lens_res_table;
+
+static void lens_res_rows(void *vctx, size_t b, size_t e, int ti) {
+  lens_res_table *t = vctx;
+  size_t W = (size_t)t->c->width, ss = t->ss;
+  for (size_t y = b; y < e; y++)
+    for (size_t x = 0; x < W; x++)
+      for (size_t j = 0; j < ss; j++)
+        for (size_t i = 0; i < ss; i++) {
+          double q[2], d[3];
+          lens_res_undo(t->L, (double)x + ((double)i + 0.5) / (double)ss - 0.5,
+                        (double)y + ((double)j + 0.5) / (double)ss - 0.5, q);
+          synth_lens_ray(t->c, q[0], q[1], d);
+          float *o = t->out + (((y * W + x) * ss + j) * ss + i) * 3;
+          for (int k = 0; k < 3; k++) o[k] = (float)d[k];
+        }
+}
+
+/* the ray table (ss x ss per pixel, as synth_ray_table) of the true lens:
+ * the model's with the residual L; NULL if out of memory */
+static float *lens_res_rays(const hearth_camera *c, const lens_res *L, int ss, int threads) {
+  size_t n = (size_t)c->width * (size_t)c->height * (size_t)(ss * ss);
+  float *out = hearth_alloc_array(n, 3 * sizeof(float));
+  if (!out) return NULL;
+  lens_res_table t = {c, L, (size_t)ss, out};
+  hearth_parallel_for((size_t)c->height, threads, lens_res_rows, &t);
+  return out;
+}
+
 /* the bench's physics of one frame (docs/virtual-rig.md, "Calibration
  * physics"); all zero: the ideal bench */
 typedef struct plate_fx {
@@ -134,6 +223,11 @@ typedef struct plate_fx {
   hearth_rigid T0;
   double mv_a[3], mv_na, mv_w[3], mv_nw, mv_speed, mv_turn, mv_pivot[3];
   double trigger_s, readout_s;
+  const lens_res *lens; /* thermal: the true lens's residual (NULL: none) */
+  /* thermal: the backing's mm-scale non-uniformity, a fraction of the hole
+   * contrast: sum of plane waves (plate coordinates, rad/m; phases) */
+  int tex_n;
+  double tex_amp, tex_k[8][2], tex_ph[8];
 } plate_fx;
 
 typedef struct plate_view {
@@ -250,7 +344,7 @@ static int classify_ray(const plate_view *v, const double d[3], double p[2]) {
   /* a bowed plate: the plane z = sag met again at the sag of the last hit
    * (the slope is a few thousandths, so three rounds are exact to nm) */
   double z0 = 0.0;
-  for (int it = 0; it < (v->g->bow != 0 ? 4 : 1); it++) {
+  for (int it = 0; it < (v->g->bow != 0 || v->g->twist != 0 ? 4 : 1); it++) {
     if (it) z0 = plate_sag(v->g, p[0], p[1]);
     double t = (v->nt + z0) / dn;
     if (t <= 0) return C_OUT;
@@ -291,6 +385,12 @@ static double thermal_value(const plate_view *v, int cls, const double p[2], con
              (v->fx.lamp_spot * exp(-(dx * dx + dy * dy) / (2 * s2)) +
               v->fx.lamp_grad[0] * (p[0] - v->g->cx) + v->fx.lamp_grad[1] * (p[1] - v->g->cy));
       }
+      if (v->fx.tex_n) {
+        double t = 0;
+        for (int i = 0; i < v->fx.tex_n; i++)
+          t += cos(v->fx.tex_k[i][0] * p[0] + v->fx.tex_k[i][1] * p[1] + v->fx.tex_ph[i]);
+        T += v->hole_dt * v->fx.tex_amp * t;
+      }
       return T;
     }
     default: break;
@@ -328,8 +428,11 @@ static double rgb_value(const plate_view *v, int cls, const double p[2], const d
 static double pixel_fine(const plate_view *v, int thermal, double x, double y, int n) {
   double c[4][2];
   for (int j = 0; j < 2; j++)
-    for (int i = 0; i < 2; i++)
-      synth_lens_unproject(v->cam, x - 0.5 + i, y - 0.5 + j, c[j * 2 + i]);
+    for (int i = 0; i < 2; i++) {
+      double q[2] = {x - 0.5 + i, y - 0.5 + j};
+      if (v->fx.lens) lens_res_undo(v->fx.lens, q[0], q[1], q);
+      synth_lens_unproject(v->cam, q[0], q[1], c[j * 2 + i]);
+    }
   double sum = 0;
   for (int j = 0; j < n; j++) {
     double b = ((double)j + 0.5) / n;
@@ -577,14 +680,22 @@ static double distance_scale(const synth_plate_geom *g, const hearth_camera *the
   return s;
 }
 
+/* lens: the true lens's residual over the model (NULL: none) */
 static void det_fill(hearth_detection *det, const char *frame, const char *camera,
-                     const hearth_camera *cam, const synth_plate_geom *g, const hearth_rigid *T) {
+                     const hearth_camera *cam, const synth_plate_geom *g, const hearth_rigid *T,
+                     const lens_res *lens) {
   memset(det, 0, sizeof *det);
   snprintf(det->frame, sizeof det->frame, "%s", frame);
   snprintf(det->camera, sizeof det->camera, "%s", camera);
   int n = synth_plate_truth(cam, g, T, det->centres);
   if ((size_t)n == g->n) {
     det->found = 1;
+    for (size_t i = 0; lens && i < g->n; i++) {
+      double d[2];
+      lens_res_at(lens, det->centres[i][0], det->centres[i][1], d);
+      det->centres[i][0] += d[0];
+      det->centres[i][1] += d[1];
+    }
   } else {
     memset(det->centres, 0, sizeof det->centres);
     det->found = 0;
@@ -605,6 +716,12 @@ static void rs_truth(const plate_view *v, hearth_detection *det) {
       double Q[3];
       hearth_rigid_apply(&vr.T, P, Q);
       if (!synth_lens_project(v->cam, Q, uv)) break;
+      if (v->fx.lens) {
+        double d[2];
+        lens_res_at(v->fx.lens, uv[0], uv[1], d);
+        uv[0] += d[0];
+        uv[1] += d[1];
+      }
       row = uv[1];
     }
     det->centres[i][0] = uv[0];
@@ -692,8 +809,8 @@ hearth_status synth_tone_map8(const hearth_image *temps, hearth_image *out, hear
   return HEARTH_OK;
 }
 
-/* the hand-held plate's flex in one frame: U(-m, m) of bow, from the
- * frame's own fork of base (nothing drawn when m is 0) */
+/* the hand-held plate's flex in one frame: U(-m, m) of bow or twist, from
+ * the frame's own fork of base (nothing drawn when m is 0) */
 static double plate_flex(const hearth_rng *base, uint64_t fork, double m) {
   if (m <= 0) return 0.0;
   hearth_rng r;
@@ -751,6 +868,11 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
   const hearth_synth_effects *E = &o->effects;
   plate_fx fx0;
   memset(&fx0, 0, sizeof fx0);
+  lens_res lres, lres_c; /* the thermal and colour lenses' residuals */
+  memset(&lres, 0, sizeof lres);
+  memset(&lres_c, 0, sizeof lres_c);
+  const float *trays = thermal_rays, *crays = rgb_rays; /* the true lenses' rays */
+  float *own_rays = NULL, *own_crays = NULL;
   double bow0 = 0.0; /* the plate's own bow; each frame adds the hand's flex */
   if (phys) {
     hearth_rng b;
@@ -770,6 +892,29 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
     fx0.fpn_offset = E->fpn_offset_c;
     fx0.fpn_gain = E->fpn_gain;
     fx0.fpn_seed = hearth_rng_u64(&b);
+    /* the thermal lens's residual over its model, from a stream of its own */
+    hearth_rng lb;
+    hearth_rng_fork(&base, 77003, &lb);
+    lens_res_draw(&lres, E->lens_residual_px, rig->thermal.width, rig->thermal.height, &lb);
+    if (lres.n) fx0.lens = &lres;
+    hearth_rng lc;
+    hearth_rng_fork(&base, 77005, &lc);
+    lens_res_draw(&lres_c, E->rgb_residual_px, rig->rgb.width, rig->rgb.height, &lc);
+    /* the backing's texture: 8 waves of 6..15 mm in random directions,
+     * rms E->backing_texture of the hole contrast */
+    if (E->backing_texture > 0) {
+      hearth_rng tb;
+      hearth_rng_fork(&base, 77004, &tb);
+      fx0.tex_n = 8;
+      fx0.tex_amp = E->backing_texture * sqrt(2.0 / fx0.tex_n);
+      for (int i = 0; i < fx0.tex_n; i++) {
+        double dir = hearth_rng_range(&tb, 0, 2 * 3.14159265358979323846);
+        double k = 2 * 3.14159265358979323846 / hearth_rng_range(&tb, 0.006, 0.015);
+        fx0.tex_k[i][0] = k * cos(dir);
+        fx0.tex_k[i][1] = k * sin(dir);
+        fx0.tex_ph[i] = hearth_rng_range(&tb, 0, 2 * 3.14159265358979323846);
+      }
+    }
     /* the plate's bow and its holes' rims, from a stream of their own */
     hearth_rng wb;
     hearth_rng_fork(&base, 77002, &wb);
@@ -800,6 +945,16 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
       st = hearth_target_write(path, &tt, err);
     }
   }
+  if (!st && lres.n) {
+    own_rays = lens_res_rays(&rig->thermal, &lres, 4, o->threads);
+    if (!own_rays) st = hearth_err_set(err, HEARTH_E_NOMEM, "calibration captures: out of memory");
+    trays = own_rays;
+  }
+  if (!st && lres_c.n && np > 0) {
+    own_crays = lens_res_rays(&rig->rgb, &lres_c, 1, o->threads);
+    if (!own_crays) st = hearth_err_set(err, HEARTH_E_NOMEM, "calibration captures: out of memory");
+    crays = own_crays;
+  }
   const double nframes = (double)(nf + np > 1 ? nf + np - 1 : 1);
 
   /* thermal-only frames for the intrinsics */
@@ -808,7 +963,10 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
     hearth_rng_fork(&base, 1000 + (uint64_t)i, &r);
     hearth_rng_fork(&base, 5000 + (uint64_t)i, &noise);
     int partial = (i % 9) == 4, blurred = (i % 9) == 7;
-    if (phys) g->bow = bow0 + plate_flex(&base, 11000 + (uint64_t)i, E->plate_flex_m);
+    if (phys) {
+      g->bow = bow0 + plate_flex(&base, 11000 + (uint64_t)i, E->plate_flex_m);
+      g->twist = plate_flex(&base, 13000 + (uint64_t)i, E->plate_twist_m);
+    }
     hearth_rigid T;
     for (int tries = 0; tries < 200; tries++) {
       double d = hearth_rng_range(&r, 0.22, 0.40) * ds;
@@ -833,9 +991,8 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
     char name[16];
     snprintf(name, sizeof name, "f%03d", i);
     snprintf(path, sizeof path, "%s/%s.csv", dir_th, name);
-    st = write_thermal(path, &v, thermal_rays, blurred ? 1.3 : 0.5, o->netd_c, &noise, o->threads,
-                       err);
-    det_fill(&dets.frames[dets.n++], name, "thermal", &rig->thermal, g, &T);
+    st = write_thermal(path, &v, trays, blurred ? 1.3 : 0.5, o->netd_c, &noise, o->threads, err);
+    det_fill(&dets.frames[dets.n++], name, "thermal", &rig->thermal, g, &T, v.fx.lens);
     hearth_progress_step(&prog, 1);
   }
 
@@ -845,7 +1002,10 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
     hearth_rng_fork(&base, 2000 + (uint64_t)i, &r);
     hearth_rng_fork(&base, 6000 + (uint64_t)i, &noise);
     int partial = (i % 8) == 3, blurred = (i % 8) == 6;
-    if (phys) g->bow = bow0 + plate_flex(&base, 12000 + (uint64_t)i, E->plate_flex_m);
+    if (phys) {
+      g->bow = bow0 + plate_flex(&base, 12000 + (uint64_t)i, E->plate_flex_m);
+      g->twist = plate_flex(&base, 14000 + (uint64_t)i, E->plate_twist_m);
+    }
     hearth_rigid T_th, T_rgb;
     for (int tries = 0; tries < 200; tries++) {
       double d = hearth_rng_range(&r, 0.27, 0.45) * ds;
@@ -879,6 +1039,7 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
       vt.fx = fx0;
       vt.plate_dt += E->plate_warming_c * (double)(nf + i) / nframes;
       vc.fx = fx0;
+      vc.fx.lens = lres_c.n ? &lres_c : NULL;
       vc.fx.motion_px = E->motion_blur_px * hearth_rng_uniform(&f);
       vc.fx.motion_dir = hearth_rng_range(&f, 0, 2 * 3.14159265358979323846);
       /* the trigger offset: the hand-held plate moves between the thermal
@@ -908,17 +1069,16 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
     char name[16];
     snprintf(name, sizeof name, "p%03d", i);
     snprintf(path, sizeof path, "%s/%s_thermal.csv", dir_st, name);
-    st = write_thermal(path, &vt, thermal_rays, blurred ? 1.3 : 0.5, o->netd_c, &noise, o->threads,
-                       err);
+    st = write_thermal(path, &vt, trays, blurred ? 1.3 : 0.5, o->netd_c, &noise, o->threads, err);
     if (!st) {
       hearth_image img = {0};
-      st = render_rgb_plate(&vc, rgb_rays, blurred ? 3.0 : 0.6, &noise, o->threads, &img, err);
+      st = render_rgb_plate(&vc, crays, blurred ? 3.0 : 0.6, &noise, o->threads, &img, err);
       snprintf(path, sizeof path, "%s/%s_rgb.jpg", dir_st, name);
       if (!st) st = hearth_jpeg_write(path, &img, phys ? E->jpeg_quality : 92, err);
       hearth_image_free(&img);
     }
-    det_fill(&dets.frames[dets.n++], name, "thermal", &rig->thermal, g, &T_th);
-    det_fill(&dets.frames[dets.n], name, "rgb", &rig->rgb, g, &T_rgb);
+    det_fill(&dets.frames[dets.n++], name, "thermal", &rig->thermal, g, &T_th, vt.fx.lens);
+    det_fill(&dets.frames[dets.n], name, "rgb", &rig->rgb, g, &T_rgb, vc.fx.lens);
     if (dets.frames[dets.n].found && vc.fx.readout_s > 0) rs_truth(&vc, &dets.frames[dets.n]);
     dets.n++;
     hearth_progress_step(&prog, 1);
@@ -929,6 +1089,8 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
     st = hearth_detections_write(path, &dets, err);
   }
   hearth_detections_free(&dets);
+  free(own_rays);
+  free(own_crays);
   free(g);
   free(c);
   return st;

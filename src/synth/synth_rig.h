@@ -119,6 +119,9 @@ typedef struct synth_plate_geom {
   /* the plate's bow: its front face at plate z = bow (1 - rho^2), rho^2 the
    * squared distance from the centre over half_w^2 + half_h^2 (0: flat) */
   double bow;
+  /* the plate's twist: its front face adds twist (x - cx)(y - cy) / (half_w
+   * half_h) (a saddle, corners +-twist; 0: none) */
+  double twist;
   /* each hole's rim irregularity: radius r + sum_k a_k cos(k phi) + b_k
    * sin(k phi), k = 1..3, as {a1, b1, a2, b2, a3, b3}; burr_max bounds the
    * sum (0: round holes, burr unused) */

@@ -4,7 +4,9 @@
  * offset between the cameras, the colour camera's rolling shutter, a bowed
  * plate flexing in the hand): `hearth detect` + `hearth calibrate` must
  * still meet the release targets against the rig's ground truth (thermal
- * focal within 0.2 %, T_thermal_from_rgb within 0.05 deg and 0.5 mm). */
+ * focal within 0.2 %, T_thermal_from_rgb within 0.05 deg and 0.5 mm), the
+ * stereo's rolling-shutter model taking the colour rows' motion out of the
+ * residual that a rigid plate per pair leaves. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -62,9 +64,20 @@ int main(void) {
   CHECK(fabs(r.thermal.fy / t.thermal.fy - 1) < 0.002);
   CHECK(ang * 180 / M_PI < 0.05);
   CHECK(dt < 0.0005);
-  /* the colour camera's rolling shutter and the plate's flex, which the
-     pipeline does not model, lift the stereo RMS from the clean bench's
-     ~0.03 px towards the paper's 0.1..0.5 px */
-  CHECK_MSG(r.stereo_rms_px >= 0.05 && r.stereo_rms_px < 0.5, "stereo RMS %g", r.stereo_rms_px);
+  /* the bench's effects keep a stereo residual above the clean bench's
+     0.009 px; the paper's 0.1..0.5 px is not reached (docs/virtual-rig.md) */
+  CHECK_MSG(r.stereo_rms_px >= 0.015 && r.stereo_rms_px < 0.5, "stereo RMS %g", r.stereo_rms_px);
+  /* a rigid plate per pair leaves the rows' motion in the residual and in
+     the extrinsic */
+  CHECK(test_sh("'" HEARTH_EXE "' calibrate '%s' --quiet --no-rolling-shutter >> '%s' 2>&1", root,
+                log) == 0);
+  hearth_rig r0;
+  snprintf(path, sizeof path, "%s/calibration/rig.json", root);
+  CHECK_OK(hearth_rig_read(path, &r0, &err), &err);
+  double ang0 = hearth_rotation_angle_between(r0.T_thermal_from_rgb.R, t.T_thermal_from_rgb.R);
+  fprintf(stderr, "rigid plate per pair: rotation %.4f deg, stereo RMS %.4f px\n",
+          ang0 * 180 / M_PI, r0.stereo_rms_px);
+  CHECK_MSG(r0.stereo_rms_px > 2 * r.stereo_rms_px, "rigid RMS %g", r0.stereo_rms_px);
+  CHECK(ang0 > ang);
   TEST_MAIN_END();
 }
