@@ -491,7 +491,7 @@ void sim_soft_update_tex(sim_soft *s, const mjModel *m, int id) {
 }
 
 /* bilinear lookup with wrap-around in level l, into c[3] (0..1) */
-static void tex_sample(const soft_tex *t, int l, float u, float v, float c[3]) {
+static inline void tex_sample(const soft_tex *t, int l, float u, float v, float c[3]) {
   int w = t->w[l], h = t->h[l];
   const uint8_t *p = t->rgb + t->off[l];
   float fu = u * (float)w - 0.5f, fv = v * (float)h - 0.5f;
@@ -683,16 +683,15 @@ static inline int soft_inside(const double A[3], const double row[3], const int 
   return 1;
 }
 
-/* one screen triangle (counter-clockwise, y up) into the depth buffer:
- * the pixels where it is the nearest surface so far take its record's
- * index (tri); the shading of the winners waits for resolve() */
-static void raster(sim_soft *s, const soft_svtx *a, const soft_svtx *b, const soft_svtx *c,
-                   const soft_mat *mt, const int level[2], uint8_t *rgb, int *ids) {
-  (void)rgb, (void)ids;
+/* one screen triangle (counter-clockwise, y up; positions and 1/w) into
+ * the depth buffer: the pixels where it is the nearest surface so far
+ * take the index of the next record, s->nrec. 1 when it won any: then
+ * rec_commit() must fill that record (the shading waits for resolve()) */
+static int raster(sim_soft *s, const soft_svtx *a, const soft_svtx *b, const soft_svtx *c) {
   double area = (b->sx - a->sx) * (c->sy - a->sy) - (b->sy - a->sy) * (c->sx - a->sx);
-  if (!(area > 0)) return;
+  if (!(area > 0)) return 0;
   int box[4];
-  if (!tri_box(s, a, b, c, box)) return;
+  if (!tri_box(s, a, b, c, box)) return 0;
   if (s->nrec == s->rcap) rec_compact(s);
   int x0 = box[0], x1 = box[1], y0 = box[2], y1 = box[3];
   /* edge i opposite vertex i: E(p) = A x + B y + C, positive inside */
@@ -706,8 +705,10 @@ static void raster(sim_soft *s, const soft_svtx *a, const soft_svtx *b, const so
     A[i] = p->sy - q->sy, B[i] = q->sx - p->sx, C[i] = p->sx * q->sy - p->sy * q->sx;
     own[i] = edge_owns(A[i], B[i]);
   }
-  double inv = 1.0 / area;
+  double inv = 1.0 / area, rA[3];
   r->inv = inv;
+  /* the roots need not be exact: the span is a pixel wider and trimmed */
+  for (int i = 0; i < 3; i++) rA[i] = A[i] != 0 ? 1.0 / A[i] : 0.0;
   float aiw = a->iw, biw = b->iw, ciw = c->iw;
   int won = 0;
   for (int y = y0; y <= y1; y++) {
@@ -721,7 +722,7 @@ static void raster(sim_soft *s, const soft_svtx *a, const soft_svtx *b, const so
         if (row[i] < 0 || (row[i] == 0 && !own[i])) hi = lo - 1;
         continue;
       }
-      double rt = -row[i] / A[i] - 0.5;
+      double rt = -row[i] * rA[i] - 0.5;
       if (rt < x0 - 1) rt = x0 - 1;
       if (rt > x1 + 1) rt = x1 + 1;
       if (A[i] > 0) {
@@ -750,64 +751,95 @@ static void raster(sim_soft *s, const soft_svtx *a, const soft_svtx *b, const so
       won |= pass;
     }
   }
-  if (!won) return;
-  r->iw[0] = aiw, r->iw[1] = biw, r->iw[2] = ciw;
+  return won;
+}
+
+/* the record of the triangle raster() just drew: its corners' 1/w and
+ * attributes, mip levels and material */
+static void rec_commit(sim_soft *s, const soft_svtx *a, const soft_svtx *b, const soft_svtx *c,
+                       const soft_mat *mt, const int level[2]) {
+  soft_rec *r = &s->rec[s->nrec++];
+  r->iw[0] = a->iw, r->iw[1] = b->iw, r->iw[2] = c->iw;
   for (int k = 0; k < 5; k++) r->a[0][k] = a->a[k], r->a[1][k] = b->a[k], r->a[2][k] = c->a[k];
   r->level[0] = level[0], r->level[1] = level[1];
   r->mat = (int)(mt - s->mats);
-  s->nrec++;
+}
+
+/* pixels x0 .. x1 - 1 of row `row` (edge functions at the row's centre
+ * line) won by triangle r: colour (o) and twin (o2) bytes; the flags say
+ * what the material has, so that each kind gets a loop of its own */
+static inline void shade_run(const soft_rec *r, const soft_mat *mt, const double row[3], int x0,
+                             int x1, uint8_t *o, uint8_t *o2, int unlit, int tex, int twin,
+                             int tex2) {
+  /* only the attributes this triangle uses */
+  int k0 = unlit ? 3 : 0, k1 = tex || tex2 ? 5 : 3;
+  double A0 = r->A[0], A1 = r->A[1], A2 = r->A[2], inv = r->inv;
+  float iw0 = r->iw[0], iw1 = r->iw[1], iw2 = r->iw[2];
+  for (int x = x0; x < x1; x++) {
+    double xc = x + 0.5;
+    float l0 = (float)((A0 * xc + row[0]) * inv), l1 = (float)((A1 * xc + row[1]) * inv),
+          l2 = (float)((A2 * xc + row[2]) * inv);
+    float iw = l0 * iw0 + l1 * iw1 + l2 * iw2;
+    float wgt = 1.0f / iw, at[5] = {1.0f, 1.0f, 1.0f, 0.0f, 0.0f};
+    for (int k = k0; k < k1; k++)
+      at[k] = (l0 * r->a[0][k] + l1 * r->a[1][k] + l2 * r->a[2][k]) * wgt;
+    float col[3] = {at[0], at[1], at[2]};
+    if (unlit && !tex) col[0] = mt->flat[0], col[1] = mt->flat[1], col[2] = mt->flat[2];
+    if (tex) {
+      float tc[3];
+      tex_sample(mt->tex, r->level[0], at[3], at[4], tc);
+      for (int k = 0; k < 3; k++) col[k] = unlit ? tc[k] : col[k] * tc[k];
+    }
+    uint8_t *p = o + 3 * x;
+    for (int k = 0; k < 3; k++) {
+      float cl = col[k] < 0 ? 0 : col[k] > 1 ? 1 : col[k];
+      p[k] = (uint8_t)(cl * 255.0f + 0.5f);
+    }
+    if (twin) {
+      uint8_t *p2 = o2 + 3 * x;
+      if (tex2) {
+        float tc[3];
+        tex_sample(mt->tex2, r->level[1], at[3], at[4], tc);
+        for (int k = 0; k < 3; k++) p2[k] = (uint8_t)(tc[k] * 255.0f + 0.5f);
+      } else {
+        p2[0] = mt->flat2[0], p2[1] = mt->flat2[1], p2[2] = mt->flat2[2];
+      }
+    }
+  }
 }
 
 /* the colours of every covered pixel from the triangle that won it, with
- * the interpolation raster's depth test used (the same values) */
+ * the interpolation raster's depth test used (the same values), run by
+ * run of pixels that one triangle won */
 static void resolve(sim_soft *s, uint8_t *rgb, int *ids) {
   for (int y = 0; y < s->h; y++) {
-    double yc = y + 0.5, row[3] = {0, 0, 0};
+    double yc = y + 0.5, row[3];
     size_t line = (size_t)y * (size_t)s->w;
-    const soft_rec *r = NULL;
-    const soft_mat *mt = NULL;
-    int last = -1, k0 = 0, k1 = 0;
-    for (int x = 0; x < s->w; x++) {
-      size_t px = line + (size_t)x;
-      int t = s->tri[px];
-      if (t < 0) continue;
-      if (t != last) {
-        r = &s->rec[t], mt = &s->mats[r->mat], last = t;
+    const int *tl = s->tri + line;
+    int x = 0;
+    while (x < s->w) {
+      int t = tl[x];
+      if (t < 0) {
+        x++;
+        continue;
+      }
+      int xe = x + 1;
+      while (xe < s->w && tl[xe] == t) xe++;
+      const soft_rec *r = &s->rec[t];
+      const soft_mat *mt = &s->mats[r->mat];
+      if (ids)
+        for (int i = x; i < xe; i++) ids[line + (size_t)i] = mt->id;
+      if (rgb) {
         for (int i = 0; i < 3; i++) row[i] = r->B[i] * yc + r->C[i];
-        k0 = mt->unlit ? 3 : 0, k1 = mt->tex || mt->tex2 ? 5 : 3;
+        uint8_t *o = rgb + 3 * line, *o2 = mt->twin ? mt->twin + 3 * line : NULL;
+        int tex = mt->tex != NULL, tex2 = mt->tex2 != NULL;
+        if (!mt->unlit && o2 && tex && tex2) shade_run(r, mt, row, x, xe, o, o2, 0, 1, 1, 1);
+        else if (!mt->unlit && o2 && !tex && !tex2) shade_run(r, mt, row, x, xe, o, o2, 0, 0, 1, 0);
+        else if (!mt->unlit && !o2 && tex) shade_run(r, mt, row, x, xe, o, o2, 0, 1, 0, 0);
+        else if (!mt->unlit && !o2 && !tex) shade_run(r, mt, row, x, xe, o, o2, 0, 0, 0, 0);
+        else shade_run(r, mt, row, x, xe, o, o2, mt->unlit, tex, o2 != NULL, tex2);
       }
-      if (ids) ids[px] = mt->id;
-      if (!rgb) continue;
-      double xc = x + 0.5, inv = r->inv;
-      float l0 = (float)((r->A[0] * xc + row[0]) * inv), l1 = (float)((r->A[1] * xc + row[1]) * inv),
-            l2 = (float)((r->A[2] * xc + row[2]) * inv);
-      float iw = l0 * r->iw[0] + l1 * r->iw[1] + l2 * r->iw[2];
-      /* only the attributes this triangle uses */
-      float wgt = 1.0f / iw, at[5] = {1.0f, 1.0f, 1.0f, 0.0f, 0.0f};
-      for (int k = k0; k < k1; k++)
-        at[k] = (l0 * r->a[0][k] + l1 * r->a[1][k] + l2 * r->a[2][k]) * wgt;
-      float col[3] = {at[0], at[1], at[2]};
-      if (mt->unlit && !mt->tex) col[0] = mt->flat[0], col[1] = mt->flat[1], col[2] = mt->flat[2];
-      if (mt->tex) {
-        float tc[3];
-        tex_sample(mt->tex, r->level[0], at[3], at[4], tc);
-        for (int k = 0; k < 3; k++) col[k] = mt->unlit ? tc[k] : col[k] * tc[k];
-      }
-      uint8_t *o = rgb + 3 * px;
-      for (int k = 0; k < 3; k++) {
-        float cl = col[k] < 0 ? 0 : col[k] > 1 ? 1 : col[k];
-        o[k] = (uint8_t)(cl * 255.0f + 0.5f);
-      }
-      if (mt->twin) {
-        uint8_t *o2 = mt->twin + 3 * px;
-        if (mt->tex2) {
-          float tc[3];
-          tex_sample(mt->tex2, r->level[1], at[3], at[4], tc);
-          for (int k = 0; k < 3; k++) o2[k] = (uint8_t)(tc[k] * 255.0f + 0.5f);
-        } else {
-          o2[0] = mt->flat2[0], o2[1] = mt->flat2[1], o2[2] = mt->flat2[2];
-        }
-      }
+      x = xe;
     }
   }
 }
@@ -855,7 +887,7 @@ static int tri_level(const soft_tex *t, const soft_vtx *p[3], const soft_svtx sv
 
 /* a triangle in the camera frame: near-plane clipping, projection, raster */
 static void draw_tri(sim_soft *s, const soft_cam *cam, const soft_vtx *p0, const soft_vtx *p1,
-                     const soft_vtx *p2, const soft_mat *mt, uint8_t *rgb, int *ids) {
+                     const soft_vtx *p2, const soft_mat *mt) {
   const soft_vtx *in[3] = {p0, p1, p2};
   float zn = (float)-cam->znear;
   int inside = (p0->z <= zn) + (p1->z <= zn) + (p2->z <= zn);
@@ -877,8 +909,9 @@ static void draw_tri(sim_soft *s, const soft_cam *cam, const soft_vtx *p0, const
   for (int i = 1; i + 1 < n; i++) {
     const soft_vtx *tp[3] = {&poly[0], &poly[i], &poly[i + 1]};
     soft_svtx ts[3] = {sv[0], sv[i], sv[i + 1]};
+    if (!raster(s, &ts[0], &ts[1], &ts[2])) continue;
     int lv[2] = {tri_level(mt->tex, tp, ts), tri_level(mt->tex2, tp, ts)};
-    raster(s, &ts[0], &ts[1], &ts[2], mt, lv, rgb, ids);
+    rec_commit(s, &ts[0], &ts[1], &ts[2], mt, lv);
   }
 }
 
@@ -1086,7 +1119,6 @@ void sim_soft_render(sim_soft *s, const mjModel *m, const mjData *d, const sim_s
     for (int c = 0; c < 3; c++)
       eye[c] = (float)(Rg[c] * -dx[0] + Rg[3 + c] * -dx[1] + Rg[6 + c] * -dx[2]);
     if (!sh->uv) mp->tex = NULL, mp->tex2 = NULL;
-    uint8_t *out = v->mode == SIM_SOFT_SEGMENT ? NULL : rgb;
     for (int i = 0; i < sh->nt; i++) {
       const int *tr = sh->tri + 3 * i;
       const float *pl = sh->plane + 4 * i;
@@ -1097,7 +1129,7 @@ void sim_soft_render(sim_soft *s, const mjModel *m, const mjData *d, const sim_s
       if (in == 0) continue;
       if (in < 3) {
         for (int k = 0; k < 3; k++) light_at(&gp, tr[k]);
-        draw_tri(s, &cam, p0, p1, p2, mp, out, ids);
+        draw_tri(s, &cam, p0, p1, p2, mp);
         continue;
       }
       /* wholly in front: back faces and triangles off the image go before
@@ -1113,7 +1145,8 @@ void sim_soft_render(sim_soft *s, const mjModel *m, const mjData *d, const sim_s
           memcmp(n0, sh->nrm + 3 * tr[2], 3 * sizeof(float)) == 0) {
         /* a flat triangle over at most two pixel centres: lit once, at its
          * first corner (across it the light changes by far less than a
-         * grey level) */
+         * grey level), and only when it is in front */
+        if (!raster(s, a, b, c)) continue;
         light_at(&gp, tr[0]);
         soft_svtx ts[3] = {*a, *b, *c};
         for (int k = 1; k < 3; k++) {
@@ -1122,13 +1155,15 @@ void sim_soft_render(sim_soft *s, const mjModel *m, const mjData *d, const sim_s
           ts[k].a[3] = tp[k]->u * iw, ts[k].a[4] = tp[k]->v * iw;
         }
         int lv[2] = {tri_level(mp->tex, tp, ts), tri_level(mp->tex2, tp, ts)};
-        raster(s, &ts[0], &ts[1], &ts[2], mp, lv, out, ids);
+        rec_commit(s, &ts[0], &ts[1], &ts[2], mp, lv);
         continue;
       }
+      /* lit only when it won pixels */
+      if (!raster(s, a, b, c)) continue;
       for (int k = 0; k < 3; k++) light_at(&gp, tr[k]);
       soft_svtx ts[3] = {*a, *b, *c};
       int lv[2] = {tri_level(mp->tex, tp, ts), tri_level(mp->tex2, tp, ts)};
-      raster(s, a, b, c, mp, lv, out, ids);
+      rec_commit(s, a, b, c, mp, lv);
     }
   }
   resolve(s, v->mode == SIM_SOFT_SEGMENT ? NULL : rgb, ids);
