@@ -43,8 +43,9 @@ int main(int argc, char **argv) {
   }
   hearth_sim_task task = hearth_sim_task_parse(tname);
   if (!root || !task || size < 16 || layouts < 1) {
-    fprintf(stderr, "usage: bench_sim_render --release ROOT [--task H1] [--size 256] "
-                    "[--layouts 2] [--renderer soft] [--ground-truth 0|1] [--steps 400]\n");
+    fprintf(stderr,
+            "usage: bench_sim_render --release ROOT [--task H1] [--size 256] "
+            "[--layouts 2] [--renderer soft] [--ground-truth 0|1] [--steps 400]\n");
     return 2;
   }
   hearth_err err = {0};
@@ -95,10 +96,11 @@ int main(int argc, char **argv) {
   double total = cpu_now() - t0;
   if (rc) fprintf(stderr, "%s\n", err.msg);
   else
-    printf("%s %d %s: %ld steps, observe %.2f s CPU (%.2f ms/step), rest %.2f s CPU, images "
-           "%016llx\n",
-           tname, size, renderer, steps, t_obs, steps ? 1e3 * t_obs / (double)steps : 0.0,
-           total - t_obs, (unsigned long long)h);
+    printf(
+        "%s %d %s: %ld steps, observe %.2f s CPU (%.2f ms/step), rest %.2f s CPU, images "
+        "%016llx\n",
+        tname, size, renderer, steps, t_obs, steps ? 1e3 * t_obs / (double)steps : 0.0,
+        total - t_obs, (unsigned long long)h);
   hearth_sim_env_free(e);
   return rc;
 }

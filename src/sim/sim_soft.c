@@ -138,10 +138,10 @@ struct sim_soft {
   int w, h, ngeom, ntex;
   soft_shape *shape;
   soft_tex *tex;
-  float *depth;       /* 1/w of the nearest surface; 0: nothing */
-  int *tri;           /* per pixel: record of the nearest triangle, -1: none */
-  soft_rec *rec;      /* the view's winning triangles, in drawing order */
-  int *remap;         /* rcap: record renumbering of rec_compact */
+  float *depth;  /* 1/w of the nearest surface; 0: nothing */
+  int *tri;      /* per pixel: record of the nearest triangle, -1: none */
+  soft_rec *rec; /* the view's winning triangles, in drawing order */
+  int *remap;    /* rcap: record renumbering of rec_compact */
   int nrec, rcap;
   soft_mat *mats;     /* ngeom: the materials of a view's geoms */
   int *order;         /* ngeom: drawing order of a view */
@@ -674,6 +674,9 @@ static void rec_compact(sim_soft *s) {
   s->nrec = n;
 }
 
+/* box width (pixels) below which raster() tests the whole box */
+#define SOFT_NARROW 8
+
 /* the exact coverage test of pixel centre xc against the three edges */
 static inline int soft_inside(const double A[3], const double row[3], const int own[3], double xc) {
   for (int i = 0; i < 3; i++) {
@@ -711,6 +714,29 @@ static int raster(sim_soft *s, const soft_svtx *a, const soft_svtx *b, const sof
   for (int i = 0; i < 3; i++) rA[i] = A[i] != 0 ? 1.0 / A[i] : 0.0;
   float aiw = a->iw, biw = b->iw, ciw = c->iw;
   int won = 0;
+  if (x1 - x0 < SOFT_NARROW) {
+    /* a narrow triangle: every centre of its box takes the exact test,
+     * without branches (cheaper than finding each row's span) */
+    int o0 = own[0], o1 = own[1], o2 = own[2];
+    for (int y = y0; y <= y1; y++) {
+      double yc = y + 0.5, r0 = B[0] * yc + C[0], r1 = B[1] * yc + C[1], r2 = B[2] * yc + C[2];
+      size_t line = (size_t)y * (size_t)s->w;
+      float *dp = s->depth + line;
+      int *tp = s->tri + line;
+      for (int x = x0; x <= x1; x++) {
+        double xc = x + 0.5, e0 = A[0] * xc + r0, e1 = A[1] * xc + r1, e2 = A[2] * xc + r2;
+        int in = ((e0 > 0) | ((e0 == 0) & o0)) & ((e1 > 0) | ((e1 == 0) & o1)) &
+                 ((e2 > 0) | ((e2 == 0) & o2));
+        float l0 = (float)(e0 * inv), l1 = (float)(e1 * inv), l2 = (float)(e2 * inv);
+        float iw = l0 * aiw + l1 * biw + l2 * ciw;
+        int pass = in & !(iw < dp[x]);
+        dp[x] = pass ? iw : dp[x];
+        tp[x] = pass ? t : tp[x];
+        won |= pass;
+      }
+    }
+    return won;
+  }
   for (int y = y0; y <= y1; y++) {
     double yc = y + 0.5, row[3];
     for (int i = 0; i < 3; i++) row[i] = B[i] * yc + C[i];
