@@ -686,15 +686,13 @@ static inline int soft_inside(const double A[3], const double row[3], const int 
   return 1;
 }
 
-/* one screen triangle (counter-clockwise, y up; positions and 1/w) into
- * the depth buffer: the pixels where it is the nearest surface so far
- * take the index of the next record, s->nrec. 1 when it won any: then
+/* one screen triangle (counter-clockwise, y up; positions and 1/w) of
+ * twice the area `area` (> 0) over pixel box `box` (tri_box) into the
+ * depth buffer: the pixels where it is the nearest surface so far take
+ * the index of the next record, s->nrec. 1 when it won any: then
  * rec_commit() must fill that record (the shading waits for resolve()) */
-static int raster(sim_soft *s, const soft_svtx *a, const soft_svtx *b, const soft_svtx *c) {
-  double area = (b->sx - a->sx) * (c->sy - a->sy) - (b->sy - a->sy) * (c->sx - a->sx);
-  if (!(area > 0)) return 0;
-  int box[4];
-  if (!tri_box(s, a, b, c, box)) return 0;
+static int raster_in(sim_soft *s, const soft_svtx *a, const soft_svtx *b, const soft_svtx *c,
+                     double area, const int box[4]) {
   if (s->nrec == s->rcap) rec_compact(s);
   int x0 = box[0], x1 = box[1], y0 = box[2], y1 = box[3];
   /* edge i opposite vertex i: E(p) = A x + B y + C, positive inside */
@@ -780,6 +778,14 @@ static int raster(sim_soft *s, const soft_svtx *a, const soft_svtx *b, const sof
   return won;
 }
 
+/* raster_in for a triangle not yet measured */
+static int raster(sim_soft *s, const soft_svtx *a, const soft_svtx *b, const soft_svtx *c) {
+  double area = (b->sx - a->sx) * (c->sy - a->sy) - (b->sy - a->sy) * (c->sx - a->sx);
+  int box[4];
+  if (!(area > 0) || !tri_box(s, a, b, c, box)) return 0;
+  return raster_in(s, a, b, c, area, box);
+}
+
 /* the record of the triangle raster() just drew: its corners' 1/w and
  * attributes, mip levels and material */
 static void rec_commit(sim_soft *s, const soft_svtx *a, const soft_svtx *b, const soft_svtx *c,
@@ -834,6 +840,41 @@ static inline void shade_run(const soft_rec *r, const soft_mat *mt, const double
   }
 }
 
+/* shade_run for a lit material without texture: the run in blocks whose
+ * arithmetic the compiler vectorises (the same operations per pixel) */
+#define SOFT_BLOCK 32
+static void shade_run_plain(const soft_rec *r, const soft_mat *mt, const double row[3], int x0,
+                            int x1, uint8_t *o, uint8_t *o2) {
+  double A0 = r->A[0], A1 = r->A[1], A2 = r->A[2], inv = r->inv, r0 = row[0], r1 = row[1],
+         r2 = row[2];
+  float iw0 = r->iw[0], iw1 = r->iw[1], iw2 = r->iw[2];
+  float a0[3], a1[3], a2[3];
+  for (int k = 0; k < 3; k++) a0[k] = r->a[0][k], a1[k] = r->a[1][k], a2[k] = r->a[2][k];
+  float c[3][SOFT_BLOCK];
+  for (int xb = x0; xb < x1; xb += SOFT_BLOCK) {
+    int n = x1 - xb < SOFT_BLOCK ? x1 - xb : SOFT_BLOCK;
+    for (int i = 0; i < n; i++) {
+      double xc = (xb + i) + 0.5;
+      float l0 = (float)((A0 * xc + r0) * inv), l1 = (float)((A1 * xc + r1) * inv),
+            l2 = (float)((A2 * xc + r2) * inv);
+      float iw = l0 * iw0 + l1 * iw1 + l2 * iw2;
+      float wgt = 1.0f / iw;
+      for (int k = 0; k < 3; k++) {
+        float v = (l0 * a0[k] + l1 * a1[k] + l2 * a2[k]) * wgt;
+        c[k][i] = v < 0 ? 0 : v > 1 ? 1 : v;
+      }
+    }
+    uint8_t *p = o + 3 * xb;
+    for (int i = 0; i < n; i++)
+      for (int k = 0; k < 3; k++) p[3 * i + k] = (uint8_t)(c[k][i] * 255.0f + 0.5f);
+    if (o2) {
+      uint8_t *p2 = o2 + 3 * xb;
+      for (int i = 0; i < n; i++)
+        p2[3 * i] = mt->flat2[0], p2[3 * i + 1] = mt->flat2[1], p2[3 * i + 2] = mt->flat2[2];
+    }
+  }
+}
+
 /* the colours of every covered pixel from the triangle that won it, with
  * the interpolation raster's depth test used (the same values), run by
  * run of pixels that one triangle won */
@@ -860,9 +901,8 @@ static void resolve(sim_soft *s, uint8_t *rgb, int *ids) {
         uint8_t *o = rgb + 3 * line, *o2 = mt->twin ? mt->twin + 3 * line : NULL;
         int tex = mt->tex != NULL, tex2 = mt->tex2 != NULL;
         if (!mt->unlit && o2 && tex && tex2) shade_run(r, mt, row, x, xe, o, o2, 0, 1, 1, 1);
-        else if (!mt->unlit && o2 && !tex && !tex2) shade_run(r, mt, row, x, xe, o, o2, 0, 0, 1, 0);
+        else if (!mt->unlit && !tex && !tex2) shade_run_plain(r, mt, row, x, xe, o, o2);
         else if (!mt->unlit && !o2 && tex) shade_run(r, mt, row, x, xe, o, o2, 0, 1, 0, 0);
-        else if (!mt->unlit && !o2 && !tex) shade_run(r, mt, row, x, xe, o, o2, 0, 0, 0, 0);
         else shade_run(r, mt, row, x, xe, o, o2, mt->unlit, tex, o2 != NULL, tex2);
       }
       x = xe;
@@ -1172,7 +1212,7 @@ void sim_soft_render(sim_soft *s, const mjModel *m, const mjData *d, const sim_s
         /* a flat triangle over at most two pixel centres: lit once, at its
          * first corner (across it the light changes by far less than a
          * grey level), and only when it is in front */
-        if (!raster(s, a, b, c)) continue;
+        if (!raster_in(s, a, b, c, area, box)) continue;
         light_at(&gp, tr[0]);
         soft_svtx ts[3] = {*a, *b, *c};
         for (int k = 1; k < 3; k++) {
@@ -1185,7 +1225,7 @@ void sim_soft_render(sim_soft *s, const mjModel *m, const mjData *d, const sim_s
         continue;
       }
       /* lit only when it won pixels */
-      if (!raster(s, a, b, c)) continue;
+      if (!raster_in(s, a, b, c, area, box)) continue;
       for (int k = 0; k < 3; k++) light_at(&gp, tr[k]);
       soft_svtx ts[3] = {*a, *b, *c};
       int lv[2] = {tri_level(mp->tex, tp, ts), tri_level(mp->tex2, tp, ts)};
