@@ -699,12 +699,13 @@ static int raster_in(sim_soft *s, const soft_svtx *a, const soft_svtx *b, const 
   const soft_svtx *v[3] = {a, b, c};
   int t = s->nrec;
   soft_rec *r = &s->rec[t];
-  double *A = r->A, *B = r->B, *C = r->C;
+  double A[3], B[3], C[3];
   int own[3];
   for (int i = 0; i < 3; i++) {
     const soft_svtx *p = v[(i + 1) % 3], *q = v[(i + 2) % 3];
     A[i] = p->sy - q->sy, B[i] = q->sx - p->sx, C[i] = p->sx * q->sy - p->sy * q->sx;
     own[i] = edge_owns(A[i], B[i]);
+    r->A[i] = A[i], r->B[i] = B[i], r->C[i] = C[i];
   }
   double inv = 1.0 / area, rA[3];
   r->inv = inv;
@@ -764,10 +765,11 @@ static int raster_in(sim_soft *s, const soft_svtx *a, const soft_svtx *b, const 
     while (hi > lo && !soft_inside(A, row, own, hi + 0.5)) hi--;
     float *dp = s->depth + line;
     int *tp = s->tri + line;
+    double A0 = A[0], A1 = A[1], A2 = A[2], r0 = row[0], r1 = row[1], r2 = row[2];
     for (int x = lo; x <= hi; x++) {
       double xc = x + 0.5;
-      float l0 = (float)((A[0] * xc + row[0]) * inv), l1 = (float)((A[1] * xc + row[1]) * inv),
-            l2 = (float)((A[2] * xc + row[2]) * inv);
+      float l0 = (float)((A0 * xc + r0) * inv), l1 = (float)((A1 * xc + r1) * inv),
+            l2 = (float)((A2 * xc + r2) * inv);
       float iw = l0 * aiw + l1 * biw + l2 * ciw;
       int pass = !(iw < dp[x]);
       dp[x] = pass ? iw : dp[x];
