@@ -1,7 +1,7 @@
 #!/bin/sh
 # The paper's full demonstration set, timed: `hearth sim collect` for H1, H2
 # and H3 with every default (200 layouts x 2 instructions = 400 demos per
-# task, 128 px, assets made by the virtual rig), the three processes started
+# task, 256 px, assets made by the virtual rig), the three processes started
 # together on this machine (2 cores on the reference machine), so the wall
 # time is that of the whole 1,200-demo collection. Reports each task's
 # expert success per instruction, replaced layouts, steps and time, the

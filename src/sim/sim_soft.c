@@ -112,13 +112,38 @@ typedef struct soft_light {
   float amb[3], dif[3], spc[3], att[3], cos_cut, expo;
 } soft_light;
 
+/* a triangle that won pixels in raster(): what resolve() shades them with */
+typedef struct soft_rec {
+  double A[3], B[3], C[3], inv; /* edge functions, 1 / twice the area */
+  float iw[3], a[3][5];         /* the corners' 1/w and attributes over w */
+  int level[2], mat;            /* mip levels; material in sim_soft.mats */
+} soft_rec;
+
+/* what one geom draws with: material, texture, level chooser */
+typedef struct soft_mat {
+  float rgba[4], spec, shin, emis;
+  const soft_pow *shin_pow;
+  const soft_tex *tex;
+  int unlit;
+  float flat[3];
+  uint8_t *twin;        /* LIT with a twin image: its buffer, */
+  const soft_tex *tex2; /* the texture it shows (NULL: flat2) */
+  uint8_t flat2[3];
+  int id;
+} soft_mat;
+
 struct sim_soft {
   soft_pow pw[SOFT_NPOW];
   int npw;
   int w, h, ngeom, ntex;
   soft_shape *shape;
   soft_tex *tex;
-  float *depth;       /* 1/w of the nearest surface; 0: nothing */
+  float *depth;  /* 1/w of the nearest surface; 0: nothing */
+  int *tri;      /* per pixel: record of the nearest triangle, -1: none */
+  soft_rec *rec; /* the view's winning triangles, in drawing order */
+  int *remap;    /* rcap: record renumbering of rec_compact */
+  int nrec, rcap;
+  soft_mat *mats;     /* ngeom: the materials of a view's geoms */
   int *order;         /* ngeom: drawing order of a view */
   double *key;        /* ngeom: its sort keys */
   soft_vtx *vtx;      /* per vertex of the geom at hand: camera frame, */
@@ -466,7 +491,7 @@ void sim_soft_update_tex(sim_soft *s, const mjModel *m, int id) {
 }
 
 /* bilinear lookup with wrap-around in level l, into c[3] (0..1) */
-static void tex_sample(const soft_tex *t, int l, float u, float v, float c[3]) {
+static inline void tex_sample(const soft_tex *t, int l, float u, float v, float c[3]) {
   int w = t->w[l], h = t->h[l];
   const uint8_t *p = t->rgb + t->off[l];
   float fu = u * (float)w - 0.5f, fv = v * (float)h - 0.5f;
@@ -502,6 +527,7 @@ void sim_soft_free(sim_soft *s) {
   free(s->order), free(s->key);
   free(s->shape), free(s->tex), free(s->depth), free(s->vtx), free(s->sv), free(s->lit);
   free(s->pcam), free(s->pscr), free(s->pdone);
+  free(s->tri), free(s->rec), free(s->remap), free(s->mats);
   free(s);
 }
 
@@ -528,6 +554,19 @@ sim_soft *sim_soft_new(const mjModel *m, int w, int h) {
   for (int i = 0; i < m->nlight; i++)
     pow_add(s, m->light_directional[i] ? 0.0f : m->light_exponent[i]);
   size_t nv = (size_t)(s->vcap > 0 ? s->vcap : 1);
+  /* records: at most two per triangle (near-plane clipping), and never
+   * more than one per pixel after rec_compact */
+  size_t ntri = 0;
+  for (int g = 0; g < m->ngeom && ok; g++) ntri += (size_t)s->shape[g].nt;
+  size_t npx = (size_t)w * (size_t)h, rcap = 2 * ntri + 1;
+  if (rcap > npx + 1) rcap = npx + 1;
+  s->rcap = (int)rcap;
+  if (ok) {
+    s->tri = malloc(sizeof(int) * npx), s->rec = malloc(sizeof(soft_rec) * rcap);
+    s->remap = malloc(sizeof(int) * rcap);
+    s->mats = malloc(sizeof(soft_mat) * (size_t)(m->ngeom > 0 ? m->ngeom : 1));
+    ok = s->tri && s->rec && s->remap && s->mats;
+  }
   if (ok) {
     s->vtx = malloc(sizeof(soft_vtx) * nv), s->sv = malloc(sizeof(soft_svtx) * nv);
     s->lit = malloc(nv);
@@ -548,19 +587,6 @@ typedef struct soft_cam {
   double znear, f;   /* near distance, focal length in pixels */
   double tanx, tany; /* half field of view tangents */
 } soft_cam;
-
-/* what one geom draws with: material, texture, level chooser */
-typedef struct soft_mat {
-  float rgba[4], spec, shin, emis;
-  const soft_pow *shin_pow;
-  const soft_tex *tex;
-  int unlit;
-  float flat[3];
-  uint8_t *twin;        /* LIT with a twin image: its buffer, */
-  const soft_tex *tex2; /* the texture it shows (NULL: flat2) */
-  uint8_t flat2[3];
-  int id;
-} soft_mat;
 
 /* the fixed-function lighting sum at one camera-frame vertex, clamped */
 static void light_vertex(const soft_light *L, int nl, const soft_mat *mt, const float p[3],
@@ -630,88 +656,258 @@ static int tri_box(const sim_soft *s, const soft_svtx *a, const soft_svtx *b, co
   return 1;
 }
 
-/* one screen triangle (counter-clockwise, y up) into the buffers */
-static void raster(sim_soft *s, const soft_svtx *a, const soft_svtx *b, const soft_svtx *c,
-                   const soft_mat *mt, const int level[2], uint8_t *rgb, int *ids) {
-  double area = (b->sx - a->sx) * (c->sy - a->sy) - (b->sy - a->sy) * (c->sx - a->sx);
-  if (!(area > 0)) return;
-  int box[4];
-  if (!tri_box(s, a, b, c, box)) return;
+/* records no pixel refers to any more go, the others keep their order
+ * (so rcap >= pixels + 1 always leaves room) */
+static void rec_compact(sim_soft *s) {
+  size_t npx = (size_t)s->w * (size_t)s->h;
+  for (int i = 0; i < s->nrec; i++) s->remap[i] = -1;
+  for (size_t p = 0; p < npx; p++)
+    if (s->tri[p] >= 0) s->remap[s->tri[p]] = 0;
+  int n = 0;
+  for (int i = 0; i < s->nrec; i++)
+    if (s->remap[i] == 0) {
+      if (n != i) s->rec[n] = s->rec[i];
+      s->remap[i] = n++;
+    }
+  for (size_t p = 0; p < npx; p++)
+    if (s->tri[p] >= 0) s->tri[p] = s->remap[s->tri[p]];
+  s->nrec = n;
+}
+
+/* box width (pixels) below which raster() tests the whole box */
+#define SOFT_NARROW 8
+
+/* the exact coverage test of pixel centre xc against the three edges */
+static inline int soft_inside(const double A[3], const double row[3], const int own[3], double xc) {
+  for (int i = 0; i < 3; i++) {
+    double e = A[i] * xc + row[i];
+    if (!(e > 0 || (e == 0 && own[i]))) return 0;
+  }
+  return 1;
+}
+
+/* one screen triangle (counter-clockwise, y up; positions and 1/w) of
+ * twice the area `area` (> 0) over pixel box `box` (tri_box) into the
+ * depth buffer: the pixels where it is the nearest surface so far take
+ * the index of the next record, s->nrec. 1 when it won any: then
+ * rec_commit() must fill that record (the shading waits for resolve()) */
+static int raster_in(sim_soft *s, const soft_svtx *a, const soft_svtx *b, const soft_svtx *c,
+                     double area, const int box[4]) {
+  if (s->nrec == s->rcap) rec_compact(s);
   int x0 = box[0], x1 = box[1], y0 = box[2], y1 = box[3];
   /* edge i opposite vertex i: E(p) = A x + B y + C, positive inside */
   const soft_svtx *v[3] = {a, b, c};
+  int t = s->nrec;
+  soft_rec *r = &s->rec[t];
   double A[3], B[3], C[3];
   int own[3];
   for (int i = 0; i < 3; i++) {
     const soft_svtx *p = v[(i + 1) % 3], *q = v[(i + 2) % 3];
     A[i] = p->sy - q->sy, B[i] = q->sx - p->sx, C[i] = p->sx * q->sy - p->sy * q->sx;
     own[i] = edge_owns(A[i], B[i]);
+    r->A[i] = A[i], r->B[i] = B[i], r->C[i] = C[i];
   }
-  double inv = 1.0 / area;
-  int k0 = mt->unlit ? 3 : 0, k1 = mt->tex || mt->tex2 ? 5 : 3;
+  double inv = 1.0 / area, rA[3];
+  r->inv = inv;
+  /* the roots need not be exact: the span is a pixel wider and trimmed */
+  for (int i = 0; i < 3; i++) rA[i] = A[i] != 0 ? 1.0 / A[i] : 0.0;
+  float aiw = a->iw, biw = b->iw, ciw = c->iw;
+  int won = 0;
+  if (x1 - x0 < SOFT_NARROW) {
+    /* a narrow triangle: every centre of its box takes the exact test,
+     * without branches (cheaper than finding each row's span) */
+    int o0 = own[0], o1 = own[1], o2 = own[2];
+    for (int y = y0; y <= y1; y++) {
+      double yc = y + 0.5, r0 = B[0] * yc + C[0], r1 = B[1] * yc + C[1], r2 = B[2] * yc + C[2];
+      size_t line = (size_t)y * (size_t)s->w;
+      float *dp = s->depth + line;
+      int *tp = s->tri + line;
+      for (int x = x0; x <= x1; x++) {
+        double xc = x + 0.5, e0 = A[0] * xc + r0, e1 = A[1] * xc + r1, e2 = A[2] * xc + r2;
+        int in = ((e0 > 0) | ((e0 == 0) & o0)) & ((e1 > 0) | ((e1 == 0) & o1)) &
+                 ((e2 > 0) | ((e2 == 0) & o2));
+        float l0 = (float)(e0 * inv), l1 = (float)(e1 * inv), l2 = (float)(e2 * inv);
+        float iw = l0 * aiw + l1 * biw + l2 * ciw;
+        int pass = in & !(iw < dp[x]);
+        dp[x] = pass ? iw : dp[x];
+        tp[x] = pass ? t : tp[x];
+        won |= pass;
+      }
+    }
+    return won;
+  }
   for (int y = y0; y <= y1; y++) {
     double yc = y + 0.5, row[3];
     for (int i = 0; i < 3; i++) row[i] = B[i] * yc + C[i];
     size_t line = (size_t)y * (size_t)s->w;
-    /* the row's span from the edges' roots, a pixel wider on each side:
-     * every pixel in it still takes the exact test */
+    /* the row's span from the edges' roots, a pixel wider on each side */
     int lo = x0, hi = x1;
     for (int i = 0; i < 3 && lo <= hi; i++) {
       if (A[i] == 0) {
         if (row[i] < 0 || (row[i] == 0 && !own[i])) hi = lo - 1;
         continue;
       }
-      double r = -row[i] / A[i] - 0.5;
-      if (r < x0 - 1) r = x0 - 1;
-      if (r > x1 + 1) r = x1 + 1;
+      double rt = -row[i] * rA[i] - 0.5;
+      if (rt < x0 - 1) rt = x0 - 1;
+      if (rt > x1 + 1) rt = x1 + 1;
       if (A[i] > 0) {
-        int k = soft_floor(r);
+        int k = soft_floor(rt);
         if (k > lo) lo = k;
       } else {
-        int k = soft_ceil(r);
+        int k = soft_ceil(rt);
         if (k < hi) hi = k;
       }
     }
+    /* each edge function is monotone in x (a product and a sum, rounded),
+     * so the centres that pass the exact test form one run: trim the
+     * span's ends to it and test nothing inside */
+    while (lo <= hi && !soft_inside(A, row, own, lo + 0.5)) lo++;
+    while (hi > lo && !soft_inside(A, row, own, hi + 0.5)) hi--;
+    float *dp = s->depth + line;
+    int *tp = s->tri + line;
+    double A0 = A[0], A1 = A[1], A2 = A[2], r0 = row[0], r1 = row[1], r2 = row[2];
     for (int x = lo; x <= hi; x++) {
-      double xc = x + 0.5, e[3];
-      int in = 1;
-      for (int i = 0; i < 3 && in; i++) {
-        e[i] = A[i] * xc + row[i];
-        in = e[i] > 0 || (e[i] == 0 && own[i]);
-      }
-      if (!in) continue;
-      float l0 = (float)(e[0] * inv), l1 = (float)(e[1] * inv), l2 = (float)(e[2] * inv);
-      float iw = l0 * a->iw + l1 * b->iw + l2 * c->iw;
-      size_t px = line + (size_t)x;
-      if (iw < s->depth[px]) continue;
-      s->depth[px] = iw;
-      if (ids) ids[px] = mt->id;
-      if (!rgb) continue;
-      /* only the attributes this triangle uses */
-      float wgt = 1.0f / iw, at[5] = {1.0f, 1.0f, 1.0f, 0.0f, 0.0f};
-      for (int k = k0; k < k1; k++) at[k] = (l0 * a->a[k] + l1 * b->a[k] + l2 * c->a[k]) * wgt;
-      float col[3] = {at[0], at[1], at[2]};
-      if (mt->unlit && !mt->tex) col[0] = mt->flat[0], col[1] = mt->flat[1], col[2] = mt->flat[2];
-      if (mt->tex) {
+      double xc = x + 0.5;
+      float l0 = (float)((A0 * xc + r0) * inv), l1 = (float)((A1 * xc + r1) * inv),
+            l2 = (float)((A2 * xc + r2) * inv);
+      float iw = l0 * aiw + l1 * biw + l2 * ciw;
+      int pass = !(iw < dp[x]);
+      dp[x] = pass ? iw : dp[x];
+      tp[x] = pass ? t : tp[x];
+      won |= pass;
+    }
+  }
+  return won;
+}
+
+/* raster_in for a triangle not yet measured */
+static int raster(sim_soft *s, const soft_svtx *a, const soft_svtx *b, const soft_svtx *c) {
+  double area = (b->sx - a->sx) * (c->sy - a->sy) - (b->sy - a->sy) * (c->sx - a->sx);
+  int box[4];
+  if (!(area > 0) || !tri_box(s, a, b, c, box)) return 0;
+  return raster_in(s, a, b, c, area, box);
+}
+
+/* the record of the triangle raster() just drew: its corners' 1/w and
+ * attributes, mip levels and material */
+static void rec_commit(sim_soft *s, const soft_svtx *a, const soft_svtx *b, const soft_svtx *c,
+                       const soft_mat *mt, const int level[2]) {
+  soft_rec *r = &s->rec[s->nrec++];
+  r->iw[0] = a->iw, r->iw[1] = b->iw, r->iw[2] = c->iw;
+  for (int k = 0; k < 5; k++) r->a[0][k] = a->a[k], r->a[1][k] = b->a[k], r->a[2][k] = c->a[k];
+  r->level[0] = level[0], r->level[1] = level[1];
+  r->mat = (int)(mt - s->mats);
+}
+
+/* pixels x0 .. x1 - 1 of row `row` (edge functions at the row's centre
+ * line) won by triangle r: colour (o) and twin (o2) bytes; the flags say
+ * what the material has, so that each kind gets a loop of its own */
+static inline void shade_run(const soft_rec *r, const soft_mat *mt, const double row[3], int x0,
+                             int x1, uint8_t *o, uint8_t *o2, int unlit, int tex, int twin,
+                             int tex2) {
+  /* only the attributes this triangle uses */
+  int k0 = unlit ? 3 : 0, k1 = tex || tex2 ? 5 : 3;
+  double A0 = r->A[0], A1 = r->A[1], A2 = r->A[2], inv = r->inv;
+  float iw0 = r->iw[0], iw1 = r->iw[1], iw2 = r->iw[2];
+  for (int x = x0; x < x1; x++) {
+    double xc = x + 0.5;
+    float l0 = (float)((A0 * xc + row[0]) * inv), l1 = (float)((A1 * xc + row[1]) * inv),
+          l2 = (float)((A2 * xc + row[2]) * inv);
+    float iw = l0 * iw0 + l1 * iw1 + l2 * iw2;
+    float wgt = 1.0f / iw, at[5] = {1.0f, 1.0f, 1.0f, 0.0f, 0.0f};
+    for (int k = k0; k < k1; k++)
+      at[k] = (l0 * r->a[0][k] + l1 * r->a[1][k] + l2 * r->a[2][k]) * wgt;
+    float col[3] = {at[0], at[1], at[2]};
+    if (unlit && !tex) col[0] = mt->flat[0], col[1] = mt->flat[1], col[2] = mt->flat[2];
+    if (tex) {
+      float tc[3];
+      tex_sample(mt->tex, r->level[0], at[3], at[4], tc);
+      for (int k = 0; k < 3; k++) col[k] = unlit ? tc[k] : col[k] * tc[k];
+    }
+    uint8_t *p = o + 3 * x;
+    for (int k = 0; k < 3; k++) {
+      float cl = col[k] < 0 ? 0 : col[k] > 1 ? 1 : col[k];
+      p[k] = (uint8_t)(cl * 255.0f + 0.5f);
+    }
+    if (twin) {
+      uint8_t *p2 = o2 + 3 * x;
+      if (tex2) {
         float tc[3];
-        tex_sample(mt->tex, level[0], at[3], at[4], tc);
-        for (int k = 0; k < 3; k++) col[k] = mt->unlit ? tc[k] : col[k] * tc[k];
+        tex_sample(mt->tex2, r->level[1], at[3], at[4], tc);
+        for (int k = 0; k < 3; k++) p2[k] = (uint8_t)(tc[k] * 255.0f + 0.5f);
+      } else {
+        p2[0] = mt->flat2[0], p2[1] = mt->flat2[1], p2[2] = mt->flat2[2];
       }
-      uint8_t *o = rgb + 3 * px;
+    }
+  }
+}
+
+/* shade_run for a lit material without texture: the run in blocks whose
+ * arithmetic the compiler vectorises (the same operations per pixel) */
+#define SOFT_BLOCK 32
+static void shade_run_plain(const soft_rec *r, const soft_mat *mt, const double row[3], int x0,
+                            int x1, uint8_t *o, uint8_t *o2) {
+  double A0 = r->A[0], A1 = r->A[1], A2 = r->A[2], inv = r->inv, r0 = row[0], r1 = row[1],
+         r2 = row[2];
+  float iw0 = r->iw[0], iw1 = r->iw[1], iw2 = r->iw[2];
+  float a0[3], a1[3], a2[3];
+  for (int k = 0; k < 3; k++) a0[k] = r->a[0][k], a1[k] = r->a[1][k], a2[k] = r->a[2][k];
+  float c[3][SOFT_BLOCK];
+  for (int xb = x0; xb < x1; xb += SOFT_BLOCK) {
+    int n = x1 - xb < SOFT_BLOCK ? x1 - xb : SOFT_BLOCK;
+    for (int i = 0; i < n; i++) {
+      double xc = (xb + i) + 0.5;
+      float l0 = (float)((A0 * xc + r0) * inv), l1 = (float)((A1 * xc + r1) * inv),
+            l2 = (float)((A2 * xc + r2) * inv);
+      float iw = l0 * iw0 + l1 * iw1 + l2 * iw2;
+      float wgt = 1.0f / iw;
       for (int k = 0; k < 3; k++) {
-        float cl = col[k] < 0 ? 0 : col[k] > 1 ? 1 : col[k];
-        o[k] = (uint8_t)(cl * 255.0f + 0.5f);
+        float v = (l0 * a0[k] + l1 * a1[k] + l2 * a2[k]) * wgt;
+        c[k][i] = v < 0 ? 0 : v > 1 ? 1 : v;
       }
-      if (mt->twin) {
-        uint8_t *o2 = mt->twin + 3 * px;
-        if (mt->tex2) {
-          float tc[3];
-          tex_sample(mt->tex2, level[1], at[3], at[4], tc);
-          for (int k = 0; k < 3; k++) o2[k] = (uint8_t)(tc[k] * 255.0f + 0.5f);
-        } else {
-          o2[0] = mt->flat2[0], o2[1] = mt->flat2[1], o2[2] = mt->flat2[2];
-        }
+    }
+    uint8_t *p = o + 3 * xb;
+    for (int i = 0; i < n; i++)
+      for (int k = 0; k < 3; k++) p[3 * i + k] = (uint8_t)(c[k][i] * 255.0f + 0.5f);
+    if (o2) {
+      uint8_t *p2 = o2 + 3 * xb;
+      for (int i = 0; i < n; i++)
+        p2[3 * i] = mt->flat2[0], p2[3 * i + 1] = mt->flat2[1], p2[3 * i + 2] = mt->flat2[2];
+    }
+  }
+}
+
+/* the colours of every covered pixel from the triangle that won it, with
+ * the interpolation raster's depth test used (the same values), run by
+ * run of pixels that one triangle won */
+static void resolve(sim_soft *s, uint8_t *rgb, int *ids) {
+  for (int y = 0; y < s->h; y++) {
+    double yc = y + 0.5, row[3];
+    size_t line = (size_t)y * (size_t)s->w;
+    const int *tl = s->tri + line;
+    int x = 0;
+    while (x < s->w) {
+      int t = tl[x];
+      if (t < 0) {
+        x++;
+        continue;
       }
+      int xe = x + 1;
+      while (xe < s->w && tl[xe] == t) xe++;
+      const soft_rec *r = &s->rec[t];
+      const soft_mat *mt = &s->mats[r->mat];
+      if (ids)
+        for (int i = x; i < xe; i++) ids[line + (size_t)i] = mt->id;
+      if (rgb) {
+        for (int i = 0; i < 3; i++) row[i] = r->B[i] * yc + r->C[i];
+        uint8_t *o = rgb + 3 * line, *o2 = mt->twin ? mt->twin + 3 * line : NULL;
+        int tex = mt->tex != NULL, tex2 = mt->tex2 != NULL;
+        if (!mt->unlit && o2 && tex && tex2) shade_run(r, mt, row, x, xe, o, o2, 0, 1, 1, 1);
+        else if (!mt->unlit && !tex && !tex2) shade_run_plain(r, mt, row, x, xe, o, o2);
+        else if (!mt->unlit && !o2 && tex) shade_run(r, mt, row, x, xe, o, o2, 0, 1, 0, 0);
+        else shade_run(r, mt, row, x, xe, o, o2, mt->unlit, tex, o2 != NULL, tex2);
+      }
+      x = xe;
     }
   }
 }
@@ -759,7 +955,7 @@ static int tri_level(const soft_tex *t, const soft_vtx *p[3], const soft_svtx sv
 
 /* a triangle in the camera frame: near-plane clipping, projection, raster */
 static void draw_tri(sim_soft *s, const soft_cam *cam, const soft_vtx *p0, const soft_vtx *p1,
-                     const soft_vtx *p2, const soft_mat *mt, uint8_t *rgb, int *ids) {
+                     const soft_vtx *p2, const soft_mat *mt) {
   const soft_vtx *in[3] = {p0, p1, p2};
   float zn = (float)-cam->znear;
   int inside = (p0->z <= zn) + (p1->z <= zn) + (p2->z <= zn);
@@ -781,8 +977,9 @@ static void draw_tri(sim_soft *s, const soft_cam *cam, const soft_vtx *p0, const
   for (int i = 1; i + 1 < n; i++) {
     const soft_vtx *tp[3] = {&poly[0], &poly[i], &poly[i + 1]};
     soft_svtx ts[3] = {sv[0], sv[i], sv[i + 1]};
+    if (!raster(s, &ts[0], &ts[1], &ts[2])) continue;
     int lv[2] = {tri_level(mt->tex, tp, ts), tri_level(mt->tex2, tp, ts)};
-    raster(s, &ts[0], &ts[1], &ts[2], mt, lv, rgb, ids);
+    rec_commit(s, &ts[0], &ts[1], &ts[2], mt, lv);
   }
 }
 
@@ -893,6 +1090,9 @@ void sim_soft_render(sim_soft *s, const mjModel *m, const mjData *d, const sim_s
                      uint8_t *rgb, uint8_t *twin, int *ids) {
   size_t npx = (size_t)s->w * (size_t)s->h;
   memset(s->depth, 0, sizeof(float) * npx);
+  for (size_t i = 0; i < npx; i++) s->tri[i] = -1;
+  s->nrec = 0;
+  int nmat = 0;
   if (rgb) memset(rgb, 0, 3 * npx);
   if (twin && rgb && v->mode == SIM_SOFT_LIT) memset(twin, 0, 3 * npx);
   else twin = NULL;
@@ -962,9 +1162,10 @@ void sim_soft_render(sim_soft *s, const mjModel *m, const mjData *d, const sim_s
     int grp = m->geom_group[g];
     if (sh->nt == 0 || grp < 0 || grp >= 6 || !v->groups[grp]) continue;
     if (v->only_geom >= 0 && g != v->only_geom) continue;
-    soft_mat mt;
-    geom_material(m, s, g, v, twin, &mt);
-    if (mt.rgba[3] == 0) continue;
+    soft_mat *mp = &s->mats[nmat];
+    geom_material(m, s, g, v, twin, mp);
+    if (mp->rgba[3] == 0) continue;
+    nmat++;
     /* camera from geom: M = R_c^T R_g, t = R_c^T (x_g - p_c) */
     const double *Rg = d->geom_xmat + 9 * g, *xg = d->geom_xpos + 3 * g;
     double M[9], t[3], dx[3] = {xg[0] - cam.p[0], xg[1] - cam.p[1], xg[2] - cam.p[2]};
@@ -977,7 +1178,7 @@ void sim_soft_render(sim_soft *s, const mjModel *m, const mjData *d, const sim_s
     float Mf[9], tf[3];
     for (int k = 0; k < 9; k++) Mf[k] = (float)M[k];
     for (int k = 0; k < 3; k++) tf[k] = (float)t[k];
-    geom_pass gp = {s, &cam, sh, &mt, L, nl, v->mode, Mf};
+    geom_pass gp = {s, &cam, sh, mp, L, nl, v->mode, Mf};
     float zn = (float)-cam.znear;
     memset(s->lit, 0, (size_t)sh->nv);
     memset(s->pdone, 0, (size_t)sh->np);
@@ -985,8 +1186,7 @@ void sim_soft_render(sim_soft *s, const mjModel *m, const mjData *d, const sim_s
     float eye[3];
     for (int c = 0; c < 3; c++)
       eye[c] = (float)(Rg[c] * -dx[0] + Rg[3 + c] * -dx[1] + Rg[6 + c] * -dx[2]);
-    if (!sh->uv) mt.tex = NULL, mt.tex2 = NULL;
-    uint8_t *out = v->mode == SIM_SOFT_SEGMENT ? NULL : rgb;
+    if (!sh->uv) mp->tex = NULL, mp->tex2 = NULL;
     for (int i = 0; i < sh->nt; i++) {
       const int *tr = sh->tri + 3 * i;
       const float *pl = sh->plane + 4 * i;
@@ -997,7 +1197,7 @@ void sim_soft_render(sim_soft *s, const mjModel *m, const mjData *d, const sim_s
       if (in == 0) continue;
       if (in < 3) {
         for (int k = 0; k < 3; k++) light_at(&gp, tr[k]);
-        draw_tri(s, &cam, p0, p1, p2, &mt, out, ids);
+        draw_tri(s, &cam, p0, p1, p2, mp);
         continue;
       }
       /* wholly in front: back faces and triangles off the image go before
@@ -1013,7 +1213,8 @@ void sim_soft_render(sim_soft *s, const mjModel *m, const mjData *d, const sim_s
           memcmp(n0, sh->nrm + 3 * tr[2], 3 * sizeof(float)) == 0) {
         /* a flat triangle over at most two pixel centres: lit once, at its
          * first corner (across it the light changes by far less than a
-         * grey level) */
+         * grey level), and only when it is in front */
+        if (!raster_in(s, a, b, c, area, box)) continue;
         light_at(&gp, tr[0]);
         soft_svtx ts[3] = {*a, *b, *c};
         for (int k = 1; k < 3; k++) {
@@ -1021,14 +1222,17 @@ void sim_soft_render(sim_soft *s, const mjModel *m, const mjData *d, const sim_s
           ts[k].a[0] = p0->r * iw, ts[k].a[1] = p0->g * iw, ts[k].a[2] = p0->b * iw;
           ts[k].a[3] = tp[k]->u * iw, ts[k].a[4] = tp[k]->v * iw;
         }
-        int lv[2] = {tri_level(mt.tex, tp, ts), tri_level(mt.tex2, tp, ts)};
-        raster(s, &ts[0], &ts[1], &ts[2], &mt, lv, out, ids);
+        int lv[2] = {tri_level(mp->tex, tp, ts), tri_level(mp->tex2, tp, ts)};
+        rec_commit(s, &ts[0], &ts[1], &ts[2], mp, lv);
         continue;
       }
+      /* lit only when it won pixels */
+      if (!raster_in(s, a, b, c, area, box)) continue;
       for (int k = 0; k < 3; k++) light_at(&gp, tr[k]);
       soft_svtx ts[3] = {*a, *b, *c};
-      int lv[2] = {tri_level(mt.tex, tp, ts), tri_level(mt.tex2, tp, ts)};
-      raster(s, a, b, c, &mt, lv, out, ids);
+      int lv[2] = {tri_level(mp->tex, tp, ts), tri_level(mp->tex2, tp, ts)};
+      rec_commit(s, a, b, c, mp, lv);
     }
   }
+  resolve(s, v->mode == SIM_SOFT_SEGMENT ? NULL : rgb, ids);
 }

@@ -2,7 +2,9 @@
  * a textured quad facing the camera shows at each pixel the bilinear
  * texel of its known texture coordinate; a sphere under one directional
  * light shows Lambert's max(0, n . l) of its ray-cast normal; of two
- * overlapping quads the nearer one wins in either drawing order; the
+ * overlapping quads the nearer one wins in either drawing order, and of
+ * nested spheres drawn inner first (more winning triangles than pixels)
+ * the outer one alone shows; the
  * thermal twin of a lit pass equals the separate unlit render. Then
  * determinism: a scene of every geom kind rendered in two threads at once
  * gives the main thread's bytes, and (with --write FILE, run by the -O0
@@ -205,6 +207,55 @@ static void check_depth(int near_first) {
   mj_deleteModel(m);
 }
 
+/* ---- layers drawn far to near ----------------------------------------------------- */
+static void check_layers(void) {
+  /* four concentric spheres with the same centre, so drawn in the order
+   * listed: the smallest first, every larger one then wins the pixels
+   * again. At 8 x 8 pixels more triangles win pixels than there are
+   * pixels, so the renderer must drop records no pixel keeps; the image
+   * must still be the outer sphere's alone */
+  const char *xml =
+      "<mujoco><visual><quality numslices=\"64\" numstacks=\"48\"/></visual>"
+      "<asset><material name=\"w\" rgba=\"0.8 0.6 0.4 1\"/></asset><worldbody>"
+      "<light pos=\"1 1 5\" dir=\"-0.2 -0.2 -1\"/><camera name=\"c\" pos=\"0 0 10\" fovy=\"6\"/>"
+      "<geom type=\"sphere\" size=\"0.2\" rgba=\"1 0 0 1\"/>"
+      "<geom type=\"sphere\" size=\"0.3\" rgba=\"0 1 0 1\"/>"
+      "<geom type=\"sphere\" size=\"0.4\" rgba=\"0 0 1 1\"/>"
+      "<geom name=\"outer\" type=\"sphere\" size=\"0.5\" material=\"w\"/>"
+      "</worldbody></mujoco>";
+  mjModel *m = load("layers", xml);
+  CHECK(m != NULL);
+  if (!m) return;
+  mjData *d = mj_makeData(m);
+  mj_forward(m, d);
+  const int W = 8;
+  int outer = mj_name2id(m, mjOBJ_GEOM, "outer");
+  sim_soft *s = sim_soft_new(m, W, W);
+  uint8_t *all = malloc(3 * W * W), *alone = malloc(3 * W * W), *inner = malloc(3 * W * W);
+  int *ids = malloc(sizeof(int) * W * W);
+  sim_soft_view v = lit_view(0);
+  sim_soft_render(s, m, d, &v, all, NULL, ids);
+  v.only_geom = outer;
+  sim_soft_render(s, m, d, &v, alone, NULL, NULL);
+  v.only_geom = 0;
+  sim_soft_render(s, m, d, &v, inner, NULL, NULL);
+  int covered = 0, wrong_id = 0, inner_px = 0;
+  for (int i = 0; i < W * W; i++) {
+    covered += ids[i] >= 0;
+    wrong_id += ids[i] >= 0 && ids[i] != outer;
+    inner_px += inner[3 * i] > 0;
+  }
+  CHECK_MSG(covered > W * W / 2 && inner_px >= 4, "layers: %d pixels covered, %d by the inner",
+            covered, inner_px);
+  CHECK_MSG(wrong_id == 0, "layers: %d pixels show an inner sphere", wrong_id);
+  CHECK_MSG(memcmp(all, alone, 3 * (size_t)W * W) == 0,
+            "layers: the scene differs from its outer sphere alone");
+  free(all), free(alone), free(inner), free(ids);
+  sim_soft_free(s);
+  mj_deleteData(d);
+  mj_deleteModel(m);
+}
+
 /* ---- the determinism scene ------------------------------------------------------ */
 /* every geom kind the sim draws, lit by the headlight and a spot light,
  * checker-textured floor, a textured mesh with its own coordinates and a
@@ -307,6 +358,7 @@ int main(int argc, char **argv) {
   check_sphere();
   check_depth(1);
   check_depth(0);
+  check_layers();
   /* the scene is not empty and not flat */
   long lit = 0;
   for (size_t i = 0; i < n; i++) lit += main_job.rgb[i] != main_job.rgb[i % 3];
