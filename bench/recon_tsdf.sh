@@ -3,7 +3,8 @@
 # masked depth with the true metric poses, marching tetrahedra, cleaning
 # and simplification, then the surface RMS in both directions against
 # ground_truth/.../mesh.glb (recon vertices to the true triangles, true
-# vertices to the recon triangles) and the wall time of the reconstruction.
+# vertices to the recon triangles, also over only the true vertices some
+# true depth camera sees) and the wall time of the reconstruction.
 # usage: bench/recon_tsdf.sh [BUILD_DIR] [WORKDIR] [CATEGORIES] [VIEWS] [VOXEL_M] [TRIANGLES]
 set -e
 B=${1:-build}

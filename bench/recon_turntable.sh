@@ -4,7 +4,8 @@
 # poses after the best similarity (rotation and camera-centre errors, the
 # largest tilt error), then the mesh fused from the depth maps with those
 # poses against the true mesh (RMS in both directions, in the truth's frame
-# through the same similarity).
+# through the same similarity; true->recon also over the true vertices some
+# true depth camera sees, by ray casting, tests/recon/true_visibility.h).
 # The manifests' turntable_deg (the encoder) holds the angles unless
 # RECON_TT_NO_ENCODER=1; RECON_TT_COLOUR=W turns the photometric term on.
 # usage: bench/recon_turntable.sh [BUILD_DIR] [WORKDIR] [CATEGORIES] [VIEWS] [VOXEL_M]

@@ -175,7 +175,7 @@ void hearth_turntable_opts_default(hearth_turntable_opts *o);
 typedef struct hearth_turntable_view {
   char state[HEARTH_NAME_MAX], view[HEARTH_NAME_MAX];
   size_t n_points;      /* object points of its depth map */
-  size_t n_plane;       /* table-plane inliers */
+  size_t n_plane;       /* table-plane inliers (0: its ring's plane taken) */
   double plane_rms_mm;  /* their distance to the plane */
   double height_m;      /* camera centre above the turntable top */
   double elevation_deg; /* of the optical axis below the horizon */
@@ -195,6 +195,9 @@ typedef struct hearth_turntable_result {
   double icp_median_mm;                /* |distance| median at the end */
   size_t n_encoder_views;              /* views held to a recorded turntable angle */
   size_t n_colour_views;               /* views with the photometric term */
+  size_t n_ring_plane_views;           /* views whose depth showed no table the
+                                          object stands on: their elevation's
+                                          mean plane taken */
   double seconds;
 } hearth_turntable_result;
 void hearth_turntable_result_free(hearth_turntable_result *r); /* accepts a zeroed one */
@@ -202,8 +205,11 @@ void hearth_turntable_result_free(hearth_turntable_result *r); /* accepts a zero
 /* Colour poses of every view of the states (NULL/0: every state of
  * instance.json) of `instance` under `root`, sorted by state (instance.json
  * order) and view (manifest order). A view without a depth map, an empty
- * cut-out, a depth map with too few object points or no table plane is an
- * error naming the file. res may be NULL. */
+ * cut-out or a depth map with too few object points is an error naming the
+ * file; a view whose depth shows no plane the object stands on takes the
+ * mean plane of its elevation's views (an error when none has one). The
+ * gauge is the mean camera position of the start, no view is held. res may
+ * be NULL. */
 hearth_status hearth_recon_turntable(const char *root, const char *instance,
                                      const char *const *states, size_t n_states,
                                      const hearth_turntable_opts *opts, hearth_poses *out,

@@ -75,8 +75,10 @@ static hearth_status write_report(const char *path, const char *instance,
   hearth_strbuf_printf(&b, ",\n  \"route\": \"turntable\",\n  \"views\": %zu,\n  \"pairs\": %zu,\n",
                        r->n_views, r->n_pairs);
   hearth_strbuf_printf(&b, "  \"iterations\": %d,\n", r->iterations);
-  hearth_strbuf_printf(&b, "  \"encoder_views\": %zu,\n  \"colour_views\": %zu,\n",
-                       r->n_encoder_views, r->n_colour_views);
+  hearth_strbuf_printf(&b,
+                       "  \"encoder_views\": %zu,\n  \"colour_views\": %zu,\n"
+                       "  \"ring_plane_views\": %zu,\n",
+                       r->n_encoder_views, r->n_colour_views, r->n_ring_plane_views);
   const struct {
     const char *k;
     double v;

@@ -28,6 +28,12 @@
 #define TT_PLANE_NEAR_M 0.25
 /* table planes fitting within this rms get the full weight */
 #define TT_PLANE_GOOD_M 0.0004
+/* the object stands on the table: this share of its points within this
+ * height above the plane */
+#define TT_ON_TABLE_M 0.05
+#define TT_ON_TABLE_SHARE 0.002
+/* a plane fitting its inliers worse than this is not the turntable top */
+#define TT_PLANE_MAX_RMS_M 0.002
 /* Huber threshold of the ICP distances */
 #define TT_HUBER_M 0.0015
 /* correspondences must have normals within this angle */
@@ -70,9 +76,10 @@ typedef struct tt_view {
   size_t n;
   float *p, *nrm; /* 3 * n each, colour camera frame */
   double centroid[3];
-  double L[9];   /* R_level_from_cam: rows forward, side, up */
-  double height; /* camera above the plane, metres */
-  size_t n_plane;
+  double L[9];    /* R_level_from_cam: rows forward, side, up */
+  double height;  /* camera above the plane, metres */
+  size_t n_plane; /* 0: none found, the ring's plane is taken */
+  size_t bg_points;
   double plane_rms;
   size_t npl;
   float *pl; /* 3 * npl: table-plane inliers (a subsample), colour frame */
@@ -163,6 +170,8 @@ static void fit_plane(const float *pts, const size_t *idx, size_t m, double n[3]
   *d = -hearth_dot3(n, mu);
 }
 
+static void set_level(tt_view *v, const double n[3]);
+
 /* The table plane among the background points bg[0..nb) (colour frame):
  * the RANSAC plane facing up in the image (normal towards the camera with
  * -y > 0.3) with the most inliers, refit to its inliers. Fills v's plane
@@ -240,7 +249,13 @@ static int table_plane(tt_view *v, const float *bg, size_t nb, uint64_t seed) {
   if (m < TT_MIN_PLANE || !v->pl) return 0;
   v->n_plane = m;
   v->height = d;
-  /* levelling: forward = the optical axis made horizontal, up = n */
+  set_level(v, n);
+  return 1;
+}
+
+/* levelling from the table normal n (colour frame): forward = the optical
+ * axis made horizontal, up = n */
+static void set_level(tt_view *v, const double n[3]) {
   double z[3] = {0, 0, 1}, f[3], s[3];
   double zn = hearth_dot3(z, n);
   for (int k = 0; k < 3; k++) f[k] = z[k] - zn * n[k];
@@ -252,7 +267,25 @@ static int table_plane(tt_view *v, const float *bg, size_t nb, uint64_t seed) {
     v->L[3 + k] = s[k];
     v->L[6 + k] = n[k];
   }
-  return 1;
+}
+
+/* Whether v's plane fits within TT_PLANE_MAX_RMS_M and the object stands
+ * on it: at least TT_ON_TABLE_SHARE of
+ * its points (cls 1 of pts) lie within TT_ON_TABLE_M above it and few
+ * below it. A backdrop or a far floor found instead of a turntable seen at
+ * grazing incidence fails. */
+static int plane_holds_object(const tt_view *v, const float *pts, const uint8_t *cls, size_t n) {
+  size_t no = 0, low = 0, under = 0;
+  for (size_t p = 0; p < n; p++) {
+    if (cls[p] != 1) continue;
+    double q[3] = {pts[3 * p], pts[3 * p + 1], pts[3 * p + 2]};
+    double h = hearth_dot3(&v->L[6], q) + v->height;
+    no++;
+    low += h < TT_ON_TABLE_M;
+    under += h < -TT_ON_TABLE_M;
+  }
+  return no && v->plane_rms <= TT_PLANE_MAX_RMS_M &&
+         (double)low >= TT_ON_TABLE_SHARE * (double)no && 20 * under <= no;
 }
 
 /* pose from the parameters */
@@ -327,7 +360,7 @@ static hearth_status load_view(tt_view *v, const char *dir, const hearth_view_fi
   const float *rd = rays_for(rays, &v->dcam);
   float *dirs = malloc((size_t)W * H * 3 * sizeof(float)); /* background points */
   float *pts = malloc((size_t)W * H * 3 * sizeof(float));  /* colour frame, NaN: none */
-  uint8_t *cls = calloc((size_t)W * H, 1);                 /* 1 object, 2 background */
+  uint8_t *cls = calloc((size_t)W * H, 1);                 /* 1 object, 2 + margin background */
   if (!on || !rd || !dirs || !pts || !cls) {
     s = hearth_err_set(err, HEARTH_E_NOMEM, "%s", v->depth_path);
     goto done;
@@ -359,7 +392,7 @@ static hearth_status load_view(tt_view *v, const char *dir, const hearth_view_fi
         int dd = (int)dp[pn] - (int)dp[p];
         edge = !dp[pn] || dd > TT_EDGE_MM || dd < -TT_EDGE_MM;
       }
-      int in = 0, near = 0;
+      int in = 0, near = 0, margin = -1;
       if (hearth_camera_project(rgb, pr, uv, NULL)) {
         long u = lround(uv[0]), w = lround(uv[1]);
         if (u >= 0 && w >= 0 && u < CW && w < CH && on[(size_t)w * CW + u]) {
@@ -371,12 +404,18 @@ static hearth_status load_view(tt_view *v, const char *dir, const hearth_view_fi
             in = uu >= 0 && ww >= 0 && uu < CW && ww < CH && on[(size_t)ww * CW + uu];
           }
         } else if (u >= 0 && w >= 0 && u < CW && w < CH) {
-          /* background unless within 3 E of the cut-out */
-          const int off[4][2] = {{3 * E, 0}, {-3 * E, 0}, {0, 3 * E}, {0, -3 * E}};
-          for (int k = 0; k < 4 && !near; k++) {
-            long uu = u + off[k][0], ww = w + off[k][1];
-            near = uu >= 0 && ww >= 0 && uu < CW && ww < CH && on[(size_t)ww * CW + uu];
+          /* background; its margin: 2 beyond 3 E of the cut-out, 1
+           * beyond E, 0 closer */
+          for (int reach = 3; reach >= 1 && margin < 0; reach -= 2) {
+            const int off[4][2] = {{reach * E, 0}, {-reach * E, 0}, {0, reach * E}, {0, -reach * E}};
+            int hit = 0;
+            for (int k = 0; k < 4 && !hit; k++) {
+              long uu = u + off[k][0], ww = w + off[k][1];
+              hit = uu >= 0 && ww >= 0 && uu < CW && ww < CH && on[(size_t)ww * CW + uu];
+            }
+            if (!hit) margin = reach == 3 ? 2 : 1;
           }
+          if (margin < 0) margin = 0;
         } else {
           near = 1;
         }
@@ -387,8 +426,8 @@ static hearth_status load_view(tt_view *v, const char *dir, const hearth_view_fi
         if (y < by0) by0 = y;
         if (x > bx1) bx1 = x;
         if (y > by1) by1 = y;
-      } else if (!near && !edge && (x % 2 == 0) && (y % 2 == 0)) {
-        cls[p] = 2;
+      } else if (!near && margin >= 0 && !edge && (x % 2 == 0) && (y % 2 == 0)) {
+        cls[p] = (uint8_t)(2 + margin);
       }
     }
   /* background points for the plane: those within TT_PLANE_NEAR_M of the
@@ -402,23 +441,32 @@ static hearth_status load_view(tt_view *v, const char *dir, const hearth_view_fi
       no++;
     }
   for (int a = 0; a < 3; a++) om[a] /= no ? (double)no : 1.0;
-  size_t nb = 0;
-  for (int pass = 0; pass < 2 && nb < TT_MIN_PLANE; pass++) {
-    nb = 0;
-    for (size_t p = 0; p < (size_t)W * H; p++) {
-      if (cls[p] != 2) continue;
-      double d[3] = {pts[3 * p] - om[0], pts[3 * p + 1] - om[1], pts[3 * p + 2] - om[2]};
-      if (pass == 0 && no && hearth_norm3(d) > TT_PLANE_NEAR_M) continue;
-      for (int a = 0; a < 3; a++) dirs[3 * nb + a] = pts[3 * p + a];
-      nb++;
+  /* the background kept clear of the cut-out by 3 E first (its blurred
+   * rim), then by E, then all of it: a flat object seen low may leave only
+   * a thin band of turntable around it inside the depth camera's range */
+  size_t nb = 0, nb_all = 0;
+  int found = 0;
+  for (int pass = 0; pass < 2 && !found; pass++)
+    for (int margin = 2; margin >= 0 && !found; margin--) {
+      nb = 0;
+      for (size_t p = 0; p < (size_t)W * H; p++) {
+        if (cls[p] < 2 + margin) continue;
+        double d[3] = {pts[3 * p] - om[0], pts[3 * p + 1] - om[1], pts[3 * p + 2] - om[2]};
+        if (pass == 0 && no && hearth_norm3(d) > TT_PLANE_NEAR_M) continue;
+        for (int a = 0; a < 3; a++) dirs[3 * nb + a] = pts[3 * p + a];
+        nb++;
+      }
+      if (nb > nb_all) nb_all = nb;
+      found = table_plane(v, dirs, nb, seed) && plane_holds_object(v, pts, cls, (size_t)W * H);
+      if (!found) { /* a plane the object does not stand on is no table */
+        free(v->pl);
+        v->pl = NULL;
+        v->npl = v->n_plane = 0;
+        v->plane_rms = 0;
+      }
     }
-  }
-  if (!table_plane(v, dirs, nb, seed)) {
-    s = hearth_err_set(err, HEARTH_E_NUMERIC,
-                       "%s: no turntable plane found (%zu depth pixels off the cut-out)",
-                       v->depth_path, nb);
-    goto done;
-  }
+  /* none: the view takes its ring's plane once every view is loaded */
+  v->bg_points = nb_all;
   if (bx1 < 0) {
     s = hearth_err_set(err, HEARTH_E_NOT_FOUND,
                        "%s: no depth pixel lies inside the cut-out %s (of view %s)", v->depth_path,
@@ -760,7 +808,7 @@ static hearth_status run_icp(tt_view *v, size_t nv, size_t n_states, const doubl
       pairs[np].gain = 1.0;
       np++;
     }
-  const size_t nu = 6 * (nv - 1);
+  const size_t nu = 6 * nv;
   double *A = malloc(nu * nu * sizeof *A), *b = malloc(nu * sizeof *b);
   if (!A || !b) {
     free(A);
@@ -792,22 +840,18 @@ static hearth_status run_icp(tt_view *v, size_t nv, size_t n_states, const doubl
       m += pr->m;
       size_t ix[2] = {pr->i, pr->j};
       for (int x = 0; x < 12; x++) {
-        size_t vx = ix[x / 6];
-        if (vx == 0) continue;
-        size_t gx = 6 * (vx - 1) + (size_t)(x % 6);
+        size_t gx = 6 * ix[x / 6] + (size_t)(x % 6);
         b[gx] -= pr->g[x];
         for (int y = 0; y < 12; y++) {
-          size_t vy = ix[y / 6];
-          if (vy == 0) continue;
-          A[gx * nu + 6 * (vy - 1) + (size_t)(y % 6)] += pr->H[12 * x + y];
+          A[gx * nu + 6 * ix[y / 6] + (size_t)(y % 6)] += pr->H[12 * x + y];
         }
       }
     }
     rms = m ? sqrt(ss / (double)m) : 0;
     if (it == 0 && res->iterations == 0) res->icp_rms_start_mm = 1000.0 * rms;
-    for (size_t vi = 1; vi < nv; vi++) {
+    for (size_t vi = 0; vi < nv; vi++) {
       const tt_view *tv = &v[vi];
-      double *Av = A + 6 * (vi - 1) * nu + 6 * (vi - 1), *bv = b + 6 * (vi - 1);
+      double *Av = A + 6 * vi * nu + 6 * vi, *bv = b + 6 * vi;
       /* the plane term: each table point at z = 0, weighted as many
        * matches as it has points, less where the plane fits worse than
        * TT_PLANE_GOOD_M (a table seen at grazing incidence) */
@@ -835,7 +879,7 @@ static hearth_status run_icp(tt_view *v, size_t nv, size_t n_states, const doubl
     /* the encoder: within each state that records it, the headings'
      * differences held to the encoder's, r_k = dh_k - mean(dh) over the
      * state's views, weighted as encoder_prior times a view's matches (its
-     * Jacobian in the headings is the centring projection; view 0 fixed) */
+     * Jacobian in the headings is the centring projection) */
     double we = o->encoder_prior * (double)(m / (nv ? nv : 1) + 1);
     for (size_t st = 0; st < n_states && we > 0; st++) {
       double mean = 0;
@@ -847,23 +891,31 @@ static hearth_status run_icp(tt_view *v, size_t nv, size_t n_states, const doubl
         }
       if (ns < 2) continue;
       mean /= (double)ns;
-      for (size_t vi = 1; vi < nv; vi++) {
+      for (size_t vi = 0; vi < nv; vi++) {
         if (!v[vi].enc || v[vi].state_index != st) continue;
-        size_t gi = 6 * (vi - 1) + 2;
+        size_t gi = 6 * vi + 2;
         b[gi] -= we * (remainder(heading(&v[vi], u) - v[vi].target, 2 * TT_PI) - mean);
-        for (size_t vj = 1; vj < nv; vj++)
+        for (size_t vj = 0; vj < nv; vj++)
           if (v[vj].enc && v[vj].state_index == st)
-            A[gi * nu + 6 * (vj - 1) + 2] += we * ((vi == vj) - 1.0 / (double)ns);
+            A[gi * nu + 6 * vj + 2] += we * ((vi == vj) - 1.0 / (double)ns);
       }
     }
+    /* the gauge: no view is held; the mean of the cameras' horizontal
+     * steps is held at zero (weighted as a view's matches), so the frame
+     * keeps the start's mean camera position and a view that starts off
+     * its neighbours moves like any other */
+    double wg = (double)(m / (nv ? nv : 1) + 1);
+    for (int a = 3; a < 5; a++)
+      for (size_t vi = 0; vi < nv; vi++)
+        for (size_t vj = 0; vj < nv; vj++) A[(6 * vi + a) * nu + 6 * vj + a] += wg / (double)nv;
     /* a scaled Levenberg term and a small floor */
     for (size_t d = 0; d < nu; d++) A[d * nu + d] = A[d * nu + d] * 1.01 + 1e-6;
     if (!chol_solve(A, b, nu)) {
       s = hearth_err_set(err, HEARTH_E_NUMERIC, "turntable: ICP normal equations not definite");
       break;
     }
-    for (size_t vi = 1; vi < nv; vi++) {
-      const double *d = b + 6 * (vi - 1);
+    for (size_t vi = 0; vi < nv; vi++) {
+      const double *d = b + 6 * vi;
       double dR[9], R[9];
       hearth_rotvec_to_matrix(d, dR);
       hearth_mat3_mul(dR, v[vi].T.R, R);
@@ -978,6 +1030,52 @@ hearth_status hearth_recon_turntable(const char *root, const char *instance,
   }
   hearth_progress_end(&prog);
   free(rays.dirs);
+  /* a view without a plane of its own takes its ring's: the mean table
+   * normal (its camera frame) and height of the views of its elevation,
+   * weighted by their inliers (the rig's cameras keep one tilt and roll a
+   * ring) */
+  for (size_t i = 0; i < nv && !s; i++) {
+    if (v[i].n_plane) continue;
+    double n[3] = {0, 0, 0}, h = 0;
+    size_t cnt = 0;
+    for (size_t j = 0; j < nv; j++)
+      if (v[j].n_plane && v[j].elevation_index == v[i].elevation_index) {
+        for (int a = 0; a < 3; a++) n[a] += (double)v[j].n_plane * v[j].L[6 + a];
+        h += (double)v[j].n_plane * v[j].height;
+        cnt += v[j].n_plane;
+      }
+    if (!cnt) {
+      s = hearth_err_set(err, HEARTH_E_NUMERIC,
+                         "%s: no turntable plane found (%zu depth pixels off the cut-out), nor "
+                         "in any view of its elevation",
+                         v[i].depth_path, v[i].bg_points);
+      break;
+    }
+    double ln = hearth_norm3(n);
+    for (int a = 0; a < 3; a++) n[a] /= ln;
+    v[i].height = h / (double)cnt;
+    set_level(&v[i], n);
+    res.n_ring_plane_views++;
+    /* the plane term then holds it to that plane, at a quarter of a good
+     * plane's weight (a ring's cameras differ in tilt by a fraction of a
+     * degree): a grid of points on it around the object's foot */
+    const int G = 20;
+    const double half = 0.08;
+    double c0[3], dc = hearth_dot3(n, v[i].centroid) + v[i].height;
+    for (int a = 0; a < 3; a++) c0[a] = v[i].centroid[a] - dc * n[a];
+    if (!(v[i].pl = malloc((size_t)G * G * 3 * sizeof(float)))) {
+      s = hearth_err_set(err, HEARTH_E_NOMEM, "%s", v[i].depth_path);
+      break;
+    }
+    for (int gy = 0; gy < G; gy++)
+      for (int gx = 0; gx < G; gx++) {
+        double fa = half * (2.0 * gx / (G - 1) - 1.0), sa = half * (2.0 * gy / (G - 1) - 1.0);
+        for (int a = 0; a < 3; a++)
+          v[i].pl[3 * v[i].npl + a] = (float)(c0[a] + fa * v[i].L[a] + sa * v[i].L[3 + a]);
+        v[i].npl++;
+      }
+    v[i].plane_rms = 2.0 * TT_PLANE_GOOD_M;
+  }
   if (!s && !(res.views = calloc(nv, sizeof *res.views)))
     s = hearth_err_set(err, HEARTH_E_NOMEM, "turntable: report");
   double u[3] = {1, 0, 0};
@@ -1047,7 +1145,7 @@ hearth_status hearth_recon_turntable(const char *root, const char *instance,
       snprintf(rv->view, sizeof rv->view, "%s", v[i].view);
       rv->n_points = v[i].n;
       rv->n_plane = v[i].n_plane;
-      rv->plane_rms_mm = 1000.0 * v[i].plane_rms;
+      rv->plane_rms_mm = v[i].n_plane ? 1000.0 * v[i].plane_rms : 0.0;
       rv->height_m = v[i].height;
       /* the optical axis (third column of R) against the horizon */
       rv->elevation_deg = -asin(fmax(-1.0, fmin(1.0, v[i].T.R[8]))) / TT_DEG;

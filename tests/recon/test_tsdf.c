@@ -13,6 +13,7 @@
 #include "../test_util.h"
 
 #include "recon/mesh_distance.h"
+#include "recon/true_visibility.h"
 
 /* ---- analytic sphere --------------------------------------------------- */
 #define SPHERE_R 0.05
@@ -177,7 +178,7 @@ static void test_errors(void) {
 
 /* Reconstruct instance of release root and compare with its true mesh. */
 static int run_release(const char *root, const char *instance, double voxel, size_t target,
-                       double trunc, double *rms_a, double *rms_b) {
+                       double trunc, double *rms_a, double *rms_b, double *rms_vis) {
   hearth_err err = {0};
   hearth_recon_tsdf_opts o;
   hearth_recon_tsdf_opts_default(&o);
@@ -199,15 +200,23 @@ static int run_release(const char *root, const char *instance, double voxel, siz
   if (dump) CHECK_OK(hearth_glb_write(dump, &m, &err), &err);
   mesh_to_mesh(&m, &gt, rms_a, &mx_a);
   mesh_to_mesh(&gt, &m, rms_b, &mx_b);
+  /* true->recon over the true vertices some depth view sees */
+  double mx_v = 0;
+  uint8_t *vis = malloc(gt.n_vertices + 1);
+  long nvis = vis ? true_visible_vertices(root, instance, &gt, vis) : -1;
+  CHECK_MSG(nvis > 0, "%s: no true vertex visible", instance);
+  if (nvis > 0) mesh_to_mesh_sel(&gt, vis, &m, rms_vis, &mx_v);
+  free(vis);
   size_t nb, nn;
   hearth_mesh_edge_stats(&m, &nb, &nn);
   CHECK_MSG(nb == 0 && nn == 0, "%s: %zu boundary, %zu non-manifold edges", instance, nb, nn);
   printf(
       "%s: voxel %.1f mm, %zu triangles (%zu boundary, %zu non-manifold edges), %.2f s; "
-      "RMS recon->true %.3f mm (max %.2f), true->recon %.3f mm (max %.2f)\n",
+      "RMS recon->true %.3f mm (max %.2f), true->recon %.3f mm (max %.2f), visible "
+      "true->recon %.3f mm (max %.2f, %ld of %zu true vertices)\n",
       instance, voxel * 1e3, m.n_triangles, nb, nn,
       (t1.tv_sec - t0.tv_sec) + 1e-9 * (t1.tv_nsec - t0.tv_nsec), *rms_a * 1e3, mx_a * 1e3,
-      *rms_b * 1e3, mx_b * 1e3);
+      *rms_b * 1e3, mx_b * 1e3, *rms_vis * 1e3, mx_v * 1e3, nvis, gt.n_vertices);
   hearth_mesh_free(&m);
   hearth_mesh_free(&gt);
   return 0;
@@ -222,21 +231,24 @@ static void test_release(void) {
            "--draft-rgb --texture 256 --map-res 64 --quiet",
            HEARTH_EXE, root);
   CHECK(system(cmd) == 0);
-  double a, b;
-  if (run_release(root, "cup_01", 0.003, 20000, 0, &a, &b) == 0) {
+  double a, b, bv;
+  if (run_release(root, "cup_01", 0.003, 20000, 0, &a, &b, &bv) == 0) {
     /* 10 views leave the cup's inside partly unseen: the true inner
      * walls lie up to a few mm from the reconstruction */
     CHECK_MSG(a < 1.5e-3 && b < 3.5e-3, "RMS %g %g", a, b);
+    /* the true surface some depth view sees is reconstructed: within the
+     * issue's 1.5 mm even at 3 mm voxels (0.8 mm measured) */
+    CHECK_MSG(bv < 1.5e-3 && bv < b, "visible true->recon RMS %g (all %g)", bv, b);
   }
 }
 
 int main(int argc, char **argv) {
   if (argc >= 3) {
-    double a, b;
+    double a, b, bv;
     double voxel = argc >= 4 ? atof(argv[3]) : 0.002;
     size_t target = argc >= 5 ? (size_t)atol(argv[4]) : 20000;
     double trunc = argc >= 6 ? atof(argv[5]) : 0;
-    return run_release(argv[1], argv[2], voxel, target, trunc, &a, &b) ? 1 : g_test_failures;
+    return run_release(argv[1], argv[2], voxel, target, trunc, &a, &b, &bv) ? 1 : g_test_failures;
   }
   test_errors();
   test_sphere();
