@@ -17,11 +17,13 @@
 #include "hearth/dataset.h"
 #include "poses/poses_internal.h"
 
-#define SCALE_MAX_ROUNDS 6    /* rounds on the full grid */
-#define SCALE_COARSE 4        /* the coarse grid's stride, in full-grid strides */
-#define SCALE_COARSE_ROUNDS 6 /* rounds on the coarse grid at most */
-#define SCALE_COARSE_TOL 1e-5 /* relative change of s that ends the coarse rounds */
-#define SCALE_COARSE_MIN 1000 /* fewer coarse pairs: the full grid from the start */
+#define SCALE_MAX_ROUNDS 6     /* rounds on the full grid */
+#define SCALE_COARSE 4         /* the coarse grid's stride, in full-grid strides */
+#define SCALE_COARSE_ROUNDS 6  /* rounds on the coarse grid at most */
+#define SCALE_COARSE_TOL 1e-5  /* relative change of s that ends the coarse rounds */
+#define SCALE_COARSE_MIN 1000  /* fewer coarse pairs: the full grid from the start */
+#define SCALE_COARSE_VSTEP 8   /* the coarse rounds' box: every 8th vertex, */
+#define SCALE_COARSE_MARGIN 16 /* and this many px around them */
 
 void hearth_scale_opts_default(hearth_scale_opts *o) {
   memset(o, 0, sizeof *o);
@@ -51,6 +53,8 @@ typedef struct scale_scratch {
 
 typedef struct scale_ctx {
   const hearth_mesh *mesh;
+  const hearth_mesh *box_mesh; /* the vertices whose projection bounds the cast */
+  int margin;                  /* px around them */
   const hearth_raycaster *rc;
   const hearth_scale_view *views;
   const hearth_scale_opts *o;
@@ -143,7 +147,7 @@ static void scale_view(scale_ctx *c, size_t v, scale_scratch *sc) {
    * whole grid when a hit touches the box's border */
   scale_box bx = {{0, gw, 0, gh}, gw, gh, 0};
   int pb[4];
-  if (rf_mesh_box(c->mesh, &sv->depth_cam, &T_world_from_depth, SCALE_MARGIN, pb)) {
+  if (rf_mesh_box(c->box_mesh, &sv->depth_cam, &T_world_from_depth, c->margin, pb)) {
     bx.b[0] = ((size_t)pb[0] + st - 1) / st;
     bx.b[1] = ((size_t)pb[2] + st - 1) / st;
     bx.b[2] = ((size_t)pb[1] + st - 1) / st;
@@ -363,6 +367,7 @@ hearth_status hearth_scale_estimate(const hearth_mesh *recon_mesh, const hearth_
   uint8_t *own_c = calloc(n_views, 1);
   size_t *n_pairs = calloc(n_views, sizeof *n_pairs);
   double *tmp = NULL;
+  float *box_positions = NULL; /* the coarse rounds' vertex sample */
   int nt = opts->threads > 0 ? opts->threads : hearth_default_threads();
   if ((size_t)nt > n_views) nt = (int)n_views;
   scale_scratch **scratch = calloc((size_t)nt, sizeof *scratch);
@@ -382,6 +387,20 @@ hearth_status hearth_scale_estimate(const hearth_mesh *recon_mesh, const hearth_
   /* the coarse grid's rays (none where the fine grid is too small for one) */
   size_t cstride = stride * SCALE_COARSE;
   int coarse = views[0].depth->width >= 16 * cstride && views[0].depth->height >= 16 * cstride;
+  /* the coarse rounds bound their casts by a sample of the vertices with a
+     wider margin (a box too small shows as hits on its border, and then the
+     whole grid is cast) */
+  hearth_mesh box_mesh = {0};
+  box_mesh.n_vertices = (recon_mesh->n_vertices + SCALE_COARSE_VSTEP - 1) / SCALE_COARSE_VSTEP;
+  if (coarse && !(box_positions = hearth_alloc_array(box_mesh.n_vertices ? box_mesh.n_vertices : 1,
+                                                     3 * sizeof *box_positions))) {
+    s = hearth_err_set(err, HEARTH_E_NOMEM, "scale: out of memory");
+    goto done;
+  }
+  for (size_t i = 0; coarse && i < box_mesh.n_vertices; i++)
+    memcpy(box_positions + 3 * i, recon_mesh->positions + 3 * i * SCALE_COARSE_VSTEP,
+           3 * sizeof *box_positions);
+  box_mesh.positions = box_positions;
   if (coarse && (s = make_grids(views, n_views, cstride, nt, dirs_c, own_c))) {
     hearth_err_set(err, s,
                    s == HEARTH_E_NOMEM ? "scale: out of memory"
@@ -394,7 +413,18 @@ hearth_status hearth_scale_estimate(const hearth_mesh *recon_mesh, const hearth_
   double scale = 1.0;
   int rounds = 0, from_coarse = 0;
   for (int round = 0; coarse && round < SCALE_COARSE_ROUNDS; round++) {
-    scale_ctx c = {recon_mesh, rc, views, opts, scale, cstride, dirs_c, scratch, pairs, n_pairs, 0};
+    scale_ctx c = {.mesh = recon_mesh,
+                   .box_mesh = &box_mesh,
+                   .margin = SCALE_COARSE_MARGIN,
+                   .rc = rc,
+                   .views = views,
+                   .o = opts,
+                   .s = scale,
+                   .stride = cstride,
+                   .dirs = dirs_c,
+                   .scratch = scratch,
+                   .pairs = pairs,
+                   .n_pairs = n_pairs};
     size_t total;
     if ((s = scale_round(&c, n_views, nt, &total, err))) goto done;
     rounds++;
@@ -407,7 +437,18 @@ hearth_status hearth_scale_estimate(const hearth_mesh *recon_mesh, const hearth_
     if (round > 0 && change < SCALE_COARSE_TOL) break;
   }
   for (int round = 0; round < SCALE_MAX_ROUNDS; round++) {
-    scale_ctx c = {recon_mesh, rc, views, opts, scale, stride, dirs, scratch, pairs, n_pairs, 0};
+    scale_ctx c = {.mesh = recon_mesh,
+                   .box_mesh = recon_mesh,
+                   .margin = SCALE_MARGIN,
+                   .rc = rc,
+                   .views = views,
+                   .o = opts,
+                   .s = scale,
+                   .stride = stride,
+                   .dirs = dirs,
+                   .scratch = scratch,
+                   .pairs = pairs,
+                   .n_pairs = n_pairs};
     size_t total;
     if ((s = scale_round(&c, n_views, nt, &total, err))) goto done;
     if (total < 10) {
@@ -443,6 +484,7 @@ done:
   free(pairs);
   free(n_pairs);
   free(tmp);
+  free(box_positions);
   hearth_raycaster_free(own);
   return s;
 }
