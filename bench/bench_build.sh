@@ -8,6 +8,8 @@
 # Times are wall clock and CPU (user + sys) on a possibly shared machine:
 # compare the ratios, not the seconds, across machines.
 #   bench/bench_build.sh [BUILD_DIR] [WORK_DIR]
+# HEARTH_BENCH_DEMO=0 leaves out the demo part (it takes most of the run's
+# time and does not enter the ratio).
 # The synthetic release is made once in WORK_DIR/pristine and reused.
 set -euo pipefail
 build=$(cd "${1:-build}" && pwd)
@@ -89,12 +91,15 @@ stages_table=$(awk -v m="$c_map1" -v d="$c_detect" -v ca="$c_calib" -v sc="$c_sc
   printf "  %-10s %6.2f s CPU %5.1fx\n", "all", t, (m > 0 ? t / m : 0) }')
 echo "$stages_table"
 
-echo "== hearth demo, then hearth build of its release"
-rm -rf "$work/demo"
-"$h" demo "$work/demo" --quiet > "$work/demo.log" 2>&1 || { cat "$work/demo.log"; exit 1; }
-timed "$h" build "$work/demo/release" > "$work/rebuild.log"
-rebuild_runs=$(sed -n 's/.* \([0-9]*\) stage(s) run.*/\1/p' "$work/rebuild.log")
-echo "  $(grep '^build summary' "$work/rebuild.log")"
+demo=${HEARTH_BENCH_DEMO:-1}
+if [ "$demo" != 0 ]; then
+  echo "== hearth demo, then hearth build of its release"
+  rm -rf "$work/demo"
+  "$h" demo "$work/demo" --quiet > "$work/demo.log" 2>&1 || { cat "$work/demo.log"; exit 1; }
+  timed "$h" build "$work/demo/release" > "$work/rebuild.log"
+  rebuild_runs=$(sed -n 's/.* \([0-9]*\) stage(s) run.*/\1/p' "$work/rebuild.log")
+  echo "  $(grep '^build summary' "$work/rebuild.log")"
+fi
 
 echo "== peak memory (cup_01, first state)"
 state=$(sed -n 's/.*"states": *\["\([^"]*\)".*/\1/p' "$work/rel/instances/cup_01/instance.json")
@@ -107,7 +112,7 @@ printf "build -j2      %7.2f s wall %7.2f s CPU\n" "$build_wall" "$build_cpu"
 printf "map, 4 states  %7.2f s wall %7.2f s CPU\n" "$map_wall" "$map_cpu"
 awk -v a="$build_wall" -v b="$map_wall" -v c="$build_cpu" -v d="$map_cpu" 'BEGIN {
   printf "ratio build / map: %.1fx wall, %.1fx CPU (target: at most 12x)\n", a / b, (d > 0 ? c / d : 0) }'
-printf "build after demo: %s stage(s) run (must be 0)\n" "${rebuild_runs:-?}"
+[ "$demo" = 0 ] || printf "build after demo: %s stage(s) run (must be 0)\n" "${rebuild_runs:-?}"
 awk -v a="$rss_map" -v b="$rss_rgb" 'BEGIN {
   printf "peak RSS: map %.0f MiB, map --rgb %.0f MiB (%.2fx)\n", a / 1024, b / 1024, (a > 0 ? b / a : 0) }'
-[ "${rebuild_runs:-1}" = 0 ]
+[ "$demo" = 0 ] || [ "${rebuild_runs:-1}" = 0 ]

@@ -51,7 +51,7 @@ typedef struct hearth_scale_result {
   double residual_rms_mm;    /* over inliers */
   double residual_p90_mm;    /* over inliers */
   double inlier_fraction;
-  int iterations; /* outer (baseline) iterations used */
+  int iterations; /* outer (baseline) rounds used, coarse and full grid */
 } hearth_scale_result;
 
 /* Robust scale: per pixel, z_measured / z_rendered of the recon mesh, edges,

@@ -6,7 +6,10 @@
  * The depth camera's centre in the recon frame depends on s itself (the
  * factory baseline is metric), so the cast is repeated with the latest s
  * until it settles; the baseline is small, so this fixed point converges in
- * a few rounds. */
+ * a few rounds. The first rounds, far from it, cast a grid SCALE_COARSE
+ * times sparser in x and y (a sixteenth of the rays) until s moves by less
+ * than SCALE_COARSE_TOL; the full grid's rounds then start close to the
+ * fixed point and need fewer of the costly casts. */
 #include <jansson.h>
 #include <math.h>
 #include <stdlib.h>
@@ -14,7 +17,13 @@
 #include "hearth/dataset.h"
 #include "poses/poses_internal.h"
 
-#define SCALE_MAX_ROUNDS 6
+#define SCALE_MAX_ROUNDS 6     /* rounds on the full grid */
+#define SCALE_COARSE 4         /* the coarse grid's stride, in full-grid strides */
+#define SCALE_COARSE_ROUNDS 6  /* rounds on the coarse grid at most */
+#define SCALE_COARSE_TOL 1e-5  /* relative change of s that ends the coarse rounds */
+#define SCALE_COARSE_MIN 1000  /* fewer coarse pairs: the full grid from the start */
+#define SCALE_COARSE_VSTEP 8   /* the coarse rounds' box: every 8th vertex, */
+#define SCALE_COARSE_MARGIN 16 /* and this many px around them */
 
 void hearth_scale_opts_default(hearth_scale_opts *o) {
   memset(o, 0, sizeof *o);
@@ -44,10 +53,13 @@ typedef struct scale_scratch {
 
 typedef struct scale_ctx {
   const hearth_mesh *mesh;
+  const hearth_mesh *box_mesh; /* the vertices whose projection bounds the cast */
+  int margin;                  /* px around them */
   const hearth_raycaster *rc;
   const hearth_scale_view *views;
   const hearth_scale_opts *o;
   double s;                /* current estimate (for the baseline) */
+  size_t stride;           /* the sampled pixels: every stride-th in x and y */
   float **dirs;            /* per view: its camera's pixel rays (3 per sampled pixel), shared
                           by the views of one camera */
   scale_scratch **scratch; /* per worker */
@@ -115,7 +127,7 @@ static void scale_cast(const scale_ctx *c, scale_scratch *sc, const float *dirs,
 static void scale_view(scale_ctx *c, size_t v, scale_scratch *sc) {
   const hearth_scale_view *sv = &c->views[v];
   const hearth_image *D = sv->depth;
-  size_t st = (size_t)(c->o->pixel_stride > 0 ? c->o->pixel_stride : 1);
+  size_t st = c->stride;
   size_t gw = (D->width + st - 1) / st, gh = (D->height + st - 1) / st, n = gw * gh;
   float *zr = hearth_alloc_array(n ? n : 1, sizeof *zr);
   zpair *out = hearth_alloc_array(n ? n : 1, sizeof *out);
@@ -135,7 +147,7 @@ static void scale_view(scale_ctx *c, size_t v, scale_scratch *sc) {
    * whole grid when a hit touches the box's border */
   scale_box bx = {{0, gw, 0, gh}, gw, gh, 0};
   int pb[4];
-  if (rf_mesh_box(c->mesh, &sv->depth_cam, &T_world_from_depth, SCALE_MARGIN, pb)) {
+  if (rf_mesh_box(c->box_mesh, &sv->depth_cam, &T_world_from_depth, c->margin, pb)) {
     bx.b[0] = ((size_t)pb[0] + st - 1) / st;
     bx.b[1] = ((size_t)pb[2] + st - 1) / st;
     bx.b[2] = ((size_t)pb[1] + st - 1) / st;
@@ -289,6 +301,34 @@ static void robust_fit(zpair *const *pairs, const size_t *n_pairs, size_t n_view
   res->residual_median_mm = rf_quantile(tmp, m, 0.5);
 }
 
+/* one round: every view's pairs cast from the baseline at c->s into
+ * c->pairs, their count into *total */
+static hearth_status scale_round(scale_ctx *c, size_t n_views, int nt, size_t *total,
+                                 hearth_err *err) {
+  for (size_t v = 0; v < n_views; v++) {
+    free(c->pairs[v]);
+    c->pairs[v] = NULL;
+    c->n_pairs[v] = 0;
+  }
+  hearth_status s = hearth_parallel_for(n_views, nt, scale_range, c);
+  if (s) return hearth_err_set(err, s, "scale: cannot start worker threads");
+  if (c->failed) return hearth_err_set(err, HEARTH_E_NOMEM, "scale: out of memory");
+  *total = 0;
+  for (size_t v = 0; v < n_views; v++) *total += c->n_pairs[v];
+  return HEARTH_OK;
+}
+
+/* robust_fit of the round's total pairs, with scratch *tmp made for them */
+static hearth_status scale_fit(zpair *const *pairs, const size_t *n_pairs, size_t n_views,
+                               const hearth_scale_opts *o, size_t total, double **tmp,
+                               hearth_scale_result *res, hearth_err *err) {
+  free(*tmp);
+  if (!(*tmp = hearth_alloc_array(total, sizeof **tmp)))
+    return hearth_err_set(err, HEARTH_E_NOMEM, "scale: out of memory");
+  robust_fit(pairs, n_pairs, n_views, o, *tmp, res);
+  return HEARTH_OK;
+}
+
 hearth_status hearth_scale_estimate(const hearth_mesh *recon_mesh, const hearth_raycaster *rc,
                                     const hearth_scale_view *views, size_t n_views,
                                     const hearth_scale_opts *opts, hearth_scale_result *out,
@@ -323,12 +363,15 @@ hearth_status hearth_scale_estimate(const hearth_mesh *recon_mesh, const hearth_
   zpair **pairs = calloc(n_views, sizeof *pairs);
   float **dirs = calloc(n_views, sizeof *dirs);
   uint8_t *own_dirs = calloc(n_views, 1);
+  float **dirs_c = calloc(n_views, sizeof *dirs_c); /* the coarse grid's */
+  uint8_t *own_c = calloc(n_views, 1);
   size_t *n_pairs = calloc(n_views, sizeof *n_pairs);
   double *tmp = NULL;
+  float *box_positions = NULL; /* the coarse rounds' vertex sample */
   int nt = opts->threads > 0 ? opts->threads : hearth_default_threads();
   if ((size_t)nt > n_views) nt = (int)n_views;
   scale_scratch **scratch = calloc((size_t)nt, sizeof *scratch);
-  int nomem = !pairs || !n_pairs || !dirs || !own_dirs || !scratch;
+  int nomem = !pairs || !n_pairs || !dirs || !own_dirs || !dirs_c || !own_c || !scratch;
   for (int t = 0; t < nt && !nomem; t++) nomem = !(scratch[t] = malloc(sizeof **scratch));
   if (nomem) {
     s = hearth_err_set(err, HEARTH_E_NOMEM, "scale: out of memory");
@@ -341,26 +384,73 @@ hearth_status hearth_scale_estimate(const hearth_mesh *recon_mesh, const hearth_
                                        : "scale: cannot start worker threads");
     goto done;
   }
+  /* the coarse grid's rays (none where the fine grid is too small for one) */
+  size_t cstride = stride * SCALE_COARSE;
+  int coarse = views[0].depth->width >= 16 * cstride && views[0].depth->height >= 16 * cstride;
+  /* the coarse rounds bound their casts by a sample of the vertices with a
+     wider margin (a box too small shows as hits on its border, and then the
+     whole grid is cast) */
+  hearth_mesh box_mesh = {0};
+  box_mesh.n_vertices = (recon_mesh->n_vertices + SCALE_COARSE_VSTEP - 1) / SCALE_COARSE_VSTEP;
+  if (coarse && !(box_positions = hearth_alloc_array(box_mesh.n_vertices ? box_mesh.n_vertices : 1,
+                                                     3 * sizeof *box_positions))) {
+    s = hearth_err_set(err, HEARTH_E_NOMEM, "scale: out of memory");
+    goto done;
+  }
+  for (size_t i = 0; coarse && i < box_mesh.n_vertices; i++)
+    memcpy(box_positions + 3 * i, recon_mesh->positions + 3 * i * SCALE_COARSE_VSTEP,
+           3 * sizeof *box_positions);
+  box_mesh.positions = box_positions;
+  if (coarse && (s = make_grids(views, n_views, cstride, nt, dirs_c, own_c))) {
+    hearth_err_set(err, s,
+                   s == HEARTH_E_NOMEM ? "scale: out of memory"
+                                       : "scale: cannot start worker threads");
+    goto done;
+  }
   /* first round: the baseline taken as if recon units were metres; each
-     later round uses the latest scale */
+     later round uses the latest scale. The coarse rounds only bring s near
+     the fixed point; the result is that of the full grid's rounds. */
   double scale = 1.0;
+  int rounds = 0, from_coarse = 0;
+  for (int round = 0; coarse && round < SCALE_COARSE_ROUNDS; round++) {
+    scale_ctx c = {.mesh = recon_mesh,
+                   .box_mesh = &box_mesh,
+                   .margin = SCALE_COARSE_MARGIN,
+                   .rc = rc,
+                   .views = views,
+                   .o = opts,
+                   .s = scale,
+                   .stride = cstride,
+                   .dirs = dirs_c,
+                   .scratch = scratch,
+                   .pairs = pairs,
+                   .n_pairs = n_pairs};
+    size_t total;
+    if ((s = scale_round(&c, n_views, nt, &total, err))) goto done;
+    rounds++;
+    if (total < SCALE_COARSE_MIN) break; /* too few to go by */
+    if ((s = scale_fit(pairs, n_pairs, n_views, opts, total, &tmp, out, err))) goto done;
+    if (!(out->scale > 0) || !isfinite(out->scale)) break;
+    double change = fabs(out->scale - scale) / out->scale;
+    scale = out->scale;
+    from_coarse = 1;
+    if (round > 0 && change < SCALE_COARSE_TOL) break;
+  }
   for (int round = 0; round < SCALE_MAX_ROUNDS; round++) {
-    scale_ctx c = {recon_mesh, rc, views, opts, scale, dirs, scratch, pairs, n_pairs, 0};
-    for (size_t v = 0; v < n_views; v++) {
-      free(pairs[v]);
-      pairs[v] = NULL;
-      n_pairs[v] = 0;
-    }
-    if ((s = hearth_parallel_for(n_views, nt, scale_range, &c))) {
-      hearth_err_set(err, s, "scale: cannot start worker threads");
-      goto done;
-    }
-    if (c.failed) {
-      s = hearth_err_set(err, HEARTH_E_NOMEM, "scale: out of memory");
-      goto done;
-    }
-    size_t total = 0;
-    for (size_t v = 0; v < n_views; v++) total += n_pairs[v];
+    scale_ctx c = {.mesh = recon_mesh,
+                   .box_mesh = recon_mesh,
+                   .margin = SCALE_MARGIN,
+                   .rc = rc,
+                   .views = views,
+                   .o = opts,
+                   .s = scale,
+                   .stride = stride,
+                   .dirs = dirs,
+                   .scratch = scratch,
+                   .pairs = pairs,
+                   .n_pairs = n_pairs};
+    size_t total;
+    if ((s = scale_round(&c, n_views, nt, &total, err))) goto done;
     if (total < 10) {
       s = hearth_err_set(err, HEARTH_E_INCONSISTENT,
                          "scale: only %zu depth pixels see the mesh away from edges (expected at "
@@ -368,35 +458,33 @@ hearth_status hearth_scale_estimate(const hearth_mesh *recon_mesh, const hearth_
                          total);
       goto done;
     }
-    free(tmp);
-    tmp = hearth_alloc_array(total, sizeof *tmp);
-    if (!tmp) {
-      s = hearth_err_set(err, HEARTH_E_NOMEM, "scale: out of memory");
-      goto done;
-    }
-    robust_fit(pairs, n_pairs, n_views, opts, tmp, out);
-    out->iterations = round + 1;
+    if ((s = scale_fit(pairs, n_pairs, n_views, opts, total, &tmp, out, err))) goto done;
+    out->iterations = ++rounds;
     if (!(out->scale > 0) || !isfinite(out->scale)) {
       s = hearth_err_set(err, HEARTH_E_NUMERIC, "scale: the fit gave a non-positive scale");
       goto done;
     }
     double change = fabs(out->scale - scale) / out->scale;
     scale = out->scale;
-    if (round > 0 && change < 1e-8) break;
+    if ((round > 0 || from_coarse) && change < 1e-8) break;
   }
 done:
   for (size_t v = 0; v < n_views; v++) {
     if (pairs) free(pairs[v]);
     if (dirs && own_dirs && own_dirs[v]) free(dirs[v]);
+    if (dirs_c && own_c && own_c[v]) free(dirs_c[v]);
   }
   if (scratch)
     for (int t = 0; t < nt; t++) free(scratch[t]);
   free(scratch);
   free(own_dirs);
   free(dirs);
+  free(own_c);
+  free(dirs_c);
   free(pairs);
   free(n_pairs);
   free(tmp);
+  free(box_positions);
   hearth_raycaster_free(own);
   return s;
 }
