@@ -66,4 +66,23 @@ static void scene_look_at(const double c[3], const double target[3], hearth_rigi
     T->t[r] = c[r];
   }
 }
+/* A start pose: truth moved by a rotation of deg degrees and a translation
+ * of mm millimetres, each about a direction drawn from rng. */
+static inline hearth_rigid scene_nudged_start(const hearth_rigid *truth, double deg, double mm,
+                                              hearth_rng *rng) {
+  hearth_pose_nudge n = {{0}, {0}, {0}, {0}};
+  double r[3], t[3];
+  for (int k = 0; k < 3; k++) {
+    r[k] = hearth_rng_normal(rng);
+    t[k] = hearth_rng_normal(rng);
+  }
+  double lr = hearth_norm3(r), lt = hearth_norm3(t);
+  for (int k = 0; k < 3; k++) {
+    n.d_rot_deg[k] = deg * r[k] / lr;
+    n.d_t_mm[k] = mm * t[k] / lt;
+  }
+  hearth_rigid start = *truth;
+  hearth_pose_nudge_apply(&n, &start);
+  return start;
+}
 #endif

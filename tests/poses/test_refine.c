@@ -43,19 +43,7 @@ int main(void) {
     scene_look_at(c, tgt, &truth[v]);
     render(&cam, &truth[v], 55.0, &imgs[0][v]);
     render(&cam, &truth[v], 22.0, &imgs[1][v]); /* no contrast at all */
-    hearth_pose_nudge n = {"hot", "v", {0}, {0}};
-    double r[3], t[3];
-    for (int k = 0; k < 3; k++) {
-      r[k] = hearth_rng_normal(&rng);
-      t[k] = hearth_rng_normal(&rng);
-    }
-    double lr = hearth_norm3(r), lt = hearth_norm3(t);
-    for (int k = 0; k < 3; k++) {
-      n.d_rot_deg[k] = 1.0 * r[k] / lr;
-      n.d_t_mm[k] = 5.0 * t[k] / lt;
-    }
-    hearth_rigid start = truth[v];
-    hearth_pose_nudge_apply(&n, &start);
+    hearth_rigid start = scene_nudged_start(&truth[v], 1.0, 5.0, &rng);
     views[0][v] = (hearth_map_view){&imgs[0][v], start};
     views[1][v] = (hearth_map_view){&imgs[1][v], start};
   }

@@ -55,19 +55,7 @@ int main(void) {
     double c[3] = {0.33 * cos(a), 0.33 * sin(a), h}, tgt[3] = {0.005, 0.0, 0.055};
     scene_look_at(c, tgt, &truth[v]);
     render(&cam, &truth[v], &imgs[v]);
-    hearth_pose_nudge n = {"iced", "v", {0}, {0}};
-    double r[3], t[3];
-    for (int k = 0; k < 3; k++) {
-      r[k] = hearth_rng_normal(&rng);
-      t[k] = hearth_rng_normal(&rng);
-    }
-    double lr = hearth_norm3(r), lt = hearth_norm3(t);
-    for (int k = 0; k < 3; k++) {
-      n.d_rot_deg[k] = 0.1 * r[k] / lr;
-      n.d_t_mm[k] = 0.3 * t[k] / lt;
-    }
-    hearth_rigid start = truth[v];
-    hearth_pose_nudge_apply(&n, &start);
+    hearth_rigid start = scene_nudged_start(&truth[v], 0.1, 0.3, &rng);
     views[v] = (hearth_map_view){&imgs[v], start};
   }
   hearth_refine_opts o;
