@@ -37,7 +37,6 @@ static hearth_sim_env *make_env(hearth_sim_task t, int size, const char *rendere
   return e;
 }
 
-/* heat-capacity weighted mean of a network */
 static void test_names(void) {
   CHECK(hearth_sim_task_parse("H5") == HEARTH_SIM_H5);
   CHECK(hearth_sim_task_parse("h6") == HEARTH_SIM_H6);
