@@ -16,7 +16,7 @@
 #include "sim/sim_env.h"
 #include "test_probe.h"
 #include "test_util.h"
-#include "hearth/synth.h"
+#include "test_sim_release.h"
 
 static const char *g_root;
 
@@ -24,44 +24,22 @@ static const char *g_root;
  * stand out 3 cm from the body, so the mesh (3000 triangles), the map
  * (128 texels a side) and the up direction must resolve them */
 static const char *h4_release(const char *dir) {
-  static char root[1200];
-  snprintf(root, sizeof root, "%s/release", dir);
-  hearth_remove_tree(root, NULL);
   hearth_synth_opts so;
-  hearth_synth_opts_default(&so);
-  so.ideal = 1;
-  so.out_root = root;
+  test_sim_release_opts(dir, &so);
   static const char *cats[] = {"pot", "eraser", "cup", "orange"};
   so.n_categories = 4;
   for (int i = 0; i < 4; i++) so.categories[i] = cats[i];
   so.n_states = 2;
-  so.states[0] = "neutral", so.states[1] = "hot";
   so.n_views = 6; /* the up direction from 2 views tilts the pot by ~4 degrees */
   so.triangles = 3000;
   so.texture_size = 128;
   so.map_resolution = 128;
-  so.calibration = 0;
-  so.rgb_full_size = 0;
-  so.quiet = 1;
-  hearth_err err = {0};
-  CHECK_OK(hearth_synth_release(&so, &err), &err);
-  return root;
+  return test_sim_release_make(&so);
 }
 
+/* dynamic asked: H4 runs static */
 static hearth_sim_env *make_env(int size, const char *renderer) {
-  hearth_sim_opts o;
-  hearth_sim_opts_default(&o);
-  o.task = HEARTH_SIM_H4;
-  o.release_root = g_root;
-  o.width = o.height = size;
-  o.render_wrist = 0;
-  o.renderer = renderer;
-  /* dynamic asked: H4 runs static */
-  o.thermal = HEARTH_SIM_THERMAL_DYNAMIC;
-  hearth_sim_env *e = NULL;
-  hearth_err err = {0};
-  CHECK_OK(hearth_sim_env_new(&o, &e, &err), &err);
-  return e;
+  return test_sim_env(HEARTH_SIM_H4, g_root, size, renderer, HEARTH_SIM_THERMAL_DYNAMIC);
 }
 
 static void test_names(void) {

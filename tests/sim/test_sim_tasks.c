@@ -21,20 +21,9 @@
 
 static const char *g_root;
 
+/* static asked: the task forces dynamic */
 static hearth_sim_env *make_env(hearth_sim_task t, int size, const char *renderer) {
-  hearth_sim_opts o;
-  hearth_sim_opts_default(&o);
-  o.task = t;
-  o.release_root = g_root;
-  o.width = o.height = size;
-  o.render_wrist = 0;
-  o.renderer = renderer;
-  /* static asked: the task forces dynamic */
-  o.thermal = HEARTH_SIM_THERMAL_STATIC;
-  hearth_sim_env *e = NULL;
-  hearth_err err = {0};
-  CHECK_OK(hearth_sim_env_new(&o, &e, &err), &err);
-  return e;
+  return test_sim_env(t, g_root, size, renderer, HEARTH_SIM_THERMAL_STATIC);
 }
 
 static void test_names(void) {

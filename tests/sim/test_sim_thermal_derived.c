@@ -22,31 +22,20 @@
 #include "hearth/thermo.h"
 #include "sim/sim_env.h"
 #include "test_util.h"
+#include "test_sim_release.h"
 
 static const char *make_release(const char *dir) {
-  static char root[1200];
-  snprintf(root, sizeof root, "%s/release", dir);
-  hearth_remove_tree(root, NULL);
   hearth_synth_opts so;
-  hearth_synth_opts_default(&so);
-  so.ideal = 1;
-  so.out_root = root;
+  test_sim_release_opts(dir, &so);
   so.seed = 3;
   static const char *cats[] = {"cup", "electric_kettle", "eraser"};
   so.n_categories = 3;
   for (int i = 0; i < 3; i++) so.categories[i] = cats[i];
   so.n_states = 2;
-  so.states[0] = "neutral", so.states[1] = "hot";
   so.n_views = 4;
-  so.triangles = 800;
-  so.texture_size = 64;
-  so.map_resolution = 32;
-  so.calibration = 0;
-  so.rgb_full_size = 0;
   so.threads = 2;
-  so.quiet = 1;
+  const char *root = test_sim_release_make(&so);
   hearth_err err = {0};
-  CHECK_OK(hearth_synth_release(&so, &err), &err);
   /* the true rig as the calibration */
   char a[1400], b[1400];
   snprintf(a, sizeof a, "%s/ground_truth/rig.json", root);
