@@ -170,38 +170,9 @@ static void lens_res_undo(const lens_res *L, double u, double v, double q[2]) {
   }
 }
 
-typedef struct lens_res_table {
-  const hearth_camera *c;
-  const lens_res *L;
-  size_t ss;
-  float *out;
-} lens_res_table;
-
-static void lens_res_rows(void *vctx, size_t b, size_t e, int ti) {
-  lens_res_table *t = vctx;
-  size_t W = (size_t)t->c->width, ss = t->ss;
-  for (size_t y = b; y < e; y++)
-    for (size_t x = 0; x < W; x++)
-      for (size_t j = 0; j < ss; j++)
-        for (size_t i = 0; i < ss; i++) {
-          double q[2], d[3];
-          lens_res_undo(t->L, (double)x + ((double)i + 0.5) / (double)ss - 0.5,
-                        (double)y + ((double)j + 0.5) / (double)ss - 0.5, q);
-          synth_lens_ray(t->c, q[0], q[1], d);
-          float *o = t->out + (((y * W + x) * ss + j) * ss + i) * 3;
-          for (int k = 0; k < 3; k++) o[k] = (float)d[k];
-        }
-}
-
-/* the ray table (ss x ss per pixel, as synth_ray_table) of the true lens:
- * the model's with the residual L; NULL if out of memory */
-static float *lens_res_rays(const hearth_camera *c, const lens_res *L, int ss, int threads) {
-  size_t n = (size_t)c->width * (size_t)c->height * (size_t)(ss * ss);
-  float *out = hearth_alloc_array(n, 3 * sizeof(float));
-  if (!out) return NULL;
-  lens_res_table t = {c, L, (size_t)ss, out};
-  hearth_parallel_for((size_t)c->height, threads, lens_res_rows, &t);
-  return out;
+/* synth_pixel_warp of a lens residual: the model's pixel a true pixel shows */
+static void lens_res_warp(const void *L, double u, double v, double q[2]) {
+  lens_res_undo(L, u, v, q);
 }
 
 /* the bench's physics of one frame (docs/virtual-rig.md, "Calibration
@@ -946,12 +917,12 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
     }
   }
   if (!st && lres.n) {
-    own_rays = lens_res_rays(&rig->thermal, &lres, 4, o->threads);
+    own_rays = synth_ray_table_warped(&rig->thermal, 4, o->threads, lens_res_warp, &lres);
     if (!own_rays) st = hearth_err_set(err, HEARTH_E_NOMEM, "calibration captures: out of memory");
     trays = own_rays;
   }
   if (!st && lres_c.n && np > 0) {
-    own_crays = lens_res_rays(&rig->rgb, &lres_c, 1, o->threads);
+    own_crays = synth_ray_table_warped(&rig->rgb, 1, o->threads, lens_res_warp, &lres_c);
     if (!own_crays) st = hearth_err_set(err, HEARTH_E_NOMEM, "calibration captures: out of memory");
     crays = own_crays;
   }

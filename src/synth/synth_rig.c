@@ -107,6 +107,8 @@ void synth_lens_ray(const hearth_camera *c, double u, double v, double dir[3]) {
 typedef struct table_ctx {
   const hearth_camera *c;
   int ss;
+  synth_pixel_warp warp; /* NULL: the model's own pixels */
+  const void *warp_ctx;
   float *out;
 } table_ctx;
 
@@ -117,9 +119,11 @@ static void table_rows(void *vctx, size_t b, size_t e, int ti) {
     for (size_t x = 0; x < W; x++)
       for (size_t j = 0; j < ss; j++)
         for (size_t i = 0; i < ss; i++) {
-          double d[3];
-          synth_lens_ray(t->c, (double)x + ((double)i + 0.5) / (double)ss - 0.5,
-                         (double)y + ((double)j + 0.5) / (double)ss - 0.5, d);
+          double q[2] = {(double)x + ((double)i + 0.5) / (double)ss - 0.5,
+                         (double)y + ((double)j + 0.5) / (double)ss - 0.5},
+                 d[3];
+          if (t->warp) t->warp(t->warp_ctx, q[0], q[1], q);
+          synth_lens_ray(t->c, q[0], q[1], d);
           float *o = t->out + (((y * W + x) * ss + j) * ss + i) * 3;
           o[0] = (float)d[0];
           o[1] = (float)d[1];
@@ -127,13 +131,18 @@ static void table_rows(void *vctx, size_t b, size_t e, int ti) {
         }
 }
 
-float *synth_ray_table(const hearth_camera *c, int ss, int threads) {
+float *synth_ray_table_warped(const hearth_camera *c, int ss, int threads, synth_pixel_warp warp,
+                              const void *warp_ctx) {
   size_t n = (size_t)c->width * (size_t)c->height * (size_t)ss * (size_t)ss;
   float *out = hearth_alloc_array(n, 3 * sizeof(float));
   if (!out) return NULL;
-  table_ctx t = {c, ss, out};
+  table_ctx t = {c, ss, warp, warp_ctx, out};
   hearth_parallel_for((size_t)c->height, threads, table_rows, &t);
   return out;
+}
+
+float *synth_ray_table(const hearth_camera *c, int ss, int threads) {
+  return synth_ray_table_warped(c, ss, threads, NULL, NULL);
 }
 
 /* R = rotation about axis (unit) by angle */

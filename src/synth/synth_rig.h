@@ -34,6 +34,11 @@ void synth_lens_ray(const hearth_camera *c, double u, double v, double dir[3]);
  * ((y * W + x) * ss * ss + j * ss + i) * 3 is the ray through
  * (x + (i + 0.5) / ss - 0.5, y + (j + 0.5) / ss - 0.5). malloc'ed. */
 float *synth_ray_table(const hearth_camera *c, int ss, int threads);
+/* The same table for a lens whose pixel (u, v) shows what c's model shows
+ * at warp(warp_ctx, u, v) (a lens that departs from its model). */
+typedef void (*synth_pixel_warp)(const void *warp_ctx, double u, double v, double q[2]);
+float *synth_ray_table_warped(const hearth_camera *c, int ss, int threads, synth_pixel_warp warp,
+                              const void *warp_ctx);
 
 /* The rig drawn from a seed (realistic Femto Bolt + Mini2 ranges). */
 void synth_rig_draw(uint64_t seed, hearth_rig *rig);
