@@ -6,19 +6,21 @@
 # time is that of the whole 1,200-demo collection. Reports each task's
 # expert success per instruction, replaced layouts, steps and time, the
 # total wall and CPU time, and checks every file with h5py.
-# Usage: bench/sim_full.sh BUILD_DIR OUT_DIR [LAYOUTS=200]
+# Usage: bench/sim_full.sh BUILD_DIR OUT_DIR [LAYOUTS=200] [SIZE=256]
+#   SIZE: the stored image side (--size), 128 for the speed issue's views
 set -eu
 BUILD=${1:-build}
-OUT=${2:?usage: sim_full.sh BUILD_DIR OUT_DIR [LAYOUTS]}
+OUT=${2:?usage: sim_full.sh BUILD_DIR OUT_DIR [LAYOUTS] [SIZE]}
 L=${3:-200}
+S=${4:-256}
 HEARTH="$BUILD/hearth"
 mkdir -p "$OUT"
 now() { date +%s.%N; }
-echo "cores: $(nproc), layouts per task: $L, started $(date -u +%FT%TZ)"
+echo "cores: $(nproc), layouts per task: $L, image side: $S px, started $(date -u +%FT%TZ)"
 t0=$(now)
 for T in H1 H2 H3; do
   # progress goes to the .err file (tail -f it to watch)
-  ( /usr/bin/time -f "%U %S" -o "$OUT/$T.cpu" "$HEARTH" sim collect --task "$T" --layouts "$L" \
+  ( /usr/bin/time -f "%U %S" -o "$OUT/$T.cpu" "$HEARTH" sim collect --task "$T" --layouts "$L" --size "$S" \
       --out "$OUT/$T.hdf5" > "$OUT/$T.log" 2> "$OUT/$T.err"; echo $? > "$OUT/$T.rc" ) &
 done
 wait
