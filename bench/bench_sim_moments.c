@@ -80,22 +80,8 @@ int main(int argc, char **argv) {
   snprintf(root, sizeof root, "%s/release", out);
   if (hearth_mkdirs(out, &err)) return fprintf(stderr, "%s\n", err.msg), 1;
   hearth_synth_opts so;
-  hearth_synth_opts_default(&so);
-  so.ideal = 1;
+  hearth_synth_opts_sim_assets(&so);
   so.out_root = root;
-  const char *cats[] = {"cup",    "canned_drink", "electric_kettle", "eraser",
-                        "orange", "pot",          "smartphone",      "sponge"};
-  so.n_categories = 8;
-  for (int i = 0; i < 8; i++) so.categories[i] = cats[i];
-  so.n_states = 3;
-  so.states[0] = "neutral", so.states[1] = "hot", so.states[2] = "iced";
-  so.n_views = 6;
-  so.triangles = 4000;
-  so.texture_size = 256;
-  so.map_resolution = 256;
-  so.calibration = 0;
-  so.rgb_full_size = 0;
-  so.quiet = 1;
   hearth_remove_tree(root, NULL);
   if (hearth_synth_release(&so, &err)) return fprintf(stderr, "%s\n", err.msg), 1;
   hearth_sim_opts o;

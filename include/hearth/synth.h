@@ -124,6 +124,11 @@ typedef struct hearth_synth_opts {
 } hearth_synth_opts;
 
 void hearth_synth_opts_default(hearth_synth_opts *o);
+/* The small clean release the simulator's commands make when given no
+ * release: the eight categories tasks H1-H6 draw from, states neutral, hot
+ * and iced, 6 views, 4000 triangles, 256-texel textures and maps, no
+ * calibration, draft raw colour, quiet. out_root is left NULL. */
+void hearth_synth_opts_sim_assets(hearth_synth_opts *o);
 /* the default magnitudes of every effect */
 void hearth_synth_effects_default(hearth_synth_effects *e);
 /* Write a complete release tree (atomically: built under a temporary name

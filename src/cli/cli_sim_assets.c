@@ -29,22 +29,8 @@ int sim_cli_assets(const char *release, int gt, char *root, size_t rootsz, char 
   }
   snprintf(root, rootsz, "%s/release", tmpdir);
   hearth_synth_opts so;
-  hearth_synth_opts_default(&so);
-  so.ideal = 1; /* the clean rig: assets as before the effects */
+  hearth_synth_opts_sim_assets(&so);
   so.out_root = root;
-  const char *cats[] = {"cup",    "canned_drink", "electric_kettle", "eraser",
-                        "orange", "pot",          "smartphone",      "sponge"};
-  so.n_categories = 8;
-  for (int i = 0; i < 8; i++) so.categories[i] = cats[i];
-  so.n_states = 3;
-  so.states[0] = "neutral", so.states[1] = "hot", so.states[2] = "iced";
-  so.n_views = 6; /* 2 azimuths per elevation: enough for the up direction */
-  so.triangles = 4000;
-  so.texture_size = 256;
-  so.map_resolution = 256;
-  so.calibration = 0;
-  so.rgb_full_size = 0; /* draft raw colour frames: the sim reads none of them */
-  so.quiet = 1;
   if (!quiet) fprintf(stderr, "hearth sim: making assets with the virtual rig...\n");
   hearth_err err = {0};
   if (hearth_synth_release(&so, &err)) {

@@ -43,6 +43,24 @@ void hearth_synth_opts_default(hearth_synth_opts *o) {
   hearth_synth_effects_default(&o->effects);
 }
 
+void hearth_synth_opts_sim_assets(hearth_synth_opts *o) {
+  static const char *const cats[] = {"cup",    "canned_drink", "electric_kettle", "eraser",
+                                     "orange", "pot",          "smartphone",      "sponge"};
+  hearth_synth_opts_default(o);
+  o->ideal = 1; /* the clean rig: assets as before the effects */
+  o->n_categories = sizeof cats / sizeof cats[0];
+  for (size_t i = 0; i < o->n_categories; i++) o->categories[i] = cats[i];
+  o->n_states = 3;
+  o->states[0] = "neutral", o->states[1] = "hot", o->states[2] = "iced";
+  o->n_views = 6; /* 2 azimuths per elevation: enough for the up direction */
+  o->triangles = 4000;
+  o->texture_size = 256;
+  o->map_resolution = 256;
+  o->calibration = 0;
+  o->rgb_full_size = 0; /* draft raw colour frames: the simulator reads none of them */
+  o->quiet = 1;
+}
+
 void hearth_synth_effects_default(hearth_synth_effects *e) {
   memset(e, 0, sizeof *e);
   e->emissivity = 1.0;
