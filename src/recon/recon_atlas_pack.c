@@ -99,10 +99,20 @@ static void grid_xy(const atlas_chart *c, size_t v, double s, int rot, double *x
   *y = s * (rot ? u : w);
 }
 
+/* One chart's cells at one scale and turn: its own runs of cells and
+ * those grown by the gutter, per row. */
+typedef struct chart_runs {
+  int32_t *own;       /* the chart's own runs: pairs (first, last cell) */
+  int32_t *grown;     /* its grown runs: pairs */
+  size_t *own_at;     /* per own row: its first run; rows + 1 */
+  size_t *grown_at;   /* per grown row: its first run; rows + 1 */
+  int32_t *grown_len; /* per grown row: its longest run */
+} chart_runs;
+
 /* The packing's state: the grid of G x G cells and, per row, the last
  * occupied cell at or left of each cell (-1 when none) and the longest
  * run of free cells. Scratch for one chart: its cell bitmap, the bitmap
- * grown sideways, and its runs of cells per row, own and grown. */
+ * grown sideways, and its runs of cells in each turn. */
 typedef struct pack_grid {
   int G, d;
   int32_t *last;      /* G * G */
@@ -111,11 +121,7 @@ typedef struct pack_grid {
   uint8_t *bits;      /* one chart's cells, rows of G */
   uint8_t *wide;      /* those grown by d sideways, rows of G */
   int32_t *count;     /* per column: grown cells in the rows under the window */
-  int32_t *own;       /* the chart's own runs: pairs (first, last cell) */
-  int32_t *grown;     /* its grown runs: pairs */
-  size_t *own_at;     /* per own row: its first run; rows + 1 */
-  size_t *grown_at;   /* per grown row: its first run; rows + 1 */
-  int32_t *grown_len; /* per grown row: its longest run */
+  chart_runs runs[2]; /* one chart's runs, as it lies and turned */
 } pack_grid;
 
 /* one placed or candidate footprint */
@@ -123,6 +129,7 @@ typedef struct footprint {
   int rows;       /* rows of the chart itself, H */
   int cmin, rmin; /* integer shift that brings its cells to start at 0 */
   int lo, hi;     /* first and last column over the grown runs */
+  chart_runs *cr; /* its runs */
 } footprint;
 
 /* the runs of set cells of the n-cell row b into run (pairs, column
@@ -150,6 +157,7 @@ static size_t row_runs(const uint8_t *b, int n, int off, int32_t *run, int32_t *
  * from -d. 0 when it cannot fit the grid. */
 static int chart_cells(const atlas_chart *c, double s, int rot, pack_grid *g, footprint *fp) {
   const int G = g->G, d = g->d;
+  chart_runs *cr = fp->cr = &g->runs[rot];
   double xmin = INFINITY, ymin = INFINITY, xmax = -INFINITY, ymax = -INFINITY;
   for (size_t v = 0; v < c->n_vertices; v++) {
     double x, y;
@@ -196,13 +204,13 @@ static int chart_cells(const atlas_chart *c, double s, int rot, pack_grid *g, fo
     const uint8_t *b = g->bits + (size_t)r * (size_t)G;
     uint8_t *w = g->wide + (size_t)r * (size_t)G;
     int32_t longest;
-    g->own_at[r] = k;
-    k += row_runs(b, W, 0, g->own + 2 * k, &longest);
+    cr->own_at[r] = k;
+    k += row_runs(b, W, 0, cr->own + 2 * k, &longest);
     memset(w, 0, Wg);
-    for (size_t j = g->own_at[r]; j < k; j++)
-      memset(w + g->own[2 * j], 1, (size_t)(g->own[2 * j + 1] - g->own[2 * j] + 1 + 2 * d));
+    for (size_t j = cr->own_at[r]; j < k; j++)
+      memset(w + cr->own[2 * j], 1, (size_t)(cr->own[2 * j + 1] - cr->own[2 * j] + 1 + 2 * d));
   }
-  g->own_at[H] = k;
+  cr->own_at[H] = k;
   /* grown row q is the union of wide rows q - 2d .. q: a count per column
      of the rows in that window */
   memset(g->count, 0, Wg * sizeof *g->count);
@@ -219,15 +227,15 @@ static int chart_cells(const atlas_chart *c, double s, int rot, pack_grid *g, fo
       for (size_t x = 0; x < Wg; x++) g->count[x] -= w[x];
     }
     for (size_t x = 0; x < Wg; x++) acc[x] = g->count[x] > 0;
-    g->grown_at[q] = k;
-    size_t nr = row_runs(acc, (int)Wg, -d, g->grown + 2 * k, &g->grown_len[q]);
+    cr->grown_at[q] = k;
+    size_t nr = row_runs(acc, (int)Wg, -d, cr->grown + 2 * k, &cr->grown_len[q]);
     if (nr) {
-      if (g->grown[2 * k] < fp->lo) fp->lo = g->grown[2 * k];
-      if (g->grown[2 * (k + nr) - 1] > fp->hi) fp->hi = g->grown[2 * (k + nr) - 1];
+      if (cr->grown[2 * k] < fp->lo) fp->lo = cr->grown[2 * k];
+      if (cr->grown[2 * (k + nr) - 1] > fp->hi) fp->hi = cr->grown[2 * (k + nr) - 1];
     }
     k += nr;
   }
-  g->grown_at[H + 2 * d] = k;
+  cr->grown_at[H + 2 * d] = k;
   return fp->lo <= fp->hi && fp->hi - fp->lo < G;
 }
 
@@ -236,11 +244,12 @@ static int chart_cells(const atlas_chart *c, double s, int rot, pack_grid *g, fo
  * row that failed last, tried first. */
 static int try_at(const pack_grid *g, const footprint *fp, int X, int Y, int *hint) {
   const int G = g->G, d = g->d, nq = fp->rows + 2 * d;
+  const chart_runs *cr = fp->cr;
   for (int i = 0; i < nq; i++) {
     int q = i == 0 ? *hint : i <= *hint ? i - 1 : i;
     const int32_t *row = g->last + (size_t)(Y - d + q) * (size_t)G;
-    for (size_t j = g->grown_at[q]; j < g->grown_at[q + 1]; j++) {
-      int32_t a = g->grown[2 * j], l = row[X + g->grown[2 * j + 1]];
+    for (size_t j = cr->grown_at[q]; j < cr->grown_at[q + 1]; j++) {
+      int32_t a = cr->grown[2 * j], l = row[X + cr->grown[2 * j + 1]];
       if (l >= X + a) {
         *hint = q;
         return (int)l + 1 - a;
@@ -267,15 +276,16 @@ static int32_t row_run(pack_grid *g, int y) {
  * 0 when none. */
 static int first_fit(pack_grid *g, const footprint *fp, int y_stop, int *px, int *py) {
   const int G = g->G, d = g->d, H = fp->rows;
+  const chart_runs *cr = fp->cr;
   const int xa = -fp->lo, xb = G - 1 - fp->hi;
   int hint = 0, shortest = INT_MAX; /* the shortest grown run of a row */
   for (int q = 0; q < H + 2 * d; q++)
-    if (g->grown_len[q] && g->grown_len[q] < shortest) shortest = g->grown_len[q];
+    if (cr->grown_len[q] && cr->grown_len[q] < shortest) shortest = cr->grown_len[q];
   for (int Y = d; Y + H - 1 + d <= G - 1 && Y < y_stop; Y++) {
     int ok = 1; /* a run of free cells as long as each grown run */
     for (int q = 0; q < H + 2 * d && ok; q++) {
-      int32_t run = g->grown_len[q] ? row_run(g, Y - d + q) : INT32_MAX;
-      if (run >= g->grown_len[q]) continue;
+      int32_t run = cr->grown_len[q] ? row_run(g, Y - d + q) : INT32_MAX;
+      if (run >= cr->grown_len[q]) continue;
       ok = 0;
       /* a grid row too full for any run: no place that covers it */
       if (run < shortest) Y = Y + q;
@@ -296,11 +306,12 @@ static int first_fit(pack_grid *g, const footprint *fp, int y_stop, int *px, int
 /* occupy the chart's own cells (its own runs) at (X, Y) */
 static void occupy(pack_grid *g, const footprint *fp, int X, int Y) {
   const int G = g->G;
+  const chart_runs *cr = fp->cr;
   for (int r = 0; r < fp->rows; r++) {
-    if (g->own_at[r] == g->own_at[r + 1]) continue;
+    if (cr->own_at[r] == cr->own_at[r + 1]) continue;
     int32_t *row = g->last + (size_t)(Y + r) * (size_t)G;
-    for (size_t j = g->own_at[r]; j < g->own_at[r + 1]; j++) {
-      int a = X + g->own[2 * j], b = X + g->own[2 * j + 1];
+    for (size_t j = cr->own_at[r]; j < cr->own_at[r + 1]; j++) {
+      int a = X + cr->own[2 * j], b = X + cr->own[2 * j + 1];
       for (int x = a; x <= b; x++) row[x] = x;
       for (int x = b + 1; x < G && row[x] < b; x++) row[x] = b;
     }
@@ -324,9 +335,11 @@ static int pack_at(const atlas_chart *c, const size_t *ord, size_t n, double s, 
     int best_reach = INT_MAX, found = 0;
     /* a quarter turn is worth trying unless the chart is square */
     int n_rot = fabs(ch->w - ch->h) * s >= 1 ? 2 : 1;
+    footprint fps[2];
     for (int rot = 0; rot < n_rot; rot++) {
       footprint fp;
       if (!chart_cells(ch, s, rot, g, &fp)) continue;
+      fps[rot] = fp;
       int X, Y;
       /* it can only do better if it starts above best_reach - rows */
       int y_stop = found ? best_reach - fp.rows + 1 : INT_MAX;
@@ -341,9 +354,7 @@ static int pack_at(const atlas_chart *c, const size_t *ord, size_t n, double s, 
     if (!found) {
       return 0;
     }
-    footprint fp;
-    chart_cells(ch, s, best.rot, g, &fp);
-    occupy(g, &fp, best.X, best.Y);
+    occupy(g, &fps[best.rot], best.X, best.Y);
     pl[ord[k]] = best;
   }
   return 1;
@@ -422,11 +433,16 @@ hearth_status ra_pack(atlas_chart *charts, size_t n, int texture_size, double gu
   g.bits = hearth_alloc_array(G * G, 1);
   g.wide = hearth_alloc_array(G * G, 1);
   g.count = hearth_alloc_array(G, sizeof *g.count);
-  g.own = hearth_alloc_array(2 * runs, sizeof *g.own);
-  g.grown = hearth_alloc_array(2 * runs, sizeof *g.grown);
-  g.own_at = hearth_alloc_array(rows, sizeof *g.own_at);
-  g.grown_at = hearth_alloc_array(rows, sizeof *g.grown_at);
-  g.grown_len = hearth_alloc_array(rows, sizeof *g.grown_len);
+  int runs_ok = 1;
+  for (int k = 0; k < 2; k++) {
+    chart_runs *cr = &g.runs[k];
+    cr->own = hearth_alloc_array(2 * runs, sizeof *cr->own);
+    cr->grown = hearth_alloc_array(2 * runs, sizeof *cr->grown);
+    cr->own_at = hearth_alloc_array(rows, sizeof *cr->own_at);
+    cr->grown_at = hearth_alloc_array(rows, sizeof *cr->grown_at);
+    cr->grown_len = hearth_alloc_array(rows, sizeof *cr->grown_len);
+    runs_ok = runs_ok && cr->own && cr->grown && cr->own_at && cr->grown_at && cr->grown_len;
+  }
   pack_key *key = hearth_alloc_array(n ? n : 1, sizeof *key);
   size_t *ord = hearth_alloc_array(n ? n : 1, sizeof *ord);
   placement *pl = hearth_alloc_array(n ? n : 1, sizeof *pl);
@@ -434,8 +450,8 @@ hearth_status ra_pack(atlas_chart *charts, size_t n, int texture_size, double gu
   const atlas_chart **sord = hearth_alloc_array(n ? n : 1, sizeof *sord);
   double *spos = hearth_alloc_array(2 * (n ? n : 1), sizeof *spos);
   hearth_status s = HEARTH_OK;
-  if (!g.last || !g.max_run || !g.stale || !g.bits || !g.wide || !g.count || !g.own || !g.grown ||
-      !g.own_at || !g.grown_at || !g.grown_len || !key || !ord || !pl || !best || !sord || !spos) {
+  if (!g.last || !g.max_run || !g.stale || !g.bits || !g.wide || !g.count || !runs_ok || !key ||
+      !ord || !pl || !best || !sord || !spos) {
     s = hearth_err_set(err, HEARTH_E_NOMEM, "atlas: packing");
     goto done;
   }
@@ -496,7 +512,10 @@ hearth_status ra_pack(atlas_chart *charts, size_t n, int texture_size, double gu
   }
 done:
   free(g.last), free(g.max_run), free(g.stale), free(g.bits), free(g.wide), free(g.count);
-  free(g.own), free(g.grown), free(g.own_at), free(g.grown_at), free(g.grown_len);
+  for (int k = 0; k < 2; k++) {
+    chart_runs *cr = &g.runs[k];
+    free(cr->own), free(cr->grown), free(cr->own_at), free(cr->grown_at), free(cr->grown_len);
+  }
   free(key), free(ord), free(pl), free(best), free(sord), free(spos);
   return s;
 }
