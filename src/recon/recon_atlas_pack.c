@@ -1,7 +1,7 @@
 /* recon_atlas_pack.c - the flattened charts packed into the unit square:
  * each chart turned to its minimal-area box, rasterised conservatively on
- * a packing grid (per row, the hull of the cells its triangles touch),
- * that footprint grown by the gutter, and placed first-fit where it
+ * a packing grid (every cell its triangles touch, kept as runs per row, so
+ * a curved chart's hollow stays free), that footprint grown by the gutter, and placed first-fit where it
  * reaches least far down (then leftmost), as it lies or turned a quarter,
  * clear of every chart placed before; the common scale is the largest
  * that fits (bisection). */
@@ -99,31 +99,65 @@ static void grid_xy(const atlas_chart *c, size_t v, double s, int rot, double *x
   *y = s * (rot ? u : w);
 }
 
+/* One chart's cells at one scale and turn: its own runs of cells and
+ * those grown by the gutter, per row. */
+typedef struct chart_runs {
+  int32_t *own;       /* the chart's own runs: pairs (first, last cell) */
+  int32_t *grown;     /* its grown runs: pairs */
+  size_t *own_at;     /* per own row: its first run; rows + 1 */
+  size_t *grown_at;   /* per grown row: its first run; rows + 1 */
+  int32_t *grown_len; /* per grown row: its longest run */
+} chart_runs;
+
 /* The packing's state: the grid of G x G cells and, per row, the last
  * occupied cell at or left of each cell (-1 when none) and the longest
- * run of free cells. Scratch for one chart's rows: 2 * (G + 2 d + 2) ints each. */
+ * run of free cells. Scratch for one chart: its cell bitmap, the bitmap
+ * grown sideways, and its runs of cells in each turn. */
 typedef struct pack_grid {
   int G, d;
-  int32_t *last;            /* G * G */
-  int32_t *max_run;         /* per row: its longest run of free cells */
-  uint8_t *stale;           /* per row: max_run is to be counted again */
-  int *x0, *x1, *dx0, *dx1; /* one chart: covered and grown hull per row */
+  int32_t *last;      /* G * G */
+  int32_t *max_run;   /* per row: its longest run of free cells */
+  uint8_t *stale;     /* per row: max_run is to be counted again */
+  uint8_t *bits;      /* one chart's cells, rows of G */
+  uint8_t *wide;      /* those grown by d sideways, rows of G */
+  int32_t *count;     /* per column: grown cells in the rows under the window */
+  chart_runs runs[2]; /* one chart's runs, as it lies and turned */
 } pack_grid;
 
 /* one placed or candidate footprint */
 typedef struct footprint {
   int rows;       /* rows of the chart itself, H */
   int cmin, rmin; /* integer shift that brings its cells to start at 0 */
-  int lo, hi;     /* smallest dx0, largest dx1 over the grown rows */
+  int lo, hi;     /* first and last column over the grown runs */
+  chart_runs *cr; /* its runs */
 } footprint;
 
-/* Conservative cells of chart c at (s, rot): per row r, the hull
- * [x0[r], x1[r]] of every cell (closed unit square) a triangle meets,
- * exactly from the triangle clipped to the row's strip. Then grown by d
- * cells in every direction (Chebyshev) into dx0/dx1, rows -d .. H + d
- * stored at 0 .. H + 2d. 0 when it cannot fit the grid. */
+/* the runs of set cells of the n-cell row b into run (pairs, column
+ * shift off); their count */
+static size_t row_runs(const uint8_t *b, int n, int off, int32_t *run, int32_t *longest) {
+  size_t k = 0;
+  *longest = 0;
+  for (int x = 0; x < n;) {
+    if (!b[x]) {
+      x++;
+      continue;
+    }
+    int a = x;
+    while (x < n && b[x]) x++;
+    run[2 * k] = a + off, run[2 * k + 1] = x - 1 + off, k++;
+    if (x - a > *longest) *longest = x - a;
+  }
+  return k;
+}
+
+/* Conservative cells of chart c at (s, rot): every cell (closed unit
+ * square) a triangle meets, exactly from the triangle clipped to each
+ * row's strip, as runs per row; then those cells grown by d in every
+ * direction (Chebyshev), rows -d .. H + d stored at 0 .. H + 2d, columns
+ * from -d. 0 when it cannot fit the grid. */
 static int chart_cells(const atlas_chart *c, double s, int rot, pack_grid *g, footprint *fp) {
   const int G = g->G, d = g->d;
+  chart_runs *cr = fp->cr = &g->runs[rot];
   double xmin = INFINITY, ymin = INFINITY, xmax = -INFINITY, ymax = -INFINITY;
   for (size_t v = 0; v < c->n_vertices; v++) {
     double x, y;
@@ -132,10 +166,11 @@ static int chart_cells(const atlas_chart *c, double s, int rot, pack_grid *g, fo
   }
   if (!(xmax - xmin < G) || !(ymax - ymin < G)) return 0;
   fp->cmin = (int)floor(xmin), fp->rmin = (int)floor(ymin);
-  int H = (int)floor(ymax) - fp->rmin + 1;
-  if (H + 2 * d > G || (int)floor(xmax) - fp->cmin + 1 + 2 * d > G) return 0;
+  const int H = (int)floor(ymax) - fp->rmin + 1, W = (int)floor(xmax) - fp->cmin + 1;
+  if (H + 2 * d > G || W + 2 * d > G) return 0;
   fp->rows = H;
-  for (int r = 0; r < H; r++) g->x0[r] = INT_MAX, g->x1[r] = INT_MIN;
+  const size_t Wg = (size_t)W + 2 * (size_t)d;
+  memset(g->bits, 0, (size_t)H * (size_t)G);
   for (size_t f = 0; f < c->n_faces; f++) {
     double p[3][2];
     for (int j = 0; j < 3; j++) {
@@ -159,26 +194,48 @@ static int chart_cells(const atlas_chart *c, double s, int rot, pack_grid *g, fo
       }
       if (!(a <= b)) continue;
       int ca = (int)floor(a), cb = (int)floor(b);
-      if (ca < g->x0[r]) g->x0[r] = ca;
-      if (cb > g->x1[r]) g->x1[r] = cb;
+      ca = ca < 0 ? 0 : ca, cb = cb >= W ? W - 1 : cb;
+      if (ca <= cb) memset(g->bits + (size_t)r * (size_t)G + ca, 1, (size_t)(cb - ca + 1));
     }
   }
+  /* own runs; each row grown sideways: column x of wide is cell x - d */
+  size_t k = 0;
+  for (int r = 0; r < H; r++) {
+    const uint8_t *b = g->bits + (size_t)r * (size_t)G;
+    uint8_t *w = g->wide + (size_t)r * (size_t)G;
+    int32_t longest;
+    cr->own_at[r] = k;
+    k += row_runs(b, W, 0, cr->own + 2 * k, &longest);
+    memset(w, 0, Wg);
+    for (size_t j = cr->own_at[r]; j < k; j++)
+      memset(w + cr->own[2 * j], 1, (size_t)(cr->own[2 * j + 1] - cr->own[2 * j] + 1 + 2 * d));
+  }
+  cr->own_at[H] = k;
+  /* grown row q is the union of wide rows q - 2d .. q: a count per column
+     of the rows in that window */
+  memset(g->count, 0, Wg * sizeof *g->count);
+  uint8_t *acc = g->bits; /* the own bitmap is no longer needed: one row of scratch */
   fp->lo = INT_MAX, fp->hi = INT_MIN;
+  k = 0;
   for (int q = 0; q < H + 2 * d; q++) {
-    int a = INT_MAX, b = INT_MIN;
-    for (int r = q - 2 * d; r <= q; r++) {
-      if (r < 0 || r >= H || g->x0[r] > g->x1[r]) continue;
-      if (g->x0[r] < a) a = g->x0[r];
-      if (g->x1[r] > b) b = g->x1[r];
+    if (q < H) {
+      const uint8_t *w = g->wide + (size_t)q * (size_t)G;
+      for (size_t x = 0; x < Wg; x++) g->count[x] += w[x];
     }
-    if (a > b) {
-      g->dx0[q] = INT_MAX, g->dx1[q] = INT_MIN;
-      continue;
+    if (q - 2 * d - 1 >= 0) {
+      const uint8_t *w = g->wide + (size_t)(q - 2 * d - 1) * (size_t)G;
+      for (size_t x = 0; x < Wg; x++) g->count[x] -= w[x];
     }
-    g->dx0[q] = a - d, g->dx1[q] = b + d;
-    if (a - d < fp->lo) fp->lo = a - d;
-    if (b + d > fp->hi) fp->hi = b + d;
+    for (size_t x = 0; x < Wg; x++) acc[x] = g->count[x] > 0;
+    cr->grown_at[q] = k;
+    size_t nr = row_runs(acc, (int)Wg, -d, cr->grown + 2 * k, &cr->grown_len[q]);
+    if (nr) {
+      if (cr->grown[2 * k] < fp->lo) fp->lo = cr->grown[2 * k];
+      if (cr->grown[2 * (k + nr) - 1] > fp->hi) fp->hi = cr->grown[2 * (k + nr) - 1];
+    }
+    k += nr;
   }
+  cr->grown_at[H + 2 * d] = k;
   return fp->lo <= fp->hi && fp->hi - fp->lo < G;
 }
 
@@ -187,14 +244,16 @@ static int chart_cells(const atlas_chart *c, double s, int rot, pack_grid *g, fo
  * row that failed last, tried first. */
 static int try_at(const pack_grid *g, const footprint *fp, int X, int Y, int *hint) {
   const int G = g->G, d = g->d, nq = fp->rows + 2 * d;
+  const chart_runs *cr = fp->cr;
   for (int i = 0; i < nq; i++) {
     int q = i == 0 ? *hint : i <= *hint ? i - 1 : i;
-    if (g->dx0[q] > g->dx1[q]) continue;
     const int32_t *row = g->last + (size_t)(Y - d + q) * (size_t)G;
-    int32_t l = row[X + g->dx1[q]];
-    if (l >= X + g->dx0[q]) {
-      *hint = q;
-      return (int)l + 1 - g->dx0[q];
+    for (size_t j = cr->grown_at[q]; j < cr->grown_at[q + 1]; j++) {
+      int32_t a = cr->grown[2 * j], l = row[X + cr->grown[2 * j + 1]];
+      if (l >= X + a) {
+        *hint = q;
+        return (int)l + 1 - a;
+      }
     }
   }
   return -1;
@@ -217,12 +276,20 @@ static int32_t row_run(pack_grid *g, int y) {
  * 0 when none. */
 static int first_fit(pack_grid *g, const footprint *fp, int y_stop, int *px, int *py) {
   const int G = g->G, d = g->d, H = fp->rows;
+  const chart_runs *cr = fp->cr;
   const int xa = -fp->lo, xb = G - 1 - fp->hi;
-  int hint = 0;
+  int hint = 0, shortest = INT_MAX; /* the shortest grown run of a row */
+  for (int q = 0; q < H + 2 * d; q++)
+    if (cr->grown_len[q] && cr->grown_len[q] < shortest) shortest = cr->grown_len[q];
   for (int Y = d; Y + H - 1 + d <= G - 1 && Y < y_stop; Y++) {
-    int ok = 1; /* a run of free cells as long as each row */
-    for (int q = 0; q < H + 2 * d && ok; q++)
-      if (g->dx0[q] <= g->dx1[q] && row_run(g, Y - d + q) < g->dx1[q] - g->dx0[q] + 1) ok = 0;
+    int ok = 1; /* a run of free cells as long as each grown run */
+    for (int q = 0; q < H + 2 * d && ok; q++) {
+      int32_t run = cr->grown_len[q] ? row_run(g, Y - d + q) : INT32_MAX;
+      if (run >= cr->grown_len[q]) continue;
+      ok = 0;
+      /* a grid row too full for any run: no place that covers it */
+      if (run < shortest) Y = Y + q;
+    }
     if (!ok) continue;
     for (int X = xa; X <= xb;) {
       int nx = try_at(g, fp, X, Y, &hint);
@@ -236,15 +303,18 @@ static int first_fit(pack_grid *g, const footprint *fp, int y_stop, int *px, int
   return 0;
 }
 
-/* occupy the chart's own cells (x0/x1 rows) at (X, Y) */
+/* occupy the chart's own cells (its own runs) at (X, Y) */
 static void occupy(pack_grid *g, const footprint *fp, int X, int Y) {
   const int G = g->G;
+  const chart_runs *cr = fp->cr;
   for (int r = 0; r < fp->rows; r++) {
-    if (g->x0[r] > g->x1[r]) continue;
+    if (cr->own_at[r] == cr->own_at[r + 1]) continue;
     int32_t *row = g->last + (size_t)(Y + r) * (size_t)G;
-    int a = X + g->x0[r], b = X + g->x1[r];
-    for (int x = a; x <= b; x++) row[x] = x;
-    for (int x = b + 1; x < G && row[x] < b; x++) row[x] = b;
+    for (size_t j = cr->own_at[r]; j < cr->own_at[r + 1]; j++) {
+      int a = X + cr->own[2 * j], b = X + cr->own[2 * j + 1];
+      for (int x = a; x <= b; x++) row[x] = x;
+      for (int x = b + 1; x < G && row[x] < b; x++) row[x] = b;
+    }
     g->stale[Y + r] = 1;
   }
 }
@@ -265,9 +335,11 @@ static int pack_at(const atlas_chart *c, const size_t *ord, size_t n, double s, 
     int best_reach = INT_MAX, found = 0;
     /* a quarter turn is worth trying unless the chart is square */
     int n_rot = fabs(ch->w - ch->h) * s >= 1 ? 2 : 1;
+    footprint fps[2];
     for (int rot = 0; rot < n_rot; rot++) {
       footprint fp;
       if (!chart_cells(ch, s, rot, g, &fp)) continue;
+      fps[rot] = fp;
       int X, Y;
       /* it can only do better if it starts above best_reach - rows */
       int y_stop = found ? best_reach - fp.rows + 1 : INT_MAX;
@@ -282,9 +354,7 @@ static int pack_at(const atlas_chart *c, const size_t *ord, size_t n, double s, 
     if (!found) {
       return 0;
     }
-    footprint fp;
-    chart_cells(ch, s, best.rot, g, &fp);
-    occupy(g, &fp, best.X, best.Y);
+    occupy(g, &fps[best.rot], best.X, best.Y);
     pl[ord[k]] = best;
   }
   return 1;
@@ -354,14 +424,25 @@ hearth_status ra_pack(atlas_chart *charts, size_t n, int texture_size, double gu
   /* the gutter in cells, rounded up: cells are at least as large as texels */
   g.d = (int)ceil(gutter_texels * g.G / texture_size - 1e-9);
   if (g.d < 0) g.d = 0;
-  const size_t G = (size_t)g.G, rows = G + 2 * (size_t)g.d + 2;
+  const size_t G = (size_t)g.G, rows = G + 1;
+  /* a chart's cells fit G x G with their growth: at most G / 2 + 1 runs a row */
+  const size_t runs = G * (G / 2 + 1);
   g.last = hearth_alloc_array(G * G, sizeof *g.last);
   g.max_run = hearth_alloc_array(G, sizeof *g.max_run);
   g.stale = hearth_alloc_array(G, sizeof *g.stale);
-  g.x0 = hearth_alloc_array(rows, sizeof *g.x0);
-  g.x1 = hearth_alloc_array(rows, sizeof *g.x1);
-  g.dx0 = hearth_alloc_array(rows, sizeof *g.dx0);
-  g.dx1 = hearth_alloc_array(rows, sizeof *g.dx1);
+  g.bits = hearth_alloc_array(G * G, 1);
+  g.wide = hearth_alloc_array(G * G, 1);
+  g.count = hearth_alloc_array(G, sizeof *g.count);
+  int runs_ok = 1;
+  for (int k = 0; k < 2; k++) {
+    chart_runs *cr = &g.runs[k];
+    cr->own = hearth_alloc_array(2 * runs, sizeof *cr->own);
+    cr->grown = hearth_alloc_array(2 * runs, sizeof *cr->grown);
+    cr->own_at = hearth_alloc_array(rows, sizeof *cr->own_at);
+    cr->grown_at = hearth_alloc_array(rows, sizeof *cr->grown_at);
+    cr->grown_len = hearth_alloc_array(rows, sizeof *cr->grown_len);
+    runs_ok = runs_ok && cr->own && cr->grown && cr->own_at && cr->grown_at && cr->grown_len;
+  }
   pack_key *key = hearth_alloc_array(n ? n : 1, sizeof *key);
   size_t *ord = hearth_alloc_array(n ? n : 1, sizeof *ord);
   placement *pl = hearth_alloc_array(n ? n : 1, sizeof *pl);
@@ -369,8 +450,8 @@ hearth_status ra_pack(atlas_chart *charts, size_t n, int texture_size, double gu
   const atlas_chart **sord = hearth_alloc_array(n ? n : 1, sizeof *sord);
   double *spos = hearth_alloc_array(2 * (n ? n : 1), sizeof *spos);
   hearth_status s = HEARTH_OK;
-  if (!g.last || !g.max_run || !g.stale || !g.x0 || !g.x1 || !g.dx0 || !g.dx1 || !key || !ord ||
-      !pl || !best || !sord || !spos) {
+  if (!g.last || !g.max_run || !g.stale || !g.bits || !g.wide || !g.count || !runs_ok || !key ||
+      !ord || !pl || !best || !sord || !spos) {
     s = hearth_err_set(err, HEARTH_E_NOMEM, "atlas: packing");
     goto done;
   }
@@ -430,7 +511,11 @@ hearth_status ra_pack(atlas_chart *charts, size_t n, int texture_size, double gu
     c->uv = uv;
   }
 done:
-  free(g.last), free(g.max_run), free(g.stale), free(g.x0), free(g.x1), free(g.dx0), free(g.dx1);
+  free(g.last), free(g.max_run), free(g.stale), free(g.bits), free(g.wide), free(g.count);
+  for (int k = 0; k < 2; k++) {
+    chart_runs *cr = &g.runs[k];
+    free(cr->own), free(cr->grown), free(cr->own_at), free(cr->grown_at), free(cr->grown_len);
+  }
   free(key), free(ord), free(pl), free(best), free(sord), free(spos);
   return s;
 }

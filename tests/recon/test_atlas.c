@@ -9,7 +9,8 @@
  * chart, the GLB through the Khronos validator and hearth's reader.
  * Packing bounds in closed form: 64 equal squares fill an 8 x 8 grid, (1 -
  * 9 g)^2 of the square at gutter g, at three texture sizes and gutters;
- * 64 parallelograms beat 2/3, the most any packing of their boxes holds.
+ * 64 parallelograms beat 2/3, the most any packing of their boxes holds;
+ * 5 nested rings beat the most that one run of cells per row can hold.
  *
  * With arguments GLB_IN [GLB_OUT] it only runs the atlas on that mesh and
  * prints its figures (bench use). */
@@ -560,6 +561,108 @@ static void test_tiles(void) {
   hearth_mesh_free(&m);
 }
 
+/* Nested rings in the plane z = 0: ring k the annulus sector of radii
+ * [rad[2k], rad[2k+1]] over 350 degrees (a disc, cut by a 10-degree
+ * slit), nu segments along, two across; rings 3 units apart */
+static void make_rings(soup *s, const double *rad, int n, int nu, double unit) {
+  for (int k = 0; k < n; k++) {
+    double ox = 3 * unit * k, r0 = unit * rad[2 * k], r1 = unit * rad[2 * k + 1];
+    for (int i = 0; i < nu; i++)
+      for (int j = 0; j < 2; j++) {
+        double q[4][3];
+        for (int c = 0; c < 4; c++) {
+          double th = (M_PI / 180) * (95 + 350.0 * (i + (c == 1 || c == 2)) / nu);
+          double r = r0 + (r1 - r0) * (j + (c >= 2)) / 2;
+          q[c][0] = ox + r * cos(th), q[c][1] = r * sin(th), q[c][2] = 0;
+        }
+        soup_tri(s, q[0], q[1], q[2]);
+        soup_tri(s, q[0], q[2], q[3]);
+      }
+  }
+}
+
+/* The area of the triangles p (9 each, z ignored) turned by th and filled
+ * row by row: the integral over lines of constant y of the span from the
+ * first to the last point the triangles hold on that line, by the
+ * midpoint rule over n_lines. */
+static double row_hull_area(const float *p, size_t nt, double th, int n_lines) {
+  const double c = cos(th), sn = sin(th);
+  double lo = INFINITY, hi = -INFINITY;
+  for (size_t i = 0; i < 3 * nt; i++) {
+    double y = sn * p[3 * i] + c * p[3 * i + 1];
+    lo = fmin(lo, y), hi = fmax(hi, y);
+  }
+  const double dy = (hi - lo) / n_lines;
+  double *x0 = malloc(n_lines * sizeof *x0), *x1 = malloc(n_lines * sizeof *x1);
+  for (int l = 0; l < n_lines; l++) x0[l] = INFINITY, x1[l] = -INFINITY;
+  for (size_t t = 0; t < nt; t++) {
+    double v[3][2], ya = INFINITY, yb = -INFINITY;
+    for (int j = 0; j < 3; j++) {
+      const float *q = p + 9 * t + 3 * j;
+      v[j][0] = c * q[0] - sn * q[1], v[j][1] = sn * q[0] + c * q[1];
+      ya = fmin(ya, v[j][1]), yb = fmax(yb, v[j][1]);
+    }
+    int la = (int)ceil((ya - lo) / dy - 0.5), lb = (int)floor((yb - lo) / dy - 0.5);
+    for (int l = la < 0 ? 0 : la; l <= lb && l < n_lines; l++) {
+      double y = lo + (l + 0.5) * dy;
+      for (int e = 0; e < 3; e++) {
+        const double *P = v[e], *Q = v[(e + 1) % 3];
+        if ((P[1] - y) * (Q[1] - y) > 0 || P[1] == Q[1]) continue;
+        double x = P[0] + (y - P[1]) * (Q[0] - P[0]) / (Q[1] - P[1]);
+        x0[l] = fmin(x0[l], x), x1[l] = fmax(x1[l], x);
+      }
+    }
+  }
+  double sum = 0;
+  for (int l = 0; l < n_lines; l++)
+    if (x0[l] <= x1[l]) sum += (x1[l] - x0[l]) * dy;
+  free(x0), free(x1);
+  return sum;
+}
+
+/* Packing bound on nested rings: a packing that keeps one run of cells
+ * per row fills at least each chart's row hull in the turn it is packed
+ * at, so it holds at most the rings' area over the sum of their least row
+ * hulls (over turns at every degree; 0.267 here). Each ring fits the
+ * hole of the one before with a radial slack of about 12 gutters, so the
+ * nest packed alone gives the rings' area over (2 R)^2 (0.420) less the
+ * gutters;
+ * packing that uses the holes must beat the first and reach 0.9 of the
+ * second. */
+static void test_rings(void) {
+  const double rad[] = {0.90, 1.00, 0.70, 0.80, 0.50, 0.60, 0.30, 0.40, 0.10, 0.20};
+  const int n = 5, nu = 96;
+  double area = 0, hull = 0;
+  for (int k = 0; k < n; k++) {
+    soup s = {0};
+    make_rings(&s, rad + 2 * k, 1, nu, 1.0);
+    for (size_t t = 0; t < s.n; t++) {
+      const float *v = s.p + 9 * t;
+      area += 0.5 * fabs((v[3] - v[0]) * (v[7] - v[1]) - (v[6] - v[0]) * (v[4] - v[1]));
+    }
+    double least = INFINITY;
+    for (int deg = 0; deg < 180; deg++)
+      least = fmin(least, row_hull_area(s.p, s.n, M_PI * deg / 180, 2000));
+    hull += least;
+    free(s.p);
+  }
+  const double run_bound = area / hull, nest = area / 4;
+  soup s = {0};
+  make_rings(&s, rad, n, nu, 0.05);
+  hearth_mesh m;
+  soup_weld(&s, &m);
+  atlas_check r;
+  hearth_atlas_stats st;
+  run_case_at("5 nested rings", &m, 1024, 4, &r, &st, NULL);
+  printf("  rings: packing %.3f, one run per row holds <= %.3f, the nest alone %.3f\n",
+         r.efficiency, run_bound, nest);
+  CHECK_MSG(st.n_charts == (size_t)n, "rings: %zu charts", st.n_charts);
+  CHECK_MSG(r.efficiency > run_bound, "rings: packing %g, one run per row holds <= %g",
+            r.efficiency, run_bound);
+  CHECK_MSG(r.efficiency >= 0.9 * nest, "rings: packing %g, the nest gives %g", r.efficiency, nest);
+  hearth_mesh_free(&m);
+}
+
 /* the atlas of a fused mesh, written as GLB, validated and read back */
 static void atlas_glb(const char *name, const hearth_mesh *m, const char *path) {
   hearth_err e = {0};
@@ -626,6 +729,7 @@ int main(int argc, char **argv) {
   }
   test_closed_forms();
   test_tiles();
+  test_rings();
   test_release();
   return g_test_failures;
 }
