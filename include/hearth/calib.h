@@ -86,6 +86,16 @@ typedef struct hearth_calib_opts {
    * (first order in each point's row time) is solved with its pose and kept
    * when it explains more than noise would; default 1 */
   int rolling_shutter;
+  /* hearth_calib_stereo_joint: camera b's intrinsics and distortion are
+   * refined with the extrinsic, from the pairs (whose plate poses camera a
+   * fixes) and camera b's own frames; default 1 (0: camera b's intrinsics
+   * held fixed, the paper's stereo) */
+  int stereo_intrinsics;
+  /* with stereo_intrinsics: the target's holes are taken as drilled where
+   * the data put them, each hole's in-plane offset from the nominal lattice
+   * estimated in turn with the rest (the offsets' affine part held at zero:
+   * the gauge); default 0 */
+  int target_points;
 } hearth_calib_opts;
 void hearth_calib_opts_default(hearth_calib_opts *o);
 
@@ -124,6 +134,20 @@ hearth_status hearth_calib_stereo(const hearth_camera *cam_a, const hearth_camer
                                   const double *img_b, size_t n_pairs, const hearth_calib_opts *o,
                                   hearth_rigid *T_b_from_a, double *rms_px, double *pair_rms,
                                   int *pair_used, hearth_err *err);
+
+/* hearth_calib_stereo, then (o->stereo_intrinsics) camera b's fx fy cx cy
+ * and k1 k2 p1 p2 k3 refined jointly with T_b_from_a, every used pair's
+ * plate pose (and velocity) and the pose of each of camera b's own frames
+ * img_c (n_c frames of n_pts points, as img_b; the frames its intrinsics
+ * were calibrated from, or none): cam_b is updated. own_rms_px (may be
+ * NULL): the RMS over img_c at the end (NAN without the refinement). */
+hearth_status hearth_calib_stereo_joint(const hearth_camera *cam_a, hearth_camera *cam_b,
+                                        const double (*obj)[3], size_t n_pts, const double *img_a,
+                                        const double *img_b, size_t n_pairs, const double *img_c,
+                                        size_t n_c, const hearth_calib_opts *o,
+                                        hearth_rigid *T_b_from_a, double *rms_px,
+                                        double *own_rms_px, double *pair_rms, int *pair_used,
+                                        hearth_err *err);
 
 /* ---- release stages ----------------------------------------------------------- */
 /* Detect the target of <root>/calibration/target.json (absent: the paper's

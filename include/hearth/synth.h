@@ -64,6 +64,10 @@ typedef struct hearth_synth_effects {
                                fall by U(-1, 1) of it (a saddle, m); default 0 */
   double hole_burr_m;       /* irregularity of each hole's rim (burrs, drill wander): 1 sigma
                                of the first three Fourier terms of its radius (m); default 0 */
+  double hole_position_m;   /* each hole's drilled position off its nominal one in the plate
+                               plane: 1 sigma per axis (m), cut at 3 sigma, one draw per hole
+                               and seed; the pipeline is given the nominal lattice; default
+                               0 (off) */
   double lens_residual_px;  /* the thermal lens's departure from its 5-parameter model in the
                                calibration captures: rms per axis (px) of a smooth field of
                                2.5..6 cycles across the image; default 0 */

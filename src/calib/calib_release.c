@@ -662,6 +662,7 @@ hearth_status hearth_calib_calibrate_release(const char *root, const hearth_cali
   double *img_t = hearth_alloc_array(n * NH * 2, sizeof(double));
   double *img_a = hearth_alloc_array(n * NH * 2, sizeof(double));
   double *img_b = hearth_alloc_array(n * NH * 2, sizeof(double));
+  double *img_c = hearth_alloc_array(n * NH * 2, sizeof(double));
   double *frms = hearth_alloc_array(n + 1, sizeof(double));
   double *tmp = hearth_alloc_array(n + 1, sizeof(double));
   int *used = hearth_calloc_array(n + 1, sizeof(int));
@@ -670,8 +671,8 @@ hearth_status hearth_calib_calibrate_release(const char *root, const hearth_cali
   hearth_rigid *poses = hearth_alloc_array(n + 1, sizeof(hearth_rigid));
   rep->thermal = hearth_calloc_array(n + 1, sizeof(hearth_calib_frame_report));
   rep->pairs = hearth_calloc_array(n + 1, sizeof(hearth_calib_frame_report));
-  if (!obj || !bias || !raw || !img_t || !img_a || !img_b || !frms || !tmp || !used || !tidx ||
-      !pidx || !poses || !rep->thermal || !rep->pairs) {
+  if (!obj || !bias || !raw || !img_t || !img_a || !img_b || !img_c || !frms || !tmp || !used ||
+      !tidx || !pidx || !poses || !rep->thermal || !rep->pairs) {
     st = hearth_err_set(err, HEARTH_E_NOMEM, "calibrate: out of memory");
     goto done;
   }
@@ -780,6 +781,14 @@ hearth_status hearth_calib_calibrate_release(const char *root, const hearth_cali
     for (size_t i = 0, k = 0; i < nt; i++)
       if (used[i]) frms[i] = tmp[k++];
   }
+  /* the used thermal frames as the intrinsics were solved from them */
+  size_t nc = 0;
+  for (size_t i = 0; i < nt; i++) {
+    if (!used[i]) continue;
+    /* with the perspective correction img_b holds them packed and corrected */
+    const double *src = o->perspective_correction ? img_b + 2 * NH * nc : img_t + 2 * NH * i;
+    memcpy(img_c + 2 * NH * nc++, src, sizeof(double) * 2 * NH);
+  }
   for (size_t i = 0; i < nt; i++) {
     hearth_calib_frame_report *fr = &rep->thermal[tidx[i]];
     fr->rms_px = frms[i];
@@ -836,8 +845,9 @@ hearth_status hearth_calib_calibrate_release(const char *root, const hearth_cali
   }
   hearth_rigid Tth;
   double srms;
-  if ((st = hearth_calib_stereo(&fc.rgb, &th, (const double(*)[3])obj, NH, img_a, img_b, npair, o,
-                                &Tth, &srms, frms, used, err))) {
+  double crms = NAN;
+  if ((st = hearth_calib_stereo_joint(&fc.rgb, &th, (const double(*)[3])obj, NH, img_a, img_b,
+                                      npair, img_c, nc, o, &Tth, &srms, &crms, frms, used, err))) {
     hearth_err_prefix(err, "%s", pdet);
     goto done;
   }
@@ -853,7 +863,7 @@ hearth_status hearth_calib_calibrate_release(const char *root, const hearth_cali
   rig->T_depth_from_rgb = fc.T_depth_from_rgb;
   rig->thermal = th;
   rig->T_thermal_from_rgb = Tth;
-  rig->thermal_rms_px = trms;
+  rig->thermal_rms_px = isfinite(crms) ? crms : trms;
   rig->stereo_rms_px = srms;
   rep->t_calib_s = hearth_now() - t0;
   /* outputs: the extras first, rig.json (what later stages read) last */
@@ -871,6 +881,7 @@ done:
   free(img_t);
   free(img_a);
   free(img_b);
+  free(img_c);
   free(frms);
   free(tmp);
   free(used);

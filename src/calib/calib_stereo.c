@@ -1,19 +1,27 @@
-/* Stereo calibration with both intrinsics fixed: the rigid T_b_from_a and
- * the plate pose of every pair in camera a, refined jointly by
- * Levenberg-Marquardt over the reprojection errors in both cameras (Schur
- * complement on the per-pair blocks), with outlier pairs dropped. With
- * opts->rolling_shutter, camera a may read its rows in turn while the plate
- * moves: each pair then also has a plate velocity in camera a (a twist per
- * frame readout, first order in the row's time), kept only when it explains
- * more than 6 free parameters per pair would fit of noise. */
+/* Stereo calibration: the rigid T_b_from_a and the plate pose of every pair
+ * in camera a, refined jointly by Levenberg-Marquardt over the reprojection
+ * errors in both cameras (Schur complement on the per-pair blocks), with
+ * outlier pairs dropped. With opts->rolling_shutter, camera a may read its
+ * rows in turn while the plate moves: each pair then also has a plate
+ * velocity in camera a (a twist per frame readout, first order in the row's
+ * time) and the time camera b saw it (the trigger offset, under a weak
+ * prior), kept only when they explain more than 7 free parameters per pair
+ * would fit of noise. hearth_calib_stereo_joint then refines camera b's
+ * intrinsics with the rest, from the pairs and camera b's own frames, and
+ * optionally the target's hole positions. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include "calib/calib_internal.h"
 
 /* the largest per-pair block: pose (rotation vector, translation), then the
- * plate's velocity in camera a (angular, linear; per frame readout) */
-#define NQ_MAX 12
+ * plate's velocity in camera a (angular, linear; per frame readout), then
+ * the time camera b saw the plate (frames of camera a's readout from its
+ * middle row: the two cameras' trigger offset) */
+#define NQ_MAX 13
+/* the trigger offset's prior: zero, 1 sigma this many frames (weak: the
+ * data fix it where the plate moves, the prior where it does not) */
+#define TB_SIGMA 1.0
 
 typedef struct stereo_prob {
   const hearth_camera *ca, *cb;
@@ -21,7 +29,7 @@ typedef struct stereo_prob {
   size_t n_pts, n_pairs;
   const double *img_a, *img_b;
   const int *used;
-  int nq; /* parameters per pair: 6 (rigid pose) or 12 (pose and velocity) */
+  int nq; /* parameters per pair: 6 (rigid pose) or 13 (pose, velocity, trigger time) */
 } stereo_prob;
 
 /* when camera a reads pixel row v, in frames from its middle row */
@@ -38,28 +46,82 @@ static void rs_move(const double q[6], double s, const double Xa[3], double out[
   out[2] = Xa[2] + s * (w[0] * Xa[1] - w[1] * Xa[0] + u[2]);
 }
 
-/* squared error of pair i (both cameras); INFINITY if behind a camera */
+/* plate point X of pair block p (nq parameters, rotation R and its
+ * derivatives dR from p) in camera a's frame at time s (camera b: s = its
+ * trigger time p[12], with_s: that column filled), and its 3 x nq
+ * Jacobian dX (row-major) when dX is non-NULL */
+static void block_point(const double *p, int nq, const double R[9], const double dR[27], double s,
+                        int with_s, const double X[3], double Xm[3], double *dX) {
+  double Xa[3];
+  for (int k = 0; k < 3; k++)
+    Xa[k] = R[3 * k] * X[0] + R[3 * k + 1] * X[1] + R[3 * k + 2] * X[2] + p[3 + k];
+  if (nq == 6) {
+    memcpy(Xm, Xa, sizeof Xa);
+  } else {
+    rs_move(p + 6, s, Xa, Xm);
+  }
+  if (!dX) return;
+  memset(dX, 0, sizeof(double) * 3 * (size_t)nq);
+  /* d Xa / d pose = [dR X | I] */
+  double G[3][6];
+  for (int k = 0; k < 3; k++) {
+    const double *D = dR + 9 * k;
+    for (int c = 0; c < 3; c++) {
+      G[c][k] = D[3 * c] * X[0] + D[3 * c + 1] * X[1] + D[3 * c + 2] * X[2];
+      G[c][3 + k] = c == k;
+    }
+  }
+  if (nq == 6) {
+    for (int c = 0; c < 3; c++) memcpy(dX + 6 * c, G[c], sizeof G[c]);
+    return;
+  }
+  const double *w = p + 6;
+  /* d Xm / d Xa = I + s [w]x */
+  const double A[9] = {1, -s * w[2], s * w[1], s * w[2], 1, -s * w[0], -s * w[1], s * w[0], 1};
+  for (int c = 0; c < 3; c++) {
+    double *row = dX + nq * c;
+    for (int k = 0; k < 6; k++)
+      row[k] = A[3 * c] * G[0][k] + A[3 * c + 1] * G[1][k] + A[3 * c + 2] * G[2][k];
+  }
+  /* d Xm / d w = -s [Xa]x, d Xm / d u = s I */
+  const double B[9] = {0,         s * Xa[2], -s * Xa[1], -s * Xa[2], 0,
+                       s * Xa[0], s * Xa[1], -s * Xa[0], 0};
+  for (int c = 0; c < 3; c++)
+    for (int k = 0; k < 3; k++) {
+      dX[nq * c + 6 + k] = B[3 * c + k];
+      dX[nq * c + 9 + k] = c == k ? s : 0.0;
+    }
+  if (with_s && nq > 12) {
+    /* d Xm / d s = w x Xa + u */
+    const double *u = p + 9;
+    dX[nq * 0 + 12] = w[1] * Xa[2] - w[2] * Xa[1] + u[0];
+    dX[nq * 1 + 12] = w[2] * Xa[0] - w[0] * Xa[2] + u[1];
+    dX[nq * 2 + 12] = w[0] * Xa[1] - w[1] * Xa[0] + u[2];
+  }
+}
+
+/* camera b's time of pair block p */
+static double tb_time(const double *p, int nq) { return nq > 12 ? p[12] : 0.0; }
+
+/* squared error of pair i (both cameras, and the trigger prior); INFINITY
+ * if behind a camera */
 static double pair_cost(const stereo_prob *P, size_t i, const hearth_rigid *Tba, const double *p) {
-  hearth_rigid Ta;
-  calib_rigid_from_params(p, &Ta);
+  double R[9];
+  hearth_rotvec_to_matrix(p, R);
   double s = 0;
   for (size_t j = 0; j < P->n_pts; j++) {
-    double Xa[3], Xb[3], uv[2];
-    hearth_rigid_apply(&Ta, P->obj[j], Xa);
+    double Xm[3], Xb[3], uv[2];
     const double *m = P->img_a + 2 * (i * P->n_pts + j);
-    if (P->nq > 6) {
-      double Xm[3];
-      rs_move(p + 6, row_time(P->ca, m[1]), Xa, Xm);
-      if (!hearth_camera_project(P->ca, Xm, uv, NULL)) return INFINITY;
-    } else if (!hearth_camera_project(P->ca, Xa, uv, NULL)) {
-      return INFINITY;
-    }
+    block_point(p, P->nq, R, NULL, row_time(P->ca, m[1]), 0, P->obj[j], Xm, NULL);
+    if (!hearth_camera_project(P->ca, Xm, uv, NULL)) return INFINITY;
     s += (uv[0] - m[0]) * (uv[0] - m[0]) + (uv[1] - m[1]) * (uv[1] - m[1]);
-    hearth_rigid_apply(Tba, Xa, Xb);
+    block_point(p, P->nq, R, NULL, tb_time(p, P->nq), 0, P->obj[j], Xm, NULL);
+    hearth_rigid_apply(Tba, Xm, Xb);
     if (!hearth_camera_project(P->cb, Xb, uv, NULL)) return INFINITY;
     m = P->img_b + 2 * (i * P->n_pts + j);
     s += (uv[0] - m[0]) * (uv[0] - m[0]) + (uv[1] - m[1]) * (uv[1] - m[1]);
   }
+  if (P->nq > 12) s += (p[12] / TB_SIGMA) * (p[12] / TB_SIGMA);
   return s;
 }
 
@@ -76,37 +138,37 @@ static double total_cost(const stereo_prob *P, const double pT[6], const double 
   return s;
 }
 
-/* camera a's residual and its 2 x 12 Jacobian (pose, then velocity) with
- * the velocity q; returns 0 if behind the camera */
-static int project_moving(const hearth_camera *ca, const double R[9], const double dR[27],
-                          const double t[3], const double q[6], double s, const double X[3],
-                          double uv[2], double dp[24]) {
-  double Xa[3], Xm[3];
-  for (int k = 0; k < 3; k++)
-    Xa[k] = R[3 * k] * X[0] + R[3 * k + 1] * X[1] + R[3 * k + 2] * X[2] + t[k];
-  rs_move(q, s, Xa, Xm);
+/* one pair's residual rows: camera a's (ra, 2 x nq block Jacobian ja)
+ * and camera b's (rb, block Jacobian jb, extrinsic Jacobian jT 2 x 6 and
+ * the projection's jac for camera b's intrinsics); returns 0 if behind a
+ * camera */
+static int pair_rows(const stereo_prob *P, const hearth_camera *cb, const double RT[9],
+                     const double dRT[27], const double tT[3], const double *p, const double R[9],
+                     const double dR[27], size_t i, size_t j, double ra[2], double *ja,
+                     double rb[2], double *jb, double jT[12], hearth_project_jac *jacb) {
+  const int D = P->nq;
+  const double *X = P->obj[j];
+  double Xm[3], dX[3 * NQ_MAX], uv[2];
   hearth_project_jac jac;
-  if (!hearth_camera_project(ca, Xm, uv, &jac)) return 0;
-  const double *J = jac.d_point, *w = q;
-  /* d Xm / d Xa = I + s [w]x */
-  const double A[9] = {1, -s * w[2], s * w[1], s * w[2], 1, -s * w[0], -s * w[1], s * w[0], 1};
-  /* d Xm / d w = -s [Xa]x */
-  const double B[9] = {0,         s * Xa[2], -s * Xa[1], -s * Xa[2], 0,
-                       s * Xa[0], s * Xa[1], -s * Xa[0], 0};
+  const double *m = P->img_a + 2 * (i * P->n_pts + j);
+  block_point(p, D, R, dR, row_time(P->ca, m[1]), 0, X, Xm, dX);
+  if (!hearth_camera_project(P->ca, Xm, uv, &jac)) return 0;
   for (int row = 0; row < 2; row++) {
-    const double *Jr = J + 3 * row;
-    double JA[3], *d = dp + 12 * row;
-    for (int k = 0; k < 3; k++) JA[k] = Jr[0] * A[k] + Jr[1] * A[3 + k] + Jr[2] * A[6 + k];
-    for (int k = 0; k < 3; k++) {
-      const double *D = dR + 9 * k;
-      double gk[3];
-      for (int c = 0; c < 3; c++)
-        gk[c] = D[3 * c] * X[0] + D[3 * c + 1] * X[1] + D[3 * c + 2] * X[2];
-      d[k] = JA[0] * gk[0] + JA[1] * gk[1] + JA[2] * gk[2];
-      d[3 + k] = JA[k];
-      d[6 + k] = Jr[0] * B[k] + Jr[1] * B[3 + k] + Jr[2] * B[6 + k];
-      d[9 + k] = s * Jr[k];
-    }
+    const double *J = jac.d_point + 3 * row;
+    ra[row] = uv[row] - m[row];
+    for (int k = 0; k < D; k++)
+      ja[D * row + k] = J[0] * dX[k] + J[1] * dX[D + k] + J[2] * dX[2 * D + k];
+  }
+  block_point(p, D, R, dR, tb_time(p, D), 1, X, Xm, dX);
+  if (!calib_project_pose(cb, RT, dRT, tT, Xm, uv, jacb, jT, NULL)) return 0;
+  m = P->img_b + 2 * (i * P->n_pts + j);
+  for (int row = 0; row < 2; row++) {
+    const double *J = jacb->d_point + 3 * row;
+    double JR[3];
+    for (int k = 0; k < 3; k++) JR[k] = J[0] * RT[k] + J[1] * RT[3 + k] + J[2] * RT[6 + k];
+    rb[row] = uv[row] - m[row];
+    for (int k = 0; k < D; k++)
+      jb[D * row + k] = JR[0] * dX[k] + JR[1] * dX[D + k] + JR[2] * dX[2 * D + k];
   }
   return 1;
 }
@@ -130,56 +192,26 @@ static int stereo_normal(const stereo_prob *P, const double pT[6], const double 
     double R[9], dR[27];
     hearth_rotvec_to_matrix_jac(p, R, dR);
     for (size_t j = 0; j < P->n_pts; j++) {
-      const double *X = P->obj[j];
-      double uv[2], dp[24], Xa[3];
+      double ra[2], rb[2], ja[2 * NQ_MAX], jb[2 * NQ_MAX], jT[12];
       hearth_project_jac jac;
-      const double *m = P->img_a + 2 * (i * P->n_pts + j);
-      /* camera a: depends on the pair's own parameters only */
-      if (D > 6) {
-        if (!project_moving(P->ca, R, dR, p + 3, p + 6, row_time(P->ca, m[1]), X, uv, dp)) return 0;
-        for (int k = 0; k < 3; k++)
-          Xa[k] = R[3 * k] * X[0] + R[3 * k + 1] * X[1] + R[3 * k + 2] * X[2] + p[3 + k];
-      } else if (!calib_project_pose(P->ca, R, dR, p + 3, X, uv, &jac, dp, Xa)) {
-        return 0;
-      }
-      double r[2] = {uv[0] - m[0], uv[1] - m[1]};
-      for (int row = 0; row < 2; row++)
+      if (!pair_rows(P, P->cb, RT, dRT, pT + 3, p, R, dR, i, j, ra, ja, rb, jb, jT, &jac)) return 0;
+      for (int row = 0; row < 2; row++) {
+        const double *a_ = ja + D * row, *b_ = jb + D * row, *t_ = jT + 6 * row;
         for (int a = 0; a < D; a++) {
-          for (int b = 0; b < D; b++) Vi[a * D + b] += dp[D * row + a] * dp[D * row + b];
-          g[a] -= dp[D * row + a] * r[row];
+          for (int b = 0; b < D; b++) Vi[a * D + b] += a_[a] * a_[b] + b_[a] * b_[b];
+          g[a] -= a_[a] * ra[row] + b_[a] * rb[row];
         }
-      /* camera b: Xb = RT Xa + tT (the pose's time) */
-      double jT[12], jp[12];
-      if (!calib_project_pose(P->cb, RT, dRT, pT + 3, Xa, uv, &jac, jT, NULL)) return 0;
-      m = P->img_b + 2 * (i * P->n_pts + j);
-      r[0] = uv[0] - m[0];
-      r[1] = uv[1] - m[1];
-      /* d uv_b / d pose = J_b RT [dR X | I] */
-      double JR[6];
-      for (int row = 0; row < 2; row++)
-        for (int k = 0; k < 3; k++)
-          JR[3 * row + k] = jac.d_point[3 * row] * RT[k] + jac.d_point[3 * row + 1] * RT[3 + k] +
-                            jac.d_point[3 * row + 2] * RT[6 + k];
-      for (int k = 0; k < 3; k++) {
-        const double *Dk = dR + 9 * k;
-        double gk[3];
-        for (int q = 0; q < 3; q++)
-          gk[q] = Dk[3 * q] * X[0] + Dk[3 * q + 1] * X[1] + Dk[3 * q + 2] * X[2];
-        for (int row = 0; row < 2; row++) {
-          jp[6 * row + k] = JR[3 * row] * gk[0] + JR[3 * row + 1] * gk[1] + JR[3 * row + 2] * gk[2];
-          jp[6 * row + 3 + k] = JR[3 * row + k];
+        for (int a = 0; a < 6; a++) {
+          for (int b = 0; b < 6; b++) U[a * 6 + b] += t_[a] * t_[b];
+          for (int b = 0; b < D; b++) Wi[a * D + b] += t_[a] * b_[b];
+          gT[a] -= t_[a] * rb[row];
         }
       }
-      for (int row = 0; row < 2; row++)
-        for (int a = 0; a < 6; a++) {
-          for (int b = 0; b < 6; b++) {
-            U[a * 6 + b] += jT[6 * row + a] * jT[6 * row + b];
-            Vi[a * D + b] += jp[6 * row + a] * jp[6 * row + b];
-            Wi[a * D + b] += jT[6 * row + a] * jp[6 * row + b];
-          }
-          gT[a] -= jT[6 * row + a] * r[row];
-          g[a] -= jp[6 * row + a] * r[row];
-        }
+    }
+    if (D > 12) {
+      /* the trigger prior */
+      Vi[12 * D + 12] += 1.0 / (TB_SIGMA * TB_SIGMA);
+      g[12] -= p[12] / (TB_SIGMA * TB_SIGMA);
     }
   }
   return 1;
@@ -304,11 +336,12 @@ static int stereo_rounds(stereo_prob *P, int *used, double pT[6], double *poses,
 }
 
 /* the rolling-shutter model of camera a, tried from the rigid solution
- * (pT, poses, used): kept when the velocities lower the cost by more than
- * twice what 6 parameters per pair would take off pure noise (the expected
- * drop is 6 sigma^2 per pair); then solved again, with the outlier rule,
- * from every pair with a pose start (with_pose). On success pT, poses
- * (12 per pair) and used hold that solution and *moving is 1. */
+ * (pT, poses, used): kept when the velocities and trigger times lower the
+ * cost by more than twice what 7 parameters per pair would take off pure
+ * noise (the expected drop is 7 sigma^2 per pair); then solved again, with
+ * the outlier rule, from every pair with a pose start (with_pose). On
+ * success pT, poses (13 per pair) and used hold that solution and *moving
+ * is 1. */
 static int stereo_try_moving(const stereo_prob *P0, const int *with_pose, int *used, double pT[6],
                              const double *poses, double *poses_m, const hearth_calib_opts *o,
                              double *scratch, double *tmp, double *pc, int *moving) {
@@ -325,8 +358,8 @@ static int stereo_try_moving(const stereo_prob *P0, const int *with_pose, int *u
   memcpy(qT, pT, sizeof qT);
   if (!stereo_lm(&Q, qT, poses_m, o->max_iterations, scratch)) return 1;
   double c1 = total_cost(&Q, qT, poses_m, NULL);
-  double dof = 4.0 * (double)(m * P0->n_pts) - 6.0 - 12.0 * (double)m;
-  if (!(dof > 0 && isfinite(c1)) || c0 - c1 <= 2.0 * 6.0 * (double)m * c1 / dof) return 1;
+  double dof = 4.0 * (double)(m * P0->n_pts) - 6.0 - 13.0 * (double)m;
+  if (!(dof > 0 && isfinite(c1)) || c0 - c1 <= 2.0 * 7.0 * (double)m * c1 / dof) return 1;
   /* kept: every pair with a pose start again, under the moving model */
   int *cand = hearth_alloc_array(n, sizeof(int));
   if (!cand) return 0;
@@ -343,22 +376,18 @@ static int stereo_try_moving(const stereo_prob *P0, const int *with_pose, int *u
   return 1;
 }
 
-hearth_status hearth_calib_stereo(const hearth_camera *cam_a, const hearth_camera *cam_b,
-                                  const double (*obj)[3], size_t n_pts, const double *img_a,
-                                  const double *img_b, size_t n_pairs, const hearth_calib_opts *o,
-                                  hearth_rigid *T_b_from_a, double *rms_px, double *pair_rms,
-                                  int *pair_used, hearth_err *err) {
+/* the stereo solve: outputs pT (T_b_from_a), the pair blocks of the
+ * chosen model in *sol (stride *nq, malloc'ed, the caller frees) and used */
+static hearth_status stereo_core(const hearth_camera *cam_a, const hearth_camera *cam_b,
+                                 const double (*obj)[3], size_t n_pts, const double *img_a,
+                                 const double *img_b, size_t n_pairs, const hearth_calib_opts *o,
+                                 double pT_out[6], double **sol_out, int *nq_out, int *used_out,
+                                 hearth_err *err) {
   hearth_calib_opts def;
   if (!o) {
     hearth_calib_opts_default(&def);
     o = &def;
   }
-  if (!cam_a || !cam_b || !obj || !img_a || !img_b || !T_b_from_a)
-    return hearth_err_set(err, HEARTH_E_ARG, "stereo calibration: missing argument");
-  if (n_pairs < 1)
-    return hearth_err_set(err, HEARTH_E_SIZE, "stereo calibration: no usable stereo pairs");
-  if (n_pts < 4 || n_pts > 100000 || n_pairs > 100000)
-    return hearth_err_set(err, HEARTH_E_SIZE, "stereo calibration: %zu points per pair", n_pts);
   hearth_status st = HEARTH_OK;
   double *poses = hearth_calloc_array(6 * n_pairs, sizeof(double));
   double *poses_m = hearth_calloc_array(NQ_MAX * n_pairs, sizeof(double));
@@ -410,26 +439,17 @@ hearth_status hearth_calib_stereo(const hearth_camera *cam_a, const hearth_camer
     st = hearth_err_set(err, HEARTH_E_NOMEM, "stereo calibration: out of memory");
     goto done;
   }
-  const double *sol = poses;
+  /* hand over the chosen model's blocks */
+  *nq_out = moving ? NQ_MAX : 6;
   if (moving) {
-    P.nq = NQ_MAX;
-    sol = poses_m;
+    *sol_out = poses_m;
+    poses_m = NULL;
+  } else {
+    *sol_out = poses;
+    poses = NULL;
   }
-  calib_rigid_from_params(pT, T_b_from_a);
-  total_cost(&P, pT, sol, pc);
-  double sum = 0;
-  size_t m = 0;
-  for (size_t i = 0; i < n_pairs; i++) {
-    /* a pair without a pose start has no meaningful residual */
-    double r = isfinite(pc[i]) ? sqrt(pc[i] / (2.0 * (double)n_pts)) : NAN;
-    if (pair_rms) pair_rms[i] = r;
-    if (pair_used) pair_used[i] = used[i];
-    if (used[i]) {
-      sum += pc[i];
-      m++;
-    }
-  }
-  if (rms_px) *rms_px = sqrt(sum / (2.0 * (double)(m * n_pts)));
+  memcpy(pT_out, pT, sizeof pT);
+  memcpy(used_out, used, sizeof(int) * n_pairs);
 done:
   free(poses);
   free(poses_m);
@@ -439,5 +459,501 @@ done:
   free(pc);
   free(used);
   free(with_pose);
+  return st;
+}
+
+/* the stereo RMS and per-pair outputs of a solution */
+static void stereo_report(const stereo_prob *P, const double pT[6], const double *sol, double *pc,
+                          double *rms_px, double *pair_rms, int *pair_used) {
+  total_cost(P, pT, sol, pc);
+  double sum = 0;
+  size_t m = 0;
+  for (size_t i = 0; i < P->n_pairs; i++) {
+    /* a pair without a pose start has no meaningful residual */
+    double r = isfinite(pc[i]) ? sqrt(pc[i] / (2.0 * (double)P->n_pts)) : NAN;
+    if (pair_rms) pair_rms[i] = r;
+    if (pair_used) pair_used[i] = P->used[i];
+    if (P->used[i]) {
+      sum += pc[i];
+      m++;
+    }
+  }
+  if (rms_px) *rms_px = sqrt(sum / (2.0 * (double)(m * P->n_pts)));
+}
+
+hearth_status hearth_calib_stereo(const hearth_camera *cam_a, const hearth_camera *cam_b,
+                                  const double (*obj)[3], size_t n_pts, const double *img_a,
+                                  const double *img_b, size_t n_pairs, const hearth_calib_opts *o,
+                                  hearth_rigid *T_b_from_a, double *rms_px, double *pair_rms,
+                                  int *pair_used, hearth_err *err) {
+  if (!cam_a || !cam_b || !obj || !img_a || !img_b || !T_b_from_a)
+    return hearth_err_set(err, HEARTH_E_ARG, "stereo calibration: missing argument");
+  if (n_pairs < 1)
+    return hearth_err_set(err, HEARTH_E_SIZE, "stereo calibration: no usable stereo pairs");
+  if (n_pts < 4 || n_pts > 100000 || n_pairs > 100000)
+    return hearth_err_set(err, HEARTH_E_SIZE, "stereo calibration: %zu points per pair", n_pts);
+  int *used = hearth_calloc_array(n_pairs, sizeof(int));
+  double *pc = hearth_alloc_array(n_pairs, sizeof(double));
+  double *sol = NULL, pT[6];
+  int nq = 6;
+  hearth_status st = HEARTH_OK;
+  if (!used || !pc) st = hearth_err_set(err, HEARTH_E_NOMEM, "stereo calibration: out of memory");
+  else
+    st = stereo_core(cam_a, cam_b, obj, n_pts, img_a, img_b, n_pairs, o, pT, &sol, &nq, used, err);
+  if (!st) {
+    stereo_prob P = {cam_a, cam_b, obj, n_pts, n_pairs, img_a, img_b, used, nq};
+    calib_rigid_from_params(pT, T_b_from_a);
+    stereo_report(&P, pT, sol, pc, rms_px, pair_rms, pair_used);
+  }
+  free(sol);
+  free(used);
+  free(pc);
+  return st;
+}
+
+/* ---- stereo with camera b's intrinsics refined ---------------------------- */
+/* The extrinsic, camera b's fx fy cx cy k1 k2 p1 p2 k3 (the global block,
+ * JG parameters) and the blocks of the pairs (stride nq, from the stereo
+ * solve) and of camera b's own frames (a pose each, stride 6, after the
+ * pairs), solved together through the Schur complement of the blocks. */
+#define NB_INTR 9
+#define JG (6 + NB_INTR)
+
+typedef struct joint_prob {
+  stereo_prob P;            /* the pairs; P.cb is replaced by the trial camera */
+  const hearth_camera *cb0; /* camera b's size, model and k4..k6 */
+  const double *img_c;      /* camera b's own frames */
+  size_t n_c;
+} joint_prob;
+
+static void joint_cam(const joint_prob *J, const double *g, hearth_camera *c) {
+  *c = *J->cb0;
+  c->fx = g[6];
+  c->fy = g[7];
+  c->cx = g[8];
+  c->cy = g[9];
+  for (int k = 0; k < 5; k++) c->dist[k] = g[10 + k];
+}
+
+/* squared error of camera b's own frame k at pose p */
+static double own_cost(const joint_prob *J, const hearth_camera *cb, size_t k, const double *p) {
+  hearth_rigid T;
+  calib_rigid_from_params(p, &T);
+  double s = 0;
+  for (size_t j = 0; j < J->P.n_pts; j++) {
+    double X[3], uv[2];
+    hearth_rigid_apply(&T, J->P.obj[j], X);
+    if (!hearth_camera_project(cb, X, uv, NULL)) return INFINITY;
+    const double *m = J->img_c + 2 * (k * J->P.n_pts + j);
+    s += (uv[0] - m[0]) * (uv[0] - m[0]) + (uv[1] - m[1]) * (uv[1] - m[1]);
+  }
+  return s;
+}
+
+static double joint_cost(const joint_prob *J, const double *g, const double *x) {
+  hearth_camera cb;
+  joint_cam(J, g, &cb);
+  stereo_prob P = J->P;
+  P.cb = &cb;
+  double s = total_cost(&P, g, x, NULL);
+  const double *xc = x + (size_t)P.nq * P.n_pairs;
+  for (size_t k = 0; k < J->n_c && isfinite(s); k++) s += own_cost(J, &cb, k, xc + 6 * k);
+  return isfinite(s) ? s : INFINITY;
+}
+
+/* one residual row: global Jacobian jg (JG, or NULL: none), block Jacobian
+ * jb (d) and residual r into U, gg and the block's V, W, gb */
+static void joint_row(int d, const double *jg, const double *jb, double r, double *U, double *gg,
+                      double *V, double *W, double *gb) {
+  for (int a = 0; a < d; a++) {
+    for (int b = 0; b < d; b++) V[a * d + b] += jb[a] * jb[b];
+    gb[a] -= jb[a] * r;
+  }
+  if (!jg) return;
+  for (int a = 0; a < JG; a++) {
+    if (jg[a] == 0) continue;
+    for (int b = 0; b < JG; b++) U[a * JG + b] += jg[a] * jg[b];
+    for (int b = 0; b < d; b++) W[a * d + b] += jg[a] * jb[b];
+    gg[a] -= jg[a] * r;
+  }
+}
+
+/* camera b's projection with intrinsic rows ji (2 x NB_INTR) */
+static void intr_rows(const hearth_project_jac *jac, double ji[2][NB_INTR]) {
+  for (int row = 0; row < 2; row++) {
+    for (int k = 0; k < 4; k++) ji[row][k] = jac->d_intr[4 * row + k];
+    for (int k = 0; k < 5; k++) ji[row][4 + k] = jac->d_dist[5 * row + k];
+  }
+}
+
+/* normal equations of the joint problem at (g, x); block b's V at
+ * V + NQ_MAX^2 b, W (JG x d) at W + JG NQ_MAX b, gradient at gb + NQ_MAX b */
+static int joint_normal(const joint_prob *J, const double *g, const double *x, double *U,
+                        double *gg, double *V, double *W, double *gb) {
+  const stereo_prob *P = &J->P;
+  const int D = P->nq;
+  hearth_camera cb;
+  joint_cam(J, g, &cb);
+  double RT[9], dRT[27];
+  hearth_rotvec_to_matrix_jac(g, RT, dRT);
+  memset(U, 0, sizeof(double) * JG * JG);
+  memset(gg, 0, sizeof(double) * JG);
+  size_t nb = P->n_pairs + J->n_c;
+  memset(V, 0, sizeof(double) * NQ_MAX * NQ_MAX * nb);
+  memset(W, 0, sizeof(double) * JG * NQ_MAX * nb);
+  memset(gb, 0, sizeof(double) * NQ_MAX * nb);
+  for (size_t i = 0; i < P->n_pairs; i++) {
+    if (!P->used[i]) continue;
+    const double *p = x + D * i;
+    double *Vi = V + NQ_MAX * NQ_MAX * i, *Wi = W + JG * NQ_MAX * i, *g6 = gb + NQ_MAX * i;
+    double R[9], dR[27];
+    hearth_rotvec_to_matrix_jac(p, R, dR);
+    for (size_t j = 0; j < P->n_pts; j++) {
+      double ra[2], rb[2], ja[2 * NQ_MAX], jb[2 * NQ_MAX], jT[12], ji[2][NB_INTR], jgr[JG];
+      hearth_project_jac jac;
+      if (!pair_rows(P, &cb, RT, dRT, g + 3, p, R, dR, i, j, ra, ja, rb, jb, jT, &jac)) return 0;
+      intr_rows(&jac, ji);
+      for (int row = 0; row < 2; row++) {
+        joint_row(D, NULL, ja + D * row, ra[row], U, gg, Vi, Wi, g6);
+        memcpy(jgr, jT + 6 * row, sizeof(double) * 6);
+        memcpy(jgr + 6, ji[row], sizeof(double) * NB_INTR);
+        joint_row(D, jgr, jb + D * row, rb[row], U, gg, Vi, Wi, g6);
+      }
+    }
+    if (D > 12) {
+      Vi[12 * D + 12] += 1.0 / (TB_SIGMA * TB_SIGMA);
+      g6[12] -= p[12] / (TB_SIGMA * TB_SIGMA);
+    }
+  }
+  const double *xc = x + (size_t)D * P->n_pairs;
+  for (size_t k = 0; k < J->n_c; k++) {
+    size_t b = P->n_pairs + k;
+    const double *p = xc + 6 * k;
+    double *Vb = V + NQ_MAX * NQ_MAX * b, *Wb = W + JG * NQ_MAX * b, *g6 = gb + NQ_MAX * b;
+    double R[9], dR[27];
+    hearth_rotvec_to_matrix_jac(p, R, dR);
+    for (size_t j = 0; j < P->n_pts; j++) {
+      double uv[2], dp[12], ji[2][NB_INTR], jgr[JG];
+      hearth_project_jac jac;
+      if (!calib_project_pose(&cb, R, dR, p + 3, P->obj[j], uv, &jac, dp, NULL)) return 0;
+      intr_rows(&jac, ji);
+      const double *m = J->img_c + 2 * (k * P->n_pts + j);
+      for (int row = 0; row < 2; row++) {
+        memset(jgr, 0, sizeof(double) * 6);
+        memcpy(jgr + 6, ji[row], sizeof(double) * NB_INTR);
+        joint_row(6, jgr, dp + 6 * row, uv[row] - m[row], U, gg, Vb, Wb, g6);
+      }
+    }
+  }
+  return 1;
+}
+
+/* LM over (g, x) in place; returns 0 on numeric failure */
+static int joint_lm(const joint_prob *J, double *g, double *x, int max_it) {
+  const stereo_prob *P = &J->P;
+  const size_t np = P->n_pairs, nb = np + J->n_c, D = (size_t)P->nq;
+  const size_t nx = D * np + 6 * J->n_c;
+  double *V = hearth_alloc_array(NQ_MAX * NQ_MAX * nb, sizeof(double));
+  double *Vi = hearth_alloc_array(NQ_MAX * NQ_MAX * nb, sizeof(double));
+  double *W = hearth_alloc_array(JG * NQ_MAX * nb, sizeof(double));
+  double *gb = hearth_alloc_array(NQ_MAX * nb, sizeof(double));
+  double *trial = hearth_alloc_array(nx, sizeof(double));
+  int ok_all = V && Vi && W && gb && trial;
+  double cost = ok_all ? joint_cost(J, g, x) : INFINITY, lambda = 1e-3;
+  if (!isfinite(cost)) ok_all = 0;
+  for (int it = 0; ok_all && it < max_it; it++) {
+    double U[JG * JG], gg[JG];
+    if (!joint_normal(J, g, x, U, gg, V, W, gb)) {
+      ok_all = 0;
+      break;
+    }
+    int improved = 0;
+    for (int tries = 0; tries < 12 && !improved; tries++) {
+      double S[JG * JG], rhs[JG];
+      memcpy(S, U, sizeof S);
+      memcpy(rhs, gg, sizeof rhs);
+      for (int a = 0; a < JG; a++) S[a * JG + a] *= 1.0 + lambda;
+      int ok = 1;
+      for (size_t b = 0; b < nb && ok; b++) {
+        size_t d = b < np ? D : 6;
+        if (b < np && !P->used[b]) continue;
+        double *Vd = Vi + NQ_MAX * NQ_MAX * b;
+        memcpy(Vd, V + NQ_MAX * NQ_MAX * b, sizeof(double) * d * d);
+        for (size_t a = 0; a < d; a++) Vd[a * d + a] *= 1.0 + lambda;
+        if (!calib_chol_invert(Vd, (int)d)) {
+          ok = 0;
+          break;
+        }
+        const double *Wb = W + JG * NQ_MAX * b, *gv = gb + NQ_MAX * b;
+        double WV[JG * NQ_MAX];
+        for (size_t a = 0; a < JG; a++)
+          for (size_t c = 0; c < d; c++) {
+            double s = 0;
+            for (size_t k = 0; k < d; k++) s += Wb[a * d + k] * Vd[k * d + c];
+            WV[a * d + c] = s;
+          }
+        for (size_t a = 0; a < JG; a++) {
+          for (size_t c = 0; c < JG; c++) {
+            double s = 0;
+            for (size_t k = 0; k < d; k++) s += WV[a * d + k] * Wb[c * d + k];
+            S[a * JG + c] -= s;
+          }
+          double s = 0;
+          for (size_t k = 0; k < d; k++) s += WV[a * d + k] * gv[k];
+          rhs[a] -= s;
+        }
+      }
+      if (ok) ok = calib_chol_solve(S, rhs, JG);
+      if (!ok) {
+        lambda *= 10;
+        continue;
+      }
+      double gn[JG];
+      for (int a = 0; a < JG; a++) gn[a] = g[a] + rhs[a];
+      memcpy(trial, x, sizeof(double) * nx);
+      for (size_t b = 0; b < nb; b++) {
+        if (b < np && !P->used[b]) continue;
+        size_t d = b < np ? D : 6;
+        double *xb = trial + (b < np ? D * b : D * np + 6 * (b - np));
+        const double *Vd = Vi + NQ_MAX * NQ_MAX * b, *Wb = W + JG * NQ_MAX * b,
+                     *gv = gb + NQ_MAX * b;
+        double r6[NQ_MAX];
+        for (size_t c = 0; c < d; c++) {
+          double s = gv[c];
+          for (size_t a = 0; a < JG; a++) s -= Wb[a * d + c] * rhs[a];
+          r6[c] = s;
+        }
+        for (size_t a = 0; a < d; a++) {
+          double s = 0;
+          for (size_t c = 0; c < d; c++) s += Vd[a * d + c] * r6[c];
+          xb[a] += s;
+        }
+      }
+      double cn = joint_cost(J, gn, trial);
+      if (cn < cost) {
+        double rel = (cost - cn) / (cost > 0 ? cost : 1);
+        memcpy(g, gn, sizeof gn);
+        memcpy(x, trial, sizeof(double) * nx);
+        cost = cn;
+        lambda = lambda / 10 > 1e-12 ? lambda / 10 : 1e-12;
+        improved = 1;
+        if (rel < 1e-14) it = max_it;
+      } else {
+        lambda *= 10;
+      }
+    }
+    if (!improved) break;
+  }
+  free(V);
+  free(Vi);
+  free(W);
+  free(gb);
+  free(trial);
+  return ok_all;
+}
+
+/* ---- the target's own points ---------------------------------------------- */
+/* residuals of hole j at plate point X in pair i (4: camera a, then b) */
+static int pair_point_res(const stereo_prob *P, const hearth_rigid *Tba, const double *p, size_t i,
+                          size_t j, const double X[3], double r[4]) {
+  double R[9], Xm[3], Xb[3], uv[2];
+  hearth_rotvec_to_matrix(p, R);
+  const double *m = P->img_a + 2 * (i * P->n_pts + j);
+  block_point(p, P->nq, R, NULL, row_time(P->ca, m[1]), 0, X, Xm, NULL);
+  if (!hearth_camera_project(P->ca, Xm, uv, NULL)) return 0;
+  r[0] = uv[0] - m[0];
+  r[1] = uv[1] - m[1];
+  block_point(p, P->nq, R, NULL, tb_time(p, P->nq), 0, X, Xm, NULL);
+  hearth_rigid_apply(Tba, Xm, Xb);
+  if (!hearth_camera_project(P->cb, Xb, uv, NULL)) return 0;
+  m = P->img_b + 2 * (i * P->n_pts + j);
+  r[2] = uv[0] - m[0];
+  r[3] = uv[1] - m[1];
+  return 1;
+}
+
+/* residuals of hole j at plate point X in camera b's own frame k */
+static int own_point_res(const joint_prob *J, const hearth_camera *cb, const double *p, size_t k,
+                         size_t j, const double X[3], double r[2]) {
+  hearth_rigid T;
+  calib_rigid_from_params(p, &T);
+  double Xc[3], uv[2];
+  hearth_rigid_apply(&T, X, Xc);
+  if (!hearth_camera_project(cb, Xc, uv, NULL)) return 0;
+  const double *m = J->img_c + 2 * (k * J->P.n_pts + j);
+  r[0] = uv[0] - m[0];
+  r[1] = uv[1] - m[1];
+  return 1;
+}
+
+/* one Gauss-Newton step of every hole's in-plane position (cameras and
+ * poses held), then the affine part of the offsets from nom removed (the
+ * gauge: the plate poses, the scale and the intrinsics take it); pts (the
+ * current points) is updated */
+static void target_step(const joint_prob *J, const double *g, const double *x,
+                        const double (*nom)[3], double (*pts)[3]) {
+  const stereo_prob *P = &J->P;
+  const size_t n = P->n_pts;
+  const double h = 1e-6;
+  hearth_camera cb;
+  joint_cam(J, g, &cb);
+  stereo_prob Pb = *P;
+  Pb.cb = &cb;
+  hearth_rigid Tba;
+  calib_rigid_from_params(g, &Tba);
+  double off[HEARTH_TARGET_MAX_HOLES][2];
+  for (size_t j = 0; j < n; j++) {
+    double A[4] = {0}, b[2] = {0};
+    for (size_t blk = 0; blk < P->n_pairs + J->n_c; blk++) {
+      int own = blk >= P->n_pairs, nr = own ? 2 : 4;
+      if (!own && !P->used[blk]) continue;
+      const double *p =
+          own ? x + (size_t)P->nq * P->n_pairs + 6 * (blk - P->n_pairs) : x + (size_t)P->nq * blk;
+      double r0[4], r1[4], jac[2][4];
+      int ok = own ? own_point_res(J, &cb, p, blk - P->n_pairs, j, pts[j], r0)
+                   : pair_point_res(&Pb, &Tba, p, blk, j, pts[j], r0);
+      for (int a = 0; a < 2 && ok; a++) {
+        double X[3] = {pts[j][0], pts[j][1], pts[j][2]};
+        X[a] += h;
+        ok = own ? own_point_res(J, &cb, p, blk - P->n_pairs, j, X, r1)
+                 : pair_point_res(&Pb, &Tba, p, blk, j, X, r1);
+        for (int k = 0; k < nr; k++) jac[a][k] = (r1[k] - r0[k]) / h;
+      }
+      if (!ok) continue;
+      for (int k = 0; k < nr; k++) {
+        A[0] += jac[0][k] * jac[0][k];
+        A[1] += jac[0][k] * jac[1][k];
+        A[3] += jac[1][k] * jac[1][k];
+        b[0] -= jac[0][k] * r0[k];
+        b[1] -= jac[1][k] * r0[k];
+      }
+    }
+    double det = A[0] * A[3] - A[1] * A[1], d0 = 0, d1 = 0;
+    if (det > 0) {
+      d0 = (A[3] * b[0] - A[1] * b[1]) / det;
+      d1 = (A[0] * b[1] - A[1] * b[0]) / det;
+    }
+    off[j][0] = pts[j][0] + d0 - nom[j][0];
+    off[j][1] = pts[j][1] + d1 - nom[j][1];
+  }
+  /* least-squares affine map of the nominal points onto the offsets */
+  double M[9] = {0}, c[2][3] = {{0}};
+  for (size_t j = 0; j < n; j++) {
+    double q[3] = {nom[j][0], nom[j][1], 1};
+    for (int a = 0; a < 3; a++) {
+      for (int e = 0; e < 3; e++) M[3 * a + e] += q[a] * q[e];
+      c[0][a] += q[a] * off[j][0];
+      c[1][a] += q[a] * off[j][1];
+    }
+  }
+  for (int k = 0; k < 2; k++) {
+    double Mk[9];
+    memcpy(Mk, M, sizeof Mk);
+    if (!calib_chol_solve(Mk, c[k], 3)) c[k][0] = c[k][1] = c[k][2] = 0;
+  }
+  for (size_t j = 0; j < n; j++)
+    for (int k = 0; k < 2; k++)
+      pts[j][k] = nom[j][k] + off[j][k] - (c[k][0] * nom[j][0] + c[k][1] * nom[j][1] + c[k][2]);
+}
+
+hearth_status hearth_calib_stereo_joint(const hearth_camera *cam_a, hearth_camera *cam_b,
+                                        const double (*obj)[3], size_t n_pts, const double *img_a,
+                                        const double *img_b, size_t n_pairs, const double *img_c,
+                                        size_t n_c, const hearth_calib_opts *o,
+                                        hearth_rigid *T_b_from_a, double *rms_px,
+                                        double *own_rms_px, double *pair_rms, int *pair_used,
+                                        hearth_err *err) {
+  hearth_calib_opts def;
+  if (!o) {
+    hearth_calib_opts_default(&def);
+    o = &def;
+  }
+  if (!cam_a || !cam_b || !obj || !img_a || !img_b || (n_c && !img_c) || !T_b_from_a)
+    return hearth_err_set(err, HEARTH_E_ARG, "stereo calibration: missing argument");
+  if (n_pairs < 1)
+    return hearth_err_set(err, HEARTH_E_SIZE, "stereo calibration: no usable stereo pairs");
+  if (n_pts < 4 || n_pts > 100000 || n_pairs > 100000 || n_c > 100000)
+    return hearth_err_set(err, HEARTH_E_SIZE, "stereo calibration: %zu points per pair", n_pts);
+  int *used = hearth_calloc_array(n_pairs, sizeof(int));
+  double *pc = hearth_alloc_array(n_pairs, sizeof(double));
+  double *sol = NULL, *x = NULL, pT[6];
+  double(*tpts)[3] = NULL;
+  int nq = 6;
+  hearth_status st = HEARTH_OK;
+  if (!used || !pc) {
+    st = hearth_err_set(err, HEARTH_E_NOMEM, "stereo calibration: out of memory");
+    goto done;
+  }
+  if ((st = stereo_core(cam_a, cam_b, obj, n_pts, img_a, img_b, n_pairs, o, pT, &sol, &nq, used,
+                        err)))
+    goto done;
+  stereo_prob P = {cam_a, cam_b, obj, n_pts, n_pairs, img_a, img_b, used, nq};
+  hearth_camera cb = *cam_b;
+  if (o->stereo_intrinsics) {
+    /* camera b's own frames: their poses at the current intrinsics */
+    size_t nx = (size_t)nq * n_pairs + 6 * n_c;
+    x = hearth_calloc_array(nx, sizeof(double));
+    if (!x) {
+      st = hearth_err_set(err, HEARTH_E_NOMEM, "stereo calibration: out of memory");
+      goto done;
+    }
+    memcpy(x, sol, sizeof(double) * (size_t)nq * n_pairs);
+    for (size_t k = 0; k < n_c; k++) {
+      hearth_rigid T;
+      hearth_err e2;
+      if (hearth_calib_pose(cam_b, obj, n_pts, img_c + 2 * k * n_pts, &T, NULL, &e2)) {
+        st = hearth_err_set(err, HEARTH_E_NUMERIC, "stereo calibration: own frame %zu: no pose", k);
+        goto done;
+      }
+      calib_params_from_rigid(&T, x + (size_t)nq * n_pairs + 6 * k);
+    }
+    double g[JG];
+    memcpy(g, pT, sizeof pT);
+    g[6] = cam_b->fx;
+    g[7] = cam_b->fy;
+    g[8] = cam_b->cx;
+    g[9] = cam_b->cy;
+    for (int k = 0; k < 5; k++) g[10 + k] = cam_b->dist[k];
+    joint_prob J = {P, cam_b, img_c, n_c};
+    int ok = joint_lm(&J, g, x, o->max_iterations);
+    if (ok && o->target_points && n_pts <= HEARTH_TARGET_MAX_HOLES) {
+      /* the holes' own in-plane positions, in turn with the rest */
+      tpts = hearth_alloc_array(n_pts, sizeof *tpts);
+      if (!tpts) {
+        st = hearth_err_set(err, HEARTH_E_NOMEM, "stereo calibration: out of memory");
+        goto done;
+      }
+      memcpy(tpts, obj, sizeof(double) * 3 * n_pts);
+      J.P.obj = P.obj = (const double(*)[3])tpts;
+      for (int round = 0; ok && round < 8; round++) {
+        target_step(&J, g, x, obj, tpts);
+        ok = joint_lm(&J, g, x, o->max_iterations);
+      }
+    }
+    if (!ok) {
+      st = hearth_err_set(err, HEARTH_E_NUMERIC, "stereo calibration: joint refinement failed");
+      goto done;
+    }
+    memcpy(pT, g, sizeof pT);
+    memcpy(sol, x, sizeof(double) * (size_t)nq * n_pairs);
+    joint_cam(&J, g, &cb);
+    if (own_rms_px) {
+      double s = 0;
+      for (size_t k = 0; k < n_c; k++) s += own_cost(&J, &cb, k, x + (size_t)nq * n_pairs + 6 * k);
+      *own_rms_px = n_c ? sqrt(s / (double)(n_c * n_pts)) : NAN;
+    }
+  } else if (own_rms_px) {
+    *own_rms_px = NAN;
+  }
+  *cam_b = cb;
+  P.cb = cam_b;
+  calib_rigid_from_params(pT, T_b_from_a);
+  stereo_report(&P, pT, sol, pc, rms_px, pair_rms, pair_used);
+done:
+  free(sol);
+  free(x);
+  free(tpts);
+  free(used);
+  free(pc);
   return st;
 }

@@ -93,6 +93,13 @@ int hearth_cmd_calibrate(int argc, char **argv) {
                "take each colour frame of a stereo pair as read at one instant (by default a "
                "plate velocity per pair is solved when the residuals show the rows were read "
                "while it moved)"),
+      CLI_FLAG("--fixed-intrinsics", &o.stereo_intrinsics, 0,
+               "hold the thermal intrinsics of the thermal-only frames fixed in the stereo "
+               "stage (the paper's; by default they are refined with the extrinsic, the pairs' "
+               "plate poses fixed by the colour camera)"),
+      CLI_FLAG("--refine-target", &o.target_points, 1,
+               "also estimate each hole's in-plane offset from the nominal lattice in the "
+               "stereo stage (drilling tolerance; the offsets' affine part held at zero)"),
       CLI_FLAG("--quiet", &quiet, 1, "summary line only"),
       CLI_GROUP("with --detect, the options of `hearth detect`", detect_opts, &detect_opt),
       CLI_END,

@@ -185,6 +185,9 @@ int hearth_cmd_synth(int argc, char **argv) {
               "0: none)"),
       CLI_NUM("--hole-burr", "M", &o.effects.hole_burr_m, 0, 0.001,
               "1 sigma irregularity of each hole's rim (m; 0: round)"),
+      CLI_NUM("--hole-position", "M", &o.effects.hole_position_m, 0, 0.001,
+              "1 sigma per axis of each hole's drilled position off the nominal lattice (m; 0: "
+              "exact)"),
       CLI_NUM("--lens-residual", "PX", &o.effects.lens_residual_px, 0, 5,
               "rms per axis of the thermal lens's departure from its 5-parameter model in the "
               "calibration captures (px; 0: the model lens)"),

@@ -75,7 +75,7 @@ static double plate_sag(const synth_plate_geom *g, double x, double y) {
 
 static int classify_plate(const synth_plate_geom *g, double x, double y, size_t *hole) {
   if (fabs(x - g->cx) > g->half_w || fabs(y - g->cy) > g->half_h) return C_OUT;
-  const double R = g->r + g->burr_max, P = g->t.pitch_m;
+  const double R = g->r + g->burr_max + g->pos_max, P = g->t.pitch_m;
   /* quick accept of the margin around the pattern */
   if (x < -R || y < -R || x > g->ext_x + R || y > g->ext_y + R) return C_PLATE;
   int r0 = (int)lrint(y / g->step);
@@ -904,6 +904,24 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
           sum += fabs((double)g->burr[i][k]);
         }
         if (sum > g->burr_max) g->burr_max = sum;
+      }
+    }
+    if (E->hole_position_m > 0) {
+      /* each hole drilled off its nominal position (a stream of its own):
+       * the holes, their rims and the ground truth move, the target file
+       * keeps the nominal lattice */
+      hearth_rng hp;
+      hearth_rng_fork(&base, 77006, &hp);
+      const double lim = 3.0 * E->hole_position_m;
+      for (size_t i = 0; i < g->n; i++) {
+        double d2 = 0;
+        for (int k = 0; k < 2; k++) {
+          double a = E->hole_position_m * hearth_rng_normal(&hp);
+          a = a < -lim ? -lim : a > lim ? lim : a;
+          g->holes[i][k] += a;
+          d2 += a * a;
+        }
+        if (sqrt(d2) > g->pos_max) g->pos_max = sqrt(d2);
       }
     }
     if (fx0.thickness > 0) {

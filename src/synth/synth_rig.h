@@ -132,6 +132,9 @@ typedef struct synth_plate_geom {
    * sum (0: round holes, burr unused) */
   double burr_max;
   float burr[HEARTH_TARGET_MAX_HOLES][6];
+  /* the largest distance of a hole centre from its lattice position (holes
+   * drilled off nominal; 0: exact) */
+  double pos_max;
 } synth_plate_geom;
 /* target may be NULL or zeroed (the paper's plate, 200 x 150 mm). */
 void synth_plate_geom_init(synth_plate_geom *g, const hearth_target *target);

@@ -65,8 +65,9 @@ int main(void) {
   CHECK(ang * 180 / M_PI < 0.05);
   CHECK(dt < 0.0005);
   /* the bench's effects keep a stereo residual above the clean bench's
-     0.009 px; the paper's 0.1..0.5 px is not reached (docs/virtual-rig.md) */
-  CHECK_MSG(r.stereo_rms_px >= 0.015 && r.stereo_rms_px < 0.5, "stereo RMS %g", r.stereo_rms_px);
+     0.009 px (0.016 px here with the trigger offset modelled); the paper's
+     0.1..0.5 px is not reached with the estimates held (docs/virtual-rig.md) */
+  CHECK_MSG(r.stereo_rms_px >= 0.012 && r.stereo_rms_px < 0.5, "stereo RMS %g", r.stereo_rms_px);
   /* a rigid plate per pair leaves the rows' motion in the residual and in
      the extrinsic */
   CHECK(test_sh("'" HEARTH_EXE "' calibrate '%s' --quiet --no-rolling-shutter >> '%s' 2>&1", root,
