@@ -2,6 +2,7 @@
  * string attributes as variable-length UTF-8 (h5py reads str), object
  * timestamps off, so the same demos written in the same order give the
  * same bytes. */
+#include <libdeflate.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -101,13 +102,46 @@ static int h5_write(hid_t g, const char *name, hid_t ftype, hid_t mtype, int ran
   hid_t sp = H5Screate_simple(rank, dims, NULL);
   hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
   H5Pset_obj_track_times(dcpl, 0); /* same inputs, same bytes */
-  if (rank == 4 && dims[0] > 0) {
-    hsize_t ch[4] = {1, dims[1], dims[2], dims[3]};
-    H5Pset_chunk(dcpl, 4, ch);
-    H5Pset_deflate(dcpl, 1);
-  }
   hid_t ds = H5Dcreate2(g, name, ftype, sp, H5P_DEFAULT, dcpl, H5P_DEFAULT);
   int ok = ds >= 0 && H5Dwrite(ds, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) >= 0;
+  if (ds >= 0) H5Dclose(ds);
+  H5Pclose(dcpl), H5Sclose(sp);
+  return ok;
+}
+
+/* An image dataset (T, S, S, 3) of U8, one frame per chunk with HDF5's
+ * deflate filter (level SIM_H5_DEFLATE_LEVEL in its filter message): each
+ * frame is compressed here with libdeflate into a zlib stream, the format
+ * that filter stores, and written as the chunk itself, so that HDF5 runs
+ * no compressor of its own. The chunks are a function of the pixels alone
+ * and any reader with the deflate filter (h5py included) decodes them. */
+static int h5_write_images(sim_h5_out *o, hid_t g, const char *name, const hsize_t dims[4],
+                           const uint8_t *data) {
+  size_t frame = (size_t)(dims[1] * dims[2] * dims[3]);
+  if (dims[0] == 0) return h5_write(g, name, H5T_STD_U8LE, H5T_NATIVE_UINT8, 4, dims, data);
+  if (!o->zc) o->zc = libdeflate_alloc_compressor(SIM_H5_DEFLATE_LEVEL);
+  size_t bound = o->zc ? libdeflate_zlib_compress_bound(o->zc, frame) : 0;
+  if (bound > o->zcap) {
+    free(o->zbuf);
+    o->zbuf = malloc(bound);
+    o->zcap = o->zbuf ? bound : 0;
+  }
+  if (!o->zc || !o->zbuf) return 0;
+  hid_t sp = H5Screate_simple(4, dims, NULL);
+  hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
+  H5Pset_obj_track_times(dcpl, 0); /* same inputs, same bytes */
+  hsize_t ch[4] = {1, dims[1], dims[2], dims[3]};
+  H5Pset_chunk(dcpl, 4, ch);
+  H5Pset_deflate(dcpl, SIM_H5_DEFLATE_LEVEL);
+  hid_t ds = H5Dcreate2(g, name, H5T_STD_U8LE, sp, H5P_DEFAULT, dcpl, H5P_DEFAULT);
+  int ok = ds >= 0;
+  for (hsize_t t = 0; t < dims[0] && ok; t++) {
+    const uint8_t *src = data + (size_t)t * frame;
+    size_t n = libdeflate_zlib_compress(o->zc, src, frame, o->zbuf, o->zcap);
+    hsize_t at[4] = {t, 0, 0, 0};
+    /* filter mask 0: the chunk went through the deflate filter */
+    ok = n > 0 && H5Dwrite_chunk(ds, H5P_DEFAULT, 0, at, n, o->zbuf) >= 0;
+  }
   if (ds >= 0) H5Dclose(ds);
   H5Pclose(dcpl), H5Sclose(sp);
   return ok;
@@ -172,9 +206,9 @@ hearth_status sim_h5_add_demo(sim_h5_out *o, const sim_demo *b, int S, const cha
     hid_t ob = ok ? h5_group(g, "obs") : -1;
     if (ob < 0) ok = 0;
     if (ok)
-      ok = (b->img == 0 || (h5_write(ob, "agentview_rgb", u8, nu8, 4, dI, b->front) &&
-                            h5_write(ob, "agentview_thermal", u8, nu8, 4, dI, b->thermal) &&
-                            h5_write(ob, "eye_in_hand_rgb", u8, nu8, 4, dI, b->wrist))) &&
+      ok = (b->img == 0 || (h5_write_images(o, ob, "agentview_rgb", dI, b->front) &&
+                            h5_write_images(o, ob, "agentview_thermal", dI, b->thermal) &&
+                            h5_write_images(o, ob, "eye_in_hand_rgb", dI, b->wrist))) &&
            h5_write(ob, "joint_states", f64, nd, 2, d7, b->joint) &&
            h5_write(ob, "gripper_states", f64, nd, 2, d2, b->grip) &&
            h5_write(ob, "ee_states", f64, nd, 2, d6, b->ee) &&
@@ -200,7 +234,15 @@ hearth_status sim_h5_add_demo(sim_h5_out *o, const sim_demo *b, int S, const cha
   return HEARTH_OK;
 }
 
+/* the image compressor and its buffer */
+static void h5_out_free_z(sim_h5_out *o) {
+  libdeflate_free_compressor(o->zc);
+  free(o->zbuf);
+  o->zc = NULL, o->zbuf = NULL, o->zcap = 0;
+}
+
 void sim_h5_abort(sim_h5_out *o) {
+  h5_out_free_z(o);
   if (o->data >= 0) H5Gclose(o->data);
   if (o->f >= 0) H5Fclose(o->f);
   o->data = o->f = -1;
@@ -209,6 +251,7 @@ void sim_h5_abort(sim_h5_out *o) {
 
 hearth_status sim_h5_finish(sim_h5_out *o, const sim_h5_meta *m, const sim_h5_shard *shard,
                             hearth_err *err) {
+  h5_out_free_z(o);
   int ok = 1;
   for (int k = 0; k < SIM_H5_NKEYS && ok; k++)
     ok = h5_str_attr(o->data, sim_h5_key_names[k], m->str[k] ? m->str[k] : "");

@@ -77,11 +77,17 @@ typedef struct sim_h5_shard {
 } sim_h5_shard;
 
 /* ---- writing ---------------------------------------------------------------- */
+/* the deflate level of the image chunks (libdeflate's scale, see sim_h5.c) */
+#define SIM_H5_DEFLATE_LEVEL 1
+struct libdeflate_compressor;
 typedef struct sim_h5_out {
   hearth_atomic_file af; /* the temporary name HDF5 writes to, renamed on finish */
   hid_t f, data;
   int ndemo;
-  long long total; /* samples over the demos */
+  long long total;                  /* samples over the demos */
+  struct libdeflate_compressor *zc; /* the image chunks' compressor, made on first use */
+  uint8_t *zbuf;                    /* zcap bytes: one compressed frame */
+  size_t zcap;
 } sim_h5_out;
 /* Create path's temporary file and its group data. */
 hearth_status sim_h5_create(sim_h5_out *o, const char *path, hearth_err *err);

@@ -674,6 +674,19 @@ static void rec_compact(sim_soft *s) {
   s->nrec = n;
 }
 
+/* The loops of the depth pass and of the shading are built twice on
+ * x86-64 with GCC: for AVX2 (4 doubles or 8 floats per vector) and for
+ * the baseline (SSE2), chosen once at load time by the CPU. Each lane
+ * does the same IEEE operations in the same order in both (no fused
+ * multiply-adds: AVX2 does not imply FMA and the file is compiled with
+ * -ffp-contract=off; no reassociated sums), so the bytes do not depend
+ * on which one runs. */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define SOFT_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define SOFT_CLONES
+#endif
+
 /* box width (pixels) below which raster() tests the whole box */
 #define SOFT_NARROW 8
 
@@ -691,8 +704,8 @@ static inline int soft_inside(const double A[3], const double row[3], const int 
  * depth buffer: the pixels where it is the nearest surface so far take
  * the index of the next record, s->nrec. 1 when it won any: then
  * rec_commit() must fill that record (the shading waits for resolve()) */
-static int raster_in(sim_soft *s, const soft_svtx *a, const soft_svtx *b, const soft_svtx *c,
-                     double area, const int box[4]) {
+SOFT_CLONES static int raster_in(sim_soft *s, const soft_svtx *a, const soft_svtx *b,
+                                 const soft_svtx *c, double area, const int box[4]) {
   if (s->nrec == s->rcap) rec_compact(s);
   int x0 = box[0], x1 = box[1], y0 = box[2], y1 = box[3];
   /* edge i opposite vertex i: E(p) = A x + B y + C, positive inside */
@@ -845,8 +858,8 @@ static inline void shade_run(const soft_rec *r, const soft_mat *mt, const double
 /* shade_run for a lit material without texture: the run in blocks whose
  * arithmetic the compiler vectorises (the same operations per pixel) */
 #define SOFT_BLOCK 32
-static void shade_run_plain(const soft_rec *r, const soft_mat *mt, const double row[3], int x0,
-                            int x1, uint8_t *o, uint8_t *o2) {
+SOFT_CLONES static void shade_run_plain(const soft_rec *r, const soft_mat *mt, const double row[3],
+                                        int x0, int x1, uint8_t *o, uint8_t *o2) {
   double A0 = r->A[0], A1 = r->A[1], A2 = r->A[2], inv = r->inv, r0 = row[0], r1 = row[1],
          r2 = row[2];
   float iw0 = r->iw[0], iw1 = r->iw[1], iw2 = r->iw[2];
@@ -880,7 +893,7 @@ static void shade_run_plain(const soft_rec *r, const soft_mat *mt, const double 
 /* the colours of every covered pixel from the triangle that won it, with
  * the interpolation raster's depth test used (the same values), run by
  * run of pixels that one triangle won */
-static void resolve(sim_soft *s, uint8_t *rgb, int *ids) {
+SOFT_CLONES static void resolve(sim_soft *s, uint8_t *rgb, int *ids) {
   for (int y = 0; y < s->h; y++) {
     double yc = y + 0.5, row[3];
     size_t line = (size_t)y * (size_t)s->w;

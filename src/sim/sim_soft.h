@@ -15,7 +15,8 @@
  * order (the file is compiled with -ffp-contract=off, so no fused
  * multiply-adds), no state outside the context: the same scene gives the
  * same bytes on any x86-64 or AArch64 machine, at any optimisation level
- * and whatever other threads do. Images are RGB U8, bottom row first. */
+ * and whatever other threads do (on x86-64 the pixel loops also have AVX2
+ * builds, picked by the CPU, that do the same operations per pixel). Images are RGB U8, bottom row first. */
 #ifndef HEARTH_SIM_SOFT_H
 #define HEARTH_SIM_SOFT_H
 

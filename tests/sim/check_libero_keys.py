@@ -2,7 +2,9 @@
 """Open `hearth sim collect` files with h5py (Debian python3-h5py) and check
 every key LIBERO's and robomimic's loaders read, with its type: string
 attributes must come back as str (variable-length UTF-8), not bytes; JSON
-attributes must parse; per-demo datasets must have the documented shapes.
+attributes must parse; per-demo datasets must have the documented shapes;
+image datasets one frame per deflate chunk, each chunk a zlib stream that
+Python's zlib inflates to the frame.
 
 usage: check_libero_keys.py FILE [--instructions N] [--size S]
   --instructions N: instructions the file holds (2, or 1 for a split file)
@@ -11,6 +13,7 @@ usage: check_libero_keys.py FILE [--instructions N] [--size S]
 import argparse
 import json
 import sys
+import zlib
 
 import h5py
 import numpy as np
@@ -124,6 +127,17 @@ def main():
                     S = a.size or x.shape[1]
                     if x.dtype != np.uint8 or x.shape != (T, S, S, 3):
                         fail("%s/obs/%s: %s %r" % (where, key, x.dtype, x.shape))
+                    # one frame per chunk through the standard deflate
+                    # filter: each stored chunk, inflated by Python's zlib,
+                    # is its frame's pixels
+                    if x.chunks != (1, S, S, 3) or x.compression != "gzip":
+                        fail("%s/obs/%s: chunks %r, filter %r; expected (1, %d, %d, 3) gzip"
+                             % (where, key, x.chunks, x.compression, S, S))
+                    frames = x[()]
+                    for t in range(T):
+                        mask, raw = x.id.read_direct_chunk((t, 0, 0, 0))
+                        if mask != 0 or zlib.decompress(raw) != frames[t].tobytes():
+                            fail("%s/obs/%s: chunk %d is not its frame as a zlib stream" % (where, key, t))
                 elif x.dtype != np.float64 or x.shape != (T, width):
                     fail("%s/obs/%s: %s %r, expected float64 (%d, %d)" % (where, key, x.dtype, x.shape, T, width))
         if total != n["total"]:
