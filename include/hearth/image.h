@@ -96,7 +96,7 @@ hearth_status hearth_apng_encode(const uint8_t *frames, size_t width, size_t hei
 /* JPEG (8-bit gray or RGB; U8 images). quality 1..100. Writes atomically. */
 hearth_status hearth_jpeg_read(const char *path, hearth_image *img, hearth_err *err);
 /* The image at half its size (sides rounded up), decoded by libjpeg's
- * scaled inverse DCT: about a third of the full decode's work, for
+ * scaled inverse DCT: about two thirds of the full decode's work, for
  * pictures shown halved. Not the pixels of halving hearth_jpeg_read's. */
 hearth_status hearth_jpeg_read_half(const char *path, hearth_image *img, hearth_err *err);
 hearth_status hearth_jpeg_read_expect(const char *path, const hearth_image_expect *want,
