@@ -71,6 +71,14 @@ hearth_status hearth_png_write(const char *path, const hearth_image *img, hearth
 /* Encode to memory (*out malloc'ed, the caller frees it). */
 hearth_status hearth_png_encode(const hearth_image *img, uint8_t **out, size_t *size,
                                 hearth_err *err);
+/* The same pixels in a file that is cheaper to make where rows repeat (an
+ * image enlarged by repeating pixels, flat backgrounds): a row equal to the
+ * one above it is stored UP-filtered, every other row as hearth_png_write
+ * stores it (SUB), so the bytes differ from hearth_png_write's there. For
+ * diagnostic pictures; measurement outputs keep hearth_png_write. */
+hearth_status hearth_png_write_picture(const char *path, const hearth_image *img, hearth_err *err);
+hearth_status hearth_png_encode_picture(const hearth_image *img, uint8_t **out, size_t *size,
+                                        hearth_err *err);
 
 /* Animated PNG (APNG): n_frames RGB U8 frames of width x height, stored
  * back to back in `frames` (top row first), each shown for
@@ -87,6 +95,10 @@ hearth_status hearth_apng_encode(const uint8_t *frames, size_t width, size_t hei
 
 /* JPEG (8-bit gray or RGB; U8 images). quality 1..100. Writes atomically. */
 hearth_status hearth_jpeg_read(const char *path, hearth_image *img, hearth_err *err);
+/* The image at half its size (sides rounded up), decoded by libjpeg's
+ * scaled inverse DCT: about two thirds of the full decode's work, for
+ * pictures shown halved. Not the pixels of halving hearth_jpeg_read's. */
+hearth_status hearth_jpeg_read_half(const char *path, hearth_image *img, hearth_err *err);
 hearth_status hearth_jpeg_read_expect(const char *path, const hearth_image_expect *want,
                                       hearth_image *img, hearth_err *err);
 hearth_status hearth_jpeg_read_mem(const void *data, size_t size, const char *name,

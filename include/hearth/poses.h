@@ -183,7 +183,9 @@ hearth_status hearth_overlay_render(const hearth_raycaster *rc, const hearth_cam
                                     hearth_image *out, hearth_err *err);
 
 /* hearth overlay: derived/overlay/<state>/vNN.png (after, with before in a
- * second colour) and derived/overlay/<state>/contact_sheet.png. */
+ * second colour) and derived/overlay/<state>/contact_sheet.png (cells at
+ * the camera's pixels: a pixel is on the outline when one of its zoom x
+ * zoom sub-pixels is). Both are stored by hearth_png_write_picture. */
 typedef struct hearth_overlay_job {
   const char *root, *instance, *state;
   const char *mesh_path, *rig_path;

@@ -81,74 +81,30 @@ typedef struct det_ctx {
   int want_rgb_w, want_rgb_h;
 } det_ctx;
 
-/* The two enlargements of the overlays, equal to hearth_image_resize at
- * those ratios: there every weight is a multiple of 1/8, so its double
- * sums are exact and integer sums in eighths give the same bytes. */
+/* The overlays' pictures: thermal in Turbo enlarged 4 times by repeating
+ * each pixel (the sensor's pixels stay visible as 4 x 4 blocks, as in the
+ * pose overlays); colour at half size, as libjpeg decodes it halved. */
 
-/* colour halved: the mean of each 2 x 2 block, rounded half up; a grey
- * source is repeated in the three channels */
-static void half_box(const hearth_image *src, hearth_image *dst) {
+/* an RGB image enlarged 4 times, each pixel repeated 4 x 4 times: every
+ * source row widened once, then copied into the next three rows */
+static void rep4(const hearth_image *src, hearth_image *dst) {
   const uint8_t *p = src->data;
+  size_t sw = src->width, rowv = 3 * dst->width;
   uint8_t *q = dst->data;
-  size_t sc = (size_t)src->channels, sw = src->width;
-  for (size_t y = 0; y < dst->height; y++)
-    for (size_t x = 0; x < dst->width; x++) {
-      const uint8_t *a = p + ((2 * y) * sw + 2 * x) * sc, *b = a + sw * sc;
-      for (size_t k = 0; k < 3; k++) {
-        size_t c = sc >= 3 ? k : 0;
-        unsigned sum = (unsigned)a[c] + a[sc + c] + b[c] + b[sc + c];
-        q[3 * (y * dst->width + x) + k] = (uint8_t)((sum + 2) / 4);
-      }
-    }
-}
-
-/* the linear taps of output sample o when n samples are enlarged 4 times:
- * source i0 with weight 8 - f8 and i0 + 1 with f8 (eighths), the centre
- * (o + 0.5) / 4 - 0.5 clamped to the samples */
-static void taps4(size_t o, size_t n, size_t *i0, unsigned *f8) {
-  long x8 = 2 * (long)o - 3, top = 8 * ((long)n - 1);
-  if (x8 < 0) x8 = 0;
-  if (x8 > top) x8 = top;
-  *i0 = (size_t)(x8 / 8);
-  *f8 = (unsigned)(x8 % 8);
-  if (*i0 + 1 >= n) *f8 = 0;
-}
-
-/* an RGB image enlarged 4 times, bilinear between pixel centres: every
- * source row enlarged along x first (eighths), then the rows blended */
-static hearth_status up4(const hearth_image *src, hearth_image *dst, hearth_err *err) {
-  const uint8_t *p = src->data;
-  size_t sw = src->width, sh = src->height, dw = dst->width, rowv = 3 * dw;
-  uint16_t *rows = hearth_alloc_array(sh, rowv * sizeof *rows);
-  if (!rows) return hearth_err_set(err, HEARTH_E_NOMEM, "overlay: out of memory");
-  for (size_t x = 0; x < dw; x++) {
-    size_t x0;
-    unsigned fx;
-    taps4(x, sw, &x0, &fx);
-    size_t x1 = fx ? x0 + 1 : x0;
-    for (size_t y = 0; y < sh; y++)
-      for (size_t k = 0; k < 3; k++)
-        rows[y * rowv + 3 * x + k] =
-            (uint16_t)((8 - fx) * p[3 * (y * sw + x0) + k] + fx * p[3 * (y * sw + x1) + k]);
+  for (size_t y = 0; y < src->height; y++) {
+    uint8_t *o = q + 4 * y * rowv;
+    for (size_t x = 0; x < sw; x++)
+      for (size_t r = 0; r < 4; r++) memcpy(o + 3 * (4 * x + r), p + 3 * (y * sw + x), 3);
+    for (size_t r = 1; r < 4; r++) memcpy(o + r * rowv, o, rowv);
   }
-  uint8_t *q = dst->data;
-  for (size_t y = 0; y < dst->height; y++) {
-    size_t y0;
-    unsigned fy;
-    taps4(y, sh, &y0, &fy);
-    const uint16_t *h0 = rows + y0 * rowv, *h1 = rows + (fy ? y0 + 1 : y0) * rowv;
-    uint8_t *o = q + y * rowv;
-    for (size_t i = 0; i < rowv; i++) o[i] = (uint8_t)(((8 - fy) * h0[i] + fy * h1[i] + 32) / 64);
-  }
-  free(rows);
-  return HEARTH_OK;
 }
 
-/* the image enlarged s times (4: thermal, 0.5: colour), through
- * hearth_image_resize where the shortcuts above do not apply */
-static hearth_status overlay_scale(const hearth_image *img, int thermal, double s,
-                                   hearth_image *big, hearth_err *err) {
-  size_t w = (size_t)lround((double)img->width * s), h = (size_t)lround((double)img->height * s);
+/* the image of a capture of native_w x native_h enlarged s times (4:
+ * thermal, 0.5: colour; a colour image already of that size is copied), through hearth_image_resize where
+ * the shortcuts above do not apply */
+static hearth_status overlay_scale(const hearth_image *img, size_t native_w, size_t native_h,
+                                   int thermal, double s, hearth_image *big, hearth_err *err) {
+  size_t w = (size_t)lround((double)native_w * s), h = (size_t)lround((double)native_h * s);
   hearth_image rgb = {0};
   hearth_status st;
   if (thermal) {
@@ -162,36 +118,37 @@ static hearth_status overlay_scale(const hearth_image *img, int thermal, double 
     const uint8_t nan_rgb[3] = {0, 0, 0};
     if ((st = hearth_turbo_image(img, lo, hi > lo ? hi : lo + 1, nan_rgb, &rgb, err))) return st;
     if (w == 4 * rgb.width && h == 4 * rgb.height) {
-      if (!(st = hearth_image_alloc(big, w, h, 3, HEARTH_PIX_U8, err)) &&
-          (st = up4(&rgb, big, err)))
-        hearth_image_free(big);
+      if (!(st = hearth_image_alloc(big, w, h, 3, HEARTH_PIX_U8, err))) rep4(&rgb, big);
     } else {
       st = hearth_image_resize(&rgb, w, h, big, err);
     }
     hearth_image_free(&rgb);
     return st;
   }
-  if (2 * w == img->width && 2 * h == img->height) {
-    if (!(st = hearth_image_alloc(big, w, h, 3, HEARTH_PIX_U8, err))) half_box(img, big);
-    return st;
-  }
   if ((st = hearth_image_alloc(&rgb, img->width, img->height, 3, HEARTH_PIX_U8, err))) return st;
   const uint8_t *p = img->data;
   uint8_t *q = rgb.data;
-  for (size_t i = 0; i < img->width * img->height; i++)
-    for (int k = 0; k < 3; k++)
-      q[3 * i + (size_t)k] = p[i * (size_t)img->channels + (img->channels >= 3 ? (size_t)k : 0)];
+  if (img->channels == 3) memcpy(q, p, hearth_image_bytes(&rgb));
+  else
+    for (size_t i = 0; i < img->width * img->height; i++)
+      for (int k = 0; k < 3; k++)
+        q[3 * i + (size_t)k] = p[i * (size_t)img->channels + (img->channels > 3 ? (size_t)k : 0)];
+  if (rgb.width == w && rgb.height == h) {
+    *big = rgb;
+    return HEARTH_OK;
+  }
   st = hearth_image_resize(&rgb, w, h, big, err);
   hearth_image_free(&rgb);
   return st;
 }
 
 /* overlay: the image (thermal in Turbo, enlarged 4x; colour halved) with
- * the centres joined row by row, one colour per row; encoded into j->png */
+ * the centres joined row by row, one colour per row; encoded into j->png
+ * as a picture (its repeated rows are cheap to store) */
 static hearth_status draw_overlay(det_job *j, const hearth_image *img, hearth_err *err) {
   hearth_image big = {0};
   double s = j->thermal ? 4 : 0.5;
-  hearth_status st = overlay_scale(img, j->thermal, s, &big, err);
+  hearth_status st = overlay_scale(img, j->width, j->height, j->thermal, s, &big, err);
   if (st) return st;
   if (j->det.found) {
     static const uint8_t row_rgb[8][3] = {{255, 0, 0},   {255, 128, 0}, {255, 255, 0},
@@ -218,7 +175,7 @@ static hearth_status draw_overlay(det_job *j, const hearth_image *img, hearth_er
     snprintf(msg, sizeof msg, "%s: %s", j->det.frame, j->det.reason);
     hearth_draw_text(&big, 8, 8, msg, red, 2);
   }
-  st = hearth_png_encode(&big, &j->png, &j->png_size, err);
+  st = hearth_png_encode_picture(&big, &j->png, &j->png_size, err);
   hearth_image_free(&big);
   return st;
 }
@@ -232,6 +189,8 @@ hearth_status calib_overlay_encode(const hearth_image *img, int thermal,
   j->target = hearth_target_or_default(target, &tdef);
   j->thermal = thermal;
   j->det = *det;
+  j->width = img->width;
+  j->height = img->height;
   hearth_status st = draw_overlay(j, img, err);
   *png = j->png;
   *size = j->png_size;
@@ -250,9 +209,11 @@ static void det_range(void *vctx, size_t b, size_t e, int ti) {
       const hearth_csv_opts any = {0, 0};
       j->st = hearth_thermal_read_csv(j->path, &any, &img, &j->err);
       if (!j->st) j->st = hearth_detect_plate_thermal(&img, &c->run->detect, &j->det, &j->err);
+      j->width = img.width;
+      j->height = img.height;
     } else {
       /* detection reads the luma plane only (no chroma work); the overlay,
-       * if wanted, decodes the colour image too */
+       * if wanted, decodes the colour image at half size */
       /* the colour camera's size (factory.json), checked from the header
        * before the pixels are decoded */
       hearth_image_expect want = {(size_t)c->want_rgb_w,
@@ -264,13 +225,13 @@ static void det_range(void *vctx, size_t b, size_t e, int ti) {
       j->st =
           hearth_jpeg_read_gray_expect(j->path, c->want_rgb_w > 0 ? &want : NULL, &img, &j->err);
       if (!j->st) j->st = hearth_detect_plate_color(&img, &c->run->detect, &j->det, &j->err);
+      j->width = img.width;
+      j->height = img.height;
       if (!j->st && c->run->overlays) {
         hearth_image_free(&img);
-        j->st = hearth_jpeg_read(j->path, &img, &j->err);
+        j->st = hearth_jpeg_read_half(j->path, &img, &j->err);
       }
     }
-    j->width = img.width;
-    j->height = img.height;
     if (!j->st && c->run->overlays) j->st = draw_overlay(j, &img, &j->err);
     hearth_image_free(&img);
     /* every error names its file */

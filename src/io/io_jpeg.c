@@ -52,6 +52,7 @@ typedef struct jpeg_reader {
   hearth_status status; /* our own check failures */
   char msg[256];
   int want_gray;                   /* decode to luma only (Y of a YCbCr file) */
+  int half;                        /* decode at half the size (libjpeg's scaled IDCT) */
   const hearth_image_expect *want; /* NULL: any image */
   hearth_image img;
 } jpeg_reader;
@@ -108,6 +109,13 @@ static int jpeg_decode(jpeg_reader *r) {
     r->img = (hearth_image){w, h, channels, HEARTH_PIX_U8, NULL};
     return 0;
   }
+  if (r->half) {
+    /* the 4 x 4 inverse DCT of each 8 x 8 block: sides rounded up */
+    r->cinfo.scale_num = 1;
+    r->cinfo.scale_denom = 2;
+    w = (w + 1) / 2;
+    h = (h + 1) / 2;
+  }
   if ((r->status = hearth_image_bytes_check(w, h, channels, 1, r->msg, sizeof r->msg))) return 2;
   jpeg_start_decompress(&r->cinfo);
   if ((int)r->cinfo.output_components != channels || r->cinfo.output_width != w ||
@@ -138,7 +146,7 @@ static int jpeg_decode(jpeg_reader *r) {
 }
 
 static hearth_status jpeg_read_mem(const void *data, size_t size, const char *name, int want_gray,
-                                   const hearth_image_expect *want, hearth_image *img,
+                                   int half, const hearth_image_expect *want, hearth_image *img,
                                    hearth_err *err) {
   if (!name) name = "<memory>";
   memset(img, 0, sizeof *img);
@@ -151,6 +159,7 @@ static hearth_status jpeg_read_mem(const void *data, size_t size, const char *na
   r->data = data;
   r->size = size;
   r->want_gray = want_gray;
+  r->half = half;
   r->want = want;
   init_errmgr(&r->jerr);
   r->cinfo.err = &r->jerr.pub;
@@ -168,10 +177,10 @@ static hearth_status jpeg_read_mem(const void *data, size_t size, const char *na
 
 hearth_status hearth_jpeg_read_mem(const void *data, size_t size, const char *name,
                                    hearth_image *img, hearth_err *err) {
-  return jpeg_read_mem(data, size, name, 0, NULL, img, err);
+  return jpeg_read_mem(data, size, name, 0, 0, NULL, img, err);
 }
 
-static hearth_status jpeg_read_file(const char *path, int want_gray,
+static hearth_status jpeg_read_file(const char *path, int want_gray, int half,
                                     const hearth_image_expect *want, hearth_image *img,
                                     hearth_err *err) {
   memset(img, 0, sizeof *img);
@@ -179,27 +188,31 @@ static hearth_status jpeg_read_file(const char *path, int want_gray,
   size_t n;
   hearth_status s = hearth_read_file(path, JPEG_MAX_FILE_BYTES, &buf, &n, err);
   if (s) return s;
-  s = jpeg_read_mem(buf, n, path, want_gray, want, img, err);
+  s = jpeg_read_mem(buf, n, path, want_gray, half, want, img, err);
   free(buf);
   return s;
 }
 
 hearth_status hearth_jpeg_read(const char *path, hearth_image *img, hearth_err *err) {
-  return jpeg_read_file(path, 0, NULL, img, err);
+  return jpeg_read_file(path, 0, 0, NULL, img, err);
+}
+
+hearth_status hearth_jpeg_read_half(const char *path, hearth_image *img, hearth_err *err) {
+  return jpeg_read_file(path, 0, 1, NULL, img, err);
 }
 
 hearth_status hearth_jpeg_read_expect(const char *path, const hearth_image_expect *want,
                                       hearth_image *img, hearth_err *err) {
-  return jpeg_read_file(path, 0, want, img, err);
+  return jpeg_read_file(path, 0, 0, want, img, err);
 }
 
 hearth_status hearth_jpeg_read_gray(const char *path, hearth_image *img, hearth_err *err) {
-  return jpeg_read_file(path, 1, NULL, img, err);
+  return jpeg_read_file(path, 1, 0, NULL, img, err);
 }
 
 hearth_status hearth_jpeg_read_gray_expect(const char *path, const hearth_image_expect *want,
                                            hearth_image *img, hearth_err *err) {
-  return jpeg_read_file(path, 1, want, img, err);
+  return jpeg_read_file(path, 1, 0, want, img, err);
 }
 
 /* ---- writing ------------------------------------------------------------------ */

@@ -449,7 +449,8 @@ static hearth_status check_writable(const hearth_image *img, const char *name, h
  * dynamic-Huffman block) ended with a sync flush, the last with the final
  * block; concatenated behind a zlib header and followed by the Adler-32 of
  * all filtered bytes (combined band by band) they form the one zlib stream
- * of the IDAT chunks. Run-length matching only looks one byte back, so the
+ * of the IDAT chunks. The picture variants store a row equal to the one
+ * above it UP-filtered instead (all zeros: a few matches). Run-length matching only looks one byte back, so the
  * bands lose little against one stream. The bands are fixed, so the bytes
  * do not depend on the thread count. Speed over size: textures are encoded
  * on every build; a noisy 1024x1024 RGB texture encodes about 4x faster
@@ -465,7 +466,8 @@ typedef struct band_job {
   size_t *out_len;
   uLong *adler; /* per band: Adler-32 of its filtered bytes */
   size_t *raw_len;
-  int *failed; /* per band */
+  int *failed;    /* per band */
+  int up_repeats; /* a row equal to the one above: UP-filtered (all zero) */
 } band_job;
 
 static void encode_bands(void *ctx, size_t b, size_t e, int t) {
@@ -485,7 +487,10 @@ static void encode_bands(void *ctx, size_t b, size_t e, int t) {
       uint8_t *dst = raw + (y - y0) * rowb;
       dst[0] = 1; /* SUB */
       uint8_t *px = dst + 1;
-      if (swap16) {
+      if (j->up_repeats && y > 0 && !memcmp(src, src - j->stride, j->stride)) {
+        dst[0] = 2; /* UP: every difference to the row above is zero */
+        memset(px, 0, j->stride);
+      } else if (swap16) {
         for (size_t i = 0; i + 1 < j->stride; i += 2) {
           px[i] = src[i + 1];
           px[i + 1] = src[i];
@@ -529,8 +534,8 @@ uint8_t *hearth_png_put_chunk(uint8_t *o, const char type[4], const uint8_t *a, 
 }
 
 /* the whole PNG file in a malloc'ed buffer */
-static hearth_status png_encode_mem(const hearth_image *img, const char *name, uint8_t **out,
-                                    size_t *size, hearth_err *err) {
+static hearth_status png_encode_mem(const hearth_image *img, const char *name, int up_repeats,
+                                    uint8_t **out, size_t *size, hearth_err *err) {
   *out = NULL;
   *size = 0;
   size_t bpp = (size_t)img->channels * (size_t)img->type, stride = img->width * bpp;
@@ -543,7 +548,8 @@ static hearth_status png_encode_mem(const hearth_image *img, const char *name, u
                 calloc(nb, sizeof(size_t)),
                 calloc(nb, sizeof(uLong)),
                 calloc(nb, sizeof(size_t)),
-                calloc(nb, sizeof(int))};
+                calloc(nb, sizeof(int)),
+                up_repeats};
   hearth_status s = HEARTH_OK;
   if (!j.out || !j.out_len || !j.adler || !j.raw_len || !j.failed) {
     s = hearth_err_set(err, HEARTH_E_NOMEM, "%s: out of memory encoding PNG", name);
@@ -606,16 +612,34 @@ hearth_status hearth_png_encode(const hearth_image *img, uint8_t **out, size_t *
   *size = 0;
   hearth_status s = check_writable(img, "<memory>", err);
   if (s) return s;
-  return png_encode_mem(img, "<memory>", out, size, err);
+  return png_encode_mem(img, "<memory>", 0, out, size, err);
 }
 
-hearth_status hearth_png_write(const char *path, const hearth_image *img, hearth_err *err) {
+hearth_status hearth_png_encode_picture(const hearth_image *img, uint8_t **out, size_t *size,
+                                        hearth_err *err) {
+  *out = NULL;
+  *size = 0;
+  hearth_status s = check_writable(img, "<memory>", err);
+  if (s) return s;
+  return png_encode_mem(img, "<memory>", 1, out, size, err);
+}
+
+static hearth_status png_write_file(const char *path, const hearth_image *img, int up_repeats,
+                                    hearth_err *err) {
   hearth_status s = check_writable(img, path, err);
   if (s) return s;
   uint8_t *buf;
   size_t n;
-  if ((s = png_encode_mem(img, path, &buf, &n, err))) return s;
+  if ((s = png_encode_mem(img, path, up_repeats, &buf, &n, err))) return s;
   s = hearth_write_file_atomic(path, buf, n, err);
   free(buf);
   return s;
+}
+
+hearth_status hearth_png_write(const char *path, const hearth_image *img, hearth_err *err) {
+  return png_write_file(path, img, 0, err);
+}
+
+hearth_status hearth_png_write_picture(const char *path, const hearth_image *img, hearth_err *err) {
+  return png_write_file(path, img, 1, err);
 }

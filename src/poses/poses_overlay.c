@@ -2,7 +2,9 @@
  * thermal image, per view and as a contact sheet (include/hearth/poses.h).
  *
  * The thermal camera is the same in every view, so the rays through its
- * sub-pixel centres are undistorted once per zoom (ov_grid).
+ * sub-pixel centres are undistorted once (ov_grid). The contact sheet's
+ * cells, at the camera's own pixels, pool the enlarged outlines (a pixel is
+ * on the outline when one of its sub-pixels is) instead of casting again.
  *
  * A ray caster sees back faces too, but where the mesh is closed (every edge
  * shared by two triangles running it in opposite directions, vertices
@@ -44,8 +46,10 @@ typedef struct ov_grid {
 
 /* per worker */
 typedef struct ov_scratch {
-  float *depth;  /* w x h of the largest grid: distance along the ray, INFINITY: no surface */
-  uint8_t *edge; /* w x h: outline sub-pixels */
+  float *depth;     /* w x h of the largest grid: distance along the ray, INFINITY: no surface */
+  uint8_t *edge;    /* w x h: outline sub-pixels */
+  size_t eb[4];     /* x0, x1, y0, y1 (exclusive): no outline sub-pixel outside it */
+  uint8_t *cell[2]; /* per side (before, after): the outline pooled to camera pixels */
   float org[3 * OV_BATCH], dir[3 * OV_BATCH];
   hearth_ray_hit hits[OV_BATCH];
   size_t pix[OV_BATCH];     /* grid index of each ray of the batch */
@@ -173,6 +177,8 @@ static void ov_scratch_free(ov_scratch *s) {
   if (!s) return;
   free(s->depth);
   free(s->edge);
+  free(s->cell[0]);
+  free(s->cell[1]);
   free(s->vals);
   free(s->turbo);
   free(s->fan_scratch);
@@ -189,13 +195,15 @@ static ov_scratch *ov_scratch_new(size_t n_sub, size_t n_px, size_t fan_bytes) {
   if (!s) return NULL;
   s->depth = hearth_alloc_array(n_sub ? n_sub : 1, sizeof *s->depth);
   s->edge = hearth_alloc_array(n_sub ? n_sub : 1, 1);
+  s->cell[0] = hearth_alloc_array(n_px ? n_px : 1, 1);
+  s->cell[1] = hearth_alloc_array(n_px ? n_px : 1, 1);
   s->vals = hearth_alloc_array(n_px ? n_px : 1, sizeof *s->vals);
   s->turbo = hearth_alloc_array(n_px ? n_px : 1, 3);
   if (fan_bytes) {
     s->fan_scratch = calloc(1, fan_bytes);
     s->fan_hits = hearth_alloc_array(n_sub ? n_sub : 1, sizeof *s->fan_hits);
   }
-  if (!s->depth || !s->edge || !s->vals || !s->turbo ||
+  if (!s->depth || !s->edge || !s->cell[0] || !s->cell[1] || !s->vals || !s->turbo ||
       (fan_bytes && (!s->fan_scratch || !s->fan_hits))) {
     ov_scratch_free(s);
     free(s);
@@ -257,7 +265,8 @@ static int ov_hit_on_border(const ov_grid *g, const float *depth, const size_t b
 }
 
 /* mark outline sub-pixels (silhouette and depth jumps) of the mesh seen
- * from T in s->edge; mesh (may be NULL: cast everything) bounds the cast */
+ * from T in s->edge, and their box in s->eb; mesh (may be NULL: cast
+ * everything) bounds the cast */
 static void ov_outline(const hearth_raycaster *rc, const hearth_mesh *mesh,
                        const hearth_camera *cam, const ov_grid *g, const hearth_rigid *T,
                        ov_scratch *s) {
@@ -308,12 +317,44 @@ static void ov_outline(const hearth_raycaster *rc, const hearth_mesh *mesh,
           edge[y * w + x] = edge[(size_t)ny * w + (size_t)nx] = 1;
       }
     }
+  /* an outline sub-pixel is a surface one or its neighbour */
+  if (b[0] < b[1] && b[2] < b[3]) {
+    s->eb[0] = b[0] ? b[0] - 1 : 0;
+    s->eb[1] = b[1] < w ? b[1] + 1 : w;
+    s->eb[2] = b[2] ? b[2] - 1 : 0;
+    s->eb[3] = b[3] < h ? b[3] + 1 : h;
+  } else {
+    s->eb[0] = s->eb[1] = s->eb[2] = s->eb[3] = 0;
+  }
 }
 
-static void ov_paint(hearth_image *out, const uint8_t *edge, const uint8_t rgb[3]) {
+/* the outline sub-pixels inside box eb (x0, x1, y0, y1; NULL: the whole
+   image) painted rgb */
+static void ov_paint(hearth_image *out, const uint8_t *edge, const size_t *eb,
+                     const uint8_t rgb[3]) {
   uint8_t *o = out->data;
-  for (size_t i = 0; i < out->width * out->height; i++)
-    if (edge[i]) memcpy(o + 3 * i, rgb, 3);
+  const size_t w = out->width, all[4] = {0, w, 0, out->height};
+  if (!eb) eb = all;
+  for (size_t y = eb[2]; y < eb[3]; y++)
+    for (size_t x = eb[0]; x < eb[1]; x++)
+      if (edge[y * w + x]) memcpy(o + 3 * (y * w + x), rgb, 3);
+}
+
+/* the zoom x zoom outline sub-pixels of g (all inside box eb) pooled into
+ * camera pixels: a pixel is on the outline when any of its sub-pixels is */
+static void ov_pool(const uint8_t *edge, const ov_grid *g, const size_t eb[4], uint8_t *cell) {
+  const size_t z = (size_t)g->zoom, cw = g->w / z, ch = g->h / z;
+  memset(cell, 0, cw * ch);
+  const size_t cx0 = eb[0] / z, cx1 = (eb[1] + z - 1) / z;
+  for (size_t y = eb[2]; y < eb[3]; y++) {
+    const uint8_t *e = edge + y * g->w;
+    uint8_t *c = cell + (y / z) * cw;
+    for (size_t x = cx0; x < cx1; x++) {
+      uint8_t any = 0;
+      for (size_t k = 0; k < z; k++) any |= e[z * x + k];
+      c[x] |= any;
+    }
+  }
 }
 
 /* the 2..98 % range of the image, so low-contrast states stay readable */
@@ -365,7 +406,9 @@ static hearth_status ov_background(const uint8_t *turbo, size_t tw, size_t th, s
   uint8_t *o = out->data;
   for (size_t ty = 0; ty < th; ty++) {
     uint8_t *row = o + 3 * (ty * zoom) * w;
-    for (size_t x = 0; x < w; x++) memcpy(row + 3 * x, turbo + 3 * (ty * tw + x / zoom), 3);
+    for (size_t tx = 0; tx < tw; tx++)
+      for (size_t r = 0; r < zoom; r++)
+        memcpy(row + 3 * (tx * zoom + r), turbo + 3 * (ty * tw + tx), 3);
     for (size_t r = 1; r < zoom; r++) memcpy(row + 3 * r * w, row, 3 * w);
   }
   return HEARTH_OK;
@@ -398,7 +441,7 @@ hearth_status hearth_overlay_render(const hearth_raycaster *rc, const hearth_cam
   }
   if ((st = ov_grid_make(cam, zoom, 0, &g, err))) goto done;
   ov_outline(rc, NULL, cam, &g, T_world_from_cam, s);
-  ov_paint(out, s->edge, rgb);
+  ov_paint(out, s->edge, s->eb, rgb);
 done:
   ov_grid_free(&g);
   ov_scratch_free(s);
@@ -416,13 +459,13 @@ typedef struct ov_ctx {
   const hearth_manifest *man;
   const hearth_poses *before, *after; /* before: NULL when there is none */
   const char *after_path, *dir;
-  const char *rig_path;       /* the camera's document, named in size errors */
-  const ov_grid *big, *small; /* at the job's zoom and at 1; fans only where the mesh
-                                 allows them (see above) */
-  ov_scratch **scratch;       /* per worker */
-  hearth_image (*thumbs)[2];  /* per view: the sheet's before and after cells */
-  hearth_status *st;          /* per view */
-  hearth_err *errs;           /* per view */
+  const char *rig_path;      /* the camera's document, named in size errors */
+  const ov_grid *big;        /* at the job's zoom; a fan only where the mesh allows
+                                 it (see above) */
+  ov_scratch **scratch;      /* per worker */
+  hearth_image (*thumbs)[2]; /* per view: the sheet's before and after cells */
+  hearth_status *st;         /* per view */
+  hearth_err *errs;          /* per view */
 } ov_ctx;
 
 /* view k: its own file, and its two contact-sheet cells in thumbs */
@@ -449,21 +492,23 @@ static hearth_status ov_view(const ov_ctx *c, ov_scratch *s, size_t k, hearth_im
   const uint8_t white[3] = {255, 255, 255}, magenta[3] = {255, 0, 255};
   hearth_image *ov = &s->big;
   if ((st = ov_background(s->turbo, cw, ch, (size_t)c->big->zoom, ov, err))) return st;
+  /* the sheet's cells (camera pixels) pool the enlarged outlines: no cast
+     of their own */
   if (pb) {
     ov_outline(c->rc, c->mesh, c->cam, c->big, &pb->T_world_from_cam, s);
-    ov_paint(ov, s->edge, magenta);
+    ov_paint(ov, s->edge, s->eb, magenta);
+    ov_pool(s->edge, c->big, s->eb, s->cell[0]);
   }
   ov_outline(c->rc, c->mesh, c->cam, c->big, &pa->T_world_from_cam, s);
-  ov_paint(ov, s->edge, white);
+  ov_paint(ov, s->edge, s->eb, white);
+  ov_pool(s->edge, c->big, s->eb, s->cell[1]);
   hearth_draw_text(ov, 4, 4, vf->view, white, 2);
   rf_pathf(path, "%s/%s.png", c->dir, vf->view);
-  st = hearth_png_write(path, ov, err);
+  st = hearth_png_write_picture(path, ov, err);
   for (int side = 0; side < 2 && !st; side++) {
-    const hearth_view_pose *p = side ? pa : pb;
-    if (!p) continue;
+    if (!(side ? pa : pb)) continue;
     if ((st = ov_background(s->turbo, cw, ch, 1, &thumbs[side], err))) break;
-    ov_outline(c->rc, c->mesh, c->cam, c->small, &p->T_world_from_cam, s);
-    ov_paint(&thumbs[side], s->edge, white);
+    ov_paint(&thumbs[side], s->cell[side], NULL, white);
   }
   return st;
 }
@@ -498,7 +543,7 @@ hearth_status hearth_overlay_run(const hearth_overlay_job *job, size_t *n_writte
   hearth_raycaster *rc = NULL;
   hearth_manifest man = {0};
   hearth_image sheet = {0};
-  ov_grid big = {0}, small = {0};
+  ov_grid big = {0};
   ov_ctx c = {0};
   int nt = 0;
   size_t written = 0;
@@ -531,24 +576,18 @@ hearth_status hearth_overlay_run(const hearth_overlay_job *job, size_t *n_writte
   /* the rays of the thermal camera, once for every view */
   int fan = rf_mesh_closed_outward(&mesh);
   if ((s = ov_grid_make(&rig.thermal, zoom, fan, &big, err))) goto done;
-  if (zoom != 1 && (s = ov_grid_make(&rig.thermal, 1, fan, &small, err))) goto done;
   nt = job->threads > 0 ? job->threads : hearth_default_threads();
   if ((size_t)nt > man.n_views) nt = (int)man.n_views;
   if (nt < 1) nt = 1;
-  c = (ov_ctx){job,    &mesh,      rc,   &rig.thermal, &man, have_before ? &before : NULL,
-               &after, after_path, dir,  rig_path,     &big, zoom != 1 ? &small : &big,
-               NULL,   NULL,       NULL, NULL};
+  c = (ov_ctx){job,    &mesh,      rc,  &rig.thermal, &man, have_before ? &before : NULL,
+               &after, after_path, dir, rig_path,     &big, NULL,
+               NULL,   NULL,       NULL};
   c.scratch = calloc((size_t)nt, sizeof *c.scratch);
   c.thumbs = calloc(man.n_views, sizeof *c.thumbs);
   c.st = calloc(man.n_views, sizeof *c.st);
   c.errs = calloc(man.n_views, sizeof *c.errs);
   int nomem = !c.scratch || !c.thumbs || !c.st || !c.errs;
-  /* fan scratch for the larger fan serves the smaller one too */
   size_t fan_bytes = big.fan ? hearth_ray_fan_scratch_size(big.fan, mesh.n_vertices) : 0;
-  if (small.fan) {
-    size_t k = hearth_ray_fan_scratch_size(small.fan, mesh.n_vertices);
-    if (k > fan_bytes) fan_bytes = k;
-  }
   for (int t = 0; t < nt && !nomem; t++)
     nomem = !(c.scratch[t] = ov_scratch_new(big.w * big.h, cw * ch, fan_bytes));
   if (nomem) {
@@ -579,7 +618,7 @@ hearth_status hearth_overlay_run(const hearth_overlay_job *job, size_t *n_writte
   }
 sheet:
   rf_pathf(path, "%s/contact_sheet.png", dir);
-  if ((s = hearth_png_write(path, &sheet, err))) goto done;
+  if ((s = hearth_png_write_picture(path, &sheet, err))) goto done;
   written++;
   if (n_written) *n_written = written;
 done:
@@ -598,7 +637,6 @@ done:
   free(c.st);
   free(c.errs);
   ov_grid_free(&big);
-  ov_grid_free(&small);
   hearth_image_free(&sheet);
   hearth_manifest_free(&man);
   hearth_raycaster_free(rc);

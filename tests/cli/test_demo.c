@@ -72,5 +72,10 @@ int main(void) {
   /* a second run reuses the release and rebuilds nothing */
   rc = test_run_capture(cmd, out, sizeof out);
   CHECK(rc == 0 && strstr(out, " 0 stage(s) run"));
+  /* and so does a plain build of its release: the demo's build parameters
+     are kept with it */
+  snprintf(cmd, sizeof cmd, "'%s' build '%s/d/release' -j2", HEARTH_EXE, base);
+  rc = test_run_capture(cmd, out, sizeof out);
+  CHECK_MSG(rc == 0 && strstr(out, " 0 stage(s) run"), "build after demo: exit %d: %s", rc, out);
   TEST_MAIN_END();
 }

@@ -205,10 +205,51 @@ static void test_expect(const char *dir) {
   CHECK(!back.data && back.width == 64 && back.height == 48 && back.channels == 3);
 }
 
+/* hearth_jpeg_read_half: sides rounded up, and close to the written image
+ * halved by 2 x 2 means (the last odd column and row their own) */
+static void test_half(const char *dir) {
+  hearth_err err = {0};
+  for (int c = 1; c <= 3; c += 2) {
+    hearth_image img, half, ref;
+    CHECK_OK(hearth_image_alloc(&img, 161, 121, c, HEARTH_PIX_U8, &err), &err);
+    smooth_image(&img);
+    char path[1024];
+    snprintf(path, sizeof path, "%s/half%d.jpg", dir, c);
+    CHECK_OK(hearth_jpeg_write(path, &img, 95, &err), &err);
+    CHECK_OK(hearth_jpeg_read_half(path, &half, &err), &err);
+    CHECK(half.width == 81 && half.height == 61 && half.channels == c);
+    CHECK_OK(hearth_image_alloc(&ref, 81, 61, c, HEARTH_PIX_U8, &err), &err);
+    const uint8_t *p = img.data;
+    uint8_t *q = ref.data;
+    for (size_t y = 0; y < 61; y++)
+      for (size_t x = 0; x < 81; x++)
+        for (int k = 0; k < c; k++) {
+          unsigned sum = 0, n = 0;
+          for (size_t dy = 0; dy < 2; dy++)
+            for (size_t dx = 0; dx < 2; dx++) {
+              size_t sx = 2 * x + dx, sy = 2 * y + dy;
+              if (sx >= 161 || sy >= 121) continue;
+              sum += p[(sy * 161 + sx) * (size_t)c + (size_t)k];
+              n++;
+            }
+          q[(y * 81 + x) * (size_t)c + (size_t)k] = (uint8_t)((sum + n / 2) / n);
+        }
+    if (half.data && half.width == 81 && half.height == 61 && half.channels == c) {
+      double d = psnr_u8(&ref, &half);
+      printf("jpeg half %d channel(s): PSNR %.2f dB against 2x2 means\n", c, d);
+      CHECK_MSG(d > 35.0, "PSNR %.2f", d);
+    }
+    hearth_image_free(&img);
+    hearth_image_free(&half);
+    hearth_image_free(&ref);
+  }
+}
+
 int main(void) {
   const char *dir = test_tmpdir("io_jpeg");
   test_expect(dir);
   test_round_trip(dir);
+  test_half(dir);
   test_bad_inputs(dir);
   test_bad_writes(dir);
   TEST_MAIN_END();
