@@ -237,11 +237,13 @@ typedef struct hearth_report_entry {
      |observed - apparent| (the normal-incidence reading at the scan's start) and
      |observed - true|; and among the worst 5 % of all observed texels against the
      apparent truth, the shares seen only obliquely (best cosine < 0.5), mirroring the
-     warm source in some view, and drifting by more than 1 degC from cooling */
+     warm source in some view, drifting by more than 1 degC from cooling, within
+     2 texels of a surface texel whose apparent truth differs by at least the
+     worst 5 %'s threshold (registration), and in none of these */
   int has_apparent;
   size_t n_away;
   double app_median_abs_c, app_p95_abs_c, away_true_median_abs_c, away_true_p95_abs_c;
-  double worst_grazing, worst_mirror, worst_cooling;
+  double worst_grazing, worst_mirror, worst_cooling, worst_registration, worst_none;
   /* through surface correspondence (hearth_truth_match_state): on observed
      texels seen by some thermal view within 60 degrees of the normal (n_corr,
      corr_share of the observed ones), |observed - true| at the nearest true

@@ -103,6 +103,8 @@ static void free_phase_state(map_ctx *m) {
   free(m->view_hits);
   if (m->max) map_max_free(m->max);
   if (m->rec) map_records_free(m->rec);
+  free(m->corr_best);
+  m->corr_best = NULL;
 }
 
 /* The result's arrays (observed and best_cos made here unless max fusion's

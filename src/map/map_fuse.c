@@ -380,6 +380,58 @@ static size_t keep_near_best(cr *a, size_t n) {
   return k;
 }
 
+/* A view that sees a texel well may still leave it without a record: its
+   pixels are coarser than the texels, and each splats only into the four
+   texels around its hit. Such a texel's records then come from oblique
+   views alone. A texel whose own records are all seen more than the keep
+   band (0.2) more obliquely than the best record of a texel within
+   BORROW_R texels of its island borrows the records of those neighbours
+   that lie within the band of that best cosine, their weight halved per
+   texel of distance; the oblique records then fall out of the keep band. */
+#define BORROW_R 2
+#define BORROW_SPAN ((2 * BORROW_R + 1) * (2 * BORROW_R + 1))
+
+/* view v's record of texel p, or NULL */
+static const float *record_of(const view_records *r, size_t v, uint32_t p, size_t RW) {
+  size_t k = lower_bound_u32(r->q[v], r->n[v], p);
+  return k < r->n[v] && r->q[v][k] == p ? r->d[v] + k * RW : NULL;
+}
+
+/* texel q's n records in a (room for n_views * BORROW_SPAN) with the
+   neighbours' records borrowed where they see it much better (above);
+   returns the new count */
+static size_t borrow_neighbours(const map_ctx *m, size_t q, cr *a, size_t n) {
+  const long R = (long)m->l->R, x = (long)q % R, y = (long)q / R;
+  const size_t RW = REC_WORDS(m->C);
+  const uint32_t *iot = m->l->island_of_texel;
+  const float *best = m->corr_best;
+  float nb = 0;
+  for (long dy = -BORROW_R; dy <= BORROW_R; dy++)
+    for (long dx = -BORROW_R; dx <= BORROW_R; dx++) {
+      const long px = x + dx, py = y + dy;
+      if (px < 0 || py < 0 || px >= R || py >= R) continue;
+      const size_t p = (size_t)(py * R + px);
+      if (iot[p] == iot[q] && best[p] > nb) nb = best[p];
+    }
+  if (nb <= best[q] + 0.2f) return n;
+  const float lo = nb - 0.2f;
+  for (long dy = -BORROW_R; dy <= BORROW_R; dy++)
+    for (long dx = -BORROW_R; dx <= BORROW_R; dx++) {
+      const long px = x + dx, py = y + dy;
+      if ((!dx && !dy) || px < 0 || py < 0 || px >= R || py >= R) continue;
+      const size_t p = (size_t)(py * R + px);
+      if (iot[p] != iot[q] || best[p] < lo) continue;
+      const long d = labs(dx) > labs(dy) ? labs(dx) : labs(dy);
+      const float f = ldexpf(1.0f, -(int)d);
+      for (size_t v = 0; v < m->n_views; v++) {
+        const float *rec = record_of(m->rec, v, (uint32_t)p, RW);
+        if (rec && rec[1] >= lo)
+          a[n++] = (cr){rec[2], rec[0] * f, rec[1], (float)m->views[v].time_s, m->views[v].pass};
+      }
+    }
+  return n;
+}
+
 /* texels [q0, q1), corrected fusion: each kept view's reading brought back
    to time 0, then their weighted median */
 static int fold_corrected(const map_ctx *m, hearth_map_result *out, uint32_t *cnt, cr **all,
@@ -394,6 +446,7 @@ static int fold_corrected(const map_ctx *m, hearth_map_result *out, uint32_t *cn
     memcpy(tmp, *all + start, n * sizeof *tmp);
     for (size_t j = 0; j < n; j++)
       if (out->best_cos && tmp[j].c > out->best_cos[q0 + i]) out->best_cos[q0 + i] = tmp[j].c;
+    n = borrow_neighbours(m, q0 + i, tmp, n);
     n = keep_near_best(tmp, n);
     for (size_t j = 0; j < n; j++) {
       double v = normal_equivalent(tmp[j].v, A, tmp[j].c);
@@ -526,6 +579,16 @@ int map_correction_estimate(map_ctx *m, int nt) {
   }
   free(ring);
   m->corr_rate = 0;
+  /* every texel's best viewing cosine among its records */
+  const size_t RW = REC_WORDS(m->C), NT = m->l->R * m->l->R;
+  m->corr_best = calloc(NT ? NT : 1, sizeof *m->corr_best);
+  if (!m->corr_best) return 0;
+  for (size_t v = 0; v < m->n_views; v++)
+    for (size_t j = 0; j < m->rec->n[v]; j++) {
+      const uint32_t q = m->rec->q[v][j];
+      const float c = m->rec->d[v][j * RW + 1];
+      if (c > m->corr_best[q]) m->corr_best[q] = c;
+    }
   if (!n) return 1;
   /* the rate: the weighted median of the texels' slopes, gathered in band
      order (a texel's weight is its spread of times, so texels seen over a
@@ -582,7 +645,8 @@ void map_fuse_bands(void *ctx, size_t b, size_t e, int t) {
     bs.cnt = hearth_alloc_array(band + 1, sizeof *bs.cnt);
     bs.tmp = hearth_alloc_array(nv ? nv : 1, sizeof *bs.tmp);
   }
-  if (fusion == HEARTH_FUSE_CORRECTED) ctmp = hearth_alloc_array(nv ? nv : 1, sizeof *ctmp);
+  if (fusion == HEARTH_FUSE_CORRECTED)
+    ctmp = hearth_alloc_array((nv ? nv : 1) * BORROW_SPAN, sizeof *ctmp);
   if ((fusion == HEARTH_FUSE_MEAN && !m->rec->acc && !bs.acc) ||
       ((fusion == HEARTH_FUSE_ROBUST || fusion == HEARTH_FUSE_CORRECTED) && (!bs.cnt || !bs.tmp)) ||
       (fusion == HEARTH_FUSE_CORRECTED && !ctmp)) {

@@ -132,6 +132,8 @@ typedef struct map_ctx {
   hearth_err *load_errs;   /* per view, with opts->load: its load's error (status 0: none) */
   double corr_ambient;     /* corrected fusion: the ambient estimate (degC) */
   double corr_rate;        /* corrected fusion: the cooling rate (1/s) towards it */
+  float *corr_best;        /* corrected fusion: per texel, the best viewing cosine of its
+                              records (R * R, 0 without any); owned */
   _Atomic int failed;      /* 1 out of memory, 2 a view not in front after all, 3 a load failed
                               (load_errs) */
 } map_ctx;

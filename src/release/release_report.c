@@ -60,6 +60,27 @@ static hearth_status write_turbo(const char *path, const float *v, const uint8_t
   return s;
 }
 
+/* Registration: whether the apparent truth a[] changes by at least d
+   between texel i and a surface texel (mask 1 or 2) within EDGE_REACH
+   texels of it, i.e. whether texel i lies so near a material or thermal
+   edge (or a silhouette between parts) that a reading moved by that much
+   along the surface, by a pose error or the thermal camera's blur, is off
+   by d. EDGE_REACH is 2 texels: about 1 mm on the rig's objects at R =
+   1024, the order of the thermal pixel's footprint and of the refined
+   poses' centre error. */
+#define EDGE_REACH 2
+static int near_edge(const uint8_t *m, const float *a, size_t R, size_t i, double d) {
+  const long x = (long)(i % R), y = (long)(i / R), r = EDGE_REACH;
+  for (long dy = -r; dy <= r; dy++)
+    for (long dx = -r; dx <= r; dx++) {
+      const long px = x + dx, py = y + dy;
+      if (px < 0 || py < 0 || px >= (long)R || py >= (long)R) continue;
+      const size_t p = (size_t)py * R + (size_t)px;
+      if ((m[p] == 1 || m[p] == 2) && isfinite(a[p]) && fabs((double)a[p] - a[i]) >= d) return 1;
+    }
+  return 0;
+}
+
 /* the errors against the apparent truth a[] and where the largest sit,
    with the truth's viewing conditions c[] (3 per texel); all in the map's
    UV layout. A texel counts as seen within 60 degrees where away[] is 1
@@ -97,18 +118,24 @@ static hearth_status report_effects(const uint8_t *m, const float *o, const floa
   /* the worst 5 % of all observed texels */
   qsort(all, nall, sizeof *all, cmp_double);
   const double cut = quantile(all, nall, 0.95);
-  size_t nw = 0, ng = 0, nm = 0, nc = 0;
+  size_t nw = 0, ng = 0, nm = 0, nc = 0, nr = 0, nn = 0;
   for (size_t i = 0; nall && i < n; i++) {
     if (m[i] != 1 || !isfinite(o[i]) || !isfinite(a[i]) || fabs((double)o[i] - a[i]) < cut)
       continue;
     nw++;
-    ng += away ? !away[i] : c[3 * i] < 0.5f;
-    nm += c[3 * i + 1] > 0.0f;
-    nc += c[3 * i + 2] > 1.0f;
+    const int g = away ? !away[i] : c[3 * i]<0.5f, mi = c[3 * i + 1]> 0.0f,
+              co = c[3 * i + 2] > 1.0f, re = near_edge(m, a, R, i, cut);
+    ng += g;
+    nm += mi;
+    nc += co;
+    nr += re;
+    nn += !(g || mi || co || re);
   }
   e->worst_grazing = nw ? (double)ng / (double)nw : NAN;
   e->worst_mirror = nw ? (double)nm / (double)nw : NAN;
   e->worst_cooling = nw ? (double)nc / (double)nw : NAN;
+  e->worst_registration = nw ? (double)nr / (double)nw : NAN;
+  e->worst_none = nw ? (double)nn / (double)nw : NAN;
   free(da);
   free(dt);
   free(all);
@@ -196,6 +223,7 @@ static hearth_status report_state(const char *root, const char *out_dir, const c
   e->app_median_abs_c = e->app_p95_abs_c = NAN;
   e->away_true_median_abs_c = e->away_true_p95_abs_c = NAN;
   e->worst_grazing = e->worst_mirror = e->worst_cooling = NAN;
+  e->worst_registration = e->worst_none = NAN;
   e->corr_median_abs_c = e->corr_p95_abs_c = e->corr_dist_median_mm = e->corr_dist_p95_mm = NAN;
   e->corr_app_median_abs_c = e->corr_app_p95_abs_c = NAN;
   *have_truth_png = *have_overlay = 0;
@@ -437,15 +465,20 @@ hearth_status hearth_report_write(const char *root, const char *out_dir, const c
         "reads at the start of the scan) and |observed &minus; true| (the true surface "
         "temperature then). Of the worst 5 % of all observed texels against the apparent truth: "
         "the shares seen only beyond 60&deg; (grazing), mirroring the warm source in a view "
-        "(reflections), and drifting by more than 1 &deg;C during the scan (cooling).</p>\n"
+        "(reflections), drifting by more than 1 &deg;C during the scan (cooling), and lying "
+        "within 2 texels of a texel whose apparent truth differs by at least the worst 5 "
+        "%'s threshold (registration: a reading moved that far along the surface, by a pose "
+        "error or the thermal blur, is that wrong); a texel may be in several classes, and the "
+        "last column is the share in none.</p>\n"
         "<table class=\"n\"><tr><th>instance</th><th>state</th><th>texels</th>"
         "<th>median |err| apparent</th><th>p95</th><th>median |err| true</th><th>p95</th>"
-        "<th>worst: grazing</th><th>reflections</th><th>cooling</th></tr>\n",
+        "<th>worst: grazing</th><th>reflections</th><th>cooling</th><th>registration</th>"
+        "<th>none</th></tr>\n",
         f);
     for (size_t j = 0; j < rep->n; j++) {
       const hearth_report_entry *e = &rep->entries[j];
       if (!e->has_apparent) continue;
-      char v[7][32];
+      char v[9][32];
       fmt2(v[0], sizeof v[0], e->app_median_abs_c);
       fmt2(v[1], sizeof v[1], e->app_p95_abs_c);
       fmt2(v[2], sizeof v[2], e->away_true_median_abs_c);
@@ -453,11 +486,14 @@ hearth_status hearth_report_write(const char *root, const char *out_dir, const c
       fmt2(v[4], sizeof v[4], 100.0 * e->worst_grazing);
       fmt2(v[5], sizeof v[5], 100.0 * e->worst_mirror);
       fmt2(v[6], sizeof v[6], 100.0 * e->worst_cooling);
+      fmt2(v[7], sizeof v[7], 100.0 * e->worst_registration);
+      fmt2(v[8], sizeof v[8], 100.0 * e->worst_none);
       fprintf(f,
               "<tr><td style=\"text-align:left\">%s</td><td style=\"text-align:left\">%s</td>"
               "<td>%zu</td><td>%s</td><td>%s</td><td>%s</td><td>%s</td><td>%s %%</td>"
-              "<td>%s %%</td><td>%s %%</td></tr>\n",
-              e->instance, e->state, e->n_away, v[0], v[1], v[2], v[3], v[4], v[5], v[6]);
+              "<td>%s %%</td><td>%s %%</td><td>%s %%</td><td>%s %%</td></tr>\n",
+              e->instance, e->state, e->n_away, v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7],
+              v[8]);
     }
     fputs("</table>\n", f);
   }

@@ -12,7 +12,7 @@ B=$1
 S=$2
 W=$(mktemp -d "${TMPDIR:-/tmp}/hearth_rig_effects.XXXXXX")
 trap 'rm -rf "$W"' EXIT
-bash "$S/bench/rig_effects.sh" "$B" "$W/w" 128 12 1 > "$W/table.txt"
+STATES= bash "$S/bench/rig_effects.sh" "$B" "$W/w" 128 12 1 > "$W/table.txt"
 cat "$W/table.txt"
 /usr/bin/python3 - "$W/table.txt" <<'PY'
 import sys
