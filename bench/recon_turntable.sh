@@ -7,7 +7,8 @@
 # through the same similarity; true->recon also over the true vertices some
 # true depth camera sees, by ray casting, tests/recon/true_visibility.h).
 # The manifests' turntable_deg (the encoder) holds the angles unless
-# RECON_TT_NO_ENCODER=1; RECON_TT_COLOUR=W turns the photometric term on.
+# RECON_TT_NO_ENCODER=1; RECON_TT_COLOUR=W turns the photometric term on;
+# RECON_TT_AIM=W sets the aim term's weight (0: off, the route before it).
 # usage: bench/recon_turntable.sh [BUILD_DIR] [WORKDIR] [CATEGORIES] [VIEWS] [VOXEL_M]
 set -e
 B=${1:-build}

@@ -127,8 +127,9 @@ hearth_status hearth_recon_tsdf(const char *root, const char *instance, const ch
  * degrees of every view jointly over all views of all states (pairs of
  * views whose optical axes are within max_pair_deg, projective association
  * in the target's depth image, Huber weights, a shrinking distance gate;
- * view 0 holds the gauge), with each view's table points (those within
- * 0.25 m of its object points) held at z = 0 and the turntable's azimuth
+ * the cameras' mean horizontal step held at zero as the gauge), with each
+ * view's table points (those within 0.25 m of its object points) held at
+ * z = 0 and the turntable's azimuth
  * as a weak prior. Where every view of a state carries the manifest's
  * turntable_deg (and not ignore_encoder), the differences of those views'
  * angles are held stiffly to the encoder's, over all such states at once
@@ -137,7 +138,14 @@ hearth_status hearth_recon_tsdf(const char *root, const char *instance, const ch
  * all views' table normals (a turntable camera tilts about it between
  * rings); with colour_weight > 0 the views without the encoder add a
  * photometric term (recon_photo.c: band-passed grey inside the cut-out,
- * view i's point against view j's image at its depth correspondence). The frame of the result: metres,
+ * view i's point against view j's image at its depth correspondence). With
+ * aim_prior > 0, the aim term: the rig aims its cameras at the object
+ * and the turntable turns the object under them, so the point C of the
+ * axis they aim at lies at one place P in every camera's frame, within
+ * aim_side_m across the optical axis and aim_depth_tol of its distance
+ * along it (C per state and P are unknowns of the ICP). It fixes a
+ * camera's place where its depth does not: a flat object's low ring, the
+ * radius of a smooth cylinder. The frame of the result: metres,
  * +z up the axis, the turntable top at z = 0, view 0's azimuth at its
  * nominal value. A surface of revolution without azimuthal detail leaves
  * the angle about its own axis unobserved by its depth: those views keep
@@ -167,6 +175,20 @@ typedef struct hearth_turntable_opts {
                               1e-2; default 0 (off: on the virtual rig it
                               does not yet improve on depth alone) */
   int colour_with_encoder; /* 1: the photometric term on the encoder's views too */
+  double aim_prior;        /* weight, per match a view has, of the aim term:
+                              the axis point the cameras aim at (unknown, per
+                              state) held at one place (unknown) in every
+                              camera's frame; 0: off; default 0.1 */
+  double aim_depth_tol;    /* that place's spread along the optical axis, a
+                              share of its distance (one sigma); default 0.012
+                              (the virtual rig's +-2% distance jitter) */
+  double aim_side_m;       /* its spread across the optical axis (m); default
+                              0.0005 */
+  int aim_per_ring;        /* 1: one place per ring (rings aimed at different
+                              points); 0 (default): one for all views */
+  double aim_height_tol;   /* the aimed-at point's height held to half the
+                              object's top within this share of the top (and
+                              at least 2 mm); 0: free; default 0.15 */
   int threads;             /* 0: hearth_default_threads() */
   int quiet;               /* 1: no progress on stderr */
 } hearth_turntable_opts;

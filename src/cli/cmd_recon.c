@@ -170,6 +170,9 @@ int hearth_cmd_recon(int argc, char **argv) {
                "turntable: azimuth grows clockwise seen from above"),
       CLI_FLAG("--no-encoder", &tj.poses.ignore_encoder, 1,
                "turntable: leave the manifests' turntable_deg unused"),
+      CLI_NUM("--aim", "W", &tj.poses.aim_prior, 0, 100,
+              "turntable: weight of the aim term (every camera aimed at one axis point; 0: off)",
+              .def = "0.1"),
       CLI_NUM("--colour", "W", &tj.poses.colour_weight, 0, 10,
               "turntable: weight of the photometric term of states without turntable_deg "
               "(about 0.01; experimental)",

@@ -55,6 +55,11 @@ void hearth_turntable_opts_default(hearth_turntable_opts *o) {
   o->azimuth_prior = 3e-3;
   o->encoder_prior = 1.0;
   o->colour_weight = 0;
+  o->aim_prior = 0.1;
+  o->aim_depth_tol = 0.012;
+  o->aim_side_m = 0.0005;
+  o->aim_per_ring = 0;
+  o->aim_height_tol = 0.15;
 }
 
 void hearth_turntable_result_free(hearth_turntable_result *r) {
@@ -91,6 +96,8 @@ typedef struct tt_view {
   double target, target_nominal;
   int enc;
   size_t state_index; /* its encoder group: its state's index, or 0 for all */
+  size_t state_no;    /* its state's index */
+  int ring;           /* its group in the aim term, -1: none */
   hearth_rigid T;     /* current pose */
   /* the photometric term's view (without the encoder) and each point's
    * band-passed grey in it (NaN: none) */
@@ -786,6 +793,159 @@ static void view_dir(const tt_view *v, double d[3]) {
   for (int a = 0; a < 3; a++) d[a] = v->T.R[3 * a + 2];
 }
 
+/* ---- the aim term -----------------------------------------------------------
+ * The rig aims its cameras at the object and the turntable turns the
+ * object under them, so a point C on the axis (where the aim meets it)
+ * lies at one place P in every camera's frame: sideways and up in the
+ * image (x, y) all but exactly, along the optical axis (z) within the
+ * cameras' distance spread. Unknowns beside the poses: C per state (the
+ * object may move between states) and P, one for all views (the rig aims
+ * every ring at one point) or one per ring (aim_per_ring). */
+typedef struct tt_aim {
+  size_t n_states, n_groups;
+  double C[3 * HEARTH_MAX_STATES];
+  double *P; /* 3 * n_groups, camera frame */
+} tt_aim;
+
+/* view i's group, -1: not in the term (a ring of fewer than 3 views) */
+static int aim_group(const tt_view *v, size_t nv, size_t i, int per_ring, int *elev, size_t *ne) {
+  if (!per_ring) return 0;
+  size_t cnt = 0, k = 0;
+  for (size_t j = 0; j < nv; j++) cnt += v[j].elevation_index == v[i].elevation_index;
+  if (cnt < 3) return -1;
+  while (k < *ne && elev[k] != v[i].elevation_index) k++;
+  if (k == *ne) elev[(*ne)++] = v[i].elevation_index;
+  return (int)k;
+}
+
+/* The groups, and C and P started from the current poses by least squares
+ * (sum over views of |C - t_i - R_i P|^2, a small ridge for a state or group
+ * that fixes nothing). 0: no term (too few views, or no memory). */
+static int aim_setup(tt_view *v, size_t nv, size_t n_states, int per_ring, tt_aim *am) {
+  memset(am, 0, sizeof *am);
+  am->n_states = n_states < HEARTH_MAX_STATES ? n_states : HEARTH_MAX_STATES;
+  int *elev = malloc((nv ? nv : 1) * sizeof *elev);
+  if (!elev) return 0;
+  size_t ne = 0, used = 0;
+  for (size_t i = 0; i < nv; i++) {
+    v[i].ring = v[i].state_no < am->n_states ? aim_group(v, nv, i, per_ring, elev, &ne) : -1;
+    used += v[i].ring >= 0;
+  }
+  free(elev);
+  am->n_groups = per_ring ? ne : 1;
+  if (used < 3 || !am->n_groups) return 0;
+  const size_t n = 3 * (am->n_states + am->n_groups), p0 = 3 * am->n_states;
+  double *M = calloc(n * n, sizeof *M), *r = calloc(n, sizeof *r);
+  am->P = calloc(3 * am->n_groups, sizeof *am->P);
+  int ok = M && r && am->P;
+  for (size_t i = 0; ok && i < nv; i++) {
+    if (v[i].ring < 0) continue;
+    /* residual C - t - R P: rows a, unknowns C_a (+1) and P_b (-R_ab) */
+    size_t c = 3 * v[i].state_no, q = p0 + 3 * (size_t)v[i].ring;
+    for (int a = 0; a < 3; a++) {
+      double J[4] = {1.0, -v[i].T.R[3 * a], -v[i].T.R[3 * a + 1], -v[i].T.R[3 * a + 2]};
+      size_t ix[4] = {c + (size_t)a, q, q + 1, q + 2};
+      for (int x = 0; x < 4; x++) {
+        r[ix[x]] += J[x] * v[i].T.t[a];
+        for (int y = 0; y < 4; y++) M[ix[x] * n + ix[y]] += J[x] * J[y];
+      }
+    }
+  }
+  for (size_t d = 0; ok && d < n; d++) M[d * n + d] += 1e-9;
+  ok = ok && chol_solve(M, r, n);
+  if (ok) {
+    memcpy(am->C, r, 3 * am->n_states * sizeof *r);
+    memcpy(am->P, r + p0, 3 * am->n_groups * sizeof *r);
+  }
+  free(M);
+  free(r);
+  if (!ok) {
+    free(am->P);
+    am->P = NULL;
+  }
+  return ok;
+}
+
+/* The aim term's normal equations, added to A (nu x nu) and b: per view
+ * the residuals g_k . (C - t) - P_k along its camera axes g_k (columns of
+ * R): sigma aim_side_m across the optical axis, aim_depth_tol of |P| along
+ * it; in the view's rotation and place, its state's C and its group's P
+ * (the unknowns after the 6 nv of the poses: C by state, then P by group),
+ * each weighted as aim_prior times a view's matches at TT_HUBER_M per
+ * sigma. */
+static int cmp_double(const void *a, const void *b) {
+  double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
+/* The object's top: the 99.5th percentile of its points' heights over all
+ * views (every 8th point); 0 when there are none */
+static double object_top(const tt_view *v, size_t nv) {
+  size_t n = 0;
+  for (size_t i = 0; i < nv; i++) n += (v[i].n + 7) / 8;
+  double *z = malloc((n ? n : 1) * sizeof *z);
+  if (!z || !n) {
+    free(z);
+    return 0;
+  }
+  size_t m = 0;
+  for (size_t i = 0; i < nv; i++)
+    for (size_t k = 0; k < v[i].n; k += 8) {
+      double p[3] = {v[i].p[3 * k], v[i].p[3 * k + 1], v[i].p[3 * k + 2]}, q[3];
+      hearth_rigid_apply(&v[i].T, p, q);
+      z[m++] = q[2];
+    }
+  qsort(z, m, sizeof *z, cmp_double);
+  double top = z[(size_t)(0.995 * (double)(m - 1))];
+  free(z);
+  return top;
+}
+
+static void aim_system(const tt_view *v, size_t nv, const tt_aim *am,
+                       const hearth_turntable_opts *o, double w_view, double *A, double *b,
+                       size_t nu) {
+  const size_t c0 = 6 * nv, p0 = c0 + 3 * am->n_states;
+  /* the height aimed at: the object's middle (half its top above the
+   * turntable), within aim_height_tol of its top (and 2 mm), weighted as
+   * all views' matches; without it the aim's height trades against the
+   * rings' radii */
+  double top = object_top(v, nv);
+  double sig_h = fmax(o->aim_height_tol * top, 0.002);
+  for (size_t st = 0; st < am->n_states && o->aim_height_tol > 0; st++) {
+    size_t ns = 0;
+    for (size_t i = 0; i < nv; i++) ns += v[i].ring >= 0 && v[i].state_no == st;
+    double w = o->aim_prior * w_view * (double)ns * (TT_HUBER_M / sig_h) * (TT_HUBER_M / sig_h);
+    size_t ix = c0 + 3 * st + 2;
+    b[ix] -= w * (am->C[3 * st + 2] - 0.5 * top);
+    A[ix * nu + ix] += w;
+  }
+  for (size_t i = 0; i < nv; i++) {
+    if (v[i].ring < 0) continue;
+    const size_t st = v[i].state_no, g = (size_t)v[i].ring;
+    const double *C = &am->C[3 * st], *P = &am->P[3 * g];
+    double d[3] = {C[0] - v[i].T.t[0], C[1] - v[i].T.t[1], C[2] - v[i].T.t[2]};
+    for (int k = 0; k < 3; k++) {
+      double sig = k < 2 ? o->aim_side_m : o->aim_depth_tol * hearth_norm3(P);
+      if (!(sig > 0)) continue;
+      double gk[3] = {v[i].T.R[k], v[i].T.R[3 + k], v[i].T.R[6 + k]}, gx[3];
+      double res = hearth_dot3(gk, d) - P[k];
+      /* d g / d w = w x g: d res / d w = g x d */
+      hearth_cross3(gk, d, gx);
+      double J[10] = {gx[0], gx[1], gx[2], -gk[0], -gk[1], -gk[2], gk[0], gk[1], gk[2], -1.0};
+      size_t ix[10] = {6 * i,           6 * i + 1,
+                       6 * i + 2,       6 * i + 3,
+                       6 * i + 4,       6 * i + 5,
+                       c0 + 3 * st,     c0 + 3 * st + 1,
+                       c0 + 3 * st + 2, p0 + 3 * g + (size_t)k};
+      double w = o->aim_prior * w_view * (TT_HUBER_M / sig) * (TT_HUBER_M / sig);
+      for (int x = 0; x < 10; x++) {
+        b[ix[x]] -= w * J[x] * res;
+        for (int y = 0; y < 10; y++) A[ix[x] * nu + ix[y]] += w * J[x] * J[y];
+      }
+    }
+  }
+}
+
 static hearth_status run_icp(tt_view *v, size_t nv, size_t n_states, const double u[3],
                              const hearth_camera *rgb, const hearth_turntable_opts *o,
                              hearth_turntable_result *res, hearth_err *err) {
@@ -808,11 +968,14 @@ static hearth_status run_icp(tt_view *v, size_t nv, size_t n_states, const doubl
       pairs[np].gain = 1.0;
       np++;
     }
-  const size_t nu = 6 * nv;
+  tt_aim am = {0};
+  int aim = o->aim_prior > 0 && aim_setup(v, nv, n_states, o->aim_per_ring, &am);
+  const size_t nu = 6 * nv + (aim ? 3 * (am.n_states + am.n_groups) : 0);
   double *A = malloc(nu * nu * sizeof *A), *b = malloc(nu * sizeof *b);
   if (!A || !b) {
     free(A);
     free(b);
+    free(am.P);
     free(pairs);
     return hearth_err_set(err, HEARTH_E_NOMEM, "turntable: normal equations");
   }
@@ -908,6 +1071,7 @@ static hearth_status run_icp(tt_view *v, size_t nv, size_t n_states, const doubl
     for (int a = 3; a < 5; a++)
       for (size_t vi = 0; vi < nv; vi++)
         for (size_t vj = 0; vj < nv; vj++) A[(6 * vi + a) * nu + 6 * vj + a] += wg / (double)nv;
+    if (aim) aim_system(v, nv, &am, o, wg, A, b, nu);
     /* a scaled Levenberg term and a small floor */
     for (size_t d = 0; d < nu; d++) A[d * nu + d] = A[d * nu + d] * 1.01 + 1e-6;
     if (!chol_solve(A, b, nu)) {
@@ -922,6 +1086,10 @@ static hearth_status run_icp(tt_view *v, size_t nv, size_t n_states, const doubl
       hearth_orthonormalize(R);
       memcpy(v[vi].T.R, R, sizeof R);
       for (int a = 0; a < 3; a++) v[vi].T.t[a] += d[3 + a];
+    }
+    if (aim) {
+      for (size_t k = 0; k < 3 * am.n_states; k++) am.C[k] += b[6 * nv + k];
+      for (size_t k = 0; k < 3 * am.n_groups; k++) am.P[k] += b[6 * nv + 3 * am.n_states + k];
     }
     if (last && res->views) {
       memset(res->views, 0, nv * sizeof *res->views);
@@ -957,6 +1125,7 @@ static hearth_status run_icp(tt_view *v, size_t nv, size_t n_states, const doubl
   res->n_pairs = np;
   res->iterations += iterations;
   for (size_t k = 0; k < np; k++) free(pairs[k].r);
+  free(am.P);
   free(pairs);
   free(A);
   free(b);
@@ -1019,6 +1188,7 @@ hearth_status hearth_recon_turntable(const char *root, const char *instance,
       tt_view *tv = &v[k];
       snprintf(tv->state, sizeof tv->state, "%s", states[i]);
       snprintf(tv->view, sizeof tv->view, "%s", vf->view);
+      tv->state_no = i;
       tv->elevation_index = vf->elevation_index;
       tv->azimuth_index = vf->azimuth_index;
       s = load_view(tv, dir, vf, &fac.rgb, o.erode_px, 0x7475726eULL + k, &rays, err);
