@@ -125,6 +125,23 @@ static double pair_cost(const stereo_prob *P, size_t i, const hearth_rigid *Tba,
   return s;
 }
 
+/* Levenberg-Marquardt's step rule for a trial of cost cn: a lower cost is
+ * taken (*cost = cn, lambda ten times smaller, not below 1e-12) and 1
+ * returned, *done set when the relative gain is under 1e-14; otherwise
+ * lambda grows ten-fold and 0 is returned. */
+static int lm_take(double *cost, double cn, double *lambda, int *done) {
+  *done = 0;
+  if (!(cn < *cost)) {
+    *lambda *= 10;
+    return 0;
+  }
+  double rel = (*cost - cn) / (*cost > 0 ? *cost : 1);
+  *cost = cn;
+  *lambda = *lambda / 10 > 1e-12 ? *lambda / 10 : 1e-12;
+  *done = rel < 1e-14;
+  return 1;
+}
+
 static double total_cost(const stereo_prob *P, const double pT[6], const double *poses,
                          double *per_pair) {
   hearth_rigid Tba;
@@ -286,17 +303,12 @@ static int stereo_lm(const stereo_prob *P, double pT[6], double *poses, int max_
           trial[D * i + a] += s;
         }
       }
-      double cn = total_cost(P, pTn, trial, NULL);
-      if (cn < cost) {
-        double rel = (cost - cn) / (cost > 0 ? cost : 1);
+      int done;
+      if (lm_take(&cost, total_cost(P, pTn, trial, NULL), &lambda, &done)) {
         memcpy(pT, pTn, sizeof(double) * 6);
         memcpy(poses, trial, sizeof(double) * D * n);
-        cost = cn;
-        lambda = lambda / 10 > 1e-12 ? lambda / 10 : 1e-12;
         improved = 1;
-        if (rel < 1e-14) it = max_it;
-      } else {
-        lambda *= 10;
+        if (done) it = max_it;
       }
     }
     if (!improved) break;
@@ -729,17 +741,12 @@ static int joint_lm(const joint_prob *J, double *g, double *x, int max_it) {
           xb[a] += s;
         }
       }
-      double cn = joint_cost(J, gn, trial);
-      if (cn < cost) {
-        double rel = (cost - cn) / (cost > 0 ? cost : 1);
+      int done;
+      if (lm_take(&cost, joint_cost(J, gn, trial), &lambda, &done)) {
         memcpy(g, gn, sizeof gn);
         memcpy(x, trial, sizeof(double) * nx);
-        cost = cn;
-        lambda = lambda / 10 > 1e-12 ? lambda / 10 : 1e-12;
         improved = 1;
-        if (rel < 1e-14) it = max_it;
-      } else {
-        lambda *= 10;
+        if (done) it = max_it;
       }
     }
     if (!improved) break;
