@@ -789,6 +789,12 @@ static double plate_flex(const hearth_rng *base, uint64_t fork, double m) {
   return m * hearth_rng_range(&r, -1.0, 1.0);
 }
 
+/* N(0, sigma^2) from r, clipped to +-3 sigma */
+static double normal_3sigma(hearth_rng *r, double sigma) {
+  const double lim = 3.0 * sigma, a = sigma * hearth_rng_normal(r);
+  return a < -lim ? -lim : a > lim ? lim : a;
+}
+
 hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
                                       const hearth_synth_opts *o, uint64_t seed,
                                       const float *thermal_rays, const float *rgb_rays,
@@ -894,13 +900,10 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
     g->bow = bow0;
     if (E->hole_burr_m > 0) {
       /* each term within 3 sigma; burr_max the largest sum of magnitudes */
-      const double lim = 3.0 * E->hole_burr_m;
       for (size_t i = 0; i < g->n; i++) {
         double sum = 0;
         for (int k = 0; k < 6; k++) {
-          double a = E->hole_burr_m * hearth_rng_normal(&wb);
-          a = a < -lim ? -lim : a > lim ? lim : a;
-          g->burr[i][k] = (float)a;
+          g->burr[i][k] = (float)normal_3sigma(&wb, E->hole_burr_m);
           sum += fabs((double)g->burr[i][k]);
         }
         if (sum > g->burr_max) g->burr_max = sum;
@@ -912,12 +915,10 @@ hearth_status synth_calibration_write(const char *root, const hearth_rig *rig,
        * keeps the nominal lattice */
       hearth_rng hp;
       hearth_rng_fork(&base, 77006, &hp);
-      const double lim = 3.0 * E->hole_position_m;
       for (size_t i = 0; i < g->n; i++) {
         double d2 = 0;
         for (int k = 0; k < 2; k++) {
-          double a = E->hole_position_m * hearth_rng_normal(&hp);
-          a = a < -lim ? -lim : a > lim ? lim : a;
+          double a = normal_3sigma(&hp, E->hole_position_m);
           g->holes[i][k] += a;
           d2 += a * a;
         }
