@@ -1,6 +1,11 @@
-/* Test meshes built from axis-aligned rectangles (two triangles each). */
+/* Test scenes on planes: meshes built from axis-aligned rectangles (two
+ * triangles each), and views of the plane z = 0 rendered without the ray
+ * caster. */
 #ifndef HEARTH_TESTS_QUAD_MESH_H
 #define HEARTH_TESTS_QUAD_MESH_H
+#include "hearth/camera.h"
+#include "hearth/geom.h"
+#include "hearth/image.h"
 #include "hearth/mesh.h"
 
 /* Append the rectangle [x0, x1] x [y0, y1] at height z, facing +z (up) if
@@ -26,6 +31,28 @@ static inline void add_quad(hearth_mesh *m, size_t *nv, size_t *nt, double x0, d
   }
   *nv += 4;
   *nt += 2;
+}
+
+/* A single-channel float view of the plane z = 0 rendered the simple way,
+ * independent of the ray caster: the ray through each pixel centre of cam
+ * (pose T, camera to world) meets the plane at (x, y), in front of the
+ * camera when front; value(x, y, front, ctx) is that pixel's reading. */
+static inline void render_plane_view(const hearth_camera *cam, const hearth_rigid *T,
+                                     double (*value)(double x, double y, int front,
+                                                     const void *ctx),
+                                     const void *ctx, hearth_image *img) {
+  hearth_err err;
+  hearth_image_alloc(img, (size_t)cam->width, (size_t)cam->height, 1, HEARTH_PIX_F32, &err);
+  float *px = img->data;
+  for (int v = 0; v < cam->height; v++)
+    for (int u = 0; u < cam->width; u++) {
+      double d[3], w[3];
+      hearth_camera_ray(cam, u, v, d);
+      hearth_rigid_rotate(T, d, w);
+      double t = -T->t[2] / w[2];
+      px[(size_t)v * (size_t)cam->width + (size_t)u] =
+          (float)value(T->t[0] + t * w[0], T->t[1] + t * w[1], t > 0, ctx);
+    }
 }
 
 #endif

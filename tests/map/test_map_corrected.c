@@ -15,23 +15,17 @@
 #define OBLIQUE_DEG 65.0
 #define OBLIQUE_KEEP 0.6 /* share of the excess over the room read at 65 degrees */
 
-/* one view of the plate [-0.05, 0.05]^2: a ray per pixel centre against the
-   plane; the plate reads keep of its excess, the rest of the scene the room */
+/* one view of the plate [-0.05, 0.05]^2: the plate reads keep of its
+   excess, the rest of the scene the room */
+static double plate_value(double x, double y, int front, const void *ctx) {
+  const double keep = *(const double *)ctx;
+  int on = front && fabs(x) <= 0.05 && fabs(y) <= 0.05;
+  return on ? T_ROOM + keep * (T_PLATE - T_ROOM) : T_ROOM;
+}
+
 static void render(const hearth_camera *cam, const hearth_rigid *T, double keep,
                    hearth_image *img) {
-  hearth_err err;
-  hearth_image_alloc(img, (size_t)cam->width, (size_t)cam->height, 1, HEARTH_PIX_F32, &err);
-  float *px = img->data;
-  for (int v = 0; v < cam->height; v++)
-    for (int u = 0; u < cam->width; u++) {
-      double d[3], w[3];
-      hearth_camera_ray(cam, u, v, d);
-      hearth_rigid_rotate(T, d, w);
-      double t = -T->t[2] / w[2], x = T->t[0] + t * w[0], y = T->t[1] + t * w[1];
-      int on = t > 0 && fabs(x) <= 0.05 && fabs(y) <= 0.05;
-      px[(size_t)v * (size_t)cam->width + (size_t)u] =
-          (float)(on ? T_ROOM + keep * (T_PLATE - T_ROOM) : T_ROOM);
-    }
+  render_plane_view(cam, T, plate_value, &keep, img);
 }
 
 /* a camera at distance r from the origin, tilted by deg from +z about the

@@ -10,26 +10,18 @@
 /* field on the visible quads: T = 20 + 200 x (degC, x in metres) */
 static double field(double x) { return 20.0 + 200.0 * x; }
 
-/* render the scene's temperatures the simple way: a ray per pixel centre
- * against the planes (independent of the ray caster) */
+/* the scene's temperatures: the field on the two quads (plus offset), the
+ * background elsewhere */
+static double scene_value(double x, double y, int front, const void *ctx) {
+  (void)front; /* every view looks down at the plane */
+  int on_a = x >= -0.12 && x <= -0.02 && y >= -0.05 && y <= 0.05;
+  int on_b = x >= 0.02 && x <= 0.12 && y >= -0.05 && y <= 0.05;
+  return on_a || on_b ? field(x) + *(const double *)ctx : 22.0;
+}
+
 static void render(const hearth_camera *cam, const hearth_rigid *T, double offset,
                    hearth_image *img) {
-  hearth_err err;
-  hearth_image_alloc(img, (size_t)cam->width, (size_t)cam->height, 1, HEARTH_PIX_F32, &err);
-  float *px = img->data;
-  for (int v = 0; v < cam->height; v++)
-    for (int u = 0; u < cam->width; u++) {
-      double d[3], w[3];
-      hearth_camera_ray(cam, u, v, d);
-      hearth_rigid_rotate(T, d, w);
-      double t = -T->t[2] / w[2]; /* plane z = 0 */
-      double x = T->t[0] + t * w[0], y = T->t[1] + t * w[1];
-      double val = 22.0; /* background */
-      int on_a = x >= -0.12 && x <= -0.02 && y >= -0.05 && y <= 0.05;
-      int on_b = x >= 0.02 && x <= 0.12 && y >= -0.05 && y <= 0.05;
-      if (on_a || on_b) val = field(x) + offset;
-      px[(size_t)v * (size_t)cam->width + (size_t)u] = (float)val;
-    }
+  render_plane_view(cam, T, scene_value, &offset, img);
 }
 
 static void look_down(double cx, double cy, double h, hearth_rigid *T) {
