@@ -33,4 +33,15 @@ size_t hb_calib_stages(const char *root, int overlays, hearth_build_stage *stage
 hearth_status hb_contact_picture(const char *root, const char *inst, const char *state,
                                  const char *out_path, hearth_err *err);
 
+/* The errors of one state's observed map o[] (R x R, the map's UV layout,
+ * texels with mask m[] == 1) against the apparent truth a[] and the true
+ * temperature t[], and the classes of the worst 5 % (release_report.c):
+ * grazing (away[i] == 0, or without away c[3i] < 0.5), reflections
+ * (c[3i+1] > 0), cooling (c[3i+2] > 1), registration (a[] changes by at
+ * least the worst-5 % threshold within 2 texels) and none. Fills e's
+ * has_apparent, n_away, app_*, away_true_* and worst_* fields. */
+hearth_status hb_report_effects(const uint8_t *m, const float *o, const float *t, const float *a,
+                                const float *c, const uint8_t *away, size_t R,
+                                hearth_report_entry *e, hearth_err *err);
+
 #endif

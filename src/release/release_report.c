@@ -86,9 +86,9 @@ static int near_edge(const uint8_t *m, const float *a, size_t R, size_t i, doubl
    UV layout. A texel counts as seen within 60 degrees where away[] is 1
    (hearth's mesh and poses: hearth_truth_match), or without away[] where
    the truth's best viewing cosine c[0] is at least 0.5 (the stand-in) */
-static hearth_status report_effects(const uint8_t *m, const float *o, const float *t,
-                                    const float *a, const float *c, const uint8_t *away, size_t R,
-                                    hearth_report_entry *e, hearth_err *err) {
+hearth_status hb_report_effects(const uint8_t *m, const float *o, const float *t, const float *a,
+                                const float *c, const uint8_t *away, size_t R,
+                                hearth_report_entry *e, hearth_err *err) {
   const size_t n = R * R;
   double *da = hearth_alloc_array(n, sizeof *da), *dt = hearth_alloc_array(n, sizeof *dt);
   double *all = hearth_alloc_array(n, sizeof *all);
@@ -160,7 +160,7 @@ static hearth_status report_effects_files(const char *root, const char *inst, co
       cond.ndim != 3 || cond.dtype != HEARTH_NPY_F32 || cond.shape[0] != R || cond.shape[1] != R ||
       cond.shape[2] != 3)
     goto done; /* another layout: not compared */
-  s = report_effects(m, o, t, app.data, cond.data, NULL, R, e, err);
+  s = hb_report_effects(m, o, t, app.data, cond.data, NULL, R, e, err);
 done:
   hearth_npy_free(&app);
   hearth_npy_free(&cond);
@@ -317,7 +317,7 @@ static hearth_status report_state(const char *root, const char *out_dir, const c
       *have_truth_png = 1;
       if (!have_tm || tm.same_uvs) s = report_effects_files(root, inst, state, m, o, t, R, e, err);
       else if (tm.t_apparent && tm.conditions)
-        s = report_effects(m, o, t, tm.t_apparent, tm.conditions, tm.away, R, e, err);
+        s = hb_report_effects(m, o, t, tm.t_apparent, tm.conditions, tm.away, R, e, err);
       if (s) goto done;
     }
   }
