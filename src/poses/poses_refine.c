@@ -98,8 +98,9 @@ typedef struct rf_sample {
 } rf_sample;
 
 typedef struct rf_scratch {
-  uint8_t *hit;    /* per image pixel */
-  rf_sample *samp; /* candidates */
+  uint8_t *hit;     /* per image pixel */
+  rf_sample *samp;  /* candidates */
+  rf_sample *samp0; /* the start pose's silhouette (refine_one) */
   size_t cap;
   float *smooth; /* smoothed image */
   int box[4];    /* pixel box of the last extraction */
@@ -349,9 +350,8 @@ static double contour_contrast(const rf_ctx *c, const rf_scratch *sc, size_t ns,
 
 /* the criterion at pose T: mean over silhouette samples of min(d^2, c^2),
  * d = distance to the edge found within the evaluation window */
-static double eval_cost(const rf_ctx *c, rf_scratch *sc, const hearth_rigid *T, double pol,
-                        double thr, size_t *n_in, size_t *n_s) {
-  size_t ns = extract_contour(c, sc, T, c->o->max_samples);
+static double eval_cost_on(const rf_ctx *c, const rf_scratch *sc, size_t ns, const hearth_rigid *T,
+                           double pol, double thr, size_t *n_in, size_t *n_s) {
   hearth_rigid Tcw;
   hearth_rigid_inverse(T, &Tcw);
   double sum = 0;
@@ -371,6 +371,13 @@ static double eval_cost(const rf_ctx *c, rf_scratch *sc, const hearth_rigid *T, 
   if (n_in) *n_in = in;
   if (n_s) *n_s = ns;
   return ns ? sum / (double)ns : INFINITY;
+}
+
+/* eval_cost_on the silhouette extracted at T */
+static double eval_cost(const rf_ctx *c, rf_scratch *sc, const hearth_rigid *T, double pol,
+                        double thr, size_t *n_in, size_t *n_s) {
+  size_t ns = extract_contour(c, sc, T, c->o->max_samples);
+  return eval_cost_on(c, sc, ns, T, pol, thr, n_in, n_s);
 }
 
 /* solve the 6x6 SPD system A x = b by Cholesky; 0 if not positive definite */
@@ -549,9 +556,13 @@ static void refine_one(rf_ctx *c, size_t v, int t) {
   double contrast = contour_contrast(c, sc, ns, &T0);
   res->contrast_c = contrast;
   double pol = contrast >= 0 ? 1.0 : -1.0, thr = 0.08 * fabs(contrast);
-  /* the criterion at the start leaves the start's silhouette in sc */
+  /* the criterion at the start, on the start's silhouette just extracted
+     (extraction is a function of the pose alone); the silhouette is kept
+     for the local refinement, which starts from T0 again */
   size_t n_in0 = 0;
-  res->cost_start = eval_cost(c, sc, &T0, pol, thr, &n_in0, &ns);
+  res->cost_start = eval_cost_on(c, sc, ns, &T0, pol, thr, &n_in0, &ns);
+  const size_t ns0 = ns;
+  memcpy(sc->samp0, sc->samp, ns0 * sizeof *sc->samp);
   res->cost_final = res->cost_start;
   if (fabs(contrast) < o->min_contrast_c) {
     snprintf(res->reason, sizeof res->reason, "kept: contrast %.2f degC below %.2f", fabs(contrast),
@@ -575,22 +586,33 @@ static void refine_one(rf_ctx *c, size_t v, int t) {
   hearth_rigid T;
   double H[36], sigma2 = 0;
   solve(c, sc, &T0, ns, 0, pol, thr, &T, H, &sigma2);
+  size_t n_in = 0, n_s = 0;
+  double cost;
   if ((double)n_in0 >= RF_LOCAL_SHARE * (double)ns) {
-    size_t in_c = 0, ns_c = 0;
+    size_t in_c = 0, ns_c = 0, in_l = 0, ns_l = 0;
     double cost_coarse = eval_cost(c, sc, &T, pol, thr, &in_c, &ns_c);
     hearth_rigid Tl;
     double Hl[36], sigma2_l = 0;
-    ns = extract_contour(c, sc, &T0, o->max_samples);
+    ns = ns0;
+    memcpy(sc->samp, sc->samp0, ns0 * sizeof *sc->samp);
     solve(c, sc, &T0, ns, 1, pol, thr, &Tl, Hl, &sigma2_l);
-    double cost_local = eval_cost(c, sc, &Tl, pol, thr, NULL, NULL);
+    double cost_local = eval_cost(c, sc, &Tl, pol, thr, &in_l, &ns_l);
+    /* the final criterion is the one just evaluated at the pose kept */
     if (!(cost_coarse < cost_local && (double)in_c >= RF_FULL_SHARE * (double)ns_c)) {
       T = Tl;
       memcpy(H, Hl, sizeof H);
       sigma2 = sigma2_l;
+      cost = cost_local;
+      n_in = in_l;
+      n_s = ns_l;
+    } else {
+      cost = cost_coarse;
+      n_in = in_c;
+      n_s = ns_c;
     }
+  } else {
+    cost = eval_cost(c, sc, &T, pol, thr, &n_in, &n_s);
   }
-  size_t n_in = 0, n_s = 0;
-  double cost = eval_cost(c, sc, &T, pol, thr, &n_in, &n_s);
   double dr, dt;
   pose_change(&T0, &T, &dr, &dt);
   res->n_samples = n_s;
@@ -683,8 +705,9 @@ hearth_status hearth_refine_views(const hearth_mesh *mesh, const hearth_raycaste
     scr[t].hit = calloc(npx, 1);
     scr[t].cap = 4 * npx;
     scr[t].samp = hearth_alloc_array(scr[t].cap, sizeof *scr[t].samp);
+    scr[t].samp0 = hearth_alloc_array(scr[t].cap, sizeof *scr[t].samp0);
     scr[t].smooth = hearth_alloc_array(npx, sizeof(float));
-    if (!scr[t].hit || !scr[t].samp || !scr[t].smooth) {
+    if (!scr[t].hit || !scr[t].samp || !scr[t].samp0 || !scr[t].smooth) {
       s = hearth_err_set(err, HEARTH_E_NOMEM, "refine: out of memory");
       goto done;
     }
@@ -699,6 +722,7 @@ done:
     for (int t = 0; t < nt; t++) {
       free(scr[t].hit);
       free(scr[t].samp);
+      free(scr[t].samp0);
       free(scr[t].smooth);
     }
   free(scr);
