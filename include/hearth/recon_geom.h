@@ -221,6 +221,12 @@ typedef struct hearth_turntable_result {
                                           object stands on: their elevation's
                                           mean plane taken */
   double seconds;
+  /* the aim term's estimate (hearth_turntable_aim_state and _place at the
+   * end of this header; none when the term is off): per state, per place
+   * (one, or one per ring) */
+  size_t n_aim_states, n_aim_places;
+  struct hearth_turntable_aim_state *aim_states; /* owned */
+  struct hearth_turntable_aim_place *aim_places; /* owned */
 } hearth_turntable_result;
 void hearth_turntable_result_free(hearth_turntable_result *r); /* accepts a zeroed one */
 
@@ -324,6 +330,11 @@ hearth_status hearth_mesh_atlas(const hearth_mesh *in, const hearth_atlas_opts *
  * the colour texture into derived/), and recon/report.json:
  *   {"instance", "route": "turntable", "views": N, "pairs", "iterations",
  *    "encoder_views", "colour_views", "icp_rms_start_mm", "icp_rms_mm", "icp_median_mm", "seconds",
+ *    "aim": null (the term off) or {"weight", "axis_direction": [0, 0, 1],
+ *            "states": [{"state", "views", "point_m", "axis_m"}],
+ *            "places": [{"ring" (null: every ring), "views", "camera_m",
+ *                        "distance_m", "side_rms_mm", "depth_rms_mm",
+ *                        "depth_rms_rel"}]},
  *    "mesh": {"vertices", "triangles", "voxel_m"},
  *    "atlas": {"charts", "merged", "stretch_l2", "stretch_l2_max",
  *              "stretch_l2_chart_max", "area_distortion", "angle_distortion",
@@ -355,6 +366,31 @@ typedef struct hearth_recon_summary {
 void hearth_recon_summary_free(hearth_recon_summary *s);
 hearth_status hearth_recon_run(const hearth_recon_job *job, hearth_recon_summary *sum,
                                hearth_err *err);
+
+/* ---- the aim point (recon_turntable.c) ------------------------------------ */
+/* What the aim term of hearth_recon_turntable estimated, after its last
+ * iteration (the poses' frame: metres, +z up the turntable axis, the top at
+ * z = 0). The axis is +z by construction; the aimed-at point C lies on it,
+ * so the axis is the vertical line through C. */
+typedef struct hearth_turntable_aim_state {
+  char state[HEARTH_NAME_MAX];
+  size_t n_views;    /* the state's views in the term */
+  double point_m[3]; /* C, the axis point the cameras aim at */
+  double axis_m[3];  /* where the axis meets the turntable top: (Cx, Cy, 0) */
+} hearth_turntable_aim_state;
+
+/* P, C's place in the colour camera's frame, and its fitted spread: per
+ * view the residual r = R^T (C - t) - P (C in that view's frame, less P),
+ * across the optical axis sqrt(mean(rx^2 + ry^2)), along it sqrt(mean(rz^2))
+ * (in metres and as a share of |P|). */
+typedef struct hearth_turntable_aim_place {
+  int elevation_index;  /* its ring; -1: one place for every ring */
+  size_t n_views;       /* views in the term at that place */
+  double camera_m[3];   /* P */
+  double side_rms_m;    /* spread across the optical axis */
+  double depth_rms_m;   /* spread along it */
+  double depth_rms_rel; /* depth_rms_m / |P| */
+} hearth_turntable_aim_place;
 
 #ifdef __cplusplus
 }

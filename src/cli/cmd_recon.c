@@ -113,7 +113,8 @@ static const char *k_about =
     "recon/mesh_geometry.glb (the depth maps fused with those poses; no UVs),\n"
     "recon/mesh.glb (that mesh with a UV atlas of its own: normal-clustered disc charts,\n"
     "LSCM, packed with gutters; no texture, map --rgb bakes it) and recon/report.json\n"
-    "(views, ICP residuals, per-view plane and match figures, chart stretch and packing).\n"
+    "(views, ICP residuals, the aim point, per-view plane and match figures, chart\n"
+    "stretch and packing).\n"
     "--poses colmap runs COLMAP (Debian's `colmap`, CPU only): feature_extractor with the\n"
     "cut-outs as masks and one camera shared by all views, exhaustive_matcher and mapper\n"
     "over every view of every state, then imports the model with the most registered\n"
@@ -137,6 +138,11 @@ static int run_turntable(const char *root, const char *instance, const hearth_re
   printf("recon %s: %zu views, %zu pairs, ICP rms %.3f -> %.3f mm (median %.3f), %.1f s -> %s\n",
          instance, r->n_views, r->n_pairs, r->icp_rms_start_mm, r->icp_rms_mm, r->icp_median_mm,
          r->seconds, sum.poses_path);
+  for (size_t i = 0; i < r->n_aim_states; i++) {
+    const hearth_turntable_aim_state *a = &r->aim_states[i];
+    printf("recon %s/%s: aimed at (%.4f, %.4f, %.4f) m on the axis\n", instance, a->state,
+           a->point_m[0], a->point_m[1], a->point_m[2]);
+  }
   if (!job.no_mesh) {
     printf("recon %s: mesh %zu vertices, %zu triangles -> %s\n", instance, sum.mesh_vertices,
            sum.mesh_triangles, sum.mesh_path);

@@ -66,9 +66,62 @@ static hearth_status cameras_of(const hearth_camera *rgb, const hearth_poses *p,
   return HEARTH_OK;
 }
 
+static void json_vec3(hearth_strbuf *b, const double x[3]) {
+  for (int k = 0; k < 3; k++) {
+    hearth_strbuf_printf(b, k ? ", " : "[");
+    rc_json_real(b, x[k]);
+  }
+  hearth_strbuf_printf(b, "]");
+}
+
+/* "aim": the aim term's axis point per state and its place in the camera
+ * frame with its fitted spread; null when the term was off */
+static void write_aim(hearth_strbuf *b, const hearth_turntable_result *r, double weight) {
+  if (!r->n_aim_places) {
+    hearth_strbuf_printf(b, "  \"aim\": null,\n");
+    return;
+  }
+  hearth_strbuf_printf(b, "  \"aim\": {\"weight\": ");
+  rc_json_real(b, weight);
+  hearth_strbuf_printf(b, ", \"axis_direction\": [0.0, 0.0, 1.0],\n    \"states\": [");
+  for (size_t i = 0; i < r->n_aim_states; i++) {
+    const hearth_turntable_aim_state *a = &r->aim_states[i];
+    hearth_strbuf_printf(b, "%s\n      {\"state\": ", i ? "," : "");
+    rc_json_string(b, a->state);
+    hearth_strbuf_printf(b, ", \"views\": %zu, \"point_m\": ", a->n_views);
+    json_vec3(b, a->point_m);
+    hearth_strbuf_printf(b, ", \"axis_m\": ");
+    json_vec3(b, a->axis_m);
+    hearth_strbuf_printf(b, "}");
+  }
+  hearth_strbuf_printf(b, "],\n    \"places\": [");
+  for (size_t i = 0; i < r->n_aim_places; i++) {
+    const hearth_turntable_aim_place *p = &r->aim_places[i];
+    hearth_strbuf_printf(b, "%s\n      {\"ring\": ", i ? "," : "");
+    if (p->elevation_index < 0) hearth_strbuf_printf(b, "null");
+    else hearth_strbuf_printf(b, "%d", p->elevation_index);
+    hearth_strbuf_printf(b, ", \"views\": %zu, \"camera_m\": ", p->n_views);
+    json_vec3(b, p->camera_m);
+    const struct {
+      const char *k;
+      double v;
+    } f[] = {{"distance_m", hearth_norm3(p->camera_m)},
+             {"side_rms_mm", 1000.0 * p->side_rms_m},
+             {"depth_rms_mm", 1000.0 * p->depth_rms_m},
+             {"depth_rms_rel", p->depth_rms_rel}};
+    for (size_t k = 0; k < sizeof f / sizeof f[0]; k++) {
+      hearth_strbuf_printf(b, ", \"%s\": ", f[k].k);
+      rc_json_real(b, f[k].v);
+    }
+    hearth_strbuf_printf(b, "}");
+  }
+  hearth_strbuf_printf(b, "]},\n");
+}
+
 static hearth_status write_report(const char *path, const char *instance,
-                                  const hearth_turntable_result *r, const hearth_mesh *m,
-                                  double voxel, const hearth_atlas_stats *at, hearth_err *err) {
+                                  const hearth_turntable_result *r, double aim_weight,
+                                  const hearth_mesh *m, double voxel, const hearth_atlas_stats *at,
+                                  hearth_err *err) {
   hearth_strbuf b = {0};
   hearth_strbuf_printf(&b, "{\n  \"instance\": ");
   rc_json_string(&b, instance);
@@ -90,6 +143,7 @@ static hearth_status write_report(const char *path, const char *instance,
     rc_json_real(&b, f[i].v);
     hearth_strbuf_printf(&b, ",\n");
   }
+  write_aim(&b, r, aim_weight);
   if (m) {
     hearth_strbuf_printf(&b, "  \"mesh\": {\"vertices\": %zu, \"triangles\": %zu, \"voxel_m\": ",
                          m->n_vertices, m->n_triangles);
@@ -218,8 +272,9 @@ hearth_status hearth_recon_run(const hearth_recon_job *job, hearth_recon_summary
               sum->atlas.packing_efficiency);
   }
   if (!s)
-    s = write_report(sum->report_path, job->instance, &sum->poses, have_mesh ? &mesh : NULL,
-                     job->geometry.voxel_m, have_mesh ? &sum->atlas : NULL, err);
+    s = write_report(sum->report_path, job->instance, &sum->poses, job->poses.aim_prior,
+                     have_mesh ? &mesh : NULL, job->geometry.voxel_m,
+                     have_mesh ? &sum->atlas : NULL, err);
   hearth_mesh_free(&atlas);
   hearth_mesh_free(&mesh);
   if (s) hearth_recon_summary_free(sum);

@@ -65,6 +65,8 @@ void hearth_turntable_opts_default(hearth_turntable_opts *o) {
 void hearth_turntable_result_free(hearth_turntable_result *r) {
   if (!r) return;
   free(r->views);
+  free(r->aim_states);
+  free(r->aim_places);
   memset(r, 0, sizeof *r);
 }
 
@@ -946,6 +948,61 @@ static void aim_system(const tt_view *v, size_t nv, const tt_aim *am,
   }
 }
 
+/* The aim term's estimate into res: C per state, P per group with the
+ * spread of the views' residuals about it (the final poses, C and P). */
+static hearth_status aim_result(const tt_view *v, size_t nv, const tt_aim *am, int per_ring,
+                                hearth_turntable_result *res, hearth_err *err) {
+  res->aim_states = calloc(am->n_states ? am->n_states : 1, sizeof *res->aim_states);
+  res->aim_places = calloc(am->n_groups, sizeof *res->aim_places);
+  if (!res->aim_states || !res->aim_places) {
+    free(res->aim_states);
+    free(res->aim_places);
+    res->aim_states = NULL;
+    res->aim_places = NULL;
+    return hearth_err_set(err, HEARTH_E_NOMEM, "turntable: aim point");
+  }
+  res->n_aim_states = am->n_states;
+  res->n_aim_places = am->n_groups;
+  for (size_t st = 0; st < am->n_states; st++) {
+    hearth_turntable_aim_state *a = &res->aim_states[st];
+    for (int k = 0; k < 3; k++) a->point_m[k] = am->C[3 * st + k];
+    a->axis_m[0] = a->point_m[0];
+    a->axis_m[1] = a->point_m[1];
+    a->axis_m[2] = 0;
+  }
+  for (size_t i = 0; i < nv; i++)
+    if (v[i].state_no < am->n_states && !res->aim_states[v[i].state_no].state[0])
+      snprintf(res->aim_states[v[i].state_no].state, HEARTH_NAME_MAX, "%s", v[i].state);
+  for (size_t g = 0; g < am->n_groups; g++) res->aim_places[g].elevation_index = -1;
+  double *ss = calloc(2 * am->n_groups, sizeof *ss);
+  if (!ss) return hearth_err_set(err, HEARTH_E_NOMEM, "turntable: aim point");
+  for (size_t i = 0; i < nv; i++) {
+    if (v[i].ring < 0) continue;
+    const size_t st = v[i].state_no, g = (size_t)v[i].ring;
+    hearth_turntable_aim_state *a = &res->aim_states[st];
+    hearth_turntable_aim_place *pl = &res->aim_places[g];
+    a->n_views++;
+    pl->n_views++;
+    if (per_ring) pl->elevation_index = v[i].elevation_index;
+    const double *C = &am->C[3 * st], *P = &am->P[3 * g];
+    double d[3] = {C[0] - v[i].T.t[0], C[1] - v[i].T.t[1], C[2] - v[i].T.t[2]}, r[3];
+    for (int k = 0; k < 3; k++)
+      r[k] = v[i].T.R[k] * d[0] + v[i].T.R[3 + k] * d[1] + v[i].T.R[6 + k] * d[2] - P[k];
+    ss[2 * g] += r[0] * r[0] + r[1] * r[1];
+    ss[2 * g + 1] += r[2] * r[2];
+  }
+  for (size_t g = 0; g < am->n_groups; g++) {
+    hearth_turntable_aim_place *pl = &res->aim_places[g];
+    for (int k = 0; k < 3; k++) pl->camera_m[k] = am->P[3 * g + k];
+    double n = pl->n_views ? (double)pl->n_views : 1.0, len = hearth_norm3(pl->camera_m);
+    pl->side_rms_m = sqrt(ss[2 * g] / n);
+    pl->depth_rms_m = sqrt(ss[2 * g + 1] / n);
+    pl->depth_rms_rel = len > 0 ? pl->depth_rms_m / len : 0;
+  }
+  free(ss);
+  return HEARTH_OK;
+}
+
 static hearth_status run_icp(tt_view *v, size_t nv, size_t n_states, const double u[3],
                              const hearth_camera *rgb, const hearth_turntable_opts *o,
                              hearth_turntable_result *res, hearth_err *err) {
@@ -1122,6 +1179,7 @@ static hearth_status run_icp(tt_view *v, size_t nv, size_t n_states, const doubl
     hearth_progress_step(&prog, 1);
   }
   hearth_progress_end(&prog);
+  if (!s && aim) s = aim_result(v, nv, &am, o->aim_per_ring, res, err);
   res->n_pairs = np;
   res->iterations += iterations;
   for (size_t k = 0; k < np; k++) free(pairs[k].r);
