@@ -146,17 +146,22 @@ static void test_intrinsics(void) {
   CHECK(strstr(err.msg, "at least 3") != NULL);
 }
 
+/* the test cameras, thermal a few cm beside the colour camera, slightly
+   rotated */
+static void stereo_rig(hearth_camera *ca, hearth_camera *cb, hearth_rigid *Tba) {
+  td_rgb_cam(ca);
+  td_thermal_cam(cb);
+  double w[3] = {0.01, -0.02, 0.005};
+  hearth_rotvec_to_matrix(w, Tba->R);
+  Tba->t[0] = -0.045;
+  Tba->t[1] = 0.012;
+  Tba->t[2] = 0.003;
+}
+
 static void test_stereo(void) {
   hearth_camera ca, cb;
-  td_rgb_cam(&ca);
-  td_thermal_cam(&cb);
-  /* thermal a few cm beside the colour camera, slightly rotated */
   hearth_rigid Tba;
-  double w[3] = {0.01, -0.02, 0.005};
-  hearth_rotvec_to_matrix(w, Tba.R);
-  Tba.t[0] = -0.045;
-  Tba.t[1] = 0.012;
-  Tba.t[2] = 0.003;
+  stereo_rig(&ca, &cb, &Tba);
   hearth_rng rng;
   hearth_rng_seed(&rng, 9);
   enum { NV = 10 };
@@ -450,14 +455,8 @@ static void joint_data(hearth_rng *rng, const hearth_camera *ca, const hearth_ca
 
 static void test_stereo_joint(void) {
   hearth_camera ca, cb, c0;
-  td_rgb_cam(&ca);
-  td_thermal_cam(&cb);
   hearth_rigid Tba;
-  double w[3] = {0.01, -0.02, 0.005};
-  hearth_rotvec_to_matrix(w, Tba.R);
-  Tba.t[0] = -0.045;
-  Tba.t[1] = 0.012;
-  Tba.t[2] = 0.003;
+  stereo_rig(&ca, &cb, &Tba);
   enum { NV = 12, NC = 10 };
   static double ua[NV * NP * 2], ub[NV * NP * 2], uc[NC * NP * 2];
   hearth_rng rng;
