@@ -161,8 +161,12 @@ def main():
         ok &= ang <= 0.05 and dt <= 0.5 and rig["stereo_rms_px"] <= 0.3
 
     # ---- OpenCV on the same points: hearth without its perspective
-    # correction (OpenCV has none), same frames and pairs ----
-    run([exe, "calibrate", root, "--quiet", "--no-perspective-correction"])
+    # correction and rolling-shutter model (OpenCV has neither), same frames
+    # and pairs, and with the thermal intrinsics held in the stereo solve as
+    # cv2.stereoCalibrate's CALIB_FIX_INTRINSIC holds them (hearth's default
+    # refines them) ----
+    run([exe, "calibrate", root, "--quiet", "--no-perspective-correction",
+         "--no-rolling-shutter", "--fixed-intrinsics"])
     rig = json.load(open(os.path.join(cal, "rig.json")))
     rep = json.load(open(os.path.join(cal, "calibration_report.json")))
     Kt, Dt = cam(rig["thermal"])
