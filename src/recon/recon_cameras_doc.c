@@ -44,7 +44,7 @@ void rc_json_string(hearth_strbuf *b, const char *s) {
   hearth_strbuf_printf(b, "\"");
 }
 
-static void w_reals(hearth_strbuf *b, const double *x, size_t n) {
+void rc_json_reals(hearth_strbuf *b, const double *x, size_t n) {
   hearth_strbuf_printf(b, "[");
   for (size_t i = 0; i < n; i++) {
     if (i) hearth_strbuf_printf(b, ", ");
@@ -66,18 +66,18 @@ static char *cameras_text(const hearth_recon_cameras *c) {
                          (unsigned)k->id);
     rc_json_string(&b, model ? model : "");
     hearth_strbuf_printf(&b, ",\n      \"colmap_params\": ");
-    w_reals(&b, k->params, k->n_params);
+    rc_json_reals(&b, k->params, k->n_params);
     hearth_strbuf_printf(&b, ",\n      \"width\": %d,\n      \"height\": %d,\n      \"K\": [\n",
                          h->width, h->height);
     double K[9];
     hearth_camera_K(h, K);
     for (int r = 0; r < 3; r++) {
       hearth_strbuf_printf(&b, "        ");
-      w_reals(&b, K + 3 * r, 3);
+      rc_json_reals(&b, K + 3 * r, 3);
       hearth_strbuf_printf(&b, "%s\n", r < 2 ? "," : "");
     }
     hearth_strbuf_printf(&b, "      ],\n      \"dist\": ");
-    w_reals(&b, h->dist, 5);
+    rc_json_reals(&b, h->dist, 5);
     hearth_strbuf_printf(&b, "\n    }%s\n", i + 1 < c->n_cameras ? "," : "");
   }
   hearth_strbuf_printf(&b, "%s],\n  \"views\": [%s", c->n_cameras ? "  " : "",

@@ -84,6 +84,8 @@ int rc_photo_sample(const rc_photo *ph, const double uv[2], double *val, double 
 void rc_json_real(hearth_strbuf *b, double x);
 /* s as a JSON string literal. */
 void rc_json_string(hearth_strbuf *b, const char *s);
+/* x[0..n) as a JSON array "[a, b, ...]" of rc_json_real numbers */
+void rc_json_reals(hearth_strbuf *b, const double *x, size_t n);
 
 /* The inputs every depth-based reconstruction of an instance starts from
  * (recon_instance.c): its instance.json into *inst; with states NULL or

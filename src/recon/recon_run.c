@@ -66,14 +66,6 @@ static hearth_status cameras_of(const hearth_camera *rgb, const hearth_poses *p,
   return HEARTH_OK;
 }
 
-static void json_vec3(hearth_strbuf *b, const double x[3]) {
-  for (int k = 0; k < 3; k++) {
-    hearth_strbuf_printf(b, k ? ", " : "[");
-    rc_json_real(b, x[k]);
-  }
-  hearth_strbuf_printf(b, "]");
-}
-
 /* "aim": the aim term's axis point per state and its place in the camera
  * frame with its fitted spread; null when the term was off */
 static void write_aim(hearth_strbuf *b, const hearth_turntable_result *r, double weight) {
@@ -89,9 +81,9 @@ static void write_aim(hearth_strbuf *b, const hearth_turntable_result *r, double
     hearth_strbuf_printf(b, "%s\n      {\"state\": ", i ? "," : "");
     rc_json_string(b, a->state);
     hearth_strbuf_printf(b, ", \"views\": %zu, \"point_m\": ", a->n_views);
-    json_vec3(b, a->point_m);
+    rc_json_reals(b, a->point_m, 3);
     hearth_strbuf_printf(b, ", \"axis_m\": ");
-    json_vec3(b, a->axis_m);
+    rc_json_reals(b, a->axis_m, 3);
     hearth_strbuf_printf(b, "}");
   }
   hearth_strbuf_printf(b, "],\n    \"places\": [");
@@ -101,7 +93,7 @@ static void write_aim(hearth_strbuf *b, const hearth_turntable_result *r, double
     if (p->elevation_index < 0) hearth_strbuf_printf(b, "null");
     else hearth_strbuf_printf(b, "%d", p->elevation_index);
     hearth_strbuf_printf(b, ", \"views\": %zu, \"camera_m\": ", p->n_views);
-    json_vec3(b, p->camera_m);
+    rc_json_reals(b, p->camera_m, 3);
     const struct {
       const char *k;
       double v;
