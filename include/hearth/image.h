@@ -101,6 +101,13 @@ hearth_status hearth_jpeg_read(const char *path, hearth_image *img, hearth_err *
 hearth_status hearth_jpeg_read_half(const char *path, hearth_image *img, hearth_err *err);
 hearth_status hearth_jpeg_read_expect(const char *path, const hearth_image_expect *want,
                                       hearth_image *img, hearth_err *err);
+/* Every step-th pixel of every step-th row (step >= 1): an image of
+ * ceil(width / step) x ceil(height / step) whose pixel (x, y) is the full
+ * decode's pixel (x * step, y * step), bit for bit, decoded a row at a time
+ * so that only the kept pixels are held. want applies to the file's own
+ * size. */
+hearth_status hearth_jpeg_read_grid(const char *path, const hearth_image_expect *want, size_t step,
+                                    hearth_image *img, hearth_err *err);
 hearth_status hearth_jpeg_read_mem(const void *data, size_t size, const char *name,
                                    hearth_image *img, hearth_err *err);
 /* Luma only (1 channel): the stored Y plane of a colour JPEG, decoded

@@ -53,6 +53,8 @@ typedef struct jpeg_reader {
   char msg[256];
   int want_gray;                   /* decode to luma only (Y of a YCbCr file) */
   int half;                        /* decode at half the size (libjpeg's scaled IDCT) */
+  size_t step;                     /* > 1: keep every step-th pixel and row (grid) */
+  JSAMPROW line;                   /* with step > 1: one full decoded row */
   const hearth_image_expect *want; /* NULL: any image */
   hearth_image img;
 } jpeg_reader;
@@ -124,16 +126,30 @@ static int jpeg_decode(jpeg_reader *r) {
     snprintf(r->msg, sizeof r->msg, "unexpected output layout");
     return 2;
   }
+  const size_t step = r->step > 1 ? r->step : 1, gw = (w + step - 1) / step,
+               gh = (h + step - 1) / step;
   hearth_err aerr;
-  if (hearth_image_alloc(&r->img, w, h, channels, HEARTH_PIX_U8, &aerr) != HEARTH_OK) {
+  if (hearth_image_alloc(&r->img, gw, gh, channels, HEARTH_PIX_U8, &aerr) != HEARTH_OK) {
     r->status = aerr.status;
     snprintf(r->msg, sizeof r->msg, "%s", aerr.msg);
     return 2;
   }
-  size_t stride = w * (size_t)channels;
+  size_t stride = gw * (size_t)channels;
+  if (step > 1 && !(r->line = malloc(w * (size_t)channels))) {
+    r->status = HEARTH_E_NOMEM;
+    snprintf(r->msg, sizeof r->msg, "out of memory for a row");
+    return 2;
+  }
   while (r->cinfo.output_scanline < r->cinfo.output_height) {
-    JSAMPROW row = (JSAMPROW)r->img.data + (size_t)r->cinfo.output_scanline * stride;
-    if (jpeg_read_scanlines(&r->cinfo, &row, 1) != 1) {
+    const size_t y = r->cinfo.output_scanline;
+    JSAMPROW row = step > 1 ? r->line : (JSAMPROW)r->img.data + y * stride;
+    int got = jpeg_read_scanlines(&r->cinfo, &row, 1) == 1;
+    if (got && step > 1 && y % step == 0) {
+      uint8_t *dst = (uint8_t *)r->img.data + (y / step) * stride;
+      for (size_t x = 0; x < gw; x++)
+        memcpy(dst + x * (size_t)channels, r->line + x * step * (size_t)channels, (size_t)channels);
+    }
+    if (!got) {
       r->status = HEARTH_E_PARSE;
       snprintf(r->msg, sizeof r->msg, "image data ends at row %u of %zu",
                (unsigned)r->cinfo.output_scanline, h);
@@ -146,8 +162,8 @@ static int jpeg_decode(jpeg_reader *r) {
 }
 
 static hearth_status jpeg_read_mem(const void *data, size_t size, const char *name, int want_gray,
-                                   int half, const hearth_image_expect *want, hearth_image *img,
-                                   hearth_err *err) {
+                                   int half, size_t step, const hearth_image_expect *want,
+                                   hearth_image *img, hearth_err *err) {
   if (!name) name = "<memory>";
   memset(img, 0, sizeof *img);
   if (size < 3 || !data || memcmp(data, "\xff\xd8\xff", 3) != 0)
@@ -160,12 +176,14 @@ static hearth_status jpeg_read_mem(const void *data, size_t size, const char *na
   r->size = size;
   r->want_gray = want_gray;
   r->half = half;
+  r->step = step;
   r->want = want;
   init_errmgr(&r->jerr);
   r->cinfo.err = &r->jerr.pub;
   int rc = jpeg_decode(r);
   /* safe even if creation failed: the struct was zeroed (no memory manager) */
   jpeg_destroy_decompress(&r->cinfo);
+  free(r->line);
   hearth_status s = HEARTH_OK;
   if (rc == 1) s = hearth_err_set(err, HEARTH_E_PARSE, "%s: invalid JPEG: %s", name, r->jerr.msg);
   else if (rc == 2) s = hearth_err_set(err, r->status, "%s: %s", name, r->msg);
@@ -177,10 +195,10 @@ static hearth_status jpeg_read_mem(const void *data, size_t size, const char *na
 
 hearth_status hearth_jpeg_read_mem(const void *data, size_t size, const char *name,
                                    hearth_image *img, hearth_err *err) {
-  return jpeg_read_mem(data, size, name, 0, 0, NULL, img, err);
+  return jpeg_read_mem(data, size, name, 0, 0, 1, NULL, img, err);
 }
 
-static hearth_status jpeg_read_file(const char *path, int want_gray, int half,
+static hearth_status jpeg_read_file(const char *path, int want_gray, int half, size_t step,
                                     const hearth_image_expect *want, hearth_image *img,
                                     hearth_err *err) {
   memset(img, 0, sizeof *img);
@@ -188,31 +206,36 @@ static hearth_status jpeg_read_file(const char *path, int want_gray, int half,
   size_t n;
   hearth_status s = hearth_read_file(path, JPEG_MAX_FILE_BYTES, &buf, &n, err);
   if (s) return s;
-  s = jpeg_read_mem(buf, n, path, want_gray, half, want, img, err);
+  s = jpeg_read_mem(buf, n, path, want_gray, half, step, want, img, err);
   free(buf);
   return s;
 }
 
 hearth_status hearth_jpeg_read(const char *path, hearth_image *img, hearth_err *err) {
-  return jpeg_read_file(path, 0, 0, NULL, img, err);
+  return jpeg_read_file(path, 0, 0, 1, NULL, img, err);
 }
 
 hearth_status hearth_jpeg_read_half(const char *path, hearth_image *img, hearth_err *err) {
-  return jpeg_read_file(path, 0, 1, NULL, img, err);
+  return jpeg_read_file(path, 0, 1, 1, NULL, img, err);
 }
 
 hearth_status hearth_jpeg_read_expect(const char *path, const hearth_image_expect *want,
                                       hearth_image *img, hearth_err *err) {
-  return jpeg_read_file(path, 0, 0, want, img, err);
+  return jpeg_read_file(path, 0, 0, 1, want, img, err);
+}
+
+hearth_status hearth_jpeg_read_grid(const char *path, const hearth_image_expect *want, size_t step,
+                                    hearth_image *img, hearth_err *err) {
+  return jpeg_read_file(path, 0, 0, step ? step : 1, want, img, err);
 }
 
 hearth_status hearth_jpeg_read_gray(const char *path, hearth_image *img, hearth_err *err) {
-  return jpeg_read_file(path, 1, 0, NULL, img, err);
+  return jpeg_read_file(path, 1, 0, 1, NULL, img, err);
 }
 
 hearth_status hearth_jpeg_read_gray_expect(const char *path, const hearth_image_expect *want,
                                            hearth_image *img, hearth_err *err) {
-  return jpeg_read_file(path, 1, 0, want, img, err);
+  return jpeg_read_file(path, 1, 0, 1, want, img, err);
 }
 
 /* ---- writing ------------------------------------------------------------------ */

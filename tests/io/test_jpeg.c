@@ -245,8 +245,57 @@ static void test_half(const char *dir) {
   }
 }
 
+/* hearth_jpeg_read_grid: every step-th pixel of every step-th row of the
+ * full decode, bit for bit (gray and colour, odd sides, so the last column
+ * and row of the grid are the image's last kept ones), the size checked
+ * against the file's own size, and a truncated file refused by name */
+static void test_grid(const char *dir) {
+  hearth_err err = {0};
+  for (int c = 1; c <= 3; c += 2) {
+    hearth_image img, full, grid;
+    CHECK_OK(hearth_image_alloc(&img, 161, 121, c, HEARTH_PIX_U8, &err), &err);
+    smooth_image(&img);
+    uint8_t *p = img.data;
+    for (size_t k = 0; k < hearth_image_bytes(&img); k += 7) p[k] ^= 0x5a; /* detail */
+    char path[1024];
+    snprintf(path, sizeof path, "%s/grid%d.jpg", dir, c);
+    CHECK_OK(hearth_jpeg_write(path, &img, 90, &err), &err);
+    CHECK_OK(hearth_jpeg_read(path, &full, &err), &err);
+    for (size_t st = 1; st <= 5; st++) {
+      hearth_image_expect want = {161, 121, 0, 0, 0, NULL};
+      CHECK_OK(hearth_jpeg_read_grid(path, &want, st, &grid, &err), &err);
+      size_t gw = (161 + st - 1) / st, gh = (121 + st - 1) / st;
+      CHECK(grid.width == gw && grid.height == gh && grid.channels == c);
+      size_t differ = 0;
+      const uint8_t *f = full.data, *g = grid.data;
+      for (size_t y = 0; grid.data && y < gh; y++)
+        for (size_t x = 0; x < gw; x++)
+          differ += memcmp(g + (y * gw + x) * (size_t)c, f + (y * st * 161 + x * st) * (size_t)c,
+                           (size_t)c) != 0;
+      CHECK_MSG(differ == 0, "step %zu, %d channel(s): %zu pixels differ", st, c, differ);
+      hearth_image_free(&grid);
+    }
+    hearth_image_expect rig = {1920, 1080, 3, 0, 0, "(the colour camera of rig.json)"};
+    CHECK(hearth_jpeg_read_grid(path, &rig, 2, &grid, &err) == HEARTH_E_SIZE && !grid.data);
+    CHECK_MSG(strstr(err.msg, "image is 161x121, expected 1920x1080") != NULL, "%s", err.msg);
+    /* truncated in the middle of its data */
+    uint8_t *buf;
+    size_t n;
+    CHECK_OK(hearth_read_file(path, 1 << 24, &buf, &n, &err), &err);
+    char cut[1100];
+    snprintf(cut, sizeof cut, "%s/grid_cut%d.jpg", dir, c);
+    write_bytes(cut, buf, n / 2);
+    free(buf);
+    CHECK(hearth_jpeg_read_grid(cut, NULL, 2, &grid, &err) != HEARTH_OK && !grid.data);
+    CHECK_MSG(strstr(err.msg, "grid_cut") != NULL, "%s", err.msg);
+    hearth_image_free(&img);
+    hearth_image_free(&full);
+  }
+}
+
 int main(void) {
   const char *dir = test_tmpdir("io_jpeg");
+  test_grid(dir);
   test_expect(dir);
   test_round_trip(dir);
   test_half(dir);
