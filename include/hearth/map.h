@@ -62,6 +62,8 @@ typedef struct hearth_map_opts {
                              rasterise it; default 0 (the same hits up to float rounding) */
   int skip_best_cos;    /* 1: leave the result's best_cos NULL, saving an R*R map per
                              worker; default 0 */
+  int skip_observed;    /* 1: leave the result's observed NULL: the filled map is made in
+                             its place, saving an R*R*channels map; default 0 */
   /* Views whose image is NULL have it made by load(load_ctx, v, &img, err)
      when their cast reaches them (a U8 RGB or F32 gray image of the
      camera's size, freed by the mapping after the view's splat), so that a
@@ -72,6 +74,11 @@ typedef struct hearth_map_opts {
   hearth_status (*load)(void *load_ctx, size_t view, hearth_image *img, hearth_err *err);
   void *load_ctx;
   int load_channels;
+  /* 1: load makes only the pixels the mapping reads, the grid of every
+     pixel_stride-th pixel: an image of ceil(width / stride) x
+     ceil(height / stride) whose pixel (x, y) is the camera's pixel
+     (x * stride, y * stride); 0 (default): the camera's whole image */
+  int load_grid;
 } hearth_map_opts;
 void hearth_map_opts_default(hearth_map_opts *o);
 
@@ -89,7 +96,8 @@ typedef struct hearth_map_view {
 typedef struct hearth_map_result {
   size_t R;
   int channels;        /* 1 for temperature, 3 for colour */
-  float *observed;     /* R*R*channels; NaN where mask != OBSERVED */
+  float *observed;     /* R*R*channels; NaN where mask != OBSERVED; NULL with
+                                 opts.skip_observed */
   float *filled;       /* R*R*channels; NaN where mask not in {OBSERVED, FILLED} */
   uint8_t *mask;       /* R*R, HEARTH_TEXEL_* */
   float *best_cos;     /* R*R: largest viewing cosine among observing views (0 if none);

@@ -77,65 +77,103 @@ typedef struct pix_box {
   size_t x0, x1, y0, y1; /* inclusive; x0 > x1 when empty */
 } pix_box;
 
-/* record a hit (or a miss) of grid pixel p = (px, py) */
-static void keep_hit(map_worker *w, size_t p, size_t px, size_t py, const hearth_ray_hit *h,
-                     pix_box *box) {
-  if (h->prim != UINT32_MAX && h->front) {
-    if (px < box->x0) box->x0 = px;
-    if (px > box->x1) box->x1 = px;
-    if (py < box->y0) box->y0 = py;
-    if (py > box->y1) box->y1 = py;
-    w->hit_t[p] = h->t;
-    w->hit_tri[p] = h->prim;
-    w->hit_b1[p] = h->b1;
-    w->hit_b2[p] = h->b2;
-  } else {
-    w->hit_t[p] = INFINITY;
-    w->hit_tri[p] = UINT32_MAX;
+/* A view's hits are kept in the frame of their box grown by the 2 pixels
+ * the silhouette filter reads (clipped to the grid): the worker's
+ * per-pixel arrays are indexed within the frame, row after row, so that a
+ * view touches memory in proportion to its box rather than to the rows of
+ * the camera's grid it spans. */
+typedef struct hit_frame {
+  pix_box box;         /* the hits' box, grid pixels */
+  size_t x0, y0, w, h; /* the frame, grid pixels (w = h = 0 without hits) */
+} hit_frame;
+
+/* the frame of box, its pixels all misses */
+static void frame_open(const hearth_map_layout *l, map_worker *w, const pix_box *box,
+                       hit_frame *f) {
+  f->box = *box;
+  f->x0 = f->y0 = f->w = f->h = 0;
+  if (box->x0 > box->x1) return;
+  f->x0 = box->x0 >= 2 ? box->x0 - 2 : 0;
+  f->y0 = box->y0 >= 2 ? box->y0 - 2 : 0;
+  f->w = (box->x1 + 2 < l->pw ? box->x1 + 2 : l->pw - 1) - f->x0 + 1;
+  f->h = (box->y1 + 2 < l->ph ? box->y1 + 2 : l->ph - 1) - f->y0 + 1;
+  for (size_t k = 0; k < f->w * f->h; k++) {
+    w->hit_t[k] = INFINITY;
+    w->hit_tri[k] = UINT32_MAX;
   }
 }
 
+/* grid pixel (x, y)'s place in the frame */
+static inline size_t frame_at(const hit_frame *f, size_t x, size_t y) {
+  return (y - f->y0) * f->w + (x - f->x0);
+}
+
+/* a front-face hit kept at frame place k */
+static inline void frame_put(map_worker *w, size_t k, const hearth_ray_hit *h) {
+  w->hit_t[k] = h->t;
+  w->hit_tri[k] = h->prim;
+  w->hit_b1[k] = h->b1;
+  w->hit_b2[k] = h->b2;
+}
+
+static inline int front_hit(const hearth_ray_hit *h) { return h->prim != UINT32_MAX && h->front; }
+
+static inline void box_add(pix_box *box, size_t x, size_t y) {
+  if (x < box->x0) box->x0 = x;
+  if (x > box->x1) box->x1 = x;
+  if (y < box->y0) box->y0 = y;
+  if (y > box->y1) box->y1 = y;
+}
+
 /* view v, whose camera has the whole mesh in front: rasterised through the
- * fan; the hits' box, and misses in a 2-pixel ring around it (what the
- * silhouette filter reads) */
-static void cast_fan(map_ctx *m, size_t v, map_worker *w, pix_box *box) {
+ * fan (its hits lie within the box it returns) */
+static void cast_fan(map_ctx *m, size_t v, map_worker *w, hit_frame *f) {
   const hearth_map_layout *l = m->l;
   size_t fb[4];
+  pix_box box = {SIZE_MAX, 0, SIZE_MAX, 0};
   if (hearth_ray_fan_cast(l->fan, l->mesh, &m->views[v].T_world_from_cam, w->fan_scratch, w->hits,
                           fb, NULL)) {
     m->failed = 2; /* cannot happen: the bounding sphere lies in front */
     return;
   }
-  if (fb[0] > fb[1]) return; /* no hit */
-  const size_t W = l->pw, H = l->ph;
-  for (size_t y = fb[2] >= 2 ? fb[2] - 2 : 0; y <= fb[3] + 2 && y < H; y++)
-    for (size_t x = fb[0] >= 2 ? fb[0] - 2 : 0; x <= fb[1] + 2 && x < W; x++) {
-      size_t p = y * W + x;
-      if (x >= fb[0] && x <= fb[1] && y >= fb[2] && y <= fb[3]) {
-        keep_hit(w, p, x, y, &w->hits[p], box);
-      } else {
-        w->hit_t[p] = INFINITY;
-        w->hit_tri[p] = UINT32_MAX;
-      }
+  const size_t W = l->pw;
+  for (size_t y = fb[2]; fb[0] <= fb[1] && y <= fb[3]; y++)
+    for (size_t x = fb[0]; x <= fb[1]; x++)
+      if (front_hit(&w->hits[y * W + x])) box_add(&box, x, y);
+  frame_open(l, w, &box, f);
+  for (size_t y = box.y0; box.x0 <= box.x1 && y <= box.y1; y++)
+    for (size_t x = box.x0; x <= box.x1; x++) {
+      const hearth_ray_hit *h = &w->hits[y * W + x];
+      if (front_hit(h)) frame_put(w, frame_at(f, x, y), h);
     }
 }
+
+/* the grid pixels in 4x4 tiles (coherent packets of 16): the block after (pw, ph) runs for
+   each with x, y and its place i in that order */
+#define FOR_TILED_PIXELS(pw, ph, ...)                                       \
+  do {                                                                      \
+    size_t i = 0;                                                           \
+    for (size_t ty = 0; ty < (ph); ty += 4)                                 \
+      for (size_t tx = 0; tx < (pw); tx += 4)                               \
+        for (size_t y = ty; y < ty + 4 && y < (ph); y++)                    \
+          for (size_t x = tx; x < tx + 4 && x < (pw); x++, i++) __VA_ARGS__ \
+  } while (0)
 
 /* view v by traced rays, in 4x4 pixel tiles (packets of nearly parallel
  * rays); rays that miss the mesh's bounding sphere are not cast at all, and
  * back faces are culled by continuing the ray behind them */
-static void cast_rays(const map_ctx *m, size_t v, map_worker *w, pix_box *box) {
+static void cast_rays(const map_ctx *m, size_t v, map_worker *w, hit_frame *f) {
   const hearth_map_layout *l = m->l;
   const hearth_rigid *T = &m->views[v].T_world_from_cam;
-  const size_t n = l->np;
+  const size_t n = l->np, pw = l->pw, ph = l->ph;
   float *org = w->ray_org, *dir = w->ray_dir;
   hearth_ray_hit *hits = w->hits;
   const double *S = l->sphere;
   double oc[3] = {S[0] - T->t[0], S[1] - T->t[1], S[2] - T->t[2]};
   double oc2 = oc[0] * oc[0] + oc[1] * oc[1] + oc[2] * oc[2];
   double r2 = S[3] * S[3];
-  for (size_t i = 0; i < n; i++) {
-    size_t p = l->tile_order[i];
-    const float *d = l->pix_dir + 3 * p;
+  FOR_TILED_PIXELS(pw, ph, {
+    const float *d = l->pix_dir + 3 * (y * pw + x);
     double wd[3];
     for (int k = 0; k < 3; k++)
       wd[k] = T->R[3 * k] * d[0] + T->R[3 * k + 1] * d[1] + T->R[3 * k + 2] * d[2];
@@ -148,13 +186,15 @@ static void cast_rays(const map_ctx *m, size_t v, map_worker *w, pix_box *box) {
       org[3 * i + k] = (float)T->t[k];
       dir[3 * i + k] = skip ? 0.0f : (float)wd[k]; /* a zero direction is not cast */
     }
-  }
+  });
   /* views already run in parallel: cast on this thread only, unless there
      is a single worker for all views */
   hearth_raycast_batch_mt(m->rc, n, org, dir, 0.0f, INFINITY, hits,
                           m->n_threads > 1 ? 1 : m->cast_threads);
-  for (size_t i = 0; i < n; i++) {
-    size_t p = l->tile_order[i];
+  /* back faces skipped, then the front hits' box; then the hits kept in
+     its frame */
+  pix_box box = {SIZE_MAX, 0, SIZE_MAX, 0};
+  FOR_TILED_PIXELS(pw, ph, {
     hearth_ray_hit h = hits[i];
     for (int k = 0; k < MAX_BACKFACE_SKIPS && h.prim != UINT32_MAX && !h.front; k++) {
       double o[3] = {org[3 * i], org[3 * i + 1], org[3 * i + 2]};
@@ -162,8 +202,15 @@ static void cast_rays(const map_ctx *m, size_t v, map_worker *w, pix_box *box) {
       double tn = (double)h.t * (1.0 + 1e-6) + 1e-7;
       if (!hearth_raycast(m->rc, o, d, tn, INFINITY, &h)) h.prim = UINT32_MAX;
     }
-    keep_hit(w, p, p % l->pw, p / l->pw, &h, box);
-  }
+    hits[i] = h;
+    if (front_hit(&h)) box_add(&box, x, y);
+  });
+  frame_open(l, w, &box, f);
+  if (box.x0 > box.x1) return;
+  FOR_TILED_PIXELS(pw, ph, {
+    if (x >= box.x0 && x <= box.x1 && y >= box.y0 && y <= box.y1 && front_hit(&hits[i]))
+      frame_put(w, frame_at(f, x, y), &hits[i]);
+  });
 }
 
 /* silhouette flags: 1 if a grid pixel lies within 2 pixels of a
@@ -172,18 +219,22 @@ static void cast_rays(const map_ctx *m, size_t v, map_worker *w, pix_box *box) {
  * The lens blur and the pixel footprint mix the two sides of such an edge,
  * so these pixels do not measure one surface. Computed with separable 5x5
  * minimum and maximum filters of the hit distance (a miss is +inf). Only
- * pixels inside box (the hits' bounding box) get flags; the filters read up
- * to 2 pixels beyond it, where ht holds the misses. */
-static void silhouettes(const hearth_map_layout *l, const float *ht, const pix_box *box, float *lo,
-                        float *hi, float *tmp_lo, float *tmp_hi, uint8_t *sil) {
-  size_t W = l->pw, H = l->ph;
-  size_t ry0 = box->y0 >= 2 ? box->y0 - 2 : 0, ry1 = box->y1 + 2 < H ? box->y1 + 2 : H - 1;
+ * pixels inside the hits' box get flags; the filters read up to 2 pixels
+ * beyond it, the rest of the frame, where ht holds the misses. Every array
+ * is indexed within the frame, which the clipping to the image keeps
+ * as it was: the frame ends 2 pixels beyond the box or at the image's
+ * edge. */
+static void silhouettes(const hit_frame *f, const float *ht, float *lo, float *hi, float *tmp_lo,
+                        float *tmp_hi, uint8_t *sil) {
+  const size_t W = f->w, H = f->h;
+  const pix_box b = {f->box.x0 - f->x0, f->box.x1 - f->x0, f->box.y0 - f->y0, f->box.y1 - f->y0};
+  size_t ry0 = b.y0 >= 2 ? b.y0 - 2 : 0, ry1 = b.y1 + 2 < H ? b.y1 + 2 : H - 1;
   for (size_t y = ry0; y <= ry1; y++) {
     const float *r = ht + y * W;
-    for (size_t x = box->x0; x <= box->x1; x++) {
-      size_t a = x >= 2 ? x - 2 : 0, b = x + 2 < W ? x + 2 : W - 1;
+    for (size_t x = b.x0; x <= b.x1; x++) {
+      size_t a = x >= 2 ? x - 2 : 0, e = x + 2 < W ? x + 2 : W - 1;
       float mn = r[a], mx = r[a];
-      for (size_t k = a + 1; k <= b; k++) {
+      for (size_t k = a + 1; k <= e; k++) {
         mn = r[k] < mn ? r[k] : mn;
         mx = r[k] > mx ? r[k] : mx;
       }
@@ -191,11 +242,11 @@ static void silhouettes(const hearth_map_layout *l, const float *ht, const pix_b
       tmp_hi[y * W + x] = mx;
     }
   }
-  for (size_t y = box->y0; y <= box->y1; y++) {
-    size_t a = y >= 2 ? y - 2 : 0, b = y + 2 < H ? y + 2 : H - 1;
-    for (size_t x = box->x0; x <= box->x1; x++) {
+  for (size_t y = b.y0; y <= b.y1; y++) {
+    size_t a = y >= 2 ? y - 2 : 0, e = y + 2 < H ? y + 2 : H - 1;
+    for (size_t x = b.x0; x <= b.x1; x++) {
       float mn = tmp_lo[a * W + x], mx = tmp_hi[a * W + x];
-      for (size_t k = a + 1; k <= b; k++) {
+      for (size_t k = a + 1; k <= e; k++) {
         float lv = tmp_lo[k * W + x], hv = tmp_hi[k * W + x];
         mn = lv < mn ? lv : mn;
         mx = hv > mx ? hv : mx;
@@ -204,8 +255,8 @@ static void silhouettes(const hearth_map_layout *l, const float *ht, const pix_b
       hi[y * W + x] = mx;
     }
   }
-  for (size_t y = box->y0; y <= box->y1; y++)
-    for (size_t x = box->x0; x <= box->x1; x++) {
+  for (size_t y = b.y0; y <= b.y1; y++)
+    for (size_t x = b.x0; x <= b.x1; x++) {
       size_t p = y * W + x;
       float t0 = ht[p];
       if (!isfinite(t0)) {
@@ -221,9 +272,11 @@ static void silhouettes(const hearth_map_layout *l, const float *ht, const pix_b
  * silhouette (with edges) or seen more obliquely than min_cos are dropped,
  * and so are footprints entirely off the map. *n_hits counts the hits kept
  * before that last test (the view's pixels on the surface). */
-static size_t splat_hits(const map_ctx *m, size_t v, const hearth_image *img, map_worker *w,
-                         const pix_box *box, int edges, uint32_t *n_hits) {
+static size_t splat_hits(const map_ctx *m, size_t v, const hearth_image *img, int grid,
+                         map_worker *w, const hit_frame *f, int edges, uint32_t *n_hits) {
+  const pix_box *box = &f->box;
   const hearth_map_layout *l = m->l;
+  const size_t st = l->stride, W = (size_t)l->cam.width;
   const hearth_mesh *mesh = l->mesh;
   const size_t R = l->R;
   const int C = m->C;
@@ -235,10 +288,11 @@ static size_t splat_hits(const map_ctx *m, size_t v, const hearth_image *img, ma
   uint32_t hits = 0;
   size_t n_sp = 0;
   for (size_t py = box->y0; py <= box->y1 && box->x0 <= box->x1; py++) {
-    for (size_t p = py * l->pw + box->x0; p <= py * l->pw + box->x1; p++) {
-      uint32_t tri = htri[p];
+    for (size_t px = box->x0; px <= box->x1; px++) {
+      const size_t p = py * l->pw + px, fk = frame_at(f, px, py);
+      uint32_t tri = htri[fk];
       if (tri == UINT32_MAX) continue;
-      if (edges && sil[p]) continue;
+      if (edges && sil[fk]) continue;
       const float *nrm = l->tri_normal + 3 * (size_t)tri, *dc = l->pix_dir + 3 * p;
       float d[3];
       for (int k = 0; k < 3; k++)
@@ -248,7 +302,7 @@ static size_t splat_hits(const map_ctx *m, size_t v, const hearth_image *img, ma
       hits++;
       /* UV of the hit point */
       const uint32_t *ix = mesh->indices + 3 * (size_t)tri;
-      float b1 = w->hit_b1[p], b2 = w->hit_b2[p], b0 = 1.0f - b1 - b2;
+      float b1 = w->hit_b1[fk], b2 = w->hit_b2[fk], b0 = 1.0f - b1 - b2;
       float u = b0 * mesh->uvs[2 * ix[0]] + b1 * mesh->uvs[2 * ix[1]] + b2 * mesh->uvs[2 * ix[2]];
       float vv = b0 * mesh->uvs[2 * ix[0] + 1] + b1 * mesh->uvs[2 * ix[1] + 1] +
                  b2 * mesh->uvs[2 * ix[2] + 1];
@@ -262,7 +316,8 @@ static size_t splat_hits(const map_ctx *m, size_t v, const hearth_image *img, ma
       e->y0 = (int32_t)y0f;
       e->island = l->island_of_tri[tri];
       e->cosv = cosv;
-      size_t src = l->pix_index[p];
+      /* the camera pixel of grid pixel p */
+      size_t src = grid ? p : (py * st) * W + px * st;
       for (int c = 0; c < C; c++) e->val[c] = image_value(img, src, c);
     }
   }
@@ -399,9 +454,12 @@ static int load_view(map_ctx *m, size_t v, hearth_image *img) {
   int kind = img->type == HEARTH_PIX_F32 && img->channels == 1  ? 1
              : img->type == HEARTH_PIX_U8 && img->channels >= 3 ? 3
                                                                 : 0;
-  if (!img->data || img->width != (size_t)cam->width || img->height != (size_t)cam->height)
-    hearth_err_set(e, HEARTH_E_SIZE, "map: view %zu is %zux%zu, the camera is %dx%d", v, img->width,
-                   img->height, cam->width, cam->height);
+  /* the camera's image, or with load_grid its pixel grid's */
+  const int grid = m->opts->load_grid;
+  size_t w = grid ? m->l->pw : (size_t)cam->width, h = grid ? m->l->ph : (size_t)cam->height;
+  if (!img->data || img->width != w || img->height != h)
+    hearth_err_set(e, HEARTH_E_SIZE, "map: view %zu is %zux%zu, the camera%s is %zux%zu", v,
+                   img->width, img->height, grid ? "'s pixel grid" : "", w, h);
   else if (kind != m->C)
     hearth_err_set(e, HEARTH_E_INCONSISTENT, "map: view %zu: its image is not of the views' kind",
                    v);
@@ -413,7 +471,7 @@ static int load_view(map_ctx *m, size_t v, hearth_image *img) {
 static void process_view(map_ctx *m, size_t v, int t) {
   const hearth_map_layout *l = m->l;
   map_worker *w = &m->workers[t];
-  pix_box box = {SIZE_MAX, 0, SIZE_MAX, 0};
+  hit_frame f = {{1, 0, 1, 0}, 0, 0, 0, 0}; /* no hit: empty */
   hearth_image own = {0};
   const hearth_image *img = m->views[v].image;
   if (!img) {
@@ -424,22 +482,22 @@ static void process_view(map_ctx *m, size_t v, int t) {
     }
     img = &own;
   }
-  if (m->view_fan[v]) cast_fan(m, v, w, &box);
-  else cast_rays(m, v, w, &box);
+  if (m->view_fan[v]) cast_fan(m, v, w, &f);
+  else cast_rays(m, v, w, &f);
   if (m->failed) {
     hearth_image_free(&own);
     return;
   }
-  if (box.x0 > box.x1) box = (pix_box){1, 0, 1, 0}; /* no hit: empty */
+  if (f.box.x0 > f.box.x1) f.box = (pix_box){1, 0, 1, 0}; /* no hit: empty */
   const int edges = m->opts->fusion == HEARTH_FUSE_ROBUST ||
                     m->opts->fusion == HEARTH_FUSE_CORRECTED || !m->opts->keep_edges;
-  if (edges && box.x0 <= box.x1) {
+  if (edges && f.box.x0 <= f.box.x1) {
     /* the ray arrays are free again: scratch for the filters */
     const size_t n = l->np;
-    silhouettes(l, w->hit_t, &box, w->ray_org, w->ray_org + n, w->ray_dir, w->ray_dir + n, w->sil);
+    silhouettes(&f, w->hit_t, w->ray_org, w->ray_org + n, w->ray_dir, w->ray_dir + n, w->sil);
   }
   uint32_t hits = 0;
-  size_t n_sp = splat_hits(m, v, img, w, &box, edges, &hits);
+  size_t n_sp = splat_hits(m, v, img, own.data && m->opts->load_grid, w, &f, edges, &hits);
   hearth_image_free(&own); /* the splats hold the values */
   size_t n_tc = 0;
   const touch *tc = sorted_touches(w, n_sp, l->R, &n_tc);

@@ -117,8 +117,17 @@ static hearth_status fuse_views(map_ctx *m, hearth_map_result *out, island_box *
   out->R = R;
   out->channels = m->C;
   out->n_views = m->n_views;
-  if (!m->max) out->observed = hearth_alloc_array(N, C * sizeof(float));
-  out->filled = hearth_alloc_array(N, C * sizeof(float));
+  if (m->rec && m->rec->acc) {
+    /* mean fusion: the sums become the means in place */
+    out->observed = m->rec->acc;
+    m->rec->acc_owned = 0;
+  } else if (!m->max) {
+    out->observed = hearth_alloc_array(N, C * sizeof(float));
+  }
+  /* without observed, the fill makes filled in its place: it copies only
+     observed texels' values, which stay as they are */
+  if (m->opts->skip_observed) out->filled = out->observed;
+  else out->filled = hearth_alloc_array(N, C * sizeof(float));
   /* every texel of these is written by the fusion */
   out->mask = hearth_alloc_array(N, 1);
   if (!m->max && want_cos) out->best_cos = hearth_alloc_array(N, sizeof(float));
@@ -241,6 +250,9 @@ hearth_status hearth_map_views_with_layout(const hearth_map_layout *l,
     goto done;
   }
   hearth_parallel_chunks(n_views, 1, nt, map_cast_views, &m);
+  /* the workers' scratch (per pixel of the camera's grid) is not needed by
+     the fusion: its memory goes before the result's maps are made */
+  for (int t = 0; t < m.n_threads; t++) map_worker_free(&m.workers[t]);
   if (m.load_errs) {
     /* every view tried its load: the lowest failure, whatever the threads */
     for (size_t v = 0; v < n_views; v++)
@@ -262,6 +274,13 @@ hearth_status hearth_map_views_with_layout(const hearth_map_layout *l,
   double t_fuse0 = hearth_now();
   if (timing) timing->cast = t_fuse0 - t_cast0;
   if ((s = fuse_views(&m, out, &parts, err))) goto done;
+  /* the fusion's sums and records go before the fill */
+  if (m.rec) {
+    map_records_free(m.rec);
+    m.rec = NULL;
+  }
+  free(m.corr_best);
+  m.corr_best = NULL;
   double t_fill0 = hearth_now();
   if (timing) timing->fuse = t_fill0 - t_fuse0;
   if (map_fill_islands(l->R, (size_t)C, l->island_of_texel, l->n_islands, parts, nt, out->mask,
@@ -269,6 +288,7 @@ hearth_status hearth_map_views_with_layout(const hearth_map_layout *l,
     s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory while filling");
     goto done;
   }
+  if (opts.skip_observed) out->observed = NULL; /* it is filled */
   if ((s = count_texels(out, nt, err))) goto done;
   if (timing) {
     timing->fill = hearth_now() - t_fill0;
@@ -280,6 +300,7 @@ done:
   free_phase_state(&m);
   hearth_raycaster_free(own_rc);
   free(parts);
+  if (s && out->observed == out->filled) out->observed = NULL; /* one array */
   if (s) hearth_map_result_free(out);
   return s;
 }

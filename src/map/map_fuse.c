@@ -1,8 +1,9 @@
 /* Fusion across views (see map_internal.h), over bands of whole texel rows,
  * each band touching only its slice of the maps: for max fusion the
- * workers' maxima maps merged and decoded; for mean and robust fusion every
- * view's records of the band's texels folded in view order (the weighted
- * mean, or the weighted median). Each band then prepares its rows for the
+ * workers' maxima maps merged and decoded; for mean fusion the sums the
+ * views were folded into (in view order, as they were done) divided in
+ * place; for robust fusion every view's records of the band's texels
+ * folded in view order (the weighted median). Each band then prepares its rows for the
  * fill (map_fill.c). Also the fusion rules' state: max fusion's maps and
  * the views' records. */
 #include <math.h>
@@ -62,10 +63,12 @@ int map_records_alloc(view_records *r, size_t n_views, int stream, size_t R, int
   if (!r->q || !r->d || !r->n) return 0;
   if (!stream) return 1;
   /* calloc: the pages of texels no view observes are never touched */
-  r->acc = calloc(R * R, ((size_t)C + 1) * sizeof *r->acc);
+  r->acc = calloc(R * R, (size_t)C * sizeof *r->acc);
+  r->acc_owned = 1;
+  r->acc_w = calloc(R * R, sizeof *r->acc_w);
   if (want_cos) r->best_cos = calloc(R * R, sizeof *r->best_cos);
   r->waiting = calloc(n_views ? n_views : 1, 1);
-  if (!r->acc || (want_cos && !r->best_cos) || !r->waiting) return 0;
+  if (!r->acc || !r->acc_w || (want_cos && !r->best_cos) || !r->waiting) return 0;
   if (pthread_mutex_init(&r->mu, NULL)) return 0;
   r->have_mu = 1;
   return 1;
@@ -77,7 +80,8 @@ void map_records_free(view_records *r) {
   free(r->q);
   free(r->d);
   free(r->n);
-  free(r->acc);
+  if (r->acc_owned) free(r->acc);
+  free(r->acc_w);
   free(r->best_cos);
   free(r->waiting);
   if (r->have_mu) pthread_mutex_destroy(&r->mu);
@@ -87,14 +91,14 @@ void map_records_free(view_records *r) {
 /* n records of one view into the sums: per texel, its weighted values and
    its weight added as the band fusion would add them */
 static void add_records(view_records *r, const uint32_t *rq, const float *rd, size_t n, int C) {
-  const size_t RW = REC_WORDS(C), C1 = (size_t)C + 1;
+  const size_t RW = REC_WORDS(C);
   for (size_t k = 0; k < n; k++) {
     const size_t q = rq[k];
     const float *d = rd + k * RW;
     if (r->best_cos && d[1] > r->best_cos[q]) r->best_cos[q] = d[1];
-    double *a = r->acc + q * C1;
+    float *a = r->acc + q * (size_t)C;
     for (size_t c = 0; c < (size_t)C; c++) a[c] += d[2 + c];
-    a[C] += d[0];
+    r->acc_w[q] += d[0];
   }
 }
 
@@ -164,7 +168,6 @@ static size_t lower_bound_u32(const uint32_t *a, size_t n, uint32_t q) {
 
 /* one worker's scratch for a band of the fusion; the worker owns it */
 typedef struct band_scratch {
-  double *acc;   /* mean: sums per channel and weight, per texel of a band */
   uint32_t *cnt; /* robust: records per texel of a band, then offsets */
   vw *all;       /* robust: every record's pair of the band, texel by texel */
   size_t all_cap;
@@ -195,7 +198,7 @@ static void merge_maxima(const map_ctx *m, hearth_map_result *out, size_t q0, si
   }
 }
 
-/* texels [q0, q1), mean and robust fusion: no view yet */
+/* texels [q0, q1), robust fusion: no view yet */
 static void clear_band(const map_ctx *m, hearth_map_result *out, size_t q0, size_t q1) {
   const size_t C = (size_t)m->C;
   const uint32_t *iot = m->l->island_of_texel;
@@ -207,39 +210,18 @@ static void clear_band(const map_ctx *m, hearth_map_result *out, size_t q0, size
 }
 
 /* texels [q0, q1), mean fusion: each view counts with its total weight at
-   a texel */
-static void fold_mean(const map_ctx *m, hearth_map_result *out, band_scratch *bs, size_t q0,
-                      size_t q1) {
+   a texel; the views are summed already, in the result's observed map,
+   whose sums become the means in place (-inf where no view observed) */
+static void fold_mean(const map_ctx *m, hearth_map_result *out, size_t q0, size_t q1) {
   const view_records *r = m->rec;
-  const size_t C = (size_t)m->C, RW = REC_WORDS(C);
-  if (r->acc) {
-    /* the views are summed already */
-    for (size_t q = q0; q < q1; q++) {
-      const double *a = r->acc + q * (C + 1);
-      if (r->best_cos) out->best_cos[q] = r->best_cos[q];
-      if (a[C] > 0.0)
-        for (size_t c = 0; c < C; c++) out->observed[q * C + c] = (float)(a[c] / a[C]);
-    }
-    return;
-  }
-  double *acc = bs->acc;
-  memset(acc, 0, (q1 - q0) * (C + 1) * sizeof *acc);
-  for (size_t v = 0; v < r->n_views; v++) {
-    const uint32_t *rq = r->q[v];
-    const float *rd = r->d[v];
-    for (size_t k = lower_bound_u32(rq, r->n[v], (uint32_t)q0); k < r->n[v] && rq[k] < q1; k++) {
-      const size_t q = rq[k];
-      const float *d = rd + k * RW;
-      if (out->best_cos && d[1] > out->best_cos[q]) out->best_cos[q] = d[1];
-      double *a = acc + (q - q0) * (C + 1);
-      for (size_t c = 0; c < C; c++) a[c] += d[2 + c];
-      a[C] += d[0];
-    }
-  }
+  const size_t C = (size_t)m->C;
+  const uint32_t *iot = m->l->island_of_texel;
   for (size_t q = q0; q < q1; q++) {
-    const double *a = acc + (q - q0) * (C + 1);
-    if (a[C] > 0.0)
-      for (size_t c = 0; c < C; c++) out->observed[q * C + c] = (float)(a[c] / a[C]);
+    const float w = r->acc_w[q];
+    if (out->best_cos) out->best_cos[q] = r->best_cos ? r->best_cos[q] : 0.0f;
+    out->mask[q] = iot[q] == UINT32_MAX ? HEARTH_TEXEL_NONE : HEARTH_TEXEL_UNOBSERVED;
+    float *a = out->observed + q * C;
+    for (size_t c = 0; c < C; c++) a[c] = w > 0.0f ? a[c] / w : -INFINITY;
   }
 }
 
@@ -639,16 +621,13 @@ void map_fuse_bands(void *ctx, size_t b, size_t e, int t) {
   band_scratch bs = {0};
   cr *call = NULL, *ctmp = NULL;
   size_t ccap = 0;
-  if (fusion == HEARTH_FUSE_MEAN && !m->rec->acc)
-    bs.acc = hearth_alloc_array(band, (C + 1) * sizeof *bs.acc);
   if (fusion == HEARTH_FUSE_ROBUST || fusion == HEARTH_FUSE_CORRECTED) {
     bs.cnt = hearth_alloc_array(band + 1, sizeof *bs.cnt);
     bs.tmp = hearth_alloc_array(nv ? nv : 1, sizeof *bs.tmp);
   }
   if (fusion == HEARTH_FUSE_CORRECTED)
     ctmp = hearth_alloc_array((nv ? nv : 1) * BORROW_SPAN, sizeof *ctmp);
-  if ((fusion == HEARTH_FUSE_MEAN && !m->rec->acc && !bs.acc) ||
-      ((fusion == HEARTH_FUSE_ROBUST || fusion == HEARTH_FUSE_CORRECTED) && (!bs.cnt || !bs.tmp)) ||
+  if (((fusion == HEARTH_FUSE_ROBUST || fusion == HEARTH_FUSE_CORRECTED) && (!bs.cnt || !bs.tmp)) ||
       (fusion == HEARTH_FUSE_CORRECTED && !ctmp)) {
     fp->nomem[t] = 1;
     goto done;
@@ -658,10 +637,11 @@ void map_fuse_bands(void *ctx, size_t b, size_t e, int t) {
     const size_t q0 = bi * band, q1 = q0 + band < N ? q0 + band : N;
     if (m->max) {
       merge_maxima(m, out, q0, q1);
+    } else if (fusion == HEARTH_FUSE_MEAN) {
+      fold_mean(m, out, q0, q1);
     } else {
       clear_band(m, out, q0, q1);
-      if (fusion == HEARTH_FUSE_MEAN) fold_mean(m, out, &bs, q0, q1);
-      else if (fusion == HEARTH_FUSE_CORRECTED) {
+      if (fusion == HEARTH_FUSE_CORRECTED) {
         if (!fold_corrected(m, out, bs.cnt, &call, &ccap, ctmp, q0, q1)) {
           fp->nomem[t] = 1;
           goto done;
@@ -676,7 +656,6 @@ void map_fuse_bands(void *ctx, size_t b, size_t e, int t) {
 done:
   free(call);
   free(ctmp);
-  free(bs.acc);
   free(bs.cnt);
   free(bs.all);
   free(bs.tmp);

@@ -36,9 +36,9 @@ struct hearth_map_layout {
   float *tri_normal;    /* 3 per triangle, unit */
   double sphere[4];     /* mesh bounding sphere: rays that miss it are not cast */
   size_t pw, ph, np;    /* pixel grid: every stride-th pixel */
-  float *pix_dir;       /* 3 per grid pixel, camera frame, unit (0: never cast) */
-  uint32_t *pix_index;  /* image pixel index of each grid pixel */
-  uint32_t *tile_order; /* grid pixels in 4x4 tiles: coherent packets of 16 */
+  const float *pix_dir; /* 3 per grid pixel, camera frame, unit (0: never cast); the
+                           fan's own directions where there is a fan */
+  int own_pix_dir;      /* pix_dir is the layout's (no fan) */
   hearth_ray_fan *fan;  /* the pixel grid as a ray fan; NULL where it cannot hold it */
 };
 
@@ -71,12 +71,13 @@ typedef struct touch {
  * one view (the pixel grid's np pixels, or 4 touches a pixel). The worker
  * owns every array. */
 typedef struct map_worker {
-  float *hit_t, *hit_b1, *hit_b2; /* np: the hit distance (+inf: none) and barycentrics */
-  uint32_t *hit_tri;              /* np: the hit triangle (UINT32_MAX: none) */
+  float *hit_t, *hit_b1, *hit_b2; /* np: the hit distance (+inf: none) and barycentrics, in
+                                     the view's frame (map_cast.c) */
+  uint32_t *hit_tri;              /* np: the hit triangle (UINT32_MAX: none), in the frame */
   float *ray_org,
       *ray_dir;         /* 3 * np: traced rays; after the cast, the silhouette filters' scratch */
   hearth_ray_hit *hits; /* np */
-  uint8_t *sil;         /* np: silhouette flags */
+  uint8_t *sil;         /* np: silhouette flags, in the frame */
   splat *splats;        /* np */
   touch *touches, *touches_tmp; /* 4 * np: a view's touches and the sort's second buffer */
   void *fan_scratch;            /* the ray fan's scratch (NULL without a fan) */
@@ -103,9 +104,11 @@ typedef struct view_records {
   uint32_t **q; /* per view: n[v] texels */
   float **d;    /* per view: n[v] * REC_WORDS(C) words */
   size_t *n;
-  /* mean fusion (NULL otherwise): R * R * (C + 1) sums (per channel the
-     weighted values, then the weight), zero where no view observed */
-  double *acc;
+  /* mean fusion (NULL otherwise): R * R * C sums of the weighted values and
+     R * R sums of the weights, zero where no view observed; the fusion
+     turns acc into the result's observed map in place (acc_owned 0) */
+  float *acc, *acc_w;
+  int acc_owned;
   float *best_cos;  /* R * R best viewing cosines (0: none); NULL with skip_best_cos */
   uint8_t *waiting; /* per view: done, its records kept until its turn */
   size_t next;      /* the first view not yet folded */

@@ -15,9 +15,9 @@
 typedef struct grid_build {
   const hearth_camera *cam;
   size_t stride, pw, ph;
-  float *pix_dir;
-  uint32_t *pix_index, *tile_order;
-  hearth_ray_fan *fan; /* NULL where the fan cannot hold the grid */
+  const float *pix_dir; /* the fan's directions, or made here without a fan */
+  int own_pix_dir;      /* pix_dir is not the fan's */
+  hearth_ray_fan *fan;  /* NULL where the fan cannot hold the grid */
   int nomem;
   /* then the UV islands (the mesh only) */
   const hearth_mesh *mesh;
@@ -31,22 +31,22 @@ static void *grid_build_run(void *arg) {
   size_t st = g->stride, pw = g->pw, ph = g->ph, np = pw * ph;
   hearth_status s = hearth_ray_fan_new(g->cam, st, &g->fan, NULL);
   if (s == HEARTH_OK) {
-    memcpy(g->pix_dir, hearth_ray_fan_dirs(g->fan, NULL, NULL), np * 3 * sizeof *g->pix_dir);
-  } else {
-    g->nomem = s == HEARTH_E_NOMEM;
-    /* a pixel the lens model cannot invert gets a zero direction: never cast */
-    if (hearth_camera_ray_grid(g->cam, st, g->pix_dir))
-      for (size_t k = 0; k < 3 * np; k++)
-        if (isnan(g->pix_dir[k])) g->pix_dir[k] = 0.0f;
+    /* the fan's directions are the grid's (zero where never cast) */
+    g->pix_dir = hearth_ray_fan_dirs(g->fan, NULL, NULL);
+    return NULL;
   }
-  for (size_t y = 0; y < ph; y++)
-    for (size_t x = 0; x < pw; x++)
-      g->pix_index[y * pw + x] = (uint32_t)(y * st * (size_t)g->cam->width + x * st);
-  size_t k = 0;
-  for (size_t ty = 0; ty < ph; ty += 4)
-    for (size_t tx = 0; tx < pw; tx += 4)
-      for (size_t y = ty; y < ty + 4 && y < ph; y++)
-        for (size_t x = tx; x < tx + 4 && x < pw; x++) g->tile_order[k++] = (uint32_t)(y * pw + x);
+  g->nomem = s == HEARTH_E_NOMEM;
+  float *dir = hearth_alloc_array(np, 3 * sizeof *dir);
+  if (!dir) {
+    g->nomem = 1;
+    return NULL;
+  }
+  g->pix_dir = dir;
+  g->own_pix_dir = 1;
+  /* a pixel the lens model cannot invert gets a zero direction: never cast */
+  if (hearth_camera_ray_grid(g->cam, st, dir))
+    for (size_t k = 0; k < 3 * np; k++)
+      if (isnan(dir[k])) dir[k] = 0.0f;
   return NULL;
 }
 
@@ -109,11 +109,6 @@ static hearth_status alloc_grid(hearth_map_layout *l, hearth_err *err) {
   if (l->np > UINT32_MAX / 4)
     return hearth_err_set(err, HEARTH_E_LIMIT, "map: a %zu x %zu pixel grid exceeds the limit",
                           l->pw, l->ph);
-  l->pix_dir = hearth_alloc_array(l->np, 3 * sizeof *l->pix_dir);
-  l->pix_index = hearth_alloc_array(l->np, sizeof *l->pix_index);
-  l->tile_order = hearth_alloc_array(l->np, sizeof *l->tile_order);
-  if (!l->pix_dir || !l->pix_index || !l->tile_order)
-    return hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
   const size_t nt = l->mesh->n_triangles;
   l->island_of_tri = hearth_alloc_array(nt ? nt : 1, sizeof *l->island_of_tri);
   if (!l->island_of_tri) return hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory");
@@ -131,9 +126,12 @@ static hearth_status build_layout(hearth_map_layout *l, hearth_err *err) {
   int gb_started = 0, isl_started = 0;
   hearth_status s = alloc_grid(l, err);
   if (s) goto done;
-  gb = (grid_build){&l->cam,       l->stride, l->pw, l->ph, l->pix_dir,       l->pix_index,
-                    l->tile_order, NULL,      0,     mesh,  l->island_of_tri, 0,
-                    HEARTH_OK,     {0}};
+  gb = (grid_build){.cam = &l->cam,
+                    .stride = l->stride,
+                    .pw = l->pw,
+                    .ph = l->ph,
+                    .mesh = mesh,
+                    .island_of_tri = l->island_of_tri};
   gb_started = pthread_create(&gb_tid, NULL, grid_build_run, &gb) == 0;
   if (!gb_started) grid_build_run(&gb); /* no thread: make it here */
   isl_started = pthread_create(&isl_tid, NULL, islands_run, &gb) == 0;
@@ -159,11 +157,16 @@ static hearth_status build_layout(hearth_map_layout *l, hearth_err *err) {
   hearth_parallel_chunks(mesh->n_triangles, 8192, 0, tri_normals, l);
   bounding_sphere(mesh, l->sphere);
   l->fan = gb.fan;
+  l->pix_dir = gb.pix_dir;
+  l->own_pix_dir = gb.own_pix_dir;
   gb.fan = NULL;
-  if (gb.nomem) s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory for the pixel grid");
+  gb.pix_dir = NULL;
+  if (!l->pix_dir || gb.nomem)
+    s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory for the pixel grid");
 done:
   if (gb_started) pthread_join(gb_tid, NULL);
   if (isl_started) pthread_join(isl_tid, NULL);
+  if (gb.own_pix_dir) free((void *)gb.pix_dir);
   hearth_ray_fan_free(gb.fan);
   return s;
 }
@@ -173,9 +176,7 @@ void hearth_map_layout_free(hearth_map_layout *l) {
   free(l->island_of_tri);
   free(l->island_of_texel);
   free(l->tri_normal);
-  free(l->pix_dir);
-  free(l->pix_index);
-  free(l->tile_order);
+  if (l->own_pix_dir) free((void *)l->pix_dir);
   hearth_ray_fan_free(l->fan);
   free(l);
 }

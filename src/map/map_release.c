@@ -439,10 +439,12 @@ typedef struct bake_frames {
   const char *root, *inst, *state, *rig_path;
   const hearth_manifest *man;
   const hearth_camera *cam;
+  size_t stride; /* the mapping's pixel grid: every stride-th pixel is decoded */
 } bake_frames;
 
 /* view k's colour frame: of the colour camera's size (checked before its
-   pixels are decoded), RGB; header_only: its header alone */
+   pixels are decoded), RGB, its pixel grid only (the mapping's load_grid);
+   header_only: its header alone */
 static hearth_status bake_frame(const bake_frames *f, size_t k, int header_only, hearth_image *img,
                                 hearth_err *err) {
   char path[PATH_SZ], why[PATH_SZ + 32];
@@ -450,7 +452,7 @@ static hearth_status bake_frame(const bake_frames *f, size_t k, int header_only,
   snprintf(why, sizeof why, "(the colour camera of %s)", f->rig_path);
   hearth_image_expect want =
       {(size_t)f->cam->width, (size_t)f->cam->height, 0, 0, header_only, why};
-  hearth_status s = hearth_jpeg_read_expect(path, &want, img, err);
+  hearth_status s = hearth_jpeg_read_grid(path, &want, f->stride, img, err);
   if (s) return s;
   if (img->channels != 3) {
     hearth_image_free(img);
@@ -506,7 +508,8 @@ hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err) {
     s = hearth_err_set(err, HEARTH_E_NOMEM, "bake: out of memory");
     goto done;
   }
-  bake_frames frames = {root, inst, state, rig_path, &man, &rig.rgb};
+  const int stride = job->pixel_stride > 0 ? job->pixel_stride : 2;
+  bake_frames frames = {root, inst, state, rig_path, &man, &rig.rgb, (size_t)stride};
   for (size_t k = 0; k < man.n_views; k++) {
     const hearth_view_files *vf = &man.views[k];
     const hearth_view_pose *vp = hearth_poses_find(&poses, state, vf->view);
@@ -524,13 +527,15 @@ hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err) {
   hearth_map_opts_default(&mo);
   mo.fusion = HEARTH_FUSE_MEAN;
   mo.resolution = job->resolution ? job->resolution : 1024;
-  mo.pixel_stride = job->pixel_stride > 0 ? job->pixel_stride : 2;
+  mo.pixel_stride = stride;
   mo.min_cos = 0.2; /* grazing colour samples smear texture detail */
   mo.threads = job->threads;
   mo.skip_best_cos = 1;
+  mo.skip_observed = 1; /* the texture is made from the filled map */
   mo.load = bake_load;
   mo.load_ctx = &frames;
   mo.load_channels = 3;
+  mo.load_grid = 1;
   if ((s = hearth_map_views(&mesh, NULL, &rig.rgb, views, man.n_views, &mo, &r, err))) goto done;
   if (!r.n_surface) {
     s = hearth_err_set(err, HEARTH_E_RANGE,

@@ -39,6 +39,24 @@ static hearth_status copy_image(void *ctx, size_t v, hearth_image *img, hearth_e
   if (!s) memcpy(img->data, src->data, hearth_image_bytes(src));
   return s;
 }
+/* the loader of load_grid: every GRID_STRIDE-th pixel of every
+   GRID_STRIDE-th row of the view's image, subsampled here */
+typedef struct grid_src {
+  const hearth_image *const *imgs;
+  size_t stride;
+} grid_src;
+static hearth_status grid_image(void *ctx, size_t v, hearth_image *img, hearth_err *err) {
+  const grid_src *g = ctx;
+  const hearth_image *src = g->imgs[v];
+  const size_t st = g->stride, w = (src->width + st - 1) / st, h = (src->height + st - 1) / st;
+  hearth_status s = hearth_image_alloc(img, w, h, src->channels, src->type, err);
+  if (s) return s;
+  const float *in = src->data;
+  float *out = img->data;
+  for (size_t y = 0; y < h; y++)
+    for (size_t x = 0; x < w; x++) out[y * w + x] = in[y * st * src->width + x * st];
+  return HEARTH_OK;
+}
 static hearth_status fail_image(void *ctx, size_t v, hearth_image *img, hearth_err *err) {
   (void)ctx;
   memset(img, 0, sizeof *img);
@@ -225,6 +243,53 @@ int main(void) {
     CHECK(hearth_map_views(&m, NULL, &cam, lazy, 2, &lo, &r4, &err) == HEARTH_E_SIZE);
     CHECK(strstr(err.msg, "view 1") != NULL);
     hearth_image_free(&tiny);
+    /* load_grid: a loader that makes only the grid's pixels (every 2nd and
+       every 3rd pixel: 256 x 192 gives 128 x 96 and 86 x 64) maps what the
+       whole images map at that stride; the camera's whole image is then
+       refused */
+    for (int st = 2; st <= 3; st++) {
+      hearth_map_opts go = o;
+      go.pixel_stride = st;
+      hearth_map_result full, grid;
+      CHECK_OK(hearth_map_views(&m, NULL, &cam, views, 2, &go, &full, &err), &err);
+      CHECK(full.n_observed > 500);
+      grid_src gs = {(const hearth_image *const *)imgs, (size_t)st};
+      go.load = grid_image;
+      go.load_ctx = &gs;
+      go.load_channels = 1;
+      go.load_grid = 1;
+      go.threads = 2;
+      hearth_map_view lz[2] = {views[0], views[1]};
+      lz[0].image = lz[1].image = NULL;
+      CHECK_OK(hearth_map_views(&m, NULL, &cam, lz, 2, &go, &grid, &err), &err);
+      CHECK(grid.n_observed == full.n_observed && grid.n_filled == full.n_filled);
+      CHECK(!memcmp(full.mask, grid.mask, (size_t)RES * RES));
+      CHECK(!memcmp(full.observed, grid.observed, (size_t)RES * RES * sizeof(float)));
+      CHECK(!memcmp(full.filled, grid.filled, (size_t)RES * RES * sizeof(float)));
+      hearth_map_result_free(&grid);
+      hearth_map_result_free(&full);
+      go.load = copy_image;
+      go.load_ctx = imgs;
+      CHECK(hearth_map_views(&m, NULL, &cam, lz, 2, &go, &grid, &err) == HEARTH_E_SIZE);
+      CHECK_MSG(strstr(err.msg, "pixel grid") != NULL, "%s", err.msg);
+    }
+  }
+  /* skip_observed: no observed map, the same filled map and mask (made in
+     the observed map's place), for mean and max fusion */
+  for (int fu = 0; fu < 2; fu++) {
+    hearth_map_opts so = o;
+    so.fusion = fu ? HEARTH_FUSE_MAX : HEARTH_FUSE_MEAN;
+    so.threads = 2;
+    hearth_map_result keep, skip;
+    CHECK_OK(hearth_map_views(&m, NULL, &cam, views, 2, &so, &keep, &err), &err);
+    so.skip_observed = 1;
+    CHECK_OK(hearth_map_views(&m, NULL, &cam, views, 2, &so, &skip, &err), &err);
+    CHECK(skip.observed == NULL && skip.filled != NULL);
+    CHECK(keep.n_filled > 100 && skip.n_filled == keep.n_filled);
+    CHECK(!memcmp(keep.mask, skip.mask, (size_t)RES * RES));
+    CHECK(!memcmp(keep.filled, skip.filled, (size_t)RES * RES * sizeof(float)));
+    hearth_map_result_free(&keep);
+    hearth_map_result_free(&skip);
   }
 
   /* errors: mesh without UVs, wrong image size */
