@@ -108,6 +108,8 @@ hearth_status hearth_jpeg_read_expect(const char *path, const hearth_image_expec
  * size. */
 hearth_status hearth_jpeg_read_grid(const char *path, const hearth_image_expect *want, size_t step,
                                     hearth_image *img, hearth_err *err);
+hearth_status hearth_jpeg_read_grid_mem(const void *data, size_t size, const char *name,
+                                        size_t step, hearth_image *img, hearth_err *err);
 hearth_status hearth_jpeg_read_mem(const void *data, size_t size, const char *name,
                                    hearth_image *img, hearth_err *err);
 /* Luma only (1 channel): the stored Y plane of a colour JPEG, decoded

@@ -198,6 +198,11 @@ hearth_status hearth_jpeg_read_mem(const void *data, size_t size, const char *na
   return jpeg_read_mem(data, size, name, 0, 0, 1, NULL, img, err);
 }
 
+hearth_status hearth_jpeg_read_grid_mem(const void *data, size_t size, const char *name,
+                                        size_t step, hearth_image *img, hearth_err *err) {
+  return jpeg_read_mem(data, size, name, 0, 0, step ? step : 1, NULL, img, err);
+}
+
 static hearth_status jpeg_read_file(const char *path, int want_gray, int half, size_t step,
                                     const hearth_image_expect *want, hearth_image *img,
                                     hearth_err *err) {
