@@ -329,7 +329,8 @@ hearth_status hearth_mesh_atlas(const hearth_mesh *in, const hearth_atlas_opts *
  * (hearth_mesh_atlas) as recon/mesh.glb (UVs, no texture: map --rgb bakes
  * the colour texture into derived/), and recon/report.json:
  *   {"instance", "route": "turntable", "views": N, "pairs", "iterations",
- *    "encoder_views", "colour_views", "icp_rms_start_mm", "icp_rms_mm", "icp_median_mm", "seconds",
+ *    "encoder_views", "colour_views", "ring_plane_views", "icp_rms_start_mm", "icp_rms_mm",
+ *    "icp_median_mm",
  *    "aim": null (the term off) or {"weight", "axis_direction": [0, 0, 1],
  *            "states": [{"state", "views", "point_m", "axis_m"}],
  *            "places": [{"ring" (null: every ring), "views", "camera_m",
@@ -342,6 +343,7 @@ hearth_status hearth_mesh_atlas(const hearth_mesh *in, const hearth_atlas_opts *
  *    "per_view": [{"state", "view", "points", "plane_inliers",
  *                  "plane_rms_mm", "height_m", "elevation_deg", "pairs",
  *                  "matches", "icp_rms_mm", "d_azimuth_deg"}]}
+ * (docs/dataset.md; hearth validate checks it against the files beside it).
  * Every file is written atomically; an existing recon/poses_rgb.json is
  * kept (HEARTH_E_ARG, as the COLMAP route does) unless force; so are a
  * recon/mesh.glb and recon/rgb_texture.png another tool handed over (in
