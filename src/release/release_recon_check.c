@@ -132,6 +132,12 @@ static void check_aim(const rc_ctx *c, const json_t *aim, long long n_views) {
       long long nv = get_count(c, st, where, "views", hi);
       if (nv < 0) sums_ok = 0;
       else sum_states += nv;
+      static const char *const sig[] = {"sigma_along_mm", "sigma_across_mm"};
+      for (size_t j = 0; j < 2; j++) {
+        const json_t *js = json_object_get(st, sig[j]);
+        if (!js) BAD(c, "%s%s: missing (a number, or null)", where, sig[j]);
+        else if (!json_is_null(js)) get_real(c, st, where, sig[j], 1);
+      }
       double C[3], A[3];
       int hc = get_vec3(c, st, where, "point_m", C), ha = get_vec3(c, st, where, "axis_m", A);
       if (hc && ha && (A[0] != C[0] || A[1] != C[1] || A[2] != 0))
