@@ -627,9 +627,13 @@ int main(int argc, char **argv) {
     hearth_pose_alignment al;
     double tilt, icp;
     hearth_poses est = {0};
-    int r = run_release(argv[1], argv[2], &al, &tilt, &icp, &est, NULL, 0);
+    /* ROOT INSTANCE aim STATES VIEWS: through hearth recon, the report's
+     * aim point and its sigmas against the truth (a state's VIEWS views) */
+    int aim = argc >= 6 && !strcmp(argv[3], "aim");
+    int r = run_release(argv[1], argv[2], &al, &tilt, &icp, &est, NULL, aim);
     printf("%s: tilt max %.3f deg\n", argv[2], tilt);
     if (!r && argc >= 4 && !strcmp(argv[3], "mesh")) bench_mesh(argv[1], argv[2], &al, &est);
+    if (!r && aim) check_aim(argv[1], argv[2], &al, (size_t)atoi(argv[4]), (size_t)atoi(argv[5]));
     hearth_poses_free(&est);
     return r ? 1 : g_test_failures;
   }
