@@ -1022,7 +1022,7 @@ static hearth_status aim_result(const tt_view *v, size_t nv, const tt_aim *am,
  * the axis), each view's residual weighted by its group's fitted spread
  * (across: side_rms / sqrt 2 per axis, along: depth_rms), with the height
  * prior; the variances are the diagonal of the inverse normal matrix.
- * Where the depth does fix the radii this is an upper estimate. */
+ * Where the depth fixes the radii better it should be an upper estimate. */
 static void aim_sigma(const tt_view *v, size_t nv, const tt_aim *am, const hearth_turntable_opts *o,
                       hearth_turntable_result *res) {
   for (size_t st = 0; st < am->n_states; st++)
