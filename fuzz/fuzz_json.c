@@ -1,6 +1,7 @@
 /* Fuzz target for the JSON documents of a release: the same bytes go to
  * every parser (rig, factory, depth intrinsics, manifest, poses,
- * detections, scale, instance, release). Parsers must fail cleanly, never
+ * detections, scale, instance, release, and hearth validate's check of
+ * recon/report.json). Parsers must fail cleanly, never
  * crash, leak or read out of bounds, and what they accept must keep the
  * invariants the readers promise. */
 #include <stdint.h>
@@ -8,6 +9,7 @@
 #include <string.h>
 
 #include "hearth/dataset.h"
+#include "release/release_internal.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   const char *text = (const char *)data;
@@ -47,5 +49,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   hearth_release_doc rel;
   hearth_release_parse(text, size, "fuzz", &rel, &err);
   hearth_release_free(&rel);
+
+  /* recon/report.json against a two-state instance with no files beside it:
+   * every problem is a line, none may crash */
+  static const char *const states[] = {"neutral", "hot"};
+  hb_recon_expect x = {"cup_01", 2, states, NULL, -1, NULL, -1, -1, -1};
+  hearth_problems pr = {0};
+  hb_recon_report_check(text, size, "fuzz", &x, &pr);
+  for (size_t i = 0; i < pr.n; i++)
+    if (!pr.items[i].what[0]) abort();
+  hearth_problems_free(&pr);
   return 0;
 }

@@ -329,9 +329,11 @@ hearth_status hearth_mesh_atlas(const hearth_mesh *in, const hearth_atlas_opts *
  * (hearth_mesh_atlas) as recon/mesh.glb (UVs, no texture: map --rgb bakes
  * the colour texture into derived/), and recon/report.json:
  *   {"instance", "route": "turntable", "views": N, "pairs", "iterations",
- *    "encoder_views", "colour_views", "icp_rms_start_mm", "icp_rms_mm", "icp_median_mm", "seconds",
+ *    "encoder_views", "colour_views", "ring_plane_views", "icp_rms_start_mm", "icp_rms_mm",
+ *    "icp_median_mm",
  *    "aim": null (the term off) or {"weight", "axis_direction": [0, 0, 1],
- *            "states": [{"state", "views", "point_m", "axis_m"}],
+ *            "states": [{"state", "views", "point_m", "axis_m",
+ *                        "sigma_along_mm", "sigma_across_mm" (null: not had)}],
  *            "places": [{"ring" (null: every ring), "views", "camera_m",
  *                        "distance_m", "side_rms_mm", "depth_rms_mm",
  *                        "depth_rms_rel"}]},
@@ -342,6 +344,7 @@ hearth_status hearth_mesh_atlas(const hearth_mesh *in, const hearth_atlas_opts *
  *    "per_view": [{"state", "view", "points", "plane_inliers",
  *                  "plane_rms_mm", "height_m", "elevation_deg", "pairs",
  *                  "matches", "icp_rms_mm", "d_azimuth_deg"}]}
+ * (docs/dataset.md; hearth validate checks it against the files beside it).
  * Every file is written atomically; an existing recon/poses_rgb.json is
  * kept (HEARTH_E_ARG, as the COLMAP route does) unless force; so are a
  * recon/mesh.glb and recon/rgb_texture.png another tool handed over (in
@@ -377,6 +380,12 @@ typedef struct hearth_turntable_aim_state {
   size_t n_views;    /* the state's views in the term */
   double point_m[3]; /* C, the axis point the cameras aim at */
   double axis_m[3];  /* where the axis meets the turntable top: (Cx, Cy, 0) */
+  /* C's standard deviation along the axis (its height) and across it (per
+   * horizontal direction): the aim term linearised in C, P and a free
+   * radius per ring (what the depth barely fixes about a surface of
+   * revolution), each view weighted by its place's fitted spread, with the
+   * height prior; NAN where it cannot be had (docs/dataset.md) */
+  double sigma_along_m, sigma_across_m;
 } hearth_turntable_aim_state;
 
 /* P, C's place in the colour camera's frame, and its fitted spread: per

@@ -2,6 +2,7 @@
  * turntable route (`hearth recon ROOT`), by running COLMAP over it
  * (`--poses colmap`) or by importing a sparse model COLMAP made
  * (`hearth recon import-colmap MODEL_DIR ...`). */
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 #include "cli/cli.h"
@@ -140,8 +141,12 @@ static int run_turntable(const char *root, const char *instance, const hearth_re
          r->seconds, sum.poses_path);
   for (size_t i = 0; i < r->n_aim_states; i++) {
     const hearth_turntable_aim_state *a = &r->aim_states[i];
-    printf("recon %s/%s: aimed at (%.4f, %.4f, %.4f) m on the axis\n", instance, a->state,
+    printf("recon %s/%s: aimed at (%.4f, %.4f, %.4f) m on the axis", instance, a->state,
            a->point_m[0], a->point_m[1], a->point_m[2]);
+    if (isfinite(a->sigma_along_m) && isfinite(a->sigma_across_m))
+      printf(", sigma %.2f mm along it, %.2f mm across", 1e3 * a->sigma_along_m,
+             1e3 * a->sigma_across_m);
+    printf("\n");
   }
   if (!job.no_mesh) {
     printf("recon %s: mesh %zu vertices, %zu triangles -> %s\n", instance, sum.mesh_vertices,

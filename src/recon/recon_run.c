@@ -1,6 +1,7 @@
 /* recon_run.c - `hearth recon ROOT` on the embedded route: turntable poses,
  * the metric mesh from depth with them, its UV atlas, and the
  * reconstruction report. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -84,6 +85,15 @@ static void write_aim(hearth_strbuf *b, const hearth_turntable_result *r, double
     rc_json_reals(b, a->point_m, 3);
     hearth_strbuf_printf(b, ", \"axis_m\": ");
     rc_json_reals(b, a->axis_m, 3);
+    const struct {
+      const char *k;
+      double v;
+    } sg[] = {{"sigma_along_mm", a->sigma_along_m}, {"sigma_across_mm", a->sigma_across_m}};
+    for (size_t k = 0; k < 2; k++) {
+      hearth_strbuf_printf(b, ", \"%s\": ", sg[k].k);
+      if (isfinite(sg[k].v)) rc_json_real(b, 1000.0 * sg[k].v);
+      else hearth_strbuf_printf(b, "null");
+    }
     hearth_strbuf_printf(b, "}");
   }
   hearth_strbuf_printf(b, "],\n    \"places\": [");

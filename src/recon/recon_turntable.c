@@ -948,10 +948,15 @@ static void aim_system(const tt_view *v, size_t nv, const tt_aim *am,
   }
 }
 
+static void aim_sigma(const tt_view *v, size_t nv, const tt_aim *am, const hearth_turntable_opts *o,
+                      hearth_turntable_result *res);
+
 /* The aim term's estimate into res: C per state, P per group with the
  * spread of the views' residuals about it (the final poses, C and P). */
-static hearth_status aim_result(const tt_view *v, size_t nv, const tt_aim *am, int per_ring,
-                                hearth_turntable_result *res, hearth_err *err) {
+static hearth_status aim_result(const tt_view *v, size_t nv, const tt_aim *am,
+                                const hearth_turntable_opts *o, hearth_turntable_result *res,
+                                hearth_err *err) {
+  const int per_ring = o->aim_per_ring;
   res->aim_states = calloc(am->n_states ? am->n_states : 1, sizeof *res->aim_states);
   res->aim_places = calloc(am->n_groups, sizeof *res->aim_places);
   if (!res->aim_states || !res->aim_places) {
@@ -1000,7 +1005,100 @@ static hearth_status aim_result(const tt_view *v, size_t nv, const tt_aim *am, i
     pl->depth_rms_rel = len > 0 ? pl->depth_rms_m / len : 0;
   }
   free(ss);
+  aim_sigma(v, nv, am, o, res);
   return HEARTH_OK;
+}
+
+/* The standard deviation of each state's C along the axis and across it,
+ * into res->aim_states (NAN where it cannot be had). C along the axis is
+ * fixed only by the rings' relative placement: raising C by d and moving a
+ * ring at elevation e in by d cot e leaves its views' image places of C as
+ * they were and shortens their distances by d / sin e, so the rings'
+ * different distances (held only within aim_depth_tol) carry it, and the
+ * rings' radii are what the depth barely fixes about a surface of
+ * revolution (the can's "breathing"). The model: the linearised aim term
+ * in C per state, P per group and a free radius per ring (state and
+ * elevation: its views moved along their own horizontal direction from
+ * the axis), each view's residual weighted by its group's fitted spread
+ * (across: side_rms / sqrt 2 per axis, along: depth_rms), with the height
+ * prior; the variances are the diagonal of the inverse normal matrix.
+ * Where the depth fixes the radii better it should be an upper estimate. */
+static void aim_sigma(const tt_view *v, size_t nv, const tt_aim *am, const hearth_turntable_opts *o,
+                      hearth_turntable_result *res) {
+  for (size_t st = 0; st < am->n_states; st++)
+    res->aim_states[st].sigma_along_m = res->aim_states[st].sigma_across_m = NAN;
+  /* the rings: (state, elevation) pairs of the views in the term */
+  int *ring = malloc((nv ? nv : 1) * sizeof *ring), *key_e = malloc((nv ? nv : 1) * sizeof *key_e);
+  size_t *key_s = malloc((nv ? nv : 1) * sizeof *key_s), nr = 0;
+  if (!ring || !key_e || !key_s) goto out;
+  for (size_t i = 0; i < nv; i++) {
+    ring[i] = -1;
+    if (v[i].ring < 0) continue;
+    size_t k = 0;
+    while (k < nr && !(key_s[k] == v[i].state_no && key_e[k] == v[i].elevation_index)) k++;
+    if (k == nr) {
+      key_s[nr] = v[i].state_no;
+      key_e[nr++] = v[i].elevation_index;
+    }
+    ring[i] = (int)k;
+  }
+  const size_t p0 = 3 * am->n_states, r0 = p0 + 3 * am->n_groups, n = r0 + nr;
+  double *N = calloc(n * n, sizeof *N), *A = malloc(n * n * sizeof *A), *e = malloc(n * sizeof *e);
+  if (!N || !A || !e) {
+    free(N);
+    free(A);
+    free(e);
+    goto out;
+  }
+  double top = object_top(v, nv);
+  for (size_t i = 0; i < nv; i++) {
+    if (ring[i] < 0) continue;
+    const size_t st = v[i].state_no, g = (size_t)v[i].ring;
+    const hearth_turntable_aim_place *pl = &res->aim_places[g];
+    const double floor_m = 1e-6;
+    double sx = fmax(pl->side_rms_m / sqrt(2.0), floor_m), sz = fmax(pl->depth_rms_m, floor_m);
+    const double *C = &am->C[3 * st];
+    double h[3] = {v[i].T.t[0] - C[0], v[i].T.t[1] - C[1], 0}, lh = hypot(h[0], h[1]);
+    if (lh > 0) h[0] /= lh, h[1] /= lh;
+    for (int k = 0; k < 3; k++) {
+      /* residual k = g_k . (C - t) - P_k; the radius moves t along h */
+      double gk[3] = {v[i].T.R[k], v[i].T.R[3 + k], v[i].T.R[6 + k]};
+      double J[5] = {gk[0], gk[1], gk[2], -1.0, -hearth_dot3(gk, h)};
+      size_t ix[5] = {3 * st, 3 * st + 1, 3 * st + 2, p0 + 3 * g + (size_t)k, r0 + (size_t)ring[i]};
+      double w = 1.0 / ((k < 2 ? sx : sz) * (k < 2 ? sx : sz));
+      for (int a = 0; a < 5; a++)
+        for (int b = 0; b < 5; b++) N[ix[a] * n + ix[b]] += w * J[a] * J[b];
+    }
+  }
+  if (o->aim_height_tol > 0) {
+    double sig_h = fmax(o->aim_height_tol * top, 0.002);
+    for (size_t st = 0; st < am->n_states; st++)
+      N[(3 * st + 2) * n + 3 * st + 2] += 1 / (sig_h * sig_h);
+  }
+  /* a ring or group that fixes nothing: held within 0.1 m */
+  for (size_t d = p0; d < n; d++) N[d * n + d] += 100.0;
+  for (size_t st = 0; st < am->n_states; st++) {
+    if (!res->aim_states[st].n_views) continue;
+    double var[3];
+    int ok = 1;
+    for (int k = 0; k < 3 && ok; k++) {
+      memcpy(A, N, n * n * sizeof *A);
+      memset(e, 0, n * sizeof *e);
+      e[3 * st + (size_t)k] = 1;
+      ok = chol_solve(A, e, n);
+      var[k] = e[3 * st + (size_t)k];
+    }
+    if (!ok) continue;
+    res->aim_states[st].sigma_along_m = sqrt(var[2]);
+    res->aim_states[st].sigma_across_m = sqrt(0.5 * (var[0] + var[1]));
+  }
+  free(N);
+  free(A);
+  free(e);
+out:
+  free(ring);
+  free(key_e);
+  free(key_s);
 }
 
 static hearth_status run_icp(tt_view *v, size_t nv, size_t n_states, const double u[3],
@@ -1179,7 +1277,7 @@ static hearth_status run_icp(tt_view *v, size_t nv, size_t n_states, const doubl
     hearth_progress_step(&prog, 1);
   }
   hearth_progress_end(&prog);
-  if (!s && aim) s = aim_result(v, nv, &am, o->aim_per_ring, res, err);
+  if (!s && aim) s = aim_result(v, nv, &am, o, res, err);
   res->n_pairs = np;
   res->iterations += iterations;
   for (size_t k = 0; k < np; k++) free(pairs[k].r);

@@ -2,6 +2,8 @@
 #ifndef HEARTH_RELEASE_INTERNAL_H
 #define HEARTH_RELEASE_INTERNAL_H
 
+#include "hearth/dataset.h"
+#include "hearth/mesh.h"
 #include "hearth/release.h"
 
 /* The parameters of a build that shape its outputs, as build.json at the
@@ -43,5 +45,27 @@ hearth_status hb_contact_picture(const char *root, const char *inst, const char 
 hearth_status hb_report_effects(const uint8_t *m, const float *o, const float *t, const float *a,
                                 const float *c, const uint8_t *away, size_t R,
                                 hearth_report_entry *e, hearth_err *err);
+
+/* recon/report.json checked against what lies beside it (release_recon_check.c,
+ * hearth validate): what is known of the instance; a member left NULL or -1
+ * is not compared. */
+typedef struct hb_recon_expect {
+  const char *instance; /* instance.json's id */
+  size_t n_states;
+  const char *const *states;               /* instance.json's states */
+  const hearth_manifest *manifests;        /* one per state (n_views 0: unreadable), or NULL */
+  long long manifest_views;                /* all the manifests' views, -1: unknown */
+  const hearth_poses *poses;               /* recon/poses_rgb.json, or NULL */
+  long long mesh_vertices, mesh_triangles; /* recon/mesh_geometry.glb's, -1: not read */
+  long long atlas_charts;                  /* recon/mesh.glb's UV islands, -1: not read */
+} hb_recon_expect;
+/* Every problem of the report text[0..len) (as "MEMBER: what" under path)
+ * into p; a text that does not parse is one problem naming its line and
+ * column. */
+void hb_recon_report_check(const char *text, size_t len, const char *path, const hb_recon_expect *x,
+                           hearth_problems *p);
+/* The UV islands of a mesh: components of its triangles over shared
+ * vertices (hearth's atlas: one per chart); -1 out of memory. */
+long long hb_mesh_islands(const hearth_mesh *m);
 
 #endif

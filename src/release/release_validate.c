@@ -449,6 +449,53 @@ static void check_leftovers(hearth_problems *p, const char *dir, int depth) {
   free(names);
 }
 
+/* recon/report.json (hearth recon's turntable route), when present: its
+ * members against the manifests, recon/poses_rgb.json and the meshes
+ * beside it (those files themselves are another tool's hand-over, or
+ * hearth's, and read only to compare) */
+static void check_recon_report(hearth_problems *p, const char *dir, const char *id,
+                               const hearth_instance_doc *doc, const state_views *sv,
+                               size_t *nfiles) {
+  char path[PATH_SZ], f[PATH_SZ];
+  snprintf(path, sizeof path, "%s/recon/report.json", dir);
+  if (!present(path)) return;
+  (*nfiles)++;
+  hearth_err e = {0};
+  uint8_t *text = NULL;
+  size_t len = 0;
+  if (hearth_read_file(path, (size_t)64 << 20, &text, &len, &e)) {
+    add_err(p, path, &e);
+    return;
+  }
+  hearth_manifest man[HEARTH_MAX_STATES];
+  const char *states[HEARTH_MAX_STATES];
+  size_t ns = doc->n_states < HEARTH_MAX_STATES ? doc->n_states : HEARTH_MAX_STATES;
+  long long all = 0;
+  for (size_t k = 0; k < ns; k++) {
+    states[k] = doc->states[k];
+    man[k] = sv[k].man;
+    if (!sv[k].ok) all = -1;
+    else if (all >= 0) all += (long long)sv[k].man.n_views;
+  }
+  hb_recon_expect x = {id, ns, states, man, all, NULL, -1, -1, -1};
+  hearth_poses poses = {0};
+  snprintf(f, sizeof f, "%s/recon/poses_rgb.json", dir);
+  if (present(f) && !hearth_poses_read(f, &poses, NULL)) x.poses = &poses;
+  hearth_mesh m = {0};
+  snprintf(f, sizeof f, "%s/recon/mesh_geometry.glb", dir);
+  if (present(f) && !hearth_glb_read(f, NULL, &m, NULL)) {
+    x.mesh_vertices = (long long)m.n_vertices;
+    x.mesh_triangles = (long long)m.n_triangles;
+  }
+  hearth_mesh_free(&m);
+  snprintf(f, sizeof f, "%s/recon/mesh.glb", dir);
+  if (present(f) && !hearth_glb_read(f, NULL, &m, NULL)) x.atlas_charts = hb_mesh_islands(&m);
+  hearth_mesh_free(&m);
+  hb_recon_report_check((const char *)text, len, path, &x, p);
+  hearth_poses_free(&poses);
+  free(text);
+}
+
 static void check_instance(const char *root, const char *id, const hearth_validate_opts *o,
                            const size_t tsize[2], hearth_problems *p, size_t *nfiles) {
   char path[PATH_SZ], dir[PATH_SZ];
@@ -540,6 +587,7 @@ static void check_instance(const char *root, const char *id, const hearth_valida
       }
     }
   }
+  check_recon_report(p, dir, id, &doc, sv, nfiles);
   if (o->raw_only) goto done;
 
   /* derived/: scale, mesh, poses, per-state maps (one line if never built) */

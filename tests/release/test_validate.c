@@ -1,13 +1,15 @@
 /* hearth validate: a clean tiny built release has no problem; each planted
  * defect (missing view file, 255x192 CSV, mask value 7, non-rotation pose,
- * provenance naming a view that does not exist) is reported with its path. */
+ * provenance naming a view that does not exist) is reported with its path.
+ * recon/report.json of hearth's own reconstruction passes, and each damaged
+ * copy of it fails with the member named. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include "hearth/npy.h"
 #include "hearth/map.h"
 #include "hearth/poses.h"
-#include "hearth/poses.h"
+#include "hearth/recon_geom.h"
 #include "hearth/dataset.h"
 #include "hearth/release.h"
 #include "hearth/synth.h"
@@ -17,12 +19,14 @@ static char g_root[1024];
 
 /* problems of the release at root; returns the count, fills a hit flag for a
  * problem whose path ends with `suffix` and whose text contains `needle` */
-static size_t validate(const char *root, const char *suffix, const char *needle, int *hit) {
+static size_t validate_opts(const char *root, int raw_only, const char *suffix, const char *needle,
+                            int *hit) {
   hearth_problems pr = {0};
   hearth_err err = {0};
   hearth_validate_opts o;
   hearth_validate_opts_default(&o);
   o.threads = 2;
+  o.raw_only = raw_only;
   CHECK_OK(hearth_validate_release(root, &o, &pr, NULL, &err), &err);
   if (hit) *hit = 0;
   for (size_t i = 0; i < pr.n; i++) {
@@ -37,6 +41,10 @@ static size_t validate(const char *root, const char *suffix, const char *needle,
   return n;
 }
 
+static size_t validate(const char *root, const char *suffix, const char *needle, int *hit) {
+  return validate_opts(root, 0, suffix, needle, hit);
+}
+
 /* a fresh copy of the built release to damage */
 static const char *fresh_copy(const char *name) {
   static char dst[1200];
@@ -44,6 +52,120 @@ static const char *fresh_copy(const char *name) {
   test_sh("rm -rf '%s'%s", dst, "");
   test_sh("cp -a '%s' '%s'", g_root, dst);
   return dst;
+}
+
+/* recon/report.json as hearth recon writes it (a can, 6 views x 2 states,
+ * poses, mesh and atlas): it passes; each copy damaged by one python edit
+ * of the JSON (or of the file beside it) fails with exactly one problem
+ * naming the report and the member. */
+static void test_recon_report(void) {
+  const char *base = test_tmpdir("validate_recon");
+  hearth_err err = {0};
+  char root[1100], p[2048];
+  snprintf(root, sizeof root, "%s/rel", base);
+  hearth_synth_opts so;
+  hearth_synth_opts_default(&so);
+  so.out_root = root;
+  so.n_categories = 1;
+  so.categories[0] = "canned_drink";
+  so.seed = 1;
+  so.n_views = 6;
+  so.texture_size = 64;
+  so.map_resolution = 32;
+  so.calibration = 0;
+  so.no_recon = 1;
+  so.threads = 2;
+  so.quiet = 1;
+  so.rgb_full_size = 0;
+  CHECK_OK(hearth_synth_release(&so, &err), &err);
+  hearth_recon_job job;
+  hearth_recon_job_default(&job);
+  job.root = root;
+  job.instance = "canned_drink_01";
+  job.poses.threads = 2;
+  job.quiet = 1;
+  hearth_recon_summary sum;
+  CHECK_OK(hearth_recon_run(&job, &sum, &err), &err);
+  hearth_recon_summary_free(&sum);
+  int hit;
+  size_t n = validate_opts(root, 1, NULL, NULL, NULL);
+  CHECK_MSG(n == 0, "hearth's own recon/: %zu problem(s)", n);
+  const char *rep = "instances/canned_drink_01/recon/report.json";
+  /* each damage: a python statement on d (the report's JSON) or a shell
+   * command in the copy, and the problem expected */
+  static const struct {
+    const char *py, *sh, *want;
+    size_t n; /* problems in all (0: one) */
+  } cases[] = {
+      {NULL, "truncate -s 100 %s", "line "},
+      /* and poses_rgb.json's 12 and per_view's 12 */
+      {"d['views'] -= 1", NULL, "views: 11, but the manifests list 12", 3},
+      {"del d['icp_rms_mm']", NULL, "icp_rms_mm: missing (a number)"},
+      {"d['route'] = 'colmap'", NULL, "route: 'colmap', expected 'turntable'"},
+      {"d['per_view'][3]['view'] = 'v77'", NULL,
+       "per_view[3].view: 'v77' does not exist in neutral's manifest"},
+      {"d['per_view'][4]['matches'] = -3", NULL, "per_view[4].matches: expected an integer >= 0"},
+      {"d['per_view'].pop()", NULL, "per_view: 11 entries, but views is 12"},
+      {"d['aim']['states'][1]['state'] = 'hot'", NULL,
+       "aim.states[1].state: 'hot' is not a state of this instance"},
+      {"d['aim']['states'][1]['state'] = 'neutral'", NULL,
+       "aim.states[1].state: 'neutral' listed twice"},
+      {"d['aim']['states'][0]['point_m'][2] = 'x'", NULL,
+       "aim.states[0].point_m: expected an array of 3 finite numbers"},
+      {"d['aim']['states'][0]['axis_m'][2] = 0.01", NULL, "aim.states[0].axis_m: ("},
+      {"d['aim']['states'][1]['sigma_along_mm'] = -2.0", NULL,
+       "aim.states[1].sigma_along_mm: -2, expected a number >= 0"},
+      {"del d['aim']['states'][0]['sigma_across_mm']", NULL,
+       "aim.states[0].sigma_across_mm: missing (a number, or null)"},
+      {"d['aim']['axis_direction'] = [0.0, 1.0, 0.0]", NULL, "aim.axis_direction: (0, 1, 0)"},
+      {"d['aim']['places'][0]['distance_m'] *= 2", NULL, "aim.places[0].distance_m: "},
+      {"d['aim']['places'][0]['views'] = 11", NULL, "aim: the states hold 12 views, the places 11"},
+      {"d['aim'] = 0.1", NULL, "aim: expected null (the term off) or an object"},
+      {"d['mesh']['triangles'] += 1", NULL, "but mesh_geometry.glb has"},
+      {"d['atlas']['charts'] += 1", NULL, "UV islands"},
+      {"d['atlas']['packing_efficiency'] = 1.5", NULL, "atlas.packing_efficiency: 1.5"},
+      {NULL,
+       "python3 -c \"import json; f='instances/canned_drink_01/recon/poses_rgb.json'; "
+       "d=json.load(open(f)); d['views'].pop(); json.dump(d, open(f, 'w'))\"",
+       "views: 12, but poses_rgb.json has 11", 2 /* and the view without a pose */},
+  };
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+    char d[1200], name[32];
+    snprintf(name, sizeof name, "recon%zu", i);
+    snprintf(d, sizeof d, "%s/%s", base, name);
+    test_sh("rm -rf '%s'%s", d, "");
+    test_sh("cp -a '%s' '%s'", root, d);
+    snprintf(p, sizeof p, "%s/%s", d, rep);
+    if (cases[i].py) {
+      char cmd[2048];
+      snprintf(cmd, sizeof cmd,
+               "python3 -c \"import json,sys; f=sys.argv[1]; d=json.load(open(f)); %s; "
+               "json.dump(d, open(f, 'w'))\" '%%s'%%s",
+               cases[i].py);
+      test_sh(cmd, p, "");
+    } else {
+      char cmd[2048];
+      snprintf(cmd, sizeof cmd, cases[i].sh, rep);
+      test_sh("cd '%s' && %s", d, cmd);
+    }
+    n = validate_opts(d, 1, rep, cases[i].want, &hit);
+    CHECK_MSG(hit && n == (cases[i].n ? cases[i].n : 1), "case %zu (%s): hit %d, %zu problem(s)", i,
+              cases[i].py ? cases[i].py : cases[i].sh, hit, n);
+  }
+  /* the term off: aim null is well formed */
+  {
+    char d[1200];
+    snprintf(d, sizeof d, "%s/aim_null", base);
+    test_sh("rm -rf '%s'%s", d, "");
+    test_sh("cp -a '%s' '%s'", root, d);
+    snprintf(p, sizeof p, "%s/%s", d, rep);
+    test_sh(
+        "python3 -c \"import json,sys; f=sys.argv[1]; d=json.load(open(f)); d['aim'] = None; "
+        "json.dump(d, open(f, 'w'))\" '%s'%s",
+        p, "");
+    n = validate_opts(d, 1, NULL, NULL, NULL);
+    CHECK_MSG(n == 0, "aim null: %zu problem(s)", n);
+  }
 }
 
 int main(void) {
@@ -180,5 +302,6 @@ int main(void) {
     n = validate(d, NULL, NULL, NULL);
     CHECK_MSG(n == 3, "three defects: %zu problem(s)", n);
   }
+  test_recon_report();
   TEST_MAIN_END();
 }
