@@ -8,7 +8,10 @@
  * prior), kept only when they explain more than 7 free parameters per pair
  * would fit of noise. hearth_calib_stereo_joint then refines camera b's
  * intrinsics with the rest, from the pairs and camera b's own frames, and
- * optionally the target's hole positions. */
+ * optionally the target's hole positions; with the rolling-shutter model
+ * it does so under the rigid model first and tries the moving model from
+ * the refined camera b. The RMS reported is the points' alone (the trigger
+ * prior's term left out). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -481,6 +484,11 @@ static void stereo_report(const stereo_prob *P, const double pT[6], const double
   double sum = 0;
   size_t m = 0;
   for (size_t i = 0; i < P->n_pairs; i++) {
+    /* the points' error only: the trigger prior is no pixel error */
+    if (P->nq > 12) {
+      const double tb = tb_time(sol + (size_t)P->nq * i, P->nq) / TB_SIGMA;
+      pc[i] = fmax(0.0, pc[i] - tb * tb);
+    }
     /* a pair without a pose start has no meaningful residual */
     double r = isfinite(pc[i]) ? sqrt(pc[i] / (2.0 * (double)P->n_pts)) : NAN;
     if (pair_rms) pair_rms[i] = r;
@@ -863,13 +871,13 @@ static void target_step(const joint_prob *J, const double *g, const double *x,
       pts[j][k] = nom[j][k] + off[j][k] - (c[k][0] * nom[j][0] + c[k][1] * nom[j][1] + c[k][2]);
 }
 
-hearth_status hearth_calib_stereo_joint(const hearth_camera *cam_a, hearth_camera *cam_b,
-                                        const double (*obj)[3], size_t n_pts, const double *img_a,
-                                        const double *img_b, size_t n_pairs, const double *img_c,
-                                        size_t n_c, const hearth_calib_opts *o,
-                                        hearth_rigid *T_b_from_a, double *rms_px,
-                                        double *own_rms_px, double *pair_rms, int *pair_used,
-                                        hearth_err *err) {
+hearth_status calib_stereo_joint_times(const hearth_camera *cam_a, hearth_camera *cam_b,
+                                       const double (*obj)[3], size_t n_pts, const double *img_a,
+                                       const double *img_b, size_t n_pairs, const double *img_c,
+                                       size_t n_c, const hearth_calib_opts *o,
+                                       hearth_rigid *T_b_from_a, double *rms_px, double *own_rms_px,
+                                       double *pair_rms, int *pair_used, double *pair_time,
+                                       hearth_err *err) {
   hearth_calib_opts def;
   if (!o) {
     hearth_calib_opts_default(&def);
@@ -887,15 +895,31 @@ hearth_status hearth_calib_stereo_joint(const hearth_camera *cam_a, hearth_camer
   double(*tpts)[3] = NULL;
   int nq = 6;
   hearth_status st = HEARTH_OK;
+  hearth_camera cb = *cam_b; /* camera b's start, then its estimate */
   if (!used || !pc) {
     st = hearth_err_set(err, HEARTH_E_NOMEM, "stereo calibration: out of memory");
     goto done;
   }
-  if ((st = stereo_core(cam_a, cam_b, obj, n_pts, img_a, img_b, n_pairs, o, pT, &sol, &nq, used,
-                        err)))
+  if (o->stereo_intrinsics && o->rolling_shutter) {
+    /* the moving model tried at camera b's start intrinsics takes part of
+     * their error into its velocities and trigger times and can settle in
+     * a false minimum: camera b is refined under the rigid model first and
+     * the moving model tried from there (from the start itself if that
+     * fails) */
+    hearth_calib_opts o1 = *o;
+    o1.rolling_shutter = 0;
+    o1.target_points = 0;
+    hearth_rigid T1;
+    hearth_err e1;
+    if (calib_stereo_joint_times(cam_a, &cb, obj, n_pts, img_a, img_b, n_pairs, img_c, n_c, &o1,
+                                 &T1, NULL, NULL, NULL, NULL, NULL, &e1))
+      cb = *cam_b;
+  }
+  if ((st =
+           stereo_core(cam_a, &cb, obj, n_pts, img_a, img_b, n_pairs, o, pT, &sol, &nq, used, err)))
     goto done;
-  stereo_prob P = {cam_a, cam_b, obj, n_pts, n_pairs, img_a, img_b, used, nq};
-  hearth_camera cb = *cam_b;
+  const hearth_camera cb_start = cb;
+  stereo_prob P = {cam_a, &cb_start, obj, n_pts, n_pairs, img_a, img_b, used, nq};
   if (o->stereo_intrinsics) {
     /* camera b's own frames: their poses at the current intrinsics */
     size_t nx = (size_t)nq * n_pairs + 6 * n_c;
@@ -908,7 +932,7 @@ hearth_status hearth_calib_stereo_joint(const hearth_camera *cam_a, hearth_camer
     for (size_t k = 0; k < n_c; k++) {
       hearth_rigid T;
       hearth_err e2;
-      if (hearth_calib_pose(cam_b, obj, n_pts, img_c + 2 * k * n_pts, &T, NULL, &e2)) {
+      if (hearth_calib_pose(&cb_start, obj, n_pts, img_c + 2 * k * n_pts, &T, NULL, &e2)) {
         st = hearth_err_set(err, HEARTH_E_NUMERIC, "stereo calibration: own frame %zu: no pose", k);
         goto done;
       }
@@ -916,12 +940,12 @@ hearth_status hearth_calib_stereo_joint(const hearth_camera *cam_a, hearth_camer
     }
     double g[JG];
     memcpy(g, pT, sizeof pT);
-    g[6] = cam_b->fx;
-    g[7] = cam_b->fy;
-    g[8] = cam_b->cx;
-    g[9] = cam_b->cy;
-    for (int k = 0; k < 5; k++) g[10 + k] = cam_b->dist[k];
-    joint_prob J = {P, cam_b, img_c, n_c};
+    g[6] = cb_start.fx;
+    g[7] = cb_start.fy;
+    g[8] = cb_start.cx;
+    g[9] = cb_start.cy;
+    for (int k = 0; k < 5; k++) g[10 + k] = cb_start.dist[k];
+    joint_prob J = {P, &cb_start, img_c, n_c};
     int ok = joint_lm(&J, g, x, o->max_iterations);
     if (ok && o->target_points && n_pts <= HEARTH_TARGET_MAX_HOLES) {
       /* the holes' own in-plane positions, in turn with the rest */
@@ -956,6 +980,9 @@ hearth_status hearth_calib_stereo_joint(const hearth_camera *cam_a, hearth_camer
   P.cb = cam_b;
   calib_rigid_from_params(pT, T_b_from_a);
   stereo_report(&P, pT, sol, pc, rms_px, pair_rms, pair_used);
+  if (pair_time)
+    for (size_t i = 0; i < n_pairs; i++)
+      pair_time[i] = nq > 12 && used[i] ? tb_time(sol + (size_t)nq * i, nq) : NAN;
 done:
   free(sol);
   free(x);
@@ -963,4 +990,15 @@ done:
   free(used);
   free(pc);
   return st;
+}
+
+hearth_status hearth_calib_stereo_joint(const hearth_camera *cam_a, hearth_camera *cam_b,
+                                        const double (*obj)[3], size_t n_pts, const double *img_a,
+                                        const double *img_b, size_t n_pairs, const double *img_c,
+                                        size_t n_c, const hearth_calib_opts *o,
+                                        hearth_rigid *T_b_from_a, double *rms_px,
+                                        double *own_rms_px, double *pair_rms, int *pair_used,
+                                        hearth_err *err) {
+  return calib_stereo_joint_times(cam_a, cam_b, obj, n_pts, img_a, img_b, n_pairs, img_c, n_c, o,
+                                  T_b_from_a, rms_px, own_rms_px, pair_rms, pair_used, NULL, err);
 }
