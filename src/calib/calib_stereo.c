@@ -871,24 +871,16 @@ static void target_step(const joint_prob *J, const double *g, const double *x,
       pts[j][k] = nom[j][k] + off[j][k] - (c[k][0] * nom[j][0] + c[k][1] * nom[j][1] + c[k][2]);
 }
 
-hearth_status calib_stereo_joint_times(const hearth_camera *cam_a, hearth_camera *cam_b,
-                                       const double (*obj)[3], size_t n_pts, const double *img_a,
-                                       const double *img_b, size_t n_pairs, const double *img_c,
-                                       size_t n_c, const hearth_calib_opts *o,
-                                       hearth_rigid *T_b_from_a, double *rms_px, double *own_rms_px,
-                                       double *pair_rms, int *pair_used, double *pair_time,
-                                       hearth_err *err) {
-  hearth_calib_opts def;
-  if (!o) {
-    hearth_calib_opts_default(&def);
-    o = &def;
-  }
-  if (!cam_a || !cam_b || !obj || !img_a || !img_b || (n_c && !img_c) || !T_b_from_a)
-    return hearth_err_set(err, HEARTH_E_ARG, "stereo calibration: missing argument");
-  if (n_pairs < 1)
-    return hearth_err_set(err, HEARTH_E_SIZE, "stereo calibration: no usable stereo pairs");
-  if (n_pts < 4 || n_pts > 100000 || n_pairs > 100000 || n_c > 100000)
-    return hearth_err_set(err, HEARTH_E_SIZE, "stereo calibration: %zu points per pair", n_pts);
+/* the joint solve from camera b's start *cam_b (its estimate on return);
+ * *cost (the final cost, prior and own frames included) and *n_used (pairs
+ * used) when cost is non-NULL; arguments checked by the caller */
+static hearth_status joint_solve(const hearth_camera *cam_a, hearth_camera *cam_b,
+                                 const double (*obj)[3], size_t n_pts, const double *img_a,
+                                 const double *img_b, size_t n_pairs, const double *img_c,
+                                 size_t n_c, const hearth_calib_opts *o, hearth_rigid *T_b_from_a,
+                                 double *rms_px, double *own_rms_px, double *pair_rms,
+                                 int *pair_used, double *pair_time, double *cost, size_t *n_used,
+                                 hearth_err *err) {
   int *used = hearth_calloc_array(n_pairs, sizeof(int));
   double *pc = hearth_alloc_array(n_pairs, sizeof(double));
   double *sol = NULL, *x = NULL, pT[6];
@@ -899,21 +891,6 @@ hearth_status calib_stereo_joint_times(const hearth_camera *cam_a, hearth_camera
   if (!used || !pc) {
     st = hearth_err_set(err, HEARTH_E_NOMEM, "stereo calibration: out of memory");
     goto done;
-  }
-  if (o->stereo_intrinsics && o->rolling_shutter) {
-    /* the moving model tried at camera b's start intrinsics takes part of
-     * their error into its velocities and trigger times and can settle in
-     * a false minimum: camera b is refined under the rigid model first and
-     * the moving model tried from there (from the start itself if that
-     * fails) */
-    hearth_calib_opts o1 = *o;
-    o1.rolling_shutter = 0;
-    o1.target_points = 0;
-    hearth_rigid T1;
-    hearth_err e1;
-    if (calib_stereo_joint_times(cam_a, &cb, obj, n_pts, img_a, img_b, n_pairs, img_c, n_c, &o1,
-                                 &T1, NULL, NULL, NULL, NULL, NULL, &e1))
-      cb = *cam_b;
   }
   if ((st =
            stereo_core(cam_a, &cb, obj, n_pts, img_a, img_b, n_pairs, o, pT, &sol, &nq, used, err)))
@@ -965,6 +942,7 @@ hearth_status calib_stereo_joint_times(const hearth_camera *cam_a, hearth_camera
       st = hearth_err_set(err, HEARTH_E_NUMERIC, "stereo calibration: joint refinement failed");
       goto done;
     }
+    if (cost) *cost = joint_cost(&J, g, x);
     memcpy(pT, g, sizeof pT);
     memcpy(sol, x, sizeof(double) * (size_t)nq * n_pairs);
     joint_cam(&J, g, &cb);
@@ -983,6 +961,10 @@ hearth_status calib_stereo_joint_times(const hearth_camera *cam_a, hearth_camera
   if (pair_time)
     for (size_t i = 0; i < n_pairs; i++)
       pair_time[i] = nq > 12 && used[i] ? tb_time(sol + (size_t)nq * i, nq) : NAN;
+  if (n_used) {
+    *n_used = 0;
+    for (size_t i = 0; i < n_pairs; i++) *n_used += used[i] != 0;
+  }
 done:
   free(sol);
   free(x);
@@ -990,6 +972,72 @@ done:
   free(used);
   free(pc);
   return st;
+}
+
+hearth_status calib_stereo_joint_times(const hearth_camera *cam_a, hearth_camera *cam_b,
+                                       const double (*obj)[3], size_t n_pts, const double *img_a,
+                                       const double *img_b, size_t n_pairs, const double *img_c,
+                                       size_t n_c, const hearth_calib_opts *o,
+                                       hearth_rigid *T_b_from_a, double *rms_px, double *own_rms_px,
+                                       double *pair_rms, int *pair_used, double *pair_time,
+                                       hearth_err *err) {
+  hearth_calib_opts def;
+  if (!o) {
+    hearth_calib_opts_default(&def);
+    o = &def;
+  }
+  if (!cam_a || !cam_b || !obj || !img_a || !img_b || (n_c && !img_c) || !T_b_from_a)
+    return hearth_err_set(err, HEARTH_E_ARG, "stereo calibration: missing argument");
+  if (n_pairs < 1)
+    return hearth_err_set(err, HEARTH_E_SIZE, "stereo calibration: no usable stereo pairs");
+  if (n_pts < 4 || n_pts > 100000 || n_pairs > 100000 || n_c > 100000)
+    return hearth_err_set(err, HEARTH_E_SIZE, "stereo calibration: %zu points per pair", n_pts);
+  if (!o->stereo_intrinsics || !o->rolling_shutter)
+    return joint_solve(cam_a, cam_b, obj, n_pts, img_a, img_b, n_pairs, img_c, n_c, o, T_b_from_a,
+                       rms_px, own_rms_px, pair_rms, pair_used, pair_time, NULL, NULL, err);
+  /* The moving model's velocities and trigger times, tried at camera b's
+   * start intrinsics, can take part of their error and settle in a false
+   * minimum; tried from camera b refined under the rigid model they can
+   * settle in another. Both are solved and the one with the lower mean
+   * squared residual over the points it used kept (the first on a tie;
+   * each drops its own outlier pairs). */
+  hearth_calib_opts o1 = *o;
+  o1.rolling_shutter = 0;
+  o1.target_points = 0;
+  hearth_camera cr = *cam_b, c0 = *cam_b;
+  hearth_rigid T1;
+  hearth_err e1;
+  int refined = !joint_solve(cam_a, &cr, obj, n_pts, img_a, img_b, n_pairs, img_c, n_c, &o1, &T1,
+                             NULL, NULL, NULL, NULL, NULL, NULL, NULL, &e1);
+  double cost0 = INFINITY, cost1 = INFINITY;
+  size_t nu0 = 0, nu1 = 0;
+  hearth_status st =
+      joint_solve(cam_a, &c0, obj, n_pts, img_a, img_b, n_pairs, img_c, n_c, o, T_b_from_a, rms_px,
+                  own_rms_px, pair_rms, pair_used, pair_time, &cost0, &nu0, err);
+  if (st || !refined) {
+    if (!st) *cam_b = c0;
+    return st;
+  }
+  double *d1 = hearth_alloc_array(2 * n_pairs, sizeof(double));
+  int *u1 = hearth_alloc_array(n_pairs, sizeof(int));
+  double rms1, own1;
+  if (d1 && u1 &&
+      !joint_solve(cam_a, &cr, obj, n_pts, img_a, img_b, n_pairs, img_c, n_c, o, &T1, &rms1, &own1,
+                   d1, u1, d1 + n_pairs, &cost1, &nu1, &e1) &&
+      cost1 / (double)(4 * n_pts * nu1 + 2 * n_pts * n_c) <
+          cost0 / (double)(4 * n_pts * nu0 + 2 * n_pts * n_c)) {
+    c0 = cr;
+    *T_b_from_a = T1;
+    if (rms_px) *rms_px = rms1;
+    if (own_rms_px) *own_rms_px = own1;
+    if (pair_rms) memcpy(pair_rms, d1, sizeof(double) * n_pairs);
+    if (pair_used) memcpy(pair_used, u1, sizeof(int) * n_pairs);
+    if (pair_time) memcpy(pair_time, d1 + n_pairs, sizeof(double) * n_pairs);
+  }
+  *cam_b = c0;
+  free(d1);
+  free(u1);
+  return HEARTH_OK;
 }
 
 hearth_status hearth_calib_stereo_joint(const hearth_camera *cam_a, hearth_camera *cam_b,
