@@ -634,8 +634,8 @@ static void test_stereo_joint_rolling(uint64_t seed) {
             "joint rolling (seed %d, %s): times within %.4f frames, rotation %.4f (rigid %.4f) deg, "
             "translation %.3f (%.3f) mm, rms %.4f (%.4f) px, own %.4f px, fx %.2e cx %.3f cy "
             "%.3f px\n",
-            (int)seed, noisy ? "noisy" : "exact", maxe, ang, ang0, 1000 * dt, 1000 * dt0, rms, rms0, own,
-            cj.fx / cb.fx - 1, cj.cx - cb.cx, cj.cy - cb.cy);
+            (int)seed, noisy ? "noisy" : "exact", maxe, ang, ang0, 1000 * dt, 1000 * dt0, rms, rms0,
+            own, cj.fx / cb.fx - 1, cj.cx - cb.cx, cj.cy - cb.cy);
     /* rigid per pair, the motion is unexplained: the extrinsic is degrees
        and millimetres off and the RMS several times the noise's */
     CHECK_MSG(ang0 > 0.5 && dt0 > 2e-3 && rms0 > 0.4, "rigid: %g deg, %g m, rms %g", ang0, dt0,
