@@ -3,7 +3,8 @@
 ground truth and against OpenCV (cv2.calibrateCamera / cv2.stereoCalibrate)
 on the same detected points, with the time ratio.
 
-usage: /usr/bin/python3 bench/calib_vs_opencv.py ROOT [--hearth PATH] [--runs N]
+usage: /usr/bin/python3 bench/calib_vs_opencv.py ROOT [--hearth PATH] [--centres PATH]
+       [--runs N]
 
 ROOT is a release with calibration/captures and calibration/factory.json
 (a virtual-rig release also has ground_truth/). The script runs
@@ -13,6 +14,14 @@ calibration_report.json (the default calibration is left in place at the
 end). The OpenCV comparison runs hearth with --no-perspective-correction so
 both solvers see exactly the same points and frames. Exit status 1 if a
 Done-means figure fails.
+
+The hole centres against the rig's truth: on a root of `hearth synth
+--ideal` the detected centroids themselves (detections.json); on a root
+with the bench's physics (the default synth: a thick plate whose walls
+hide part of each hole, blur, ...) the centroids are biased by design and
+the check is on the centres calibrate solves from instead, the centroids
+corrected for the walls and the perspective (build/bench_calib_centres,
+--centres names it; compared on either rig).
 """
 import json
 import math
@@ -43,6 +52,42 @@ def cam(block):
 def rot_angle_deg(Ra, Rb):
     c = (np.trace(Ra.T @ Rb) - 1) / 2
     return math.degrees(math.acos(max(-1.0, min(1.0, c))))
+
+
+def root_ideal(root):
+    """(ideal, why): whether ROOT is a `hearth synth --ideal` release, from
+    its files: the bench's physics writes each view's time_s into the
+    state manifests (the scan's cooling clock) and the plate's thickness_m
+    into calibration/target.json; the ideal rig writes neither"""
+    inst = os.path.join(root, "instances")
+    for dirpath, _, files in sorted(os.walk(inst)) if os.path.isdir(inst) else []:
+        if "manifest.json" in files:
+            m = json.load(open(os.path.join(dirpath, "manifest.json")))
+            if any("time_s" in v for v in m.get("views", [])):
+                return False, "manifest time_s (%s)" % os.path.relpath(dirpath, root)
+    tp = os.path.join(root, "calibration", "target.json")
+    if os.path.exists(tp) and json.load(open(tp)).get("thickness_m", 0) > 0:
+        return False, "calibration/target.json thickness_m"
+    return True, "no manifest time_s, no plate thickness"
+
+
+def centre_errors(found, src):
+    """squared centre errors per camera of the frames found (truth frames)
+    against src[(frame, camera)]["centres"]; and the count of mis-ordered
+    frames (a centre nearer another hole's truth than its own)"""
+    err = {"thermal": [], "rgb": []}
+    misordered = 0
+    for f in found:
+        a = np.array(src[(f["frame"], f["camera"])]["centres"])
+        b = np.array(f["centres"])
+        d = np.linalg.norm(a - b, axis=1)
+        nn = np.argmin(np.linalg.norm(a[:, None, :] - b[None, :, :], axis=2), axis=1)
+        if np.any(nn != np.arange(len(b))):
+            misordered += 1
+            continue
+        err[f["camera"]].extend((d ** 2).tolist())
+    rms = {c: math.sqrt(np.mean(e)) if e else float("nan") for c, e in err.items()}
+    return rms, misordered
 
 
 LAST_CPU = [0.0]
@@ -81,10 +126,14 @@ def main():
     root = args[0]
     exe = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "build", "hearth")
     runs = 3
+    centres_exe = None
     i = 1
     while i < len(args):
         if args[i] == "--hearth":
             exe = args[i + 1]
+            i += 2
+        elif args[i] == "--centres":
+            centres_exe = args[i + 1]
             i += 2
         elif args[i] == "--runs":
             runs = int(args[i + 1])
@@ -93,6 +142,8 @@ def main():
             sys.exit("unknown option " + args[i])
     if not os.access(exe, os.X_OK):
         sys.exit("no hearth executable at %s (use --hearth PATH)" % exe)
+    if centres_exe is None:
+        centres_exe = os.path.join(os.path.dirname(exe), "bench_calib_centres")
     ok = True
 
     # ---- hearth: detection + calibration, timed (best of runs) ----
@@ -122,25 +173,38 @@ def main():
         found = [f for f in full if frames.get((f["frame"], f["camera"]), {}).get("found")]
         false_pos = [f for f in gt["frames"] if not f["found"]
                      and frames.get((f["frame"], f["camera"]), {}).get("found")]
-        err = {"thermal": [], "rgb": []}
-        misordered = 0
-        for f in found:
-            a = np.array(frames[(f["frame"], f["camera"])]["centres"])
-            b = np.array(f["centres"])
-            d = np.linalg.norm(a - b, axis=1)
-            # mis-ordered: a centre nearer another hole's truth than its own
-            nn = np.argmin(np.linalg.norm(a[:, None, :] - b[None, :, :], axis=2), axis=1)
-            if np.any(nn != np.arange(len(b))):
-                misordered += 1
-                continue
-            err[f["camera"]].extend((d ** 2).tolist())
+        ideal, why = root_ideal(root)
+        raw, misordered = centre_errors(found, frames)
         rate = len(found) / max(1, len(full))
-        rms_t = math.sqrt(np.mean(err["thermal"])) if err["thermal"] else float("nan")
-        rms_c = math.sqrt(np.mean(err["rgb"])) if err["rgb"] else float("nan")
         print("detection: %d of %d full-view frames found (%.1f%%), %d partial frames accepted, "
               "%d mis-ordered" % (len(found), len(full), 100 * rate, len(false_pos), misordered))
-        print("centre error vs truth: thermal %.4f px RMS, colour %.4f px RMS" % (rms_t, rms_c))
-        ok &= rate >= 0.98 and misordered == 0 and rms_t <= 0.05 and rms_c <= 0.1
+        print("rig: %s (%s)" % ("ideal" if ideal else "the bench's physics", why))
+        print("centre error vs truth, detected centroids: thermal %.4f px RMS, colour %.4f px RMS"
+              % (raw["thermal"], raw["rgb"]))
+        ok &= rate >= 0.98 and misordered == 0
+        if ideal:
+            # the clean rig: a thin plate, no blur: the centroid is the
+            # centre up to its perspective bias (0.028 and 0.067 px on seed 1);
+            # with the physics it is off by design (0.87-1.20 px thermal,
+            # 3.4-4.7 px colour: the walls hide part of each hole at a tilt)
+            ok &= raw["thermal"] <= 0.05 and raw["rgb"] <= 0.1
+        if not os.access(centres_exe, os.X_OK):
+            print("no %s: the corrected centres are not compared" % centres_exe)
+            ok &= ideal
+        else:
+            p = subprocess.run([centres_exe, root], capture_output=True, text=True)
+            if p.returncode != 0:
+                sys.stderr.write(p.stderr)
+                sys.exit("command failed: %s %s" % (centres_exe, root))
+            cor_frames = {(f["frame"], f["camera"]): f for f in json.loads(p.stdout)["frames"]}
+            cor, mis_c = centre_errors(found, cor_frames)
+            print("centre error vs truth, corrected centres (calibrate's): thermal %.4f px RMS, "
+                  "colour %.4f px RMS" % (cor["thermal"], cor["rgb"]))
+            # the ideal rig's bounds on either rig: measured 0.023-0.029 px
+            # (thermal) and 0.048-0.061 px (colour) with the physics over
+            # seeds 1-4 and 7, 0.022 and 0.025 px on the ideal rig (seed 1;
+            # bench/README.md)
+            ok &= mis_c == 0 and cor["thermal"] <= 0.05 and cor["rgb"] <= 0.1
         ok &= len(false_pos) == 0
         grig = json.load(open(os.path.join(root, "ground_truth", "rig.json")))
         Kg, Dg = cam(grig["thermal"])

@@ -53,6 +53,19 @@ int calib_project_pose(const hearth_camera *cam, const double R[9], const double
 void calib_circle_bias(const hearth_camera *cam, const hearth_rigid *T, const double (*obj)[3],
                        size_t n, double radius, double thickness, double *bias);
 
+/* hearth_calib_stereo_joint, and each pair's trigger time into pair_time
+ * (n_pairs; may be NULL): when camera b saw the plate, in frames of camera
+ * a's readout from camera a's middle row (positive: after it), as the
+ * rolling-shutter model solved it; NAN for a pair not used or where the
+ * model was not kept (o->rolling_shutter off, or a still plate). */
+hearth_status calib_stereo_joint_times(const hearth_camera *cam_a, hearth_camera *cam_b,
+                                       const double (*obj)[3], size_t n_pts, const double *img_a,
+                                       const double *img_b, size_t n_pairs, const double *img_c,
+                                       size_t n_c, const hearth_calib_opts *o,
+                                       hearth_rigid *T_b_from_a, double *rms_px, double *own_rms_px,
+                                       double *pair_rms, int *pair_used, double *pair_time,
+                                       hearth_err *err);
+
 /* ---- shared by the release stages (calib_release.c) and the thermal-only
  * calibration (calib_thermal_only.c) ---- */
 /* The overlay of a detection of target (as `detect` draws it), PNG-encoded

@@ -8,7 +8,10 @@
  * prior), kept only when they explain more than 7 free parameters per pair
  * would fit of noise. hearth_calib_stereo_joint then refines camera b's
  * intrinsics with the rest, from the pairs and camera b's own frames, and
- * optionally the target's hole positions. */
+ * optionally the target's hole positions; with the rolling-shutter model
+ * it does so under the rigid model first and tries the moving model from
+ * the refined camera b. The RMS reported is the points' alone (the trigger
+ * prior's term left out). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -481,6 +484,11 @@ static void stereo_report(const stereo_prob *P, const double pT[6], const double
   double sum = 0;
   size_t m = 0;
   for (size_t i = 0; i < P->n_pairs; i++) {
+    /* the points' error only: the trigger prior is no pixel error */
+    if (P->nq > 12) {
+      const double tb = tb_time(sol + (size_t)P->nq * i, P->nq) / TB_SIGMA;
+      pc[i] = fmax(0.0, pc[i] - tb * tb);
+    }
     /* a pair without a pose start has no meaningful residual */
     double r = isfinite(pc[i]) ? sqrt(pc[i] / (2.0 * (double)P->n_pts)) : NAN;
     if (pair_rms) pair_rms[i] = r;
@@ -863,39 +871,32 @@ static void target_step(const joint_prob *J, const double *g, const double *x,
       pts[j][k] = nom[j][k] + off[j][k] - (c[k][0] * nom[j][0] + c[k][1] * nom[j][1] + c[k][2]);
 }
 
-hearth_status hearth_calib_stereo_joint(const hearth_camera *cam_a, hearth_camera *cam_b,
-                                        const double (*obj)[3], size_t n_pts, const double *img_a,
-                                        const double *img_b, size_t n_pairs, const double *img_c,
-                                        size_t n_c, const hearth_calib_opts *o,
-                                        hearth_rigid *T_b_from_a, double *rms_px,
-                                        double *own_rms_px, double *pair_rms, int *pair_used,
-                                        hearth_err *err) {
-  hearth_calib_opts def;
-  if (!o) {
-    hearth_calib_opts_default(&def);
-    o = &def;
-  }
-  if (!cam_a || !cam_b || !obj || !img_a || !img_b || (n_c && !img_c) || !T_b_from_a)
-    return hearth_err_set(err, HEARTH_E_ARG, "stereo calibration: missing argument");
-  if (n_pairs < 1)
-    return hearth_err_set(err, HEARTH_E_SIZE, "stereo calibration: no usable stereo pairs");
-  if (n_pts < 4 || n_pts > 100000 || n_pairs > 100000 || n_c > 100000)
-    return hearth_err_set(err, HEARTH_E_SIZE, "stereo calibration: %zu points per pair", n_pts);
+/* the joint solve from camera b's start *cam_b (its estimate on return);
+ * *cost (the final cost, prior and own frames included) and *n_used (pairs
+ * used) when cost is non-NULL; arguments checked by the caller */
+static hearth_status joint_solve(const hearth_camera *cam_a, hearth_camera *cam_b,
+                                 const double (*obj)[3], size_t n_pts, const double *img_a,
+                                 const double *img_b, size_t n_pairs, const double *img_c,
+                                 size_t n_c, const hearth_calib_opts *o, hearth_rigid *T_b_from_a,
+                                 double *rms_px, double *own_rms_px, double *pair_rms,
+                                 int *pair_used, double *pair_time, double *cost, size_t *n_used,
+                                 hearth_err *err) {
   int *used = hearth_calloc_array(n_pairs, sizeof(int));
   double *pc = hearth_alloc_array(n_pairs, sizeof(double));
   double *sol = NULL, *x = NULL, pT[6];
   double(*tpts)[3] = NULL;
   int nq = 6;
   hearth_status st = HEARTH_OK;
+  hearth_camera cb = *cam_b; /* camera b's start, then its estimate */
   if (!used || !pc) {
     st = hearth_err_set(err, HEARTH_E_NOMEM, "stereo calibration: out of memory");
     goto done;
   }
-  if ((st = stereo_core(cam_a, cam_b, obj, n_pts, img_a, img_b, n_pairs, o, pT, &sol, &nq, used,
-                        err)))
+  if ((st =
+           stereo_core(cam_a, &cb, obj, n_pts, img_a, img_b, n_pairs, o, pT, &sol, &nq, used, err)))
     goto done;
-  stereo_prob P = {cam_a, cam_b, obj, n_pts, n_pairs, img_a, img_b, used, nq};
-  hearth_camera cb = *cam_b;
+  const hearth_camera cb_start = cb;
+  stereo_prob P = {cam_a, &cb_start, obj, n_pts, n_pairs, img_a, img_b, used, nq};
   if (o->stereo_intrinsics) {
     /* camera b's own frames: their poses at the current intrinsics */
     size_t nx = (size_t)nq * n_pairs + 6 * n_c;
@@ -908,7 +909,7 @@ hearth_status hearth_calib_stereo_joint(const hearth_camera *cam_a, hearth_camer
     for (size_t k = 0; k < n_c; k++) {
       hearth_rigid T;
       hearth_err e2;
-      if (hearth_calib_pose(cam_b, obj, n_pts, img_c + 2 * k * n_pts, &T, NULL, &e2)) {
+      if (hearth_calib_pose(&cb_start, obj, n_pts, img_c + 2 * k * n_pts, &T, NULL, &e2)) {
         st = hearth_err_set(err, HEARTH_E_NUMERIC, "stereo calibration: own frame %zu: no pose", k);
         goto done;
       }
@@ -916,12 +917,12 @@ hearth_status hearth_calib_stereo_joint(const hearth_camera *cam_a, hearth_camer
     }
     double g[JG];
     memcpy(g, pT, sizeof pT);
-    g[6] = cam_b->fx;
-    g[7] = cam_b->fy;
-    g[8] = cam_b->cx;
-    g[9] = cam_b->cy;
-    for (int k = 0; k < 5; k++) g[10 + k] = cam_b->dist[k];
-    joint_prob J = {P, cam_b, img_c, n_c};
+    g[6] = cb_start.fx;
+    g[7] = cb_start.fy;
+    g[8] = cb_start.cx;
+    g[9] = cb_start.cy;
+    for (int k = 0; k < 5; k++) g[10 + k] = cb_start.dist[k];
+    joint_prob J = {P, &cb_start, img_c, n_c};
     int ok = joint_lm(&J, g, x, o->max_iterations);
     if (ok && o->target_points && n_pts <= HEARTH_TARGET_MAX_HOLES) {
       /* the holes' own in-plane positions, in turn with the rest */
@@ -941,6 +942,7 @@ hearth_status hearth_calib_stereo_joint(const hearth_camera *cam_a, hearth_camer
       st = hearth_err_set(err, HEARTH_E_NUMERIC, "stereo calibration: joint refinement failed");
       goto done;
     }
+    if (cost) *cost = joint_cost(&J, g, x);
     memcpy(pT, g, sizeof pT);
     memcpy(sol, x, sizeof(double) * (size_t)nq * n_pairs);
     joint_cam(&J, g, &cb);
@@ -956,6 +958,13 @@ hearth_status hearth_calib_stereo_joint(const hearth_camera *cam_a, hearth_camer
   P.cb = cam_b;
   calib_rigid_from_params(pT, T_b_from_a);
   stereo_report(&P, pT, sol, pc, rms_px, pair_rms, pair_used);
+  if (pair_time)
+    for (size_t i = 0; i < n_pairs; i++)
+      pair_time[i] = nq > 12 && used[i] ? tb_time(sol + (size_t)nq * i, nq) : NAN;
+  if (n_used) {
+    *n_used = 0;
+    for (size_t i = 0; i < n_pairs; i++) *n_used += used[i] != 0;
+  }
 done:
   free(sol);
   free(x);
@@ -963,4 +972,81 @@ done:
   free(used);
   free(pc);
   return st;
+}
+
+hearth_status calib_stereo_joint_times(const hearth_camera *cam_a, hearth_camera *cam_b,
+                                       const double (*obj)[3], size_t n_pts, const double *img_a,
+                                       const double *img_b, size_t n_pairs, const double *img_c,
+                                       size_t n_c, const hearth_calib_opts *o,
+                                       hearth_rigid *T_b_from_a, double *rms_px, double *own_rms_px,
+                                       double *pair_rms, int *pair_used, double *pair_time,
+                                       hearth_err *err) {
+  hearth_calib_opts def;
+  if (!o) {
+    hearth_calib_opts_default(&def);
+    o = &def;
+  }
+  if (!cam_a || !cam_b || !obj || !img_a || !img_b || (n_c && !img_c) || !T_b_from_a)
+    return hearth_err_set(err, HEARTH_E_ARG, "stereo calibration: missing argument");
+  if (n_pairs < 1)
+    return hearth_err_set(err, HEARTH_E_SIZE, "stereo calibration: no usable stereo pairs");
+  if (n_pts < 4 || n_pts > 100000 || n_pairs > 100000 || n_c > 100000)
+    return hearth_err_set(err, HEARTH_E_SIZE, "stereo calibration: %zu points per pair", n_pts);
+  if (!o->stereo_intrinsics || !o->rolling_shutter)
+    return joint_solve(cam_a, cam_b, obj, n_pts, img_a, img_b, n_pairs, img_c, n_c, o, T_b_from_a,
+                       rms_px, own_rms_px, pair_rms, pair_used, pair_time, NULL, NULL, err);
+  /* The moving model's velocities and trigger times, tried at camera b's
+   * start intrinsics, can take part of their error and settle in a false
+   * minimum; tried from camera b refined under the rigid model they can
+   * settle in another. Both are solved and the one with the lower mean
+   * squared residual over the points it used kept (the first on a tie;
+   * each drops its own outlier pairs). */
+  hearth_calib_opts o1 = *o;
+  o1.rolling_shutter = 0;
+  o1.target_points = 0;
+  hearth_camera cr = *cam_b, c0 = *cam_b;
+  hearth_rigid T1;
+  hearth_err e1;
+  int refined = !joint_solve(cam_a, &cr, obj, n_pts, img_a, img_b, n_pairs, img_c, n_c, &o1, &T1,
+                             NULL, NULL, NULL, NULL, NULL, NULL, NULL, &e1);
+  double cost0 = INFINITY, cost1 = INFINITY;
+  size_t nu0 = 0, nu1 = 0;
+  hearth_status st =
+      joint_solve(cam_a, &c0, obj, n_pts, img_a, img_b, n_pairs, img_c, n_c, o, T_b_from_a, rms_px,
+                  own_rms_px, pair_rms, pair_used, pair_time, &cost0, &nu0, err);
+  if (st || !refined) {
+    if (!st) *cam_b = c0;
+    return st;
+  }
+  double *d1 = hearth_alloc_array(2 * n_pairs, sizeof(double));
+  int *u1 = hearth_alloc_array(n_pairs, sizeof(int));
+  double rms1, own1;
+  if (d1 && u1 &&
+      !joint_solve(cam_a, &cr, obj, n_pts, img_a, img_b, n_pairs, img_c, n_c, o, &T1, &rms1, &own1,
+                   d1, u1, d1 + n_pairs, &cost1, &nu1, &e1) &&
+      cost1 / (double)(4 * n_pts * nu1 + 2 * n_pts * n_c) <
+          cost0 / (double)(4 * n_pts * nu0 + 2 * n_pts * n_c)) {
+    c0 = cr;
+    *T_b_from_a = T1;
+    if (rms_px) *rms_px = rms1;
+    if (own_rms_px) *own_rms_px = own1;
+    if (pair_rms) memcpy(pair_rms, d1, sizeof(double) * n_pairs);
+    if (pair_used) memcpy(pair_used, u1, sizeof(int) * n_pairs);
+    if (pair_time) memcpy(pair_time, d1 + n_pairs, sizeof(double) * n_pairs);
+  }
+  *cam_b = c0;
+  free(d1);
+  free(u1);
+  return HEARTH_OK;
+}
+
+hearth_status hearth_calib_stereo_joint(const hearth_camera *cam_a, hearth_camera *cam_b,
+                                        const double (*obj)[3], size_t n_pts, const double *img_a,
+                                        const double *img_b, size_t n_pairs, const double *img_c,
+                                        size_t n_c, const hearth_calib_opts *o,
+                                        hearth_rigid *T_b_from_a, double *rms_px,
+                                        double *own_rms_px, double *pair_rms, int *pair_used,
+                                        hearth_err *err) {
+  return calib_stereo_joint_times(cam_a, cam_b, obj, n_pts, img_a, img_b, n_pairs, img_c, n_c, o,
+                                  T_b_from_a, rms_px, own_rms_px, pair_rms, pair_used, NULL, err);
 }

@@ -204,25 +204,50 @@ static void test_stereo(void) {
                             NULL, &err) == HEARTH_E_SIZE);
 }
 
-/* camera a with a rolling shutter: row v of its frame sees the plate at
- * time s = (v + 0.5) / height - 0.5 frames from the middle row, the plate
- * turning by s w about its pattern centre and moving by s u (exact rigid
- * motion; each point at the row it lands in, by fixed point). */
-static void rs_project(const hearth_camera *ca, const hearth_rigid *Ta, const double w[3],
-                       const double u[3], const double (*obj)[3], double *uv) {
-  double pc[3], c[3];
+/* the plate Ta (camera a from plate at camera a's middle row) as it is
+ * s frames of camera a's readout later: turned by s w about its pattern
+ * centre and moved by s u (exact rigid motion) */
+static void plate_at(const hearth_rigid *Ta, const double w[3], const double u[3], double s,
+                     hearth_rigid *Ts) {
+  double pc[3], c[3], Rc[3], ws[3] = {s * w[0], s * w[1], s * w[2]};
   td_pattern_centre(pc);
   hearth_rigid_apply(Ta, pc, c);
+  hearth_rigid M;
+  hearth_rotvec_to_matrix(ws, M.R);
+  hearth_rigid_rotate(&M, c, Rc);
+  for (int k = 0; k < 3; k++) M.t[k] = c[k] - Rc[k] + s * u[k];
+  hearth_rigid_compose(&M, Ta, Ts);
+}
+
+/* a hand-held plate's velocity: random directions, |w| = turn (rad) and
+ * |u| = move (m) per frame readout */
+static void hand_motion(hearth_rng *rng, double turn, double move, double w[3], double u[3]) {
+  double nw = 0, nu = 0;
+  for (int k = 0; k < 3; k++) {
+    w[k] = hearth_rng_normal(rng);
+    u[k] = hearth_rng_normal(rng);
+    nw += w[k] * w[k];
+    nu += u[k] * u[k];
+  }
+  for (int k = 0; k < 3; k++) {
+    w[k] *= turn / sqrt(nw);
+    u[k] *= move / sqrt(nu);
+  }
+}
+
+/* camera a with a rolling shutter: row v of its frame sees the plate at
+ * time s = (v + 0.5) / height - 0.5 frames from the middle row, moved by
+ * plate_at (each point at the row it lands in, by fixed point). */
+static void rs_project(const hearth_camera *ca, const hearth_rigid *Ta, const double w[3],
+                       const double u[3], const double (*obj)[3], double *uv) {
   for (int j = 0; j < NP; j++) {
-    double X[3], row = 0.5 * (ca->height - 1);
-    hearth_rigid_apply(Ta, obj[j], X);
+    double row = 0.5 * (ca->height - 1);
     for (int it = 0; it < 6; it++) {
-      double s = (row + 0.5) / ca->height - 0.5, ws[3] = {s * w[0], s * w[1], s * w[2]}, R[9];
-      hearth_rotvec_to_matrix(ws, R);
-      double d[3] = {X[0] - c[0], X[1] - c[1], X[2] - c[2]}, Y[3];
-      for (int k = 0; k < 3; k++)
-        Y[k] = c[k] + R[3 * k] * d[0] + R[3 * k + 1] * d[1] + R[3 * k + 2] * d[2] + s * u[k];
-      CHECK(hearth_camera_project(ca, Y, uv + 2 * j, NULL));
+      double X[3];
+      hearth_rigid Ts;
+      plate_at(Ta, w, u, (row + 0.5) / ca->height - 0.5, &Ts);
+      hearth_rigid_apply(&Ts, obj[j], X);
+      CHECK(hearth_camera_project(ca, X, uv + 2 * j, NULL));
       row = uv[2 * j + 1];
     }
   }
@@ -256,17 +281,8 @@ static void test_stereo_rolling(void) {
     hearth_rigid Ta;
     hearth_rigid_compose(&Tbai, &Tb[v], &Ta);
     CHECK(td_project(&ca, &Ta, us + v * NP * 2, 0) == NP);
-    double w[3], u[3], nw = 0, nu = 0;
-    for (int k = 0; k < 3; k++) {
-      w[k] = hearth_rng_normal(&rng);
-      u[k] = hearth_rng_normal(&rng);
-      nw += w[k] * w[k];
-      nu += u[k] * u[k];
-    }
-    for (int k = 0; k < 3; k++) {
-      w[k] *= 0.002 / sqrt(nw);
-      u[k] *= 0.001 / sqrt(nu);
-    }
+    double w[3], u[3];
+    hand_motion(&rng, 0.002, 0.001, w, u);
     rs_project(&ca, &Ta, w, u, (const double(*)[3])obj, ua + v * NP * 2);
   }
   for (int i = 0; i < NV * NP * 2; i++) {
@@ -438,19 +454,32 @@ static void test_circle_bias_thick(void) {
  * the wrong intrinsics (the paper's stereo) turns the extrinsic measurably;
  * with noise the RMS is the noise's and the estimates stay within a few
  * standard errors */
+/* the joint solve's data: nv still pairs (camera a's plate poses into Ta
+ * when non-NULL) and nc frames of camera b alone */
 static void joint_data(hearth_rng *rng, const hearth_camera *ca, const hearth_camera *cb,
-                       const hearth_rigid *Tba, int nv, int nc, double *ua, double *ub,
-                       double *uc) {
-  hearth_rigid Tb[16], Tc[16], Tbai;
+                       const hearth_rigid *Tba, int nv, int nc, double *ua, double *ub, double *uc,
+                       hearth_rigid *Ta) {
+  hearth_rigid Tb[16], Tc[16], Tbai, Tv;
   CHECK(nv <= 16 && nc <= 16);
   CHECK(td_views(rng, cb, nv, 0.6, Tb, ub) == nv);
   CHECK(td_views(rng, cb, nc, 0.7, Tc, uc) == nc);
   hearth_rigid_inverse(Tba, &Tbai);
   for (int v = 0; v < nv; v++) {
-    hearth_rigid Ta;
-    hearth_rigid_compose(&Tbai, &Tb[v], &Ta);
-    CHECK(td_project(ca, &Ta, ua + v * NP * 2, 0) == NP);
+    hearth_rigid_compose(&Tbai, &Tb[v], &Tv);
+    CHECK(td_project(ca, &Tv, ua + v * NP * 2, 0) == NP);
+    if (Ta) Ta[v] = Tv;
   }
+}
+
+/* the joint solve's start: camera b's intrinsics off as a separate
+ * calibration might leave them */
+static void joint_start(const hearth_camera *cb, hearth_camera *c0) {
+  *c0 = *cb;
+  c0->fx *= 1.02;
+  c0->fy *= 0.985;
+  c0->cx += 3.0;
+  c0->cy -= 2.0;
+  c0->dist[0] *= 0.8;
 }
 
 static void test_stereo_joint(void) {
@@ -461,16 +490,10 @@ static void test_stereo_joint(void) {
   static double ua[NV * NP * 2], ub[NV * NP * 2], uc[NC * NP * 2];
   hearth_rng rng;
   hearth_rng_seed(&rng, 21);
-  joint_data(&rng, &ca, &cb, &Tba, NV, NC, ua, ub, uc);
+  joint_data(&rng, &ca, &cb, &Tba, NV, NC, ua, ub, uc, NULL);
   double obj[NP][3];
   calib_plate_points(obj);
-  /* the start: thermal intrinsics off as a separate calibration might be */
-  c0 = cb;
-  c0.fx *= 1.02;
-  c0.fy *= 0.985;
-  c0.cx += 3.0;
-  c0.cy -= 2.0;
-  c0.dist[0] *= 0.8;
+  joint_start(&cb, &c0);
   hearth_calib_opts o;
   hearth_calib_opts_default(&o);
   o.rolling_shutter = 0;
@@ -536,6 +559,116 @@ static void test_stereo_joint(void) {
                                   &rms, NULL, NULL, NULL, &err) == HEARTH_E_SIZE);
 }
 
+/* error of an estimated T_b_from_a: rotation (deg) and translation (m) */
+static void rigid_error(const hearth_rigid *E, const hearth_rigid *T, double *deg, double *m) {
+  *deg = hearth_rotation_angle_between(E->R, T->R) * 180 / M_PI;
+  double d = 0;
+  for (int i = 0; i < 3; i++) d += (E->t[i] - T->t[i]) * (E->t[i] - T->t[i]);
+  *m = sqrt(d);
+}
+
+/* the joint solve with the trigger time. The solver's convention
+ * (calib_stereo.c): camera a (colour) reads row v at s = (v + 0.5) / height
+ * - 0.5 frames of its readout from its middle row, camera b (thermal) sees
+ * the whole plate at its own time tb in the same frames (positive: after
+ * camera a's middle row), the plate moving at a constant velocity. Truth:
+ * a brisk hand (5 mm and 10 mrad per frame readout: 25 cm/s and 0.5 rad/s
+ * over 20 ms), each pair's tb known (-0.25 to 0.25 frames, 5 ms either
+ * way), camera b's intrinsics started off as in test_stereo_joint. */
+static void test_stereo_joint_rolling(uint64_t seed) {
+  hearth_camera ca, cb, c0;
+  hearth_rigid Tba;
+  stereo_rig(&ca, &cb, &Tba);
+  enum { NV = 12, NC = 10 };
+  static double ua[NV * NP * 2], ub[NV * NP * 2], uc[NC * NP * 2];
+  hearth_rigid Ta[NV];
+  hearth_rng rng;
+  hearth_rng_seed(&rng, seed);
+  joint_data(&rng, &ca, &cb, &Tba, NV, NC, ua, ub, uc, Ta);
+  double obj[NP][3], tb[NV];
+  calib_plate_points(obj);
+  for (int v = 0; v < NV; v++) {
+    double w[3], u[3];
+    hand_motion(&rng, 0.01, 0.005, w, u);
+    tb[v] = 0.25 * (2.0 * v / (NV - 1) - 1.0);
+    rs_project(&ca, &Ta[v], w, u, (const double(*)[3])obj, ua + v * NP * 2);
+    hearth_rigid Ts, Tbs;
+    plate_at(&Ta[v], w, u, tb[v], &Ts);
+    hearth_rigid_compose(&Tba, &Ts, &Tbs);
+    CHECK(td_project(&cb, &Tbs, ub + v * NP * 2, 0) == NP);
+  }
+  joint_start(&cb, &c0);
+  hearth_calib_opts o;
+  hearth_calib_opts_default(&o);
+  CHECK(o.rolling_shutter && o.stereo_intrinsics);
+  hearth_err err = {0};
+  for (int noisy = 0; noisy < 2; noisy++) {
+    if (noisy) {
+      /* as test_stereo_joint: 0.1 px on colour, 0.05 px on thermal */
+      for (int i = 0; i < NV * NP * 2; i++) {
+        ua[i] += 0.1 * hearth_rng_normal(&rng);
+        ub[i] += 0.05 * hearth_rng_normal(&rng);
+      }
+      for (int i = 0; i < NC * NP * 2; i++) uc[i] += 0.05 * hearth_rng_normal(&rng);
+    }
+    hearth_rigid E, E0;
+    hearth_camera cj = c0, c00 = c0;
+    double rms, own, rms0, t[NV];
+    int used[NV];
+    o.rolling_shutter = 1;
+    CHECK_OK(calib_stereo_joint_times(&ca, &cj, (const double(*)[3])obj, NP, ua, ub, NV, uc, NC, &o,
+                                      &E, &rms, &own, NULL, used, t, &err),
+             &err);
+    o.rolling_shutter = 0;
+    CHECK_OK(hearth_calib_stereo_joint(&ca, &c00, (const double(*)[3])obj, NP, ua, ub, NV, uc, NC,
+                                       &o, &E0, &rms0, NULL, NULL, NULL, &err),
+             &err);
+    double ang, dt, ang0, dt0, maxe = 0;
+    rigid_error(&E, &Tba, &ang, &dt);
+    rigid_error(&E0, &Tba, &ang0, &dt0);
+    for (int v = 0; v < NV; v++) {
+      CHECK_MSG(used[v] && isfinite(t[v]), "pair %d: used %d, time %g", v, used[v], t[v]);
+      maxe = fmax(maxe, fabs(t[v] - tb[v]));
+    }
+    fprintf(stderr,
+            "joint rolling (seed %d, %s): times within %.4f frames, rotation %.4f (rigid %.4f) deg, "
+            "translation %.3f (%.3f) mm, rms %.4f (%.4f) px, own %.4f px, fx %.2e cx %.3f cy "
+            "%.3f px\n",
+            (int)seed, noisy ? "noisy" : "exact", maxe, ang, ang0, 1000 * dt, 1000 * dt0, rms, rms0,
+            own, cj.fx / cb.fx - 1, cj.cx - cb.cx, cj.cy - cb.cy);
+    /* rigid per pair, the motion is unexplained: the extrinsic is degrees
+       and millimetres off and the RMS several times the noise's */
+    CHECK_MSG(ang0 > 0.5 && dt0 > 2e-3 && rms0 > 0.4, "rigid: %g deg, %g m, rms %g", ang0, dt0,
+              rms0);
+    if (!noisy) {
+      /* exact points: what is left is the trigger prior's pull (zero, 1
+         frame), about tb / (1 + I) on a time the data inform with I
+         (80-2000 px^2 per frame^2 here, from the thermal image's motion):
+         measured 0.014 frames, and 0.0017 px RMS, 0.011 deg, 0.12 mm,
+         fx 4e-4 and 0.05 px in the principal point; the bounds leave
+         about twice that */
+      CHECK_MSG(maxe < 0.03, "exact times within %g frames", maxe);
+      CHECK_MSG(rms < 0.004 && own < 0.002, "exact rms %g, own %g", rms, own);
+      CHECK_MSG(ang < 0.025 && dt < 2.5e-4, "exact: %g deg, %g m", ang, dt);
+      CHECK(fabs(cj.fx / cb.fx - 1) < 1e-3 && fabs(cj.cx - cb.cx) < 0.1 &&
+            fabs(cj.cy - cb.cy) < 0.1);
+    } else {
+      /* noise: each time's standard error is at least 0.05 px / sqrt(I)
+         (0.001 to 0.006 frames; more where the pose and velocity share
+         the information), the extrinsic's as in test_stereo_joint; measured
+         0.013 frames, 0.044 deg, 0.05 mm, fx 2e-4, 0.13 px principal
+         point and 0.1105 px RMS (that of test_stereo_joint's noise) */
+      CHECK_MSG(maxe < 0.04, "noisy times within %g frames", maxe);
+      CHECK_MSG(rms > 0.095 && rms < 0.125 && own > 0.06 && own < 0.075, "noisy rms %g, own %g",
+                rms, own);
+      CHECK_MSG(ang < 0.15 && dt < 5e-4, "noisy: %g deg, %g m", ang, dt);
+      CHECK(fabs(cj.fx / cb.fx - 1) < 1e-3 && fabs(cj.cx - cb.cx) < 0.3 &&
+            fabs(cj.cy - cb.cy) < 0.3);
+    }
+    CHECK(ang0 > 20 * ang && rms0 > 4 * rms);
+  }
+}
+
 int main(void) {
   test_circle_bias();
   test_circle_bias_thick();
@@ -545,5 +678,9 @@ int main(void) {
   test_stereo();
   test_stereo_rolling();
   test_stereo_joint();
+  /* seed 35 settles in a false minimum when the moving model is tried at
+     camera b's start intrinsics */
+  test_stereo_joint_rolling(31);
+  test_stereo_joint_rolling(35);
   TEST_MAIN_END();
 }
