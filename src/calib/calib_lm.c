@@ -415,11 +415,24 @@ hearth_status hearth_calib_pose(const hearth_camera *cam, const double (*obj)[3]
  * returns the new count */
 static int clip_edge(const double (*p)[2], int n, const double a[2], const double b[2], double s,
                      double (*out)[2]) {
+  /* each vertex's side once (an edge's far end is the next one's near
+     end), with the same arithmetic as per edge */
+  double d[256];
+  if (n > 256) return 0;
+  int inside = 0;
+  for (int i = 0; i < n; i++) {
+    d[i] = s * ((b[0] - a[0]) * (p[i][1] - a[1]) - (b[1] - a[1]) * (p[i][0] - a[0]));
+    inside += d[i] >= 0;
+  }
+  if (inside == n) {
+    /* the edge cuts nothing: the polygon as it is */
+    memcpy(out, p, sizeof(double) * 2 * (size_t)n);
+    return n;
+  }
   int m = 0;
   for (int i = 0; i < n; i++) {
     const double *P = p[i], *Q = p[(i + 1) % n];
-    double dp = s * ((b[0] - a[0]) * (P[1] - a[1]) - (b[1] - a[1]) * (P[0] - a[0]));
-    double dq = s * ((b[0] - a[0]) * (Q[1] - a[1]) - (b[1] - a[1]) * (Q[0] - a[0]));
+    double dp = d[i], dq = d[(i + 1) % n];
     if (dp >= 0) {
       out[m][0] = P[0];
       out[m][1] = P[1];
