@@ -200,7 +200,7 @@ hearth_status hearth_jpeg_read_mem(const void *data, size_t size, const char *na
 
 hearth_status hearth_jpeg_read_grid_mem(const void *data, size_t size, const char *name,
                                         size_t step, hearth_image *img, hearth_err *err) {
-  return jpeg_read_mem(data, size, name, 0, 0, step ? step : 1, NULL, img, err);
+  return jpeg_read_mem(data, size, name, 0, 0, step, NULL, img, err);
 }
 
 static hearth_status jpeg_read_file(const char *path, int want_gray, int half, size_t step,
@@ -231,7 +231,7 @@ hearth_status hearth_jpeg_read_expect(const char *path, const hearth_image_expec
 
 hearth_status hearth_jpeg_read_grid(const char *path, const hearth_image_expect *want, size_t step,
                                     hearth_image *img, hearth_err *err) {
-  return jpeg_read_file(path, 0, 0, step ? step : 1, want, img, err);
+  return jpeg_read_file(path, 0, 0, step, want, img, err);
 }
 
 hearth_status hearth_jpeg_read_gray(const char *path, hearth_image *img, hearth_err *err) {

@@ -97,14 +97,29 @@ static int alloc_phase_state(map_ctx *m, max_maps *mx, view_records *rec, hearth
                            !m->opts->skip_best_cos);
 }
 
-static void free_phase_state(map_ctx *m) {
+/* the workers' scratch (per pixel of the camera's grid), which only the
+   cast reads */
+static void free_cast_state(map_ctx *m) {
   for (int t = 0; m->workers && t < m->n_threads; t++) map_worker_free(&m->workers[t]);
-  free(m->workers);
-  free(m->view_hits);
+}
+
+/* the fusion rule's state (max fusion's other workers' maps, the records
+   and sums, the corrected fusion's best cosines), which the fill does not
+   read; max fusion's worker 0 maps are the result's and stay */
+static void free_fusion_state(map_ctx *m) {
   if (m->max) map_max_free(m->max);
   if (m->rec) map_records_free(m->rec);
+  m->max = NULL;
+  m->rec = NULL;
   free(m->corr_best);
   m->corr_best = NULL;
+}
+
+static void free_phase_state(map_ctx *m) {
+  free_cast_state(m);
+  free(m->workers);
+  free(m->view_hits);
+  free_fusion_state(m);
 }
 
 /* The result's arrays (observed and best_cos made here unless max fusion's
@@ -250,9 +265,8 @@ hearth_status hearth_map_views_with_layout(const hearth_map_layout *l,
     goto done;
   }
   hearth_parallel_chunks(n_views, 1, nt, map_cast_views, &m);
-  /* the workers' scratch (per pixel of the camera's grid) is not needed by
-     the fusion: its memory goes before the result's maps are made */
-  for (int t = 0; t < m.n_threads; t++) map_worker_free(&m.workers[t]);
+  /* its memory goes before the result's maps are made */
+  free_cast_state(&m);
   if (m.load_errs) {
     /* every view tried its load: the lowest failure, whatever the threads */
     for (size_t v = 0; v < n_views; v++)
@@ -274,13 +288,7 @@ hearth_status hearth_map_views_with_layout(const hearth_map_layout *l,
   double t_fuse0 = hearth_now();
   if (timing) timing->cast = t_fuse0 - t_cast0;
   if ((s = fuse_views(&m, out, &parts, err))) goto done;
-  /* the fusion's sums and records go before the fill */
-  if (m.rec) {
-    map_records_free(m.rec);
-    m.rec = NULL;
-  }
-  free(m.corr_best);
-  m.corr_best = NULL;
+  free_fusion_state(&m); /* before the fill */
   double t_fill0 = hearth_now();
   if (timing) timing->fuse = t_fill0 - t_fuse0;
   if (map_fill_islands(l->R, (size_t)C, l->island_of_texel, l->n_islands, parts, nt, out->mask,
