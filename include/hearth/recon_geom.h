@@ -188,7 +188,7 @@ typedef struct hearth_turntable_opts {
                               points); 0 (default): one for all views */
   double aim_height_tol;   /* the aimed-at point's height held to half the
                               object's top within this share of the top (and
-                              at least 2 mm); 0: free; default 0.15 */
+                              at least 2 mm); 0: free; default 0.6 */
   int threads;             /* 0: hearth_default_threads() */
   int quiet;               /* 1: no progress on stderr */
 } hearth_turntable_opts;

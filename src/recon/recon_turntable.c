@@ -59,7 +59,7 @@ void hearth_turntable_opts_default(hearth_turntable_opts *o) {
   o->aim_depth_tol = 0.012;
   o->aim_side_m = 0.0005;
   o->aim_per_ring = 0;
-  o->aim_height_tol = 0.15;
+  o->aim_height_tol = 0.6;
 }
 
 void hearth_turntable_result_free(hearth_turntable_result *r) {
