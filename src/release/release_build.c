@@ -791,6 +791,7 @@ static hearth_status run_release_stage(const char *root, const hearth_build_stag
   }
   if (o->dry_run) {
     if (!o->quiet) fprintf(log, "build: %s: would run\n", bs->name);
+    *ran = -1; /* neither run nor up to date */
     goto done;
   }
   double t0 = hearth_now();
@@ -941,9 +942,9 @@ hearth_status hearth_build_release(const char *root, const hearth_build_opts *o_
     if (s_rel) {
       rep->release_failed = 1;
       snprintf(rep->release_reason, sizeof rep->release_reason, "%s", err->msg);
-    } else if (ran) {
+    } else if (ran > 0) {
       rep->stages_run++;
-    } else {
+    } else if (ran == 0) {
       rep->stages_up_to_date++;
     }
     pthread_mutex_unlock(&c.mu);
