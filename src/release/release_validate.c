@@ -503,8 +503,9 @@ static void check_recon_report(hearth_problems *p, const char *dir, const char *
  * rig's stand-in or hearth's own): every file a rebuild reads from it must
  * read with the strict readers. Its poses may leave views out (a COLMAP
  * model that did not register them), but each names a view of this
- * instance; the mesh needs UVs; the texture, the geometry-only mesh and the
- * cameras document are checked where present. */
+ * instance; the mesh (with UVs), the geometry-only mesh, the texture and
+ * the cameras document are checked where present (hearth recon --no-mesh
+ * leaves poses only). */
 static void check_recon_files(hearth_problems *p, const char *dir, const state_views *sv, size_t ns,
                               int decode, size_t *nfiles) {
   char f[PATH_SZ];
@@ -516,14 +517,7 @@ static void check_recon_files(hearth_problems *p, const char *dir, const state_v
   static const char *glbs[2] = {"mesh.glb", "mesh_geometry.glb"};
   for (int j = 0; j < 2; j++) {
     snprintf(f, sizeof f, "%s/recon/%s", dir, glbs[j]);
-    if (!present(f)) {
-      if (j == 0) {
-        (*nfiles)++;
-        hearth_problems_add(p, f,
-                            "missing (the reconstruction's mesh with UVs, which scale reads)");
-      }
-      continue;
-    }
+    if (!present(f)) continue; /* hearth recon --no-mesh writes poses only */
     (*nfiles)++;
     hearth_mesh mesh = {0};
     hearth_glb_read_opts go = {.require_uvs = j == 0};
