@@ -108,6 +108,15 @@ static inline int test_sh(const char *fmt, const char *a, const char *b) {
   return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
 }
 
+/* sha256 of every file of a release tree except the build's stamps (they
+ * record input mtimes), sorted by path, into out_file; the exit status */
+static inline int test_tree_hash(const char *root, const char *out_file) {
+  return test_sh(
+      "cd '%s' && find . -type f ! -path '*/.stamps/*' | LC_ALL=C sort | "
+      "xargs sha256sum > '%s'",
+      root, out_file);
+}
+
 #define TEST_MAIN_END()                                                            \
   do {                                                                             \
     if (g_test_failures) fprintf(stderr, "%d check(s) failed\n", g_test_failures); \

@@ -133,7 +133,8 @@ typedef struct hearth_build_stage {
  * so a later build without options changes nothing. */
 #define HEARTH_BUILD_FUSION_UNSET ((hearth_fusion)-1)
 typedef struct hearth_build_opts {
-  int jobs;                     /* instances in parallel; 0 = min(cores, instances) */
+  int jobs;                     /* stages in parallel (of different instances, or states);
+                                   0 = min(cores, instances) */
   int threads;                  /* total worker threads; 0 = hearth_default_threads() */
   int shard_index, shard_count; /* this machine does instances with index % count == index */
   const char *only_instance;    /* NULL: all of release.json */
@@ -170,7 +171,8 @@ typedef struct hearth_build_report {
   hearth_build_instance *instances; /* owned */
   size_t stages_run, stages_up_to_date;
   size_t temps_removed; /* temporaries of killed runs removed before re-running stages */
-  int release_failed;   /* a release-level stage failed (no instance was built) */
+  int release_failed;   /* a release-level stage failed (no instance report; only the stages
+                           that do not read the calibration, scale, may have run) */
   char release_reason[1024];
   double seconds;
 } hearth_build_report;

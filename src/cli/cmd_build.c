@@ -34,9 +34,10 @@ int hearth_cmd_build(int argc, char **argv) {
   hearth_build_opts_default(&o);
   int fusion = (int)o.fusion;
   const cli_opt opts[] = {
-      CLI_INT("--jobs", "N", &o.jobs, 1, 4096,
-              "instances built in parallel; the cores are shared among the jobs", .alias = "-j",
-              .def = "all cores, at most one per instance"),
+      CLI_INT(
+          "--jobs", "N", &o.jobs, 1, 4096,
+          "stages run at once (of different instances or states); the cores are shared among the jobs",
+          .alias = "-j", .def = "all cores, at most one per instance"),
       CLI_INT("--threads", "N", &o.threads, 1, 4096, "total worker threads",
               .def = "HEARTH_THREADS or all cores"),
       CLI_SHARD(

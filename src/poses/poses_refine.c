@@ -62,18 +62,44 @@ int rf_mesh_box(const hearth_mesh *mesh, const hearth_camera *cam,
   hearth_rigid_inverse(T_world_from_cam, &Tcw);
   double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
   int any = 0, behind = 0;
-  for (size_t i = 0; i < mesh->n_vertices; i++) {
-    double X[3] = {mesh->positions[3 * i], mesh->positions[3 * i + 1], mesh->positions[3 * i + 2]},
-           Xc[3], uv[2];
-    hearth_rigid_apply(&Tcw, X, Xc);
-    if (!hearth_camera_project(cam, Xc, uv, NULL)) {
-      behind = 1;
-      continue;
+  if (cam->model == HEARTH_LENS_BROWN5) {
+    /* hearth_rigid_apply and hearth_camera_project written out, operation
+       for operation (the same numbers, hence the same box), without a call
+       per vertex: this runs for every vertex of the mesh at every pose */
+    const double *R = Tcw.R, *t = Tcw.t, fx = cam->fx, fy = cam->fy, cx = cam->cx, cy = cam->cy;
+    for (size_t i = 0; i < mesh->n_vertices; i++) {
+      const float *p = mesh->positions + 3 * i;
+      double X0 = p[0], X1 = p[1], X2 = p[2];
+      double Z = (R[6] * X0 + R[7] * X1 + R[8] * X2) + t[2];
+      if (!(Z > 0.0)) {
+        behind = 1;
+        continue;
+      }
+      double iz = 1.0 / Z, x = ((R[0] * X0 + R[1] * X1 + R[2] * X2) + t[0]) * iz,
+             y = ((R[3] * X0 + R[4] * X1 + R[5] * X2) + t[1]) * iz, xd, yd;
+      hearth_distort_xy(cam->dist, x, y, &xd, &yd);
+      double u = fx * xd + cx, v = fy * yd + cy;
+      lo[0] = u < lo[0] ? u : lo[0];
+      hi[0] = u > hi[0] ? u : hi[0];
+      lo[1] = v < lo[1] ? v : lo[1];
+      hi[1] = v > hi[1] ? v : hi[1];
+      any = 1;
     }
-    any = 1;
-    for (int k = 0; k < 2; k++) {
-      if (uv[k] < lo[k]) lo[k] = uv[k];
-      if (uv[k] > hi[k]) hi[k] = uv[k];
+  } else {
+    for (size_t i = 0; i < mesh->n_vertices; i++) {
+      double X[3] = {mesh->positions[3 * i], mesh->positions[3 * i + 1],
+                     mesh->positions[3 * i + 2]},
+             Xc[3], uv[2];
+      hearth_rigid_apply(&Tcw, X, Xc);
+      if (!hearth_camera_project(cam, Xc, uv, NULL)) {
+        behind = 1;
+        continue;
+      }
+      any = 1;
+      for (int k = 0; k < 2; k++) {
+        if (uv[k] < lo[k]) lo[k] = uv[k];
+        if (uv[k] > hi[k]) hi[k] = uv[k];
+      }
     }
   }
   if (!any) return 0;

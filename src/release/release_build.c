@@ -14,9 +14,14 @@
  * The parameters that shape the outputs come from the caller, else from the
  * release's build.json (the last build's), else the defaults, and are
  * recorded there before any stage runs (release_params.c).
- * Instances run in parallel (one worker per job); each stage gets
- * threads / jobs workers. Stages are deterministic for any thread count, so
- * the bytes do not depend on -j. */
+ * The work is scheduled by stage: each instance's stages in order, its
+ * per-state stages (map, overlay) of different states side by side once the
+ * stages before them are done, and the stages that do not read the
+ * calibration (scale) already while detection and calibration run, so a
+ * core the single-threaded calibration leaves idle does an instance's work.
+ * jobs workers take the next ready stage; each stage gets threads / jobs
+ * workers of its own (the release-level stages all threads). Stages are
+ * deterministic for any thread count, so the bytes do not depend on -j. */
 #include <dirent.h>
 #include <errno.h>
 #include <jansson.h>
@@ -273,6 +278,19 @@ typedef struct inst_plan {
   char why[1024];
 } inst_plan;
 
+/* one stage run of one instance (and state, for map and overlay) */
+enum { UNIT_PENDING, UNIT_RUNNING, UNIT_OK, UNIT_FAILED };
+typedef struct build_unit {
+  size_t inst; /* index into plans */
+  int st;
+  size_t k;  /* the state, for per-state stages */
+  int state; /* UNIT_* */
+} build_unit;
+
+/* the release-level stages' outcome, which every stage that reads the
+   calibration waits for */
+enum { GATE_CLOSED, GATE_OPEN, GATE_FAILED };
+
 typedef struct build_ctx {
   const char *root;
   const hearth_build_opts *o;
@@ -280,7 +298,12 @@ typedef struct build_ctx {
   int use_stage[ST_COUNT];
   inst_plan *plans;
   hearth_build_instance *res;
-  size_t n, next;
+  size_t n;
+  build_unit *units; /* instance after instance, each in stage order */
+  size_t n_units, units_left, running;
+  int gate;
+  int gate_all; /* caller-supplied release stages: every stage waits for them */
+  pthread_cond_t cv;
   size_t units_total, units_done;
   size_t stages_run, stages_fresh, temps_removed;
   hearth_progress prog;
@@ -583,9 +606,9 @@ static int do_stage(build_ctx *c, size_t idx, int st, size_t k) {
   if (!c->o->force && stamp_fresh(c->root, stamp, params, &in, &out)) {
     pthread_mutex_lock(&c->mu);
     c->stages_fresh++;
-    pthread_mutex_unlock(&c->mu);
     r->stages_skipped++;
     if (st == ST_MAP) r->states_mapped++;
+    pthread_mutex_unlock(&c->mu);
     unit_done(c, what, "up to date", -1);
     goto done;
   }
@@ -604,20 +627,22 @@ static int do_stage(build_ctx *c, size_t idx, int st, size_t k) {
   if ((s = stage_run(c, p, st, k, &mapped, &err))) goto fail;
   if ((s = stamp_write(c->root, stamp, k_stage_names[st], what, params, &in, &out, &err)))
     goto fail;
+  pthread_mutex_lock(&c->mu);
   r->states_mapped += mapped;
   r->stages_run++;
-  pthread_mutex_lock(&c->mu);
   c->stages_run++;
   pthread_mutex_unlock(&c->mu);
   unit_done(c, what, "done", hearth_now() - t0);
   goto done;
 fail:
   ok = 0;
+  pthread_mutex_lock(&c->mu);
   if (!r->failed) {
     r->failed = 1;
     snprintf(r->failed_stage, sizeof r->failed_stage, "%s", k_stage_names[st]);
     snprintf(r->reason, sizeof r->reason, "%s", err.msg[0] ? err.msg : hearth_strerror(s));
   }
+  pthread_mutex_unlock(&c->mu);
   unit_done(c, what, "FAILED", -1);
   if (!c->o->quiet && c->tty) {
     pthread_mutex_lock(&c->mu);
@@ -638,50 +663,89 @@ static size_t sweep_tree(const char *dir, int depth, int dry_run) {
   return n;
 }
 
-static void build_instance(build_ctx *c, size_t idx) {
+/* the temporaries of killed writers in an instance, removed before any of
+   its stages runs; an unreadable instance fails whole */
+static void prepare_instance(build_ctx *c, size_t idx) {
   inst_plan *p = &c->plans[idx];
   hearth_build_instance *r = &c->res[idx];
   char dir[PATH_SZ];
   snprintf(dir, sizeof dir, "%s/instances/%s", c->root, p->id);
-  size_t swept = sweep_tree(dir, 8, c->o->dry_run);
-  if (swept) {
-    pthread_mutex_lock(&c->mu);
-    c->temps_removed += swept;
-    pthread_mutex_unlock(&c->mu);
-  }
-  if (!p->readable) {
-    r->failed = 1;
-    snprintf(r->failed_stage, sizeof r->failed_stage, "read");
-    snprintf(r->reason, sizeof r->reason, "%s", p->why);
-    size_t u = units_of(c, p);
-    for (size_t i = 0; i < u; i++) unit_done(c, p->id, "FAILED", -1);
-    return;
-  }
-  int failed = 0;
-  for (int st = 0; st < ST_COUNT; st++) {
-    if (!stage_used(c, p, st)) continue;
-    int per_state = st == ST_MAP || st == ST_OVERLAY;
-    size_t nk = per_state ? p->n_states : 1;
-    for (size_t k = 0; k < nk; k++) {
-      if (failed) {
-        unit_done(c, p->id, NULL, -1); /* skipped after an earlier failure */
-        continue;
-      }
-      if (!do_stage(c, idx, st, k) && !per_state) failed = 1;
-    }
-  }
+  c->temps_removed += sweep_tree(dir, 8, c->o->dry_run);
+  if (p->readable) return;
+  r->failed = 1;
+  snprintf(r->failed_stage, sizeof r->failed_stage, "read");
+  snprintf(r->reason, sizeof r->reason, "%s", p->why);
+  size_t u = units_of(c, p);
+  for (size_t i = 0; i < u; i++) unit_done(c, p->id, "FAILED", -1);
 }
 
-static void *worker(void *arg) {
-  build_ctx *c = arg;
-  for (;;) {
-    pthread_mutex_lock(&c->mu);
-    size_t i = c->next++;
-    pthread_mutex_unlock(&c->mu);
-    if (i >= c->n) break;
-    build_instance(c, i);
+static int per_state_stage(int st) { return st == ST_MAP || st == ST_OVERLAY; }
+
+/* scale reads only the instance's own files; every other stage reads
+   calibration/rig.json */
+static int needs_gate(const build_ctx *c, int st) { return c->gate_all || st != ST_SCALE; }
+
+/* The first unit ready to run, marked running; NULL when none is. A unit is
+ * ready when every earlier stage of its instance that is not per-state has
+ * succeeded (and the gate is open, if it reads the calibration); one after a
+ * failed such stage is skipped (counted, no line), as in a serial build.
+ * Called with c->mu held. */
+static build_unit *next_unit(build_ctx *c) {
+  for (size_t i = 0; i < c->n_units; i++) {
+    build_unit *u = &c->units[i];
+    if (u->state != UNIT_PENDING) continue;
+    int blocked = 0, dead = 0;
+    for (size_t j = i; j-- > 0 && c->units[j].inst == u->inst;) {
+      const build_unit *v = &c->units[j];
+      if (per_state_stage(v->st) || v->st >= u->st) continue;
+      if (v->state == UNIT_FAILED) dead = 1;
+      else if (v->state != UNIT_OK) blocked = 1;
+    }
+    if (dead) {
+      u->state = UNIT_FAILED;
+      c->units_left--;
+      c->units_done++;
+      if (!c->o->quiet && c->tty) hearth_progress_step(&c->prog, 1);
+      continue;
+    }
+    if (blocked || (needs_gate(c, u->st) && c->gate != GATE_OPEN)) continue;
+    u->state = UNIT_RUNNING;
+    c->running++;
+    return u;
   }
   return NULL;
+}
+
+/* a job: ready units until none is left or none can become ready (every
+   one left waits for a gate that failed) */
+static void *worker(void *arg) {
+  build_ctx *c = arg;
+  pthread_mutex_lock(&c->mu);
+  while (c->units_left) {
+    build_unit *u = next_unit(c);
+    if (u) {
+      pthread_mutex_unlock(&c->mu);
+      int ok = do_stage(c, u->inst, u->st, u->k);
+      pthread_mutex_lock(&c->mu);
+      u->state = ok ? UNIT_OK : UNIT_FAILED;
+      c->units_left--;
+      c->running--;
+      pthread_cond_broadcast(&c->cv);
+      continue;
+    }
+    if (c->gate != GATE_CLOSED && !c->running) break;
+    pthread_cond_wait(&c->cv, &c->mu);
+  }
+  pthread_cond_broadcast(&c->cv);
+  pthread_mutex_unlock(&c->mu);
+  return NULL;
+}
+
+static void open_gate(build_ctx *c, int gate) {
+  pthread_mutex_lock(&c->mu);
+  c->gate = gate;
+  pthread_cond_broadcast(&c->cv);
+  pthread_mutex_unlock(&c->mu);
 }
 
 /* read instance.json and manifests (the stage file lists need them) */
@@ -727,6 +791,7 @@ static hearth_status run_release_stage(const char *root, const hearth_build_stag
   }
   if (o->dry_run) {
     if (!o->quiet) fprintf(log, "build: %s: would run\n", bs->name);
+    *ran = -1; /* neither run nor up to date */
     goto done;
   }
   double t0 = hearth_now();
@@ -779,25 +844,6 @@ hearth_status hearth_build_release(const char *root, const hearth_build_opts *o_
                           o.n_release_stages, HEARTH_BUILD_MAX_STAGES);
   }
   for (size_t i = 0; i < o.n_release_stages; i++) stages[n_stages++] = o.release_stages[i];
-  rep->temps_removed += sweep_tree(root, 0, o.dry_run);
-  char cdir[PATH_SZ];
-  snprintf(cdir, sizeof cdir, "%s/calibration", root);
-  rep->temps_removed += sweep_tree(cdir, 8, o.dry_run);
-  for (size_t i = 0; i < n_stages; i++) {
-    int ran = 0;
-    size_t swept = 0;
-    s = run_release_stage(root, &stages[i], &o, threads, log, &ran, &swept, err);
-    rep->temps_removed += swept;
-    if (s) {
-      rep->release_failed = 1;
-      snprintf(rep->release_reason, sizeof rep->release_reason, "%s", err->msg);
-      hearth_release_free(&rel);
-      rep->seconds = hearth_now() - t_start;
-      return s;
-    }
-    if (ran) rep->stages_run++;
-    else rep->stages_up_to_date++;
-  }
 
   /* this shard's instances, in release order */
   size_t n = 0;
@@ -815,6 +861,7 @@ hearth_status hearth_build_release(const char *root, const hearth_build_opts *o_
   c.root = root;
   c.o = &o;
   c.log = log;
+  c.gate_all = o.n_release_stages > 0;
   c.plans = calloc(n ? n : 1, sizeof *c.plans);
   c.res = calloc(n ? n : 1, sizeof *c.res);
   if (!c.plans || !c.res) {
@@ -835,22 +882,49 @@ hearth_status hearth_build_release(const char *root, const hearth_build_opts *o_
   c.n = n;
   for (int st = 0; st < ST_COUNT; st++) c.use_stage[st] = stage_available(st);
   if (!o.bake_rgb) c.use_stage[ST_BAKE] = 0;
+  size_t n_units = 0;
   for (size_t i = 0; i < n; i++) {
     plan_instance(root, &c.plans[i]);
     c.res[i].n_states = c.plans[i].n_states;
-    c.units_total += c.plans[i].readable ? units_of(&c, &c.plans[i]) : units_of(&c, &c.plans[i]);
+    c.units_total += units_of(&c, &c.plans[i]);
+    if (c.plans[i].readable) n_units += units_of(&c, &c.plans[i]);
   }
+  c.units = calloc(n_units ? n_units : 1, sizeof *c.units);
+  if (!c.units) {
+    for (size_t i = 0; i < n; i++)
+      for (size_t k = 0; k < c.plans[i].n_states; k++) hearth_manifest_free(&c.plans[i].man[k]);
+    free(c.plans);
+    free(c.res);
+    return hearth_err_set(err, HEARTH_E_NOMEM, "build: out of memory");
+  }
+  for (size_t i = 0; i < n; i++)
+    for (int st = 0; c.plans[i].readable && st < ST_COUNT; st++) {
+      if (!stage_used(&c, &c.plans[i], st)) continue;
+      size_t nk = per_state_stage(st) ? c.plans[i].n_states : 1;
+      for (size_t k = 0; k < nk; k++) c.units[c.n_units++] = (build_unit){i, st, k, UNIT_PENDING};
+    }
+  c.units_left = c.n_units;
+  c.gate = n_stages ? GATE_CLOSED : GATE_OPEN;
   int jobs = o.jobs > 0 ? o.jobs : threads;
   if ((size_t)jobs > n) jobs = n ? (int)n : 1;
   c.stage_threads = threads / jobs > 0 ? threads / jobs : 1;
   pthread_mutex_init(&c.mu, NULL);
+  pthread_cond_init(&c.cv, NULL);
   c.tty = isatty(fileno(stderr));
+
+  rep->temps_removed += sweep_tree(root, 0, o.dry_run);
+  char cdir[PATH_SZ];
+  snprintf(cdir, sizeof cdir, "%s/calibration", root);
+  rep->temps_removed += sweep_tree(cdir, 8, o.dry_run);
+  for (size_t i = 0; i < n; i++) prepare_instance(&c, i);
   if (!o.quiet) {
     fprintf(log, "build: %zu instance(s)%s, %zu stage run(s) to check, %d job(s) x %d thread(s)\n",
             n, o.shard_count > 1 ? " in this shard" : "", c.units_total, jobs, c.stage_threads);
     fflush(log);
     if (c.tty) hearth_progress_begin(&c.prog, "build", c.units_total, 0);
   }
+  /* the other jobs start at once: stages that do not read the calibration
+     run beside the release-level stages, which this thread runs */
   pthread_t *tids = calloc((size_t)jobs, sizeof *tids);
   int started = 0;
   if (tids)
@@ -858,20 +932,44 @@ hearth_status hearth_build_release(const char *root, const hearth_build_opts *o_
       if (pthread_create(&tids[t], NULL, worker, &c) != 0) break;
       started = t;
     }
+  hearth_status s_rel = HEARTH_OK;
+  for (size_t i = 0; i < n_stages && !s_rel; i++) {
+    int ran = 0;
+    size_t swept = 0;
+    s_rel = run_release_stage(root, &stages[i], &o, threads, log, &ran, &swept, err);
+    pthread_mutex_lock(&c.mu);
+    rep->temps_removed += swept;
+    if (s_rel) {
+      rep->release_failed = 1;
+      snprintf(rep->release_reason, sizeof rep->release_reason, "%s", err->msg);
+    } else if (ran > 0) {
+      rep->stages_run++;
+    } else if (ran == 0) {
+      rep->stages_up_to_date++;
+    }
+    pthread_mutex_unlock(&c.mu);
+  }
+  open_gate(&c, s_rel ? GATE_FAILED : GATE_OPEN);
   worker(&c);
   for (int t = 1; t <= started; t++) pthread_join(tids[t], NULL);
   free(tids);
   if (!o.quiet && c.tty) hearth_progress_end(&c.prog);
+  pthread_cond_destroy(&c.cv);
   pthread_mutex_destroy(&c.mu);
   for (size_t i = 0; i < n; i++)
     for (size_t k = 0; k < c.plans[i].n_states; k++) hearth_manifest_free(&c.plans[i].man[k]);
   free(c.plans);
-  rep->n_instances = n;
-  rep->instances = c.res;
+  free(c.units);
   rep->stages_run += c.stages_run;
   rep->stages_up_to_date += c.stages_fresh;
   rep->temps_removed += c.temps_removed;
   rep->seconds = hearth_now() - t_start;
+  if (s_rel) { /* no instance report: its stages that read the calibration never ran */
+    free(c.res);
+    return s_rel;
+  }
+  rep->n_instances = n;
+  rep->instances = c.res;
   return HEARTH_OK;
 }
 

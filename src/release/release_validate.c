@@ -12,6 +12,7 @@
 #include "hearth/image.h"
 #include "hearth/mesh.h"
 #include "hearth/npy.h"
+#include "hearth/recon.h"
 #include "hearth/dataset.h"
 #include "hearth/release.h"
 #include "hearth/thermal.h"
@@ -207,9 +208,10 @@ static int has_view(const state_views *sv, size_t ns, const char *state, const c
 }
 
 /* a poses file: readable (rotations are checked by the reader), every entry
- * names a view of a state of this instance, and every view has a pose */
+ * names a view of a state of this instance, and (every_view) every view has
+ * a pose, else at least one view has */
 static void check_poses(hearth_problems *p, const char *path, const state_views *sv, size_t ns,
-                        size_t *nfiles) {
+                        int every_view, size_t *nfiles) {
   hearth_poses poses = {0};
   hearth_err e = {0};
   (*nfiles)++;
@@ -231,11 +233,12 @@ static void check_poses(hearth_problems *p, const char *path, const state_views 
       hearth_problems_add(p, path, "views[%zu]: view '%s' does not exist in state '%s'", i,
                           poses.views[i].view, poses.views[i].state);
   }
-  for (size_t k = 0; k < ns; k++)
+  for (size_t k = 0; every_view && k < ns; k++)
     for (size_t v = 0; v < sv[k].man.n_views; v++)
       if (!hearth_poses_find(&poses, sv[k].state, sv[k].man.views[v].view))
         hearth_problems_add(p, path, "no pose for state '%s' view '%s'", sv[k].state,
                             sv[k].man.views[v].view);
+  if (!every_view && !poses.n) hearth_problems_add(p, path, "no view has a pose");
   hearth_poses_free(&poses);
 }
 
@@ -496,6 +499,43 @@ static void check_recon_report(hearth_problems *p, const char *dir, const char *
   free(text);
 }
 
+/* recon/, the reconstruction's hand-over (an outside tool's, the virtual
+ * rig's stand-in or hearth's own): every file a rebuild reads from it must
+ * read with the strict readers. Its poses may leave views out (a COLMAP
+ * model that did not register them), but each names a view of this
+ * instance; the mesh (with UVs), the geometry-only mesh, the texture and
+ * the cameras document are checked where present (hearth recon --no-mesh
+ * leaves poses only). */
+static void check_recon_files(hearth_problems *p, const char *dir, const state_views *sv, size_t ns,
+                              int decode, size_t *nfiles) {
+  char f[PATH_SZ];
+  hearth_err e = {0};
+  snprintf(f, sizeof f, "%s/recon", dir);
+  if (!hearth_path_exists(f)) return;
+  snprintf(f, sizeof f, "%s/recon/poses_rgb.json", dir);
+  check_poses(p, f, sv, ns, 0, nfiles);
+  static const char *glbs[2] = {"mesh.glb", "mesh_geometry.glb"};
+  for (int j = 0; j < 2; j++) {
+    snprintf(f, sizeof f, "%s/recon/%s", dir, glbs[j]);
+    if (!present(f)) continue; /* hearth recon --no-mesh writes poses only */
+    (*nfiles)++;
+    hearth_mesh mesh = {0};
+    hearth_glb_read_opts go = {.require_uvs = j == 0};
+    if (hearth_glb_read(f, &go, &mesh, &e)) add_err(p, f, &e);
+    hearth_mesh_free(&mesh);
+  }
+  static const int rgb34[] = {3, 4, 0};
+  snprintf(f, sizeof f, "%s/recon/rgb_texture.png", dir);
+  if (present(f)) check_image(p, f, IMG_PNG, 0, 0, rgb34, 8, decode, nfiles);
+  snprintf(f, sizeof f, "%s/recon/poses_rgb_cameras.json", dir);
+  if (present(f)) {
+    (*nfiles)++;
+    hearth_recon_cameras cams = {0};
+    if (hearth_recon_cameras_read(f, &cams, &e)) add_err(p, f, &e);
+    hearth_recon_cameras_free(&cams);
+  }
+}
+
 static void check_instance(const char *root, const char *id, const hearth_validate_opts *o,
                            const size_t tsize[2], hearth_problems *p, size_t *nfiles) {
   char path[PATH_SZ], dir[PATH_SZ];
@@ -587,6 +627,7 @@ static void check_instance(const char *root, const char *id, const hearth_valida
       }
     }
   }
+  check_recon_files(p, dir, sv, doc.n_states, o->decode_images, nfiles);
   check_recon_report(p, dir, id, &doc, sv, nfiles);
   if (o->raw_only) goto done;
 
@@ -617,7 +658,7 @@ static void check_instance(const char *root, const char *id, const hearth_valida
                                      "poses_thermal.json"};
   for (int j = 0; j < 3; j++) {
     snprintf(path, sizeof path, "%s/derived/%s", dir, pose_files[j]);
-    check_poses(p, path, sv, doc.n_states, nfiles);
+    check_poses(p, path, sv, doc.n_states, 1, nfiles);
   }
   for (size_t k = 0; k < doc.n_states; k++) {
     if (!sv[k].ok) continue;

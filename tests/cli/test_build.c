@@ -9,16 +9,6 @@
 #include <unistd.h>
 #include "test_util.h"
 
-/* sha256 of every file except the stamps (they record input mtimes) */
-static int tree_hash(const char *root, const char *out_file) {
-  char cmd[4096];
-  snprintf(cmd, sizeof cmd,
-           "cd '%s' && find . -type f ! -path '*/.stamps/*' | sort | "
-           "xargs sha256sum > '%s'",
-           root, out_file);
-  return system(cmd);
-}
-
 int main(void) {
   static char out[1 << 18];
   char cmd[8192], a[2048], b[2048];
@@ -57,7 +47,7 @@ int main(void) {
   CHECK(rc == 0);
   CHECK_MSG(strstr(out, " 0 stage(s) run") != NULL, "second run did work: %s", out);
   snprintf(a, sizeof a, "%s/hash_full.txt", base);
-  CHECK(tree_hash(root, a) == 0);
+  CHECK(test_tree_hash(root, a) == 0);
 
   /* validate and stats of the result */
   snprintf(cmd, sizeof cmd, "'%s' validate '%s'", HEARTH_EXE, root);
@@ -123,7 +113,7 @@ int main(void) {
   CHECK_MSG(strstr(out, "10 complete") && !strstr(out, " 0 up to date"),
             "resume did not reuse finished stages: %s", out);
   snprintf(b, sizeof b, "%s/hash_resumed.txt", base);
-  CHECK(tree_hash(root, b) == 0);
+  CHECK(test_tree_hash(root, b) == 0);
   snprintf(cmd, sizeof cmd, "cmp '%s' '%s'", a, b);
   CHECK_MSG(system(cmd) == 0, "resumed build differs from the uninterrupted one");
 
@@ -139,7 +129,7 @@ int main(void) {
   rc = test_run_capture(cmd, out, sizeof out);
   CHECK_MSG(rc == 0 && strstr(out, "5 instance(s): 5 complete"), "shards: %s", out);
   snprintf(b, sizeof b, "%s/hash_shards.txt", base);
-  CHECK(tree_hash(moved, b) == 0);
+  CHECK(test_tree_hash(moved, b) == 0);
   snprintf(cmd, sizeof cmd, "cmp '%s' '%s'", a, b);
   CHECK_MSG(system(cmd) == 0, "sharded build (elsewhere) differs from the single build");
   TEST_MAIN_END();

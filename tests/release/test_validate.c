@@ -302,6 +302,32 @@ int main(void) {
     n = validate(d, NULL, NULL, NULL);
     CHECK_MSG(n == 3, "three defects: %zu problem(s)", n);
   }
+  /* 6. recon/, the hand-over a rebuild reads: a view the reconstruction did
+     not register is fine; a truncated poses file, a pose of a view that
+     does not exist and a truncated mesh are each named (raw-only too) */
+  {
+    const char *d = fresh_copy("recon");
+    snprintf(p, sizeof p, "%s/instances/cup_01/recon/poses_rgb.json", d);
+    test_sh(
+        "python3 -c \"import json,sys; f=sys.argv[1]; d=json.load(open(f)); "
+        "del d['views'][0]; json.dump(d,open(f,'w'))\" '%s'%s",
+        p, "");
+    n = validate(d, NULL, NULL, NULL);
+    CHECK_MSG(n == 0, "recon poses without one view: %zu problem(s)", n);
+    test_sh(
+        "python3 -c \"import json,sys; f=sys.argv[1]; d=json.load(open(f)); "
+        "d['views'][1]['view']='v77'; json.dump(d,open(f,'w'))\" '%s'%s",
+        p, "");
+    n = validate(d, "recon/poses_rgb.json", "'v77' does not exist", &hit);
+    CHECK_MSG(hit && n == 1, "recon pose v77: hit %d, %zu problem(s)", hit, n);
+    test_sh("f='%s' && head -c 200 \"$f\" > \"$f.cut\" && mv \"$f.cut\" \"$f\"%s", p, "");
+    n = validate_opts(d, 1, "recon/poses_rgb.json", "line", &hit);
+    CHECK_MSG(hit && n == 1, "truncated recon poses (raw-only): hit %d, %zu problem(s)", hit, n);
+    snprintf(p, sizeof p, "%s/instances/cup_01/recon/mesh.glb", d);
+    test_sh("f='%s' && head -c 1000 \"$f\" > \"$f.cut\" && mv \"$f.cut\" \"$f\"%s", p, "");
+    n = validate(d, "recon/mesh.glb", "does not match the file size", &hit);
+    CHECK_MSG(hit && n == 2, "truncated recon mesh: hit %d, %zu problem(s)", hit, n);
+  }
   test_recon_report();
   TEST_MAIN_END();
 }
