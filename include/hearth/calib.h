@@ -93,8 +93,9 @@ typedef struct hearth_calib_opts {
   int stereo_intrinsics;
   /* with stereo_intrinsics: the target's holes are taken as drilled where
    * the data put them, each hole's in-plane offset from the nominal lattice
-   * solved jointly with the rest (the offsets' affine part held at zero:
-   * the gauge), under a prior N(0, target_sigma_m^2) per axis; default 0 */
+   * solved jointly with the rest (the offsets' similarity part held at
+   * zero: the gauge), under a prior N(0, target_sigma_m^2) per axis, and
+   * the calibration run again from the target as solved; default 0 */
   int target_points;
   double target_sigma_m; /* the holes' drilling tolerance, 1 sigma; default 4e-5 */
 } hearth_calib_opts;

@@ -99,7 +99,7 @@ int hearth_cmd_calibrate(int argc, char **argv) {
                "plate poses fixed by the colour camera)"),
       CLI_FLAG("--refine-target", &o.target_points, 1,
                "also solve each hole's in-plane offset from the nominal lattice with the "
-               "stereo stage (drilling tolerance; the offsets' affine part held at zero), then "
+               "stereo stage (drilling tolerance; the offsets' similarity part held at zero), then "
                "calibrate again from the target as solved; experimental"),
       CLI_FLAG("--quiet", &quiet, 1, "summary line only"),
       CLI_GROUP("with --detect, the options of `hearth detect`", detect_opts, &detect_opt),

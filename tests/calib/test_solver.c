@@ -671,8 +671,10 @@ static void test_stereo_joint_rolling(uint64_t seed) {
 
 /* the target model (opts.target_points): the holes drilled off the nominal
  * lattice by N(0, 0.04 mm) per axis (the CNC tolerance of the virtual rig,
- * docs/virtual-rig.md), with no affine part (the model's gauge: an affine
- * part trades with the plate poses and the intrinsics). Exact points of the
+ * docs/virtual-rig.md), with no affine part (the model's gauge is their
+ * similarity part, which the plate poses and the scale take exactly; the
+ * affine part's shear and anisotropic scale are left out too, as weakly
+ * seen). Exact points of the
  * drilled plate: solved against the nominal lattice the thermal camera and
  * the extrinsic come out measurably off and the RMS is the drilling's;
  * with the offsets solved jointly, the drilled positions, the camera and
