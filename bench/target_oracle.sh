@@ -8,6 +8,8 @@
 # with --hole-position M, detects, and calibrates with the target taken as
 #   nominal  the lattice of target.json (what a drawing gives),
 #   true     the drilled positions,
+#   nosim    the drilled positions less their best-fit similarity (the best
+#            a refinement gauge-fixed on the similarity part can reach),
 #   noaff    the drilled positions less their best-fit affine part (the
 #            best a refinement gauge-fixed on the affine part can reach),
 #   noproj   less their best-fit affine and first-order projective part
@@ -56,8 +58,12 @@ N = np.array([(pitch * c + (0.5 * pitch if q & 1 else 0.0), step * q)
               for q in range(rows) for c in range(cols - (q & 1))])
 O = (T - N).ravel()
 x, y, one = N[:, 0], N[:, 1], np.ones(len(N))
-def modes(proj):
+def modes(proj, sim=False):
     cols_ = []
+    if sim:
+        for f in ((one, 0 * x), (0 * x, one), (x, y), (-y, x)):
+            v = np.zeros(O.size); v[0::2] = f[0]; v[1::2] = f[1]; cols_.append(v)
+        return np.array(cols_).T
     for k in range(2):
         for f in (x, y, one):
             v = np.zeros(O.size); v[k::2] = f; cols_.append(v)
@@ -67,13 +73,15 @@ def modes(proj):
     return np.array(cols_).T
 A = modes(False); a = A @ np.linalg.lstsq(A, O, rcond=None)[0]
 P = modes(True); p = P @ np.linalg.lstsq(P, O, rcond=None)[0]
+S = modes(False, True); q = S @ np.linalg.lstsq(S, O, rcond=None)[0]
 um = lambda v: 1e6 * np.sqrt((v ** 2).mean() * 2)
 print(f"seed {sys.argv[2]}: offsets {um(O):.1f} um rms length, affine part {um(a):.1f} um, "
       f"affine + projective part {um(p):.1f} um")
-for name, v in (("nominal", 0 * O), ("noaff", O - a), ("noproj", O - p), ("affonly", a)):
+for name, v in (("nominal", 0 * O), ("nosim", O - q), ("noaff", O - a), ("noproj", O - p),
+                ("affonly", a)):
     np.savetxt(f"{r}/holes_{name}.txt", N + v.reshape(-1, 2), fmt="%.17g")
 PY
-  for c in nominal true noaff noproj affonly refine; do
+  for c in nominal true nosim noaff noproj affonly refine; do
     f="$r/holes_$c.txt"
     a=""
     [ $c = refine ] && f="" && a=--refine-target
