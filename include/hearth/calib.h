@@ -93,9 +93,11 @@ typedef struct hearth_calib_opts {
   int stereo_intrinsics;
   /* with stereo_intrinsics: the target's holes are taken as drilled where
    * the data put them, each hole's in-plane offset from the nominal lattice
-   * estimated in turn with the rest (the offsets' affine part held at zero:
-   * the gauge); default 0 */
+   * solved jointly with the rest (the offsets' similarity part held at
+   * zero: the gauge), under a prior N(0, target_sigma_m^2) per axis, and
+   * the calibration run again from the target as solved; default 0 */
   int target_points;
+  double target_sigma_m; /* the holes' drilling tolerance, 1 sigma; default 4e-5 */
 } hearth_calib_opts;
 void hearth_calib_opts_default(hearth_calib_opts *o);
 
@@ -203,6 +205,10 @@ typedef struct hearth_calib_report {
   hearth_calib_frame_report *thermal; /* owned */
   hearth_calib_frame_report *pairs;   /* owned */
   hearth_rig rig;
+  /* the stereo RMS against the nominal target (rig.stereo_rms_px is after
+   * the target model, with opts.target_points; the same without it); NAN
+   * for a thermal-only calibration */
+  double stereo_rms_nominal_px;
   double t_calib_s;        /* seconds spent reading, solving (not writing) */
   hearth_lens_choice lens; /* thermal-only calibration only */
 } hearth_calib_report;

@@ -8,9 +8,10 @@
 #include <stdio.h>
 #include "hearth/calib.h"
 
-/* Solve A x = b for a symmetric positive definite n x n A (row-major, n <= 16)
- * by Cholesky; A and b are overwritten (b becomes x). Returns 0 if A is not
- * positive definite. */
+/* Solve A x = b for a symmetric positive definite n x n A (row-major, n <=
+ * CALIB_CHOL_MAX) by Cholesky; A and b are overwritten (b becomes x).
+ * Returns 0 if A is not positive definite. */
+#define CALIB_CHOL_MAX (16 + 2 * HEARTH_TARGET_MAX_HOLES)
 int calib_chol_solve(double *A, double *b, int n);
 /* Invert a symmetric positive definite n x n matrix in place (n <= 16). */
 int calib_chol_invert(double *A, int n);
@@ -57,13 +58,18 @@ void calib_circle_bias(const hearth_camera *cam, const hearth_rigid *T, const do
  * (n_pairs; may be NULL): when camera b saw the plate, in frames of camera
  * a's readout from camera a's middle row (positive: after it), as the
  * rolling-shutter model solved it; NAN for a pair not used or where the
- * model was not kept (o->rolling_shutter off, or a still plate). */
+ * model was not kept (o->rolling_shutter off, or a still plate).
+ * rms_nominal_px (may be NULL): the stereo RMS solved against the nominal
+ * target obj (with o->target_points, before the holes' offsets are solved;
+ * otherwise *rms_px). pts_out (n_pts, may be NULL): the target's points
+ * as solved (obj itself without o->target_points). */
 hearth_status calib_stereo_joint_times(const hearth_camera *cam_a, hearth_camera *cam_b,
                                        const double (*obj)[3], size_t n_pts, const double *img_a,
                                        const double *img_b, size_t n_pairs, const double *img_c,
                                        size_t n_c, const hearth_calib_opts *o,
                                        hearth_rigid *T_b_from_a, double *rms_px, double *own_rms_px,
                                        double *pair_rms, int *pair_used, double *pair_time,
+                                       double *rms_nominal_px, double (*pts_out)[3],
                                        hearth_err *err);
 
 /* ---- shared by the release stages (calib_release.c) and the thermal-only

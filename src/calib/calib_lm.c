@@ -18,6 +18,7 @@ void hearth_calib_opts_default(hearth_calib_opts *o) {
   o->hole_radius_m = 0.004;
   o->rolling_shutter = 1;
   o->stereo_intrinsics = 1;
+  o->target_sigma_m = 4e-5;
 }
 
 #define NI_MAX 12 /* fx fy cx cy k1 k2 p1 p2 k3 [k4 k5 k6] */

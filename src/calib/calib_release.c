@@ -487,6 +487,14 @@ static hearth_status write_report(const char *path, const hearth_calib_report *r
   fputs(",\n  \"stereo_rms_px\": ", fp);
   hearth_format_fixed(b, sizeof b, r->rig.stereo_rms_px, 5);
   fputs(b, fp);
+  if (isfinite(r->stereo_rms_nominal_px)) {
+    /* against the nominal target: what a calibration that takes the
+     * target as drawn reports (the same as stereo_rms_px without the
+     * target model) */
+    fputs(",\n  \"stereo_rms_nominal_px\": ", fp);
+    hearth_format_fixed(b, sizeof b, r->stereo_rms_nominal_px, 5);
+    fputs(b, fp);
+  }
   fputs("\n}\n", fp);
   if (ferror(fp)) return hearth_atomic_fail(&af, err);
   return hearth_atomic_commit(&af, err);
@@ -562,6 +570,7 @@ hearth_status hearth_calib_calibrate_release(const char *root, const hearth_cali
   }
   if (!root || !rep) return hearth_err_set(err, HEARTH_E_ARG, "calibrate: missing argument");
   memset(rep, 0, sizeof *rep);
+  rep->stereo_rms_nominal_px = NAN;
   char pdet[4096], pfac[4096], path[4096];
   snprintf(pdet, sizeof pdet, "%s/calibration/detections.json", root);
   snprintf(pfac, sizeof pfac, "%s/calibration/factory.json", root);
@@ -618,6 +627,7 @@ hearth_status hearth_calib_calibrate_release(const char *root, const hearth_cali
   const double wall_t = o->wall_correction ? target.thickness_m : 0.0;
   size_t n = dets.n;
   double(*obj)[3] = hearth_alloc_array(NH, sizeof *obj);
+  double(*solved)[3] = hearth_alloc_array(NH, sizeof *solved);
   double *bias = hearth_alloc_array(2 * NH, sizeof(double));
   double *raw = hearth_alloc_array(2 * NH, sizeof(double));
   double *img_t = hearth_alloc_array(n * NH * 2, sizeof(double));
@@ -632,87 +642,114 @@ hearth_status hearth_calib_calibrate_release(const char *root, const hearth_cali
   hearth_rigid *poses = hearth_alloc_array(n + 1, sizeof(hearth_rigid));
   rep->thermal = hearth_calloc_array(n + 1, sizeof(hearth_calib_frame_report));
   rep->pairs = hearth_calloc_array(n + 1, sizeof(hearth_calib_frame_report));
-  if (!obj || !bias || !raw || !img_t || !img_a || !img_b || !img_c || !frms || !tmp || !used ||
-      !tidx || !pidx || !poses || !rep->thermal || !rep->pairs) {
+  if (!obj || !solved || !bias || !raw || !img_t || !img_a || !img_b || !img_c || !frms || !tmp ||
+      !used || !tidx || !pidx || !poses || !rep->thermal || !rep->pairs) {
     st = hearth_err_set(err, HEARTH_E_NOMEM, "calibrate: out of memory");
     goto done;
   }
   hearth_target_points(&target, obj);
-  /* thermal-only frames (fNNN) */
-  size_t nt = 0;
-  for (size_t i = 0; i < n; i++) {
-    const hearth_detection *d = &dets.frames[i];
-    if (d->frame[0] != 'f' || strcmp(d->camera, "thermal")) continue;
-    hearth_calib_frame_report *fr = &rep->thermal[rep->n_thermal++];
-    snprintf(fr->frame, sizeof fr->frame, "%s", d->frame);
-    fr->rms_px = NAN;
-    if (!d->found) {
-      snprintf(fr->note, sizeof fr->note, "not detected: %.80s", d->reason);
-      continue;
-    }
-    fr->used = 1;
-    tidx[nt] = rep->n_thermal - 1;
-    memcpy(img_t + nt * NH * 2, d->centres, sizeof(double) * 2 * NH);
-    nt++;
-  }
-  if (nt < 3) {
-    st = hearth_err_set(err, HEARTH_E_SIZE,
-                        "%s: %zu thermal-only frames with the plate found, at least 3 needed", pdet,
-                        nt);
-    goto done;
-  }
-  /* intrinsics; frames far above the median residual are dropped and the
-   * solve repeated */
+  /* With the target model the calibration runs twice: the frames are
+   * chosen (outlier rules), the centroids corrected and the offsets solved
+   * first against the nominal target, whose drilling errors inflate every
+   * residual alike and so let frames with their own errors through; then
+   * all again from the target as solved. The RMS against the nominal
+   * target is the first run's. */
   hearth_camera th;
-  double trms = 0;
-  for (size_t i = 0; i < nt; i++) used[i] = 1;
-  for (int round = 0; round < 4; round++) {
-    size_t m = 0;
-    double *pts = img_b; /* scratch: the used frames packed */
-    for (size_t i = 0; i < nt; i++)
-      if (used[i]) memcpy(pts + 2 * NH * m++, img_t + 2 * NH * i, sizeof(double) * 2 * NH);
-    if ((st = hearth_calib_intrinsics((const double(*)[3])obj, NH, pts, m, tw, th_h, o, &th, &trms,
-                                      tmp, NULL, err))) {
-      hearth_err_prefix(err, "%s", pdet);
+  hearth_rigid Tth;
+  double trms = 0, srms = NAN, snom = NAN, crms = NAN;
+  for (int run = 0; run < (o->target_points && o->stereo_intrinsics ? 2 : 1); run++) {
+    rep->n_thermal = rep->n_pairs = 0;
+    /* thermal-only frames (fNNN) */
+    size_t nt = 0;
+    for (size_t i = 0; i < n; i++) {
+      const hearth_detection *d = &dets.frames[i];
+      if (d->frame[0] != 'f' || strcmp(d->camera, "thermal")) continue;
+      hearth_calib_frame_report *fr = &rep->thermal[rep->n_thermal++];
+      snprintf(fr->frame, sizeof fr->frame, "%s", d->frame);
+      fr->rms_px = NAN;
+      if (!d->found) {
+        snprintf(fr->note, sizeof fr->note, "not detected: %.80s", d->reason);
+        continue;
+      }
+      fr->used = 1;
+      tidx[nt] = rep->n_thermal - 1;
+      memcpy(img_t + nt * NH * 2, d->centres, sizeof(double) * 2 * NH);
+      nt++;
+    }
+    if (nt < 3) {
+      st = hearth_err_set(err, HEARTH_E_SIZE,
+                          "%s: %zu thermal-only frames with the plate found, at least 3 needed",
+                          pdet, nt);
       goto done;
     }
-    /* residual of every frame (dropped ones too) at the new intrinsics */
-    for (size_t i = 0; i < nt; i++) {
-      hearth_rigid T;
-      hearth_err e2;
-      if (hearth_calib_pose(&th, (const double(*)[3])obj, NH, img_t + 2 * NH * i, &T, &frms[i],
-                            &e2))
-        frms[i] = INFINITY;
+    /* intrinsics; frames far above the median residual are dropped and the
+     * solve repeated */
+    for (size_t i = 0; i < nt; i++) used[i] = 1;
+    for (int round = 0; round < 4; round++) {
+      size_t m = 0;
+      double *pts = img_b; /* scratch: the used frames packed */
+      for (size_t i = 0; i < nt; i++)
+        if (used[i]) memcpy(pts + 2 * NH * m++, img_t + 2 * NH * i, sizeof(double) * 2 * NH);
+      if ((st = hearth_calib_intrinsics((const double(*)[3])obj, NH, pts, m, tw, th_h, o, &th,
+                                        &trms, tmp, NULL, err))) {
+        hearth_err_prefix(err, "%s", pdet);
+        goto done;
+      }
+      /* residual of every frame (dropped ones too) at the new intrinsics */
+      for (size_t i = 0; i < nt; i++) {
+        hearth_rigid T;
+        hearth_err e2;
+        if (hearth_calib_pose(&th, (const double(*)[3])obj, NH, img_t + 2 * NH * i, &T, &frms[i],
+                              &e2))
+          frms[i] = INFINITY;
+      }
+      size_t k = 0;
+      for (size_t i = 0; i < nt; i++)
+        if (used[i]) tmp[k++] = frms[i];
+      qsort(tmp, k, sizeof(double), cmp_double);
+      double lim = fmax(o->outlier_factor * tmp[k / 2], o->outlier_min_px);
+      int changed = 0;
+      for (size_t i = 0; i < nt; i++) {
+        int u = frms[i] <= lim;
+        if (u != used[i]) changed = 1;
+        used[i] = u;
+      }
+      size_t nu = 0;
+      for (size_t i = 0; i < nt; i++) nu += (size_t)used[i];
+      if (nu < 3) {
+        st = hearth_err_set(err, HEARTH_E_NUMERIC, "%s: fewer than 3 consistent thermal frames",
+                            pdet);
+        goto done;
+      }
+      if (!changed) break;
     }
-    size_t k = 0;
-    for (size_t i = 0; i < nt; i++)
-      if (used[i]) tmp[k++] = frms[i];
-    qsort(tmp, k, sizeof(double), cmp_double);
-    double lim = fmax(o->outlier_factor * tmp[k / 2], o->outlier_min_px);
-    int changed = 0;
-    for (size_t i = 0; i < nt; i++) {
-      int u = frms[i] <= lim;
-      if (u != used[i]) changed = 1;
-      used[i] = u;
-    }
-    size_t nu = 0;
-    for (size_t i = 0; i < nt; i++) nu += (size_t)used[i];
-    if (nu < 3) {
-      st =
-          hearth_err_set(err, HEARTH_E_NUMERIC, "%s: fewer than 3 consistent thermal frames", pdet);
-      goto done;
-    }
-    if (!changed) break;
-  }
-  /* perspective bias: move each used frame's centroids to projected centres
-   * with the current intrinsics and poses, re-solve, twice */
-  if (o->perspective_correction) {
-    for (int pass = 0; pass < 2; pass++) {
+    /* perspective bias: move each used frame's centroids to projected centres
+     * with the current intrinsics and poses, re-solve, twice */
+    if (o->perspective_correction) {
+      for (int pass = 0; pass < 2; pass++) {
+        double *pts = img_b;
+        size_t m = 0;
+        for (size_t i = 0; i < nt; i++)
+          if (used[i]) memcpy(pts + 2 * NH * m++, img_t + 2 * NH * i, sizeof(double) * 2 * NH);
+        for (size_t k = 0; pass > 0 && k < m; k++) {
+          calib_circle_bias(&th, &poses[k], (const double(*)[3])obj, NH, hole_r, wall_t, bias);
+          for (size_t q = 0; q < 2 * NH; q++) pts[2 * NH * k + q] -= bias[q];
+        }
+        if ((st = hearth_calib_intrinsics((const double(*)[3])obj, NH, pts, m, tw, th_h, o, &th,
+                                          &trms, tmp, poses, err))) {
+          hearth_err_prefix(err, "%s", pdet);
+          goto done;
+        }
+        if (pass == 0) continue;
+        for (size_t i = 0, k = 0; i < nt; i++)
+          if (used[i]) frms[i] = tmp[k++];
+      }
+      /* the loop above starts from uncorrected points: one more corrected solve */
       double *pts = img_b;
       size_t m = 0;
       for (size_t i = 0; i < nt; i++)
         if (used[i]) memcpy(pts + 2 * NH * m++, img_t + 2 * NH * i, sizeof(double) * 2 * NH);
-      for (size_t k = 0; pass > 0 && k < m; k++) {
+      for (size_t k = 0; k < m; k++) {
         calib_circle_bias(&th, &poses[k], (const double(*)[3])obj, NH, hole_r, wall_t, bias);
         for (size_t q = 0; q < 2 * NH; q++) pts[2 * NH * k + q] -= bias[q];
       }
@@ -721,102 +758,87 @@ hearth_status hearth_calib_calibrate_release(const char *root, const hearth_cali
         hearth_err_prefix(err, "%s", pdet);
         goto done;
       }
-      if (pass == 0) continue;
       for (size_t i = 0, k = 0; i < nt; i++)
         if (used[i]) frms[i] = tmp[k++];
     }
-    /* the loop above starts from uncorrected points: one more corrected solve */
-    double *pts = img_b;
-    size_t m = 0;
-    for (size_t i = 0; i < nt; i++)
-      if (used[i]) memcpy(pts + 2 * NH * m++, img_t + 2 * NH * i, sizeof(double) * 2 * NH);
-    for (size_t k = 0; k < m; k++) {
-      calib_circle_bias(&th, &poses[k], (const double(*)[3])obj, NH, hole_r, wall_t, bias);
-      for (size_t q = 0; q < 2 * NH; q++) pts[2 * NH * k + q] -= bias[q];
+    /* the used thermal frames as the intrinsics were solved from them */
+    size_t nc = 0;
+    for (size_t i = 0; i < nt; i++) {
+      if (!used[i]) continue;
+      /* with the perspective correction img_b holds them packed and corrected */
+      const double *src = o->perspective_correction ? img_b + 2 * NH * nc : img_t + 2 * NH * i;
+      memcpy(img_c + 2 * NH * nc++, src, sizeof(double) * 2 * NH);
     }
-    if ((st = hearth_calib_intrinsics((const double(*)[3])obj, NH, pts, m, tw, th_h, o, &th, &trms,
-                                      tmp, poses, err))) {
-      hearth_err_prefix(err, "%s", pdet);
+    for (size_t i = 0; i < nt; i++) {
+      hearth_calib_frame_report *fr = &rep->thermal[tidx[i]];
+      fr->rms_px = frms[i];
+      fr->used = used[i];
+      if (!used[i]) snprintf(fr->note, sizeof fr->note, "rejected: residual outlier");
+    }
+    /* stereo pairs: both halves found */
+    size_t npair = 0;
+    for (size_t i = 0; i < n; i++) {
+      const hearth_detection *d = &dets.frames[i];
+      if (d->frame[0] != 'p' || strcmp(d->camera, "rgb")) continue;
+      const hearth_detection *t = NULL;
+      for (size_t k = 0; k < n; k++)
+        if (!strcmp(dets.frames[k].frame, d->frame) && !strcmp(dets.frames[k].camera, "thermal"))
+          t = &dets.frames[k];
+      hearth_calib_frame_report *fr = &rep->pairs[rep->n_pairs++];
+      snprintf(fr->frame, sizeof fr->frame, "%s", d->frame);
+      fr->rms_px = NAN;
+      if (!t) {
+        snprintf(fr->note, sizeof fr->note, "no thermal half");
+        continue;
+      }
+      if (!d->found || !t->found) {
+        snprintf(fr->note, sizeof fr->note, "not detected (%s): %.60s",
+                 !d->found ? "rgb" : "thermal", !d->found ? d->reason : t->reason);
+        continue;
+      }
+      pidx[npair] = rep->n_pairs - 1;
+      memcpy(img_a + npair * NH * 2, d->centres, sizeof(double) * 2 * NH);
+      memcpy(img_b + npair * NH * 2, t->centres, sizeof(double) * 2 * NH);
+      npair++;
+    }
+    if (npair < 1) {
+      st = hearth_err_set(err, HEARTH_E_SIZE,
+                          "%s: no stereo pair with the plate found in both cameras", pdet);
       goto done;
     }
-    for (size_t i = 0, k = 0; i < nt; i++)
-      if (used[i]) frms[i] = tmp[k++];
-  }
-  /* the used thermal frames as the intrinsics were solved from them */
-  size_t nc = 0;
-  for (size_t i = 0; i < nt; i++) {
-    if (!used[i]) continue;
-    /* with the perspective correction img_b holds them packed and corrected */
-    const double *src = o->perspective_correction ? img_b + 2 * NH * nc : img_t + 2 * NH * i;
-    memcpy(img_c + 2 * NH * nc++, src, sizeof(double) * 2 * NH);
-  }
-  for (size_t i = 0; i < nt; i++) {
-    hearth_calib_frame_report *fr = &rep->thermal[tidx[i]];
-    fr->rms_px = frms[i];
-    fr->used = used[i];
-    if (!used[i]) snprintf(fr->note, sizeof fr->note, "rejected: residual outlier");
-  }
-  /* stereo pairs: both halves found */
-  size_t npair = 0;
-  for (size_t i = 0; i < n; i++) {
-    const hearth_detection *d = &dets.frames[i];
-    if (d->frame[0] != 'p' || strcmp(d->camera, "rgb")) continue;
-    const hearth_detection *t = NULL;
-    for (size_t k = 0; k < n; k++)
-      if (!strcmp(dets.frames[k].frame, d->frame) && !strcmp(dets.frames[k].camera, "thermal"))
-        t = &dets.frames[k];
-    hearth_calib_frame_report *fr = &rep->pairs[rep->n_pairs++];
-    snprintf(fr->frame, sizeof fr->frame, "%s", d->frame);
-    fr->rms_px = NAN;
-    if (!t) {
-      snprintf(fr->note, sizeof fr->note, "no thermal half");
-      continue;
-    }
-    if (!d->found || !t->found) {
-      snprintf(fr->note, sizeof fr->note, "not detected (%s): %.60s", !d->found ? "rgb" : "thermal",
-               !d->found ? d->reason : t->reason);
-      continue;
-    }
-    pidx[npair] = rep->n_pairs - 1;
-    memcpy(img_a + npair * NH * 2, d->centres, sizeof(double) * 2 * NH);
-    memcpy(img_b + npair * NH * 2, t->centres, sizeof(double) * 2 * NH);
-    npair++;
-  }
-  if (npair < 1) {
-    st = hearth_err_set(err, HEARTH_E_SIZE,
-                        "%s: no stereo pair with the plate found in both cameras", pdet);
-    goto done;
-  }
-  /* perspective bias in both cameras from each camera's own plate pose */
-  if (o->perspective_correction) {
-    for (size_t i = 0; i < npair; i++) {
-      for (int c = 0; c < 2; c++) {
-        const hearth_camera *cc = c ? &th : &fc.rgb;
-        double *p = (c ? img_b : img_a) + 2 * NH * i;
-        memcpy(raw, p, sizeof(double) * 2 * NH);
-        for (int pass = 0; pass < 2; pass++) {
-          hearth_rigid T;
-          hearth_err e2;
-          if (hearth_calib_pose(cc, (const double(*)[3])obj, NH, p, &T, NULL, &e2)) break;
-          calib_circle_bias(cc, &T, (const double(*)[3])obj, NH, hole_r, wall_t, bias);
-          for (size_t q = 0; q < 2 * NH; q++) p[q] = raw[q] - bias[q];
+    /* perspective bias in both cameras from each camera's own plate pose */
+    if (o->perspective_correction) {
+      for (size_t i = 0; i < npair; i++) {
+        for (int c = 0; c < 2; c++) {
+          const hearth_camera *cc = c ? &th : &fc.rgb;
+          double *p = (c ? img_b : img_a) + 2 * NH * i;
+          memcpy(raw, p, sizeof(double) * 2 * NH);
+          for (int pass = 0; pass < 2; pass++) {
+            hearth_rigid T;
+            hearth_err e2;
+            if (hearth_calib_pose(cc, (const double(*)[3])obj, NH, p, &T, NULL, &e2)) break;
+            calib_circle_bias(cc, &T, (const double(*)[3])obj, NH, hole_r, wall_t, bias);
+            for (size_t q = 0; q < 2 * NH; q++) p[q] = raw[q] - bias[q];
+          }
         }
       }
     }
-  }
-  hearth_rigid Tth;
-  double srms;
-  double crms = NAN;
-  if ((st = hearth_calib_stereo_joint(&fc.rgb, &th, (const double(*)[3])obj, NH, img_a, img_b,
-                                      npair, img_c, nc, o, &Tth, &srms, &crms, frms, used, err))) {
-    hearth_err_prefix(err, "%s", pdet);
-    goto done;
-  }
-  for (size_t i = 0; i < npair; i++) {
-    hearth_calib_frame_report *fr = &rep->pairs[pidx[i]];
-    fr->rms_px = frms[i];
-    fr->used = used[i];
-    if (!used[i]) snprintf(fr->note, sizeof fr->note, "rejected: residual outlier");
+    double nom_rms = NAN;
+    crms = NAN;
+    if ((st = calib_stereo_joint_times(&fc.rgb, &th, (const double(*)[3])obj, NH, img_a, img_b,
+                                       npair, img_c, nc, o, &Tth, &srms, &crms, frms, used, NULL,
+                                       &nom_rms, solved, err))) {
+      hearth_err_prefix(err, "%s", pdet);
+      goto done;
+    }
+    memcpy(obj, solved, sizeof(double) * 3 * NH);
+    for (size_t i = 0; i < npair; i++) {
+      hearth_calib_frame_report *fr = &rep->pairs[pidx[i]];
+      fr->rms_px = frms[i];
+      fr->used = used[i];
+      if (!used[i]) snprintf(fr->note, sizeof fr->note, "rejected: residual outlier");
+    }
+    if (run == 0) snom = nom_rms;
   }
   hearth_rig *rig = &rep->rig;
   rig->rgb = fc.rgb;
@@ -826,6 +848,7 @@ hearth_status hearth_calib_calibrate_release(const char *root, const hearth_cali
   rig->T_thermal_from_rgb = Tth;
   rig->thermal_rms_px = isfinite(crms) ? crms : trms;
   rig->stereo_rms_px = srms;
+  rep->stereo_rms_nominal_px = snom;
   rep->t_calib_s = hearth_now() - t0;
   /* outputs: the extras first, rig.json (what later stages read) last */
   snprintf(path, sizeof path, "%s/calibration/rig_opencv.yaml", root);
@@ -837,6 +860,7 @@ hearth_status hearth_calib_calibrate_release(const char *root, const hearth_cali
 done:
   hearth_detections_free(&dets);
   free(obj);
+  free(solved);
   free(bias);
   free(raw);
   free(img_t);

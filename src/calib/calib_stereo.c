@@ -533,17 +533,35 @@ hearth_status hearth_calib_stereo(const hearth_camera *cam_a, const hearth_camer
 
 /* ---- stereo with camera b's intrinsics refined ---------------------------- */
 /* The extrinsic, camera b's fx fy cx cy k1 k2 p1 p2 k3 (the global block,
- * JG parameters) and the blocks of the pairs (stride nq, from the stereo
- * solve) and of camera b's own frames (a pose each, stride 6, after the
- * pairs), solved together through the Schur complement of the blocks. */
+ * JG parameters; with the target model also every hole's in-plane offset
+ * from its nominal position, 2 per hole after them) and the blocks of the
+ * pairs (stride nq, from the stereo solve) and of camera b's own frames (a
+ * pose each, stride 6, after the pairs), solved together through the Schur
+ * complement of the blocks. */
 #define NB_INTR 9
 #define JG (6 + NB_INTR)
-
+/* the target model's prior: each offset N(0, sigma^2), sigma the drilling
+ * tolerance (hearth_calib_opts.target_sigma_m), weighed against image
+ * points of this many pixels of noise (the order the rig leaves with its
+ * target known) */
+#define TARGET_PX_SIGMA 0.02
 typedef struct joint_prob {
   stereo_prob P;            /* the pairs; P.cb is replaced by the trial camera */
   const hearth_camera *cb0; /* camera b's size, model and k4..k6 */
   const double *img_c;      /* camera b's own frames */
   size_t n_c;
+  int ng; /* global parameters: JG, or JG + 2 n_pts with the target model */
+  /* with the target model: the nominal points, the current ones (scratch:
+   * nominal + offsets, P.obj points there), the prior's weight (px^2 per
+   * m^2 of offset) and the gauge: the offsets (interleaved x, y) are B z,
+   * B (2 n_pts x nb, orthonormal columns) a basis of the offsets without a
+   * similarity part (the 4 directions the plate poses and the scale trade
+   * with them exactly) */
+  const double (*nom)[3];
+  double (*pts)[3];
+  double prior;
+  const double *B;
+  int nb; /* B's columns */
 } joint_prob;
 
 static void joint_cam(const joint_prob *J, const double *g, hearth_camera *c) {
@@ -553,6 +571,21 @@ static void joint_cam(const joint_prob *J, const double *g, hearth_camera *c) {
   c->cx = g[8];
   c->cy = g[9];
   for (int k = 0; k < 5; k++) c->dist[k] = g[10 + k];
+}
+
+/* with the target model: the points at g's offsets into J->pts, and the
+ * prior's cost */
+static double joint_points(const joint_prob *J, const double *g) {
+  if (J->ng == JG) return 0.0;
+  double s = 0;
+  for (size_t j = 0; j < J->P.n_pts; j++) {
+    const double *d = g + JG + 2 * j;
+    J->pts[j][0] = J->nom[j][0] + d[0];
+    J->pts[j][1] = J->nom[j][1] + d[1];
+    J->pts[j][2] = J->nom[j][2];
+    s += J->prior * (d[0] * d[0] + d[1] * d[1]);
+  }
+  return s;
 }
 
 /* squared error of camera b's own frame k at pose p */
@@ -573,28 +606,60 @@ static double own_cost(const joint_prob *J, const hearth_camera *cb, size_t k, c
 static double joint_cost(const joint_prob *J, const double *g, const double *x) {
   hearth_camera cb;
   joint_cam(J, g, &cb);
+  double prior = joint_points(J, g);
   stereo_prob P = J->P;
   P.cb = &cb;
   double s = total_cost(&P, g, x, NULL);
   const double *xc = x + (size_t)P.nq * P.n_pairs;
   for (size_t k = 0; k < J->n_c && isfinite(s); k++) s += own_cost(J, &cb, k, xc + 6 * k);
-  return isfinite(s) ? s : INFINITY;
+  return isfinite(s) ? s + prior : INFINITY;
 }
 
-/* one residual row: global Jacobian jg (JG, or NULL: none), block Jacobian
- * jb (d) and residual r into U, gg and the block's V, W, gb */
-static void joint_row(int d, const double *jg, const double *jb, double r, double *U, double *gg,
-                      double *V, double *W, double *gb) {
+/* a residual row's global Jacobian, sparse: its nonzero entries in
+ * increasing index order */
+typedef struct sparse_row {
+  int n;
+  int idx[JG + 2];
+  double val[JG + 2];
+} sparse_row;
+
+/* the nonzero entries of a dense global row (m entries) into s */
+static void sparse_dense(sparse_row *s, const double *jg, int m) {
+  s->n = 0;
+  for (int a = 0; a < m; a++)
+    if (jg[a] != 0) {
+      s->idx[s->n] = a;
+      s->val[s->n++] = jg[a];
+    }
+}
+
+/* with the target model: hole j's offsets, from a row's derivatives dt by
+ * its block's translation (the plate point moves with it through R) */
+static void sparse_hole(sparse_row *s, const joint_prob *J, size_t j, const double dt[3],
+                        const double R[9]) {
+  if (J->ng == JG) return;
+  for (int k = 0; k < 2; k++) {
+    double v = dt[0] * R[k] + dt[1] * R[3 + k] + dt[2] * R[6 + k];
+    if (v == 0) continue;
+    s->idx[s->n] = JG + 2 * (int)j + k;
+    s->val[s->n++] = v;
+  }
+}
+
+/* one residual row: global Jacobian jg (ng columns, sparse), block
+ * Jacobian jb (d) and residual r into U, gg and the block's V, W, gb */
+static void joint_row(int d, int ng, const sparse_row *jg, const double *jb, double r, double *U,
+                      double *gg, double *V, double *W, double *gb) {
   for (int a = 0; a < d; a++) {
     for (int b = 0; b < d; b++) V[a * d + b] += jb[a] * jb[b];
     gb[a] -= jb[a] * r;
   }
-  if (!jg) return;
-  for (int a = 0; a < JG; a++) {
-    if (jg[a] == 0) continue;
-    for (int b = 0; b < JG; b++) U[a * JG + b] += jg[a] * jg[b];
-    for (int b = 0; b < d; b++) W[a * d + b] += jg[a] * jb[b];
-    gg[a] -= jg[a] * r;
+  for (int q = 0; q < jg->n; q++) {
+    const int a = jg->idx[q];
+    const double va = jg->val[q];
+    for (int e = 0; e < jg->n; e++) U[a * ng + jg->idx[e]] += va * jg->val[e];
+    for (int b = 0; b < d; b++) W[a * d + b] += va * jb[b];
+    gg[a] -= va * r;
   }
 }
 
@@ -607,37 +672,43 @@ static void intr_rows(const hearth_project_jac *jac, double ji[2][NB_INTR]) {
 }
 
 /* normal equations of the joint problem at (g, x); block b's V at
- * V + NQ_MAX^2 b, W (JG x d) at W + JG NQ_MAX b, gradient at gb + NQ_MAX b */
+ * V + NQ_MAX^2 b, W (ng x d) at W + ng NQ_MAX b, gradient at gb + NQ_MAX b */
 static int joint_normal(const joint_prob *J, const double *g, const double *x, double *U,
                         double *gg, double *V, double *W, double *gb) {
   const stereo_prob *P = &J->P;
-  const int D = P->nq;
+  const int D = P->nq, ng = J->ng;
   hearth_camera cb;
   joint_cam(J, g, &cb);
+  joint_points(J, g);
   double RT[9], dRT[27];
   hearth_rotvec_to_matrix_jac(g, RT, dRT);
-  memset(U, 0, sizeof(double) * JG * JG);
-  memset(gg, 0, sizeof(double) * JG);
+  memset(U, 0, sizeof(double) * (size_t)(ng * ng));
+  memset(gg, 0, sizeof(double) * (size_t)ng);
   size_t nb = P->n_pairs + J->n_c;
   memset(V, 0, sizeof(double) * NQ_MAX * NQ_MAX * nb);
-  memset(W, 0, sizeof(double) * JG * NQ_MAX * nb);
+  memset(W, 0, sizeof(double) * (size_t)ng * NQ_MAX * nb);
   memset(gb, 0, sizeof(double) * NQ_MAX * nb);
   for (size_t i = 0; i < P->n_pairs; i++) {
     if (!P->used[i]) continue;
     const double *p = x + D * i;
-    double *Vi = V + NQ_MAX * NQ_MAX * i, *Wi = W + JG * NQ_MAX * i, *g6 = gb + NQ_MAX * i;
+    double *Vi = V + NQ_MAX * NQ_MAX * i, *Wi = W + (size_t)ng * NQ_MAX * i, *g6 = gb + NQ_MAX * i;
     double R[9], dR[27];
     hearth_rotvec_to_matrix_jac(p, R, dR);
     for (size_t j = 0; j < P->n_pts; j++) {
       double ra[2], rb[2], ja[2 * NQ_MAX], jb[2 * NQ_MAX], jT[12], ji[2][NB_INTR], jgr[JG];
       hearth_project_jac jac;
+      sparse_row sr;
       if (!pair_rows(P, &cb, RT, dRT, g + 3, p, R, dR, i, j, ra, ja, rb, jb, jT, &jac)) return 0;
       intr_rows(&jac, ji);
       for (int row = 0; row < 2; row++) {
-        joint_row(D, NULL, ja + D * row, ra[row], U, gg, Vi, Wi, g6);
+        sr.n = 0;
+        sparse_hole(&sr, J, j, ja + D * row + 3, R);
+        joint_row(D, ng, &sr, ja + D * row, ra[row], U, gg, Vi, Wi, g6);
         memcpy(jgr, jT + 6 * row, sizeof(double) * 6);
         memcpy(jgr + 6, ji[row], sizeof(double) * NB_INTR);
-        joint_row(D, jgr, jb + D * row, rb[row], U, gg, Vi, Wi, g6);
+        sparse_dense(&sr, jgr, JG);
+        sparse_hole(&sr, J, j, jb + D * row + 3, R);
+        joint_row(D, ng, &sr, jb + D * row, rb[row], U, gg, Vi, Wi, g6);
       }
     }
     if (D > 12) {
@@ -649,21 +720,29 @@ static int joint_normal(const joint_prob *J, const double *g, const double *x, d
   for (size_t k = 0; k < J->n_c; k++) {
     size_t b = P->n_pairs + k;
     const double *p = xc + 6 * k;
-    double *Vb = V + NQ_MAX * NQ_MAX * b, *Wb = W + JG * NQ_MAX * b, *g6 = gb + NQ_MAX * b;
+    double *Vb = V + NQ_MAX * NQ_MAX * b, *Wb = W + (size_t)ng * NQ_MAX * b, *g6 = gb + NQ_MAX * b;
     double R[9], dR[27];
     hearth_rotvec_to_matrix_jac(p, R, dR);
     for (size_t j = 0; j < P->n_pts; j++) {
       double uv[2], dp[12], ji[2][NB_INTR], jgr[JG];
       hearth_project_jac jac;
+      sparse_row sr;
       if (!calib_project_pose(&cb, R, dR, p + 3, P->obj[j], uv, &jac, dp, NULL)) return 0;
       intr_rows(&jac, ji);
       const double *m = J->img_c + 2 * (k * P->n_pts + j);
       for (int row = 0; row < 2; row++) {
         memset(jgr, 0, sizeof(double) * 6);
         memcpy(jgr + 6, ji[row], sizeof(double) * NB_INTR);
-        joint_row(6, jgr, dp + 6 * row, uv[row] - m[row], U, gg, Vb, Wb, g6);
+        sparse_dense(&sr, jgr, JG);
+        sparse_hole(&sr, J, j, dp + 6 * row + 3, R);
+        joint_row(6, ng, &sr, dp + 6 * row, uv[row] - m[row], U, gg, Vb, Wb, g6);
       }
     }
+  }
+  /* the offsets' prior */
+  for (int a = JG; a < ng; a++) {
+    U[a * ng + a] += J->prior;
+    gg[a] -= J->prior * g[a];
   }
   return 1;
 }
@@ -671,28 +750,32 @@ static int joint_normal(const joint_prob *J, const double *g, const double *x, d
 /* LM over (g, x) in place; returns 0 on numeric failure */
 static int joint_lm(const joint_prob *J, double *g, double *x, int max_it) {
   const stereo_prob *P = &J->P;
-  const size_t np = P->n_pairs, nb = np + J->n_c, D = (size_t)P->nq;
+  const size_t np = P->n_pairs, nb = np + J->n_c, D = (size_t)P->nq, ng = (size_t)J->ng;
   const size_t nx = D * np + 6 * J->n_c;
   double *V = hearth_alloc_array(NQ_MAX * NQ_MAX * nb, sizeof(double));
   double *Vi = hearth_alloc_array(NQ_MAX * NQ_MAX * nb, sizeof(double));
-  double *W = hearth_alloc_array(JG * NQ_MAX * nb, sizeof(double));
+  double *W = hearth_alloc_array(ng * NQ_MAX * nb, sizeof(double));
   double *gb = hearth_alloc_array(NQ_MAX * nb, sizeof(double));
   double *trial = hearth_alloc_array(nx, sizeof(double));
-  int ok_all = V && Vi && W && gb && trial;
+  /* U, S (ng x ng), gg, rhs, gn (ng), WV (ng x NQ_MAX); with the target
+   * model ST (ng x nr), Sr (nr x nr), rr (nr) */
+  double *U = hearth_alloc_array(2 * ng * ng + 3 * ng + ng * NQ_MAX, sizeof(double));
+  double *ST = ng > JG ? hearth_alloc_array(2 * ng * ng + ng, sizeof(double)) : NULL;
+  int ok_all = V && Vi && W && gb && trial && U && (ng == JG || ST);
+  double *S = U + ng * ng, *gg = S + ng * ng, *rhs = gg + ng, *gn = rhs + ng, *WV = gn + ng;
+  double *Sr = ST ? ST + ng * ng : U, *rr = ST ? Sr + ng * ng : U; /* U: not used */
   double cost = ok_all ? joint_cost(J, g, x) : INFINITY, lambda = 1e-3;
   if (!isfinite(cost)) ok_all = 0;
   for (int it = 0; ok_all && it < max_it; it++) {
-    double U[JG * JG], gg[JG];
     if (!joint_normal(J, g, x, U, gg, V, W, gb)) {
       ok_all = 0;
       break;
     }
     int improved = 0;
     for (int tries = 0; tries < 12 && !improved; tries++) {
-      double S[JG * JG], rhs[JG];
-      memcpy(S, U, sizeof S);
-      memcpy(rhs, gg, sizeof rhs);
-      for (int a = 0; a < JG; a++) S[a * JG + a] *= 1.0 + lambda;
+      memcpy(S, U, sizeof(double) * ng * ng);
+      memcpy(rhs, gg, sizeof(double) * ng);
+      for (size_t a = 0; a < ng; a++) S[a * ng + a] *= 1.0 + lambda;
       int ok = 1;
       for (size_t b = 0; b < nb && ok; b++) {
         size_t d = b < np ? D : 6;
@@ -704,43 +787,79 @@ static int joint_lm(const joint_prob *J, double *g, double *x, int max_it) {
           ok = 0;
           break;
         }
-        const double *Wb = W + JG * NQ_MAX * b, *gv = gb + NQ_MAX * b;
-        double WV[JG * NQ_MAX];
-        for (size_t a = 0; a < JG; a++)
+        const double *Wb = W + ng * NQ_MAX * b, *gv = gb + NQ_MAX * b;
+        for (size_t a = 0; a < ng; a++)
           for (size_t c = 0; c < d; c++) {
             double s = 0;
             for (size_t k = 0; k < d; k++) s += Wb[a * d + k] * Vd[k * d + c];
             WV[a * d + c] = s;
           }
-        for (size_t a = 0; a < JG; a++) {
-          for (size_t c = 0; c < JG; c++) {
+        for (size_t a = 0; a < ng; a++) {
+          for (size_t c = 0; c < ng; c++) {
             double s = 0;
             for (size_t k = 0; k < d; k++) s += WV[a * d + k] * Wb[c * d + k];
-            S[a * JG + c] -= s;
+            S[a * ng + c] -= s;
           }
           double s = 0;
           for (size_t k = 0; k < d; k++) s += WV[a * d + k] * gv[k];
           rhs[a] -= s;
         }
       }
-      if (ok) ok = calib_chol_solve(S, rhs, JG);
+      if (ok && ng > JG) {
+        /* the step in the gauge's coordinates: (T^T S T) z = T^T rhs, then
+         * T z, T = diag(I, B per axis) */
+        const size_t n2 = 2 * P->n_pts, mb = (size_t)J->nb, nr = JG + mb;
+        const double *B = J->B;
+        for (size_t a = 0; a < ng; a++)
+          for (size_t c = 0; c < nr; c++) {
+            double v = 0;
+            if (c < JG) v = S[a * ng + c];
+            else
+              for (size_t l = 0; l < n2; l++) v += S[a * ng + JG + l] * B[l * mb + c - JG];
+            ST[a * nr + c] = v;
+          }
+        for (size_t a = 0; a < nr; a++) {
+          for (size_t c = 0; c < nr; c++) {
+            double v = 0;
+            if (a < JG) v = ST[a * nr + c];
+            else
+              for (size_t l = 0; l < n2; l++) v += B[l * mb + a - JG] * ST[(JG + l) * nr + c];
+            Sr[a * nr + c] = v;
+          }
+          double v = 0;
+          if (a < JG) v = rhs[a];
+          else
+            for (size_t l = 0; l < n2; l++) v += B[l * mb + a - JG] * rhs[JG + l];
+          rr[a] = v;
+        }
+        ok = calib_chol_solve(Sr, rr, (int)nr);
+        if (ok) {
+          memcpy(rhs, rr, sizeof(double) * JG);
+          for (size_t l = 0; l < n2; l++) {
+            double v = 0;
+            for (size_t m = 0; m < mb; m++) v += B[l * mb + m] * rr[JG + m];
+            rhs[JG + l] = v;
+          }
+        }
+      } else if (ok) {
+        ok = calib_chol_solve(S, rhs, (int)ng);
+      }
       if (!ok) {
         lambda *= 10;
         continue;
       }
-      double gn[JG];
-      for (int a = 0; a < JG; a++) gn[a] = g[a] + rhs[a];
+      for (size_t a = 0; a < ng; a++) gn[a] = g[a] + rhs[a];
       memcpy(trial, x, sizeof(double) * nx);
       for (size_t b = 0; b < nb; b++) {
         if (b < np && !P->used[b]) continue;
         size_t d = b < np ? D : 6;
         double *xb = trial + (b < np ? D * b : D * np + 6 * (b - np));
-        const double *Vd = Vi + NQ_MAX * NQ_MAX * b, *Wb = W + JG * NQ_MAX * b,
+        const double *Vd = Vi + NQ_MAX * NQ_MAX * b, *Wb = W + ng * NQ_MAX * b,
                      *gv = gb + NQ_MAX * b;
         double r6[NQ_MAX];
         for (size_t c = 0; c < d; c++) {
           double s = gv[c];
-          for (size_t a = 0; a < JG; a++) s -= Wb[a * d + c] * rhs[a];
+          for (size_t a = 0; a < ng; a++) s -= Wb[a * d + c] * rhs[a];
           r6[c] = s;
         }
         for (size_t a = 0; a < d; a++) {
@@ -751,7 +870,7 @@ static int joint_lm(const joint_prob *J, double *g, double *x, int max_it) {
       }
       int done;
       if (lm_take(&cost, joint_cost(J, gn, trial), &lambda, &done)) {
-        memcpy(g, gn, sizeof gn);
+        memcpy(g, gn, sizeof(double) * ng);
         memcpy(x, trial, sizeof(double) * nx);
         improved = 1;
         if (done) it = max_it;
@@ -759,116 +878,80 @@ static int joint_lm(const joint_prob *J, double *g, double *x, int max_it) {
     }
     if (!improved) break;
   }
+  /* the points at the solution's offsets */
+  if (ok_all) joint_points(J, g);
   free(V);
   free(Vi);
   free(W);
   free(gb);
   free(trial);
+  free(U);
+  free(ST);
   return ok_all;
 }
 
-/* ---- the target's own points ---------------------------------------------- */
-/* residuals of hole j at plate point X in pair i (4: camera a, then b) */
-static int pair_point_res(const stereo_prob *P, const hearth_rigid *Tba, const double *p, size_t i,
-                          size_t j, const double X[3], double r[4]) {
-  double R[9], Xm[3], Xb[3], uv[2];
-  hearth_rotvec_to_matrix(p, R);
-  const double *m = P->img_a + 2 * (i * P->n_pts + j);
-  block_point(p, P->nq, R, NULL, row_time(P->ca, m[1]), 0, X, Xm, NULL);
-  if (!hearth_camera_project(P->ca, Xm, uv, NULL)) return 0;
-  r[0] = uv[0] - m[0];
-  r[1] = uv[1] - m[1];
-  block_point(p, P->nq, R, NULL, tb_time(p, P->nq), 0, X, Xm, NULL);
-  hearth_rigid_apply(Tba, Xm, Xb);
-  if (!hearth_camera_project(P->cb, Xb, uv, NULL)) return 0;
-  m = P->img_b + 2 * (i * P->n_pts + j);
-  r[2] = uv[0] - m[0];
-  r[3] = uv[1] - m[1];
-  return 1;
-}
-
-/* residuals of hole j at plate point X in camera b's own frame k */
-static int own_point_res(const joint_prob *J, const hearth_camera *cb, const double *p, size_t k,
-                         size_t j, const double X[3], double r[2]) {
-  hearth_rigid T;
-  calib_rigid_from_params(p, &T);
-  double Xc[3], uv[2];
-  hearth_rigid_apply(&T, X, Xc);
-  if (!hearth_camera_project(cb, Xc, uv, NULL)) return 0;
-  const double *m = J->img_c + 2 * (k * J->P.n_pts + j);
-  r[0] = uv[0] - m[0];
-  r[1] = uv[1] - m[1];
-  return 1;
-}
-
-/* one Gauss-Newton step of every hole's in-plane position (cameras and
- * poses held), then the affine part of the offsets from nom removed (the
- * gauge: the plate poses, the scale and the intrinsics take it); pts (the
- * current points) is updated */
-static void target_step(const joint_prob *J, const double *g, const double *x,
-                        const double (*nom)[3], double (*pts)[3]) {
-  const stereo_prob *P = &J->P;
-  const size_t n = P->n_pts;
-  const double h = 1e-6;
-  hearth_camera cb;
-  joint_cam(J, g, &cb);
-  stereo_prob Pb = *P;
-  Pb.cb = &cb;
-  hearth_rigid Tba;
-  calib_rigid_from_params(g, &Tba);
-  double off[HEARTH_TARGET_MAX_HOLES][2];
-  for (size_t j = 0; j < n; j++) {
-    double A[4] = {0}, b[2] = {0};
-    for (size_t blk = 0; blk < P->n_pairs + J->n_c; blk++) {
-      int own = blk >= P->n_pairs, nr = own ? 2 : 4;
-      if (!own && !P->used[blk]) continue;
-      const double *p =
-          own ? x + (size_t)P->nq * P->n_pairs + 6 * (blk - P->n_pairs) : x + (size_t)P->nq * blk;
-      double r0[4], r1[4], jac[2][4];
-      int ok = own ? own_point_res(J, &cb, p, blk - P->n_pairs, j, pts[j], r0)
-                   : pair_point_res(&Pb, &Tba, p, blk, j, pts[j], r0);
-      for (int a = 0; a < 2 && ok; a++) {
-        double X[3] = {pts[j][0], pts[j][1], pts[j][2]};
-        X[a] += h;
-        ok = own ? own_point_res(J, &cb, p, blk - P->n_pairs, j, X, r1)
-                 : pair_point_res(&Pb, &Tba, p, blk, j, X, r1);
-        for (int k = 0; k < nr; k++) jac[a][k] = (r1[k] - r0[k]) / h;
+/* an orthonormal basis B (2n x (2n - nq), row-major, offsets interleaved
+ * x, y per point) of the in-plane offsets of the n nominal points without
+ * a part in the gauge: the similarity (nq = 4: the two translations, the
+ * rotation (-y, x) and the scale (x, y)) or the affine map (nq = 6: x, y
+ * and 1 on either axis); col is scratch of 2n; 0 if the points are
+ * degenerate */
+static int offset_basis(const double (*nom)[3], size_t n, int nq, double *B, double *col) {
+  const size_t n2 = 2 * n, m = n2 - (size_t)nq;
+  double *Q = B + n2 * m; /* the gauge's nq directions, orthonormalised */
+  for (int a = 0; a < nq; a++) {
+    double *q = Q + n2 * (size_t)a;
+    for (size_t j = 0; j < n; j++) {
+      const double x = nom[j][0], y = nom[j][1];
+      double u = 0, v = 0;
+      if (nq == 4) {
+        const double ux[4] = {1, 0, x, -y}, vy[4] = {0, 1, y, x};
+        u = ux[a];
+        v = vy[a];
+      } else {
+        const double f = a % 3 == 0 ? x : a % 3 == 1 ? y : 1.0;
+        u = a < 3 ? f : 0.0;
+        v = a < 3 ? 0.0 : f;
       }
-      if (!ok) continue;
-      for (int k = 0; k < nr; k++) {
-        A[0] += jac[0][k] * jac[0][k];
-        A[1] += jac[0][k] * jac[1][k];
-        A[3] += jac[1][k] * jac[1][k];
-        b[0] -= jac[0][k] * r0[k];
-        b[1] -= jac[1][k] * r0[k];
+      q[2 * j] = u;
+      q[2 * j + 1] = v;
+    }
+    for (int e = 0; e < a; e++) {
+      const double *p = Q + n2 * (size_t)e;
+      double d = 0;
+      for (size_t l = 0; l < n2; l++) d += q[l] * p[l];
+      for (size_t l = 0; l < n2; l++) q[l] -= d * p[l];
+    }
+    double s = 0;
+    for (size_t l = 0; l < n2; l++) s += q[l] * q[l];
+    if (!(s > 1e-300)) return 0;
+    s = 1.0 / sqrt(s);
+    for (size_t l = 0; l < n2; l++) q[l] *= s;
+  }
+  size_t k = 0;
+  for (size_t u = 0; u < n2 && k < m; u++) {
+    for (size_t l = 0; l < n2; l++) col[l] = l == u;
+    for (int pass = 0; pass < 2; pass++) {
+      for (int a = 0; a < nq; a++) {
+        const double *p = Q + n2 * (size_t)a;
+        double d = 0;
+        for (size_t l = 0; l < n2; l++) d += p[l] * col[l];
+        for (size_t l = 0; l < n2; l++) col[l] -= d * p[l];
+      }
+      for (size_t c = 0; c < k; c++) {
+        double d = 0;
+        for (size_t l = 0; l < n2; l++) d += B[l * m + c] * col[l];
+        for (size_t l = 0; l < n2; l++) col[l] -= d * B[l * m + c];
       }
     }
-    double det = A[0] * A[3] - A[1] * A[1], d0 = 0, d1 = 0;
-    if (det > 0) {
-      d0 = (A[3] * b[0] - A[1] * b[1]) / det;
-      d1 = (A[0] * b[1] - A[1] * b[0]) / det;
-    }
-    off[j][0] = pts[j][0] + d0 - nom[j][0];
-    off[j][1] = pts[j][1] + d1 - nom[j][1];
+    double s = 0;
+    for (size_t l = 0; l < n2; l++) s += col[l] * col[l];
+    if (s < 1e-6) continue;
+    s = 1.0 / sqrt(s);
+    for (size_t l = 0; l < n2; l++) B[l * m + k] = col[l] * s;
+    k++;
   }
-  /* least-squares affine map of the nominal points onto the offsets */
-  double M[9] = {0}, c[2][3] = {{0}};
-  for (size_t j = 0; j < n; j++) {
-    double q[3] = {nom[j][0], nom[j][1], 1};
-    for (int a = 0; a < 3; a++) {
-      for (int e = 0; e < 3; e++) M[3 * a + e] += q[a] * q[e];
-      c[0][a] += q[a] * off[j][0];
-      c[1][a] += q[a] * off[j][1];
-    }
-  }
-  for (int k = 0; k < 2; k++) {
-    double Mk[9];
-    memcpy(Mk, M, sizeof Mk);
-    if (!calib_chol_solve(Mk, c[k], 3)) c[k][0] = c[k][1] = c[k][2] = 0;
-  }
-  for (size_t j = 0; j < n; j++)
-    for (int k = 0; k < 2; k++)
-      pts[j][k] = nom[j][k] + off[j][k] - (c[k][0] * nom[j][0] + c[k][1] * nom[j][1] + c[k][2]);
+  return k == m;
 }
 
 /* the joint solve from camera b's start *cam_b (its estimate on return);
@@ -879,12 +962,14 @@ static hearth_status joint_solve(const hearth_camera *cam_a, hearth_camera *cam_
                                  const double *img_b, size_t n_pairs, const double *img_c,
                                  size_t n_c, const hearth_calib_opts *o, hearth_rigid *T_b_from_a,
                                  double *rms_px, double *own_rms_px, double *pair_rms,
-                                 int *pair_used, double *pair_time, double *cost, size_t *n_used,
+                                 int *pair_used, double *pair_time, double *rms_nominal_px,
+                                 double (*pts_out)[3], double *cost, size_t *n_used,
                                  hearth_err *err) {
   int *used = hearth_calloc_array(n_pairs, sizeof(int));
   double *pc = hearth_alloc_array(n_pairs, sizeof(double));
   double *sol = NULL, *x = NULL, pT[6];
   double(*tpts)[3] = NULL;
+  double *aff = NULL, *gt = NULL;
   int nq = 6;
   hearth_status st = HEARTH_OK;
   hearth_camera cb = *cam_b; /* camera b's start, then its estimate */
@@ -922,27 +1007,47 @@ static hearth_status joint_solve(const hearth_camera *cam_a, hearth_camera *cam_
     g[8] = cb_start.cx;
     g[9] = cb_start.cy;
     for (int k = 0; k < 5; k++) g[10 + k] = cb_start.dist[k];
-    joint_prob J = {P, &cb_start, img_c, n_c};
+    joint_prob J = {P, &cb_start, img_c, n_c, JG, NULL, NULL, 0, NULL, 0};
     int ok = joint_lm(&J, g, x, o->max_iterations);
+    if (ok && rms_nominal_px) {
+      /* the stereo RMS against the nominal target */
+      joint_cam(&J, g, &cb);
+      stereo_prob Pn = P;
+      Pn.cb = &cb;
+      stereo_report(&Pn, g, x, pc, rms_nominal_px, NULL, NULL);
+    }
     if (ok && o->target_points && n_pts <= HEARTH_TARGET_MAX_HOLES) {
-      /* the holes' own in-plane positions, in turn with the rest */
+      /* the holes' in-plane offsets from the nominal lattice, solved with
+       * the rest from the solution on the nominal target */
+      const size_t ng = JG + 2 * n_pts;
       tpts = hearth_alloc_array(n_pts, sizeof *tpts);
-      if (!tpts) {
+      /* the gauge: the offsets' similarity part (their shear and
+       * anisotropic scale are solved: held at zero they cost 0.02-0.04 deg
+       * on the oracle, bench/target_oracle.sh) */
+      const int ngauge = 4;
+      aff = hearth_alloc_array(2 * n_pts * 2 * n_pts + 2 * n_pts, sizeof(double));
+      gt = hearth_calloc_array(ng, sizeof(double));
+      if (!tpts || !aff || !gt) {
         st = hearth_err_set(err, HEARTH_E_NOMEM, "stereo calibration: out of memory");
         goto done;
       }
-      memcpy(tpts, obj, sizeof(double) * 3 * n_pts);
-      J.P.obj = P.obj = (const double(*)[3])tpts;
-      for (int round = 0; ok && round < 8; round++) {
-        target_step(&J, g, x, obj, tpts);
-        ok = joint_lm(&J, g, x, o->max_iterations);
+      if (!offset_basis(obj, n_pts, ngauge, aff, aff + 4 * n_pts * n_pts)) {
+        st = hearth_err_set(err, HEARTH_E_NUMERIC, "stereo calibration: degenerate target");
+        goto done;
       }
+      memcpy(gt, g, sizeof g);
+      J.ng = (int)ng;
+      J.nom = obj;
+      J.pts = tpts;
+      J.P.obj = P.obj = (const double(*)[3])tpts;
+      const double sig = o->target_sigma_m > 0 ? o->target_sigma_m : 4e-5;
+      J.prior = (TARGET_PX_SIGMA / sig) * (TARGET_PX_SIGMA / sig);
+      J.B = aff;
+      J.nb = (int)(2 * n_pts) - ngauge;
+      ok = joint_lm(&J, gt, x, o->max_iterations);
+      memcpy(g, gt, sizeof g);
     }
-    if (!ok) {
-      st = hearth_err_set(err, HEARTH_E_NUMERIC, "stereo calibration: joint refinement failed");
-      goto done;
-    }
-    if (cost) *cost = joint_cost(&J, g, x);
+    if (cost) *cost = joint_cost(&J, J.ng > JG ? gt : g, x);
     memcpy(pT, g, sizeof pT);
     memcpy(sol, x, sizeof(double) * (size_t)nq * n_pairs);
     joint_cam(&J, g, &cb);
@@ -958,6 +1063,9 @@ static hearth_status joint_solve(const hearth_camera *cam_a, hearth_camera *cam_
   P.cb = cam_b;
   calib_rigid_from_params(pT, T_b_from_a);
   stereo_report(&P, pT, sol, pc, rms_px, pair_rms, pair_used);
+  if (rms_nominal_px && !(o->stereo_intrinsics && o->target_points))
+    stereo_report(&P, pT, sol, pc, rms_nominal_px, NULL, NULL);
+  if (pts_out) memcpy(pts_out, P.obj, sizeof(double) * 3 * n_pts);
   if (pair_time)
     for (size_t i = 0; i < n_pairs; i++)
       pair_time[i] = nq > 12 && used[i] ? tb_time(sol + (size_t)nq * i, nq) : NAN;
@@ -969,6 +1077,8 @@ done:
   free(sol);
   free(x);
   free(tpts);
+  free(aff);
+  free(gt);
   free(used);
   free(pc);
   return st;
@@ -980,6 +1090,7 @@ hearth_status calib_stereo_joint_times(const hearth_camera *cam_a, hearth_camera
                                        size_t n_c, const hearth_calib_opts *o,
                                        hearth_rigid *T_b_from_a, double *rms_px, double *own_rms_px,
                                        double *pair_rms, int *pair_used, double *pair_time,
+                                       double *rms_nominal_px, double (*pts_out)[3],
                                        hearth_err *err) {
   hearth_calib_opts def;
   if (!o) {
@@ -994,7 +1105,8 @@ hearth_status calib_stereo_joint_times(const hearth_camera *cam_a, hearth_camera
     return hearth_err_set(err, HEARTH_E_SIZE, "stereo calibration: %zu points per pair", n_pts);
   if (!o->stereo_intrinsics || !o->rolling_shutter)
     return joint_solve(cam_a, cam_b, obj, n_pts, img_a, img_b, n_pairs, img_c, n_c, o, T_b_from_a,
-                       rms_px, own_rms_px, pair_rms, pair_used, pair_time, NULL, NULL, err);
+                       rms_px, own_rms_px, pair_rms, pair_used, pair_time, rms_nominal_px, pts_out,
+                       NULL, NULL, err);
   /* The moving model's velocities and trigger times, tried at camera b's
    * start intrinsics, can take part of their error and settle in a false
    * minimum; tried from camera b refined under the rigid model they can
@@ -1008,31 +1120,34 @@ hearth_status calib_stereo_joint_times(const hearth_camera *cam_a, hearth_camera
   hearth_rigid T1;
   hearth_err e1;
   int refined = !joint_solve(cam_a, &cr, obj, n_pts, img_a, img_b, n_pairs, img_c, n_c, &o1, &T1,
-                             NULL, NULL, NULL, NULL, NULL, NULL, NULL, &e1);
+                             NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL, &e1);
   double cost0 = INFINITY, cost1 = INFINITY;
   size_t nu0 = 0, nu1 = 0;
-  hearth_status st =
-      joint_solve(cam_a, &c0, obj, n_pts, img_a, img_b, n_pairs, img_c, n_c, o, T_b_from_a, rms_px,
-                  own_rms_px, pair_rms, pair_used, pair_time, &cost0, &nu0, err);
+  hearth_status st = joint_solve(cam_a, &c0, obj, n_pts, img_a, img_b, n_pairs, img_c, n_c, o,
+                                 T_b_from_a, rms_px, own_rms_px, pair_rms, pair_used, pair_time,
+                                 rms_nominal_px, pts_out, &cost0, &nu0, err);
   if (st || !refined) {
     if (!st) *cam_b = c0;
     return st;
   }
-  double *d1 = hearth_alloc_array(2 * n_pairs, sizeof(double));
+  double *d1 = hearth_alloc_array(2 * n_pairs + 3 * n_pts, sizeof(double));
   int *u1 = hearth_alloc_array(n_pairs, sizeof(int));
-  double rms1, own1;
+  double rms1, own1, nom1;
+  double(*p1)[3] = d1 ? (double(*)[3])(d1 + 2 * n_pairs) : NULL;
   if (d1 && u1 &&
       !joint_solve(cam_a, &cr, obj, n_pts, img_a, img_b, n_pairs, img_c, n_c, o, &T1, &rms1, &own1,
-                   d1, u1, d1 + n_pairs, &cost1, &nu1, &e1) &&
+                   d1, u1, d1 + n_pairs, &nom1, p1, &cost1, &nu1, &e1) &&
       cost1 / (double)(4 * n_pts * nu1 + 2 * n_pts * n_c) <
           cost0 / (double)(4 * n_pts * nu0 + 2 * n_pts * n_c)) {
     c0 = cr;
     *T_b_from_a = T1;
     if (rms_px) *rms_px = rms1;
+    if (rms_nominal_px) *rms_nominal_px = nom1;
     if (own_rms_px) *own_rms_px = own1;
     if (pair_rms) memcpy(pair_rms, d1, sizeof(double) * n_pairs);
     if (pair_used) memcpy(pair_used, u1, sizeof(int) * n_pairs);
     if (pair_time) memcpy(pair_time, d1 + n_pairs, sizeof(double) * n_pairs);
+    if (pts_out) memcpy(pts_out, p1, sizeof(double) * 3 * n_pts);
   }
   *cam_b = c0;
   free(d1);
@@ -1048,5 +1163,6 @@ hearth_status hearth_calib_stereo_joint(const hearth_camera *cam_a, hearth_camer
                                         double *own_rms_px, double *pair_rms, int *pair_used,
                                         hearth_err *err) {
   return calib_stereo_joint_times(cam_a, cam_b, obj, n_pts, img_a, img_b, n_pairs, img_c, n_c, o,
-                                  T_b_from_a, rms_px, own_rms_px, pair_rms, pair_used, NULL, err);
+                                  T_b_from_a, rms_px, own_rms_px, pair_rms, pair_used, NULL, NULL,
+                                  NULL, err);
 }

@@ -528,6 +528,7 @@ hearth_status hearth_calib_thermal_only_release(const char *root, const hearth_c
   if (force_model > HEARTH_LENS_RATIONAL8)
     return hearth_err_set(err, HEARTH_E_ARG, "calibrate: unknown lens model %d", force_model);
   memset(rep, 0, sizeof *rep);
+  rep->stereo_rms_nominal_px = NAN;
   char pdet[4096], dir[4096], path[4096];
   snprintf(pdet, sizeof pdet, "%s/calibration/detections.json", root);
   snprintf(dir, sizeof dir, "%s/calibration/captures/thermal", root);

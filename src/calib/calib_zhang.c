@@ -7,7 +7,7 @@
 #include "calib/calib_internal.h"
 
 int calib_chol_solve(double *A, double *b, int n) {
-  if (n <= 0 || n > 16) return 0;
+  if (n <= 0 || n > CALIB_CHOL_MAX) return 0;
   /* in-place lower Cholesky factor */
   for (int j = 0; j < n; j++) {
     double d = A[j * n + j];

@@ -98,8 +98,9 @@ int hearth_cmd_calibrate(int argc, char **argv) {
                "stage (the paper's; by default they are refined with the extrinsic, the pairs' "
                "plate poses fixed by the colour camera)"),
       CLI_FLAG("--refine-target", &o.target_points, 1,
-               "also estimate each hole's in-plane offset from the nominal lattice in the "
-               "stereo stage (drilling tolerance; the offsets' affine part held at zero)"),
+               "also solve each hole's in-plane offset from the nominal lattice with the "
+               "stereo stage (drilling tolerance; the offsets' similarity part held at zero), then "
+               "calibrate again from the target as solved; experimental"),
       CLI_FLAG("--quiet", &quiet, 1, "summary line only"),
       CLI_GROUP("with --detect, the options of `hearth detect`", detect_opts, &detect_opt),
       CLI_END,

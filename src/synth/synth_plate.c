@@ -90,7 +90,9 @@ static int classify_plate(const synth_plate_geom *g, double x, double y, size_t 
       const double *h = g->holes[i];
       double dx = x - h[0], dy = y - h[1], d2 = dx * dx + dy * dy;
       if (d2 < R * R) {
-        if (g->burr_max > 0) {
+        /* R is the search radius; the hole is its own rim (drilled off the
+         * lattice by pos_max at most) */
+        if (g->burr_max > 0 || g->pos_max > 0) {
           double rr = hole_radius(g, i, dx, dy);
           if (d2 >= rr * rr) continue;
         }
