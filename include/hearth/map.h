@@ -79,7 +79,20 @@ typedef struct hearth_map_opts {
      ceil(height / stride) whose pixel (x, y) is the camera's pixel
      (x * stride, y * stride); 0 (default): the camera's whole image */
   int load_grid;
+  /* viewing cosines (the corrected fusion's emissivity fall-off, its choice
+     of views and weights) from each triangle's normal averaged this many
+     times over the triangles that share a vertex with it (by position, across
+     UV seams; area-weighted; neighbours more than 60 degrees off left out),
+     instead of its own normal: a mesh fused from depth has noise in its face
+     normals at the voxel scale, which biases the fall-off correction; the
+     surface itself and which hits count are unchanged. 0 (default): the face
+     normals; hearth_map_job_default sets HEARTH_MAP_NORMALS_AUTO */
+  int normal_passes;
 } hearth_map_opts;
+/* hearth_map_run: 2 passes when the instance's recon/report.json records a
+   mesh hearth fused from depth (its "mesh" member) and the job names no mesh
+   of its own, else 0 */
+#define HEARTH_MAP_NORMALS_AUTO (-1)
 void hearth_map_opts_default(hearth_map_opts *o);
 
 /* One view: an image (F32 1-channel temperatures, or U8 RGB colour) and the

@@ -90,6 +90,10 @@ int hearth_cmd_map(int argc, char **argv) {
                "by default they are skipped because the lens blur mixes the two surfaces in "
                "them)"),
       CLI_STR("--views", "LIST", &ctx.job.views, "comma-separated view names to use", .def = "all"),
+      CLI_INT("--normal-passes", "N", &ctx.job.map.normal_passes, 0, 64,
+              "viewing cosines from face normals averaged N times over their neighbours (a "
+              "mesh fused from depth has noisy face normals; 0: the faces' own)",
+              .def = "2 for hearth recon's fused mesh (recon/report.json), else 0"),
       CLI_FLAG("--trace-rays", &ctx.job.map.trace_rays, 1,
                "trace every pixel's ray (Embree) instead of rasterising views that have the "
                "whole mesh in front (the same hits up to float rounding; slower; for "

@@ -315,6 +315,13 @@ static size_t splat_hits(const map_ctx *m, size_t v, const hearth_image *img, in
       e->x0 = (int32_t)x0f;
       e->y0 = (int32_t)y0f;
       e->island = l->island_of_tri[tri];
+      if (l->cos_normal) {
+        /* the viewing cosine from the smoothed normal (the hit stays the
+           face's); a face turned away from it counts as grazing */
+        const float *sn = l->cos_normal + 3 * (size_t)tri;
+        cosv = -(sn[0] * d[0] + sn[1] * d[1] + sn[2] * d[2]);
+        if (cosv < 0.01f) cosv = 0.01f;
+      }
       e->cosv = cosv;
       /* the camera pixel of grid pixel p */
       size_t src = grid ? p : (py * st) * W + px * st;

@@ -222,6 +222,10 @@ hearth_status hearth_map_views_with_layout(const hearth_map_layout *l,
         err, HEARTH_E_INCONSISTENT,
         "map: the layout was made for resolution %zu, stride %zu; asked for %zu, %d", l->R,
         l->stride, opts.resolution, opts.pixel_stride);
+  if ((opts.normal_passes > 0 ? opts.normal_passes : 0) != l->normal_passes)
+    return hearth_err_set(err, HEARTH_E_INCONSISTENT,
+                          "map: the layout was made for %d normal pass(es); asked for %d",
+                          l->normal_passes, opts.normal_passes);
   int C = 0;
   hearth_status s = view_channels(&l->cam, views, n_views, &opts, &C, err);
   if (s) return s;

@@ -33,7 +33,10 @@ struct hearth_map_layout {
   uint32_t *island_of_tri;
   uint32_t *island_of_texel; /* R * R; UINT32_MAX off the surface */
   uint32_t n_islands;
-  float *tri_normal;    /* 3 per triangle, unit */
+  float *tri_normal; /* 3 per triangle, unit */
+  float *cos_normal; /* 3 per triangle, unit: the smoothed normals the viewing
+                           cosines take (opts normal_passes > 0), else NULL */
+  int normal_passes;
   double sphere[4];     /* mesh bounding sphere: rays that miss it are not cast */
   size_t pw, ph, np;    /* pixel grid: every stride-th pixel */
   const float *pix_dir; /* 3 per grid pixel, camera frame, unit (0: never cast); the

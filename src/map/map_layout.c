@@ -85,6 +85,94 @@ static void tri_normals(void *ctx, size_t b, size_t e, int t) {
   }
 }
 
+/* ---- smoothed normals for the viewing cosines ---------------------------------- */
+typedef struct vpos_key {
+  const float *p;
+  uint32_t i;
+} vpos_key;
+static int cmp_vpos(const void *a, const void *b) {
+  const vpos_key *x = a, *y = b;
+  for (int k = 0; k < 3; k++)
+    if (x->p[k] != y->p[k]) return x->p[k] < y->p[k] ? -1 : 1;
+  return (x->i > y->i) - (x->i < y->i);
+}
+
+/* l->cos_normal: each triangle's normal averaged `passes` times over the
+   triangles sharing a vertex position with it (area-weighted, neighbours
+   whose face normal is more than 60 degrees off its own left out) */
+static hearth_status smooth_normals(hearth_map_layout *l, int passes, hearth_err *err) {
+  const hearth_mesh *m = l->mesh;
+  const size_t nv = m->n_vertices, nt = m->n_triangles;
+  vpos_key *key = hearth_alloc_array(nv ? nv : 1, sizeof *key);
+  uint32_t *canon = hearth_alloc_array(nv ? nv : 1, sizeof *canon);
+  size_t *start = calloc(nv + 1, sizeof *start);
+  size_t *fill = hearth_alloc_array(nv ? nv : 1, sizeof *fill);
+  uint32_t *vt = hearth_alloc_array(nt ? 3 * nt : 1, sizeof *vt);
+  float *area = hearth_alloc_array(nt ? nt : 1, sizeof *area);
+  float *a = hearth_alloc_array(nt ? 3 * nt : 1, sizeof *a);
+  float *b = hearth_alloc_array(nt ? 3 * nt : 1, sizeof *b);
+  hearth_status s = HEARTH_OK;
+  if (!key || !canon || !start || !fill || !vt || !area || !a || !b) {
+    s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory for the smoothed normals");
+    free(a);
+    goto done;
+  }
+  /* vertices welded by position (a UV seam splits a vertex) */
+  for (size_t i = 0; i < nv; i++) key[i] = (vpos_key){m->positions + 3 * i, (uint32_t)i};
+  qsort(key, nv, sizeof *key, cmp_vpos);
+  for (size_t i = 0; i < nv; i++) {
+    int same = i && !memcmp(key[i].p, key[i - 1].p, 3 * sizeof(float));
+    canon[key[i].i] = same ? canon[key[i - 1].i] : (uint32_t)i;
+  }
+  for (size_t t = 0; t < nt; t++)
+    for (int c = 0; c < 3; c++) start[canon[m->indices[3 * t + c]] + 1]++;
+  for (size_t v = 0; v < nv; v++) start[v + 1] += start[v];
+  memcpy(fill, start, nv * sizeof *fill);
+  for (size_t t = 0; t < nt; t++)
+    for (int c = 0; c < 3; c++) vt[fill[canon[m->indices[3 * t + c]]]++] = (uint32_t)t;
+  for (size_t t = 0; t < nt; t++) {
+    const uint32_t *ix = m->indices + 3 * t;
+    const float *p0 = m->positions + 3 * ix[0], *p1 = m->positions + 3 * ix[1],
+                *p2 = m->positions + 3 * ix[2];
+    double e1[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]},
+           e2[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]}, nn[3];
+    hearth_cross3(e1, e2, nn);
+    area[t] = (float)hearth_norm3(nn);
+  }
+  memcpy(a, l->tri_normal, 3 * nt * sizeof *a);
+  for (int pass = 0; pass < passes; pass++) {
+    for (size_t t = 0; t < nt; t++) {
+      const float *n0 = l->tri_normal + 3 * t;
+      double sum[3] = {0, 0, 0};
+      /* a neighbour sharing two vertices counts twice, its own triangle three times */
+      for (int c = 0; c < 3; c++) {
+        const uint32_t v = canon[m->indices[3 * t + c]];
+        for (size_t k = start[v]; k < start[v + 1]; k++) {
+          const uint32_t u = vt[k];
+          const float *nu = l->tri_normal + 3 * u;
+          if (n0[0] * nu[0] + n0[1] * nu[1] + n0[2] * nu[2] < 0.5f) continue;
+          for (int q = 0; q < 3; q++) sum[q] += (double)area[u] * a[3 * u + q];
+        }
+      }
+      double ln = hearth_norm3(sum);
+      for (int q = 0; q < 3; q++) b[3 * t + q] = ln > 0 ? (float)(sum[q] / ln) : n0[q];
+    }
+    float *tmp = a;
+    a = b;
+    b = tmp;
+  }
+  l->cos_normal = a;
+done:
+  free(key);
+  free(canon);
+  free(start);
+  free(fill);
+  free(vt);
+  free(area);
+  free(b);
+  return s;
+}
+
 /* the box centre and the farthest vertex from it, padded so that rounding
    can never cull a ray that touches the mesh */
 static void bounding_sphere(const hearth_mesh *mesh, double sphere[4]) {
@@ -155,6 +243,7 @@ static hearth_status build_layout(hearth_map_layout *l, hearth_err *err) {
   l->n_islands = gb.n_islands;
   hearth_parallel_chunks(R, 32, 0, texel_islands, l);
   hearth_parallel_chunks(mesh->n_triangles, 8192, 0, tri_normals, l);
+  if (l->normal_passes > 0 && (s = smooth_normals(l, l->normal_passes, err))) goto done;
   bounding_sphere(mesh, l->sphere);
   l->fan = gb.fan;
   l->pix_dir = gb.pix_dir;
@@ -176,6 +265,7 @@ void hearth_map_layout_free(hearth_map_layout *l) {
   free(l->island_of_tri);
   free(l->island_of_texel);
   free(l->tri_normal);
+  free(l->cos_normal);
   if (l->own_pix_dir) free((void *)l->pix_dir);
   hearth_ray_fan_free(l->fan);
   free(l);
@@ -205,6 +295,7 @@ hearth_status hearth_map_layout_new(const hearth_mesh *mesh, const hearth_camera
   l->cam = *cam;
   l->R = R;
   l->stride = (size_t)opts.pixel_stride;
+  l->normal_passes = opts.normal_passes > 0 ? opts.normal_passes : 0;
   if ((s = build_layout(l, err))) hearth_map_layout_free(l);
   else *out = l;
   return s;

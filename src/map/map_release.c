@@ -28,6 +28,7 @@ static hearth_status joinf(char *buf, const char *fmt, ...) {
 void hearth_map_job_default(hearth_map_job *job) {
   memset(job, 0, sizeof *job);
   hearth_map_opts_default(&job->map);
+  job->map.normal_passes = HEARTH_MAP_NORMALS_AUTO;
   job->turbo_lo = 10.0;
   job->turbo_hi = 60.0;
 }
@@ -128,6 +129,7 @@ static hearth_status write_provenance(const char *path, const hearth_map_job *jo
   json_object_set_new(pj, "min_cos", json_real(job->map.min_cos));
   json_object_set_new(pj, "views", json_string(job->views && *job->views ? job->views : "all"));
   json_object_set_new(pj, "keep_edges", json_boolean(job->map.keep_edges));
+  json_object_set_new(pj, "normal_passes", json_integer(job->map.normal_passes));
   json_object_set_new(pj, "visibility",
                       json_string(job->map.trace_rays ? "traced rays"
                                                       : "rasterised where the mesh is in front"));
@@ -255,7 +257,24 @@ static void *layout_build_run(void *arg) {
   return NULL;
 }
 
-hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats, hearth_err *err) {
+/* The normal passes of an automatic job: 2 for a mesh hearth fused from depth
+   (recon/report.json's "mesh" member; docs/dataset.md), 0 otherwise. */
+static int auto_normal_passes(const char *root, const char *inst) {
+  char path[PATH_SZ];
+  joinf(path, "%s/instances/%s/recon/report.json", root, inst);
+  json_t *j = json_load_file(path, 0, NULL);
+  const json_t *mj = j ? json_object_get(j, "mesh") : NULL;
+  int fused = json_is_object(mj) && json_number_value(json_object_get(mj, "voxel_m")) > 0;
+  json_decref(j);
+  return fused ? 2 : 0;
+}
+
+hearth_status hearth_map_run(const hearth_map_job *job_in, hearth_map_result *stats,
+                             hearth_err *err) {
+  if (!job_in)
+    return hearth_err_set(err, HEARTH_E_ARG, "map: root, instance and state are required");
+  hearth_map_job jc = *job_in;
+  const hearth_map_job *job = &jc;
   if (!job || !job->root || !job->instance || !job->state)
     return hearth_err_set(err, HEARTH_E_ARG, "map: root, instance and state are required");
   char rig_path[PATH_SZ], poses_path[PATH_SZ], mesh_path[PATH_SZ], man_path[PATH_SZ],
@@ -267,6 +286,8 @@ hearth_status hearth_map_run(const hearth_map_job *job, hearth_map_result *stats
   else joinf(poses_path, "%s/instances/%s/derived/poses_thermal.json", root, inst);
   if (job->mesh_path) snprintf(mesh_path, PATH_SZ, "%s", job->mesh_path);
   else joinf(mesh_path, "%s/instances/%s/derived/mesh.glb", root, inst);
+  if (jc.map.normal_passes < 0)
+    jc.map.normal_passes = job->mesh_path ? 0 : auto_normal_passes(root, inst);
   joinf(man_path, "%s/instances/%s/raw/%s/manifest.json", root, inst, job->state);
   if (job->out_dir) snprintf(out_dir, PATH_SZ, "%s", job->out_dir);
   else joinf(out_dir, "%s/instances/%s/derived/%s", root, inst, job->state);

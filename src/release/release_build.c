@@ -319,7 +319,9 @@ static void fusion_params(const hearth_build_opts *o, char *buf, size_t n) {
                                                        : "mean";
   char mc[32];
   hearth_format_fixed(mc, sizeof mc, o->min_cos, 6);
-  snprintf(buf, n, "resolution=%zu fusion=%s min_cos=%s turbo=10..60", o->resolution, f, mc);
+  /* normals=auto: hearth_map_run's smoothed normals for a fused mesh */
+  snprintf(buf, n, "resolution=%zu fusion=%s min_cos=%s turbo=10..60 normals=auto", o->resolution,
+           f, mc);
 }
 
 /* the recon stage bakes the colour texture into recon/ when the release has
