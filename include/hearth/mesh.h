@@ -48,6 +48,13 @@ void hearth_mesh_transform(hearth_mesh *m, double s, const double R[9], const do
  * triangle index otherwise. `name` is used in messages. */
 hearth_status hearth_mesh_validate(const hearth_mesh *m, const char *name, hearth_err *err);
 
+/* Vertices welded by position (a UV seam or a hard edge splits one surface
+ * point into several vertices): id[v] for each of m's vertices, equal for
+ * vertices at bit-identical positions, in 0..n_vertices-1 (the rank of the
+ * first of them in position order). HEARTH_E_RANGE naming the vertex if a
+ * position is not finite; HEARTH_E_NOMEM. */
+hearth_status hearth_mesh_weld_ids(const hearth_mesh *m, uint32_t *id, hearth_err *err);
+
 /* ---- glTF binary ---------------------------------------------------------- */
 /* What hearth_glb_read did to the file's UVs, filled on success when
  * hearth_glb_read_opts.report is set. */

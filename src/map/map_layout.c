@@ -86,24 +86,12 @@ static void tri_normals(void *ctx, size_t b, size_t e, int t) {
 }
 
 /* ---- smoothed normals for the viewing cosines ---------------------------------- */
-typedef struct vpos_key {
-  const float *p;
-  uint32_t i;
-} vpos_key;
-static int cmp_vpos(const void *a, const void *b) {
-  const vpos_key *x = a, *y = b;
-  for (int k = 0; k < 3; k++)
-    if (x->p[k] != y->p[k]) return x->p[k] < y->p[k] ? -1 : 1;
-  return (x->i > y->i) - (x->i < y->i);
-}
-
 /* l->cos_normal: each triangle's normal averaged `passes` times over the
    triangles sharing a vertex position with it (area-weighted, neighbours
    whose face normal is more than 60 degrees off its own left out) */
 static hearth_status smooth_normals(hearth_map_layout *l, int passes, hearth_err *err) {
   const hearth_mesh *m = l->mesh;
   const size_t nv = m->n_vertices, nt = m->n_triangles;
-  vpos_key *key = hearth_alloc_array(nv ? nv : 1, sizeof *key);
   uint32_t *canon = hearth_alloc_array(nv ? nv : 1, sizeof *canon);
   size_t *start = calloc(nv + 1, sizeof *start);
   size_t *fill = hearth_alloc_array(nv ? nv : 1, sizeof *fill);
@@ -112,17 +100,15 @@ static hearth_status smooth_normals(hearth_map_layout *l, int passes, hearth_err
   float *a = hearth_alloc_array(nt ? 3 * nt : 1, sizeof *a);
   float *b = hearth_alloc_array(nt ? 3 * nt : 1, sizeof *b);
   hearth_status s = HEARTH_OK;
-  if (!key || !canon || !start || !fill || !vt || !area || !a || !b) {
+  if (!canon || !start || !fill || !vt || !area || !a || !b) {
     s = hearth_err_set(err, HEARTH_E_NOMEM, "map: out of memory for the smoothed normals");
     free(a);
     goto done;
   }
   /* vertices welded by position (a UV seam splits a vertex) */
-  for (size_t i = 0; i < nv; i++) key[i] = (vpos_key){m->positions + 3 * i, (uint32_t)i};
-  qsort(key, nv, sizeof *key, cmp_vpos);
-  for (size_t i = 0; i < nv; i++) {
-    int same = i && !memcmp(key[i].p, key[i - 1].p, 3 * sizeof(float));
-    canon[key[i].i] = same ? canon[key[i - 1].i] : (uint32_t)i;
+  if ((s = hearth_mesh_weld_ids(m, canon, err))) {
+    free(a);
+    goto done;
   }
   for (size_t t = 0; t < nt; t++)
     for (int c = 0; c < 3; c++) start[canon[m->indices[3 * t + c]] + 1]++;
@@ -163,7 +149,6 @@ static hearth_status smooth_normals(hearth_map_layout *l, int passes, hearth_err
   }
   l->cos_normal = a;
 done:
-  free(key);
   free(canon);
   free(start);
   free(fill);

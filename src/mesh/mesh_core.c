@@ -124,3 +124,36 @@ hearth_status hearth_mesh_validate(const hearth_mesh *m, const char *name, heart
     }
   return HEARTH_OK;
 }
+
+typedef struct weld_key {
+  const float *p;
+  uint32_t v;
+} weld_key;
+
+static int cmp_weld(const void *a, const void *b) {
+  const weld_key *x = a, *y = b;
+  for (int k = 0; k < 3; k++)
+    if (x->p[k] != y->p[k]) return x->p[k] < y->p[k] ? -1 : 1;
+  return (x->v > y->v) - (x->v < y->v);
+}
+
+hearth_status hearth_mesh_weld_ids(const hearth_mesh *m, uint32_t *id, hearth_err *err) {
+  const size_t nv = m->n_vertices;
+  if (nv > (size_t)UINT32_MAX)
+    return hearth_err_set(err, HEARTH_E_LIMIT, "mesh of %zu vertices: too many to weld", nv);
+  for (size_t i = 0; i < nv; i++) {
+    const float *p = m->positions + 3 * i;
+    if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2]))
+      return hearth_err_set(err, HEARTH_E_RANGE, "mesh: vertex %zu: position is not finite", i);
+  }
+  weld_key *key = hearth_alloc_array(nv ? nv : 1, sizeof *key);
+  if (!key) return hearth_err_set(err, HEARTH_E_NOMEM, "mesh: out of memory welding vertices");
+  for (size_t i = 0; i < nv; i++) key[i] = (weld_key){m->positions + 3 * i, (uint32_t)i};
+  qsort(key, nv, sizeof *key, cmp_weld);
+  for (size_t i = 0, first = 0; i < nv; i++) {
+    if (i && memcmp(key[i].p, key[i - 1].p, 3 * sizeof(float))) first = i;
+    id[key[i].v] = (uint32_t)first;
+  }
+  free(key);
+  return HEARTH_OK;
+}

@@ -105,18 +105,6 @@ static void ov_grid_free(ov_grid *g) {
   hearth_ray_fan_free(g->fan);
 }
 
-typedef struct ov_vkey {
-  float p[3];
-  uint32_t v;
-} ov_vkey;
-
-static int cmp_vkey(const void *a, const void *b) {
-  const ov_vkey *x = a, *y = b;
-  for (int k = 0; k < 3; k++)
-    if (x->p[k] != y->p[k]) return x->p[k] < y->p[k] ? -1 : 1;
-  return (x->v > y->v) - (x->v < y->v);
-}
-
 static int cmp_edge(const void *a, const void *b) {
   uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
   return (x > y) - (x < y);
@@ -125,22 +113,12 @@ static int cmp_edge(const void *a, const void *b) {
 int rf_mesh_closed_outward(const hearth_mesh *m) {
   const size_t nv = m->n_vertices, nt = m->n_triangles;
   if (!nv || !nt || nv > UINT32_MAX || nt > SIZE_MAX / 3) return 0;
-  ov_vkey *keys = hearth_alloc_array(nv, sizeof *keys);
   uint32_t *id = hearth_alloc_array(nv, sizeof *id);
   uint64_t *e = hearth_alloc_array(3 * nt, sizeof *e);
-  int ok = keys && id && e;
-  for (size_t i = 0; ok && i < nv; i++) {
-    memcpy(keys[i].p, m->positions + 3 * i, sizeof keys[i].p);
-    keys[i].v = (uint32_t)i;
-    ok = isfinite(keys[i].p[0]) && isfinite(keys[i].p[1]) && isfinite(keys[i].p[2]);
-  }
+  /* welded: a position shared by several vertices is one id (a non-finite
+     position fails the weld, and the mesh is not taken as closed) */
+  int ok = id && e && !hearth_mesh_weld_ids(m, id, NULL);
   if (ok) {
-    /* weld: a vertex's id is the first of its position's vertices in order */
-    qsort(keys, nv, sizeof *keys, cmp_vkey);
-    for (size_t i = 0, first = 0; i < nv; i++) {
-      if (i && memcmp(keys[i].p, keys[i - 1].p, sizeof keys[i].p)) first = i;
-      id[keys[i].v] = (uint32_t)first;
-    }
     /* directed edges a -> b as a << 32 | b */
     double vol = 0.0;
     for (size_t t = 0; ok && t < nt; t++) {
@@ -167,7 +145,6 @@ int rf_mesh_closed_outward(const hearth_mesh *m) {
       }
     }
   }
-  free(keys);
   free(id);
   free(e);
   return ok;
