@@ -565,9 +565,9 @@ static size_t units_of(const build_ctx *c, const inst_plan *p) {
   return u;
 }
 
-/* one unit of work finished: progress bar on a terminal, a line otherwise */
-static void unit_done(build_ctx *c, const char *what, const char *outcome, double secs) {
-  pthread_mutex_lock(&c->mu);
+/* one unit of work finished: progress bar on a terminal, a line otherwise
+   (none for a unit skipped after a failure: outcome NULL); c->mu held */
+static void unit_done_locked(build_ctx *c, const char *what, const char *outcome, double secs) {
   c->units_done++;
   if (!c->o->quiet) {
     if (c->tty) {
@@ -579,6 +579,11 @@ static void unit_done(build_ctx *c, const char *what, const char *outcome, doubl
       fflush(c->log);
     }
   }
+}
+
+static void unit_done(build_ctx *c, const char *what, const char *outcome, double secs) {
+  pthread_mutex_lock(&c->mu);
+  unit_done_locked(c, what, outcome, secs);
   pthread_mutex_unlock(&c->mu);
 }
 
@@ -706,8 +711,7 @@ static build_unit *next_unit(build_ctx *c) {
     if (dead) {
       u->state = UNIT_FAILED;
       c->units_left--;
-      c->units_done++;
-      if (!c->o->quiet && c->tty) hearth_progress_step(&c->prog, 1);
+      unit_done_locked(c, NULL, NULL, -1);
       continue;
     }
     if (blocked || (needs_gate(c, u->st) && c->gate != GATE_OPEN)) continue;
@@ -748,6 +752,12 @@ static void open_gate(build_ctx *c, int gate) {
   c->gate = gate;
   pthread_cond_broadcast(&c->cv);
   pthread_mutex_unlock(&c->mu);
+}
+
+static void free_plans(build_ctx *c) {
+  for (size_t i = 0; i < c->n; i++)
+    for (size_t k = 0; k < c->plans[i].n_states; k++) hearth_manifest_free(&c->plans[i].man[k]);
+  free(c->plans);
 }
 
 /* read instance.json and manifests (the stage file lists need them) */
@@ -893,9 +903,7 @@ hearth_status hearth_build_release(const char *root, const hearth_build_opts *o_
   }
   c.units = calloc(n_units ? n_units : 1, sizeof *c.units);
   if (!c.units) {
-    for (size_t i = 0; i < n; i++)
-      for (size_t k = 0; k < c.plans[i].n_states; k++) hearth_manifest_free(&c.plans[i].man[k]);
-    free(c.plans);
+    free_plans(&c);
     free(c.res);
     return hearth_err_set(err, HEARTH_E_NOMEM, "build: out of memory");
   }
@@ -958,9 +966,7 @@ hearth_status hearth_build_release(const char *root, const hearth_build_opts *o_
   if (!o.quiet && c.tty) hearth_progress_end(&c.prog);
   pthread_cond_destroy(&c.cv);
   pthread_mutex_destroy(&c.mu);
-  for (size_t i = 0; i < n; i++)
-    for (size_t k = 0; k < c.plans[i].n_states; k++) hearth_manifest_free(&c.plans[i].man[k]);
-  free(c.plans);
+  free_plans(&c);
   free(c.units);
   rep->stages_run += c.stages_run;
   rep->stages_up_to_date += c.stages_fresh;
