@@ -209,19 +209,20 @@ static int has_view(const state_views *sv, size_t ns, const char *state, const c
 
 /* a poses file: readable (rotations are checked by the reader), every entry
  * names a view of a state of this instance, and (every_view) every view has
- * a pose, else at least one view has */
-static void check_poses(hearth_problems *p, const char *path, const state_views *sv, size_t ns,
-                        int every_view, size_t *nfiles) {
+ * a pose, else at least one view has; keep (optional) takes the poses when
+ * they read, else stays zeroed. 1 if they read. */
+static int check_poses(hearth_problems *p, const char *path, const state_views *sv, size_t ns,
+                       int every_view, hearth_poses *keep, size_t *nfiles) {
   hearth_poses poses = {0};
   hearth_err e = {0};
   (*nfiles)++;
   if (!present(path)) {
     hearth_problems_add(p, path, "missing");
-    return;
+    return 0;
   }
   if (hearth_poses_read(path, &poses, &e)) {
     add_err(p, path, &e);
-    return;
+    return 0;
   }
   for (size_t i = 0; i < poses.n; i++) {
     int state_known = 0;
@@ -239,7 +240,9 @@ static void check_poses(hearth_problems *p, const char *path, const state_views 
         hearth_problems_add(p, path, "no pose for state '%s' view '%s'", sv[k].state,
                             sv[k].man.views[v].view);
   if (!every_view && !poses.n) hearth_problems_add(p, path, "no view has a pose");
-  hearth_poses_free(&poses);
+  if (keep) *keep = poses;
+  else hearth_poses_free(&poses);
+  return 1;
 }
 
 static void check_provenance(hearth_problems *p, const char *path, const char *inst,
@@ -452,14 +455,22 @@ static void check_leftovers(hearth_problems *p, const char *dir, int depth) {
   free(names);
 }
 
+/* what check_recon_files read of recon/ for check_recon_report: the poses
+ * (zeroed unless they read), the geometry mesh's sizes and the mesh's UV
+ * islands (-1 unless they read) */
+typedef struct recon_read {
+  hearth_poses poses;
+  int poses_read;
+  long long mesh_vertices, mesh_triangles, atlas_charts;
+} recon_read;
+
 /* recon/report.json (hearth recon's turntable route), when present: its
- * members against the manifests, recon/poses_rgb.json and the meshes
- * beside it (those files themselves are another tool's hand-over, or
- * hearth's, and read only to compare) */
+ * members against the manifests and what check_recon_files read of
+ * recon/poses_rgb.json and the meshes beside it */
 static void check_recon_report(hearth_problems *p, const char *dir, const char *id,
                                const hearth_instance_doc *doc, const state_views *sv,
-                               size_t *nfiles) {
-  char path[PATH_SZ], f[PATH_SZ];
+                               const recon_read *rr, size_t *nfiles) {
+  char path[PATH_SZ];
   snprintf(path, sizeof path, "%s/recon/report.json", dir);
   if (!present(path)) return;
   (*nfiles)++;
@@ -480,22 +491,16 @@ static void check_recon_report(hearth_problems *p, const char *dir, const char *
     if (!sv[k].ok) all = -1;
     else if (all >= 0) all += (long long)sv[k].man.n_views;
   }
-  hb_recon_expect x = {id, ns, states, man, all, NULL, -1, -1, -1};
-  hearth_poses poses = {0};
-  snprintf(f, sizeof f, "%s/recon/poses_rgb.json", dir);
-  if (present(f) && !hearth_poses_read(f, &poses, NULL)) x.poses = &poses;
-  hearth_mesh m = {0};
-  snprintf(f, sizeof f, "%s/recon/mesh_geometry.glb", dir);
-  if (present(f) && !hearth_glb_read(f, NULL, &m, NULL)) {
-    x.mesh_vertices = (long long)m.n_vertices;
-    x.mesh_triangles = (long long)m.n_triangles;
-  }
-  hearth_mesh_free(&m);
-  snprintf(f, sizeof f, "%s/recon/mesh.glb", dir);
-  if (present(f) && !hearth_glb_read(f, NULL, &m, NULL)) x.atlas_charts = hb_mesh_islands(&m);
-  hearth_mesh_free(&m);
+  hb_recon_expect x = {id,
+                       ns,
+                       states,
+                       man,
+                       all,
+                       rr->poses_read ? &rr->poses : NULL,
+                       rr->mesh_vertices,
+                       rr->mesh_triangles,
+                       rr->atlas_charts};
   hb_recon_report_check((const char *)text, len, path, &x, p);
-  hearth_poses_free(&poses);
   free(text);
 }
 
@@ -507,13 +512,13 @@ static void check_recon_report(hearth_problems *p, const char *dir, const char *
  * the cameras document are checked where present (hearth recon --no-mesh
  * leaves poses only). */
 static void check_recon_files(hearth_problems *p, const char *dir, const state_views *sv, size_t ns,
-                              int decode, size_t *nfiles) {
+                              int decode, recon_read *rr, size_t *nfiles) {
   char f[PATH_SZ];
   hearth_err e = {0};
   snprintf(f, sizeof f, "%s/recon", dir);
   if (!hearth_path_exists(f)) return;
   snprintf(f, sizeof f, "%s/recon/poses_rgb.json", dir);
-  check_poses(p, f, sv, ns, 0, nfiles);
+  rr->poses_read = check_poses(p, f, sv, ns, 0, &rr->poses, nfiles);
   static const char *glbs[2] = {"mesh.glb", "mesh_geometry.glb"};
   for (int j = 0; j < 2; j++) {
     snprintf(f, sizeof f, "%s/recon/%s", dir, glbs[j]);
@@ -521,7 +526,14 @@ static void check_recon_files(hearth_problems *p, const char *dir, const state_v
     (*nfiles)++;
     hearth_mesh mesh = {0};
     hearth_glb_read_opts go = {.require_uvs = j == 0};
-    if (hearth_glb_read(f, &go, &mesh, &e)) add_err(p, f, &e);
+    if (hearth_glb_read(f, &go, &mesh, &e)) {
+      add_err(p, f, &e);
+    } else if (j == 0) {
+      rr->atlas_charts = hb_mesh_islands(&mesh);
+    } else {
+      rr->mesh_vertices = (long long)mesh.n_vertices;
+      rr->mesh_triangles = (long long)mesh.n_triangles;
+    }
     hearth_mesh_free(&mesh);
   }
   static const int rgb34[] = {3, 4, 0};
@@ -627,8 +639,10 @@ static void check_instance(const char *root, const char *id, const hearth_valida
       }
     }
   }
-  check_recon_files(p, dir, sv, doc.n_states, o->decode_images, nfiles);
-  check_recon_report(p, dir, id, &doc, sv, nfiles);
+  recon_read rr = {{0}, 0, -1, -1, -1};
+  check_recon_files(p, dir, sv, doc.n_states, o->decode_images, &rr, nfiles);
+  check_recon_report(p, dir, id, &doc, sv, &rr, nfiles);
+  hearth_poses_free(&rr.poses);
   if (o->raw_only) goto done;
 
   /* derived/: scale, mesh, poses, per-state maps (one line if never built) */
@@ -658,7 +672,7 @@ static void check_instance(const char *root, const char *id, const hearth_valida
                                      "poses_thermal.json"};
   for (int j = 0; j < 3; j++) {
     snprintf(path, sizeof path, "%s/derived/%s", dir, pose_files[j]);
-    check_poses(p, path, sv, doc.n_states, 1, nfiles);
+    check_poses(p, path, sv, doc.n_states, 1, NULL, nfiles);
   }
   for (size_t k = 0; k < doc.n_states; k++) {
     if (!sv[k].ok) continue;
