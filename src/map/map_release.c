@@ -275,7 +275,7 @@ hearth_status hearth_map_run(const hearth_map_job *job_in, hearth_map_result *st
     return hearth_err_set(err, HEARTH_E_ARG, "map: root, instance and state are required");
   hearth_map_job jc = *job_in;
   const hearth_map_job *job = &jc;
-  if (!job || !job->root || !job->instance || !job->state)
+  if (!job->root || !job->instance || !job->state)
     return hearth_err_set(err, HEARTH_E_ARG, "map: root, instance and state are required");
   char rig_path[PATH_SZ], poses_path[PATH_SZ], mesh_path[PATH_SZ], man_path[PATH_SZ],
       out_dir[PATH_SZ], tmp_dir[PATH_SZ], path[PATH_SZ];
