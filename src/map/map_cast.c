@@ -6,7 +6,8 @@
  * into the UV map, and the view is reduced to one value per texel it
  * observes (the view's mean there, its weight and best viewing cosine).
  * For max fusion that value folds at once into the worker's maxima maps;
- * for mean and robust fusion it becomes the view's record of the texel.
+ * for robust and corrected fusion it becomes the view's record of the
+ * texel. Mean fusion skips the reduction: the splats go into the sums.
  * Within a view, pixels are visited in raster order. */
 #include <math.h>
 #include <stdlib.h>
@@ -16,7 +17,7 @@
 #define MAX_BACKFACE_SKIPS 8
 #define PREFETCH_AHEAD 8 /* touches ahead whose texel's island is prefetched */
 
-int map_worker_alloc(map_worker *w, const hearth_map_layout *l, int C, int records) {
+int map_worker_alloc(map_worker *w, const hearth_map_layout *l, int C, int kind) {
   const size_t np = l->np;
   w->hit_t = hearth_alloc_array(np, sizeof(float));
   w->hit_tri = hearth_alloc_array(np, sizeof(uint32_t));
@@ -27,15 +28,18 @@ int map_worker_alloc(map_worker *w, const hearth_map_layout *l, int C, int recor
   w->hits = hearth_alloc_array(np, sizeof(hearth_ray_hit));
   w->sil = hearth_alloc_array(np, 1);
   w->splats = hearth_alloc_array(np, sizeof(splat));
-  w->touches = hearth_alloc_array(np, 4 * sizeof(touch));
-  w->touches_tmp = hearth_alloc_array(np, 4 * sizeof(touch));
   int ok = w->hit_t && w->hit_tri && w->hit_b1 && w->hit_b2 && w->ray_org && w->ray_dir &&
-           w->hits && w->sil && w->splats && w->touches && w->touches_tmp;
+           w->hits && w->sil && w->splats;
+  if (kind != WORKER_SPLATS) {
+    w->touches = hearth_alloc_array(np, 4 * sizeof(touch));
+    w->touches_tmp = hearth_alloc_array(np, 4 * sizeof(touch));
+    ok &= w->touches && w->touches_tmp;
+  }
   if (l->fan) {
     w->fan_scratch = calloc(1, hearth_ray_fan_scratch_size(l->fan, l->mesh->n_vertices));
     ok &= w->fan_scratch != NULL;
   }
-  if (records) {
+  if (kind == WORKER_RECORDS) {
     w->rec_q = hearth_alloc_array(np, 4 * sizeof(uint32_t));
     w->rec_d = hearth_alloc_array(np, 4 * REC_WORDS(C) * sizeof(float));
     ok &= w->rec_q && w->rec_d;
@@ -65,11 +69,6 @@ static float image_value(const hearth_image *img, size_t idx, int c) {
   if (img->type == HEARTH_PIX_F32)
     return ((const float *)img->data)[idx * (size_t)img->channels + (size_t)c];
   return (float)((const uint8_t *)img->data)[idx * (size_t)img->channels + (size_t)c];
-}
-
-/* the bilinear weight of corner k (bit 0: +x, bit 1: +y) of a splat */
-static inline float corner_weight(const splat *e, int k) {
-  return (float)(((k & 1) ? e->fx : 1.0 - e->fx) * ((k >> 1) ? e->fy : 1.0 - e->fy));
 }
 
 /* a box of grid pixels */
@@ -381,14 +380,13 @@ static inline void fold_max(uint32_t *mc, float *mcos, uint32_t q, int C, float 
   }
 }
 
-/* mean and robust fusion: a view's record of texel q, at d (see REC_WORDS) */
-static inline void put_record(float *d, int mean, int C, float wsum, float best_cos,
-                              const float sum[3]) {
+/* robust and corrected fusion: a view's record of texel q, at d (see REC_WORDS) */
+static inline void put_record(float *d, int C, float wsum, float best_cos, const float sum[3]) {
   d[0] = wsum;
   d[1] = best_cos;
   /* + 0.0f: a negative zero becomes +0, so equal means cannot make the
      maximum's bits depend on which view came first */
-  for (int c = 0; c < C; c++) d[2 + c] = mean ? sum[c] : sum[c] / wsum + 0.0f;
+  for (int c = 0; c < C; c++) d[2 + c] = sum[c] / wsum + 0.0f;
 }
 
 /* Each texel's touches in pixel order, splatted only from the texel's own
@@ -398,7 +396,6 @@ static size_t reduce_touches(const map_ctx *m, map_worker *w, const touch *tc, s
   const uint32_t *iot = m->l->island_of_texel;
   const int C = m->C;
   const size_t RW = REC_WORDS(C);
-  const int mean = m->opts->fusion == HEARTH_FUSE_MEAN;
   const splat *sp = w->splats;
   uint32_t *mc = m->max ? m->max->code[t] : NULL;
   float *mcos = m->max && m->max->cos ? m->max->cos[t] : NULL;
@@ -430,7 +427,7 @@ static size_t reduce_touches(const map_ctx *m, map_worker *w, const touch *tc, s
       continue;
     }
     w->rec_q[n_rec] = q;
-    put_record(w->rec_d + n_rec * RW, mean, C, wsum, best_cos, sum);
+    put_record(w->rec_d + n_rec * RW, C, wsum, best_cos, sum);
     n_rec++;
   }
   return n_rec;
@@ -506,15 +503,16 @@ static void process_view(map_ctx *m, size_t v, int t) {
   uint32_t hits = 0;
   size_t n_sp = splat_hits(m, v, img, own.data && m->opts->load_grid, w, &f, edges, &hits);
   hearth_image_free(&own); /* the splats hold the values */
+  m->view_hits[v] = hits;
+  if (m->rec && m->rec->acc) {
+    /* mean fusion: the splats into the sums, in view order */
+    if (!map_splats_fold(m->rec, v, w->splats, n_sp, l->island_of_texel, l->R, m->C)) m->failed = 1;
+    return;
+  }
   size_t n_tc = 0;
   const touch *tc = sorted_touches(w, n_sp, l->R, &n_tc);
-  m->view_hits[v] = hits;
   size_t n_rec = reduce_touches(m, w, tc, n_tc, t);
-  if (m->rec && m->rec->acc) {
-    if (!map_records_fold(m->rec, v, w->rec_q, w->rec_d, n_rec, m->C)) m->failed = 1;
-  } else if (m->rec) {
-    keep_records(m, v, w, n_rec);
-  }
+  if (m->rec) keep_records(m, v, w, n_rec);
 }
 
 /* views are handed out one at a time to whichever worker is free (they

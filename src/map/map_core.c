@@ -86,8 +86,11 @@ static int alloc_phase_state(map_ctx *m, max_maps *mx, view_records *rec, hearth
   m->workers = calloc((size_t)nt, sizeof *m->workers);
   m->view_hits = calloc(m->n_views ? m->n_views : 1, sizeof *m->view_hits);
   if (!m->workers || !m->view_hits) return 0;
+  const int kind = max                                   ? WORKER_MAXIMA
+                   : m->opts->fusion == HEARTH_FUSE_MEAN ? WORKER_SPLATS
+                                                         : WORKER_RECORDS;
   for (int t = 0; t < nt; t++)
-    if (!map_worker_alloc(&m->workers[t], m->l, m->C, !max)) return 0;
+    if (!map_worker_alloc(&m->workers[t], m->l, m->C, kind)) return 0;
   if (max) {
     m->max = mx;
     return map_max_alloc(mx, nt, m->l->R, m->C, !m->opts->skip_best_cos, out);

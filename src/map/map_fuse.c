@@ -62,6 +62,8 @@ int map_records_alloc(view_records *r, size_t n_views, int stream, size_t R, int
   r->n = calloc(n_views ? n_views : 1, sizeof *r->n);
   if (!r->q || !r->d || !r->n) return 0;
   if (!stream) return 1;
+  r->sp = calloc(n_views ? n_views : 1, sizeof *r->sp);
+  if (!r->sp) return 0;
   /* calloc: the pages of texels no view observes are never touched */
   r->acc = calloc(R * R, (size_t)C * sizeof *r->acc);
   r->acc_owned = 1;
@@ -77,8 +79,10 @@ int map_records_alloc(view_records *r, size_t n_views, int stream, size_t R, int
 void map_records_free(view_records *r) {
   for (size_t v = 0; r->q && v < r->n_views; v++) free(r->q[v]);
   for (size_t v = 0; r->d && v < r->n_views; v++) free(r->d[v]);
+  for (size_t v = 0; r->sp && v < r->n_views; v++) free(r->sp[v]);
   free(r->q);
   free(r->d);
+  free(r->sp);
   free(r->n);
   if (r->acc_owned) free(r->acc);
   free(r->acc_w);
@@ -88,47 +92,46 @@ void map_records_free(view_records *r) {
   memset(r, 0, sizeof *r);
 }
 
-/* n records of one view into the sums: per texel, its weighted values and
-   its weight added as the band fusion would add them */
-static void add_records(view_records *r, const uint32_t *rq, const float *rd, size_t n, int C) {
-  const size_t RW = REC_WORDS(C);
-  for (size_t k = 0; k < n; k++) {
-    const size_t q = rq[k];
-    const float *d = rd + k * RW;
-    if (r->best_cos && d[1] > r->best_cos[q]) r->best_cos[q] = d[1];
-    float *a = r->acc + q * (size_t)C;
-    for (size_t c = 0; c < (size_t)C; c++) a[c] += d[2 + c];
-    r->acc_w[q] += d[0];
+/* n splats of one view into the sums: corner by corner in pixel order, a
+   corner only into a texel of the splat's own island (as the other rules'
+   reduction of a view's touches) */
+static void add_splats(view_records *r, const uint32_t *iot, size_t R, const splat *sp, size_t n,
+                       int C) {
+  for (size_t i = 0; i < n; i++) {
+    const splat *e = &sp[i];
+    for (int k = 0; k < 4; k++) {
+      long tx = (long)e->x0 + (k & 1), ty = (long)e->y0 + (k >> 1);
+      if (tx < 0 || ty < 0 || tx >= (long)R || ty >= (long)R) continue;
+      const float wk = corner_weight(e, k);
+      const size_t q = (size_t)ty * R + (size_t)tx;
+      if (!(wk > 0.0f) || iot[q] != e->island) continue;
+      if (r->best_cos && e->cosv > r->best_cos[q]) r->best_cos[q] = e->cosv;
+      float *a = r->acc + q * (size_t)C;
+      for (int c = 0; c < C; c++) a[c] += wk * e->val[c];
+      r->acc_w[q] += wk;
+    }
   }
 }
 
-int map_records_fold(view_records *r, size_t v, const uint32_t *q, const float *d, size_t n,
-                     int C) {
-  const size_t RW = REC_WORDS(C);
+int map_splats_fold(view_records *r, size_t v, const splat *sp, size_t n, const uint32_t *iot,
+                    size_t R, int C) {
   int ok = 1;
   pthread_mutex_lock(&r->mu);
   if (v == r->next) {
-    add_records(r, q, d, n, C);
+    add_splats(r, iot, R, sp, n, C);
     /* then the views done before their turn that follow it */
     for (r->next++; r->next < r->n_views && r->waiting[r->next]; r->next++) {
       size_t w = r->next;
-      add_records(r, r->q[w], r->d[w], r->n[w], C);
-      free(r->q[w]);
-      free(r->d[w]);
-      r->q[w] = NULL;
-      r->d[w] = NULL;
+      add_splats(r, iot, R, r->sp[w], r->n[w], C);
+      free(r->sp[w]);
+      r->sp[w] = NULL;
     }
   } else {
     /* not its turn: kept until the views before it are in */
     r->n[v] = n;
-    r->q[v] = hearth_alloc_array(n ? n : 1, sizeof *q);
-    r->d[v] = hearth_alloc_array(n ? n : 1, RW * sizeof *d);
-    if (r->q[v] && r->d[v]) {
-      memcpy(r->q[v], q, n * sizeof *q);
-      memcpy(r->d[v], d, n * RW * sizeof *d);
-    } else {
-      ok = 0;
-    }
+    r->sp[v] = hearth_alloc_array(n ? n : 1, sizeof *sp);
+    if (r->sp[v]) memcpy(r->sp[v], sp, n * sizeof *sp);
+    else ok = 0, r->n[v] = 0; /* the mapping fails; nothing to fold */
     r->waiting[v] = 1;
   }
   pthread_mutex_unlock(&r->mu);

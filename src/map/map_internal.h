@@ -5,7 +5,8 @@
  *                 mesh's bounding sphere, the camera's pixel grid and ray fan
  *   map_cast.c    each view cast and splatted by one worker and reduced to
  *                 one value per texel it observes, folded into the fusion
- *                 rule's state (max_maps or view_records)
+ *                 rule's state (max_maps or view_records); for mean fusion
+ *                 the splats themselves are folded into the sums
  *   map_fuse.c    fusion across views over bands of whole texel rows
  *   map_fill.c    the nearest-observed fill within each UV island
  *
@@ -61,6 +62,11 @@ typedef struct splat {
   float val[3];
 } splat;
 
+/* the bilinear weight of corner k (bit 0: +x, bit 1: +y) of a splat */
+static inline float corner_weight(const splat *e, int k) {
+  return (float)(((k & 1) ? e->fx : 1.0 - e->fx) * ((k >> 1) ? e->fy : 1.0 - e->fy));
+}
+
 /* One bilinear touch of a texel by a splat within one view; a view's
  * touches are sorted by texel (stably: pixel order within a texel) and
  * reduced in one pass, each texel's sums added up in the same order as
@@ -82,11 +88,19 @@ typedef struct map_worker {
   hearth_ray_hit *hits; /* np */
   uint8_t *sil;         /* np: silhouette flags, in the frame */
   splat *splats;        /* np */
-  touch *touches, *touches_tmp; /* 4 * np: a view's touches and the sort's second buffer */
+  touch *touches, *touches_tmp; /* 4 * np: a view's touches and the sort's second buffer
+                                   (NULL for mean fusion, which folds the splats) */
   void *fan_scratch;            /* the ray fan's scratch (NULL without a fan) */
-  uint32_t *rec_q;              /* 4 * np: mean and robust fusion: a view's records, made */
-  float *rec_d;                 /* here, then kept in view_records (NULL for max fusion) */
+  uint32_t *rec_q;              /* 4 * np: robust and corrected fusion: a view's records, */
+  float *rec_d;                 /* made here, then kept in view_records (else NULL) */
 } map_worker;
+
+/* what a worker's scratch holds beyond the cast and the splats */
+enum {
+  WORKER_MAXIMA = 0,  /* max fusion: touches, reduced into the worker's maxima */
+  WORKER_RECORDS = 1, /* robust and corrected fusion: touches reduced to records */
+  WORKER_SPLATS = 2   /* mean fusion: the splats alone, folded into the sums */
+};
 
 /* Max fusion: each worker folds its views' means into maps of its own (the
  * maximum does not depend on the order); the fusion merges them. */
@@ -96,16 +110,18 @@ typedef struct max_maps {
   float **cos;     /* per worker: R * R best viewing cosines, 0 none; NULL with skip_best_cos */
 } max_maps;
 
-/* Mean and robust fusion: each view's records (see REC_WORDS), sorted by
- * texel, in an allocation of their own size; the fusion folds them in view
- * order. Mean fusion folds them as the views are done instead: a view's
- * records go into per-texel sums as soon as every view before it has gone
- * in (the sums see the views in view order, as the fusion would) and are
- * freed, so only the views done out of order wait as records. */
+/* Robust and corrected fusion: each view's records (see REC_WORDS), sorted
+ * by texel, in an allocation of their own size; the fusion folds them in
+ * view order. Mean fusion needs no records: a view's splats go into
+ * per-texel sums, corner by corner in pixel order, as soon as every view
+ * before it has gone in (the sums see the views in view order whatever the
+ * threads), so only the views done out of order wait, as copies of their
+ * splats. */
 typedef struct view_records {
   size_t n_views;
   uint32_t **q; /* per view: n[v] texels */
   float **d;    /* per view: n[v] * REC_WORDS(C) words */
+  splat **sp;   /* mean fusion, per view: its n[v] splats while it waits (else NULL) */
   size_t *n;
   /* mean fusion (NULL otherwise): R * R * C sums of the weighted values and
      R * R sums of the weights, zero where no view observed; the fusion
@@ -160,9 +176,9 @@ static inline float max_decode(uint32_t c) {
 
 /* map_cast.c */
 /* The scratch of one worker for the layout's pixel grid and C channels
- * (records: room for a view's records, for mean and robust fusion).
- * Returns 0 out of memory; map_worker_free frees what was made. */
-int map_worker_alloc(map_worker *w, const hearth_map_layout *l, int C, int records);
+ * (kind: WORKER_MAXIMA, _RECORDS or _SPLATS). Returns 0 out of memory;
+ * map_worker_free frees what was made. */
+int map_worker_alloc(map_worker *w, const hearth_map_layout *l, int C, int kind);
 void map_worker_free(map_worker *w);
 /* views [b, e) on worker t (a hearth_parallel_chunks function over m) */
 void map_cast_views(void *ctx, size_t b, size_t e, int t);
@@ -177,9 +193,11 @@ void map_max_free(max_maps *mx);
  * texels and C channels, and with want_cos their best cosines, zeroed.
  * Returns 0 out of memory. */
 int map_records_alloc(view_records *r, size_t n_views, int stream, size_t R, int C, int want_cos);
-/* mean fusion: view v's n records (q, d: REC_WORDS(C) words each) folded
- * in view order (see view_records); returns 0 out of memory */
-int map_records_fold(view_records *r, size_t v, const uint32_t *q, const float *d, size_t n, int C);
+/* mean fusion: view v's n splats folded into the sums of R x R texels in
+ * view order (see view_records), each corner only into a texel of the
+ * splat's island (island_of_texel); returns 0 out of memory */
+int map_splats_fold(view_records *r, size_t v, const splat *sp, size_t n,
+                    const uint32_t *island_of_texel, size_t R, int C);
 void map_records_free(view_records *r);
 
 /* The islands' bounding boxes and counts, gathered by the fusion for the
