@@ -216,6 +216,15 @@ size_t hearth_ray_fan_scratch_size(const hearth_ray_fan *f, size_t n_vertices);
 hearth_status hearth_ray_fan_cast(const hearth_ray_fan *f, const hearth_mesh *m,
                                   const hearth_rigid *T_world_from_cam, void *scratch,
                                   hearth_ray_hit *hits, size_t box[4], hearth_err *err);
+/* The same, the hits kept in a frame instead of the grid: the box grown by
+ * grow pixels on each side and clipped to the grid, frame = {x0, y0, w, h}
+ * (grid pixels; all 0 when nothing is hit). hits[(y - y0) * w + (x - x0)]
+ * is written for every pixel of the frame (misses outside the box), so
+ * hits needs room for the frame only, at most the grid. */
+hearth_status hearth_ray_fan_cast_framed(const hearth_ray_fan *f, const hearth_mesh *m,
+                                         const hearth_rigid *T_world_from_cam, void *scratch,
+                                         size_t grow, hearth_ray_hit *hits, size_t box[4],
+                                         size_t frame[4], hearth_err *err);
 
 /* ---- UV islands and texel rasterisation ----------------------------------- */
 /* Label connected UV islands: triangles sharing an edge in UV space (same two

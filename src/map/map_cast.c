@@ -125,25 +125,28 @@ static inline void box_add(pix_box *box, size_t x, size_t y) {
 }
 
 /* view v, whose camera has the whole mesh in front: rasterised through the
- * fan (its hits lie within the box it returns) */
+ * fan, its hits kept in the frame of their box (the fan's hits are all
+ * front faces, so its box is the hits' box and its frame theirs) */
 static void cast_fan(map_ctx *m, size_t v, map_worker *w, hit_frame *f) {
   const hearth_map_layout *l = m->l;
-  size_t fb[4];
-  pix_box box = {SIZE_MAX, 0, SIZE_MAX, 0};
-  if (hearth_ray_fan_cast(l->fan, l->mesh, &m->views[v].T_world_from_cam, w->fan_scratch, w->hits,
-                          fb, NULL)) {
+  size_t fb[4], fr[4];
+  if (hearth_ray_fan_cast_framed(l->fan, l->mesh, &m->views[v].T_world_from_cam, w->fan_scratch, 2,
+                                 w->hits, fb, fr, NULL)) {
     m->failed = 2; /* cannot happen: the bounding sphere lies in front */
     return;
   }
-  const size_t W = l->pw;
-  for (size_t y = fb[2]; fb[0] <= fb[1] && y <= fb[3]; y++)
-    for (size_t x = fb[0]; x <= fb[1]; x++)
-      if (front_hit(&w->hits[y * W + x])) box_add(&box, x, y);
+  pix_box box = {SIZE_MAX, 0, SIZE_MAX, 0};
+  if (fb[0] <= fb[1]) box = (pix_box){fb[0], fb[1], fb[2], fb[3]};
   frame_open(l, w, &box, f);
-  for (size_t y = box.y0; box.x0 <= box.x1 && y <= box.y1; y++)
+  if (box.x0 > box.x1) return;
+  if (f->x0 != fr[0] || f->y0 != fr[1] || f->w != fr[2] || f->h != fr[3]) {
+    m->failed = 2; /* cannot happen: both grow the box by 2 within the grid */
+    return;
+  }
+  for (size_t y = box.y0; y <= box.y1; y++)
     for (size_t x = box.x0; x <= box.x1; x++) {
-      const hearth_ray_hit *h = &w->hits[y * W + x];
-      if (front_hit(h)) frame_put(w, frame_at(f, x, y), h);
+      const size_t k = frame_at(f, x, y);
+      if (front_hit(&w->hits[k])) frame_put(w, k, &w->hits[k]);
     }
 }
 

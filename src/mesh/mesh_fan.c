@@ -208,11 +208,17 @@ static inline void grid_range(float lo, float hi, long n, long *i0, long *i1) {
   *i1 = (long)(hi + 1.0f) - 1; /* floor, hi >= -1 */
 }
 
-hearth_status hearth_ray_fan_cast(const hearth_ray_fan *f, const hearth_mesh *m,
-                                  const hearth_rigid *T_world_from_cam, void *scratch,
-                                  hearth_ray_hit *hits, size_t box[4], hearth_err *err) {
+/* The cast behind both entry points: the hits' box in box; with frame,
+ * the hits written within the frame of the box grown by grow pixels
+ * (clipped to the grid; frame = {x0, y0, w, h}, misses where the box does
+ * not reach), else grid-indexed within the box. */
+static hearth_status fan_cast(const hearth_ray_fan *f, const hearth_mesh *m,
+                              const hearth_rigid *T_world_from_cam, void *scratch,
+                              hearth_ray_hit *hits, size_t grow, size_t box[4], size_t frame[4],
+                              hearth_err *err) {
   box[0] = box[2] = 1;
   box[1] = box[3] = 0;
+  if (frame) frame[0] = frame[1] = frame[2] = frame[3] = 0;
   if (!m->n_triangles) return HEARTH_OK;
   fan_vertex *V = scratch;
   float *IZ = (float *)(void *)(V + (m->n_vertices ? m->n_vertices : 1));
@@ -356,11 +362,30 @@ hearth_status hearth_ray_fan_cast(const hearth_ray_fan *f, const hearth_mesh *m,
   box[1] = (size_t)bx1;
   box[2] = (size_t)by0;
   box[3] = (size_t)by1;
+  /* where hit (i, j) goes: hits + (j - oy) * ow + (i - ox) */
+  long ox = 0, oy = 0, ow = pw;
+  if (frame) {
+    const long g = (long)grow;
+    ox = bx0 >= g ? bx0 - g : 0;
+    oy = by0 >= g ? by0 - g : 0;
+    ow = (bx1 + g < pw ? bx1 + g : pw - 1) - ox + 1;
+    const long oh = (by1 + g < ph ? by1 + g : ph - 1) - oy + 1;
+    frame[0] = (size_t)ox;
+    frame[1] = (size_t)oy;
+    frame[2] = (size_t)ow;
+    frame[3] = (size_t)oh;
+    /* the frame's pixels outside the box: misses */
+    for (long j = oy; j < oy + oh; j++)
+      for (long i = ox; i < ox + ow; i++)
+        if (j < by0 || j > by1 || i < bx0 || i > bx1)
+          hits[(j - oy) * ow + (i - ox)] = (hearth_ray_hit){INFINITY, UINT32_MAX, 0.0f, 0.0f, 0};
+  }
   for (long j = by0; j <= by1; j++)
     for (long i = bx0; i <= bx1; i++) {
       size_t p = (size_t)j * (size_t)pw + (size_t)i;
+      hearth_ray_hit *out = hits + (size_t)((j - oy) * ow + (i - ox));
       if (!(best[p].w > 0.0f)) {
-        hits[p] = (hearth_ray_hit){INFINITY, UINT32_MAX, 0.0f, 0.0f, 0};
+        *out = (hearth_ray_hit){INFINITY, UINT32_MAX, 0.0f, 0.0f, 0};
         continue;
       }
       const uint32_t *ix = m->indices + 3 * (size_t)best[p].tri;
@@ -372,9 +397,22 @@ hearth_status hearth_ray_fan_cast(const hearth_ray_fan *f, const hearth_mesh *m,
              wc = (double)edge_eval(&ec, x, y) * IZ[ix[2]], ws = wa + wb + wc;
       /* depth 1/w along z; the distance along the unit direction is
          depth / d_z */
-      hits[p] = (hearth_ray_hit){(float)(1.0 / ((double)best[p].w * (double)f->dirs[3 * p + 2])),
-                                 best[p].tri, (float)(wb / ws), (float)(wc / ws), 1};
+      *out = (hearth_ray_hit){(float)(1.0 / ((double)best[p].w * (double)f->dirs[3 * p + 2])),
+                              best[p].tri, (float)(wb / ws), (float)(wc / ws), 1};
       best[p] = (fan_best){0.0f, 0};
     }
   return HEARTH_OK;
+}
+
+hearth_status hearth_ray_fan_cast(const hearth_ray_fan *f, const hearth_mesh *m,
+                                  const hearth_rigid *T_world_from_cam, void *scratch,
+                                  hearth_ray_hit *hits, size_t box[4], hearth_err *err) {
+  return fan_cast(f, m, T_world_from_cam, scratch, hits, 0, box, NULL, err);
+}
+
+hearth_status hearth_ray_fan_cast_framed(const hearth_ray_fan *f, const hearth_mesh *m,
+                                         const hearth_rigid *T_world_from_cam, void *scratch,
+                                         size_t grow, hearth_ray_hit *hits, size_t box[4],
+                                         size_t frame[4], hearth_err *err) {
+  return fan_cast(f, m, T_world_from_cam, scratch, hits, grow, box, frame, err);
 }

@@ -117,6 +117,32 @@ static void compare(const hearth_mesh *m, const hearth_camera *cam, size_t strid
   size_t nz = 0;
   for (size_t k = ss - w * h * 8; k < ss; k++) nz += scratch[k] != 0;
   CHECK_MSG(nz == 0, "%zu scratch bytes left set", nz);
+  /* the framed cast: the same box, the frame the box grown by 3 and
+     clipped, the grid cast's hits inside the box and misses around it */
+  {
+    hearth_ray_hit *fh = malloc(w * h * sizeof *fh);
+    size_t fbox[4], fr[4];
+    for (size_t p = 0; fh && p < w * h; p++) fh[p] = (hearth_ray_hit){-1.0f, 12345u, -1, -1, 7};
+    if (fh) CHECK_OK(hearth_ray_fan_cast_framed(fan, m, T, scratch, 3, fh, fbox, fr, &err), &err);
+    CHECK(fh && !memcmp(fbox, box, sizeof box) && box[0] <= box[1]);
+    if (fh && box[0] <= box[1]) {
+      CHECK(fr[0] == (box[0] >= 3 ? box[0] - 3 : 0) && fr[1] == (box[2] >= 3 ? box[2] - 3 : 0));
+      CHECK(fr[0] + fr[2] == (box[1] + 3 < w ? box[1] + 4 : w));
+      CHECK(fr[1] + fr[3] == (box[3] + 3 < h ? box[3] + 4 : h));
+      size_t bad = 0;
+      for (size_t y = fr[1]; y < fr[1] + fr[3]; y++)
+        for (size_t x = fr[0]; x < fr[0] + fr[2]; x++) {
+          const hearth_ray_hit *a = &fh[(y - fr[1]) * fr[2] + (x - fr[0])];
+          int in_box = x >= box[0] && x <= box[1] && y >= box[2] && y <= box[3];
+          if (in_box) bad += memcmp(a, &hits[y * w + x], sizeof *a) != 0;
+          else bad += a->prim != UINT32_MAX;
+        }
+      /* nothing written beyond the frame */
+      for (size_t p = fr[2] * fr[3]; p < w * h; p++) bad += fh[p].prim != 12345u;
+      CHECK_MSG(bad == 0, "framed cast: %zu pixels differ from the grid cast", bad);
+    }
+    free(fh);
+  }
   for (size_t p = 0; p < w * h; p++) {
     hearth_ray_hit r = reference(rc, T, dirs + 3 * p);
     size_t px = p % w, py = p / w;
