@@ -110,6 +110,16 @@ hearth_status hearth_jpeg_read_grid(const char *path, const hearth_image_expect 
                                     hearth_image *img, hearth_err *err);
 hearth_status hearth_jpeg_read_grid_mem(const void *data, size_t size, const char *name,
                                         size_t step, hearth_image *img, hearth_err *err);
+/* A window of that grid: window = {x0, y0, w, h} (grid pixels, within the
+ * grid, else HEARTH_E_ARG), an image of w x h whose pixel (x, y) is the
+ * grid's (x0 + x, y0 + y). Every row is still decoded (the whole file is
+ * checked); only the window's pixels are kept. */
+hearth_status hearth_jpeg_read_grid_window(const char *path, const hearth_image_expect *want,
+                                           size_t step, const size_t window[4], hearth_image *img,
+                                           hearth_err *err);
+hearth_status hearth_jpeg_read_grid_window_mem(const void *data, size_t size, const char *name,
+                                               size_t step, const size_t window[4],
+                                               hearth_image *img, hearth_err *err);
 hearth_status hearth_jpeg_read_mem(const void *data, size_t size, const char *name,
                                    hearth_image *img, hearth_err *err);
 /* Luma only (1 channel): the stored Y plane of a colour JPEG, decoded

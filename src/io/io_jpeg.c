@@ -54,6 +54,7 @@ typedef struct jpeg_reader {
   int want_gray;                   /* decode to luma only (Y of a YCbCr file) */
   int half;                        /* decode at half the size (libjpeg's scaled IDCT) */
   size_t step;                     /* > 1: keep every step-th pixel and row (grid) */
+  const size_t *win;               /* NULL, or the grid's window {x0, y0, w, h} kept */
   JSAMPROW line;                   /* with step > 1: one full decoded row */
   const hearth_image_expect *want; /* NULL: any image */
   hearth_image img;
@@ -126,8 +127,20 @@ static int jpeg_decode(jpeg_reader *r) {
     snprintf(r->msg, sizeof r->msg, "unexpected output layout");
     return 2;
   }
-  const size_t step = r->step > 1 ? r->step : 1, gw = (w + step - 1) / step,
-               gh = (h + step - 1) / step;
+  const size_t step = r->step > 1 ? r->step : 1;
+  size_t gw = (w + step - 1) / step, gh = (h + step - 1) / step, wx = 0, wy = 0;
+  if (r->win) {
+    /* a window of the grid: its pixel (x, y) is the grid's (x0 + x, y0 + y) */
+    const size_t *g = r->win;
+    if (g[2] == 0 || g[3] == 0 || g[0] > gw || g[2] > gw - g[0] || g[1] > gh || g[3] > gh - g[1]) {
+      r->status = HEARTH_E_ARG;
+      snprintf(r->msg, sizeof r->msg,
+               "window %zux%zu at (%zu, %zu) does not lie within the %zux%zu grid", g[2], g[3],
+               g[0], g[1], gw, gh);
+      return 2;
+    }
+    wx = g[0], wy = g[1], gw = g[2], gh = g[3];
+  }
   hearth_err aerr;
   if (hearth_image_alloc(&r->img, gw, gh, channels, HEARTH_PIX_U8, &aerr) != HEARTH_OK) {
     r->status = aerr.status;
@@ -135,19 +148,21 @@ static int jpeg_decode(jpeg_reader *r) {
     return 2;
   }
   size_t stride = gw * (size_t)channels;
-  if (step > 1 && !(r->line = malloc(w * (size_t)channels))) {
+  const int by_line = step > 1 || r->win; /* rows decoded into line, then picked */
+  if (by_line && !(r->line = malloc(w * (size_t)channels))) {
     r->status = HEARTH_E_NOMEM;
     snprintf(r->msg, sizeof r->msg, "out of memory for a row");
     return 2;
   }
   while (r->cinfo.output_scanline < r->cinfo.output_height) {
     const size_t y = r->cinfo.output_scanline;
-    JSAMPROW row = step > 1 ? r->line : (JSAMPROW)r->img.data + y * stride;
+    JSAMPROW row = by_line ? r->line : (JSAMPROW)r->img.data + y * stride;
     int got = jpeg_read_scanlines(&r->cinfo, &row, 1) == 1;
-    if (got && step > 1 && y % step == 0) {
-      uint8_t *dst = (uint8_t *)r->img.data + (y / step) * stride;
+    if (got && by_line && y % step == 0 && y / step >= wy && y / step < wy + gh) {
+      uint8_t *dst = (uint8_t *)r->img.data + (y / step - wy) * stride;
+      const uint8_t *src = r->line + wx * step * (size_t)channels;
       for (size_t x = 0; x < gw; x++)
-        memcpy(dst + x * (size_t)channels, r->line + x * step * (size_t)channels, (size_t)channels);
+        memcpy(dst + x * (size_t)channels, src + x * step * (size_t)channels, (size_t)channels);
     }
     if (!got) {
       r->status = HEARTH_E_PARSE;
@@ -162,8 +177,9 @@ static int jpeg_decode(jpeg_reader *r) {
 }
 
 static hearth_status jpeg_read_mem(const void *data, size_t size, const char *name, int want_gray,
-                                   int half, size_t step, const hearth_image_expect *want,
-                                   hearth_image *img, hearth_err *err) {
+                                   int half, size_t step, const size_t *win,
+                                   const hearth_image_expect *want, hearth_image *img,
+                                   hearth_err *err) {
   if (!name) name = "<memory>";
   memset(img, 0, sizeof *img);
   if (size < 3 || !data || memcmp(data, "\xff\xd8\xff", 3) != 0)
@@ -177,6 +193,7 @@ static hearth_status jpeg_read_mem(const void *data, size_t size, const char *na
   r->want_gray = want_gray;
   r->half = half;
   r->step = step;
+  r->win = win;
   r->want = want;
   init_errmgr(&r->jerr);
   r->cinfo.err = &r->jerr.pub;
@@ -195,52 +212,64 @@ static hearth_status jpeg_read_mem(const void *data, size_t size, const char *na
 
 hearth_status hearth_jpeg_read_mem(const void *data, size_t size, const char *name,
                                    hearth_image *img, hearth_err *err) {
-  return jpeg_read_mem(data, size, name, 0, 0, 1, NULL, img, err);
+  return jpeg_read_mem(data, size, name, 0, 0, 1, NULL, NULL, img, err);
 }
 
 hearth_status hearth_jpeg_read_grid_mem(const void *data, size_t size, const char *name,
                                         size_t step, hearth_image *img, hearth_err *err) {
-  return jpeg_read_mem(data, size, name, 0, 0, step, NULL, img, err);
+  return jpeg_read_mem(data, size, name, 0, 0, step, NULL, NULL, img, err);
 }
 
 static hearth_status jpeg_read_file(const char *path, int want_gray, int half, size_t step,
-                                    const hearth_image_expect *want, hearth_image *img,
-                                    hearth_err *err) {
+                                    const size_t *win, const hearth_image_expect *want,
+                                    hearth_image *img, hearth_err *err) {
   memset(img, 0, sizeof *img);
   uint8_t *buf;
   size_t n;
   hearth_status s = hearth_read_file(path, JPEG_MAX_FILE_BYTES, &buf, &n, err);
   if (s) return s;
-  s = jpeg_read_mem(buf, n, path, want_gray, half, step, want, img, err);
+  s = jpeg_read_mem(buf, n, path, want_gray, half, step, win, want, img, err);
   free(buf);
   return s;
 }
 
 hearth_status hearth_jpeg_read(const char *path, hearth_image *img, hearth_err *err) {
-  return jpeg_read_file(path, 0, 0, 1, NULL, img, err);
+  return jpeg_read_file(path, 0, 0, 1, NULL, NULL, img, err);
 }
 
 hearth_status hearth_jpeg_read_half(const char *path, hearth_image *img, hearth_err *err) {
-  return jpeg_read_file(path, 0, 1, 1, NULL, img, err);
+  return jpeg_read_file(path, 0, 1, 1, NULL, NULL, img, err);
 }
 
 hearth_status hearth_jpeg_read_expect(const char *path, const hearth_image_expect *want,
                                       hearth_image *img, hearth_err *err) {
-  return jpeg_read_file(path, 0, 0, 1, want, img, err);
+  return jpeg_read_file(path, 0, 0, 1, NULL, want, img, err);
 }
 
 hearth_status hearth_jpeg_read_grid(const char *path, const hearth_image_expect *want, size_t step,
                                     hearth_image *img, hearth_err *err) {
-  return jpeg_read_file(path, 0, 0, step, want, img, err);
+  return jpeg_read_file(path, 0, 0, step, NULL, want, img, err);
+}
+
+hearth_status hearth_jpeg_read_grid_window(const char *path, const hearth_image_expect *want,
+                                           size_t step, const size_t window[4], hearth_image *img,
+                                           hearth_err *err) {
+  return jpeg_read_file(path, 0, 0, step, window, want, img, err);
+}
+
+hearth_status hearth_jpeg_read_grid_window_mem(const void *data, size_t size, const char *name,
+                                               size_t step, const size_t window[4],
+                                               hearth_image *img, hearth_err *err) {
+  return jpeg_read_mem(data, size, name, 0, 0, step, window, NULL, img, err);
 }
 
 hearth_status hearth_jpeg_read_gray(const char *path, hearth_image *img, hearth_err *err) {
-  return jpeg_read_file(path, 1, 0, 1, NULL, img, err);
+  return jpeg_read_file(path, 1, 0, 1, NULL, NULL, img, err);
 }
 
 hearth_status hearth_jpeg_read_gray_expect(const char *path, const hearth_image_expect *want,
                                            hearth_image *img, hearth_err *err) {
-  return jpeg_read_file(path, 1, 0, 1, want, img, err);
+  return jpeg_read_file(path, 1, 0, 1, NULL, want, img, err);
 }
 
 /* ---- writing ------------------------------------------------------------------ */
