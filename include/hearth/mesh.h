@@ -225,6 +225,17 @@ hearth_status hearth_ray_fan_cast_framed(const hearth_ray_fan *f, const hearth_m
                                          const hearth_rigid *T_world_from_cam, void *scratch,
                                          size_t grow, hearth_ray_hit *hits, size_t box[4],
                                          size_t frame[4], hearth_err *err);
+/* Without making a fan: a box of the grid pixels (every stride-th pixel of
+ * cam) that a cast of m from T_world_from_cam can hit, box = {x0, x1, y0,
+ * y1} inclusive (x0 > x1: none). It is the union over every triangle of its
+ * vertices' pixels grown by the cast's own bound on the lens's curvature
+ * and slack_px (room for the grid's undistortion residual and rounding,
+ * e.g. 1), so it holds the hits of any fan of cam's grid, or of any crop of
+ * it. HEARTH_E_UNSUPPORTED (naming the vertex) if a vertex is not in front
+ * of the camera. */
+hearth_status hearth_ray_fan_extent(const hearth_camera *cam, size_t stride, const hearth_mesh *m,
+                                    const hearth_rigid *T_world_from_cam, double slack_px,
+                                    size_t box[4], hearth_err *err);
 
 /* ---- UV islands and texel rasterisation ----------------------------------- */
 /* Label connected UV islands: triangles sharing an edge in UV space (same two

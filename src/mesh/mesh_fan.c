@@ -416,3 +416,64 @@ hearth_status hearth_ray_fan_cast_framed(const hearth_ray_fan *f, const hearth_m
                                          size_t frame[4], hearth_err *err) {
   return fan_cast(f, m, T_world_from_cam, scratch, hits, grow, box, frame, err);
 }
+
+hearth_status hearth_ray_fan_extent(const hearth_camera *cam, size_t stride, const hearth_mesh *m,
+                                    const hearth_rigid *T_world_from_cam, double slack_px,
+                                    size_t box[4], hearth_err *err) {
+  box[0] = box[2] = 1;
+  box[1] = box[3] = 0;
+  if (stride < 1) stride = 1;
+  if (!m->n_triangles) return HEARTH_OK;
+  const double *R = T_world_from_cam->R, *t = T_world_from_cam->t;
+  /* per vertex: its point in the plane z = 1 and its pixel */
+  double *V = hearth_alloc_array(m->n_vertices ? m->n_vertices : 1, 4 * sizeof *V);
+  if (!V) return hearth_err_set(err, HEARTH_E_NOMEM, "ray fan: out of memory");
+  for (size_t i = 0; i < m->n_vertices; i++) {
+    const float *p = m->positions + 3 * i;
+    double d[3] = {p[0] - t[0], p[1] - t[1], p[2] - t[2]}, c[3];
+    for (int k = 0; k < 3; k++) c[k] = R[k] * d[0] + R[3 + k] * d[1] + R[6 + k] * d[2];
+    if (!(c[2] > 0.0)) {
+      free(V);
+      return hearth_err_set(err, HEARTH_E_UNSUPPORTED,
+                            "ray fan: vertex %zu is not in front of the camera (z = %g)", i, c[2]);
+    }
+    double x = c[0] / c[2], y = c[1] / c[2], xd, yd;
+    hearth_distort(cam->dist, x, y, &xd, &yd, NULL);
+    V[4 * i] = x;
+    V[4 * i + 1] = y;
+    V[4 * i + 2] = cam->fx * xd + cam->cx;
+    V[4 * i + 3] = cam->fy * yd + cam->cy;
+  }
+  const long pw = (long)(((size_t)cam->width + stride - 1) / stride),
+             ph = (long)(((size_t)cam->height + stride - 1) / stride);
+  long bx0 = LONG_MAX, bx1 = -1, by0 = LONG_MAX, by1 = -1;
+  /* every triangle, whichever way it faces (back faces only widen the box):
+     the pixels of its projection, grown by the cast's margin */
+  for (size_t tri = 0; tri < m->n_triangles; tri++) {
+    const uint32_t *ix = m->indices + 3 * tri;
+    const double *a = V + 4 * (size_t)ix[0], *b = V + 4 * (size_t)ix[1], *c = V + 4 * (size_t)ix[2];
+    double minx = fmin(a[0], fmin(b[0], c[0])), maxx = fmax(a[0], fmax(b[0], c[0]));
+    double miny = fmin(a[1], fmin(b[1], c[1])), maxy = fmax(a[1], fmax(b[1], c[1]));
+    double d2 = (maxx - minx) * (maxx - minx) + (maxy - miny) * (maxy - miny);
+    float hu, hv;
+    lens_curvature(cam, (float)fmax(maxx, -minx), (float)fmax(maxy, -miny), &hu, &hv);
+    double mu = hu * d2 + slack_px, mv = hv * d2 + slack_px;
+    long i0, i1, j0, j1;
+    grid_range((float)((fmin(a[2], fmin(b[2], c[2])) - mu) / (double)stride),
+               (float)((fmax(a[2], fmax(b[2], c[2])) + mu) / (double)stride), pw, &i0, &i1);
+    grid_range((float)((fmin(a[3], fmin(b[3], c[3])) - mv) / (double)stride),
+               (float)((fmax(a[3], fmax(b[3], c[3])) + mv) / (double)stride), ph, &j0, &j1);
+    if (i0 > i1 || j0 > j1) continue;
+    bx0 = i0 < bx0 ? i0 : bx0;
+    bx1 = i1 > bx1 ? i1 : bx1;
+    by0 = j0 < by0 ? j0 : by0;
+    by1 = j1 > by1 ? j1 : by1;
+  }
+  free(V);
+  if (bx1 < 0) return HEARTH_OK;
+  box[0] = (size_t)bx0;
+  box[1] = (size_t)bx1;
+  box[2] = (size_t)by0;
+  box[3] = (size_t)by1;
+  return HEARTH_OK;
+}
