@@ -459,9 +459,52 @@ done:
 typedef struct bake_frames {
   const char *root, *inst, *state, *rig_path;
   const hearth_manifest *man;
-  const hearth_camera *cam;
-  size_t stride; /* the mapping's pixel grid: every stride-th pixel is decoded */
+  const hearth_camera *cam; /* the colour camera, whole */
+  size_t stride;            /* the mapping's pixel grid: every stride-th pixel is decoded */
+  size_t win[4];            /* the part of that grid decoded: {x0, y0, w, h} (bake_window) */
 } bake_frames;
+
+/* The colour views see the object in a part of the image. The mapping's
+ * pixel grid is cut to the window that holds every view's possible hits
+ * (hearth_ray_fan_extent) grown by the 2 pixels the silhouette filter reads
+ * beyond them, so its per-pixel arrays, the fan and the decoded frames are
+ * the window's. The crop is the camera with its principal point moved by
+ * the window's corner (a multiple of the stride): every grid pixel keeps
+ * its ray, every view its hits and their frame, and the texture is the
+ * same. win = {x0, y0, w, h} (grid pixels); the whole grid when a view
+ * cannot bound its hits (a vertex behind it) or none has any. */
+static void bake_window(const hearth_camera *cam, size_t stride, const hearth_mesh *mesh,
+                        const hearth_map_view *views, size_t n_views, hearth_camera *crop,
+                        size_t win[4]) {
+  const size_t pw = ((size_t)cam->width + stride - 1) / stride,
+               ph = ((size_t)cam->height + stride - 1) / stride;
+  *crop = *cam;
+  win[0] = win[1] = 0;
+  win[2] = pw;
+  win[3] = ph;
+  size_t u[4] = {SIZE_MAX, 0, SIZE_MAX, 0}; /* x0, x1, y0, y1 */
+  for (size_t v = 0; v < n_views; v++) {
+    size_t b[4];
+    if (hearth_ray_fan_extent(cam, stride, mesh, &views[v].T_world_from_cam, 1.0, b, NULL)) return;
+    if (b[0] > b[1]) continue;
+    u[0] = b[0] < u[0] ? b[0] : u[0];
+    u[1] = b[1] > u[1] ? b[1] : u[1];
+    u[2] = b[2] < u[2] ? b[2] : u[2];
+    u[3] = b[3] > u[3] ? b[3] : u[3];
+  }
+  if (u[0] > u[1]) return;
+  const size_t x0 = u[0] > 2 ? u[0] - 2 : 0, x1 = u[1] + 2 < pw ? u[1] + 2 : pw - 1,
+               y0 = u[2] > 2 ? u[2] - 2 : 0, y1 = u[3] + 2 < ph ? u[3] + 2 : ph - 1;
+  win[0] = x0;
+  win[1] = y0;
+  win[2] = x1 - x0 + 1;
+  win[3] = y1 - y0 + 1;
+  crop->cx = cam->cx - (double)(x0 * stride);
+  crop->cy = cam->cy - (double)(y0 * stride);
+  /* a grid of exactly w x h pixels, the last one within the image */
+  crop->width = (int)((win[2] - 1) * stride + 1);
+  crop->height = (int)((win[3] - 1) * stride + 1);
+}
 
 /* view k's colour frame: of the colour camera's size (checked before its
    pixels are decoded), RGB, its pixel grid only (the mapping's load_grid);
@@ -473,7 +516,9 @@ static hearth_status bake_frame(const bake_frames *f, size_t k, int header_only,
   snprintf(why, sizeof why, "(the colour camera of %s)", f->rig_path);
   hearth_image_expect want =
       {(size_t)f->cam->width, (size_t)f->cam->height, 0, 0, header_only, why};
-  hearth_status s = hearth_jpeg_read_grid(path, &want, f->stride, img, err);
+  hearth_status s = header_only
+                        ? hearth_jpeg_read_grid(path, &want, f->stride, img, err)
+                        : hearth_jpeg_read_grid_window(path, &want, f->stride, f->win, img, err);
   if (s) return s;
   if (img->channels != 3) {
     hearth_image_free(img);
@@ -530,7 +575,7 @@ hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err) {
     goto done;
   }
   const int stride = job->pixel_stride > 0 ? job->pixel_stride : 2;
-  bake_frames frames = {root, inst, state, rig_path, &man, &rig.rgb, (size_t)stride};
+  bake_frames frames = {root, inst, state, rig_path, &man, &rig.rgb, (size_t)stride, {0}};
   for (size_t k = 0; k < man.n_views; k++) {
     const hearth_view_files *vf = &man.views[k];
     const hearth_view_pose *vp = hearth_poses_find(&poses, state, vf->view);
@@ -544,6 +589,8 @@ hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err) {
     views[k].image = NULL; /* decoded by the mapping (bake_load) */
     views[k].T_world_from_cam = vp->T_world_from_cam;
   }
+  hearth_camera crop;
+  bake_window(&rig.rgb, (size_t)stride, &mesh, views, man.n_views, &crop, frames.win);
   hearth_map_opts mo;
   hearth_map_opts_default(&mo);
   mo.fusion = HEARTH_FUSE_MEAN;
@@ -557,7 +604,7 @@ hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err) {
   mo.load_ctx = &frames;
   mo.load_channels = 3;
   mo.load_grid = 1;
-  if ((s = hearth_map_views(&mesh, NULL, &rig.rgb, views, man.n_views, &mo, &r, err))) goto done;
+  if ((s = hearth_map_views(&mesh, NULL, &crop, views, man.n_views, &mo, &r, err))) goto done;
   if (!r.n_surface) {
     s = hearth_err_set(err, HEARTH_E_RANGE,
                        "%s/%s: %s: the mesh's UV layout covers no texel of the %zux%zu colour "

@@ -44,17 +44,20 @@ static hearth_status copy_image(void *ctx, size_t v, hearth_image *img, hearth_e
 typedef struct grid_src {
   const hearth_image *const *imgs;
   size_t stride;
+  size_t win[4]; /* the part of the grid made, {x0, y0, w, h}; w = 0: all of it */
 } grid_src;
 static hearth_status grid_image(void *ctx, size_t v, hearth_image *img, hearth_err *err) {
   const grid_src *g = ctx;
   const hearth_image *src = g->imgs[v];
-  const size_t st = g->stride, w = (src->width + st - 1) / st, h = (src->height + st - 1) / st;
+  const size_t st = g->stride;
+  size_t x0 = g->win[0], y0 = g->win[1], w = g->win[2], h = g->win[3];
+  if (!w) w = (src->width + st - 1) / st, h = (src->height + st - 1) / st;
   hearth_status s = hearth_image_alloc(img, w, h, src->channels, src->type, err);
   if (s) return s;
   const float *in = src->data;
   float *out = img->data;
   for (size_t y = 0; y < h; y++)
-    for (size_t x = 0; x < w; x++) out[y * w + x] = in[y * st * src->width + x * st];
+    for (size_t x = 0; x < w; x++) out[y * w + x] = in[(y0 + y) * st * src->width + (x0 + x) * st];
   return HEARTH_OK;
 }
 static hearth_status fail_image(void *ctx, size_t v, hearth_image *img, hearth_err *err) {
@@ -255,7 +258,7 @@ int main(void) {
       hearth_map_result full, grid;
       CHECK_OK(hearth_map_views(&m, NULL, &cam, views, 2, &go, &full, &err), &err);
       CHECK(full.n_observed > 500);
-      grid_src gs = {(const hearth_image *const *)imgs, (size_t)st};
+      grid_src gs = {(const hearth_image *const *)imgs, (size_t)st, {0, 0, 0, 0}};
       go.load = grid_image;
       go.load_ctx = &gs;
       go.load_channels = 1;
@@ -269,6 +272,43 @@ int main(void) {
       CHECK(!memcmp(full.observed, grid.observed, (size_t)RES * RES * sizeof(float)));
       CHECK(!memcmp(full.filled, grid.filled, (size_t)RES * RES * sizeof(float)));
       hearth_map_result_free(&grid);
+      /* the grid cut to the window of the views' extents grown by the
+         silhouette filter's 2 pixels, through the camera cropped to it
+         (the colour bake's window): every pixel keeps its ray, and the
+         maps are the same */
+      {
+        const size_t pw = (cam.width + (size_t)st - 1) / (size_t)st,
+                     ph = (cam.height + (size_t)st - 1) / (size_t)st;
+        size_t u[4] = {SIZE_MAX, 0, SIZE_MAX, 0};
+        for (int k = 0; k < 2; k++) {
+          size_t b[4];
+          CHECK_OK(hearth_ray_fan_extent(&cam, (size_t)st, &m, &views[k].T_world_from_cam, 1.0, b,
+                                         &err),
+                   &err);
+          u[0] = b[0] < u[0] ? b[0] : u[0];
+          u[1] = b[1] > u[1] ? b[1] : u[1];
+          u[2] = b[2] < u[2] ? b[2] : u[2];
+          u[3] = b[3] > u[3] ? b[3] : u[3];
+        }
+        const size_t x0 = u[0] > 2 ? u[0] - 2 : 0, y0 = u[2] > 2 ? u[2] - 2 : 0,
+                     x1 = u[1] + 2 < pw ? u[1] + 2 : pw - 1, y1 = u[3] + 2 < ph ? u[3] + 2 : ph - 1;
+        /* a real cut: the window leaves part of the grid out */
+        CHECK(u[0] <= u[1] && (x1 - x0 + 1) * (y1 - y0 + 1) < pw * ph);
+        hearth_camera crop = cam;
+        crop.cx -= (double)(x0 * (size_t)st);
+        crop.cy -= (double)(y0 * (size_t)st);
+        crop.width = (int)((x1 - x0) * (size_t)st + 1);
+        crop.height = (int)((y1 - y0) * (size_t)st + 1);
+        grid_src ws = {(const hearth_image *const *)imgs,
+                       (size_t)st,
+                       {x0, y0, x1 - x0 + 1, y1 - y0 + 1}};
+        go.load_ctx = &ws;
+        CHECK_OK(hearth_map_views(&m, NULL, &crop, lz, 2, &go, &grid, &err), &err);
+        CHECK(!memcmp(full.mask, grid.mask, (size_t)RES * RES));
+        CHECK(!memcmp(full.filled, grid.filled, (size_t)RES * RES * sizeof(float)));
+        hearth_map_result_free(&grid);
+        go.load_ctx = &gs;
+      }
       hearth_map_result_free(&full);
       go.load = copy_image;
       go.load_ctx = imgs;
