@@ -19,17 +19,14 @@
 
 int map_worker_alloc(map_worker *w, const hearth_map_layout *l, int C, int kind) {
   const size_t np = l->np;
-  w->hit_t = hearth_alloc_array(np, sizeof(float));
-  w->hit_tri = hearth_alloc_array(np, sizeof(uint32_t));
-  w->hit_b1 = hearth_alloc_array(np, sizeof(float));
-  w->hit_b2 = hearth_alloc_array(np, sizeof(float));
-  w->ray_org = hearth_alloc_array(np, 3 * sizeof(float));
-  w->ray_dir = hearth_alloc_array(np, 3 * sizeof(float));
+  /* the rays' origins and directions in one block: a frame's hits fit in
+     it once the rays are cast (6 words a pixel against 5) */
+  w->ray_org = hearth_alloc_array(np, 6 * sizeof(float));
+  w->ray_dir = w->ray_org ? w->ray_org + 3 * np : NULL;
   w->hits = hearth_alloc_array(np, sizeof(hearth_ray_hit));
   w->sil = hearth_alloc_array(np, 1);
   w->splats = hearth_alloc_array(np, sizeof(splat));
-  int ok = w->hit_t && w->hit_tri && w->hit_b1 && w->hit_b2 && w->ray_org && w->ray_dir &&
-           w->hits && w->sil && w->splats;
+  int ok = w->ray_org && w->hits && w->sil && w->splats;
   if (kind != WORKER_SPLATS) {
     w->touches = hearth_alloc_array(np, 4 * sizeof(touch));
     w->touches_tmp = hearth_alloc_array(np, 4 * sizeof(touch));
@@ -48,12 +45,7 @@ int map_worker_alloc(map_worker *w, const hearth_map_layout *l, int C, int kind)
 }
 
 void map_worker_free(map_worker *w) {
-  free(w->hit_t);
-  free(w->hit_tri);
-  free(w->hit_b1);
-  free(w->hit_b2);
-  free(w->ray_org);
-  free(w->ray_dir);
+  free(w->ray_org); /* ray_dir lies in its block */
   free(w->hits);
   free(w->sil);
   free(w->splats);
@@ -77,18 +69,22 @@ typedef struct pix_box {
 } pix_box;
 
 /* A view's hits are kept in the frame of their box grown by the 2 pixels
- * the silhouette filter reads (clipped to the grid): the worker's
- * per-pixel arrays are indexed within the frame, row after row, so that a
- * view touches memory in proportion to its box rather than to the rows of
- * the camera's grid it spans. */
+ * the silhouette filter reads (clipped to the grid), row after row, so
+ * that a view touches memory in proportion to its box rather than to the
+ * rows of the camera's grid it spans. Fan views keep them in the worker's
+ * hits array and traced ones in its rays' block; the other of the two is
+ * the silhouette filters' scratch. */
 typedef struct hit_frame {
-  pix_box box;         /* the hits' box, grid pixels */
-  size_t x0, y0, w, h; /* the frame, grid pixels (w = h = 0 without hits) */
+  pix_box box;          /* the hits' box, grid pixels */
+  size_t x0, y0, w, h;  /* the frame, grid pixels (w = h = 0 without hits) */
+  hearth_ray_hit *hits; /* w * h: front-face hits, misses elsewhere (prim UINT32_MAX, t +inf) */
+  float *scratch;       /* 2 * w * h floats */
 } hit_frame;
 
-/* the frame of box, its pixels all misses */
-static void frame_open(const hearth_map_layout *l, map_worker *w, const pix_box *box,
-                       hit_frame *f) {
+static const hearth_ray_hit k_miss = {INFINITY, UINT32_MAX, 0.0f, 0.0f, 0};
+
+/* the frame of box (its arrays not yet set) */
+static void frame_of(const hearth_map_layout *l, const pix_box *box, hit_frame *f) {
   f->box = *box;
   f->x0 = f->y0 = f->w = f->h = 0;
   if (box->x0 > box->x1) return;
@@ -96,23 +92,11 @@ static void frame_open(const hearth_map_layout *l, map_worker *w, const pix_box 
   f->y0 = box->y0 >= 2 ? box->y0 - 2 : 0;
   f->w = (box->x1 + 2 < l->pw ? box->x1 + 2 : l->pw - 1) - f->x0 + 1;
   f->h = (box->y1 + 2 < l->ph ? box->y1 + 2 : l->ph - 1) - f->y0 + 1;
-  for (size_t k = 0; k < f->w * f->h; k++) {
-    w->hit_t[k] = INFINITY;
-    w->hit_tri[k] = UINT32_MAX;
-  }
 }
 
 /* grid pixel (x, y)'s place in the frame */
 static inline size_t frame_at(const hit_frame *f, size_t x, size_t y) {
   return (y - f->y0) * f->w + (x - f->x0);
-}
-
-/* a front-face hit kept at frame place k */
-static inline void frame_put(map_worker *w, size_t k, const hearth_ray_hit *h) {
-  w->hit_t[k] = h->t;
-  w->hit_tri[k] = h->prim;
-  w->hit_b1[k] = h->b1;
-  w->hit_b2[k] = h->b2;
 }
 
 static inline int front_hit(const hearth_ray_hit *h) { return h->prim != UINT32_MAX && h->front; }
@@ -137,17 +121,11 @@ static void cast_fan(map_ctx *m, size_t v, map_worker *w, hit_frame *f) {
   }
   pix_box box = {SIZE_MAX, 0, SIZE_MAX, 0};
   if (fb[0] <= fb[1]) box = (pix_box){fb[0], fb[1], fb[2], fb[3]};
-  frame_open(l, w, &box, f);
-  if (box.x0 > box.x1) return;
-  if (f->x0 != fr[0] || f->y0 != fr[1] || f->w != fr[2] || f->h != fr[3]) {
+  frame_of(l, &box, f);
+  f->hits = w->hits;
+  f->scratch = w->ray_org;
+  if (box.x0 <= box.x1 && (f->x0 != fr[0] || f->y0 != fr[1] || f->w != fr[2] || f->h != fr[3]))
     m->failed = 2; /* cannot happen: both grow the box by 2 within the grid */
-    return;
-  }
-  for (size_t y = box.y0; y <= box.y1; y++)
-    for (size_t x = box.x0; x <= box.x1; x++) {
-      const size_t k = frame_at(f, x, y);
-      if (front_hit(&w->hits[k])) frame_put(w, k, &w->hits[k]);
-    }
 }
 
 /* the grid pixels in 4x4 tiles (coherent packets of 16): the block after (pw, ph) runs for
@@ -207,11 +185,16 @@ static void cast_rays(const map_ctx *m, size_t v, map_worker *w, hit_frame *f) {
     hits[i] = h;
     if (front_hit(&h)) box_add(&box, x, y);
   });
-  frame_open(l, w, &box, f);
+  /* the rays are cast: their block holds the frame's hits, the hits'
+     array is the scratch */
+  frame_of(l, &box, f);
+  f->hits = (hearth_ray_hit *)(void *)w->ray_org;
+  f->scratch = (float *)(void *)w->hits;
   if (box.x0 > box.x1) return;
+  for (size_t k = 0; k < f->w * f->h; k++) f->hits[k] = k_miss;
   FOR_TILED_PIXELS(pw, ph, {
     if (x >= box.x0 && x <= box.x1 && y >= box.y0 && y <= box.y1 && front_hit(&hits[i]))
-      frame_put(w, frame_at(f, x, y), &hits[i]);
+      f->hits[frame_at(f, x, y)] = hits[i];
   });
 }
 
@@ -222,52 +205,50 @@ static void cast_rays(const map_ctx *m, size_t v, map_worker *w, hit_frame *f) {
  * so these pixels do not measure one surface. Computed with separable 5x5
  * minimum and maximum filters of the hit distance (a miss is +inf). Only
  * pixels inside the hits' box get flags; the filters read up to 2 pixels
- * beyond it, the rest of the frame, where ht holds the misses. Every array
+ * beyond it, the rest of the frame, which holds misses there. Every array
  * is indexed within the frame, which the clipping to the image keeps
  * as it was: the frame ends 2 pixels beyond the box or at the image's
  * edge. */
-static void silhouettes(const hit_frame *f, const float *ht, float *lo, float *hi, float *tmp_lo,
-                        float *tmp_hi, uint8_t *sil) {
+static void silhouettes(const hit_frame *f, uint8_t *sil) {
   const size_t W = f->w, H = f->h;
+  const hearth_ray_hit *ht = f->hits;
+  float *tmp_lo = f->scratch, *tmp_hi = f->scratch + W * H;
   const pix_box b = {f->box.x0 - f->x0, f->box.x1 - f->x0, f->box.y0 - f->y0, f->box.y1 - f->y0};
   size_t ry0 = b.y0 >= 2 ? b.y0 - 2 : 0, ry1 = b.y1 + 2 < H ? b.y1 + 2 : H - 1;
   for (size_t y = ry0; y <= ry1; y++) {
-    const float *r = ht + y * W;
+    const hearth_ray_hit *r = ht + y * W;
     for (size_t x = b.x0; x <= b.x1; x++) {
       size_t a = x >= 2 ? x - 2 : 0, e = x + 2 < W ? x + 2 : W - 1;
-      float mn = r[a], mx = r[a];
+      float mn = r[a].t, mx = r[a].t;
       for (size_t k = a + 1; k <= e; k++) {
-        mn = r[k] < mn ? r[k] : mn;
-        mx = r[k] > mx ? r[k] : mx;
+        mn = r[k].t < mn ? r[k].t : mn;
+        mx = r[k].t > mx ? r[k].t : mx;
       }
       tmp_lo[y * W + x] = mn;
       tmp_hi[y * W + x] = mx;
     }
   }
+  /* the vertical pass, and each pixel's flag from its neighbourhood's
+     extremes */
   for (size_t y = b.y0; y <= b.y1; y++) {
     size_t a = y >= 2 ? y - 2 : 0, e = y + 2 < H ? y + 2 : H - 1;
     for (size_t x = b.x0; x <= b.x1; x++) {
-      float mn = tmp_lo[a * W + x], mx = tmp_hi[a * W + x];
-      for (size_t k = a + 1; k <= e; k++) {
-        float lv = tmp_lo[k * W + x], hv = tmp_hi[k * W + x];
-        mn = lv < mn ? lv : mn;
-        mx = hv > mx ? hv : mx;
-      }
-      lo[y * W + x] = mn;
-      hi[y * W + x] = mx;
-    }
-  }
-  for (size_t y = b.y0; y <= b.y1; y++)
-    for (size_t x = b.x0; x <= b.x1; x++) {
-      size_t p = y * W + x;
-      float t0 = ht[p];
+      const size_t p = y * W + x;
+      const float t0 = ht[p].t;
       if (!isfinite(t0)) {
         sil[p] = 1;
         continue;
       }
+      float lo = tmp_lo[a * W + x], hi = tmp_hi[a * W + x];
+      for (size_t k = a + 1; k <= e; k++) {
+        float lv = tmp_lo[k * W + x], hv = tmp_hi[k * W + x];
+        lo = lv < lo ? lv : lo;
+        hi = hv > hi ? hv : hi;
+      }
       float tol = 0.03f * t0;
-      sil[p] = !isfinite(hi[p]) || hi[p] - t0 > tol || t0 - lo[p] > tol;
+      sil[p] = !isfinite(hi) || hi - t0 > tol || t0 - lo > tol;
     }
+  }
 }
 
 /* The splats of view v's hits within box, in raster order: hits at a
@@ -284,7 +265,7 @@ static size_t splat_hits(const map_ctx *m, size_t v, const hearth_image *img, in
   const int C = m->C;
   const double *Rw = m->views[v].T_world_from_cam.R;
   const float min_cos = (float)m->opts->min_cos;
-  const uint32_t *htri = w->hit_tri;
+  const hearth_ray_hit *fh = f->hits;
   const uint8_t *sil = w->sil;
   splat *sp = w->splats;
   uint32_t hits = 0;
@@ -292,7 +273,7 @@ static size_t splat_hits(const map_ctx *m, size_t v, const hearth_image *img, in
   for (size_t py = box->y0; py <= box->y1 && box->x0 <= box->x1; py++) {
     for (size_t px = box->x0; px <= box->x1; px++) {
       const size_t p = py * l->pw + px, fk = frame_at(f, px, py);
-      uint32_t tri = htri[fk];
+      uint32_t tri = fh[fk].prim;
       if (tri == UINT32_MAX) continue;
       if (edges && sil[fk]) continue;
       const float *nrm = l->tri_normal + 3 * (size_t)tri, *dc = l->pix_dir + 3 * p;
@@ -304,7 +285,7 @@ static size_t splat_hits(const map_ctx *m, size_t v, const hearth_image *img, in
       hits++;
       /* UV of the hit point */
       const uint32_t *ix = mesh->indices + 3 * (size_t)tri;
-      float b1 = w->hit_b1[fk], b2 = w->hit_b2[fk], b0 = 1.0f - b1 - b2;
+      float b1 = fh[fk].b1, b2 = fh[fk].b2, b0 = 1.0f - b1 - b2;
       float u = b0 * mesh->uvs[2 * ix[0]] + b1 * mesh->uvs[2 * ix[1]] + b2 * mesh->uvs[2 * ix[2]];
       float vv = b0 * mesh->uvs[2 * ix[0] + 1] + b1 * mesh->uvs[2 * ix[1] + 1] +
                  b2 * mesh->uvs[2 * ix[2] + 1];
@@ -314,8 +295,8 @@ static size_t splat_hits(const map_ctx *m, size_t v, const hearth_image *img, in
       splat *e = &sp[n_sp++];
       e->fx = x - x0f;
       e->fy = y - y0f;
-      e->x0 = (int32_t)x0f;
-      e->y0 = (int32_t)y0f;
+      e->x0 = (int16_t)x0f;
+      e->y0 = (int16_t)y0f;
       e->island = l->island_of_tri[tri];
       if (l->cos_normal) {
         /* the viewing cosine from the smoothed normal (the hit stays the
@@ -327,7 +308,11 @@ static size_t splat_hits(const map_ctx *m, size_t v, const hearth_image *img, in
       e->cosv = cosv;
       /* the camera pixel of grid pixel p */
       size_t src = grid ? p : (py * st) * W + px * st;
-      for (int c = 0; c < C; c++) e->val[c] = image_value(img, src, c);
+      /* one channel: F32 temperatures; three: U8 colour (view_channels) */
+      if (C == 1) e->val.t = image_value(img, src, 0);
+      else
+        for (int c = 0; c < 3; c++)
+          e->val.rgb[c] = ((const uint8_t *)img->data)[src * (size_t)img->channels + (size_t)c];
     }
   }
   *n_hits = hits;
@@ -421,7 +406,7 @@ static size_t reduce_touches(const map_ctx *m, map_worker *w, const touch *tc, s
       any = 1;
       float wk = corner_weight(e, (int)(tc[k].sk & 3));
       wsum += wk;
-      for (int c = 0; c < C; c++) sum[c] += wk * e->val[c];
+      for (int c = 0; c < C; c++) sum[c] += wk * splat_value(e, C, c);
     }
     i = j;
     if (!any) continue;
@@ -475,17 +460,19 @@ static int load_view(map_ctx *m, size_t v, hearth_image *img) {
   return 0;
 }
 
-static void process_view(map_ctx *m, size_t v, int t) {
+/* view v on worker t; returns whether its splats went into the mean
+   fusion's sums (0 for the other rules, and for a view that failed) */
+static int process_view(map_ctx *m, size_t v, int t) {
   const hearth_map_layout *l = m->l;
   map_worker *w = &m->workers[t];
-  hit_frame f = {{1, 0, 1, 0}, 0, 0, 0, 0}; /* no hit: empty */
+  hit_frame f = {{1, 0, 1, 0}, 0, 0, 0, 0, NULL, NULL}; /* no hit: empty */
   hearth_image own = {0};
   const hearth_image *img = m->views[v].image;
   if (!img) {
     /* every view tries its load, so the lowest failure is found */
     if (!load_view(m, v, &own)) {
       m->failed = 3;
-      return;
+      return 0;
     }
     img = &own;
   }
@@ -493,15 +480,13 @@ static void process_view(map_ctx *m, size_t v, int t) {
   else cast_rays(m, v, w, &f);
   if (m->failed) {
     hearth_image_free(&own);
-    return;
+    return 0;
   }
   if (f.box.x0 > f.box.x1) f.box = (pix_box){1, 0, 1, 0}; /* no hit: empty */
   const int edges = m->opts->fusion == HEARTH_FUSE_ROBUST ||
                     m->opts->fusion == HEARTH_FUSE_CORRECTED || !m->opts->keep_edges;
   if (edges && f.box.x0 <= f.box.x1) {
-    /* the ray arrays are free again: scratch for the filters */
-    const size_t n = l->np;
-    silhouettes(&f, w->hit_t, w->ray_org, w->ray_org + n, w->ray_dir, w->ray_dir + n, w->sil);
+    silhouettes(&f, w->sil);
   }
   uint32_t hits = 0;
   size_t n_sp = splat_hits(m, v, img, own.data && m->opts->load_grid, w, &f, edges, &hits);
@@ -509,19 +494,24 @@ static void process_view(map_ctx *m, size_t v, int t) {
   m->view_hits[v] = hits;
   if (m->rec && m->rec->acc) {
     /* mean fusion: the splats into the sums, in view order */
-    if (!map_splats_fold(m->rec, v, w->splats, n_sp, l->island_of_texel, l->R, m->C)) m->failed = 1;
-    return;
+    map_splats_fold(m->rec, v, w->splats, n_sp, l->island_of_texel, l->R, m->C);
+    return 1;
   }
   size_t n_tc = 0;
   const touch *tc = sorted_touches(w, n_sp, l->R, &n_tc);
   size_t n_rec = reduce_touches(m, w, tc, n_tc, t);
   if (m->rec) keep_records(m, v, w, n_rec);
+  return 0;
 }
 
 /* views are handed out one at a time to whichever worker is free (they
    differ in cost, and a shared machine slows workers unevenly); a view's
-   records do not depend on the worker */
+   records do not depend on the worker. For mean fusion a view that failed
+   still takes its turn, folding nothing, so that the views after it do
+   not wait for it (the mapping fails). */
 void map_cast_views(void *ctx, size_t b, size_t e, int t) {
   map_ctx *m = ctx;
-  for (size_t v = b; v < e; v++) process_view(m, v, t);
+  for (size_t v = b; v < e; v++)
+    if (!process_view(m, v, t) && m->rec && m->rec->acc)
+      map_splats_fold(m->rec, v, NULL, 0, m->l->island_of_texel, m->l->R, m->C);
 }

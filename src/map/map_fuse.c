@@ -62,16 +62,17 @@ int map_records_alloc(view_records *r, size_t n_views, int stream, size_t R, int
   r->n = calloc(n_views ? n_views : 1, sizeof *r->n);
   if (!r->q || !r->d || !r->n) return 0;
   if (!stream) return 1;
-  r->sp = calloc(n_views ? n_views : 1, sizeof *r->sp);
-  if (!r->sp) return 0;
   /* calloc: the pages of texels no view observes are never touched */
   r->acc = calloc(R * R, (size_t)C * sizeof *r->acc);
   r->acc_owned = 1;
   r->acc_w = calloc(R * R, sizeof *r->acc_w);
   if (want_cos) r->best_cos = calloc(R * R, sizeof *r->best_cos);
-  r->waiting = calloc(n_views ? n_views : 1, 1);
-  if (!r->acc || !r->acc_w || (want_cos && !r->best_cos) || !r->waiting) return 0;
+  if (!r->acc || !r->acc_w || (want_cos && !r->best_cos)) return 0;
   if (pthread_mutex_init(&r->mu, NULL)) return 0;
+  if (pthread_cond_init(&r->turn, NULL)) {
+    pthread_mutex_destroy(&r->mu);
+    return 0;
+  }
   r->have_mu = 1;
   return 1;
 }
@@ -79,16 +80,16 @@ int map_records_alloc(view_records *r, size_t n_views, int stream, size_t R, int
 void map_records_free(view_records *r) {
   for (size_t v = 0; r->q && v < r->n_views; v++) free(r->q[v]);
   for (size_t v = 0; r->d && v < r->n_views; v++) free(r->d[v]);
-  for (size_t v = 0; r->sp && v < r->n_views; v++) free(r->sp[v]);
   free(r->q);
   free(r->d);
-  free(r->sp);
   free(r->n);
   if (r->acc_owned) free(r->acc);
   free(r->acc_w);
   free(r->best_cos);
-  free(r->waiting);
-  if (r->have_mu) pthread_mutex_destroy(&r->mu);
+  if (r->have_mu) {
+    pthread_mutex_destroy(&r->mu);
+    pthread_cond_destroy(&r->turn);
+  }
   memset(r, 0, sizeof *r);
 }
 
@@ -107,35 +108,24 @@ static void add_splats(view_records *r, const uint32_t *iot, size_t R, const spl
       if (!(wk > 0.0f) || iot[q] != e->island) continue;
       if (r->best_cos && e->cosv > r->best_cos[q]) r->best_cos[q] = e->cosv;
       float *a = r->acc + q * (size_t)C;
-      for (int c = 0; c < C; c++) a[c] += wk * e->val[c];
+      for (int c = 0; c < C; c++) a[c] += wk * splat_value(e, C, c);
       r->acc_w[q] += wk;
     }
   }
 }
 
-int map_splats_fold(view_records *r, size_t v, const splat *sp, size_t n, const uint32_t *iot,
-                    size_t R, int C) {
-  int ok = 1;
+void map_splats_fold(view_records *r, size_t v, const splat *sp, size_t n, const uint32_t *iot,
+                     size_t R, int C) {
+  /* the views before v are in once next reaches v; until v is in, no other
+     view touches the sums, so they are added without the lock */
   pthread_mutex_lock(&r->mu);
-  if (v == r->next) {
-    add_splats(r, iot, R, sp, n, C);
-    /* then the views done before their turn that follow it */
-    for (r->next++; r->next < r->n_views && r->waiting[r->next]; r->next++) {
-      size_t w = r->next;
-      add_splats(r, iot, R, r->sp[w], r->n[w], C);
-      free(r->sp[w]);
-      r->sp[w] = NULL;
-    }
-  } else {
-    /* not its turn: kept until the views before it are in */
-    r->n[v] = n;
-    r->sp[v] = hearth_alloc_array(n ? n : 1, sizeof *sp);
-    if (r->sp[v]) memcpy(r->sp[v], sp, n * sizeof *sp);
-    else ok = 0, r->n[v] = 0; /* the mapping fails; nothing to fold */
-    r->waiting[v] = 1;
-  }
+  while (r->next != v) pthread_cond_wait(&r->turn, &r->mu);
   pthread_mutex_unlock(&r->mu);
-  return ok;
+  add_splats(r, iot, R, sp, n, C);
+  pthread_mutex_lock(&r->mu);
+  r->next = v + 1;
+  pthread_cond_broadcast(&r->turn);
+  pthread_mutex_unlock(&r->mu);
 }
 
 /* a (value, weight) pair of one view at one texel */

@@ -53,14 +53,23 @@ struct hearth_map_layout {
 #define REC_WORDS(C) (2 + (size_t)(C))
 #define BAND_TEXELS 16384 /* texels per band of the fusion phase (whole rows) */
 
-/* one hit pixel's splat: its bilinear footprint, island, cosine and value */
+/* one hit pixel's splat: its bilinear footprint, island, cosine and value
+   (32 bytes: a view's splats are the mapping's largest scratch) */
 typedef struct splat {
   double fx, fy;  /* bilinear fractions */
-  int32_t x0, y0; /* lower-left texel of the 2 x 2 footprint */
+  int16_t x0, y0; /* lower-left texel of the 2 x 2 footprint: -1..R-1, R <= 16384 */
   uint32_t island;
   float cosv;
-  float val[3];
+  union {
+    float t;        /* one channel: the temperature */
+    uint8_t rgb[3]; /* three: the colour (views of three channels are U8) */
+  } val;
 } splat;
+
+/* channel c of a splat's value, of C channels */
+static inline float splat_value(const splat *e, int C, int c) {
+  return C == 1 ? e->val.t : (float)e->val.rgb[c];
+}
 
 /* the bilinear weight of corner k (bit 0: +x, bit 1: +y) of a splat */
 static inline float corner_weight(const splat *e, int k) {
@@ -80,14 +89,12 @@ typedef struct touch {
  * one view (the pixel grid's np pixels, or 4 touches a pixel). The worker
  * owns every array. */
 typedef struct map_worker {
-  float *hit_t, *hit_b1, *hit_b2; /* np: the hit distance (+inf: none) and barycentrics, in
-                                     the view's frame (map_cast.c) */
-  uint32_t *hit_tri;              /* np: the hit triangle (UINT32_MAX: none), in the frame */
-  float *ray_org,
-      *ray_dir;         /* 3 * np: traced rays; after the cast, the silhouette filters' scratch */
-  hearth_ray_hit *hits; /* np */
-  uint8_t *sil;         /* np: silhouette flags, in the frame */
-  splat *splats;        /* np */
+  float *ray_org, *ray_dir;     /* 3 * np each, one block: traced rays; after their cast, the
+                               frame's hits (map_cast.c), or a fan view's filter scratch */
+  hearth_ray_hit *hits;         /* np: the cast's hits (a fan view's in its frame); after a traced
+                               view's, its filter scratch */
+  uint8_t *sil;                 /* np: silhouette flags, in the frame */
+  splat *splats;                /* np */
   touch *touches, *touches_tmp; /* 4 * np: a view's touches and the sort's second buffer
                                    (NULL for mean fusion, which folds the splats) */
   void *fan_scratch;            /* the ray fan's scratch (NULL without a fan) */
@@ -113,25 +120,25 @@ typedef struct max_maps {
 /* Robust and corrected fusion: each view's records (see REC_WORDS), sorted
  * by texel, in an allocation of their own size; the fusion folds them in
  * view order. Mean fusion needs no records: a view's splats go into
- * per-texel sums, corner by corner in pixel order, as soon as every view
- * before it has gone in (the sums see the views in view order whatever the
- * threads), so only the views done out of order wait, as copies of their
- * splats. */
+ * per-texel sums, corner by corner in pixel order, once every view before
+ * it has gone in (the sums see the views in view order whatever the
+ * threads). A worker whose view is done before its turn waits for it with
+ * the splats in its scratch: a copy would cost the memory of a view's
+ * splats at the moment the sums are fullest. */
 typedef struct view_records {
   size_t n_views;
   uint32_t **q; /* per view: n[v] texels */
   float **d;    /* per view: n[v] * REC_WORDS(C) words */
-  splat **sp;   /* mean fusion, per view: its n[v] splats while it waits (else NULL) */
   size_t *n;
   /* mean fusion (NULL otherwise): R * R * C sums of the weighted values and
      R * R sums of the weights, zero where no view observed; the fusion
      turns acc into the result's observed map in place (acc_owned 0) */
   float *acc, *acc_w;
   int acc_owned;
-  float *best_cos;  /* R * R best viewing cosines (0: none); NULL with skip_best_cos */
-  uint8_t *waiting; /* per view: done, its records kept until its turn */
-  size_t next;      /* the first view not yet folded */
-  pthread_mutex_t mu;
+  float *best_cos;     /* R * R best viewing cosines (0: none); NULL with skip_best_cos */
+  size_t next;         /* mean fusion: the first view not yet folded */
+  pthread_mutex_t mu;  /* guards next */
+  pthread_cond_t turn; /* next moved */
   int have_mu;
 } view_records;
 
@@ -194,10 +201,11 @@ void map_max_free(max_maps *mx);
  * Returns 0 out of memory. */
 int map_records_alloc(view_records *r, size_t n_views, int stream, size_t R, int C, int want_cos);
 /* mean fusion: view v's n splats folded into the sums of R x R texels in
- * view order (see view_records), each corner only into a texel of the
- * splat's island (island_of_texel); returns 0 out of memory */
-int map_splats_fold(view_records *r, size_t v, const splat *sp, size_t n,
-                    const uint32_t *island_of_texel, size_t R, int C);
+ * view order, once every view before it is in (the caller waits for its
+ * turn; see view_records), each corner only into a texel of the splat's
+ * island (island_of_texel). Every view must come, failed ones with n = 0. */
+void map_splats_fold(view_records *r, size_t v, const splat *sp, size_t n,
+                     const uint32_t *island_of_texel, size_t R, int C);
 void map_records_free(view_records *r);
 
 /* The islands' bounding boxes and counts, gathered by the fusion for the
