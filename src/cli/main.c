@@ -2,9 +2,6 @@
  * A subcommand exists in a build when its cmd_<name>.c is compiled in; the
  * weak references below let areas add commands without touching this file. */
 #include <errno.h>
-#ifdef __GLIBC__
-#include <malloc.h>
-#endif
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -94,15 +91,6 @@ static void list_commands(FILE *out) {
 }
 
 int main(int argc, char **argv) {
-#ifdef __GLIBC__
-  /* Large arrays (maps, a view's per-pixel scratch, decoded frames) come
-     from mmap and go back to the system when freed. glibc otherwise raises
-     its mmap threshold to the largest block freed so far (up to 32 MiB),
-     after which freed maps stay in the heap: a command that maps several
-     states, or bakes then maps, held the first one's memory through the
-     rest. */
-  mallopt(M_MMAP_THRESHOLD, 256 * 1024);
-#endif
   int version = 0;
   const cli_opt opts[] = {
       CLI_FLAG("--version", &version, 1, "print the version"),
