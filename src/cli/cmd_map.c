@@ -4,9 +4,6 @@
 #include <string.h>
 #include "cli/cli.h"
 #include "hearth/map.h"
-#ifdef __GLIBC__ /* defined by the C library's headers above */
-#include <malloc.h>
-#endif
 
 static const char *k_about =
     "Casts every thermal pixel's undistorted centre onto the metric mesh (nearest\n"
@@ -72,18 +69,6 @@ static hearth_status map_rgb_one(void *vctx, const char *instance, hearth_err *e
 }
 
 int hearth_cmd_map(int argc, char **argv) {
-#ifdef __GLIBC__
-  /* The mapping's arrays are large and short-lived (maps, sums, each
-     view's scratch). glibc raises its mmap threshold to the largest block
-     freed so far, after which such arrays come from the heap: freed, they
-     stay with the process, and calloc must zero a recycled block whole
-     where fresh pages stay untouched until written. A fixed threshold
-     keeps them mmapped, so each map or bake of a command starts from
-     what it needs (map --rgb: 1.00x a plain map's peak; 1.3x without).
-     Not for every command: stages that free and remake buffers of a
-     megabyte a view (the overlays) pay for it in page faults. */
-  mallopt(M_MMAP_THRESHOLD, 256 * 1024);
-#endif
   const char *instance = NULL, *state = NULL;
   map_ctx ctx;
   memset(&ctx, 0, sizeof ctx);

@@ -82,20 +82,8 @@ hearth_status hearth_map_bake_run(const hearth_map_job *map, const hearth_bake_j
   bake_outputs o;
   memset(&o, 0, sizeof o);
   hearth_status s = outputs_plan(map, states, n_states, &o, err);
-  /* the states' maps, then the bake: the bake leaves more behind (the
-   * pages of its JPEG decoding) than a map does, so run last it keeps the
-   * command's peak at the larger of the two instead of adding to the
-   * maps'. A bad colour view is then found after the maps are made; the
-   * run still leaves everything as it was. */
-  for (size_t k = 0; k < n_states && !s; k++) {
-    if ((s = hearth_temp_dir(o.dir[k], o.dir_tmp[k], PATH_SZ, err))) break;
-    hearth_map_job mj = *map;
-    mj.state = states[k];
-    mj.out_dir = o.dir_tmp[k];
-    double t0 = hearth_now();
-    s = hearth_map_run(&mj, stats ? &stats[k] : NULL, err);
-    if (seconds) seconds[k + 1] = hearth_now() - t0;
-  }
+  /* the bake first: it reads another state's colour views, so a bad one
+   * stops the run before any map is made */
   if (!s) s = hearth_temp_file(o.texture, o.texture_tmp, PATH_SZ, NULL, err);
   if (!s) s = hearth_temp_file(o.mesh, o.mesh_tmp, PATH_SZ, NULL, err);
   if (!s) {
@@ -107,6 +95,15 @@ hearth_status hearth_map_bake_run(const hearth_map_job *map, const hearth_bake_j
     double t0 = hearth_now();
     s = hearth_bake_rgb_run(&bj, err);
     if (seconds) seconds[0] = hearth_now() - t0;
+  }
+  for (size_t k = 0; k < n_states && !s; k++) {
+    if ((s = hearth_temp_dir(o.dir[k], o.dir_tmp[k], PATH_SZ, err))) break;
+    hearth_map_job mj = *map;
+    mj.state = states[k];
+    mj.out_dir = o.dir_tmp[k];
+    double t0 = hearth_now();
+    s = hearth_map_run(&mj, stats ? &stats[k] : NULL, err);
+    if (seconds) seconds[k + 1] = hearth_now() - t0;
   }
   if (!s) s = outputs_commit(&o, err);
   outputs_discard(&o);
