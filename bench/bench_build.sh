@@ -4,7 +4,8 @@
 # calibration captures) per stage, against `hearth map` of all its states in
 # the same run (the target: the build at most 12x the mapping); then
 # `hearth demo` followed by `hearth build` of its release, which must run no
-# stage; then the peak memory of `hearth map --rgb` beside plain `hearth map`.
+# stage; then the peak memory of the colour bake (as `hearth map --rgb`
+# reports it) and of the whole `hearth map --rgb` beside plain `hearth map`.
 # Times are wall clock and CPU (user + sys) on a possibly shared machine:
 # compare the ratios, not the seconds, across machines.
 #   bench/bench_build.sh [BUILD_DIR] [WORK_DIR]
@@ -106,6 +107,10 @@ state=$(sed -n 's/.*"states": *\["\([^"]*\)".*/\1/p' "$work/rel/instances/cup_01
 rss() { if [ -x /usr/bin/time ]; then /usr/bin/time -f "%M" -o "$work/rss.txt" "$@" > /dev/null && cat "$work/rss.txt"; else echo 0; fi; }
 rss_map=$(rss "$h" map "$work/rel" --instance cup_01 --state "$state")
 rss_rgb=$(rss "$h" map "$work/rel" --instance cup_01 --state "$state" --rgb)
+# the bake runs first in map --rgb and reports the process's peak when it
+# ends: the bake's own peak (MiB)
+"$h" map "$work/rel" --instance cup_01 --state "$state" --rgb > "$work/rgb.log"
+rss_bake=$(sed -n 's/.*colour texture baked (.*peak memory so far \([0-9.]*\) MiB).*/\1/p' "$work/rgb.log")
 
 echo
 printf "build -j2      %7.2f s wall %7.2f s CPU\n" "$build_wall" "$build_cpu"
@@ -113,6 +118,7 @@ printf "map, 4 states  %7.2f s wall %7.2f s CPU\n" "$map_wall" "$map_cpu"
 awk -v a="$build_wall" -v b="$map_wall" -v c="$build_cpu" -v d="$map_cpu" 'BEGIN {
   printf "ratio build / map: %.1fx wall, %.1fx CPU (target: at most 12x)\n", a / b, (d > 0 ? c / d : 0) }'
 [ "$demo" = 0 ] || printf "build after demo: %s stage(s) run (must be 0)\n" "${rebuild_runs:-?}"
-awk -v a="$rss_map" -v b="$rss_rgb" 'BEGIN {
-  printf "peak RSS: map %.0f MiB, map --rgb %.0f MiB (%.2fx)\n", a / 1024, b / 1024, (a > 0 ? b / a : 0) }'
+awk -v a="$rss_map" -v b="$rss_rgb" -v c="${rss_bake:-0}" 'BEGIN {
+  printf "peak RSS: map %.1f MiB; the bake %.1f MiB (%.2fx the map, target: at most 1x); map --rgb as a whole %.1f MiB (%.2fx)\n",
+    a / 1024, c, (a > 0 ? c * 1024 / a : 0), b / 1024, (a > 0 ? b / a : 0) }'
 [ "$demo" = 0 ] || [ "${rebuild_runs:-1}" = 0 ]

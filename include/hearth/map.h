@@ -223,10 +223,13 @@ hearth_status hearth_bake_rgb_run(const hearth_bake_job *job, hearth_err *err);
  * output is as it was and no temporary is left. Temporaries of killed
  * earlier runs are removed first. stats (optional, n_states) receives each
  * state's counters; seconds (optional, n_states + 1) the bake's time, then
- * each state's. */
+ * each state's; bake_peak_kib (optional) the process's peak resident memory
+ * when the bake ended (KiB, getrusage): the bake runs first, so in a
+ * process that has done nothing bigger before, the bake's own peak. */
 hearth_status hearth_map_bake_run(const hearth_map_job *map, const hearth_bake_job *bake,
                                   const char *const *states, size_t n_states,
-                                  hearth_map_result *stats, double *seconds, hearth_err *err);
+                                  hearth_map_result *stats, double *seconds, size_t *bake_peak_kib,
+                                  hearth_err *err);
 
 #ifdef __cplusplus
 }

@@ -57,9 +57,12 @@ static hearth_status map_rgb_one(void *vctx, const char *instance, hearth_err *e
   for (size_t k = 0; k < n && !s; k++) names[k] = c->states->names[k];
   hearth_map_job mj = c->job;
   mj.instance = instance;
-  if (!s) s = hearth_map_bake_run(&mj, &bj, names, n, st, secs, err);
+  size_t peak_kib = 0;
+  if (!s) s = hearth_map_bake_run(&mj, &bj, names, n, st, secs, &peak_kib, err);
   if (!s) {
-    printf("map %s: colour texture baked (%.2f s)\n", instance, secs[0]);
+    /* the process's peak so far: the bake's own for the first instance */
+    printf("map %s: colour texture baked (%.2f s; peak memory so far %.1f MiB)\n", instance,
+           secs[0], (double)peak_kib / 1024.0);
     for (size_t k = 0; k < n; k++) print_state(instance, names[k], &st[k], secs[k + 1]);
   }
   free(names);

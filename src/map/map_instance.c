@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <unistd.h>
 #include "hearth/map.h"
 
@@ -76,7 +77,8 @@ static hearth_status outputs_commit(bake_outputs *o, hearth_err *err) {
 
 hearth_status hearth_map_bake_run(const hearth_map_job *map, const hearth_bake_job *bake,
                                   const char *const *states, size_t n_states,
-                                  hearth_map_result *stats, double *seconds, hearth_err *err) {
+                                  hearth_map_result *stats, double *seconds, size_t *bake_peak_kib,
+                                  hearth_err *err) {
   if (!map || !bake || !map->root || !map->instance || (n_states && !states))
     return hearth_err_set(err, HEARTH_E_ARG, "map: root, instance and states are required");
   bake_outputs o;
@@ -95,6 +97,8 @@ hearth_status hearth_map_bake_run(const hearth_map_job *map, const hearth_bake_j
     double t0 = hearth_now();
     s = hearth_bake_rgb_run(&bj, err);
     if (seconds) seconds[0] = hearth_now() - t0;
+    struct rusage ru;
+    if (bake_peak_kib) *bake_peak_kib = getrusage(RUSAGE_SELF, &ru) ? 0 : (size_t)ru.ru_maxrss;
   }
   for (size_t k = 0; k < n_states && !s; k++) {
     if ((s = hearth_temp_dir(o.dir[k], o.dir_tmp[k], PATH_SZ, err))) break;
