@@ -88,7 +88,19 @@ typedef struct hearth_map_opts {
      surface itself and which hits count are unchanged. 0 (default): the face
      normals; hearth_map_job_default sets HEARTH_MAP_NORMALS_AUTO */
   int normal_passes;
+  /* drop, with the silhouette pixels (the fusions that drop those: robust,
+     corrected, or keep_edges 0), a pixel whose 3 x 3 neighbourhood hits
+     faces whose normals lie more than this many degrees apart: at a crease
+     the thermal pixel mixes two surfaces as at a silhouette, and where a
+     mesh fused from depth rounds the crease over a voxel or two, a pixel
+     that sees one side lands on the other (the hot kettle's body read onto
+     its cooler base). 0 (default): none; hearth_map_job_default sets
+     HEARTH_MAP_CREASE_AUTO */
+  double crease_deg;
 } hearth_map_opts;
+/* hearth_map_run: 60 degrees where HEARTH_MAP_NORMALS_AUTO gives 2 passes
+   (a mesh hearth fused from depth), else 0 */
+#define HEARTH_MAP_CREASE_AUTO (-1.0)
 /* hearth_map_run: 2 passes when the instance's recon/report.json records a
    mesh hearth fused from depth (its "mesh" member) and the job names no mesh
    of its own, else 0 */

@@ -75,6 +75,26 @@ hearth_status hearth_mesh_keep_largest(hearth_mesh *m, hearth_err *err);
 hearth_status hearth_mesh_fill_holes(hearth_mesh *m, size_t max_edges, size_t *n_filled,
                                      hearth_err *err);
 
+/* Which boundary loops hearth_mesh_fill_holes_near closes: every loop of
+ * at most small_edges edges, and a longer one (up to max_edges) only when
+ * its centroid lies within tol_m of the plane plane[0..2] . x + plane[3] = 0
+ * (plane[0..2] a unit normal). */
+typedef struct hearth_hole_rule {
+  size_t max_edges;
+  size_t small_edges;
+  double plane[4];
+  double tol_m;
+} hearth_hole_rule;
+
+/* hearth_mesh_fill_holes with the rule above: the opening where an object
+ * stands on its support is closed, an opening elsewhere (surface no depth
+ * view reached, such as the inside of a cup below what the views saw) is
+ * left open rather than closed by a made-up patch. n_filled and n_open (either
+ * may be NULL) receive the loops closed and the loops of 3 or more edges
+ * left open. */
+hearth_status hearth_mesh_fill_holes_near(hearth_mesh *m, const hearth_hole_rule *rule,
+                                          size_t *n_filled, size_t *n_open, hearth_err *err);
+
 /* Edge collapse by quadric error (Garland-Heckbert) until the mesh has at
  * most target_triangles triangles or no collapse keeps it manifold
  * without flipping a triangle. Each collapse moves the kept vertex to the
@@ -87,11 +107,23 @@ hearth_status hearth_mesh_simplify(hearth_mesh *m, size_t target_triangles, hear
 void hearth_mesh_edge_stats(const hearth_mesh *m, size_t *n_boundary, size_t *n_nonmanifold);
 
 /* ---- from a release ------------------------------------------------------ */
+/* hole_support_m of `hearth recon`'s turntable route: 2.5 voxels of 2 mm;
+ * on the virtual rig the base's loop lies within 3 mm of the turntable top,
+ * the openings left 20 mm or more above it */
+#define HEARTH_RECON_HOLE_SUPPORT_M 0.005
+
 typedef struct hearth_recon_tsdf_opts {
   double voxel_m;          /* default 0.002 */
   double trunc_m;          /* default (0) 2 voxels; thin walls need it small */
   size_t hole_max_edges;   /* default 4000: enough for the unseen base of an
                               object standing on the turntable */
+  double hole_support_m;   /* default 0: every loop up to hole_max_edges is
+                              closed. > 0: a loop of more than 16 edges is
+                              closed only when its centroid lies within this
+                              distance of the support plane z = 0 (the
+                              turntable top in the frame of `hearth recon`'s
+                              poses, which sets 0.005); others stay open
+                              (hearth_mesh_fill_holes_near) */
   size_t target_triangles; /* default 20000; 0: no simplification */
   const char *poses;       /* poses file relative to the release root; default
                               ground_truth/instances/<id>/poses_rgb.json */

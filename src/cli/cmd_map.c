@@ -97,6 +97,10 @@ int hearth_cmd_map(int argc, char **argv) {
               "viewing cosines from face normals averaged N times over their neighbours (a "
               "mesh fused from depth has noisy face normals; 0: the faces' own)",
               .def = "2 for hearth recon's fused mesh (recon/report.json), else 0"),
+      CLI_NUM("--crease-deg", "DEG", &ctx.job.map.crease_deg, 0, 180,
+              "also skip pixels within 1 px of a crease of more than DEG between face normals "
+              "(the pixel mixes two surfaces; 0: none)",
+              .def = "60 for hearth recon's fused mesh (recon/report.json), else 0"),
       CLI_FLAG("--trace-rays", &ctx.job.map.trace_rays, 1,
                "trace every pixel's ray (Embree) instead of rasterising views that have the "
                "whole mesh in front (the same hits up to float rounding; slower; for "

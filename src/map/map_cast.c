@@ -251,6 +251,33 @@ static void silhouettes(const hit_frame *f, uint8_t *sil) {
   }
 }
 
+/* crease flags, added to the silhouette flags sil: a hit pixel whose 3 x 3
+ * neighbourhood (within the hits' box) hits a face whose normal is more
+ * than acos(cmin) off its own face's. Bit 1 marks them while the
+ * neighbourhoods are read, then they become 1. */
+static void creases(const hearth_map_layout *l, const hit_frame *f, float cmin, uint8_t *sil) {
+  const pix_box *b = &f->box;
+  const hearth_ray_hit *fh = f->hits;
+  for (size_t y = b->y0; y <= b->y1; y++)
+    for (size_t x = b->x0; x <= b->x1; x++) {
+      const size_t fk = frame_at(f, x, y);
+      if (fh[fk].prim == UINT32_MAX || sil[fk]) continue;
+      const float *n0 = l->tri_normal + 3 * (size_t)fh[fk].prim;
+      int cr = 0;
+      for (size_t yy = y > b->y0 ? y - 1 : y; yy <= y + 1 && yy <= b->y1 && !cr; yy++)
+        for (size_t xx = x > b->x0 ? x - 1 : x; xx <= x + 1 && xx <= b->x1 && !cr; xx++) {
+          const uint32_t t1 = fh[frame_at(f, xx, yy)].prim;
+          if (t1 == UINT32_MAX) continue;
+          const float *n1 = l->tri_normal + 3 * (size_t)t1;
+          cr = n0[0] * n1[0] + n0[1] * n1[1] + n0[2] * n1[2] < cmin;
+        }
+      if (cr) sil[fk] = 2;
+    }
+  for (size_t y = b->y0; y <= b->y1; y++)
+    for (size_t x = b->x0; x <= b->x1; x++)
+      if (sil[frame_at(f, x, y)] == 2) sil[frame_at(f, x, y)] = 1;
+}
+
 /* The splats of view v's hits within box, in raster order: hits at a
  * silhouette (with edges) or seen more obliquely than min_cos are dropped,
  * and so are footprints entirely off the map. *n_hits counts the hits kept
@@ -487,6 +514,8 @@ static int process_view(map_ctx *m, size_t v, int t) {
                     m->opts->fusion == HEARTH_FUSE_CORRECTED || !m->opts->keep_edges;
   if (edges && f.box.x0 <= f.box.x1) {
     silhouettes(&f, w->sil);
+    if (m->opts->crease_deg > 0)
+      creases(l, &f, (float)cos(m->opts->crease_deg * M_PI / 180.0), w->sil);
   }
   uint32_t hits = 0;
   size_t n_sp = splat_hits(m, v, img, own.data && m->opts->load_grid, w, &f, edges, &hits);

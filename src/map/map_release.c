@@ -29,6 +29,7 @@ void hearth_map_job_default(hearth_map_job *job) {
   memset(job, 0, sizeof *job);
   hearth_map_opts_default(&job->map);
   job->map.normal_passes = HEARTH_MAP_NORMALS_AUTO;
+  job->map.crease_deg = HEARTH_MAP_CREASE_AUTO;
   job->turbo_lo = 10.0;
   job->turbo_hi = 60.0;
 }
@@ -130,6 +131,7 @@ static hearth_status write_provenance(const char *path, const hearth_map_job *jo
   json_object_set_new(pj, "views", json_string(job->views && *job->views ? job->views : "all"));
   json_object_set_new(pj, "keep_edges", json_boolean(job->map.keep_edges));
   json_object_set_new(pj, "normal_passes", json_integer(job->map.normal_passes));
+  json_object_set_new(pj, "crease_deg", json_real(job->map.crease_deg));
   json_object_set_new(pj, "visibility",
                       json_string(job->map.trace_rays ? "traced rays"
                                                       : "rasterised where the mesh is in front"));
@@ -286,8 +288,9 @@ hearth_status hearth_map_run(const hearth_map_job *job_in, hearth_map_result *st
   else joinf(poses_path, "%s/instances/%s/derived/poses_thermal.json", root, inst);
   if (job->mesh_path) snprintf(mesh_path, PATH_SZ, "%s", job->mesh_path);
   else joinf(mesh_path, "%s/instances/%s/derived/mesh.glb", root, inst);
-  if (jc.map.normal_passes < 0)
-    jc.map.normal_passes = job->mesh_path ? 0 : auto_normal_passes(root, inst);
+  const int fused = !job->mesh_path && auto_normal_passes(root, inst) > 0;
+  if (jc.map.normal_passes < 0) jc.map.normal_passes = fused ? 2 : 0;
+  if (jc.map.crease_deg < 0) jc.map.crease_deg = fused ? 60.0 : 0.0;
   joinf(man_path, "%s/instances/%s/raw/%s/manifest.json", root, inst, job->state);
   if (job->out_dir) snprintf(out_dir, PATH_SZ, "%s", job->out_dir);
   else joinf(out_dir, "%s/instances/%s/derived/%s", root, inst, job->state);

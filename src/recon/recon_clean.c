@@ -144,9 +144,29 @@ static hearth_status fan_fill(hearth_mesh *m, const uint32_t *loop, size_t n, he
   return HEARTH_OK;
 }
 
+/* 1 if the loop loop[0..n) is to be closed under rule r */
+static int loop_closes(const hearth_mesh *m, const uint32_t *loop, size_t n,
+                       const hearth_hole_rule *r) {
+  if (n > r->max_edges) return 0;
+  if (n <= r->small_edges) return 1;
+  double d = 0;
+  for (size_t q = 0; q < n; q++) {
+    const float *p = m->positions + 3 * (size_t)loop[q];
+    d += r->plane[0] * p[0] + r->plane[1] * p[1] + r->plane[2] * p[2] + r->plane[3];
+  }
+  return fabs(d / (double)n) <= r->tol_m;
+}
+
 hearth_status hearth_mesh_fill_holes(hearth_mesh *m, size_t max_edges, size_t *n_filled,
                                      hearth_err *err) {
+  const hearth_hole_rule r = {max_edges, max_edges, {0, 0, 0, 0}, 0};
+  return hearth_mesh_fill_holes_near(m, &r, n_filled, NULL, err);
+}
+
+hearth_status hearth_mesh_fill_holes_near(hearth_mesh *m, const hearth_hole_rule *rule,
+                                          size_t *n_filled, size_t *n_open, hearth_err *err) {
   if (n_filled) *n_filled = 0;
+  if (n_open) *n_open = 0;
   size_t ne = 3 * m->n_triangles;
   if (!ne) return HEARTH_OK;
   uint64_t *und = malloc(ne * sizeof *und);
@@ -180,7 +200,7 @@ hearth_status hearth_mesh_fill_holes(hearth_mesh *m, size_t max_edges, size_t *n
   uint32_t *loop = malloc((nb ? nb : 1) * sizeof *loop);
   hearth_status s = HEARTH_OK;
   if (!used || !loop) s = hearth_err_set(err, HEARTH_E_NOMEM, "fill holes");
-  size_t filled = 0;
+  size_t filled = 0, open = 0;
   uint32_t *at = malloc((m->n_vertices ? m->n_vertices : 1) * sizeof *at);
   if (!at && !s) s = hearth_err_set(err, HEARTH_E_NOMEM, "fill holes");
   for (size_t v = 0; at && v < m->n_vertices; v++) at[v] = UINT32_MAX;
@@ -197,9 +217,11 @@ hearth_status hearth_mesh_fill_holes(hearth_mesh *m, size_t max_edges, size_t *n
       loop[n++] = from;
       if (at[to] != UINT32_MAX) {
         size_t j = at[to], len = n - j;
-        if (len >= 3 && len <= max_edges) {
+        if (len >= 3 && loop_closes(m, loop + j, len, rule)) {
           if ((s = fan_fill(m, loop + j, len, err))) break;
           filled++;
+        } else if (len >= 3) {
+          open++;
         }
         for (size_t q = j; q < n; q++) at[loop[q]] = UINT32_MAX;
         n = j;
@@ -231,6 +253,7 @@ hearth_status hearth_mesh_fill_holes(hearth_mesh *m, size_t max_edges, size_t *n
     m->uvs = NULL;
   }
   if (n_filled) *n_filled = filled;
+  if (n_open) *n_open = open;
   return s;
 }
 

@@ -14,6 +14,9 @@ void hearth_recon_job_default(hearth_recon_job *job) {
   memset(job, 0, sizeof *job);
   hearth_turntable_opts_default(&job->poses);
   hearth_recon_tsdf_opts_default(&job->geometry);
+  /* the turntable route's frame has the turntable top at z = 0: close the
+     base the object stands on, leave openings no depth view reached open */
+  job->geometry.hole_support_m = HEARTH_RECON_HOLE_SUPPORT_M;
   hearth_atlas_opts_default(&job->atlas);
 }
 

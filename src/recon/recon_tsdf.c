@@ -111,6 +111,7 @@ void hearth_recon_tsdf_opts_default(hearth_recon_tsdf_opts *o) {
   o->voxel_m = 0.002;
   o->trunc_m = 0;
   o->hole_max_edges = 4000;
+  o->hole_support_m = 0;
   o->target_triangles = 20000;
   o->poses = NULL;
 }
@@ -127,6 +128,10 @@ typedef struct recon_view {
                     RECON_SILHOUETTE_DILATE pixels of it, 0 elsewhere */
   uint8_t *mask; /* depth width * height */
 } recon_view;
+
+/* Loops of at most this many edges (about 30 mm round at 2 mm voxels) are
+ * closed wherever they lie: specks of missing surface, not openings. */
+#define RECON_HOLE_SMALL_EDGES 16
 
 /* Depth step (mm) between 4-neighbours taken as a depth edge. */
 #define RECON_EDGE_MM 8
@@ -358,7 +363,15 @@ hearth_status hearth_recon_tsdf(const char *root, const char *instance, const ch
   if (!s) s = hearth_tsdf_extract(&vol, out, err);
   hearth_tsdf_free(&vol);
   if (!s) s = hearth_mesh_keep_largest(out, err);
-  if (!s && o.hole_max_edges) s = hearth_mesh_fill_holes(out, o.hole_max_edges, NULL, err);
+  if (!s && o.hole_max_edges) {
+    /* the support plane z = 0 only where asked: other pose frames put the
+       turntable elsewhere */
+    const hearth_hole_rule r = {o.hole_max_edges,
+                                o.hole_support_m > 0 ? RECON_HOLE_SMALL_EDGES : o.hole_max_edges,
+                                {0, 0, 1, 0},
+                                o.hole_support_m};
+    s = hearth_mesh_fill_holes_near(out, &r, NULL, NULL, err);
+  }
   if (!s && o.target_triangles) s = hearth_mesh_simplify(out, o.target_triangles, err);
   if (s) {
     hearth_mesh_free(out);
