@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Calibration accuracy on the virtual rig with the bench's physics on (the
 # default synth: thick plate, lamp-heated backing, warming plate, vignetting,
-# fixed-pattern noise, colour motion blur and JPEG, trigger offset), over
+# fixed-pattern noise, colour motion blur and JPEG, trigger offset, holes
+# drilled off the nominal lattice, the plate turned every way round), over
 # seeds, with the wall-corrected hole centres and the rolling-shutter stereo
 # and the thermal intrinsics refined in the stereo stage (the defaults), with
 # the naive centroid (--no-wall-correction), with a rigid plate per pair

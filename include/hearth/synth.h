@@ -67,7 +67,10 @@ typedef struct hearth_synth_effects {
   double hole_position_m;   /* each hole's drilled position off its nominal one in the plate
                                plane: 1 sigma per axis (m), cut at 3 sigma, one draw per hole
                                and seed; the pipeline is given the nominal lattice; default
-                               0 (off) */
+                               4e-5 */
+  double plate_roll_deg;    /* the plate's turn in its own plane in each calibration frame,
+                               drawn in -it..it degrees (the paper's plate only; other targets
+                               and the ideal bench: 12); default 180 */
   double lens_residual_px;  /* the thermal lens's departure from its 5-parameter model in the
                                calibration captures: rms per axis (px) of a smooth field of
                                2.5..6 cycles across the image; default 0 */

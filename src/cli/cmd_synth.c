@@ -188,6 +188,9 @@ int hearth_cmd_synth(int argc, char **argv) {
       CLI_NUM("--hole-position", "M", &o.effects.hole_position_m, 0, 0.001,
               "1 sigma per axis of each hole's drilled position off the nominal lattice (m; 0: "
               "exact)"),
+      CLI_NUM("--calib-roll", "DEG", &o.effects.plate_roll_deg, 0, 180,
+              "the plate's turn in its own plane in the calibration frames, drawn in -DEG..DEG "
+              "(the paper's plate only; others: 12)"),
       CLI_NUM("--lens-residual", "PX", &o.effects.lens_residual_px, 0, 5,
               "rms per axis of the thermal lens's departure from its 5-parameter model in the "
               "calibration captures (px; 0: the model lens)"),

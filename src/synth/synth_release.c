@@ -84,7 +84,8 @@ void hearth_synth_effects_default(hearth_synth_effects *e) {
   e->plate_bow_m = 5e-5;
   e->plate_flex_m = 2e-4;
   e->hole_burr_m = 0.0;
-  e->hole_position_m = 0.0;
+  e->hole_position_m = 4e-5;
+  e->plate_roll_deg = 180.0;
   e->lens_residual_px = 0.0;
   e->backing_texture = 0.0;
   e->plate_twist_m = 0.0;

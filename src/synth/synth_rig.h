@@ -162,6 +162,9 @@ int synth_plate_truth(const hearth_camera *c, const synth_plate_geom *g,
  * offset (ox, oy), tilted 5..40 degrees, rolled up to 12. */
 void synth_plate_pose(const synth_plate_geom *g, hearth_rng *r, double d, double ox, double oy,
                       hearth_rigid *T_cam_from_plate);
+/* The same with the roll drawn in -roll_deg..roll_deg. */
+void synth_plate_pose_rolled(const synth_plate_geom *g, hearth_rng *r, double d, double ox,
+                             double oy, double roll_deg, hearth_rigid *T_cam_from_plate);
 /* One calibration frame of the target at pose T in camera cam: thermal (F32
  * degC, 0.05 degC noise) or colour (U8 RGB), with the look (NULL: clean),
  * deterministic in seed. out is allocated (hearth_image_free). */

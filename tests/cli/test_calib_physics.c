@@ -2,11 +2,13 @@
  * real thickness, a lamp-heated backing, a warming plate, vignetting and
  * fixed-pattern noise in thermal, motion blur and JPEG in colour, a trigger
  * offset between the cameras, the colour camera's rolling shutter, a bowed
- * plate flexing in the hand): `hearth detect` + `hearth calibrate` must
+ * plate flexing in the hand, holes drilled off their nominal positions, the
+ * plate turned every way round): `hearth detect` + `hearth calibrate` must
  * still meet the release targets against the rig's ground truth (thermal
- * focal within 0.2 %, T_thermal_from_rgb within 0.05 deg and 0.5 mm), the
- * stereo's rolling-shutter model taking the colour rows' motion out of the
- * residual that a rigid plate per pair leaves. */
+ * focal within 0.2 %, T_thermal_from_rgb within 0.05 deg and 0.5 mm) with a
+ * stereo RMS of the paper's order (0.1..0.5 px), the stereo's
+ * rolling-shutter model taking the colour rows' motion out of the residual
+ * that a rigid plate per pair leaves. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -64,10 +66,10 @@ int main(void) {
   CHECK(fabs(r.thermal.fy / t.thermal.fy - 1) < 0.002);
   CHECK(ang * 180 / M_PI < 0.05);
   CHECK(dt < 0.0005);
-  /* the bench's effects keep a stereo residual above the clean bench's
-     0.009 px (0.016 px here with the trigger offset modelled); the paper's
-     0.1..0.5 px is not reached with the estimates held (docs/virtual-rig.md) */
-  CHECK_MSG(r.stereo_rms_px >= 0.012 && r.stereo_rms_px < 0.5, "stereo RMS %g", r.stereo_rms_px);
+  /* the drilling tolerance (0.04 mm per axis against the nominal lattice
+     the pipeline is given) puts the stereo residual at the paper's order
+     (0.136 px here; the clean bench: 0.009 px), with the estimates held */
+  CHECK_MSG(r.stereo_rms_px >= 0.1 && r.stereo_rms_px < 0.5, "stereo RMS %g", r.stereo_rms_px);
   /* a rigid plate per pair leaves the rows' motion in the residual and in
      the extrinsic */
   CHECK(test_sh("'" HEARTH_EXE "' calibrate '%s' --quiet --no-rolling-shutter >> '%s' 2>&1", root,
@@ -78,7 +80,11 @@ int main(void) {
   double ang0 = hearth_rotation_angle_between(r0.T_thermal_from_rgb.R, t.T_thermal_from_rgb.R);
   fprintf(stderr, "rigid plate per pair: rotation %.4f deg, stereo RMS %.4f px\n",
           ang0 * 180 / M_PI, r0.stereo_rms_px);
-  CHECK_MSG(r0.stereo_rms_px > 2 * r.stereo_rms_px, "rigid RMS %g", r0.stereo_rms_px);
+  /* the rows' motion adds to the drilling's residual in quadrature (0.094
+     px here) */
+  double shear =
+      sqrt(fmax(0.0, r0.stereo_rms_px * r0.stereo_rms_px - r.stereo_rms_px * r.stereo_rms_px));
+  CHECK_MSG(shear > 0.05, "rigid RMS %g", r0.stereo_rms_px);
   CHECK(ang0 > ang);
   TEST_MAIN_END();
 }
