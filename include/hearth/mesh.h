@@ -232,7 +232,7 @@ hearth_status hearth_ray_fan_cast_framed(const hearth_ray_fan *f, const hearth_m
  * and slack_px (room for the grid's undistortion residual and rounding,
  * e.g. 1), so it holds the hits of any fan of cam's grid, or of any crop of
  * it. HEARTH_E_UNSUPPORTED (naming the vertex) if a vertex is not in front
- * of the camera. */
+ * of the camera, or for a lens model other than the fan's 5-parameter one. */
 hearth_status hearth_ray_fan_extent(const hearth_camera *cam, size_t stride, const hearth_mesh *m,
                                     const hearth_rigid *T_world_from_cam, double slack_px,
                                     size_t box[4], hearth_err *err);

@@ -83,7 +83,8 @@ typedef struct hit_frame {
 
 static const hearth_ray_hit k_miss = {INFINITY, UINT32_MAX, 0.0f, 0.0f, 0};
 
-/* the frame of box (its arrays not yet set) */
+/* the frame of box (its arrays not yet set), as the fan's framed cast
+   makes it with a growth of 2 */
 static void frame_of(const hearth_map_layout *l, const pix_box *box, hit_frame *f) {
   f->box = *box;
   f->x0 = f->y0 = f->w = f->h = 0;
@@ -109,8 +110,8 @@ static inline void box_add(pix_box *box, size_t x, size_t y) {
 }
 
 /* view v, whose camera has the whole mesh in front: rasterised through the
- * fan, its hits kept in the frame of their box (the fan's hits are all
- * front faces, so its box is the hits' box and its frame theirs) */
+ * fan, its hits kept in the frame of their box grown by 2 (the fan's hits
+ * are all front faces, so its box is the hits' box and its frame theirs) */
 static void cast_fan(map_ctx *m, size_t v, map_worker *w, hit_frame *f) {
   const hearth_map_layout *l = m->l;
   size_t fb[4], fr[4];
@@ -119,13 +120,15 @@ static void cast_fan(map_ctx *m, size_t v, map_worker *w, hit_frame *f) {
     m->failed = 2; /* cannot happen: the bounding sphere lies in front */
     return;
   }
-  pix_box box = {SIZE_MAX, 0, SIZE_MAX, 0};
-  if (fb[0] <= fb[1]) box = (pix_box){fb[0], fb[1], fb[2], fb[3]};
-  frame_of(l, &box, f);
+  /* the fan's frame is where it wrote the hits (all zero without hits) */
+  f->box =
+      fb[0] <= fb[1] ? (pix_box){fb[0], fb[1], fb[2], fb[3]} : (pix_box){SIZE_MAX, 0, SIZE_MAX, 0};
+  f->x0 = fr[0];
+  f->y0 = fr[1];
+  f->w = fr[2];
+  f->h = fr[3];
   f->hits = w->hits;
   f->scratch = w->ray_org;
-  if (box.x0 <= box.x1 && (f->x0 != fr[0] || f->y0 != fr[1] || f->w != fr[2] || f->h != fr[3]))
-    m->failed = 2; /* cannot happen: both grow the box by 2 within the grid */
 }
 
 /* the grid pixels in 4x4 tiles (coherent packets of 16): the block after (pw, ph) runs for
@@ -356,10 +359,9 @@ static const touch *sorted_touches(map_worker *w, size_t n_sp, size_t R, size_t 
   for (size_t i = 0; i < n_sp; i++) {
     const splat *e = &sp[i];
     for (int k = 0; k < 4; k++) {
-      long tx = (long)e->x0 + (k & 1), ty = (long)e->y0 + (k >> 1);
-      if (tx < 0 || ty < 0 || tx >= (long)R || ty >= (long)R) continue;
-      if (!(corner_weight(e, k) > 0.0f)) continue;
-      tc[n_tc++] = (touch){(uint32_t)((size_t)ty * R + (size_t)tx), (uint32_t)(4 * i + (size_t)k)};
+      uint32_t q;
+      float wk;
+      if (splat_corner(e, k, R, &q, &wk)) tc[n_tc++] = (touch){q, (uint32_t)(4 * i + (size_t)k)};
     }
   }
   /* stable LSD radix sort by texel, 11-bit digits (at most 3: R <= 16384

@@ -57,11 +57,12 @@ void map_max_free(max_maps *mx) {
 
 int map_records_alloc(view_records *r, size_t n_views, int stream, size_t R, int C, int want_cos) {
   r->n_views = n_views;
-  r->q = calloc(n_views ? n_views : 1, sizeof *r->q);
-  r->d = calloc(n_views ? n_views : 1, sizeof *r->d);
-  r->n = calloc(n_views ? n_views : 1, sizeof *r->n);
-  if (!r->q || !r->d || !r->n) return 0;
-  if (!stream) return 1;
+  if (!stream) {
+    r->q = calloc(n_views ? n_views : 1, sizeof *r->q);
+    r->d = calloc(n_views ? n_views : 1, sizeof *r->d);
+    r->n = calloc(n_views ? n_views : 1, sizeof *r->n);
+    return r->q && r->d && r->n;
+  }
   /* calloc: the pages of texels no view observes are never touched */
   r->acc = calloc(R * R, (size_t)C * sizeof *r->acc);
   r->acc_owned = 1;
@@ -101,11 +102,9 @@ static void add_splats(view_records *r, const uint32_t *iot, size_t R, const spl
   for (size_t i = 0; i < n; i++) {
     const splat *e = &sp[i];
     for (int k = 0; k < 4; k++) {
-      long tx = (long)e->x0 + (k & 1), ty = (long)e->y0 + (k >> 1);
-      if (tx < 0 || ty < 0 || tx >= (long)R || ty >= (long)R) continue;
-      const float wk = corner_weight(e, k);
-      const size_t q = (size_t)ty * R + (size_t)tx;
-      if (!(wk > 0.0f) || iot[q] != e->island) continue;
+      uint32_t q;
+      float wk;
+      if (!splat_corner(e, k, R, &q, &wk) || iot[q] != e->island) continue;
       if (r->best_cos && e->cosv > r->best_cos[q]) r->best_cos[q] = e->cosv;
       float *a = r->acc + q * (size_t)C;
       for (int c = 0; c < C; c++) a[c] += wk * splat_value(e, C, c);

@@ -76,6 +76,17 @@ static inline float corner_weight(const splat *e, int k) {
   return (float)(((k & 1) ? e->fx : 1.0 - e->fx) * ((k >> 1) ? e->fy : 1.0 - e->fy));
 }
 
+/* corner k of a splat (see corner_weight) in an R x R map: 1 with its
+   texel in *q and its weight in *wk when the corner lies on the map and
+   weighs anything, else 0 */
+static inline int splat_corner(const splat *e, int k, size_t R, uint32_t *q, float *wk) {
+  const long tx = (long)e->x0 + (k & 1), ty = (long)e->y0 + (k >> 1);
+  if (tx < 0 || ty < 0 || tx >= (long)R || ty >= (long)R) return 0;
+  *wk = corner_weight(e, k);
+  *q = (uint32_t)((size_t)ty * R + (size_t)tx);
+  return *wk > 0.0f;
+}
+
 /* One bilinear touch of a texel by a splat within one view; a view's
  * touches are sorted by texel (stably: pixel order within a texel) and
  * reduced in one pass, each texel's sums added up in the same order as
@@ -127,9 +138,9 @@ typedef struct max_maps {
  * splats at the moment the sums are fullest. */
 typedef struct view_records {
   size_t n_views;
-  uint32_t **q; /* per view: n[v] texels */
-  float **d;    /* per view: n[v] * REC_WORDS(C) words */
-  size_t *n;
+  uint32_t **q; /* robust and corrected fusion, per view: n[v] texels (NULL for mean) */
+  float **d;    /* per view: n[v] * REC_WORDS(C) words (NULL for mean) */
+  size_t *n;    /* (NULL for mean) */
   /* mean fusion (NULL otherwise): R * R * C sums of the weighted values and
      R * R sums of the weights, zero where no view observed; the fusion
      turns acc into the result's observed map in place (acc_owned 0) */

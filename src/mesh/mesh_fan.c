@@ -423,26 +423,29 @@ hearth_status hearth_ray_fan_extent(const hearth_camera *cam, size_t stride, con
   box[0] = box[2] = 1;
   box[1] = box[3] = 0;
   if (stride < 1) stride = 1;
+  if (cam->model != HEARTH_LENS_BROWN5)
+    return hearth_err_set(err, HEARTH_E_UNSUPPORTED,
+                          "ray fan: the %s lens model is not supported (the extent's bound is "
+                          "derived for the 5-parameter model)",
+                          hearth_lens_name(cam->model));
   if (!m->n_triangles) return HEARTH_OK;
-  const double *R = T_world_from_cam->R, *t = T_world_from_cam->t;
+  hearth_rigid T_cam_from_world;
+  hearth_rigid_inverse(T_world_from_cam, &T_cam_from_world);
   /* per vertex: its point in the plane z = 1 and its pixel */
   double *V = hearth_alloc_array(m->n_vertices ? m->n_vertices : 1, 4 * sizeof *V);
   if (!V) return hearth_err_set(err, HEARTH_E_NOMEM, "ray fan: out of memory");
   for (size_t i = 0; i < m->n_vertices; i++) {
     const float *p = m->positions + 3 * i;
-    double d[3] = {p[0] - t[0], p[1] - t[1], p[2] - t[2]}, c[3];
-    for (int k = 0; k < 3; k++) c[k] = R[k] * d[0] + R[3 + k] * d[1] + R[6 + k] * d[2];
-    if (!(c[2] > 0.0)) {
+    const double xw[3] = {p[0], p[1], p[2]};
+    double c[3];
+    hearth_rigid_apply(&T_cam_from_world, xw, c);
+    if (!hearth_camera_project(cam, c, V + 4 * i + 2, NULL)) {
       free(V);
       return hearth_err_set(err, HEARTH_E_UNSUPPORTED,
                             "ray fan: vertex %zu is not in front of the camera (z = %g)", i, c[2]);
     }
-    double x = c[0] / c[2], y = c[1] / c[2], xd, yd;
-    hearth_distort(cam->dist, x, y, &xd, &yd, NULL);
-    V[4 * i] = x;
-    V[4 * i + 1] = y;
-    V[4 * i + 2] = cam->fx * xd + cam->cx;
-    V[4 * i + 3] = cam->fy * yd + cam->cy;
+    V[4 * i] = c[0] / c[2];
+    V[4 * i + 1] = c[1] / c[2];
   }
   const long pw = (long)(((size_t)cam->width + stride - 1) / stride),
              ph = (long)(((size_t)cam->height + stride - 1) / stride);

@@ -230,6 +230,14 @@ int main(void) {
     /* triangles under a pixel: the extent is the hits' box but for the
        margins */
     CHECK_MSG(s.loose == 0 && s2.loose == 0, "torus: %zu + %zu loose extents", s.loose, s2.loose);
+    /* a lens the extent's bound is not derived for: refused, no box */
+    hearth_camera r8 = lens;
+    r8.model = HEARTH_LENS_RATIONAL8;
+    hearth_rigid T = look_at(1.1, 0.0, 0.05);
+    size_t ext[4];
+    CHECK(hearth_ray_fan_extent(&r8, 1, &torus, &T, 1.0, ext, &err) == HEARTH_E_UNSUPPORTED);
+    CHECK_MSG(strstr(err.msg, "rational8") != NULL, "%s", err.msg);
+    CHECK(ext[0] > ext[1]);
     hearth_mesh_free(&torus);
   }
 
