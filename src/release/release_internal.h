@@ -57,6 +57,7 @@ typedef struct hb_recon_expect {
   long long manifest_views;                /* all the manifests' views, -1: unknown */
   const hearth_poses *poses;               /* recon/poses_rgb.json, or NULL */
   long long mesh_vertices, mesh_triangles; /* recon/mesh_geometry.glb's, -1: not read */
+  long long mesh_open_loops;               /* its boundary loops, -1: not read */
   long long atlas_charts;                  /* recon/mesh.glb's UV islands, -1: not read */
 } hb_recon_expect;
 /* Every problem of the report text[0..len) (as "MEMBER: what" under path)
@@ -67,5 +68,15 @@ void hb_recon_report_check(const char *text, size_t len, const char *path, const
 /* The UV islands of a mesh: components of its triangles over shared
  * vertices (hearth's atlas: one per chart); -1 out of memory. */
 long long hb_mesh_islands(const hearth_mesh *m);
+
+/* The truth at point q of a true mesh (release_truth.c): the map (Rg x Rg,
+ * `stride` floats a texel, channel `ch`) read bilinearly at uv between the
+ * four texel centres around it. A texel counts only where it holds a finite
+ * value and its own surface point (pos[3 * texel], NaN where the UV layout
+ * has no surface there) lies within `reach` metres of q, so a texel of
+ * another island beside it in the atlas does not bleed in; the weights of
+ * those that count are renormalised. NaN when none counts. */
+double hb_truth_sample(const float *map, size_t Rg, size_t stride, size_t ch, const float *pos,
+                       const double q[3], const double uv[2], double reach);
 
 #endif

@@ -4,8 +4,11 @@
  * surface point on the built mesh is taken into the truth's frame by the
  * similarity that best maps derived/poses_rgb.json onto the true colour
  * poses, matched to the nearest point of the true mesh (a uniform grid of
- * its triangles, exact point-triangle distances), and that point's UV picks
- * the true texel (nearest). Each texel also learns whether some thermal
+ * its triangles, exact point-triangle distances), and the truth maps are
+ * read at that point's UV bilinearly, over the texels of the same stretch
+ * of surface (hb_truth_sample): a nearest texel would put up to half a
+ * texel of the truth's own grid into every comparison, 0.7 degC on the hot
+ * cup's rim at 256 texels. Each texel also learns whether some thermal
  * view of the state (derived/poses_thermal.json, the rig's thermal camera)
  * sees it unoccluded, inside the frame, within 60 degrees of its normal. */
 #include <float.h>
@@ -18,6 +21,7 @@
 #include "hearth/npy.h"
 #include "hearth/recon.h"
 #include "hearth/release.h"
+#include "release_internal.h"
 
 #define PATH_SZ 4096
 
@@ -214,6 +218,88 @@ static void uv_at(const hearth_mesh *m, uint32_t tri, const double q[3], double 
   }
 }
 
+double hb_truth_sample(const float *map, size_t Rg, size_t stride, size_t ch, const float *pos,
+                       const double q[3], const double uv[2], double reach) {
+  double x = uv[0] * (double)Rg - 0.5, y = uv[1] * (double)Rg - 0.5;
+  if (!(x > -1.0 && y > -1.0 && x < (double)Rg && y < (double)Rg)) return NAN;
+  long c0 = (long)floor(x), r0 = (long)floor(y);
+  double fx = x - (double)c0, fy = y - (double)r0, sum = 0, wsum = 0;
+  for (int k = 0; k < 4; k++) {
+    long c = c0 + (k & 1), r = r0 + (k >> 1);
+    if (c < 0 || r < 0 || c >= (long)Rg || r >= (long)Rg) continue;
+    double w = ((k & 1) ? fx : 1 - fx) * ((k >> 1) ? fy : 1 - fy);
+    size_t t = (size_t)r * Rg + (size_t)c;
+    double v = map[stride * t + ch];
+    const float *p = pos + 3 * t;
+    if (w <= 0 || !isfinite(v) || !isfinite(p[0])) continue;
+    double d0 = p[0] - q[0], d1 = p[1] - q[1], d2 = p[2] - q[2];
+    if (d0 * d0 + d1 * d1 + d2 * d2 > reach * reach) continue;
+    sum += w * v;
+    wsum += w;
+  }
+  return wsum > 0 ? sum / wsum : NAN;
+}
+
+/* how far apart two neighbouring texel centres of an R-texel map of m can
+   lie on triangle tri, doubled: the UV-to-surface map's largest stretch
+   over R, times 2 (a corner of the 2x2 cell is at most sqrt 2 texels away);
+   0 where the triangle has no UV area */
+static double truth_reach(const hearth_mesh *m, uint32_t tri, size_t R) {
+  const uint32_t *f = m->indices + 3 * (size_t)tri;
+  double e[2][3], a[2][2];
+  for (int k = 0; k < 2; k++) {
+    for (int c = 0; c < 3; c++)
+      e[k][c] = m->positions[3 * (size_t)f[k + 1] + c] - m->positions[3 * (size_t)f[0] + c];
+    for (int c = 0; c < 2; c++)
+      a[k][c] = (double)m->uvs[2 * (size_t)f[k + 1] + c] - (double)m->uvs[2 * (size_t)f[0] + c];
+  }
+  double det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+  if (!(fabs(det) > 1e-18)) return 0;
+  /* J = E A^-1: the columns are d position / du and d position / dv */
+  double j[2][3];
+  for (int c = 0; c < 3; c++) {
+    j[0][c] = (e[0][c] * a[1][1] - e[1][c] * a[0][1]) / det;
+    j[1][c] = (e[1][c] * a[0][0] - e[0][c] * a[1][0]) / det;
+  }
+  double g00 = dot(j[0], j[0]), g01 = dot(j[0], j[1]), g11 = dot(j[1], j[1]);
+  double tr = 0.5 * (g00 + g11), dd = 0.5 * (g00 - g11);
+  double s1 = sqrt(tr + sqrt(dd * dd + g01 * g01));
+  return 2.0 * s1 / (double)R;
+}
+
+/* each texel centre's point on m through an R x R raster of its UVs (NaN
+   where no triangle holds the centre), in a new array *out */
+static hearth_status texel_points(const hearth_mesh *m, size_t R, float **out, hearth_err *err) {
+  size_t n = R * R;
+  uint32_t *tri = hearth_alloc_array(n, sizeof *tri);
+  float *bary = hearth_alloc_array(n, 3 * sizeof *bary);
+  float *pos = hearth_alloc_array(n, 3 * sizeof *pos);
+  hearth_status s = HEARTH_OK;
+  if (!tri || !bary || !pos) s = hearth_err_set(err, HEARTH_E_NOMEM, "truth: out of memory");
+  else s = hearth_uv_rasterize(m, R, tri, bary, err);
+  for (size_t q = 0; !s && q < n; q++) {
+    float *p = pos + 3 * q;
+    if (tri[q] == UINT32_MAX) {
+      p[0] = p[1] = p[2] = NAN;
+      continue;
+    }
+    const uint32_t *f = m->indices + 3 * (size_t)tri[q];
+    for (int a = 0; a < 3; a++) {
+      double v = 0;
+      for (int c = 0; c < 3; c++) v += bary[3 * q + c] * m->positions[3 * (size_t)f[c] + a];
+      p[a] = (float)v;
+    }
+  }
+  free(tri);
+  free(bary);
+  if (s) {
+    free(pos);
+    pos = NULL;
+  }
+  *out = pos;
+  return s;
+}
+
 /* a 2-D float map (or 3-D with `depth` channels) of the truth, or absent */
 static hearth_status read_truth_map(const char *path, size_t depth, hearth_npy *a, int *have,
                                     hearth_err *err) {
@@ -256,7 +342,7 @@ hearth_status hearth_truth_match_state(const char *root, const char *inst, const
   hearth_raycaster *rc = NULL;
   tri_grid g = {0};
   uint32_t *tri = NULL;
-  float *bary = NULL;
+  float *bary = NULL, *gpos = NULL;
   hearth_status s;
   int have_t = 0, have_a = 0, have_c = 0;
   const size_t n = R * R;
@@ -312,6 +398,7 @@ hearth_status hearth_truth_match_state(const char *root, const char *inst, const
   if ((s = hearth_raycaster_new(&mesh, &rc, err))) goto done;
   if ((s = grid_build(&g, &gt, 0.004, err))) goto done;
   const size_t Rg = tt.shape[0];
+  if ((s = texel_points(&gt, Rg, &gpos, err))) goto done;
   const float *T = tt.data, *A = have_a ? ta.data : NULL, *C = have_c ? tc.data : NULL;
   const double cos_away = 0.5; /* 60 degrees */
   for (size_t q = 0; q < n; q++) {
@@ -362,9 +449,14 @@ hearth_status hearth_truth_match_state(const char *root, const char *inst, const
     long col = (long)floor(uvt[0] * (double)Rg), row = (long)floor(uvt[1] * (double)Rg);
     if (col < 0 || row < 0 || col >= (long)Rg || row >= (long)Rg) continue;
     size_t t = (size_t)row * Rg + (size_t)col;
+    double reach = truth_reach(&gt, gtri, Rg);
     out->dist_m[q] = (float)dist;
-    out->t_true[q] = T[t];
-    if (A && ta.shape[0] == Rg) out->t_apparent[q] = A[t];
+    double tv = hb_truth_sample(T, Rg, 1, 0, gpos, cp, uvt, reach);
+    out->t_true[q] = isfinite(tv) ? (float)tv : T[t];
+    if (A && ta.shape[0] == Rg) {
+      tv = hb_truth_sample(A, Rg, 1, 0, gpos, cp, uvt, reach);
+      out->t_apparent[q] = isfinite(tv) ? (float)tv : A[t];
+    }
     if (C && tc.shape[0] == Rg)
       for (int c = 0; c < 3; c++) out->conditions[3 * q + c] = C[3 * t + c];
   }
@@ -373,6 +465,7 @@ done:
   hearth_raycaster_free(rc);
   free(tri);
   free(bary);
+  free(gpos);
   hearth_mesh_free(&mesh);
   hearth_mesh_free(&gt);
   hearth_poses_free(&prgb);
