@@ -53,7 +53,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   /* recon/report.json against a two-state instance with no files beside it:
    * every problem is a line, none may crash */
   static const char *const states[] = {"neutral", "hot"};
-  hb_recon_expect x = {"cup_01", 2, states, NULL, -1, NULL, -1, -1, -1};
+  hb_recon_expect x = {"cup_01", 2, states, NULL, -1, NULL, -1, -1, -1, -1};
   hearth_problems pr = {0};
   hb_recon_report_check(text, size, "fuzz", &x, &pr);
   for (size_t i = 0; i < pr.n; i++)

@@ -95,6 +95,13 @@ typedef struct hearth_hole_rule {
 hearth_status hearth_mesh_fill_holes_near(hearth_mesh *m, const hearth_hole_rule *rule,
                                           size_t *n_filled, size_t *n_open, hearth_err *err);
 
+/* The boundary loops of m (3 or more edges; a boundary through a vertex
+ * twice counts as separate loops, as hearth_mesh_fill_holes splits it):
+ * n_loops and n_edges (either may be NULL) receive how many and their
+ * edges. A closed mesh has 0. */
+hearth_status hearth_mesh_open_loops(const hearth_mesh *m, size_t *n_loops, size_t *n_edges,
+                                     hearth_err *err);
+
 /* Edge collapse by quadric error (Garland-Heckbert) until the mesh has at
  * most target_triangles triangles or no collapse keeps it manifold
  * without flipping a triangle. Each collapse moves the kept vertex to the

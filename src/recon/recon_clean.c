@@ -163,10 +163,14 @@ hearth_status hearth_mesh_fill_holes(hearth_mesh *m, size_t max_edges, size_t *n
   return hearth_mesh_fill_holes_near(m, &r, n_filled, NULL, err);
 }
 
-hearth_status hearth_mesh_fill_holes_near(hearth_mesh *m, const hearth_hole_rule *rule,
-                                          size_t *n_filled, size_t *n_open, hearth_err *err) {
-  if (n_filled) *n_filled = 0;
-  if (n_open) *n_open = 0;
+/* Walk m's boundary loops: those rule closes are closed in `fill` (m
+   itself, or NULL to only count); *filled, *open and *open_edges receive
+   the loops closed, the loops of 3 or more edges left open and their
+   edges. */
+static hearth_status boundary_walk(const hearth_mesh *m, hearth_mesh *fill,
+                                   const hearth_hole_rule *rule, size_t *n_filled, size_t *n_open,
+                                   size_t *n_open_edges, hearth_err *err) {
+  *n_filled = *n_open = *n_open_edges = 0;
   size_t ne = 3 * m->n_triangles;
   if (!ne) return HEARTH_OK;
   uint64_t *und = malloc(ne * sizeof *und);
@@ -200,7 +204,7 @@ hearth_status hearth_mesh_fill_holes_near(hearth_mesh *m, const hearth_hole_rule
   uint32_t *loop = malloc((nb ? nb : 1) * sizeof *loop);
   hearth_status s = HEARTH_OK;
   if (!used || !loop) s = hearth_err_set(err, HEARTH_E_NOMEM, "fill holes");
-  size_t filled = 0, open = 0;
+  size_t filled = 0, open = 0, open_edges = 0;
   uint32_t *at = malloc((m->n_vertices ? m->n_vertices : 1) * sizeof *at);
   if (!at && !s) s = hearth_err_set(err, HEARTH_E_NOMEM, "fill holes");
   for (size_t v = 0; at && v < m->n_vertices; v++) at[v] = UINT32_MAX;
@@ -217,11 +221,12 @@ hearth_status hearth_mesh_fill_holes_near(hearth_mesh *m, const hearth_hole_rule
       loop[n++] = from;
       if (at[to] != UINT32_MAX) {
         size_t j = at[to], len = n - j;
-        if (len >= 3 && loop_closes(m, loop + j, len, rule)) {
-          if ((s = fan_fill(m, loop + j, len, err))) break;
+        if (len >= 3 && fill && loop_closes(m, loop + j, len, rule)) {
+          if ((s = fan_fill(fill, loop + j, len, err))) break;
           filled++;
         } else if (len >= 3) {
           open++;
+          open_edges += len;
         }
         for (size_t q = j; q < n; q++) at[loop[q]] = UINT32_MAX;
         n = j;
@@ -248,12 +253,32 @@ hearth_status hearth_mesh_fill_holes_near(hearth_mesh *m, const hearth_hole_rule
   free(used);
   free(loop);
   free(dir);
+  *n_filled = filled;
+  *n_open = open;
+  *n_open_edges = open_edges;
+  return s;
+}
+
+hearth_status hearth_mesh_fill_holes_near(hearth_mesh *m, const hearth_hole_rule *rule,
+                                          size_t *n_filled, size_t *n_open, hearth_err *err) {
+  size_t filled, open, open_edges;
+  hearth_status s = boundary_walk(m, m, rule, &filled, &open, &open_edges, err);
   if (m->uvs) {
     free(m->uvs);
     m->uvs = NULL;
   }
-  if (n_filled) *n_filled = filled;
-  if (n_open) *n_open = open;
+  if (n_filled) *n_filled = s ? 0 : filled;
+  if (n_open) *n_open = s ? 0 : open;
+  return s;
+}
+
+hearth_status hearth_mesh_open_loops(const hearth_mesh *m, size_t *n_loops, size_t *n_edges,
+                                     hearth_err *err) {
+  const hearth_hole_rule none = {0, 0, {0, 0, 0, 0}, 0};
+  size_t filled, open, edges;
+  hearth_status s = boundary_walk(m, NULL, &none, &filled, &open, &edges, err);
+  if (n_loops) *n_loops = s ? 0 : open;
+  if (n_edges) *n_edges = s ? 0 : edges;
   return s;
 }
 

@@ -150,10 +150,17 @@ static hearth_status write_report(const char *path, const char *instance,
   }
   write_aim(&b, r, aim_weight);
   if (m) {
+    /* the openings left where no depth view reached (hearth_hole_rule) */
+    size_t loops = 0, edges = 0;
+    hearth_status s = hearth_mesh_open_loops(m, &loops, &edges, err);
+    if (s) {
+      hearth_strbuf_free(&b);
+      return hearth_err_prefix(err, "%s", path);
+    }
     hearth_strbuf_printf(&b, "  \"mesh\": {\"vertices\": %zu, \"triangles\": %zu, \"voxel_m\": ",
                          m->n_vertices, m->n_triangles);
     rc_json_real(&b, voxel);
-    hearth_strbuf_printf(&b, "},\n");
+    hearth_strbuf_printf(&b, ", \"open_loops\": %zu, \"open_edges\": %zu},\n", loops, edges);
   }
   if (at) {
     hearth_strbuf_printf(&b, "  \"atlas\": {\"charts\": %zu, \"merged\": %zu", at->n_charts,

@@ -296,6 +296,15 @@ void hb_recon_report_check(const char *text, size_t len, const char *path, const
       BAD(&c, "mesh.vertices: %lld, but mesh_geometry.glb has %lld", v, x->mesh_vertices);
     if (t >= 0 && x->mesh_triangles >= 0 && t != x->mesh_triangles)
       BAD(&c, "mesh.triangles: %lld, but mesh_geometry.glb has %lld", t, x->mesh_triangles);
+    /* the openings: written since hearth recon left unseen ones open */
+    if (json_object_get(mesh, "open_loops") || json_object_get(mesh, "open_edges")) {
+      long long ol = get_count(&c, mesh, "mesh.", "open_loops", -1),
+                oe = get_count(&c, mesh, "mesh.", "open_edges", -1);
+      if (ol >= 0 && oe >= 0 && oe < 3 * ol)
+        BAD(&c, "mesh.open_edges: %lld, fewer than 3 for each of the %lld open loops", oe, ol);
+      if (ol >= 0 && x->mesh_open_loops >= 0 && ol != x->mesh_open_loops)
+        BAD(&c, "mesh.open_loops: %lld, but mesh_geometry.glb has %lld", ol, x->mesh_open_loops);
+    }
   } else if (x->mesh_triangles >= 0) {
     BAD(&c, "mesh: missing, but mesh_geometry.glb is beside it");
   }

@@ -11,6 +11,7 @@
 #include <sys/stat.h>
 #include "hearth/image.h"
 #include "hearth/mesh.h"
+#include "hearth/recon_geom.h"
 #include "hearth/npy.h"
 #include "hearth/recon.h"
 #include "hearth/dataset.h"
@@ -461,7 +462,7 @@ static void check_leftovers(hearth_problems *p, const char *dir, int depth) {
 typedef struct recon_read {
   hearth_poses poses;
   int poses_read;
-  long long mesh_vertices, mesh_triangles, atlas_charts;
+  long long mesh_vertices, mesh_triangles, mesh_open_loops, atlas_charts;
 } recon_read;
 
 /* recon/report.json (hearth recon's turntable route), when present: its
@@ -499,6 +500,7 @@ static void check_recon_report(hearth_problems *p, const char *dir, const char *
                        rr->poses_read ? &rr->poses : NULL,
                        rr->mesh_vertices,
                        rr->mesh_triangles,
+                       rr->mesh_open_loops,
                        rr->atlas_charts};
   hb_recon_report_check((const char *)text, len, path, &x, p);
   free(text);
@@ -533,6 +535,9 @@ static void check_recon_files(hearth_problems *p, const char *dir, const state_v
     } else {
       rr->mesh_vertices = (long long)mesh.n_vertices;
       rr->mesh_triangles = (long long)mesh.n_triangles;
+      size_t loops = 0;
+      if (hearth_mesh_open_loops(&mesh, &loops, NULL, &e)) add_err(p, f, &e);
+      else rr->mesh_open_loops = (long long)loops;
     }
     hearth_mesh_free(&mesh);
   }
@@ -639,7 +644,7 @@ static void check_instance(const char *root, const char *id, const hearth_valida
       }
     }
   }
-  recon_read rr = {{0}, 0, -1, -1, -1};
+  recon_read rr = {{0}, 0, -1, -1, -1, -1};
   check_recon_files(p, dir, sv, doc.n_states, o->decode_images, &rr, nfiles);
   check_recon_report(p, dir, id, &doc, sv, &rr, nfiles);
   hearth_poses_free(&rr.poses);

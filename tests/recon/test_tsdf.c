@@ -154,13 +154,18 @@ static void test_sphere(void) {
   s.n_triangles = w;
   hearth_mesh_edge_stats(&s, &nb, &nn);
   CHECK(nb > 20);
-  size_t filled = 0;
+  size_t filled = 0, loops = 0, loop_edges = 0;
+  CHECK_OK(hearth_mesh_open_loops(&s, &loops, &loop_edges, &err), &err);
+  CHECK_MSG(loops == 1 && loop_edges == nb, "cut cap: %zu loops of %zu edges (%zu boundary)", loops,
+            loop_edges, nb);
   CHECK_OK(hearth_mesh_fill_holes(&s, 10, &filled, &err), &err);
   CHECK(filled == 0); /* the loop is longer than 10 edges */
   CHECK_OK(hearth_mesh_fill_holes(&s, 1000, &filled, &err), &err);
   CHECK(filled == 1);
   hearth_mesh_edge_stats(&s, &nb, &nn);
   CHECK_MSG(nb == 0 && nn == 0, "filled: %zu boundary, %zu non-manifold", nb, nn);
+  CHECK_OK(hearth_mesh_open_loops(&s, &loops, &loop_edges, &err), &err);
+  CHECK(loops == 0 && loop_edges == 0);
   CHECK_OK(hearth_mesh_validate(&s, "filled", &err), &err);
   hearth_mesh_free(&s);
   hearth_mesh_free(&m);
@@ -320,6 +325,14 @@ static void test_openings(const char *root) {
       mx[0] * 1e3, rms[0] * 1e3, mx[1] * 1e3, rms[1] * 1e3, nb, low);
   CHECK_MSG(nb > 0 && nn == 0, "%zu boundary, %zu non-manifold edges", nb, nn);
   CHECK_MSG(low == 0, "%zu boundary edges at the base", low);
+  /* what recon/report.json counts: the openings left, all the boundary */
+  size_t loops[2] = {0, 0}, edges[2] = {0, 0};
+  for (int k = 0; k < 2; k++)
+    CHECK_OK(hearth_mesh_open_loops(&m[k], &loops[k], &edges[k], &err), &err);
+  printf("openings: %zu loops of %zu edges left open (every loop closed: %zu)\n", loops[1],
+         edges[1], loops[0]);
+  CHECK_MSG(loops[0] == 0 && loops[1] >= 1 && edges[1] == nb, "open loops %zu / %zu, %zu edges",
+            loops[0], loops[1], edges[1]);
   CHECK_MSG(mx[1] < 5e-3 && mx[0] > 2 * mx[1], "max recon->true %g (every loop closed %g)", mx[1],
             mx[0]);
 done:

@@ -300,7 +300,21 @@ static void test_release(void) {
   snprintf(path, sizeof path, "%s/instances/cup_01/recon/report.json", root);
   char *rep = test_slurp(path, NULL);
   CHECK(rep && strstr(rep, "\"icp_rms_mm\"") && strstr(rep, "\"per_view\""));
+  CHECK(rep && strstr(rep, "\"open_loops\": ") && strstr(rep, "\"open_edges\": "));
   free(rep);
+  /* hearth validate reads the openings against mesh_geometry.glb's: a
+     report that counts others is refused, naming the member */
+  snprintf(cmd, sizeof cmd, "'%s' validate '%s' --raw-only 2>&1", HEARTH_EXE, root);
+  run_cmd_expect(cmd, 0, "0 problem(s)");
+  snprintf(cmd, sizeof cmd,
+           "cp '%s' '%s/report.json' && sed -i 's/\"open_loops\": [0-9]*/\"open_loops\": 999/' "
+           "'%s'",
+           path, dir, path);
+  CHECK(system(cmd) == 0);
+  snprintf(cmd, sizeof cmd, "'%s' validate '%s' --raw-only 2>&1", HEARTH_EXE, root);
+  run_cmd_expect(cmd, 1, "mesh.open_loops: 999, but mesh_geometry.glb has");
+  snprintf(cmd, sizeof cmd, "cp '%s/report.json' '%s'", dir, path);
+  CHECK(system(cmd) == 0);
 
   /* the reconstructed release maps: scale, transfer, bake and map run on
      hearth's own mesh and atlas (the true rig stands in for calibration) */
