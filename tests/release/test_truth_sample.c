@@ -30,6 +30,17 @@ static double frand(unsigned *s) {
   return (double)((*s >> 8) & 0xffffff) / (double)0x1000000;
 }
 
+/* a random point of the plate at texel coordinates x0 + dx U(0,1),
+   y0 + dy U(0,1): its uv, its place q and the field there */
+static double plate_draw(unsigned *seed, double x0, double dx, double y0, double dy, double uv[2],
+                         double q[3]) {
+  double x = x0 + dx * frand(seed), y = y0 + dy * frand(seed);
+  uv[0] = x / RG;
+  uv[1] = y / RG;
+  plate_point(uv[0], uv[1], q);
+  return field(q[0], q[1]);
+}
+
 int main(void) {
   static float map[N], pos[3 * N], map3[3 * N];
   for (int r = 0; r < RG; r++)
@@ -55,11 +66,8 @@ int main(void) {
   unsigned seed = 7;
   double worst_bil = 0, worst_near = 0;
   for (int i = 0; i < 2000; i++) {
-    /* texel coordinates between the centres of rows 1..31, columns 0..15 */
-    double x = 0.5 + 15.0 * frand(&seed), y = 1.5 + 30.0 * frand(&seed);
-    double uv[2] = {x / RG, y / RG}, q[3];
-    plate_point(uv[0], uv[1], q);
-    double exact = field(q[0], q[1]);
+    /* between the texel centres of rows 1..31, columns 0..15 */
+    double uv[2], q[3], exact = plate_draw(&seed, 0.5, 15.0, 1.5, 30.0, uv, q);
     double got = hb_truth_sample(map, RG, 1, 0, pos, q, uv, reach);
     double got3 = hb_truth_sample(map3, RG, 3, 1, pos, q, uv, reach);
     CHECK_MSG(got == got3, "channel 1 of a 3-channel map: %g against %g", got3, got);
@@ -77,10 +85,7 @@ int main(void) {
      so within a texel's change of the field, and never pulled to 90 */
   double worst_seam = 0, worst_ungated = 0;
   for (int i = 0; i < 500; i++) {
-    double x = 15.0 + 0.999 * frand(&seed), y = 1.5 + 30.0 * frand(&seed);
-    double uv[2] = {x / RG, y / RG}, q[3];
-    plate_point(uv[0], uv[1], q);
-    double exact = field(q[0], q[1]);
+    double uv[2], q[3], exact = plate_draw(&seed, 15.0, 0.999, 1.5, 30.0, uv, q);
     double got = hb_truth_sample(map, RG, 1, 0, pos, q, uv, reach);
     double ungated = hb_truth_sample(map, RG, 1, 0, pos, q, uv, 1e9);
     worst_seam = fmax(worst_seam, fabs(got - exact));
