@@ -240,9 +240,9 @@ typedef struct hearth_turntable_opts {
                              about one axis, level when its aim has no roll);
                              0: off; default 1 */
   double ring_tilt_prior; /* its ring's views' R^T e_z held to their mean (one
-                             tilt a ring); 0 (default): off, as the virtual
-                             rig jitters each view's elevation by up to 0.7
-                             degrees */
+                             tilt a ring), where such a view sees no wall;
+                             0 (default): off, as the virtual rig jitters
+                             each view's elevation by up to 0.7 degrees */
   int threads;            /* 0: hearth_default_threads() */
   int quiet;              /* 1: no progress on stderr */
 } hearth_turntable_opts;
