@@ -228,8 +228,23 @@ typedef struct hearth_turntable_opts {
   double aim_height_tol;   /* the aimed-at point's height held to half the
                               object's top within this share of the top (and
                               at least 2 mm); 0: free; default 0.6 */
-  int threads;             /* 0: hearth_default_threads() */
-  int quiet;               /* 1: no progress on stderr */
+  /* the tilt of the views whose depth shows no table, or a weak one (a
+     thin band), weights per match a view has, per squared radian: */
+  double wall_prior;      /* the normal of the wall (backdrop) such a view sees
+                             held horizontal (the wall taken as vertical); 0:
+                             off, and a view that borrows its ring's plane is
+                             held to it; default 1 */
+  double roll_prior;      /* its table normal (R^T e_z) held normal to the
+                             rig's tilt axis in the camera frame (from the
+                             views with a table: the rig tilts its cameras
+                             about one axis, level when its aim has no roll);
+                             0: off; default 1 */
+  double ring_tilt_prior; /* its ring's views' R^T e_z held to their mean (one
+                             tilt a ring), where such a view sees no wall;
+                             0 (default): off, as the virtual rig jitters
+                             each view's elevation by up to 0.7 degrees */
+  int threads;            /* 0: hearth_default_threads() */
+  int quiet;              /* 1: no progress on stderr */
 } hearth_turntable_opts;
 void hearth_turntable_opts_default(hearth_turntable_opts *o);
 
@@ -259,6 +274,10 @@ typedef struct hearth_turntable_result {
   size_t n_ring_plane_views;           /* views whose depth showed no table the
                                           object stands on: their elevation's
                                           mean plane taken */
+  size_t n_free_ring_views;            /* views of a ring where no view showed
+                                          a table: levelled by the wall they
+                                          see or the other rings' elevations
+                                          extrapolated, no plane term */
   double seconds;
   /* the aim term's estimate (hearth_turntable_aim_state and _place at the
    * end of this header; none when the term is off): per state, per place
@@ -274,7 +293,9 @@ void hearth_turntable_result_free(hearth_turntable_result *r); /* accepts a zero
  * order) and view (manifest order). A view without a depth map, an empty
  * cut-out or a depth map with too few object points is an error naming the
  * file; a view whose depth shows no plane the object stands on takes the
- * mean plane of its elevation's views (an error when none has one). The
+ * mean plane of its elevation's views, and a wall (backdrop) it sees
+ * levels it; a ring where no view has one is started from the other rings
+ * (an error when no view at all has one). The
  * gauge is the mean camera position of the start, no view is held. res may
  * be NULL. */
 hearth_status hearth_recon_turntable(const char *root, const char *instance,

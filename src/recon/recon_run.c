@@ -135,8 +135,9 @@ static hearth_status write_report(const char *path, const char *instance,
   hearth_strbuf_printf(&b, "  \"iterations\": %d,\n", r->iterations);
   hearth_strbuf_printf(&b,
                        "  \"encoder_views\": %zu,\n  \"colour_views\": %zu,\n"
-                       "  \"ring_plane_views\": %zu,\n",
-                       r->n_encoder_views, r->n_colour_views, r->n_ring_plane_views);
+                       "  \"ring_plane_views\": %zu,\n  \"free_ring_views\": %zu,\n",
+                       r->n_encoder_views, r->n_colour_views, r->n_ring_plane_views,
+                       r->n_free_ring_views);
   const struct {
     const char *k;
     double v;

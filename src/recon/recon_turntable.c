@@ -32,6 +32,9 @@
  * height above the plane */
 #define TT_ON_TABLE_M 0.05
 #define TT_ON_TABLE_SHARE 0.002
+/* a table plane of fewer inliers (a thin band seen at grazing incidence)
+ * tilts its view less well than a wall it sees */
+#define TT_WEAK_PLANE 2000
 /* a plane fitting its inliers worse than this is not the turntable top */
 #define TT_PLANE_MAX_RMS_M 0.002
 /* Huber threshold of the ICP distances */
@@ -60,6 +63,9 @@ void hearth_turntable_opts_default(hearth_turntable_opts *o) {
   o->aim_side_m = 0.0005;
   o->aim_per_ring = 0;
   o->aim_height_tol = 0.6;
+  o->ring_tilt_prior = 0;
+  o->roll_prior = 1.0;
+  o->wall_prior = 1.0;
 }
 
 void hearth_turntable_result_free(hearth_turntable_result *r) {
@@ -86,6 +92,9 @@ typedef struct tt_view {
   double L[9];    /* R_level_from_cam: rows forward, side, up */
   double height;  /* camera above the plane, metres */
   size_t n_plane; /* 0: none found, the ring's plane is taken */
+  int free_ring;  /* no view of its ring found one: started from the others */
+  size_t n_wall;  /* without a table (or a weak one): the backdrop's inliers */
+  double wall[3]; /* its unit normal (colour frame), towards the camera */
   size_t bg_points;
   double plane_rms;
   size_t npl;
@@ -180,6 +189,78 @@ static void fit_plane(const float *pts, const size_t *idx, size_t m, double n[3]
 }
 
 static void set_level(tt_view *v, const double n[3]);
+
+/* A wall (the backdrop) among the background points bg[0..nb) (colour
+ * frame) of a view without a table: the RANSAC plane facing the camera
+ * (its normal within 45 degrees of the optical axis) with the most
+ * inliers, refit to them; its normal, towards the camera, into w. Its
+ * inliers, 0 when fewer than TT_MIN_PLANE or it fits worse than
+ * TT_PLANE_MAX_RMS_M. */
+static size_t wall_plane(const float *bg, size_t nb, uint64_t seed, double w[3]) {
+  if (nb < TT_MIN_PLANE) return 0;
+  hearth_rng r;
+  hearth_rng_seed(&r, seed);
+  double best_n[3] = {0}, best_d = 0;
+  size_t best = 0;
+  for (int it = 0; it < TT_RANSAC_ITER; it++) {
+    size_t i0 = hearth_rng_u64(&r) % nb, i1 = hearth_rng_u64(&r) % nb, i2 = hearth_rng_u64(&r) % nb;
+    double a[3], b[3], n[3];
+    for (int k = 0; k < 3; k++) {
+      a[k] = bg[3 * i1 + k] - bg[3 * i0 + k];
+      b[k] = bg[3 * i2 + k] - bg[3 * i0 + k];
+    }
+    hearth_cross3(a, b, n);
+    double ln = hearth_norm3(n);
+    if (ln < 1e-9) continue;
+    for (int k = 0; k < 3; k++) n[k] /= ln;
+    double p0[3] = {bg[3 * i0], bg[3 * i0 + 1], bg[3 * i0 + 2]};
+    double d = -hearth_dot3(n, p0);
+    if (d < 0) {
+      for (int k = 0; k < 3; k++) n[k] = -n[k];
+      d = -d;
+    }
+    if (-n[2] < 0.7) continue;
+    size_t cnt = 0;
+    for (size_t i = 0; i < nb; i += 2) {
+      double q[3] = {bg[3 * i], bg[3 * i + 1], bg[3 * i + 2]};
+      if (fabs(hearth_dot3(n, q) + d) < TT_PLANE_TOL_M) cnt++;
+    }
+    if (cnt > best) {
+      best = cnt;
+      memcpy(best_n, n, sizeof best_n);
+      best_d = d;
+    }
+  }
+  if (2 * best < TT_MIN_PLANE) return 0;
+  size_t *idx = malloc(nb * sizeof *idx), m = 0;
+  if (!idx) return 0;
+  double n[3] = {best_n[0], best_n[1], best_n[2]}, d = best_d, rms = 0;
+  for (int pass = 0; pass < 3; pass++) {
+    double tol = pass == 0 ? TT_PLANE_TOL_M : 2.5 * fmax(rms, 5e-4);
+    m = 0;
+    for (size_t i = 0; i < nb; i++) {
+      double q[3] = {bg[3 * i], bg[3 * i + 1], bg[3 * i + 2]};
+      if (fabs(hearth_dot3(n, q) + d) < tol) idx[m++] = i;
+    }
+    if (m < TT_MIN_PLANE) break;
+    fit_plane(bg, idx, m, n, &d);
+    if (d < 0) {
+      for (int k = 0; k < 3; k++) n[k] = -n[k];
+      d = -d;
+    }
+    double ss = 0;
+    for (size_t i = 0; i < m; i++) {
+      double q[3] = {bg[3 * idx[i]], bg[3 * idx[i] + 1], bg[3 * idx[i] + 2]};
+      double e = hearth_dot3(n, q) + d;
+      ss += e * e;
+    }
+    rms = sqrt(ss / (double)m);
+  }
+  free(idx);
+  if (m < TT_MIN_PLANE || rms > TT_PLANE_MAX_RMS_M) return 0;
+  memcpy(w, n, 3 * sizeof *w);
+  return m;
+}
 
 /* The table plane among the background points bg[0..nb) (colour frame):
  * the RANSAC plane facing up in the image (normal towards the camera with
@@ -295,6 +376,93 @@ static int plane_holds_object(const tt_view *v, const float *pts, const uint8_t 
   }
   return no && v->plane_rms <= TT_PLANE_MAX_RMS_M &&
          (double)low >= TT_ON_TABLE_SHARE * (double)no && 20 * under <= no;
+}
+
+static void tilt_axis(const tt_view *v, size_t nv, int planed, double u[3]);
+
+/* The table normal n (colour frame) of a view without a table that sees
+ * a wall (taken as vertical, its normal w): normal to w and to the rig's
+ * tilt axis u (both horizontal), up in the image. 0 when it sees none or
+ * the two are too close to parallel. */
+static int wall_level(const tt_view *v, const double u[3], double n[3]) {
+  if (!v->n_wall) return 0;
+  double c[3];
+  hearth_cross3(u, v->wall, c);
+  double ln = hearth_norm3(c);
+  if (ln < 0.5) return 0;
+  if (c[1] > 0) ln = -ln;
+  for (int a = 0; a < 3; a++) n[a] = c[a] / ln;
+  return 1;
+}
+
+/* Rings where no view found the table (a flat object seen low: the
+ * turntable at grazing incidence): each of their views levelled as a wall
+ * it sees has it (wall_level), else at the elevation the rings with
+ * planes give its index (their mean elevations fit linearly in the index,
+ * or the one such ring's) with its table normal normal to the rig's tilt
+ * axis u; placed at the height where its object points' mean stands as
+ * high over the table as in the planed views. No plane term holds them:
+ * the joint ICP against the other rings' views (with the wall and roll
+ * terms) settles them. An error naming the first view when no view at all
+ * has a plane. */
+static hearth_status free_rings(tt_view *v, size_t nv, const double u[3], size_t *n_free,
+                                hearth_err *err) {
+  double hobj = 0, wobj = 0, roll = 0, S0 = 0, S1 = 0, S2 = 0, T0 = 0, T1 = 0;
+  size_t bg = 0;
+  for (size_t i = 0; i < nv; i++) {
+    bg += v[i].bg_points;
+    if (!v[i].n_plane) continue;
+    double w = (double)v[i].n_plane;
+    hobj += w * (v[i].height + hearth_dot3(&v[i].L[6], v[i].centroid));
+    roll += w * v[i].L[6];
+    wobj += w;
+    int first = 1;
+    for (size_t j = 0; j < i && first; j++)
+      first = !(v[j].n_plane && v[j].elevation_index == v[i].elevation_index);
+    if (!first) continue;
+    /* the ring's mean elevation (the optical axis below the horizon) */
+    double el = 0, we = 0;
+    for (size_t j = i; j < nv; j++)
+      if (v[j].n_plane && v[j].elevation_index == v[i].elevation_index) {
+        el += (double)v[j].n_plane * asin(fmax(-1.0, fmin(1.0, -v[j].L[8])));
+        we += (double)v[j].n_plane;
+      }
+    double e = v[i].elevation_index;
+    S0 += 1;
+    S1 += e;
+    S2 += e * e;
+    T0 += el / we;
+    T1 += e * el / we;
+  }
+  if (!(wobj > 0))
+    return hearth_err_set(err, HEARTH_E_NUMERIC,
+                          "%s: no turntable plane found in any of the %zu views' depth (%zu "
+                          "pixels off the cut-outs in all): the views cannot be levelled",
+                          nv ? v[0].depth_path : "turntable", nv, bg);
+  hobj /= wobj;
+  roll /= wobj;
+  double den = S0 * S2 - S1 * S1, slope = den > 1e-9 ? (S0 * T1 - S1 * T0) / den : 0;
+  double icpt = (T0 - slope * S1) / S0;
+  for (size_t i = 0; i < nv; i++) {
+    int any = 0;
+    for (size_t j = 0; j < nv && !any; j++)
+      any = v[j].n_plane && v[j].elevation_index == v[i].elevation_index;
+    if (any) continue;
+    double el = fmax(1.0 * TT_DEG, fmin(85.0 * TT_DEG, icpt + slope * v[i].elevation_index));
+    double n[3] = {roll, 0, -sin(el)};
+    n[1] = -sqrt(fmax(0.0, 1.0 - n[0] * n[0] - n[2] * n[2]));
+    double nu = hearth_dot3(n, u), ln = 0;
+    for (int a = 0; a < 3; a++) n[a] -= nu * u[a];
+    ln = hearth_norm3(n);
+    for (int a = 0; a < 3; a++) n[a] /= ln;
+    double nw[3];
+    if (wall_level(&v[i], u, nw)) memcpy(n, nw, sizeof n);
+    set_level(&v[i], n);
+    v[i].height = hobj - hearth_dot3(n, v[i].centroid);
+    v[i].free_ring = 1;
+    (*n_free)++;
+  }
+  return HEARTH_OK;
 }
 
 /* pose from the parameters */
@@ -474,8 +642,19 @@ static hearth_status load_view(tt_view *v, const char *dir, const hearth_view_fi
         v->plane_rms = 0;
       }
     }
-  /* none: the view takes its ring's plane once every view is loaded */
+  /* none: the view takes its ring's plane once every view is loaded; a
+   * wall (the backdrop) it sees, taken as vertical, tilts it, and one
+   * with a weak plane */
   v->bg_points = nb_all;
+  if (v->n_plane < TT_WEAK_PLANE) {
+    nb = 0;
+    for (size_t p = 0; p < (size_t)W * H; p++)
+      if (cls[p] >= 2) {
+        for (int a = 0; a < 3; a++) dirs[3 * nb + a] = pts[3 * p + a];
+        nb++;
+      }
+    v->n_wall = wall_plane(dirs, nb, seed ^ 0x77616c6cULL, v->wall);
+  }
   if (bx1 < 0) {
     s = hearth_err_set(err, HEARTH_E_NOT_FOUND,
                        "%s: no depth pixel lies inside the cut-out %s (of view %s)", v->depth_path,
@@ -763,13 +942,17 @@ static double heading(const tt_view *v, const double u[3]) {
  * it, else the camera's x axis made normal to their mean; signed along +x.
  * A turntable camera tilts about it between rings, so its heading moves
  * with the turntable angle alone at every elevation. */
-static void tilt_axis(const tt_view *v, size_t nv, double u[3]) {
+static void tilt_axis(const tt_view *v, size_t nv, int planed, double u[3]) {
   double C[9] = {0}, m[3] = {0, 0, 0};
-  for (size_t i = 0; i < nv; i++)
+  size_t cnt = 0;
+  for (size_t i = 0; i < nv; i++) {
+    if (planed && !v[i].n_plane) continue;
+    cnt++;
     for (int a = 0; a < 3; a++) {
       m[a] += v[i].L[6 + a];
       for (int b = 0; b < 3; b++) C[3 * a + b] += v[i].L[6 + a] * v[i].L[6 + b];
     }
+  }
   double w[3], V[9];
   sym3_eigen(C, w, V);
   int k = 0;
@@ -779,7 +962,12 @@ static void tilt_axis(const tt_view *v, size_t nv, double u[3]) {
   for (int i = 0; i < 3; i++)
     if (i != k && w[i] < w1) w1 = w[i];
   /* normals spread by 10 degrees or more about the mean */
-  if (w1 > (double)nv * pow(sin(10.0 * TT_DEG), 2) / 2.0) {
+  if (!cnt) {
+    u[0] = 1;
+    u[1] = u[2] = 0;
+    return;
+  }
+  if (w1 > (double)cnt * pow(sin(10.0 * TT_DEG), 2) / 2.0) {
     for (int a = 0; a < 3; a++) u[a] = V[3 * a + k];
   } else {
     double lm = hearth_norm3(m);
@@ -1101,9 +1289,108 @@ out:
   free(key_s);
 }
 
+/* d(R^T e_z) / d w of a view turned by w (world frame) on the left:
+ * R^T [e_z]x */
+static void up_jacobian(const double R[9], double J[9]) {
+  for (int a = 0; a < 3; a++) {
+    J[3 * a] = R[3 + a];  /* column 0 of [e_z]x is e_y */
+    J[3 * a + 1] = -R[a]; /* column 1 is -e_x */
+    J[3 * a + 2] = 0;
+  }
+}
+
+/* The priors on the tilt of the views without a plane of their own (the
+ * wall and roll: or with a weak one, of fewer than TT_WEAK_PLANE inliers),
+ * each weighted as its option times a view's matches (w_view), in
+ * radians:
+ *  - the wall: the normal w of the wall (backdrop) it sees held
+ *    horizontal, (R w)_z = 0; its Jacobian in the rotation (R w) x e_z;
+ *  - the roll: its table normal in its frame (R^T e_z) held normal to
+ *    the rig's tilt axis u (from the views with a table): the rig turns
+ *    its cameras between rings about that axis, and the virtual rig's
+ *    aim has no roll; with the wall it fixes the tilt;
+ *  - the ring: in each ring (elevation index) with such a view that sees
+ *    no wall (or with the wall term off), every view's R^T e_z held to the
+ *    ring's mean, r_i = n_i - mean(n) (the Jacobian: the centring
+ *    projection times each view's R^T [e_z]x), so the ring's views pool
+ *    their evidence for one tilt. Off by default: the virtual rig jitters
+ *    each view's elevation by up to 0.7 degrees, which the term pulls
+ *    together (phone seed 3, 30 views, over all views: rotation max 0.35
+ *    degrees at 1 against 0.12 with the walls); without the walls it
+ *    lowers the max (seed 3 0.82 to 0.66 degrees, seed 2 1.50 to 1.39)
+ *    but not always the median (seed 3 at 10 views: 0.11 to 0.18). */
+static void ring_system(const tt_view *v, size_t nv, const double u[3],
+                        const hearth_turntable_opts *o, double w_view, double *A, double *b,
+                        size_t nu) {
+  const double wr = o->ring_tilt_prior * w_view, wl = o->roll_prior * w_view,
+               ww = o->wall_prior * w_view;
+  /* the wall: a view without a table that sees one holds its normal
+   * horizontal, (R w)_z = 0; d / d w_rot = (R w) x e_z */
+  for (size_t i = 0; i < nv && ww > 0; i++) {
+    if (!v[i].n_wall) continue;
+    double Rw[3], J[3], ez[3] = {0, 0, 1};
+    hearth_rigid_rotate(&v[i].T, v[i].wall, Rw);
+    hearth_cross3(Rw, ez, J);
+    for (int x = 0; x < 3; x++) {
+      b[6 * i + (size_t)x] -= ww * J[x] * Rw[2];
+      for (int y = 0; y < 3; y++)
+        A[(6 * i + (size_t)x) * nu + 6 * i + (size_t)y] += ww * J[x] * J[y];
+    }
+  }
+  for (size_t i = 0; i < nv && wl > 0; i++) {
+    if (v[i].n_plane >= TT_WEAK_PLANE) continue;
+    double Ju[9], J[3];
+    up_jacobian(v[i].T.R, Ju);
+    double r = hearth_dot3(&v[i].T.R[6], u);
+    for (int x = 0; x < 3; x++) J[x] = u[0] * Ju[x] + u[1] * Ju[3 + x] + u[2] * Ju[6 + x];
+    for (int x = 0; x < 3; x++) {
+      b[6 * i + (size_t)x] -= wl * J[x] * r;
+      for (int y = 0; y < 3; y++)
+        A[(6 * i + (size_t)x) * nu + 6 * i + (size_t)y] += wl * J[x] * J[y];
+    }
+  }
+  for (size_t i = 0; i < nv && wr > 0; i++) {
+    /* the ring's first view starts it, once */
+    int first = 1, lacking = 0;
+    for (size_t j = 0; j < nv && first; j++)
+      first = !(j < i && v[j].elevation_index == v[i].elevation_index);
+    if (!first) continue;
+    double mean[3] = {0, 0, 0};
+    size_t nr = 0;
+    for (size_t j = i; j < nv; j++)
+      if (v[j].elevation_index == v[i].elevation_index) {
+        for (int a = 0; a < 3; a++) mean[a] += v[j].T.R[6 + a];
+        lacking |= !v[j].n_plane && !(v[j].n_wall && ww > 0);
+        nr++;
+      }
+    if (!lacking || nr < 2) continue;
+    for (int a = 0; a < 3; a++) mean[a] /= (double)nr;
+    for (size_t j = i; j < nv; j++) {
+      if (v[j].elevation_index != v[i].elevation_index) continue;
+      double Jj[9], r[3];
+      up_jacobian(v[j].T.R, Jj);
+      for (int a = 0; a < 3; a++) r[a] = v[j].T.R[6 + a] - mean[a];
+      for (int x = 0; x < 3; x++)
+        for (int a = 0; a < 3; a++) b[6 * j + (size_t)x] -= wr * Jj[3 * a + x] * r[a];
+      for (size_t k = i; k < nv; k++) {
+        if (v[k].elevation_index != v[i].elevation_index) continue;
+        double Jk[9], c = wr * ((j == k) - 1.0 / (double)nr);
+        up_jacobian(v[k].T.R, Jk);
+        for (int x = 0; x < 3; x++)
+          for (int y = 0; y < 3; y++) {
+            double h = 0;
+            for (int a = 0; a < 3; a++) h += Jj[3 * a + x] * Jk[3 * a + y];
+            A[(6 * j + (size_t)x) * nu + 6 * k + (size_t)y] += c * h;
+          }
+      }
+    }
+  }
+}
+
 static hearth_status run_icp(tt_view *v, size_t nv, size_t n_states, const double u[3],
-                             const hearth_camera *rgb, const hearth_turntable_opts *o,
-                             hearth_turntable_result *res, hearth_err *err) {
+                             const double u_rig[3], const hearth_camera *rgb,
+                             const hearth_turntable_opts *o, hearth_turntable_result *res,
+                             hearth_err *err) {
   const int iterations = o->iterations;
   const double gate0 = 0.025;
   /* pairs: views looking from within max_pair_deg */
@@ -1218,6 +1505,7 @@ static hearth_status run_icp(tt_view *v, size_t nv, size_t n_states, const doubl
             A[gi * nu + 6 * vj + 2] += we * ((vi == vj) - 1.0 / (double)ns);
       }
     }
+    ring_system(v, nv, u_rig, o, (double)(m / (nv ? nv : 1) + 1), A, b, nu);
     /* the gauge: no view is held; the mean of the cameras' horizontal
      * steps is held at zero (weighted as a view's matches), so the frame
      * keeps the start's mean camera position and a view that starts off
@@ -1356,12 +1644,20 @@ hearth_status hearth_recon_turntable(const char *root, const char *instance,
   }
   hearth_progress_end(&prog);
   free(rays.dirs);
+  /* the rig's tilt axis in the camera frame (its x when its aim has no
+   * roll) from the views with a table; a ring where none has one is
+   * started from the other rings */
+  double u_rig[3] = {1, 0, 0};
+  if (!s) {
+    tilt_axis(v, nv, 1, u_rig);
+    s = free_rings(v, nv, u_rig, &res.n_free_ring_views, err);
+  }
   /* a view without a plane of its own takes its ring's: the mean table
    * normal (its camera frame) and height of the views of its elevation,
    * weighted by their inliers (the rig's cameras keep one tilt and roll a
    * ring) */
   for (size_t i = 0; i < nv && !s; i++) {
-    if (v[i].n_plane) continue;
+    if (v[i].n_plane || v[i].free_ring) continue;
     double n[3] = {0, 0, 0}, h = 0;
     size_t cnt = 0;
     for (size_t j = 0; j < nv; j++)
@@ -1370,18 +1666,16 @@ hearth_status hearth_recon_turntable(const char *root, const char *instance,
         h += (double)v[j].n_plane * v[j].height;
         cnt += v[j].n_plane;
       }
-    if (!cnt) {
-      s = hearth_err_set(err, HEARTH_E_NUMERIC,
-                         "%s: no turntable plane found (%zu depth pixels off the cut-out), nor "
-                         "in any view of its elevation",
-                         v[i].depth_path, v[i].bg_points);
-      break;
-    }
     double ln = hearth_norm3(n);
     for (int a = 0; a < 3; a++) n[a] /= ln;
     v[i].height = h / (double)cnt;
+    /* a wall it sees levels it instead, and the wall term holds it (the
+     * ring's plane, often one view's seen at grazing incidence, would
+     * pull it off by as much as that plane is) */
+    int wall = o.wall_prior > 0 && wall_level(&v[i], u_rig, n);
     set_level(&v[i], n);
     res.n_ring_plane_views++;
+    if (wall) continue;
     /* the plane term then holds it to that plane, at a quarter of a good
      * plane's weight (a ring's cameras differ in tilt by a fraction of a
      * degree): a grid of points on it around the object's foot */
@@ -1406,7 +1700,7 @@ hearth_status hearth_recon_turntable(const char *root, const char *instance,
     s = hearth_err_set(err, HEARTH_E_NOMEM, "turntable: report");
   double u[3] = {1, 0, 0};
   if (!s) {
-    tilt_axis(v, nv, u);
+    tilt_axis(v, nv, 0, u);
     /* the start: nominal azimuths (or the encoder's angles, aligned to
      * them in the mean over each encoder group), the object's centroid on
      * the axis; the tilt axis of a camera at azimuth phi looking at the
@@ -1452,7 +1746,7 @@ hearth_status hearth_recon_turntable(const char *root, const char *instance,
       tv->y = -cw[1];
       tt_pose(tv);
     }
-    s = run_icp(v, nv, n_states, u, &fac.rgb, &o, &res, err);
+    s = run_icp(v, nv, n_states, u, u_rig, &fac.rgb, &o, &res, err);
   }
   if (!s) {
     out->views = calloc(nv, sizeof *out->views);

@@ -279,6 +279,8 @@ void hb_recon_report_check(const char *text, size_t len, const char *path, const
   /* bounded by the views there are (the manifests'), else by the report's */
   long long hi = x->manifest_views >= 0 ? x->manifest_views : nv > 0 ? nv : -1;
   for (size_t j = 0; j < 3; j++) get_count(&c, o, "", of_views[j], hi);
+  /* written since the rings without a table were started from the others */
+  if (json_object_get(o, "free_ring_views")) get_count(&c, o, "", "free_ring_views", hi);
   static const char *const icp[] = {"icp_rms_start_mm", "icp_rms_mm", "icp_median_mm"};
   for (size_t j = 0; j < 3; j++) get_real(&c, o, "", icp[j], 1);
   const json_t *aim = json_object_get(o, "aim");
