@@ -278,6 +278,12 @@ typedef struct hearth_turntable_result {
                                           a table: levelled by the wall they
                                           see or the other rings' elevations
                                           extrapolated, no plane term */
+  size_t n_wall_views;                 /* views levelled by the wall (backdrop) they see:
+                                without a table or with a weak one */
+  size_t n_wall_check_views;           /* views that see both the table and a wall */
+  double wall_tilt_deg;                /* the median of their walls' departure from
+                                vertical (NAN when none): over 1 degree, no
+                                wall is taken as vertical (n_wall_views 0) */
   double seconds;
   /* the aim term's estimate (hearth_turntable_aim_state and _place at the
    * end of this header; none when the term is off): per state, per place

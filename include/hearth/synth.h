@@ -110,6 +110,9 @@ typedef struct hearth_synth_opts {
   int contact_sheet;         /* write instances/<id>/raw/<state>/contact_sheet.png */
   int no_recon;              /* 1: no recon/ stand-in (a release for `hearth recon`);
                                 ground_truth/ is written as always */
+  double backdrop_tilt_deg;  /* the backdrop behind the turntable (a plane facing each
+                                camera, 0.45 m behind the axis) leans back by this much,
+                                its top away from the camera; default 0 (vertical) */
   double netd_c;             /* thermal noise, default 0.05 degC */
   /* the calibration target; zeroed (the default): the paper's plate and no
      calibration/target.json; set: that target, written to target.json */

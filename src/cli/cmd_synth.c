@@ -104,6 +104,9 @@ int hearth_cmd_synth(int argc, char **argv) {
               .flags = CLI_LO_OPEN | CLI_HI_OPEN),
       CLI_STR("--mesh-category", "C", &o.mesh_category, "whose temperature states it gets"),
       CLI_FLAG("--contact-sheet", &o.contact_sheet, 1, "also write raw/<state>/contact_sheet.png"),
+      CLI_NUM("--backdrop-tilt", "DEG", &o.backdrop_tilt_deg, -30, 30,
+              "the backdrop behind the turntable leans back by DEG, its top away from the "
+              "camera (0: vertical)"),
       CLI_CHOICE("--recon", &o.no_recon, k_recon, NULL,
                  "stand-in: recon/ as an outside tool would hand it over (the true mesh "
                  "under a similarity); none: no recon/ (for `hearth recon`)",

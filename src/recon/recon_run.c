@@ -138,6 +138,12 @@ static hearth_status write_report(const char *path, const char *instance,
                        "  \"ring_plane_views\": %zu,\n  \"free_ring_views\": %zu,\n",
                        r->n_encoder_views, r->n_colour_views, r->n_ring_plane_views,
                        r->n_free_ring_views);
+  hearth_strbuf_printf(&b, "  \"wall_views\": %zu,\n  \"wall_check_views\": %zu,\n",
+                       r->n_wall_views, r->n_wall_check_views);
+  hearth_strbuf_printf(&b, "  \"wall_tilt_deg\": ");
+  if (isfinite(r->wall_tilt_deg)) rc_json_real(&b, r->wall_tilt_deg);
+  else hearth_strbuf_printf(&b, "null");
+  hearth_strbuf_printf(&b, ",\n");
   const struct {
     const char *k;
     double v;

@@ -190,6 +190,12 @@ static void fit_plane(const float *pts, const size_t *idx, size_t m, double n[3]
 
 static void set_level(tt_view *v, const double n[3]);
 
+/* The backdrop is taken as vertical only where the views that see both it
+ * and the table show it so: the median over them of the wall's departure
+ * from normal to the table above this, and no view is levelled by a wall.
+ * A wall no view with a table sees is taken as vertical unchecked. */
+#define TT_WALL_VERTICAL_DEG 1.0
+
 /* A wall (the backdrop) among the background points bg[0..nb) (colour
  * frame) of a view without a table: the RANSAC plane facing the camera
  * (its normal within 45 degrees of the optical axis) with the most
@@ -379,6 +385,32 @@ static int plane_holds_object(const tt_view *v, const float *pts, const uint8_t 
 }
 
 static void tilt_axis(const tt_view *v, size_t nv, int planed, double u[3]);
+
+static int cmp_double(const void *a, const void *b);
+
+/* The walls against the table (TT_WALL_VERTICAL_DEG): the check's figures
+ * into res; afterwards only the views without a table, or with a weak one,
+ * keep their wall, and none when the check fails. */
+static hearth_status check_walls(tt_view *v, size_t nv, hearth_turntable_result *res,
+                                 hearth_err *err) {
+  double *ang = malloc((nv ? nv : 1) * sizeof *ang);
+  if (!ang) return hearth_err_set(err, HEARTH_E_NOMEM, "turntable: walls");
+  size_t k = 0;
+  for (size_t i = 0; i < nv; i++)
+    if (v[i].n_plane >= TT_WEAK_PLANE && v[i].n_wall)
+      ang[k++] = asin(fmin(1.0, fabs(hearth_dot3(v[i].wall, &v[i].L[6])))) / TT_DEG;
+  qsort(ang, k, sizeof *ang, cmp_double);
+  res->n_wall_check_views = k;
+  res->wall_tilt_deg = k ? (k % 2 ? ang[k / 2] : 0.5 * (ang[k / 2 - 1] + ang[k / 2])) : NAN;
+  free(ang);
+  int vertical = !k || res->wall_tilt_deg <= TT_WALL_VERTICAL_DEG;
+  res->n_wall_views = 0;
+  for (size_t i = 0; i < nv; i++) {
+    if (v[i].n_plane >= TT_WEAK_PLANE || !vertical) v[i].n_wall = 0;
+    res->n_wall_views += v[i].n_wall != 0;
+  }
+  return HEARTH_OK;
+}
 
 /* The table normal n (colour frame) of a view without a table that sees
  * a wall (taken as vertical, its normal w): normal to w and to the rig's
@@ -644,15 +676,21 @@ static hearth_status load_view(tt_view *v, const char *dir, const hearth_view_fi
     }
   /* none: the view takes its ring's plane once every view is loaded; a
    * wall (the backdrop) it sees, taken as vertical, tilts it, and one
-   * with a weak plane */
+   * with a weak plane. Every view looks for the wall: those with a table
+   * check that it stands vertical (check_walls) */
   v->bg_points = nb_all;
-  if (v->n_plane < TT_WEAK_PLANE) {
+  {
+    /* off the table: a turntable seen from above faces the camera too */
     nb = 0;
-    for (size_t p = 0; p < (size_t)W * H; p++)
-      if (cls[p] >= 2) {
-        for (int a = 0; a < 3; a++) dirs[3 * nb + a] = pts[3 * p + a];
-        nb++;
+    for (size_t p = 0; p < (size_t)W * H; p++) {
+      if (cls[p] < 2) continue;
+      if (v->n_plane) {
+        double q[3] = {pts[3 * p], pts[3 * p + 1], pts[3 * p + 2]};
+        if (fabs(hearth_dot3(&v->L[6], q) + v->height) < TT_PLANE_TOL_M) continue;
       }
+      for (int a = 0; a < 3; a++) dirs[3 * nb + a] = pts[3 * p + a];
+      nb++;
+    }
     v->n_wall = wall_plane(dirs, nb, seed ^ 0x77616c6cULL, v->wall);
   }
   if (bx1 < 0) {
@@ -1648,6 +1686,7 @@ hearth_status hearth_recon_turntable(const char *root, const char *instance,
    * roll) from the views with a table; a ring where none has one is
    * started from the other rings */
   double u_rig[3] = {1, 0, 0};
+  if (!s) s = check_walls(v, nv, &res, err);
   if (!s) {
     tilt_axis(v, nv, 1, u_rig);
     s = free_rings(v, nv, u_rig, &res.n_free_ring_views, err);

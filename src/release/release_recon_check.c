@@ -281,6 +281,14 @@ void hb_recon_report_check(const char *text, size_t len, const char *path, const
   for (size_t j = 0; j < 3; j++) get_count(&c, o, "", of_views[j], hi);
   /* written since the rings without a table were started from the others */
   if (json_object_get(o, "free_ring_views")) get_count(&c, o, "", "free_ring_views", hi);
+  /* the backdrop's check (written since 2026-12-06) */
+  if (json_object_get(o, "wall_views")) {
+    get_count(&c, o, "", "wall_views", hi);
+    get_count(&c, o, "", "wall_check_views", hi);
+    const json_t *wt = json_object_get(o, "wall_tilt_deg");
+    if (!wt) BAD(&c, "wall_tilt_deg: missing (a number, or null when no view checked the wall)");
+    else if (!json_is_null(wt)) get_real(&c, o, "", "wall_tilt_deg", 1);
+  }
   static const char *const icp[] = {"icp_rms_start_mm", "icp_rms_mm", "icp_median_mm"};
   for (size_t j = 0; j < 3; j++) get_real(&c, o, "", icp[j], 1);
   const json_t *aim = json_object_get(o, "aim");

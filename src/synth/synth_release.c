@@ -797,6 +797,7 @@ static hearth_status write_instance(const render_ctx *rc, const char *root, synt
   synth_scene scene;
   if ((st = synth_scene_init(&scene, &inst->obj, &inst->T_world_from_obj, inst->ambient_c, err)))
     return hearth_err_prefix(err, "%s: ", inst->id);
+  scene.backdrop_tilt = o->backdrop_tilt_deg * (3.14159265358979323846 / 180.0);
   for (size_t s = 0; s < inst->n_states && !st; s++)
     st = render_state(rc, root, inst, &scene, s, err);
   if (!st) st = write_truth_maps(rc, gt, inst, &scene, err);

@@ -112,15 +112,19 @@ static void background(const synth_scene *s, const double bd[3], const double o[
       h->n[2] = 1;
     }
   }
-  double dn = bd[0] * d[0] + bd[1] * d[1];
+  /* the backdrop: through -BACKDROP_DIST bd on the turntable top, its
+     normal bd turned up by the tilt (leaning back) */
+  const double ct = cos(s->backdrop_tilt), st = sin(s->backdrop_tilt);
+  double dn = ct * (bd[0] * d[0] + bd[1] * d[1]) + st * d[2];
   if (dn < -1e-9) {
-    double t = (-BACKDROP_DIST - (bd[0] * o[0] + bd[1] * o[1])) / dn;
+    double on = ct * (bd[0] * o[0] + bd[1] * o[1]) + st * o[2];
+    double t = (-ct * BACKDROP_DIST - on) / dn;
     if (t > 0 && t < h->t) {
       h->t = t;
       h->kind = BG_BACKDROP;
-      h->n[0] = bd[0];
-      h->n[1] = bd[1];
-      h->n[2] = 0;
+      h->n[0] = ct * bd[0];
+      h->n[1] = ct * bd[1];
+      h->n[2] = st;
     }
   }
   for (int k = 0; k < 3; k++) h->p[k] = o[k] + h->t * d[k];

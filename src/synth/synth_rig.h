@@ -70,6 +70,7 @@ typedef struct synth_scene {
   double centre[3], radius; /* bounding sphere of the object, world */
   double turntable_radius;
   double ambient_c;
+  double backdrop_tilt; /* radians, the backdrop leaning back (0: vertical) */
 } synth_scene;
 
 hearth_status synth_scene_init(synth_scene *s, const synth_object *obj,

@@ -41,11 +41,16 @@ static void env_opts(hearth_turntable_opts *o) {
 /* estimate, align to the truth, print; -1 if the estimate failed. With
  * via_recon, the estimate is hearth_recon_run's (poses and report only):
  * the poses read back from recon/poses_rgb.json, beside recon/report.json;
- * n_ring_plane (NULL, or 2 counts): the views on their ring's plane, the
- * views of rings started from the others */
+ * lev (may be NULL): how the views were levelled */
+typedef struct levelling {
+  size_t ring_plane, free_ring; /* on their ring's plane; rings started from others */
+  size_t wall, wall_check;      /* levelled by the backdrop; seeing it and the table */
+  double wall_tilt_deg;         /* the backdrop's departure from vertical, measured */
+} levelling;
+
 static int run_release(const char *root, const char *instance, hearth_pose_alignment *al,
-                       double *tilt_max_deg, double *icp_rms_mm, hearth_poses *keep,
-                       size_t *n_ring_plane, int via_recon) {
+                       double *tilt_max_deg, double *icp_rms_mm, hearth_poses *keep, levelling *lev,
+                       int via_recon) {
   *tilt_max_deg = 0;
   hearth_err err = {0};
   hearth_turntable_opts o;
@@ -83,9 +88,12 @@ static int run_release(const char *root, const char *instance, hearth_pose_align
   if (getenv("RECON_TT_SAVE"))
     CHECK_OK(hearth_poses_write(getenv("RECON_TT_SAVE"), &est, &err), &err);
   *icp_rms_mm = res.icp_rms_mm;
-  if (n_ring_plane) {
-    n_ring_plane[0] = res.n_ring_plane_views;
-    n_ring_plane[1] = res.n_free_ring_views;
+  if (lev) {
+    lev->ring_plane = res.n_ring_plane_views;
+    lev->free_ring = res.n_free_ring_views;
+    lev->wall = res.n_wall_views;
+    lev->wall_check = res.n_wall_check_views;
+    lev->wall_tilt_deg = res.wall_tilt_deg;
   }
   /* the tilt: each camera's up (the axis in its frame) taken to the true
    * world by its true pose; all must agree with their mean direction */
@@ -389,10 +397,11 @@ static void test_flat_low(void) {
   CHECK(system(cmd) == 0);
   hearth_pose_alignment al;
   double tilt, icp;
-  size_t n_ring[2] = {0, 0};
-  if (run_release(root, "smartphone_01", &al, &tilt, &icp, NULL, n_ring, 0) == 0) {
+  levelling lev;
+  if (run_release(root, "smartphone_01", &al, &tilt, &icp, NULL, &lev, 0) == 0) {
     /* three of the four low views have no table of their own */
-    CHECK_MSG(n_ring[0] >= 3 && n_ring[0] <= 4, "%zu views on their ring's plane", n_ring[0]);
+    CHECK_MSG(lev.ring_plane >= 3 && lev.ring_plane <= 4, "%zu views on their ring's plane",
+              lev.ring_plane);
     /* every camera levelled: its up within 0.4 degrees of the others' */
     CHECK_MSG(tilt < 0.4, "tilt %g deg", tilt);
     CHECK_MSG(al.rot_max_deg < 0.4, "rotation max %g deg", al.rot_max_deg);
@@ -404,28 +413,51 @@ static void test_flat_low(void) {
  * turntable, so no view there can borrow a plane (before: `no turntable
  * plane found ... nor in any view of its elevation`). The ring starts from
  * the backdrop each view sees (vertical) and the rig's tilt axis from the
- * other rings, and the ICP settles it against them. */
-static void test_flat_low_ring(void) {
-  const char *dir = test_tmpdir("recon_turntable_flat_ring");
-  char root[1100], cmd[4096];
+ * other rings, and the ICP settles it against them. The backdrop is taken
+ * as vertical only because the views with a table show it so: leaning
+ * back by 5 degrees (`synth --backdrop-tilt 5`) it is measured as such
+ * and levels nothing, and the ring is still reconstructed. */
+static void flat_low_ring(double backdrop_tilt_deg, levelling *lev, hearth_pose_alignment *al,
+                          double *tilt) {
+  char name[64], root[1100], cmd[4096];
+  snprintf(name, sizeof name, "recon_turntable_flat_ring_%g", backdrop_tilt_deg);
+  const char *dir = test_tmpdir(name);
   snprintf(root, sizeof root, "%s/rel", dir);
   snprintf(cmd, sizeof cmd,
            "%s synth --out '%s' --categories smartphone --states neutral --views 10 --seed 3 "
-           "--no-calibration --draft-rgb --texture 256 --map-res 64 --recon none --quiet",
-           HEARTH_EXE, root);
+           "--no-calibration --draft-rgb --texture 256 --map-res 64 --recon none --quiet "
+           "--backdrop-tilt %g",
+           HEARTH_EXE, root, backdrop_tilt_deg);
   CHECK(system(cmd) == 0);
+  double icp;
+  memset(lev, 0, sizeof *lev);
+  lev->wall_tilt_deg = NAN;
+  al->rot_max_deg = al->pos_max = 1e9;
+  CHECK(run_release(root, "smartphone_01", al, tilt, &icp, NULL, lev, 0) == 0);
+}
+
+static void test_flat_low_ring(void) {
   hearth_pose_alignment al;
-  double tilt, icp;
-  size_t n_ring[2] = {0, 0};
-  if (run_release(root, "smartphone_01", &al, &tilt, &icp, NULL, n_ring, 0) == 0) {
-    CHECK_MSG(n_ring[0] == 0 && n_ring[1] == 4, "%zu views on their ring's plane, %zu free",
-              n_ring[0], n_ring[1]);
-    /* the ring's 4 views levelled within 0.2 degrees (0.02 now) */
-    CHECK_MSG(tilt < 0.2, "tilt %g deg", tilt);
-    CHECK_MSG(al.rot_max_deg < 0.3, "rotation max %g deg", al.rot_max_deg);
-    CHECK_MSG(al.pos_max < 0.0015, "centre max %g mm", al.pos_max * 1e3);
-    CHECK_MSG(fabs(al.ref_from_est.s - 1.0) < 0.01, "scale %g", al.ref_from_est.s);
-  }
+  double tilt;
+  levelling lev;
+  flat_low_ring(0, &lev, &al, &tilt);
+  CHECK_MSG(lev.ring_plane == 0 && lev.free_ring == 4, "%zu views on their ring's plane, %zu free",
+            lev.ring_plane, lev.free_ring);
+  CHECK_MSG(lev.wall == 4 && lev.wall_check >= 3 && lev.wall_tilt_deg < 0.2,
+            "%zu views levelled by the backdrop, %zu checked it: %g deg off vertical", lev.wall,
+            lev.wall_check, lev.wall_tilt_deg);
+  /* the ring's 4 views levelled within 0.2 degrees (0.02 now) */
+  CHECK_MSG(tilt < 0.2, "tilt %g deg", tilt);
+  CHECK_MSG(al.rot_max_deg < 0.3, "rotation max %g deg", al.rot_max_deg);
+  CHECK_MSG(al.pos_max < 0.0015, "centre max %g mm", al.pos_max * 1e3);
+  CHECK_MSG(fabs(al.ref_from_est.s - 1.0) < 0.01, "scale %g", al.ref_from_est.s);
+
+  flat_low_ring(5, &lev, &al, &tilt);
+  CHECK_MSG(lev.wall == 0 && lev.wall_check >= 3 && fabs(lev.wall_tilt_deg - 5) < 0.3,
+            "leaning backdrop: %zu views levelled by it, %zu checked it: %g deg off vertical",
+            lev.wall, lev.wall_check, lev.wall_tilt_deg);
+  CHECK_MSG(lev.free_ring == 4 && al.rot_max_deg < 5, "leaning backdrop: rotation max %g deg",
+            al.rot_max_deg);
 }
 
 /* ---- the aim point against the truth --------------------------------------
