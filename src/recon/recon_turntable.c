@@ -196,13 +196,15 @@ static void set_level(tt_view *v, const double n[3]);
  * A wall no view with a table sees is taken as vertical unchecked. */
 #define TT_WALL_VERTICAL_DEG 1.0
 
-/* A wall (the backdrop) among the background points bg[0..nb) (colour
- * frame) of a view without a table: the RANSAC plane facing the camera
- * (its normal within 45 degrees of the optical axis) with the most
- * inliers, refit to them; its normal, towards the camera, into w. Its
- * inliers, 0 when fewer than TT_MIN_PLANE or it fits worse than
- * TT_PLANE_MAX_RMS_M. */
-static size_t wall_plane(const float *bg, size_t nb, uint64_t seed, double w[3]) {
+/* The RANSAC plane among bg[0..nb) (colour frame) whose normal, turned
+ * towards the camera, has -n[axis] >= facing, with the most inliers,
+ * refit three times to them (within TT_PLANE_TOL_M, then 2.5 times the
+ * fit's rms, at least 0.5 mm): n and d (n.x + d = 0, the camera on the
+ * positive side), the inliers' rms and their indices in idx (the caller's,
+ * nb entries). Their count; below TT_MIN_PLANE, none was found. */
+static size_t facing_plane(const float *bg, size_t nb, uint64_t seed, int axis, double facing,
+                           size_t *idx, double n[3], double *d, double *rms) {
+  *rms = 0;
   if (nb < TT_MIN_PLANE) return 0;
   hearth_rng r;
   hearth_rng_seed(&r, seed);
@@ -210,129 +212,88 @@ static size_t wall_plane(const float *bg, size_t nb, uint64_t seed, double w[3])
   size_t best = 0;
   for (int it = 0; it < TT_RANSAC_ITER; it++) {
     size_t i0 = hearth_rng_u64(&r) % nb, i1 = hearth_rng_u64(&r) % nb, i2 = hearth_rng_u64(&r) % nb;
-    double a[3], b[3], n[3];
+    double a[3], b[3], c[3];
     for (int k = 0; k < 3; k++) {
       a[k] = bg[3 * i1 + k] - bg[3 * i0 + k];
       b[k] = bg[3 * i2 + k] - bg[3 * i0 + k];
     }
-    hearth_cross3(a, b, n);
-    double ln = hearth_norm3(n);
+    hearth_cross3(a, b, c);
+    double ln = hearth_norm3(c);
     if (ln < 1e-9) continue;
-    for (int k = 0; k < 3; k++) n[k] /= ln;
+    for (int k = 0; k < 3; k++) c[k] /= ln;
     double p0[3] = {bg[3 * i0], bg[3 * i0 + 1], bg[3 * i0 + 2]};
-    double d = -hearth_dot3(n, p0);
-    if (d < 0) {
-      for (int k = 0; k < 3; k++) n[k] = -n[k];
-      d = -d;
+    double dc = -hearth_dot3(c, p0);
+    if (dc < 0) { /* the camera (origin) on the positive side */
+      for (int k = 0; k < 3; k++) c[k] = -c[k];
+      dc = -dc;
     }
-    if (-n[2] < 0.7) continue;
+    if (-c[axis] < facing) continue;
     size_t cnt = 0;
     for (size_t i = 0; i < nb; i += 2) {
       double q[3] = {bg[3 * i], bg[3 * i + 1], bg[3 * i + 2]};
-      if (fabs(hearth_dot3(n, q) + d) < TT_PLANE_TOL_M) cnt++;
+      if (fabs(hearth_dot3(c, q) + dc) < TT_PLANE_TOL_M) cnt++;
     }
     if (cnt > best) {
       best = cnt;
-      memcpy(best_n, n, sizeof best_n);
-      best_d = d;
+      memcpy(best_n, c, sizeof best_n);
+      best_d = dc;
     }
   }
   if (2 * best < TT_MIN_PLANE) return 0;
-  size_t *idx = malloc(nb * sizeof *idx), m = 0;
-  if (!idx) return 0;
-  double n[3] = {best_n[0], best_n[1], best_n[2]}, d = best_d, rms = 0;
+  memcpy(n, best_n, sizeof best_n);
+  *d = best_d;
+  size_t m = 0;
   for (int pass = 0; pass < 3; pass++) {
-    double tol = pass == 0 ? TT_PLANE_TOL_M : 2.5 * fmax(rms, 5e-4);
+    double tol = pass == 0 ? TT_PLANE_TOL_M : 2.5 * (*rms > 5e-4 ? *rms : 5e-4);
     m = 0;
     for (size_t i = 0; i < nb; i++) {
       double q[3] = {bg[3 * i], bg[3 * i + 1], bg[3 * i + 2]};
-      if (fabs(hearth_dot3(n, q) + d) < tol) idx[m++] = i;
+      if (fabs(hearth_dot3(n, q) + *d) < tol) idx[m++] = i;
     }
     if (m < TT_MIN_PLANE) break;
-    fit_plane(bg, idx, m, n, &d);
-    if (d < 0) {
+    fit_plane(bg, idx, m, n, d);
+    if (*d < 0) {
       for (int k = 0; k < 3; k++) n[k] = -n[k];
-      d = -d;
+      *d = -*d;
     }
     double ss = 0;
     for (size_t i = 0; i < m; i++) {
       double q[3] = {bg[3 * idx[i]], bg[3 * idx[i] + 1], bg[3 * idx[i] + 2]};
-      double e = hearth_dot3(n, q) + d;
+      double e = hearth_dot3(n, q) + *d;
       ss += e * e;
     }
-    rms = sqrt(ss / (double)m);
+    *rms = sqrt(ss / (double)m);
   }
+  return m;
+}
+
+/* A wall (the backdrop) among the background points bg[0..nb) (colour
+ * frame) of a view: the plane facing the camera (its normal within 45
+ * degrees of the optical axis) with the most inliers; its normal, towards
+ * the camera, into w. Its inliers, 0 when fewer than TT_MIN_PLANE or it
+ * fits worse than TT_PLANE_MAX_RMS_M. */
+static size_t wall_plane(const float *bg, size_t nb, uint64_t seed, double w[3]) {
+  if (nb < TT_MIN_PLANE) return 0;
+  size_t *idx = malloc(nb * sizeof *idx);
+  if (!idx) return 0;
+  double n[3], d, rms;
+  size_t m = facing_plane(bg, nb, seed, 2, 0.7, idx, n, &d, &rms);
   free(idx);
   if (m < TT_MIN_PLANE || rms > TT_PLANE_MAX_RMS_M) return 0;
-  memcpy(w, n, 3 * sizeof *w);
+  memcpy(w, n, sizeof n);
   return m;
 }
 
 /* The table plane among the background points bg[0..nb) (colour frame):
- * the RANSAC plane facing up in the image (normal towards the camera with
- * -y > 0.3) with the most inliers, refit to its inliers. Fills v's plane
- * fields and levelling; 0 when none is found. */
+ * the plane facing up in the image (normal towards the camera with
+ * -y > 0.3) with the most inliers (facing_plane). Fills v's plane fields
+ * and levelling; 0 when none is found. */
 static int table_plane(tt_view *v, const float *bg, size_t nb, uint64_t seed) {
   if (nb < TT_MIN_PLANE) return 0;
-  hearth_rng r;
-  hearth_rng_seed(&r, seed);
-  double best_n[3] = {0}, best_d = 0;
-  size_t best = 0;
-  for (int it = 0; it < TT_RANSAC_ITER; it++) {
-    size_t i0 = hearth_rng_u64(&r) % nb, i1 = hearth_rng_u64(&r) % nb, i2 = hearth_rng_u64(&r) % nb;
-    double a[3], b[3], n[3];
-    for (int k = 0; k < 3; k++) {
-      a[k] = bg[3 * i1 + k] - bg[3 * i0 + k];
-      b[k] = bg[3 * i2 + k] - bg[3 * i0 + k];
-    }
-    hearth_cross3(a, b, n);
-    double ln = hearth_norm3(n);
-    if (ln < 1e-9) continue;
-    for (int k = 0; k < 3; k++) n[k] /= ln;
-    double p0[3] = {bg[3 * i0], bg[3 * i0 + 1], bg[3 * i0 + 2]};
-    double d = -hearth_dot3(n, p0);
-    if (d < 0) { /* the camera (origin) on the positive side */
-      for (int k = 0; k < 3; k++) n[k] = -n[k];
-      d = -d;
-    }
-    if (-n[1] < 0.3) continue;
-    size_t cnt = 0;
-    for (size_t i = 0; i < nb; i += 2) {
-      double q[3] = {bg[3 * i], bg[3 * i + 1], bg[3 * i + 2]};
-      if (fabs(hearth_dot3(n, q) + d) < TT_PLANE_TOL_M) cnt++;
-    }
-    if (cnt > best) {
-      best = cnt;
-      memcpy(best_n, n, sizeof best_n);
-      best_d = d;
-    }
-  }
-  if (2 * best < TT_MIN_PLANE) return 0;
   size_t *idx = malloc(nb * sizeof *idx);
   if (!idx) return 0;
-  double n[3] = {best_n[0], best_n[1], best_n[2]}, d = best_d;
-  size_t m = 0;
-  for (int pass = 0; pass < 3; pass++) {
-    double tol = pass == 0 ? TT_PLANE_TOL_M : 2.5 * (v->plane_rms > 5e-4 ? v->plane_rms : 5e-4);
-    m = 0;
-    for (size_t i = 0; i < nb; i++) {
-      double q[3] = {bg[3 * i], bg[3 * i + 1], bg[3 * i + 2]};
-      if (fabs(hearth_dot3(n, q) + d) < tol) idx[m++] = i;
-    }
-    if (m < TT_MIN_PLANE) break;
-    fit_plane(bg, idx, m, n, &d);
-    if (d < 0) {
-      for (int k = 0; k < 3; k++) n[k] = -n[k];
-      d = -d;
-    }
-    double ss = 0;
-    for (size_t i = 0; i < m; i++) {
-      double q[3] = {bg[3 * idx[i]], bg[3 * idx[i] + 1], bg[3 * idx[i] + 2]};
-      double e = hearth_dot3(n, q) + d;
-      ss += e * e;
-    }
-    v->plane_rms = sqrt(ss / (double)m);
-  }
+  double n[3], d;
+  size_t m = facing_plane(bg, nb, seed, 1, 0.3, idx, n, &d, &v->plane_rms);
   if (m >= TT_MIN_PLANE) {
     size_t step = m > TT_PLANE_SAMPLES ? (m + TT_PLANE_SAMPLES - 1) / TT_PLANE_SAMPLES : 1;
     v->pl = malloc((m / step + 1) * 3 * sizeof(float));
