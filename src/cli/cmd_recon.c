@@ -184,6 +184,17 @@ int hearth_cmd_recon(int argc, char **argv) {
       CLI_NUM("--aim", "W", &tj.poses.aim_prior, 0, 100,
               "turntable: weight of the aim term (every camera aimed at one axis point; 0: off)",
               .def = "0.1"),
+      CLI_NUM("--wall", "W", &tj.poses.wall_prior, 0, 100,
+              "turntable: weight of the backdrop's levelling of views without a table (taken "
+              "as vertical where the views with a table show it so; 0: off)",
+              .def = "1"),
+      CLI_NUM("--roll", "W", &tj.poses.roll_prior, 0, 100,
+              "turntable: weight holding those views' up normal to the rig's tilt axis (0: off)",
+              .def = "1"),
+      CLI_NUM("--ring-tilt", "W", &tj.poses.ring_tilt_prior, 0, 100,
+              "turntable: weight holding one up per ring where a view has neither a table nor "
+              "a backdrop (rigs without a backdrop)",
+              .def = "0: off"),
       CLI_NUM("--colour", "W", &tj.poses.colour_weight, 0, 10,
               "turntable: weight of the photometric term of states without turntable_deg "
               "(about 0.01; experimental)",

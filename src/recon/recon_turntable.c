@@ -351,9 +351,9 @@ static int cmp_double(const void *a, const void *b);
 
 /* The walls against the table (TT_WALL_VERTICAL_DEG): the check's figures
  * into res; afterwards only the views without a table, or with a weak one,
- * keep their wall, and none when the check fails. */
-static hearth_status check_walls(tt_view *v, size_t nv, hearth_turntable_result *res,
-                                 hearth_err *err) {
+ * keep their wall, and none when the check fails or o->wall_prior is 0. */
+static hearth_status check_walls(tt_view *v, size_t nv, const hearth_turntable_opts *o,
+                                 hearth_turntable_result *res, hearth_err *err) {
   double *ang = malloc((nv ? nv : 1) * sizeof *ang);
   if (!ang) return hearth_err_set(err, HEARTH_E_NOMEM, "turntable: walls");
   size_t k = 0;
@@ -364,7 +364,8 @@ static hearth_status check_walls(tt_view *v, size_t nv, hearth_turntable_result 
   res->n_wall_check_views = k;
   res->wall_tilt_deg = k ? (k % 2 ? ang[k / 2] : 0.5 * (ang[k / 2 - 1] + ang[k / 2])) : NAN;
   free(ang);
-  int vertical = !k || res->wall_tilt_deg <= TT_WALL_VERTICAL_DEG;
+  /* the term off: no wall levels a view, not even its start */
+  int vertical = o->wall_prior > 0 && (!k || res->wall_tilt_deg <= TT_WALL_VERTICAL_DEG);
   res->n_wall_views = 0;
   for (size_t i = 0; i < nv; i++) {
     if (v[i].n_plane >= TT_WEAK_PLANE || !vertical) v[i].n_wall = 0;
@@ -1647,7 +1648,7 @@ hearth_status hearth_recon_turntable(const char *root, const char *instance,
    * roll) from the views with a table; a ring where none has one is
    * started from the other rings */
   double u_rig[3] = {1, 0, 0};
-  if (!s) s = check_walls(v, nv, &res, err);
+  if (!s) s = check_walls(v, nv, &o, &res, err);
   if (!s) {
     tilt_axis(v, nv, 1, u_rig);
     s = free_rings(v, nv, u_rig, &res.n_free_ring_views, err);

@@ -278,8 +278,10 @@ static void test_release(void) {
   CHECK(system(cmd) == 0);
   snprintf(cmd, sizeof cmd, "'%s' recon '%s' --quiet 2>&1", HEARTH_EXE, root);
   run_cmd_expect(cmd, 1, "--force");
-  snprintf(cmd, sizeof cmd, "'%s' recon '%s' --quiet --force --triangles 4000 2>&1", HEARTH_EXE,
-           root);
+  snprintf(cmd, sizeof cmd,
+           "'%s' recon '%s' --quiet --force --triangles 4000 --wall 1 --roll 1 --ring-tilt 0 "
+           "2>&1",
+           HEARTH_EXE, root);
   run_cmd_expect(cmd, 0, "10 views");
   static const char *const k_files[] = {"poses_rgb.json", "poses_rgb_cameras.json",
                                         "mesh_geometry.glb", "report.json"};
@@ -451,6 +453,15 @@ static void test_flat_low_ring(void) {
   CHECK_MSG(al.rot_max_deg < 0.3, "rotation max %g deg", al.rot_max_deg);
   CHECK_MSG(al.pos_max < 0.0015, "centre max %g mm", al.pos_max * 1e3);
   CHECK_MSG(fabs(al.ref_from_est.s - 1.0) < 0.01, "scale %g", al.ref_from_est.s);
+
+  /* the wall term off (hearth recon --wall 0): nothing is levelled by the
+     backdrop, and the ring is still reconstructed */
+  setenv("RECON_TT_WALL", "0", 1);
+  flat_low_ring(0, &lev, &al, &tilt);
+  unsetenv("RECON_TT_WALL");
+  CHECK_MSG(lev.wall == 0 && lev.free_ring == 4 && al.rot_max_deg < 5,
+            "wall term off: %zu views levelled by the backdrop, rotation max %g deg", lev.wall,
+            al.rot_max_deg);
 
   flat_low_ring(5, &lev, &al, &tilt);
   CHECK_MSG(lev.wall == 0 && lev.wall_check >= 3 && fabs(lev.wall_tilt_deg - 5) < 0.3,
