@@ -1360,7 +1360,7 @@ static void ring_system(const tt_view *v, size_t nv, const double u[3],
     for (size_t j = i; j < nv; j++)
       if (v[j].elevation_index == v[i].elevation_index) {
         for (int a = 0; a < 3; a++) mean[a] += v[j].T.R[6 + a];
-        lacking |= !v[j].n_plane && !(v[j].n_wall && ww > 0);
+        lacking |= !v[j].n_plane && !v[j].n_wall; /* no wall kept when ww is 0 */
         nr++;
       }
     if (!lacking || nr < 2) continue;
@@ -1673,7 +1673,7 @@ hearth_status hearth_recon_turntable(const char *root, const char *instance,
     /* a wall it sees levels it instead, and the wall term holds it (the
      * ring's plane, often one view's seen at grazing incidence, would
      * pull it off by as much as that plane is) */
-    int wall = o.wall_prior > 0 && wall_level(&v[i], u_rig, n);
+    int wall = wall_level(&v[i], u_rig, n); /* none when --wall 0 (check_walls) */
     set_level(&v[i], n);
     res.n_ring_plane_views++;
     if (wall) continue;
